@@ -1,0 +1,166 @@
+/**
+ * @class   vtkNimbusMetaballCloudSource
+ * @brief   Metaball cloud density on a regular grid, grown fractally (004 §4).
+ *
+ * Builds a cumulus-like density field from metaballs with Wyvill's degree-6 falloff:
+ * a basic shape of large balls (user-given with AddBall, or seeded-random), then
+ * NumberOfLevels fractal growth steps. Each step extracts the isosurface of the
+ * current field at IsoValue with VTK's flying edges, places smaller balls on its
+ * triangles (area-weighted, none where the surface faces down so the base stays
+ * flat), and repeats with radii scaled by RadiusScalePerLevel. With FlatBase on the
+ * density is also faded to zero at BaseHeight (the condensation level).
+ *
+ * Output port 0: vtkImageData covering Bounds with Dimensions points and a float
+ * point array "density" (dimensionless; 0 = clear air, BallDensity at an isolated
+ * ball's centre).
+ * Output port 1: vtkPolyData with one vertex per metaball at its centre and point
+ * arrays "radius" (m), "density" and "level" (0 = basic shape).
+ *
+ * Units: Bounds, radii, heights in metres. The result depends only on the
+ * parameters and Seed (same seed -> identical bytes).
+ * Invalid parameters (non-positive dimensions, empty or non-finite bounds, no
+ * balls, non-positive radii, NaN anywhere) produce an error message and empty
+ * outputs.
+ */
+#ifndef vtkNimbusMetaballCloudSource_h
+#define vtkNimbusMetaballCloudSource_h
+
+#include "NimbusFiltersModule.h" // for export macro
+#include "vtkImageAlgorithm.h"
+
+#include <memory> // for std::unique_ptr
+
+class vtkPolyData;
+
+class NIMBUSFILTERS_EXPORT vtkNimbusMetaballCloudSource : public vtkImageAlgorithm
+{
+public:
+  static vtkNimbusMetaballCloudSource* New();
+  vtkTypeMacro(vtkNimbusMetaballCloudSource, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Number of grid points along x, y, z (each >= 1). Default 96 x 96 x 64.
+  vtkSetVector3Macro(Dimensions, int);
+  vtkGetVector3Macro(Dimensions, int);
+  ///@}
+
+  ///@{
+  /// Region covered by the grid (xmin, xmax, ymin, ymax, zmin, zmax), metres.
+  /// Default (-1500, 1500, -1500, 1500, 800, 2800). z is up.
+  vtkSetVector6Macro(Bounds, double);
+  vtkGetVector6Macro(Bounds, double);
+  ///@}
+
+  ///@{
+  /// Seed of the random basic shape and growth. Default 1.
+  vtkSetMacro(Seed, int);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /// Number of fractal growth levels (>= 0). Default 3.
+  vtkSetMacro(NumberOfLevels, int);
+  vtkGetMacro(NumberOfLevels, int);
+  ///@}
+
+  ///@{
+  /// Random basic shape (used when no ball was added with AddBall): number of
+  /// balls, their radius range (m), the radius of the disc their centres lie in
+  /// (m, around the centre of Bounds), and how far above the base the centres
+  /// may rise (m). Defaults 10, (350, 600), 700, 600.
+  vtkSetMacro(NumberOfBaseBalls, int);
+  vtkGetMacro(NumberOfBaseBalls, int);
+  vtkSetVector2Macro(BaseBallRadiusRange, double);
+  vtkGetVector2Macro(BaseBallRadiusRange, double);
+  vtkSetMacro(FootprintRadius, double);
+  vtkGetMacro(FootprintRadius, double);
+  vtkSetMacro(TowerHeight, double);
+  vtkGetMacro(TowerHeight, double);
+  ///@}
+
+  ///@{
+  /// Growth: number of balls placed at the first level, multiplied by
+  /// BallCountFactor at each further level; radii of level k are the basic
+  /// shape's range times RadiusScalePerLevel^k. Defaults 60, 2, 0.5.
+  vtkSetMacro(BallsPerLevel, int);
+  vtkGetMacro(BallsPerLevel, int);
+  vtkSetMacro(BallCountFactor, double);
+  vtkGetMacro(BallCountFactor, double);
+  vtkSetMacro(RadiusScalePerLevel, double);
+  vtkGetMacro(RadiusScalePerLevel, double);
+  ///@}
+
+  ///@{
+  /// Density at the centre of every generated ball. Default 1.
+  vtkSetMacro(BallDensity, double);
+  vtkGetMacro(BallDensity, double);
+  ///@}
+
+  ///@{
+  /// Density level of the isosurface the growth step seeds balls on. Default 0.5.
+  vtkSetMacro(IsoValue, double);
+  vtkGetMacro(IsoValue, double);
+  ///@}
+
+  ///@{
+  /// Cloud base: the random basic shape sits on BaseHeight (m). With FlatBase on
+  /// the density is also 0 at and below BaseHeight and fades in over
+  /// BaseTransitionThickness (m) above it. Defaults on, 1000, 100.
+  vtkSetMacro(FlatBase, bool);
+  vtkGetMacro(FlatBase, bool);
+  vtkBooleanMacro(FlatBase, bool);
+  vtkSetMacro(BaseHeight, double);
+  vtkGetMacro(BaseHeight, double);
+  vtkSetMacro(BaseTransitionThickness, double);
+  vtkGetMacro(BaseTransitionThickness, double);
+  ///@}
+
+  ///@{
+  /// User-given basic shape: balls added here replace the random one.
+  /// Centre and radius in metres; density at the centre.
+  void AddBall(double x, double y, double z, double radius, double density);
+  void RemoveAllBalls();
+  int GetNumberOfUserBalls() const;
+  ///@}
+
+  /// The metaballs of the last update (port 1's data).
+  vtkPolyData* GetMetaballs();
+
+protected:
+  vtkNimbusMetaballCloudSource();
+  ~vtkNimbusMetaballCloudSource() override;
+
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// Returns false (after vtkErrorMacro) when a parameter is unusable.
+  bool CheckParameters();
+
+  int Dimensions[3];
+  double Bounds[6];
+  int Seed;
+  int NumberOfLevels;
+  int NumberOfBaseBalls;
+  double BaseBallRadiusRange[2];
+  double FootprintRadius;
+  double TowerHeight;
+  int BallsPerLevel;
+  double BallCountFactor;
+  double RadiusScalePerLevel;
+  double BallDensity;
+  double IsoValue;
+  bool FlatBase;
+  double BaseHeight;
+  double BaseTransitionThickness;
+
+private:
+  vtkNimbusMetaballCloudSource(const vtkNimbusMetaballCloudSource&) = delete;
+  void operator=(const vtkNimbusMetaballCloudSource&) = delete;
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
+};
+
+#endif

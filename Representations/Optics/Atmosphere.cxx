@@ -1,0 +1,368 @@
+#include "Atmosphere.h"
+
+#include "PhaseFunctions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <stdexcept>
+#include <vector>
+
+namespace nimbus
+{
+
+namespace
+{
+using Vector3 = Atmosphere::Vector3;
+
+// Relative tolerance of the adaptive quadrature.  The Kronrod estimate is far
+// more accurate than the |K15 - G7| error bound, so the actual error is orders
+// of magnitude below this (measured < 1e-12 in TestAtmosphere).
+constexpr double kRelativeTolerance = 1e-12;
+constexpr int kMaxIntervals = 4000;
+
+double Dot(const Vector3& a, const Vector3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+bool IsFinite(const Vector3& a)
+{
+  return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
+}
+
+//------------------------------------------------------------------------------
+// Adaptive Gauss-Kronrod 7/15 quadrature (QUADPACK QK15 nodes and weights),
+// globally adaptive: always bisects the interval with the largest |K15 - G7|.
+struct GkInterval
+{
+  double a, b, value, error;
+  bool operator<(const GkInterval& o) const { return this->error < o.error; }
+};
+
+constexpr double kXgk[8] = { 0.991455371120812639206854697526329,
+  0.949107912342758524526189684047851, 0.864864423359769072789712788640926,
+  0.741531185599394439863864773280788, 0.586087235467691130294144845693013,
+  0.405845151377397166906606412076961, 0.207784955007898467600689403773245, 0.0 };
+constexpr double kWgk[8] = { 0.022935322010529224963732008058970,
+  0.063092092629978553290700663189204, 0.104790010322250183839876322541518,
+  0.140653259715525918745189590510238, 0.169004726639267902826583426598550,
+  0.190350578064785409913256402421014, 0.204432940075298892414161999234649,
+  0.209482141084727828012999174891714 };
+// 7-point Gauss weights for the odd Kronrod nodes kXgk[1], [3], [5], [7].
+constexpr double kWg[4] = { 0.129484966168869693270611432679082,
+  0.279705391489276667901467771423780, 0.381830050505118944950369775488975,
+  0.417959183673469387755102040816327 };
+
+template <class F>
+GkInterval Gk15(const F& f, double a, double b)
+{
+  const double c = 0.5 * (a + b);
+  const double h = 0.5 * (b - a);
+  const double fc = f(c);
+  double kronrod = kWgk[7] * fc;
+  double gauss = kWg[3] * fc;
+  for (int j = 0; j < 7; ++j)
+  {
+    const double sum = f(c - h * kXgk[j]) + f(c + h * kXgk[j]);
+    kronrod += kWgk[j] * sum;
+    if (j % 2 == 1)
+    {
+      gauss += kWg[j / 2] * sum;
+    }
+  }
+  return { a, b, kronrod * h, std::abs((kronrod - gauss) * h) };
+}
+
+/// Integral of f over consecutive pieces [breaks[i], breaks[i+1]].
+template <class F>
+double IntegrateAdaptive(const F& f, const std::vector<double>& breaks)
+{
+  std::priority_queue<GkInterval> queue;
+  double total = 0.0;
+  double error = 0.0;
+  for (std::size_t i = 0; i + 1 < breaks.size(); ++i)
+  {
+    if (breaks[i + 1] > breaks[i])
+    {
+      const GkInterval piece = Gk15(f, breaks[i], breaks[i + 1]);
+      total += piece.value;
+      error += piece.error;
+      queue.push(piece);
+    }
+  }
+  int count = static_cast<int>(queue.size());
+  while (!queue.empty() && error > kRelativeTolerance * std::abs(total) && count < kMaxIntervals)
+  {
+    const GkInterval worst = queue.top();
+    queue.pop();
+    const double mid = 0.5 * (worst.a + worst.b);
+    if (!(mid > worst.a && mid < worst.b))
+    {
+      break; // cannot bisect further in double precision
+    }
+    const GkInterval left = Gk15(f, worst.a, mid);
+    const GkInterval right = Gk15(f, mid, worst.b);
+    total += left.value + right.value - worst.value;
+    error += left.error + right.error - worst.error;
+    queue.push(left);
+    queue.push(right);
+    ++count;
+  }
+  // Re-sum to remove the drift of the running updates.
+  double sum = 0.0;
+  while (!queue.empty())
+  {
+    sum += queue.top().value;
+    queue.pop();
+  }
+  return sum;
+}
+
+//------------------------------------------------------------------------------
+// A ray o + s d (d unit) described by scalars, relative to the earth centre.
+struct Ray
+{
+  Vector3 o;
+  Vector3 d;
+  double r0; // |o| [m]
+  double b;  // dot(o, d) [m]; s* = -b is the point of closest approach
+};
+
+// (r0 - R)(r0 + R) = r0^2 - R^2 without cancellation near r0 = R.
+double DiffOfSquares(double r0, double R)
+{
+  return (r0 - R) * (r0 + R);
+}
+
+// Altitude along the ray at parameter s, h = r(s) - R with
+// r(s)^2 - R^2 = (r0^2 - R^2) + s (2b + s), evaluated as (r^2 - R^2)/(r + R)
+// to keep relative accuracy (no subtraction of two ~6.4e6 m numbers).
+double AltitudeAlongRay(const Ray& ray, double R, double s)
+{
+  const double r2MinusR2 = DiffOfSquares(ray.r0, R) + s * (2.0 * ray.b + s);
+  const double r = std::sqrt(std::max(0.0, R * R + r2MinusR2));
+  return r2MinusR2 / (r + R);
+}
+
+// Interval [sIn, sOut] of the full line inside the ball of radius Rb; false if the
+// line misses it (or only touches it).
+bool BallInterval(const Ray& ray, double Rb, double& sIn, double& sOut)
+{
+  const double c = DiffOfSquares(ray.r0, Rb);
+  const double disc = ray.b * ray.b - c;
+  if (!(disc > 0.0))
+  {
+    return false;
+  }
+  const double q = -(ray.b + std::copysign(std::sqrt(disc), ray.b)); // stable roots
+  double s1 = q;
+  double s2 = q != 0.0 ? c / q : 0.0;
+  if (s1 > s2)
+  {
+    std::swap(s1, s2);
+  }
+  sIn = s1;
+  sOut = s2;
+  return true;
+}
+
+// integral_{s0}^{s1} exp(-max(h,0)/H) ds, split at the closest approach s* = -b.
+double IntegrateDensity(const Ray& ray, double R, double H, double s0, double s1)
+{
+  if (!(s1 > s0))
+  {
+    return 0.0;
+  }
+  std::vector<double> breaks{ s0 };
+  const double sStar = -ray.b;
+  if (sStar > s0 && sStar < s1)
+  {
+    breaks.push_back(sStar);
+  }
+  breaks.push_back(s1);
+  const auto rho = [&](double s) {
+    return std::exp(-std::max(0.0, AltitudeAlongRay(ray, R, s)) / H);
+  };
+  return IntegrateAdaptive(rho, breaks);
+}
+
+Ray MakeRay(const Vector3& o, const Vector3& direction)
+{
+  const double len = std::sqrt(Dot(direction, direction));
+  if (!(len > 0.0) || !std::isfinite(len))
+  {
+    throw std::invalid_argument("nimbus::Atmosphere: direction is zero or not finite");
+  }
+  Ray ray;
+  ray.o = o;
+  ray.d = { direction[0] / len, direction[1] / len, direction[2] / len };
+  ray.r0 = std::sqrt(Dot(o, o));
+  ray.b = Dot(o, ray.d);
+  return ray;
+}
+
+void CheckPoint(const Vector3& p)
+{
+  if (!IsFinite(p))
+  {
+    throw std::invalid_argument("nimbus::Atmosphere: position is not finite");
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+Atmosphere::Atmosphere(const AtmosphereParameters& p)
+  : Parameters(p)
+{
+  const bool ok = std::isfinite(p.earthRadius) && std::isfinite(p.topRadius) &&
+    p.earthRadius > 0.0 && p.topRadius > p.earthRadius && std::isfinite(p.rayleighScaleHeight) &&
+    p.rayleighScaleHeight > 0.0 && std::isfinite(p.mieScaleHeight) && p.mieScaleHeight > 0.0 &&
+    std::isfinite(p.rayleighScattering550) && p.rayleighScattering550 >= 0.0 &&
+    std::isfinite(p.mieScattering) && p.mieScattering >= 0.0 &&
+    p.mieSingleScatteringAlbedo > 0.0 && p.mieSingleScatteringAlbedo <= 1.0 && !std::isnan(p.mieG);
+  if (!ok)
+  {
+    throw std::invalid_argument("nimbus::Atmosphere: invalid AtmosphereParameters");
+  }
+}
+
+double Atmosphere::Altitude(const Vector3& p) const
+{
+  return std::sqrt(Dot(p, p)) - this->Parameters.earthRadius;
+}
+
+double Atmosphere::Density(double altitude, double scaleHeight) const
+{
+  const double thickness = this->Parameters.topRadius - this->Parameters.earthRadius;
+  if (altitude > thickness)
+  {
+    return 0.0;
+  }
+  return std::exp(-std::max(0.0, altitude) / scaleHeight);
+}
+
+double Atmosphere::RayleighScattering(double lambdaNm) const
+{
+  const double x = 550.0 / lambdaNm;
+  return this->Parameters.rayleighScattering550 * (x * x) * (x * x);
+}
+
+double Atmosphere::MieScattering(double) const
+{
+  return this->Parameters.mieScattering;
+}
+
+double Atmosphere::MieExtinction(double lambdaNm) const
+{
+  return this->MieScattering(lambdaNm) / this->Parameters.mieSingleScatteringAlbedo;
+}
+
+double Atmosphere::RayleighPhase(double mu) const
+{
+  return Rayleigh(mu);
+}
+
+double Atmosphere::MiePhase(double mu) const
+{
+  return CornetteShanks(mu, this->Parameters.mieG);
+}
+
+//------------------------------------------------------------------------------
+double Atmosphere::OpticalLength(const Vector3& p0, const Vector3& p1, double H) const
+{
+  CheckPoint(p0);
+  CheckPoint(p1);
+  if (!(H > 0.0) || !std::isfinite(H))
+  {
+    throw std::invalid_argument("nimbus::Atmosphere::OpticalLength: scale height must be > 0");
+  }
+  const Vector3 delta = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+  const double length = std::sqrt(Dot(delta, delta));
+  if (!(length > 0.0))
+  {
+    return 0.0;
+  }
+  const Ray ray = MakeRay(p0, delta);
+  double sIn = 0.0, sOut = 0.0;
+  if (!BallInterval(ray, this->Parameters.topRadius, sIn, sOut))
+  {
+    return 0.0;
+  }
+  // Clip the segment [0, length] to the atmosphere ball (density 0 above the top).
+  return IntegrateDensity(
+    ray, this->Parameters.earthRadius, H, std::max(0.0, sIn), std::min(length, sOut));
+}
+
+OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& d) const
+{
+  CheckPoint(p);
+  const double R = this->Parameters.earthRadius;
+  Ray ray = MakeRay(p, d);
+  if (ray.r0 < R)
+  {
+    // Below the ground: clamp radially onto the ground (the earth centre maps to
+    // the ground point along d).
+    const Vector3 up = ray.r0 > 0.0 ? Vector3{ p[0] / ray.r0, p[1] / ray.r0, p[2] / ray.r0 } : ray.d;
+    ray.o = { R * up[0], R * up[1], R * up[2] };
+    ray.r0 = R;
+    ray.b = R * Dot(up, ray.d);
+  }
+
+  OpticalLengths result;
+  double sIn = 0.0, sOut = 0.0;
+  if (!BallInterval(ray, this->Parameters.topRadius, sIn, sOut) || !(sOut > 0.0))
+  {
+    return result; // misses the atmosphere, or above it looking away
+  }
+  double sBegin = std::max(0.0, sIn);
+  double sEnd = sOut;
+
+  // Ground: hit iff the ray moves strictly inward (b < 0) and crosses the
+  // sphere r = R (discriminant > 0; a tangent ray only grazes it).
+  const double cGround = DiffOfSquares(ray.r0, R); // >= 0 after the clamp
+  const double discGround = ray.b * ray.b - cGround;
+  if (ray.b < 0.0 && discGround > 0.0)
+  {
+    // Nearest root without cancellation: s = c / (-b + sqrt(disc)).
+    const double sGround = cGround / (-ray.b + std::sqrt(discGround));
+    result.hitsGround = true;
+    sEnd = std::min(sEnd, sGround);
+  }
+  sBegin = std::min(sBegin, sEnd);
+
+  result.rayleighLength =
+    IntegrateDensity(ray, R, this->Parameters.rayleighScaleHeight, sBegin, sEnd);
+  result.mieLength = IntegrateDensity(ray, R, this->Parameters.mieScaleHeight, sBegin, sEnd);
+  return result;
+}
+
+double Atmosphere::OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const
+{
+  return this->RayleighScattering(lambdaNm) * lengths.rayleighLength +
+    this->MieExtinction(lambdaNm) * lengths.mieLength;
+}
+
+double Atmosphere::Transmittance(const OpticalLengths& lengths, double lambdaNm) const
+{
+  if (lengths.hitsGround)
+  {
+    return 0.0;
+  }
+  return std::exp(-this->OpticalDepth(lengths, lambdaNm));
+}
+
+double Atmosphere::TransmittanceToTop(const Vector3& p, const Vector3& d, double lambdaNm) const
+{
+  return this->Transmittance(this->OpticalLengthsToTop(p, d), lambdaNm);
+}
+
+double Atmosphere::TransmittanceBetween(const Vector3& p0, const Vector3& p1, double lambdaNm) const
+{
+  OpticalLengths lengths;
+  lengths.rayleighLength = this->OpticalLength(p0, p1, this->Parameters.rayleighScaleHeight);
+  lengths.mieLength = this->OpticalLength(p0, p1, this->Parameters.mieScaleHeight);
+  return this->Transmittance(lengths, lambdaNm);
+}
+
+} // namespace nimbus

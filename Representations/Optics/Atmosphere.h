@@ -1,0 +1,112 @@
+// Spherical-earth clear-sky atmosphere: Rayleigh (molecules) + Mie (aerosols),
+// each with an exponential density profile rho(h) = exp(-h/H) (002 sky model,
+// 004 §4).  Optical quantities for the sky, sunlight attenuation and the
+// atmosphere terms of 000 Eqs. 2, 6 and 7.
+//
+// Units: lengths and positions in metres, positions relative to the earth
+// centre; scattering / extinction coefficients beta in 1/m; wavelength lambda in
+// nanometres.  An "optical length" is the sea-level-equivalent column length
+//     L = integral exp(-h(s)/H) ds          [m]
+// so that the optical depth is tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M
+// (dimensionless) and the transmittance is exp(-tau).
+//
+// Density is zero above the top of the atmosphere (r > topRadius): all paths are
+// clipped to the atmosphere shell.
+#ifndef nimbus_Atmosphere_h
+#define nimbus_Atmosphere_h
+
+#include "NimbusRepresentationsModule.h"
+
+#include <array>
+
+namespace nimbus
+{
+
+/// Parameters of the atmosphere.  Defaults: Nishita et al. 1993 / Bruneton &
+/// Neyret 2008 values.
+struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereParameters
+{
+  double earthRadius = 6360000.0;          // R_e [m]
+  double topRadius = 6420000.0;            // R_top [m], 60 km thick atmosphere
+  double rayleighScaleHeight = 8000.0;     // H_R [m]
+  double mieScaleHeight = 1200.0;          // H_M [m]
+  double rayleighScattering550 = 13.5e-6;  // beta_R at sea level and 550 nm [1/m]
+                                           // (molecules do not absorb: extinction = scattering)
+  double mieScattering = 2.0e-5;           // beta_M,s at sea level [1/m], wavelength independent
+  double mieSingleScatteringAlbedo = 0.9;  // beta_M,s / beta_M,ext
+  double mieG = 0.76;                      // Cornette-Shanks asymmetry of the aerosol phase function
+};
+
+/// Optical lengths (sea-level-equivalent column lengths, metres) along a ray.
+struct NIMBUSREPRESENTATIONS_EXPORT OpticalLengths
+{
+  double rayleighLength = 0.0; // integral exp(-h/H_R) ds [m]
+  double mieLength = 0.0;      // integral exp(-h/H_M) ds [m]
+  bool hitsGround = false;     // the ray hits the earth; lengths are up to the hit point
+};
+
+class NIMBUSREPRESENTATIONS_EXPORT Atmosphere
+{
+public:
+  using Vector3 = std::array<double, 3>;
+
+  /// Throws std::invalid_argument unless 0 < earthRadius < topRadius, scale heights
+  /// > 0, coefficients >= 0, 0 < albedo <= 1 (all finite).
+  explicit Atmosphere(const AtmosphereParameters& parameters = AtmosphereParameters());
+
+  const AtmosphereParameters& GetParameters() const { return this->Parameters; }
+
+  /// Altitude h = |p| - R_e [m] of p (relative to the earth centre).  Negative
+  /// below the ground (not clamped here).
+  double Altitude(const Vector3& p) const;
+
+  /// Relative density rho(h) = exp(-max(h,0)/H) inside the atmosphere, 0 above it.
+  double Density(double altitude, double scaleHeight) const;
+
+  /// beta_R(lambda) = rayleighScattering550 * (550/lambda)^4 [1/m] (= extinction).
+  double RayleighScattering(double lambdaNm) const;
+  /// beta_M,s [1/m] (wavelength independent).
+  double MieScattering(double lambdaNm) const;
+  /// beta_M,ext = beta_M,s / albedo [1/m].
+  double MieExtinction(double lambdaNm) const;
+  /// Rayleigh phase function [1/sr], mu = cos(scattering angle).
+  double RayleighPhase(double mu) const;
+  /// Cornette-Shanks with g = mieG [1/sr] (000 Eq. 3 / 004 Eq. 5, divided by 4 pi).
+  double MiePhase(double mu) const;
+
+  /// L = integral over the straight segment p0 -> p1 of exp(-h/H) ds [m].  The
+  /// parts of the segment above the top of the atmosphere contribute 0.  The
+  /// segment is NOT tested against the earth: parts below the ground count with
+  /// rho = 1 (h clamped to 0); use OpticalLengthsToTop for occlusion.
+  /// Throws std::invalid_argument for non-finite input or scaleHeight <= 0.
+  double OpticalLength(const Vector3& p0, const Vector3& p1, double scaleHeight) const;
+
+  /// Optical lengths from p along direction d (need not be unit length) to the top
+  /// of the atmosphere, for H_R and H_M.
+  ///  - If the ray hits the earth, hitsGround = true and the lengths are
+  ///    integrated only up to the ground hit (finite).  A ray from a point on the
+  ///    ground hits it iff d points strictly downward (dot(p, d) < 0); exactly
+  ///    horizontal rays graze the earth and are not blocked.
+  ///  - p below the ground is clamped radially onto the ground first.
+  ///  - p above the top: the lengths are those of the part of the ray inside the
+  ///    atmosphere (0 if it misses or looks away).
+  /// Throws std::invalid_argument for a zero or non-finite d or non-finite p.
+  OpticalLengths OpticalLengthsToTop(const Vector3& p, const Vector3& d) const;
+
+  /// tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M (dimensionless; ignores hitsGround).
+  double OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const;
+  /// exp(-tau(lambda)); exactly 0 when lengths.hitsGround.
+  double Transmittance(const OpticalLengths& lengths, double lambdaNm) const;
+  /// Transmittance from p toward direction d to the top of the atmosphere (e.g.
+  /// sunlight reaching p, with d toward the sun); 0 if the earth blocks the ray.
+  double TransmittanceToTop(const Vector3& p, const Vector3& d, double lambdaNm) const;
+  /// Transmittance along the segment p0 -> p1 (no ground test, see OpticalLength).
+  double TransmittanceBetween(const Vector3& p0, const Vector3& p1, double lambdaNm) const;
+
+private:
+  AtmosphereParameters Parameters;
+};
+
+} // namespace nimbus
+
+#endif

@@ -1,0 +1,311 @@
+// Tests for Atmosphere.h: optical lengths against closed forms and brute-force
+// integrals, horizon / ground / top-of-atmosphere edge cases.
+#include "Atmosphere.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace
+{
+using V = nimbus::Atmosphere::Vector3;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double R = 6360000.0;
+constexpr double Rtop = 6420000.0;
+
+double Deg(double d)
+{
+  return d * kPi / 180.0;
+}
+
+// Point at altitude h above the "north pole" and a unit direction with the given
+// elevation (angle above the local horizontal) in the x-z plane.
+V At(double h)
+{
+  return { 0.0, 0.0, R + h };
+}
+V Elevation(double degrees)
+{
+  return { std::cos(Deg(degrees)), 0.0, std::sin(Deg(degrees)) };
+}
+
+// Independent brute force: distance from p (inside the atmosphere) along unit d
+// to the top sphere, and the midpoint rule with n steps of exp(-(|p + s d| - R)/H).
+double ExitDistance(const V& p, const V& d, double radius)
+{
+  const double b = p[0] * d[0] + p[1] * d[1] + p[2] * d[2];
+  const double c = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - radius * radius;
+  return -b + std::sqrt(b * b - c);
+}
+double MidpointLength(const V& p, const V& d, double s0, double s1, double H, long n)
+{
+  const double ds = (s1 - s0) / static_cast<double>(n);
+  double sum = 0.0;
+  for (long i = 0; i < n; ++i)
+  {
+    const double s = s0 + (static_cast<double>(i) + 0.5) * ds;
+    const double x = p[0] + s * d[0], y = p[1] + s * d[1], z = p[2] + s * d[2];
+    sum += std::exp(-(std::sqrt(x * x + y * y + z * z) - R) / H);
+  }
+  return sum * ds;
+}
+
+bool Finite(const nimbus::OpticalLengths& l)
+{
+  return std::isfinite(l.rayleighLength) && std::isfinite(l.mieLength) && l.rayleighLength >= 0.0 &&
+    l.mieLength >= 0.0;
+}
+} // namespace
+
+TEST(Atmosphere, DefaultParameters)
+{
+  const nimbus::Atmosphere atm;
+  const nimbus::AtmosphereParameters& p = atm.GetParameters();
+  EXPECT_EQ(p.earthRadius, 6360000.0);
+  EXPECT_EQ(p.topRadius, 6420000.0);
+  EXPECT_EQ(p.rayleighScaleHeight, 8000.0);
+  EXPECT_EQ(p.mieScaleHeight, 1200.0);
+  // Nishita / Bruneton beta_R: 5.8e-6, 13.5e-6, 33.1e-6 1/m at 680, 550, 440 nm.
+  EXPECT_NEAR(atm.RayleighScattering(680.0), 5.8e-6, 0.01 * 5.8e-6);
+  EXPECT_DOUBLE_EQ(atm.RayleighScattering(550.0), 13.5e-6);
+  EXPECT_NEAR(atm.RayleighScattering(440.0), 33.1e-6, 0.01 * 33.1e-6);
+  EXPECT_DOUBLE_EQ(atm.MieScattering(440.0), 2.0e-5);
+  EXPECT_DOUBLE_EQ(atm.MieExtinction(440.0), 2.0e-5 / 0.9);
+  EXPECT_GT(atm.MiePhase(1.0), atm.MiePhase(0.0)); // forward peak, g = 0.76
+  EXPECT_NEAR(atm.Altitude(At(1234.5)), 1234.5, 1e-9);
+  EXPECT_DOUBLE_EQ(atm.Density(0.0, 8000.0), 1.0);
+  EXPECT_DOUBLE_EQ(atm.Density(-10.0, 8000.0), 1.0);
+  EXPECT_EQ(atm.Density(60001.0, 8000.0), 0.0);
+}
+
+TEST(Atmosphere, VerticalMatchesClosedForm)
+{
+  const nimbus::Atmosphere atm;
+  double worst = 0.0;
+  for (double H : { 8000.0, 1200.0, 300.0, 25000.0 })
+  {
+    for (double h : { 1.0, 100.0, 1000.0, 5000.0, 20000.0, 59999.0 })
+    {
+      const double exact = H * -std::expm1(-h / H); // H (1 - e^{-h/H})
+      const double L = atm.OpticalLength(At(0.0), At(h), H);
+      const double Lrev = atm.OpticalLength(At(h), At(0.0), H);
+      EXPECT_NEAR(L, exact, 1e-9 * exact) << "H=" << H << " h=" << h;
+      EXPECT_NEAR(Lrev, exact, 1e-9 * exact) << "H=" << H << " h=" << h;
+      worst = std::max(worst, std::abs(L / exact - 1.0));
+    }
+  }
+  // Beyond the top the density is 0: ground -> 100 km equals ground -> top.
+  EXPECT_NEAR(atm.OpticalLength(At(0.0), At(100000.0), 8000.0), 8000.0 * -std::expm1(-7.5), 1e-6);
+  std::printf("vertical closed form: max relative error %.2e\n", worst);
+}
+
+TEST(Atmosphere, SlantPathsMatchBruteForce)
+{
+  const nimbus::Atmosphere atm;
+  const long n = 2000000;
+  double worst = 0.0;
+  for (double H : { 8000.0, 1200.0 })
+  {
+    for (double elevation : { 90.0, 30.0, 5.0, 1.0, 0.0, -0.5 })
+    {
+      const V p = At(1000.0);
+      const V d = Elevation(elevation);
+      const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
+      ASSERT_FALSE(l.hitsGround) << elevation; // horizon dip from 1 km is 1.01 deg
+      const double L = H == 8000.0 ? l.rayleighLength : l.mieLength;
+      const double ref = MidpointLength(p, d, 0.0, ExitDistance(p, d, Rtop), H, n);
+      const double rel = std::abs(L / ref - 1.0);
+      std::printf("H=%5.0f elevation %5.1f deg: L = %.9e m, brute force %.9e m, rel.err %.1e\n", H,
+        elevation, L, ref, rel);
+      EXPECT_LT(rel, 1e-6);
+      worst = std::max(worst, rel);
+    }
+  }
+  // Ground observer, exactly horizontal ray (grazing, not blocked).
+  for (double H : { 8000.0, 1200.0 })
+  {
+    const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), { 1.0, 0.0, 0.0 });
+    EXPECT_FALSE(l.hitsGround);
+    const double L = H == 8000.0 ? l.rayleighLength : l.mieLength;
+    const V d = { 1.0, 0.0, 0.0 };
+    const double ref = MidpointLength(At(0.0), d, 0.0, ExitDistance(At(0.0), d, Rtop), H, n);
+    EXPECT_LT(std::abs(L / ref - 1.0), 1e-6) << H;
+    worst = std::max(worst, std::abs(L / ref - 1.0));
+  }
+  std::printf("slant paths: max relative error vs 2e6-step midpoint %.2e\n", worst);
+}
+
+TEST(Atmosphere, NearHorizonFiniteAndMonotone)
+{
+  const nimbus::Atmosphere atm;
+  for (double h : { 0.0, 1000.0 })
+  {
+    double previousR = std::numeric_limits<double>::infinity();
+    double previousM = previousR;
+    const double lowest = h > 0.0 ? -1.0 : 0.0; // dip of the horizon from 1 km: 1.014 deg
+    for (double e = lowest; e <= 3.0 + 1e-12; e += 0.01)
+    {
+      const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(h), Elevation(e));
+      ASSERT_TRUE(Finite(l)) << e;
+      ASSERT_FALSE(l.hitsGround) << e;
+      EXPECT_LT(l.rayleighLength, previousR) << "h=" << h << " e=" << e;
+      EXPECT_LT(l.mieLength, previousM) << "h=" << h << " e=" << e;
+      previousR = l.rayleighLength;
+      previousM = l.mieLength;
+    }
+  }
+}
+
+TEST(Atmosphere, BelowHorizonHitsGround)
+{
+  const nimbus::Atmosphere atm;
+  // From the ground any downward ray is blocked immediately.
+  for (double e : { -1e-9, -0.1, -0.5, -10.0, -90.0 })
+  {
+    const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), Elevation(e));
+    EXPECT_TRUE(l.hitsGround) << e;
+    EXPECT_TRUE(Finite(l));
+    EXPECT_EQ(atm.Transmittance(l, 550.0), 0.0);
+    EXPECT_EQ(atm.TransmittanceToTop(At(0.0), Elevation(e), 550.0), 0.0);
+  }
+  // From 1 km, 5 deg down: integrated up to the ground hit only.
+  const V p = At(1000.0);
+  const V d = Elevation(-5.0);
+  const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
+  EXPECT_TRUE(l.hitsGround);
+  const double b = p[2] * d[2];
+  const double sHit = -b - std::sqrt(b * b - (p[2] * p[2] - R * R));
+  const V ground = { sHit * d[0], 0.0, p[2] + sHit * d[2] };
+  EXPECT_NEAR(l.rayleighLength, atm.OpticalLength(p, ground, 8000.0), 1e-9 * l.rayleighLength);
+  EXPECT_NEAR(l.mieLength, atm.OpticalLength(p, ground, 1200.0), 1e-9 * l.mieLength);
+  EXPECT_EQ(atm.Transmittance(l, 680.0), 0.0);
+  // Just beyond the horizon dip (1.0141 deg) the ray hits; just above it, it does not.
+  const double dip = std::acos(R / (R + 1000.0)) * 180.0 / kPi;
+  EXPECT_TRUE(atm.OpticalLengthsToTop(p, Elevation(-dip - 1e-4)).hitsGround);
+  EXPECT_FALSE(atm.OpticalLengthsToTop(p, Elevation(-dip + 1e-4)).hitsGround);
+}
+
+TEST(Atmosphere, ZenithSun)
+{
+  const nimbus::Atmosphere atm;
+  const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), { 0.0, 0.0, 1.0 });
+  const double LR = 8000.0 * -std::expm1(-60000.0 / 8000.0);
+  const double LM = 1200.0 * -std::expm1(-60000.0 / 1200.0);
+  EXPECT_NEAR(l.rayleighLength, LR, 1e-9 * LR);
+  EXPECT_NEAR(l.mieLength, LM, 1e-9 * LM);
+  for (double lambda : { 440.0, 550.0, 680.0 })
+  {
+    const double tau = atm.RayleighScattering(lambda) * LR + 2.0e-5 / 0.9 * LM;
+    EXPECT_NEAR(atm.OpticalDepth(l, lambda), tau, 1e-12);
+    EXPECT_NEAR(atm.TransmittanceToTop(At(0.0), { 0.0, 0.0, 5.0 }, lambda), std::exp(-tau), 1e-12);
+  }
+  // Sea-level vertical transmittance at 550 nm: tau = 0.1079 + 0.0267.
+  std::printf("zenith transmittance 440/550/680 nm: %.4f %.4f %.4f\n",
+    atm.Transmittance(l, 440.0), atm.Transmittance(l, 550.0), atm.Transmittance(l, 680.0));
+}
+
+TEST(Atmosphere, TopOfAtmosphereStart)
+{
+  const nimbus::Atmosphere atm;
+  const V top = At(60000.0);
+  const nimbus::OpticalLengths up = atm.OpticalLengthsToTop(top, { 0.0, 0.0, 1.0 });
+  EXPECT_EQ(up.rayleighLength, 0.0);
+  EXPECT_EQ(up.mieLength, 0.0);
+  EXPECT_FALSE(up.hitsGround);
+  EXPECT_EQ(atm.Transmittance(up, 550.0), 1.0);
+  const nimbus::OpticalLengths flat = atm.OpticalLengthsToTop(top, { 1.0, 0.0, 0.0 });
+  EXPECT_TRUE(Finite(flat));
+  EXPECT_EQ(flat.rayleighLength, 0.0); // tangent to the top sphere
+  // 5 deg down from the top: passes above the 7.8 deg horizon dip.
+  const V d = Elevation(-5.0);
+  const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(top, d);
+  EXPECT_FALSE(l.hitsGround);
+  const double ref = MidpointLength(top, d, 0.0, ExitDistance(top, d, Rtop), 8000.0, 2000000);
+  EXPECT_NEAR(l.rayleighLength, ref, 1e-6 * ref);
+  // 30 deg down hits the ground.
+  const nimbus::OpticalLengths down = atm.OpticalLengthsToTop(top, Elevation(-30.0));
+  EXPECT_TRUE(down.hitsGround);
+  EXPECT_TRUE(Finite(down));
+  EXPECT_GT(down.rayleighLength, 0.0);
+}
+
+TEST(Atmosphere, ObserverAboveAtmosphere)
+{
+  const nimbus::Atmosphere atm;
+  const V p = At(200000.0);
+  // Looking away or missing the atmosphere: zero length, transmittance 1.
+  for (const V& d : { V{ 0.0, 0.0, 1.0 }, V{ 1.0, 0.0, 0.0 }, V{ 1.0, 0.0, -0.1 } })
+  {
+    const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
+    EXPECT_EQ(l.rayleighLength, 0.0);
+    EXPECT_EQ(l.mieLength, 0.0);
+    EXPECT_FALSE(l.hitsGround);
+  }
+  // Straight down: the full vertical column, then the ground.
+  const nimbus::OpticalLengths down = atm.OpticalLengthsToTop(p, { 0.0, 0.0, -1.0 });
+  EXPECT_TRUE(down.hitsGround);
+  const double LR = 8000.0 * -std::expm1(-60000.0 / 8000.0);
+  EXPECT_NEAR(down.rayleighLength, LR, 1e-9 * LR);
+  // Limb ray with tangent altitude 20 km: through the atmosphere and out again.
+  const double rt = R + 20000.0;
+  const double pr = R + 200000.0;
+  const double sinA = rt / pr; // angle between -p and d
+  const V d = { sinA, 0.0, -std::sqrt(1.0 - sinA * sinA) };
+  const nimbus::OpticalLengths limb = atm.OpticalLengthsToTop(p, d);
+  EXPECT_FALSE(limb.hitsGround);
+  // Brute force over the chord through the top sphere.
+  const double b = p[2] * d[2];
+  const double disc = b * b - (pr * pr - Rtop * Rtop);
+  const double ref =
+    MidpointLength(p, d, -b - std::sqrt(disc), -b + std::sqrt(disc), 8000.0, 2000000);
+  EXPECT_NEAR(limb.rayleighLength, ref, 1e-6 * ref);
+  std::printf("limb ray (tangent altitude 20 km): L_R = %.6e m, brute force %.6e m\n",
+    limb.rayleighLength, ref);
+}
+
+TEST(Atmosphere, PointBelowGroundIsClamped)
+{
+  const nimbus::Atmosphere atm;
+  const nimbus::OpticalLengths a = atm.OpticalLengthsToTop(At(-100.0), Elevation(20.0));
+  const nimbus::OpticalLengths b = atm.OpticalLengthsToTop(At(0.0), Elevation(20.0));
+  EXPECT_NEAR(a.rayleighLength, b.rayleighLength, 1e-9 * b.rayleighLength);
+  EXPECT_NEAR(a.mieLength, b.mieLength, 1e-9 * b.mieLength);
+  const nimbus::OpticalLengths c = atm.OpticalLengthsToTop({ 0.0, 0.0, 0.0 }, { 0.0, 1.0, 0.0 });
+  EXPECT_TRUE(Finite(c));
+  EXPECT_NEAR(c.rayleighLength, 8000.0 * -std::expm1(-7.5), 1e-6);
+  const nimbus::OpticalLengths e = atm.OpticalLengthsToTop(At(-100.0), Elevation(0.0));
+  EXPECT_TRUE(Finite(e));
+  EXPECT_FALSE(e.hitsGround);
+}
+
+TEST(Atmosphere, InvalidInput)
+{
+  const nimbus::Atmosphere atm;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(atm.OpticalLengthsToTop(At(0.0), { 0.0, 0.0, 0.0 }), std::invalid_argument);
+  EXPECT_THROW(atm.OpticalLengthsToTop(At(0.0), { nan, 0.0, 1.0 }), std::invalid_argument);
+  EXPECT_THROW(atm.OpticalLengthsToTop({ nan, 0.0, R }, { 0.0, 0.0, 1.0 }), std::invalid_argument);
+  EXPECT_THROW(atm.OpticalLength(At(0.0), At(10.0), 0.0), std::invalid_argument);
+  EXPECT_EQ(atm.OpticalLength(At(10.0), At(10.0), 8000.0), 0.0);
+  nimbus::AtmosphereParameters bad;
+  bad.topRadius = bad.earthRadius;
+  EXPECT_THROW(nimbus::Atmosphere{ bad }, std::invalid_argument);
+}
+
+TEST(Atmosphere, SegmentSymmetricAndAdditive)
+{
+  const nimbus::Atmosphere atm;
+  const V a = At(500.0);
+  const V b = { 300000.0, 0.0, R + 2000.0 };
+  const double ab = atm.OpticalLength(a, b, 1200.0);
+  EXPECT_NEAR(ab, atm.OpticalLength(b, a, 1200.0), 1e-10 * ab);
+  const V mid = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
+  EXPECT_NEAR(ab, atm.OpticalLength(a, mid, 1200.0) + atm.OpticalLength(mid, b, 1200.0), 1e-10 * ab);
+  const double T = atm.TransmittanceBetween(a, b, 550.0);
+  EXPECT_GT(T, 0.0);
+  EXPECT_LT(T, 1.0);
+}
