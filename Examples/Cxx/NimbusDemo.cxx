@@ -36,7 +36,7 @@ namespace
 {
 void Usage()
 {
-  std::cerr << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
+  std::cout << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
                " [--sun-azimuth DEG] [--seed N]\n";
 }
 
@@ -57,6 +57,11 @@ int main(int argc, char* argv[])
     const std::string arg = argv[i];
     const bool hasValue = i + 1 < argc;
     bool ok = true;
+    if (arg == "--help" || arg == "-h")
+    {
+      Usage();
+      return 0;
+    }
     if (arg == "--output" && hasValue)
     {
       output = argv[++i];
@@ -85,8 +90,7 @@ int main(int argc, char* argv[])
     }
     if (!ok)
     {
-      std::cerr << "nimbus-demo: bad or incomplete argument '" << arg << "'\n";
-      Usage();
+      std::cerr << "nimbus-demo: bad or incomplete argument '" << arg << "' (see --help)\n";
       return 2;
     }
   }
