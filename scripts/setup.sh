@@ -27,7 +27,7 @@ packages=(
   # build tools and tests
   cmake ninja-build g++ make libgtest-dev
   # headless OpenGL: Xvfb + Mesa llvmpipe
-  xvfb xauth libgl1-mesa-dri libglx-mesa0
+  xvfb libgl1-mesa-dri libglx-mesa0
 )
 
 missing=()

@@ -1,6 +1,7 @@
 """pvpython image test: the Nimbus plugin's metaball cloud shown as a volume.
 
-    pvpython TestPluginMetaballCloud.py --plugin Nimbus.so --baseline B.png --output-dir DIR
+    pvpython TestPluginMetaballCloud.py --plugin Nimbus.so --baseline B.png --output-dir DIR \
+        --compare-tool build/bin/nimbus-compare-images
 
 Loads the plugin with LoadPlugin, creates the source through paraview.simple,
 shows it with ParaView's volume representation, saves a screenshot and compares
@@ -24,7 +25,7 @@ def main():
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--baseline", required=True)
     parser.add_argument("--output-dir", required=True)
-    parser.add_argument("--threshold", type=float, default=0.15)
+    parser.add_argument("--compare-tool", required=True)
     args = parser.parse_args()
 
     LoadPlugin(args.plugin, ns=globals())
@@ -66,7 +67,7 @@ def main():
     os.makedirs(args.output_dir, exist_ok=True)
     image = os.path.join(args.output_dir, "TestPluginMetaballCloud.png")
     SaveScreenshot(image, view, ImageResolution=[320, 240])
-    ok = compare_with_baseline(image, args.baseline, args.output_dir, args.threshold)
+    ok = compare_with_baseline(image, args.baseline, args.output_dir, args.compare_tool)
     print("image test", "passed" if ok else "FAILED", "->", image)
     # Release the view's OpenGL context while the X connection is still open.
     Delete(display)
