@@ -316,6 +316,24 @@ TEST(MetaballCloudSource, UserBallsReplaceTheRandomShape)
   EXPECT_EQ(source->GetNumberOfUserBalls(), 0);
 }
 
+TEST(MetaballCloudSource, ReportsProgress)
+{
+  vtkNew<vtkNimbusMetaballCloudSource> source;
+  MakeSmall(source);
+  source->SetNumberOfLevels(3);
+  std::vector<double> progress;
+  vtkNew<vtkCallbackCommand> callback;
+  callback->SetClientData(&progress);
+  callback->SetCallback([](vtkObject*, unsigned long, void* clientData, void* callData)
+    { static_cast<std::vector<double>*>(clientData)->push_back(*static_cast<double*>(callData)); });
+  source->AddObserver(vtkCommand::ProgressEvent, callback);
+  source->Update();
+  // One report per growth level, one for the final sampling, and the end.
+  ASSERT_GE(progress.size(), 5u);
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_EQ(progress.back(), 1.0);
+}
+
 TEST(MetaballCloudSource, OneVoxelVolume)
 {
   vtkNew<vtkNimbusMetaballCloudSource> source;
