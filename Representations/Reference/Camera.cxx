@@ -1,0 +1,71 @@
+#include "Camera.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace nimbus
+{
+
+namespace
+{
+using Vector3 = Camera::Vector3;
+Vector3 Cross(const Vector3& a, const Vector3& b)
+{
+  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
+}
+double Norm(const Vector3& a)
+{
+  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+Vector3 Scaled(const Vector3& a, double s)
+{
+  return { { a[0] * s, a[1] * s, a[2] * s } };
+}
+}
+
+Camera::Camera(const CameraDescription& d)
+  : Position(d.Position)
+  , Width(d.Width)
+  , Height(d.Height)
+{
+  const Vector3 view{ { d.FocalPoint[0] - d.Position[0], d.FocalPoint[1] - d.Position[1],
+    d.FocalPoint[2] - d.Position[2] } };
+  const double viewLength = Norm(view);
+  if (!(viewLength > 0.0) || !std::isfinite(viewLength))
+  {
+    throw std::invalid_argument("camera: position and focal point must differ and be finite");
+  }
+  this->Forward = Scaled(view, 1.0 / viewLength);
+  const Vector3 right = Cross(this->Forward, d.ViewUp);
+  const double rightLength = Norm(right);
+  if (!(rightLength > 1e-9 * Norm(d.ViewUp)) || !std::isfinite(rightLength))
+  {
+    throw std::invalid_argument("camera: view-up must not be parallel to the view direction");
+  }
+  this->Right = Scaled(right, 1.0 / rightLength);
+  this->Up = Cross(this->Right, this->Forward);
+  if (!(d.ViewAngle > 0.0 && d.ViewAngle < 180.0))
+  {
+    throw std::invalid_argument("camera: view angle must be in (0, 180) degrees");
+  }
+  if (d.Width < 1 || d.Height < 1)
+  {
+    throw std::invalid_argument("camera: image width and height must be >= 1");
+  }
+  this->TanHalfAngle = std::tan(0.5 * d.ViewAngle * 3.14159265358979323846 / 180.0);
+}
+
+Camera::Vector3 Camera::RayDirection(double x, double y) const
+{
+  const double aspect = static_cast<double>(this->Width) / this->Height;
+  const double sx = (2.0 * x / this->Width - 1.0) * this->TanHalfAngle * aspect;
+  const double sy = (2.0 * y / this->Height - 1.0) * this->TanHalfAngle;
+  Vector3 direction;
+  for (int a = 0; a < 3; ++a)
+  {
+    direction[a] = this->Forward[a] + sx * this->Right[a] + sy * this->Up[a];
+  }
+  return Scaled(direction, 1.0 / Norm(direction));
+}
+
+} // namespace nimbus

@@ -1,0 +1,79 @@
+#include "FloatImage.h"
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace nimbus
+{
+
+namespace
+{
+bool LittleEndianHost()
+{
+  const std::uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+}
+
+void FloatImage::WritePFM(const std::string& path) const
+{
+  std::ofstream out(path, std::ios::binary);
+  if (!out)
+  {
+    throw std::runtime_error("cannot write " + path);
+  }
+  // Negative scale = little-endian data; rows bottom to top (our row order).
+  out << "PF\n" << this->Width << " " << this->Height << "\n-1.0\n";
+  if (LittleEndianHost())
+  {
+    out.write(reinterpret_cast<const char*>(this->Pixels.data()),
+      static_cast<std::streamsize>(this->Pixels.size() * sizeof(float)));
+  }
+  else
+  {
+    for (float value : this->Pixels)
+    {
+      unsigned char bytes[4];
+      std::memcpy(bytes, &value, 4);
+      const unsigned char swapped[4] = { bytes[3], bytes[2], bytes[1], bytes[0] };
+      out.write(reinterpret_cast<const char*>(swapped), 4);
+    }
+  }
+  if (!out)
+  {
+    throw std::runtime_error("error writing " + path);
+  }
+}
+
+FloatImage FloatImage::ReadPFM(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    throw std::runtime_error("cannot read " + path);
+  }
+  std::string magic;
+  int width = 0, height = 0;
+  double scale = 0.0;
+  in >> magic >> width >> height >> scale;
+  in.get(); // the single whitespace after the header
+  if (magic != "PF" || width <= 0 || height <= 0 || scale >= 0.0)
+  {
+    throw std::runtime_error(path + ": not a little-endian RGB PFM");
+  }
+  FloatImage image(width, height);
+  in.read(reinterpret_cast<char*>(image.Pixels.data()),
+    static_cast<std::streamsize>(image.Pixels.size() * sizeof(float)));
+  if (!in || !LittleEndianHost())
+  {
+    throw std::runtime_error(path + ": truncated PFM (or big-endian host)");
+  }
+  return image;
+}
+
+} // namespace nimbus

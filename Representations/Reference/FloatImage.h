@@ -1,0 +1,41 @@
+// A linear float RGB image (linear sRGB radiance, the scene's relative units),
+// row 0 at the bottom like vtkImageData and PFM.
+#ifndef NimbusFloatImage_h
+#define NimbusFloatImage_h
+
+#include "NimbusRepresentationsModule.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace nimbus
+{
+
+struct NIMBUSREPRESENTATIONS_EXPORT FloatImage
+{
+  int Width = 0;
+  int Height = 0;
+  std::vector<float> Pixels; // RGB interleaved, Width * Height * 3
+
+  FloatImage() = default;
+  FloatImage(int width, int height)
+    : Width(width)
+    , Height(height)
+    , Pixels(static_cast<std::size_t>(width) * height * 3, 0.0f)
+  {
+  }
+  float* At(int x, int y) { return &this->Pixels[3 * (static_cast<std::size_t>(y) * this->Width + x)]; }
+  const float* At(int x, int y) const
+  {
+    return &this->Pixels[3 * (static_cast<std::size_t>(y) * this->Width + x)];
+  }
+
+  /// Portable float map (little-endian "PF"); throws std::runtime_error on I/O failure.
+  void WritePFM(const std::string& path) const;
+  static FloatImage ReadPFM(const std::string& path);
+};
+
+} // namespace nimbus
+
+#endif

@@ -1,0 +1,113 @@
+// The runtime form of a scene that the reference renderers share: the camera,
+// the density grid, the cloud's and atmosphere's optical coefficients per
+// wavelength sample, the sun's spectral irradiance, the ground and background,
+// and the spectrum -> linear sRGB conversion. Renderers differ only in how they
+// integrate; everything physical comes from here, so they render the same scene.
+//
+// Units: metres, 1/m, wavelengths in nm; radiometry relative to the sun (see
+// SceneDescription.h). Scene point p maps to the earth-centred frame of
+// Atmosphere.h as (p.x, p.y, EarthRadius + SceneAltitude + p.z).
+#ifndef NimbusRenderContext_h
+#define NimbusRenderContext_h
+
+#include "NimbusRepresentationsModule.h"
+
+#include "Atmosphere.h"
+#include "Camera.h"
+#include "DensityGrid.h"
+#include "PhaseFunctions.h"
+#include "SceneDescription.h"
+#include "SpectralColor.h"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace nimbus
+{
+
+class NIMBUSREPRESENTATIONS_EXPORT RenderContext
+{
+public:
+  using Vector3 = std::array<double, 3>;
+
+  /// Validates the parts the renderers rely on (throws std::invalid_argument with
+  /// the offending field's name).
+  RenderContext(const SceneDescription& scene, DensityGrid grid);
+
+  const SceneDescription& GetScene() const { return this->Scene; }
+  const Camera& GetCamera() const { return this->ViewCamera; }
+  const DensityGrid& GetGrid() const { return this->Grid; }
+
+  // --- spectrum
+  const SpectralSamples& GetSpectrum() const { return *this->Spectrum; }
+  int GetNumberOfWavelengths() const { return static_cast<int>(this->Wavelengths.size()); }
+  const std::vector<double>& GetWavelengths() const { return this->Wavelengths; }
+  /// Spectral radiance at the wavelength samples -> linear sRGB.
+  std::array<double, 3> ToLinearSrgb(const std::vector<double>& spectralRadiance) const;
+
+  // --- sun
+  /// Unit vector toward the sun.
+  const Vector3& GetSunDirection() const { return this->SunDirection; }
+  /// Irradiance at the top of the atmosphere per wavelength sample (luminance Y = Illuminance).
+  const std::vector<double>& GetSunIrradiance() const { return this->SunIrradiance; }
+
+  // --- cloud (wavelength independent)
+  /// sigma_t = ExtinctionPerDensity * density(p), 1/m.
+  double CloudExtinction(const Vector3& p) const
+  {
+    return this->ExtinctionPerDensity * this->Grid.Sample(p);
+  }
+  /// Majorant of CloudExtinction over the grid, 1/m.
+  double CloudMajorant() const { return this->ExtinctionPerDensity * this->Grid.GetMaximum(); }
+  double GetCloudAlbedo() const { return this->Scene.Medium.SingleScatteringAlbedo; }
+  const PhaseFunctionMixture& GetCloudPhase() const { return this->CloudPhase; }
+
+  // --- atmosphere (absent when disabled)
+  bool HasAtmosphere() const { return this->Air != nullptr; }
+  const Atmosphere* GetAtmosphere() const { return this->Air.get(); }
+  Vector3 EarthCentred(const Vector3& p) const;
+  /// Per wavelength sample at scene point p (1/m): Rayleigh scattering (=
+  /// extinction), Mie scattering, Mie extinction. Zero without atmosphere.
+  void AtmosphereCoefficients(const Vector3& p, std::vector<double>& rayleighScattering,
+    double& mieScattering, double& mieExtinction) const;
+  /// Transmittance of the atmosphere from p toward the sun, per wavelength sample
+  /// (0 where the earth blocks the sun; 1 without atmosphere). The cloud is not
+  /// included: renderers march it themselves.
+  void SunAtmosphereTransmittance(const Vector3& p, std::vector<double>& transmittance) const;
+  /// Transmittance of the atmosphere along the segment p0 -> p1, per wavelength sample.
+  void AtmosphereTransmittanceBetween(
+    const Vector3& p0, const Vector3& p1, std::vector<double>& transmittance) const;
+  /// Distance along origin + t*direction (unit) to the top of the atmosphere, or
+  /// infinity without atmosphere.
+  double DistanceToTopOfAtmosphere(const Vector3& origin, const Vector3& direction) const;
+
+  // --- ground plane z = height (absent when disabled) and background
+  bool HasGround() const { return this->Scene.Ground.Enabled; }
+  double GetGroundHeight() const { return this->Scene.Ground.Height; }
+  double GetGroundAlbedo() const { return this->Scene.Ground.Albedo; }
+  /// Distance t > tMin along the ray to the ground plane, or infinity.
+  double IntersectGround(const Vector3& origin, const Vector3& direction, double tMin) const;
+  /// Background radiance per wavelength sample for rays that leave the scene
+  /// ("constant": flat spectrum with luminance Radiance; "black" and
+  /// "atmosphere": zero — the atmosphere's own scattering is integrated by the renderer).
+  const std::vector<double>& GetBackgroundRadiance() const { return this->BackgroundRadiance; }
+  bool BackgroundIsAtmosphere() const { return this->Scene.Background.Type == "atmosphere"; }
+
+private:
+  SceneDescription Scene;
+  Camera ViewCamera;
+  DensityGrid Grid;
+  std::unique_ptr<SpectralSamples> Spectrum;
+  std::vector<double> Wavelengths;
+  Vector3 SunDirection;
+  std::vector<double> SunIrradiance;
+  double ExtinctionPerDensity;
+  PhaseFunctionMixture CloudPhase;
+  std::unique_ptr<Atmosphere> Air;
+  std::vector<double> BackgroundRadiance;
+};
+
+} // namespace nimbus
+
+#endif

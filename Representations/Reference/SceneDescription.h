@@ -1,0 +1,112 @@
+// What a Nimbus scene is: everything needed to render it, in physical units,
+// independent of the renderer. Read from and written to versioned JSON by
+// SceneJson.h (format documented in docs/scene-format.md).
+//
+// Frame and units: metres; z is up; x east, y north. Angles in degrees in the
+// description. Coefficients in 1/m. Radiometry is relative: the sun's
+// irradiance at the top of the atmosphere has luminance Y = Sun.Illuminance
+// (so a white Lambertian plane facing that sun has radiance Y = Illuminance/pi).
+#ifndef NimbusSceneDescription_h
+#define NimbusSceneDescription_h
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace nimbus
+{
+
+struct CameraDescription
+{
+  std::array<double, 3> Position{ { 0.0, -6000.0, 1500.0 } };   // m
+  std::array<double, 3> FocalPoint{ { 0.0, 0.0, 1600.0 } };     // m
+  std::array<double, 3> ViewUp{ { 0.0, 0.0, 1.0 } };
+  double ViewAngle = 35.0;                                      // vertical, degrees
+  int Width = 256;                                              // pixels
+  int Height = 256;                                             // pixels
+};
+
+/// One term of a phase function (004 Eq. 4 mixtures have several).
+struct PhaseComponentDescription
+{
+  std::string Type = "cornette_shanks"; // "isotropic", "rayleigh", "henyey_greenstein", "cornette_shanks"
+  double G = 0.85;                      // asymmetry (ignored by isotropic and rayleigh)
+  double Weight = 1.0;                  // mixture weight (normalised over the components)
+};
+
+/// Where the density comes from. Either a VTK image file or a Nimbus source.
+struct DensitySourceDescription
+{
+  std::string Type = "metaball_cloud"; // "file" or "metaball_cloud"
+  std::string Path;                    // "file": .vti path, relative to the scene file
+  std::string ArrayName = "density";   // "file": the point-data array to use
+  /// "metaball_cloud": vtkNimbusMetaballCloudSource parameters (name -> value(s)),
+  /// e.g. {"Dimensions": [96, 96, 64], "Seed": [1]}; unknown names are rejected.
+  std::vector<std::pair<std::string, std::vector<double>>> Parameters;
+};
+
+struct MediumDescription
+{
+  DensitySourceDescription Density;
+  double ExtinctionPerDensity = 0.02;  // sigma_t per unit density, 1/m
+  double SingleScatteringAlbedo = 0.99; // sigma_s / sigma_t
+  std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
+};
+
+struct SunDescription
+{
+  double Azimuth = 135.0;      // degrees from north (+y) toward east (+x)
+  double Elevation = 45.0;     // degrees above the horizon
+  double Illuminance = 1.0;    // luminance Y of the irradiance at the top of the atmosphere
+  double Temperature = 5778.0; // K, blackbody spectrum
+};
+
+struct AtmosphereDescription
+{
+  bool Enabled = true;
+  double SceneAltitude = 0.0;           // m above sea level of the scene's z = 0
+  double EarthRadius = 6360000.0;       // m
+  double TopRadius = 6420000.0;         // m
+  double RayleighScattering550 = 13.5e-6; // 1/m at sea level and 550 nm
+  double RayleighScaleHeight = 8000.0;  // m
+  double MieScattering = 2.0e-5;        // 1/m at sea level
+  double MieScaleHeight = 1200.0;       // m
+  double MieAlbedo = 0.9;               // sigma_s / sigma_t of aerosols
+  double MieG = 0.76;                   // Cornette-Shanks asymmetry of aerosols
+};
+
+struct GroundDescription
+{
+  bool Enabled = true;
+  double Height = 0.0;                                  // z of the ground plane, m
+  double Albedo = 0.2;                                  // Lambertian, grey (all wavelengths)
+};
+
+struct BackgroundDescription
+{
+  /// "black"; "constant" (a grey radiance with luminance Y = Radiance at every
+  /// wavelength); "atmosphere" (only what the atmosphere scatters along the view
+  /// ray up to the top of the atmosphere: the single-scattered sky; needs
+  /// Atmosphere.Enabled).
+  std::string Type = "atmosphere";
+  double Radiance = 0.0; // for "constant": luminance Y, same relative units as the sun
+};
+
+struct SceneDescription
+{
+  static constexpr int kFormatVersion = 1;
+  std::string Name;
+  std::string Description;
+  CameraDescription Camera;
+  MediumDescription Medium;
+  SunDescription Sun;
+  AtmosphereDescription Atmosphere;
+  GroundDescription Ground;
+  BackgroundDescription Background;
+  /// Wavelengths the renderers sample (SpectralSamples; 16 = measured ΔE 0.02).
+  int SpectralSamples = 16;
+};
+
+} // namespace nimbus
+
+#endif
