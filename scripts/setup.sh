@@ -25,7 +25,7 @@ packages=(
   libjpeg-dev libpng-dev libtiff-dev libfreetype-dev zlib1g-dev libx11-dev libxt-dev
   libgl-dev python3-dev python3-mpi4py python3-numpy
   # build tools and tests
-  cmake ninja-build g++ make libgtest-dev
+  cmake ninja-build g++ make libgtest-dev nlohmann-json3-dev python3-matplotlib
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
 )

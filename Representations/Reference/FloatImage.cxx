@@ -1,5 +1,7 @@
 #include "FloatImage.h"
 
+#include "SpectralColor.h"
+
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -74,6 +76,17 @@ FloatImage FloatImage::ReadPFM(const std::string& path)
     throw std::runtime_error(path + ": truncated PFM (or big-endian host)");
   }
   return image;
+}
+
+std::vector<unsigned char> ToneMap(const FloatImage& image, double exposure)
+{
+  std::vector<unsigned char> bytes(image.Pixels.size());
+  for (std::size_t i = 0; i < image.Pixels.size(); ++i)
+  {
+    const double encoded = SrgbEncode(exposure * image.Pixels[i]); // clamps to [0, 1]
+    bytes[i] = static_cast<unsigned char>(encoded * 255.0 + 0.5);
+  }
+  return bytes;
 }
 
 } // namespace nimbus

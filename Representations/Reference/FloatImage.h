@@ -36,6 +36,11 @@ struct NIMBUSREPRESENTATIONS_EXPORT FloatImage
   static FloatImage ReadPFM(const std::string& path);
 };
 
+/// Display encoding for looking at a linear image: multiply by exposure, clip to
+/// [0, 1], apply the sRGB transfer function; 8-bit RGB, row 0 at the bottom.
+NIMBUSREPRESENTATIONS_EXPORT std::vector<unsigned char> ToneMap(
+  const FloatImage& image, double exposure);
+
 } // namespace nimbus
 
 #endif

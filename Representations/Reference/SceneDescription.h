@@ -11,6 +11,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nimbus
@@ -38,7 +39,8 @@ struct PhaseComponentDescription
 struct DensitySourceDescription
 {
   std::string Type = "metaball_cloud"; // "file" or "metaball_cloud"
-  std::string Path;                    // "file": .vti path, relative to the scene file
+  std::string Path;                    // "file": .vti path; relative ones are resolved
+                                       // against the scene file's folder when read
   std::string ArrayName = "density";   // "file": the point-data array to use
   /// "metaball_cloud": vtkNimbusMetaballCloudSource parameters (name -> value(s)),
   /// e.g. {"Dimensions": [96, 96, 64], "Seed": [1]}; unknown names are rejected.

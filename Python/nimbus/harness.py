@@ -1,0 +1,502 @@
+"""The speed <-> accuracy trade harness.
+
+For named scenes and a renderer with a list of quality settings it renders each
+setting, times it (median of several renders in this process), measures the error
+against the scene's reference image (RMSE, relative L1, max abs error, PSNR) and
+writes a CSV and an error-vs-time plot: the Pareto front users choose from.
+
+    python3 -m nimbus.harness Data/Scenes/cumulus_noon.json [more scenes] \
+        --renderer vtk-gpu --output-dir build/harness
+
+Renderers: ``vtk-gpu`` (VTK's vtkGPUVolumeRayCastMapper with the scene's optics
+mapped onto its transfer functions; needs a display: run it through
+Testing/with-display.sh), ``single`` (Nimbus's single-scattering reference at
+coarser steps) and ``path`` (the Monte Carlo path tracer at fewer samples).
+``--settings FILE.json`` replaces a renderer's default list of settings.
+
+References are rendered once and cached in --cache-dir under a hash of the scene
+file (canonical JSON), the density file it names (bytes) and the reference's own
+settings, so editing any of them renders a new reference.
+"""
+import argparse
+import csv
+import hashlib
+import json
+import math
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import nimbus
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction
+from vtkmodules.vtkIOImage import vtkPNGWriter
+
+# The reference each scene is measured against (see --reference).
+REFERENCE_SETTINGS = {
+    "single": {"mode": "single", "step_scale": 0.5, "tolerance": 1e-3, "max_refinements": 6},
+    "path": {"mode": "path", "min_spp": 64, "max_spp": 4096, "target_error": 0.01, "seed": 1},
+}
+
+# Default quality settings per renderer: each dict is one point of the trade curve.
+DEFAULT_SETTINGS = {
+    "vtk-gpu": [
+        {"shading": "absorption", "sample_distance": 1.0},
+        {"shading": "absorption", "sample_distance": 0.5},
+        {"shading": "gradient", "sample_distance": 1.0},
+        {"shading": "gradient", "sample_distance": 0.5},
+        {"shading": "gradient", "sample_distance": 0.25},
+        {"shading": "volumetric", "sample_distance": 0.5, "reach": 0.0},
+        {"shading": "volumetric", "sample_distance": 0.5, "reach": 0.25},
+        {"shading": "volumetric", "sample_distance": 0.5, "reach": 0.5},
+        {"shading": "volumetric", "sample_distance": 0.5, "reach": 1.0},
+        {"shading": "volumetric", "sample_distance": 0.25, "reach": 1.0},
+    ],
+    "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
+    "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
+}
+
+# Linear radiance -> the [0, 1] range VTK renders into (and back): radiance
+# 1/VTK_SCALE fills VTK's 8-bit framebuffer. 8-bit quantisation then costs at most
+# 1/(2*255*VTK_SCALE) = 6.5e-4 in radiance, below every error the table reports.
+VTK_SCALE = 3.0
+# Exposure of the PNGs the harness writes for looking at (not used in any metric).
+DISPLAY_EXPOSURE = 6.0
+
+
+# --- scenes and references ------------------------------------------------------------------
+
+def load_scene(path):
+    with open(path) as stream:
+        return json.load(stream)
+
+
+def scene_hash(scene_path, reference):
+    """Hash of everything the reference image depends on."""
+    scene = load_scene(scene_path)
+    digest = hashlib.sha256()
+    digest.update(json.dumps(scene, sort_keys=True).encode())
+    digest.update(json.dumps(reference, sort_keys=True).encode())
+    density = scene.get("medium", {}).get("density", {})
+    if density.get("type") == "file":
+        density_path = os.path.join(os.path.dirname(os.path.abspath(scene_path)), density["path"])
+        with open(density_path, "rb") as stream:
+            digest.update(stream.read())
+    return digest.hexdigest()[:16]
+
+
+def configure_reference_renderer(renderer, settings, threads=0):
+    mode = settings.get("mode", "single")
+    if mode == "single":
+        renderer.SetModeToSingleScattering()
+        renderer.SetStepScale(settings.get("step_scale", 0.5))
+        renderer.SetRelativeTolerance(settings.get("tolerance", 1e-3))
+        renderer.SetMaxRefinements(settings.get("max_refinements", 6))
+    else:
+        renderer.SetModeToPathTracing()
+        renderer.SetMinSamplesPerPixel(settings.get("min_spp", 16))
+        renderer.SetMaxSamplesPerPixel(settings.get("max_spp", 256))
+        renderer.SetTargetRelativeError(settings.get("target_error", 0.0))
+        renderer.SetMaxScatteringOrder(settings.get("max_order", 0))
+        renderer.SetSeed(settings.get("seed", 1))
+    renderer.SetNumberOfThreads(threads)
+
+
+def render_reference_mode(scene_path, settings, density=None):
+    """Renders with vtkNimbusReferenceRenderer; returns (H x W x 3 float32, output image)."""
+    renderer = nimbus.vtkNimbusReferenceRenderer()
+    renderer.SetSceneFileName(scene_path)
+    if density is not None:
+        renderer.SetInputData(density)
+    configure_reference_renderer(renderer, settings)
+    renderer.Update()
+    output = renderer.GetOutput()
+    radiance = output.GetPointData().GetArray("radiance")
+    if radiance is None:
+        raise RuntimeError(f"{scene_path}: the reference renderer failed (see its errors)")
+    width, height, _ = output.GetDimensions()
+    return vtk_to_numpy(radiance).reshape(height, width, 3).astype(np.float32), output
+
+
+def cached_image(cache_dir, key, compute):
+    """An image from the cache, or computed and stored (npy, float32)."""
+    os.makedirs(cache_dir, exist_ok=True)
+    path = os.path.join(cache_dir, key + ".npy")
+    if os.path.exists(path):
+        return np.load(path), True
+    image = compute()
+    np.save(path, image)
+    return image, False
+
+
+def zero_density(scene_path):
+    """The scene's density grid with every value 0 (for sky-only references)."""
+    source = nimbus.vtkNimbusSceneDensitySource()
+    source.SetSceneFileName(scene_path)
+    source.Update()
+    empty = vtkImageData()
+    empty.DeepCopy(source.GetOutput())
+    empty.GetPointData().GetScalars().Fill(0.0)
+    return empty
+
+
+# --- error metrics ----------------------------------------------------------------------------
+
+def error_metrics(image, reference):
+    difference = image.astype(np.float64) - reference.astype(np.float64)
+    rmse = float(np.sqrt(np.mean(difference ** 2)))
+    relative_l1 = float(np.sum(np.abs(difference)) / max(np.sum(np.abs(reference)), 1e-30))
+    max_abs = float(np.max(np.abs(difference)))
+    peak = float(np.max(reference))
+    psnr = float(20.0 * math.log10(peak / rmse)) if rmse > 0 and peak > 0 else float("inf")
+    return {"rmse": rmse, "relative_l1": relative_l1, "max_abs": max_abs, "psnr_db": psnr}
+
+
+# --- renderers --------------------------------------------------------------------------------
+
+class ReferenceModeRenderer:
+    """Nimbus's own reference renderers at lower quality (their own trade curve)."""
+
+    def __init__(self, scene_path, mode):
+        self.scene_path = scene_path
+        self.mode = mode
+
+    def render(self, settings):
+        merged = dict(REFERENCE_SETTINGS[self.mode])
+        merged.update(settings)
+        merged["mode"] = self.mode
+        image, _ = render_reference_mode(self.scene_path, merged)
+        return image
+
+    def close(self):
+        pass
+
+
+class VtkGpuRenderer:
+    """VTK's vtkGPUVolumeRayCastMapper with the scene mapped as faithfully as it allows.
+
+    - Extinction: opacity over the unit distance u (one grid spacing) is
+      1 - exp(-sigma_t * density * u) (Beer-Lambert), sampled at 32 densities.
+    - Colour: the single-scattering albedo (grey).
+    - Sun: a directional light whose colour and intensity are the direct sun at the
+      cloud's centre after the atmosphere (vtkNimbusSunlight, no white balance),
+      scaled so that a white Lambertian surface facing it has radiance E/pi.
+    - Sky light: VTK's ambient term, set to the mean radiance of the sky-only
+      reference (the scene rendered with zero density) in the upper half of the image.
+    - Background: VTK has no sky, so its cloud (RGBA, premultiplied) is composited
+      over the sky-only reference image.
+    - "shading": absorption (no lighting: emission = albedo x ambient), gradient
+      (Phong on the density gradient), volumetric (VTK's volumetric scattering,
+      blending 1, GlobalIlluminationReach = "reach", anisotropy = the cloud's first
+      phase component's g).
+    """
+
+    def __init__(self, scene_path, sky_image):
+        from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkLight,
+                                                 vtkRenderWindow, vtkRenderer, vtkVolume,
+                                                 vtkVolumeProperty, vtkWindowToImageFilter)
+        from vtkmodules.vtkRenderingVolumeOpenGL2 import vtkOpenGLGPUVolumeRayCastMapper
+        import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
+
+        scene = load_scene(scene_path)
+        self.scene = scene
+        self.sky = sky_image
+        density = nimbus.vtkNimbusSceneDensitySource()
+        density.SetSceneFileName(scene_path)
+        density.Update()
+        volume_data = density.GetOutput()
+        self.spacing = min(volume_data.GetSpacing())
+        medium = scene["medium"]
+        sigma_per_density = medium.get("extinction_per_density", 0.02)
+        albedo = medium.get("single_scattering_albedo", 0.99)
+        max_density = max(volume_data.GetPointData().GetScalars().GetRange()[1], 1e-6)
+
+        opacity = vtkPiecewiseFunction()
+        for i in range(33):
+            rho = max_density * i / 32.0
+            opacity.AddPoint(rho, 1.0 - math.exp(-sigma_per_density * rho * self.spacing))
+        color = vtkColorTransferFunction()
+        color.AddRGBPoint(0.0, albedo, albedo, albedo)
+        color.AddRGBPoint(max_density, albedo, albedo, albedo)
+
+        self.property = vtkVolumeProperty()
+        self.property.SetScalarOpacity(opacity)
+        self.property.SetColor(color)
+        self.property.SetScalarOpacityUnitDistance(self.spacing)
+        self.property.SetInterpolationTypeToLinear()
+        phase = medium.get("phase", [{}])
+        phase = phase if isinstance(phase, list) else [phase]
+        self.g = float(phase[0].get("g", 0.0))
+
+        self.mapper = vtkOpenGLGPUVolumeRayCastMapper()
+        self.mapper.SetInputConnection(density.GetOutputPort())
+        self.mapper.AutoAdjustSampleDistancesOff()
+        self.volume = vtkVolume()
+        self.volume.SetMapper(self.mapper)
+        self.volume.SetProperty(self.property)
+
+        # Sun after the atmosphere at the cloud's centre.
+        bounds = volume_data.GetBounds()
+        centre_z = 0.5 * (bounds[4] + bounds[5])
+        sun = scene["sun"]
+        atmosphere = scene.get("atmosphere", {})
+        sunlight = nimbus.vtkNimbusSunlight()
+        sunlight.WhiteBalanceOff()
+        if "direction" in sun:
+            dx, dy, dz = sun["direction"]
+            norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+            sunlight.SetSunElevation(math.degrees(math.asin(dz / norm)))
+            sunlight.SetSunAzimuth(math.degrees(math.atan2(dx, dy)))
+        else:
+            sunlight.SetSunElevation(sun["elevation"])
+            sunlight.SetSunAzimuth(sun.get("azimuth", 0.0))
+        sunlight.SetObserverAltitude(atmosphere.get("scene_altitude", 0.0) + centre_z)
+        rgb = [0.0, 0.0, 0.0]
+        if atmosphere.get("enabled", True):
+            sunlight.GetColor(rgb)
+        else:
+            rgb = [1.0, 1.0, 1.0]  # no atmosphere: the sun as it is (white by construction)
+        illuminance = sun.get("illuminance", 1.0)
+        rgb = [c * illuminance * VTK_SCALE / math.pi for c in rgb]
+        self.light = vtkLight()
+        sunlight.ApplyToLight(self.light)  # direction
+        brightest = max(rgb)
+        if brightest > 0:
+            self.light.SetColor(*[c / brightest for c in rgb])
+        self.light.SetIntensity(brightest)
+        height = sky_image.shape[0]
+        sky_mean = sky_image[height // 2:].reshape(-1, 3).mean(axis=0) * VTK_SCALE
+        self.light.SetAmbientColor(*[float(min(1.0, c)) for c in sky_mean])
+
+        self.renderer = vtkRenderer()
+        self.renderer.AddVolume(self.volume)
+        self.renderer.AddLight(self.light)
+        self.renderer.SetBackground(0.0, 0.0, 0.0)
+        self.renderer.SetBackgroundAlpha(0.0)
+        camera_description = scene["camera"]
+        camera = self.renderer.GetActiveCamera()
+        camera.SetPosition(*camera_description["position"])
+        camera.SetFocalPoint(*camera_description["focal_point"])
+        camera.SetViewUp(*camera_description.get("view_up", [0, 0, 1]))
+        camera.SetViewAngle(camera_description.get("view_angle", 30.0))
+        self.renderer.ResetCameraClippingRange()
+
+        self.window = vtkRenderWindow()
+        self.window.SetOffScreenRendering(1)
+        self.window.SetAlphaBitPlanes(1)
+        self.window.SetMultiSamples(0)
+        self.window.SetSize(camera_description["width"], camera_description["height"])
+        self.window.AddRenderer(self.renderer)
+        self.capture_class = vtkWindowToImageFilter
+
+    def render(self, settings):
+        shading = settings.get("shading", "gradient")
+        self.mapper.SetSampleDistance(float(settings.get("sample_distance", 0.5) * self.spacing))
+        self.property.SetShade(shading != "absorption")
+        self.property.SetAmbient(1.0)
+        self.property.SetDiffuse(0.0 if shading == "absorption" else 1.0)
+        self.property.SetSpecular(0.0)
+        if shading == "volumetric":
+            self.mapper.SetVolumetricScatteringBlending(1.0)
+            self.mapper.SetGlobalIlluminationReach(float(settings.get("reach", 0.5)))
+            self.property.SetScatteringAnisotropy(float(settings.get("g", self.g)))
+        else:
+            self.mapper.SetVolumetricScatteringBlending(0.0)
+            self.mapper.SetGlobalIlluminationReach(0.0)
+        self.window.Render()
+        capture = self.capture_class()
+        capture.SetInput(self.window)
+        capture.SetInputBufferTypeToRGBA()
+        capture.ReadFrontBufferOff()
+        capture.Update()
+        image = capture.GetOutput()
+        width, height, _ = image.GetDimensions()
+        rgba = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, 4)
+        rgba = rgba.astype(np.float32) / 255.0
+        cloud = rgba[..., :3] / VTK_SCALE  # back to the scene's linear radiance units
+        alpha = rgba[..., 3:4]
+        return cloud + (1.0 - alpha) * self.sky
+
+    def close(self):
+        self.window.Finalize()
+
+
+# --- the harness ------------------------------------------------------------------------------
+
+def setting_label(settings):
+    return ", ".join(f"{key}={value}" for key, value in settings.items())
+
+
+def measure(renderer, settings, repeats):
+    times = []
+    image = None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        image = renderer.render(settings)
+        times.append(time.perf_counter() - start)
+    return image, statistics.median(times)
+
+
+def pareto_front(rows):
+    """Rows no other row beats in both time and RMSE, sorted by time."""
+    front = []
+    for row in sorted(rows, key=lambda r: (r["median_seconds"], r["rmse"])):
+        if not front or row["rmse"] < front[-1]["rmse"]:
+            front.append(row)
+    return front
+
+
+def plot(rows, title, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axis = plt.subplots(figsize=(7, 4.5), dpi=100)
+    for renderer in sorted({row["renderer"] for row in rows}):
+        mine = [row for row in rows if row["renderer"] == renderer]
+        axis.scatter([r["median_seconds"] for r in mine], [r["rmse"] for r in mine],
+                     label=renderer, s=20)
+        front = pareto_front(mine)
+        axis.plot([r["median_seconds"] for r in front], [r["rmse"] for r in front], "-",
+                  linewidth=1)
+    axis.set_xscale("log")
+    axis.set_yscale("log")
+    axis.set_xlabel("render time (s, median)")
+    axis.set_ylabel("RMSE vs reference (linear radiance)")
+    axis.set_title(title)
+    axis.grid(True, which="both", linewidth=0.3)
+    axis.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path)
+    plt.close(figure)
+
+
+def write_png(image, path):
+    """Tone-mapped PNG of a linear image (DISPLAY_EXPOSURE, clip, sRGB), like nimbus-render."""
+    encoded = np.clip(image * DISPLAY_EXPOSURE, 0.0, 1.0)
+    encoded = np.where(encoded <= 0.0031308, 12.92 * encoded,
+                       1.055 * np.power(encoded, 1.0 / 2.4) - 0.055)
+    height, width, _ = image.shape
+    data = vtkImageData()
+    data.SetDimensions(width, height, 1)
+    pixels = numpy_to_vtk((encoded.reshape(-1, 3) * 255.0 + 0.5).astype(np.uint8), deep=True)
+    data.GetPointData().SetScalars(pixels)
+    writer = vtkPNGWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(data)
+    writer.Write()
+
+
+def run(arguments):
+    parser = argparse.ArgumentParser(prog="python3 -m nimbus.harness", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scenes", nargs="+", help="scene files (JSON)")
+    parser.add_argument("--renderer", action="append", choices=sorted(DEFAULT_SETTINGS),
+                        help="renderer(s) to measure (default: vtk-gpu)")
+    parser.add_argument("--settings", help="JSON file: a list of settings (one renderer only)")
+    parser.add_argument("--reference", choices=sorted(REFERENCE_SETTINGS), default="single",
+                        help="the ground truth: converged single scattering (default; what the "
+                             "fast renderers implement) or Monte Carlo path tracing (full "
+                             "multiple scattering; 1%% RMSE takes hours here, see docs)")
+    parser.add_argument("--repeats", type=int, default=3, help="renders per setting (median)")
+    parser.add_argument("--output-dir", default="harness-output")
+    parser.add_argument("--cache-dir", default=None,
+                        help="reference cache (default: OUTPUT_DIR/reference-cache)")
+    parser.add_argument("--markdown", help="also write the table as Markdown to this file")
+    args = parser.parse_args(arguments)
+    renderers = args.renderer or ["vtk-gpu"]
+    if args.settings and len(renderers) != 1:
+        parser.error("--settings needs exactly one --renderer")
+    if args.repeats < 1:
+        parser.error("--repeats must be >= 1")
+    cache_dir = args.cache_dir or os.path.join(args.output_dir, "reference-cache")
+    os.makedirs(args.output_dir, exist_ok=True)
+
+    all_rows = []
+    for scene_path in args.scenes:
+        scene_path = os.path.abspath(scene_path)
+        scene_name = os.path.splitext(os.path.basename(scene_path))[0]
+        reference_settings = REFERENCE_SETTINGS[args.reference]
+        key = scene_hash(scene_path, reference_settings)
+
+        def compute_reference():
+            image, output = render_reference_mode(scene_path, reference_settings)
+            error = output.GetFieldData().GetArray("EstimatedRelativeError").GetValue(0)
+            seconds = output.GetFieldData().GetArray("RenderSeconds").GetValue(0)
+            print(f"{scene_name}: reference ({args.reference}) rendered in {seconds:.1f} s, "
+                  f"estimated relative error {error:.2e}", flush=True)
+            return image
+
+        reference, cached = cached_image(cache_dir, f"{scene_name}-{args.reference}-{key}",
+                                         compute_reference)
+        if cached:
+            print(f"{scene_name}: reference ({args.reference}) from the cache", flush=True)
+        write_png(reference, os.path.join(args.output_dir, f"{scene_name}-reference.png"))
+
+        scene_rows = []
+        for renderer_name in renderers:
+            if args.settings:
+                with open(args.settings) as stream:
+                    settings_list = json.load(stream)
+            else:
+                settings_list = DEFAULT_SETTINGS[renderer_name]
+            if renderer_name == "vtk-gpu":
+                sky_key = scene_hash(scene_path, {"sky_only": reference_settings})
+
+                def compute_sky():
+                    image, _ = render_reference_mode(scene_path, reference_settings,
+                                                     density=zero_density(scene_path))
+                    return image
+
+                sky, _ = cached_image(cache_dir, f"{scene_name}-sky-{args.reference}-{sky_key}",
+                                      compute_sky)
+                renderer = VtkGpuRenderer(scene_path, sky)
+            else:
+                renderer = ReferenceModeRenderer(scene_path, renderer_name)
+            try:
+                for index, settings in enumerate(settings_list):
+                    image, seconds = measure(renderer, settings, args.repeats)
+                    row = {"scene": scene_name, "renderer": renderer_name,
+                           "setting": setting_label(settings),
+                           "settings_json": json.dumps(settings, sort_keys=True),
+                           "median_seconds": seconds, "reference": args.reference}
+                    row.update(error_metrics(image, reference))
+                    scene_rows.append(row)
+                    print(f"{scene_name} {renderer_name} [{row['setting']}]: "
+                          f"{seconds:.3f} s, RMSE {row['rmse']:.4g}, "
+                          f"PSNR {row['psnr_db']:.1f} dB", flush=True)
+                    write_png(image, os.path.join(
+                        args.output_dir, f"{scene_name}-{renderer_name}-{index}.png"))
+            finally:
+                renderer.close()
+        plot(scene_rows, f"{scene_name} (reference: {args.reference})",
+             os.path.join(args.output_dir, f"{scene_name}-trade.png"))
+        all_rows.extend(scene_rows)
+
+    fields = ["scene", "renderer", "setting", "median_seconds", "rmse", "relative_l1",
+              "max_abs", "psnr_db", "reference", "settings_json"]
+    csv_path = os.path.join(args.output_dir, "trade.csv")
+    with open(csv_path, "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=fields)
+        writer.writeheader()
+        writer.writerows(all_rows)
+    plot(all_rows, f"all scenes (reference: {args.reference})",
+         os.path.join(args.output_dir, "trade.png"))
+    if args.markdown:
+        with open(args.markdown, "w") as stream:
+            stream.write("| scene | renderer | setting | median time (s) | RMSE | rel. L1 | "
+                         "max abs | PSNR (dB) |\n|---|---|---|---|---|---|---|---|\n")
+            for row in all_rows:
+                stream.write(f"| {row['scene']} | {row['renderer']} | {row['setting']} | "
+                             f"{row['median_seconds']:.3f} | {row['rmse']:.4g} | "
+                             f"{row['relative_l1']:.3f} | {row['max_abs']:.3g} | "
+                             f"{row['psnr_db']:.1f} |\n")
+    print(csv_path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run(sys.argv[1:]))

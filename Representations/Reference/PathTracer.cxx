@@ -1,0 +1,1137 @@
+#include "PathTracer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace nimbus
+{
+
+namespace
+{
+using Vector3 = std::array<double, 3>;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+/// Voxels per macro cell edge of the cloud majorant grid.
+constexpr int kMacroCellVoxels = 4;
+/// Ratio tracking plays Russian roulette once its transmittance falls below this.
+constexpr double kRatioTrackingRouletteThreshold = 0.1;
+
+double Dot(const Vector3& a, const Vector3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+Vector3 Along(const Vector3& o, const Vector3& d, double t)
+{
+  return { { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] } };
+}
+
+//------------------------------------------------------------------------------
+// Counter-based random numbers: SplitMix64 (Steele, Lea & Flood, "Fast Splittable
+// Pseudorandom Number Generators", OOPSLA 2014). The stream of one path starts at
+// a hash of (seed, pixel, sample), so what a path draws depends on nothing else.
+std::uint64_t SplitMixFinalize(std::uint64_t z)
+{
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ull;
+
+class PathRandom
+{
+public:
+  PathRandom(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
+  {
+    std::uint64_t h = SplitMixFinalize(seed + kGolden);
+    h = SplitMixFinalize(h ^ (pixel + 2 * kGolden));
+    h = SplitMixFinalize(h ^ (sample + 3 * kGolden));
+    this->State = h;
+  }
+  std::uint64_t Next()
+  {
+    this->State += kGolden;
+    return SplitMixFinalize(this->State);
+  }
+  /// Uniform in [0, 1): the top 53 bits.
+  double Uniform() { return static_cast<double>(this->Next() >> 11) * 0x1.0p-53; }
+
+private:
+  std::uint64_t State;
+};
+
+//------------------------------------------------------------------------------
+/// Coarse majorant grid of the cloud: sigma_bar per block of kMacroCellVoxels^3
+/// voxels, the maximum over the block's grid points dilated by one point on every
+/// side. Trilinear interpolation never exceeds the corner values, so the value
+/// bounds sigma_t over the block and over one voxel around it (margin for pieces
+/// whose end points round across a block face).
+struct MacroGrid
+{
+  std::array<int, 3> Cells{ { 0, 0, 0 } };
+  Vector3 Lower{ { 0, 0, 0 } };
+  Vector3 CellSize{ { 1, 1, 1 } };
+  std::vector<double> Majorant; // 1/m
+
+  void Build(const DensityGrid& grid, double extinctionPerDensity)
+  {
+    const std::array<int, 3>& n = grid.GetDimensions();
+    std::array<std::vector<std::pair<int, int>>, 3> ranges; // point range per cell
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Lower[a] = grid.GetLower()[a];
+      if (n[a] == 1)
+      {
+        this->Cells[a] = 1;
+        this->CellSize[a] = grid.GetUpper()[a] - grid.GetLower()[a];
+        ranges[a].push_back({ 0, 0 });
+        continue;
+      }
+      const int voxels = n[a] - 1;
+      this->Cells[a] = (voxels + kMacroCellVoxels - 1) / kMacroCellVoxels;
+      this->CellSize[a] = kMacroCellVoxels * grid.GetSpacing()[a];
+      for (int c = 0; c < this->Cells[a]; ++c)
+      {
+        ranges[a].push_back({ std::max(0, c * kMacroCellVoxels - 1),
+          std::min(n[a] - 1, (c + 1) * kMacroCellVoxels + 1) });
+      }
+    }
+    // Separable running maximum: x, then y, then z.
+    const std::vector<float>& f = grid.GetValues();
+    const int cx = this->Cells[0], cy = this->Cells[1], cz = this->Cells[2];
+    std::vector<float> ax(static_cast<std::size_t>(cx) * n[1] * n[2], 0.0f);
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < n[1]; ++j)
+        for (int c = 0; c < cx; ++c)
+        {
+          float m = 0.0f;
+          for (int i = ranges[0][c].first; i <= ranges[0][c].second; ++i)
+            m = std::max(m, f[i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k)]);
+          ax[c + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)] = m;
+        }
+    std::vector<float> axy(static_cast<std::size_t>(cx) * cy * n[2], 0.0f);
+    for (int k = 0; k < n[2]; ++k)
+      for (int c = 0; c < cy; ++c)
+        for (int i = 0; i < cx; ++i)
+        {
+          float m = 0.0f;
+          for (int j = ranges[1][c].first; j <= ranges[1][c].second; ++j)
+            m = std::max(m, ax[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)]);
+          axy[i + static_cast<std::size_t>(cx) * (c + static_cast<std::size_t>(cy) * k)] = m;
+        }
+    this->Majorant.assign(static_cast<std::size_t>(cx) * cy * cz, 0.0);
+    for (int c = 0; c < cz; ++c)
+      for (int j = 0; j < cy; ++j)
+        for (int i = 0; i < cx; ++i)
+        {
+          float m = 0.0f;
+          for (int k = ranges[2][c].first; k <= ranges[2][c].second; ++k)
+            m = std::max(m, axy[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * k)]);
+          this->Majorant[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * c)] =
+            extinctionPerDensity * static_cast<double>(m);
+        }
+  }
+};
+
+/// The atmosphere's optical lengths toward the sun, L_R and L_M (Atmosphere.h),
+/// depend on a point only through r = |q| and mu_s = dot(q, s)/r (spherical
+/// symmetry). Over the cloud box both vary little, so they are tabulated there on
+/// a (r, mu_s) lattice of exact values and interpolated bilinearly; the table is
+/// kept only if the interpolation error of T(lambda) at every cell centre and edge
+/// midpoint is below kSunTableTolerance (relative), else (e.g. a grazing or
+/// setting sun) every point is evaluated exactly. Points outside the table are
+/// evaluated exactly.
+constexpr double kSunTableTolerance = 1e-6;
+
+struct SunTable
+{
+  bool Valid = false;
+  int NR = 0, NMu = 0;
+  double R0 = 0.0, DR = 1.0, Mu0 = 0.0, DMu = 1.0;
+  std::vector<double> LR, LM; // [j * NR + i]
+
+  bool Lookup(double r, double mu, double& lR, double& lM) const
+  {
+    if (!this->Valid)
+    {
+      return false;
+    }
+    const double x = (r - this->R0) / this->DR, y = (mu - this->Mu0) / this->DMu;
+    if (!(x >= 0.0 && x <= this->NR - 1 && y >= 0.0 && y <= this->NMu - 1))
+    {
+      return false;
+    }
+    const int i = std::min(this->NR - 2, static_cast<int>(x));
+    const int j = std::min(this->NMu - 2, static_cast<int>(y));
+    const double fx = x - i, fy = y - j;
+    const std::size_t k = static_cast<std::size_t>(j) * this->NR + i;
+    auto bilinear = [&](const std::vector<double>& v) {
+      const double a = v[k] + fx * (v[k + 1] - v[k]);
+      const double b = v[k + this->NR] + fx * (v[k + this->NR + 1] - v[k + this->NR]);
+      return a + fy * (b - a);
+    };
+    lR = bilinear(this->LR);
+    lM = bilinear(this->LM);
+    return true;
+  }
+};
+
+/// A ray with what its majorant pieces need.
+struct Ray
+{
+  Vector3 Origin;
+  Vector3 Direction;    // unit
+  Vector3 EarthOrigin;  // origin in the earth-centred frame
+  bool CrossesCloud = false;
+  double CloudNear = 0.0, CloudFar = 0.0;
+};
+
+enum class Scatterer
+{
+  None,
+  Cloud,
+  Rayleigh,
+  Mie,
+  Ground
+};
+
+enum class FlightEnd
+{
+  Collision, // real scattering event at the returned t
+  Boundary,  // reached tEnd
+  Absorbed,  // every weight is zero
+  Truncated  // step limit
+};
+
+/// Per-thread scratch and counters.
+struct PathState
+{
+  std::vector<double> Weight;   // spectral throughput
+  std::vector<double> Radiance; // spectral estimate of the path
+  std::vector<double> SunTransmittance;
+  std::uint64_t Steps = 0;
+  bool Truncated = false;
+};
+
+class Integrator
+{
+public:
+  Integrator(const RenderContext& context, const PathTracingSettings& settings)
+    : Context(context)
+    , Settings(settings)
+    , Grid(context.GetGrid())
+    , Air(context.GetAtmosphere())
+  {
+    this->Wavelengths = static_cast<int>(context.GetWavelengths().size());
+    this->HasCloud = !this->Grid.IsEmpty() && context.CloudMajorant() > 0.0;
+    if (this->HasCloud)
+    {
+      this->Macro.Build(this->Grid, context.GetScene().Medium.ExtinctionPerDensity);
+      this->MinCellSize = std::min(
+        { this->Macro.CellSize[0], this->Macro.CellSize[1], this->Macro.CellSize[2] });
+    }
+    this->CloudAlbedo = context.GetCloudAlbedo();
+    if (this->Air)
+    {
+      const AtmosphereParameters& a = this->Air->GetParameters();
+      this->EarthRadius = a.earthRadius;
+      this->ScaleHeightR = a.rayleighScaleHeight;
+      this->ScaleHeightM = a.mieScaleHeight;
+      this->MieG = a.mieG;
+      for (double lambda : context.GetWavelengths())
+      {
+        this->BetaR.push_back(this->Air->RayleighScattering(lambda));
+        this->BetaRMax = std::max(this->BetaRMax, this->BetaR.back());
+      }
+      // As RenderContext::AtmosphereCoefficients: Mie at 550 nm (grey).
+      this->BetaMs = this->Air->MieScattering(550.0);
+      this->BetaMt = this->Air->MieExtinction(550.0);
+      if (this->HasCloud)
+      {
+        // Lowest altitude of the box: distance from the earth centre to the box.
+        // The earth centre in the scene frame is -EarthCentred(0).
+        const Vector3 origin = this->Context.EarthCentred({ { 0.0, 0.0, 0.0 } });
+        double r2 = 0.0;
+        for (int a = 0; a < 3; ++a)
+        {
+          const double c = -origin[a];
+          const double nearest = std::min(this->Grid.GetUpper()[a], std::max(this->Grid.GetLower()[a], c));
+          r2 += (nearest - c) * (nearest - c);
+        }
+        this->CloudBoxMinRadius = std::sqrt(r2);
+        this->AirMajorantInCloudBox = this->AirMajorantAt(this->CloudBoxMinRadius - this->EarthRadius);
+      }
+    }
+    else
+    {
+      this->BetaR.assign(this->Wavelengths, 0.0);
+    }
+    this->Sun = context.GetSunDirection();
+    this->SunIrradiance = context.GetSunIrradiance();
+    this->SunOn = std::any_of(
+      this->SunIrradiance.begin(), this->SunIrradiance.end(), [](double e) { return e > 0.0; });
+    this->Background = context.GetBackgroundRadiance();
+    // ToLinearSrgb is linear in the spectrum: tabulate it once (3 x N matrix).
+    std::vector<double> unit(this->Wavelengths, 0.0);
+    this->ToRgb.resize(3 * static_cast<std::size_t>(this->Wavelengths));
+    for (int i = 0; i < this->Wavelengths; ++i)
+    {
+      unit.assign(this->Wavelengths, 0.0);
+      unit[i] = 1.0;
+      const std::array<double, 3> rgb = context.ToLinearSrgb(unit);
+      for (int c = 0; c < 3; ++c)
+      {
+        this->ToRgb[c * this->Wavelengths + i] = rgb[c];
+      }
+    }
+    if (this->Air && this->HasCloud && this->SunOn)
+    {
+      this->BuildSunTable();
+    }
+  }
+
+  int GetWavelengths() const { return this->Wavelengths; }
+
+  void BuildSunTable();
+
+  /// One camera path through image point (x, y); the spectral estimate goes to
+  /// state.Radiance, its linear sRGB to rgb.
+  void TracePath(double x, double y, PathRandom& rng, PathState& state, double rgb[3]) const;
+
+private:
+  Ray MakeRay(const Vector3& origin, const Vector3& direction) const
+  {
+    Ray ray;
+    ray.Origin = origin;
+    ray.Direction = direction;
+    ray.EarthOrigin = this->Air ? this->Context.EarthCentred(origin) : origin;
+    if (this->HasCloud)
+    {
+      ray.CrossesCloud =
+        this->Grid.IntersectRay(origin, direction, 0.0, ray.CloudNear, ray.CloudFar);
+    }
+    return ray;
+  }
+
+  /// End of the majorant piece that starts at t (<= tEnd) and its majorant, 1/m
+  /// (returned, and split into its cloud and atmosphere parts).
+  double Piece(const Ray& ray, double t, double tEnd, bool withAir, double& tNext,
+    double& cloudMajorant, double& airMajorant) const;
+  /// Largest atmosphere extinction over all wavelengths at an altitude, 1/m.
+  double AirMajorantAt(double altitude) const
+  {
+    return this->BetaRMax * this->Air->Density(altitude, this->ScaleHeightR) +
+      this->BetaMt * this->Air->Density(altitude, this->ScaleHeightM);
+  }
+  /// Delta tracking (spectral tracking) from t = 0 to tEnd.
+  FlightEnd FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, PathState& state, double& t,
+    Scatterer& scatterer) const;
+  /// Cloud transmittance from p toward the sun by ratio tracking (unbiased).
+  double CloudTransmittance(const Vector3& p, const Vector3& direction, PathRandom& rng,
+    PathState& state) const;
+  /// Adds the sun's single-scattered contribution at p (next-event estimation).
+  void SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
+    PathState& state) const;
+
+  const RenderContext& Context;
+  const PathTracingSettings& Settings;
+  const DensityGrid& Grid;
+  const Atmosphere* Air;
+  int Wavelengths = 0;
+  bool HasCloud = false;
+  MacroGrid Macro;
+  double MinCellSize = 1.0;
+  double CloudAlbedo = 1.0;
+  double EarthRadius = 0.0, ScaleHeightR = 1.0, ScaleHeightM = 1.0, MieG = 0.0;
+  std::vector<double> BetaR; // Rayleigh scattering = extinction at sea level, 1/m
+  double BetaRMax = 0.0;
+  double BetaMs = 0.0, BetaMt = 0.0; // Mie scattering / extinction at sea level, 1/m
+  double AirMajorantInCloudBox = 0.0; // at the box's lowest altitude, 1/m
+  double CloudBoxMinRadius = 0.0;     // distance from the earth centre to the box, m
+  SunTable SunLengths;
+  Vector3 Sun;
+  std::vector<double> SunIrradiance;
+  bool SunOn = false;
+  std::vector<double> Background;
+  std::vector<double> ToRgb;
+};
+
+void Integrator::BuildSunTable()
+{
+  const Vector3& sun = this->Sun;
+  // Ranges of r and mu_s over the box: from the corners and the box's lowest
+  // point, mu_s widened by 5 % (points that still fall outside are evaluated
+  // exactly).
+  double rLo = kInfinity, rHi = 0.0, muLo = kInfinity, muHi = -kInfinity;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const Vector3 p{ { (corner & 1) ? this->Grid.GetUpper()[0] : this->Grid.GetLower()[0],
+      (corner & 2) ? this->Grid.GetUpper()[1] : this->Grid.GetLower()[1],
+      (corner & 4) ? this->Grid.GetUpper()[2] : this->Grid.GetLower()[2] } };
+    const Vector3 q = this->Context.EarthCentred(p);
+    const double r = std::sqrt(Dot(q, q));
+    rLo = std::min(rLo, r);
+    rHi = std::max(rHi, r);
+    muLo = std::min(muLo, Dot(q, sun) / r);
+    muHi = std::max(muHi, Dot(q, sun) / r);
+  }
+  rLo = std::min(rLo, this->CloudBoxMinRadius) - 1.0; // the lowest point need not be a corner
+  rHi += 1.0;
+  const double muPad = 0.05 * (muHi - muLo) + 1e-9;
+  muLo = std::max(-1.0, muLo - muPad);
+  muHi = std::min(1.0, muHi + muPad);
+  // Any unit vector perpendicular to the sun direction.
+  const Vector3 helper = std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
+  Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
+    sun[0] * helper[1] - sun[1] * helper[0] } };
+  const double perpLength = std::sqrt(Dot(perp, perp));
+  for (double& c : perp)
+  {
+    c /= perpLength;
+  }
+  auto exact = [&](double r, double mu, double& lR, double& lM) {
+    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]), r * (mu * sun[1] + sinTheta * perp[1]),
+      r * (mu * sun[2] + sinTheta * perp[2]) } };
+    const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
+    lR = lengths.rayleighLength;
+    lM = lengths.mieLength;
+    return !lengths.hitsGround;
+  };
+  const double betaMax = std::max(this->BetaRMax, this->BetaMt);
+  for (int nR = 17; nR <= 257; nR = 2 * nR - 1)
+  {
+    SunTable table;
+    table.NR = nR;
+    table.NMu = 5;
+    table.R0 = rLo;
+    table.DR = (rHi - rLo) / (nR - 1);
+    table.Mu0 = muLo;
+    table.DMu = (muHi - muLo) / (table.NMu - 1);
+    table.LR.resize(static_cast<std::size_t>(nR) * table.NMu);
+    table.LM.resize(table.LR.size());
+    bool ok = true;
+    for (int j = 0; j < table.NMu && ok; ++j)
+      for (int i = 0; i < nR && ok; ++i)
+      {
+        const std::size_t k = static_cast<std::size_t>(j) * nR + i;
+        ok = exact(rLo + i * table.DR, muLo + j * table.DMu, table.LR[k], table.LM[k]);
+      }
+    if (!ok)
+    {
+      return; // the earth hides the sun somewhere here: exact everywhere
+    }
+    table.Valid = true;
+    double worst = 0.0;
+    for (int j = 0; j < 2 * table.NMu - 1 && ok; ++j)
+      for (int i = 0; i < 2 * nR - 1 && ok; ++i)
+      {
+        if (i % 2 == 0 && j % 2 == 0)
+        {
+          continue; // a node
+        }
+        const double r = rLo + 0.5 * i * table.DR, mu = muLo + 0.5 * j * table.DMu;
+        double lR, lM, tR = 0.0, tM = 0.0;
+        ok = exact(r, mu, lR, lM) && table.Lookup(r, mu, tR, tM);
+        // |delta ln T(lambda)| <= beta_max (|delta L_R| + |delta L_M|).
+        worst = std::max(worst, betaMax * (std::abs(tR - lR) + std::abs(tM - lM)));
+      }
+    if (!ok)
+    {
+      return;
+    }
+    if (worst < kSunTableTolerance)
+    {
+      this->SunLengths = std::move(table);
+      return;
+    }
+  }
+}
+
+double Integrator::Piece(const Ray& ray, double t, double tEnd, bool withAir, double& tNext,
+  double& cloudMajorant, double& airMajorant) const
+{
+  tNext = tEnd;
+  cloudMajorant = airMajorant = 0.0;
+  bool insideCloudBox = false;
+  if (ray.CrossesCloud)
+  {
+    if (t < ray.CloudNear)
+    {
+      tNext = std::min(tNext, ray.CloudNear);
+    }
+    else if (t < ray.CloudFar)
+    {
+      insideCloudBox = true;
+      // Macro cell containing the piece's start, nudged forward so that a start on
+      // a cell face selects the cell ahead (the dilation covers the rest).
+      const Vector3 p = Along(ray.Origin, ray.Direction, t + 1e-9 * this->MinCellSize);
+      double exit = ray.CloudFar;
+      std::size_t index = 0, stride = 1;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double size = this->Macro.CellSize[a];
+        const int c = std::min(this->Macro.Cells[a] - 1,
+          std::max(0, static_cast<int>(std::floor((p[a] - this->Macro.Lower[a]) / size))));
+        const double d = ray.Direction[a];
+        if (d > 0.0)
+        {
+          exit = std::min(exit, (this->Macro.Lower[a] + (c + 1) * size - ray.Origin[a]) / d);
+        }
+        else if (d < 0.0)
+        {
+          exit = std::min(exit, (this->Macro.Lower[a] + c * size - ray.Origin[a]) / d);
+        }
+        index += stride * static_cast<std::size_t>(c);
+        stride *= static_cast<std::size_t>(this->Macro.Cells[a]);
+      }
+      cloudMajorant = this->Macro.Majorant[index];
+      tNext = std::min(tNext, exit);
+    }
+  }
+  if (withAir && this->Air)
+  {
+    if (insideCloudBox)
+    {
+      // One atmosphere majorant for the whole cloud box (at its lowest altitude):
+      // small next to the cloud's, and it saves two exponentials per piece.
+      airMajorant = this->AirMajorantInCloudBox;
+    }
+    else
+    {
+      // Piece length: the altitude may change by about a quarter of the smaller
+      // scale height plus half the altitude (density is negligible high up, so
+      // pieces grow there), between 50 m and 50 km.
+      const Vector3 q = Along(ray.EarthOrigin, ray.Direction, t);
+      const double r = std::sqrt(Dot(q, q));
+      const double h = r - this->EarthRadius;
+      const double slope = std::abs(Dot(q, ray.Direction)) / r; // |dh/dt|
+      const double dh =
+        0.25 * std::min(this->ScaleHeightR, this->ScaleHeightM) + 0.5 * std::max(0.0, h);
+      const double length = std::min(5.0e4, std::max(50.0, dh / std::max(slope, 1e-6)));
+      tNext = std::min(tNext, t + length);
+      // Density decreases with altitude, and the altitude along a line is lowest at
+      // the closest approach to the earth centre: clamp it to the piece.
+      const double tLow = std::min(tNext, std::max(t, -Dot(ray.EarthOrigin, ray.Direction)));
+      const Vector3 qLow = Along(ray.EarthOrigin, ray.Direction, tLow);
+      airMajorant = this->AirMajorantAt(std::sqrt(Dot(qLow, qLow)) - this->EarthRadius);
+    }
+  }
+  if (!(tNext > t))
+  {
+    tNext = t + 1e-9 * this->MinCellSize + 1e-12 * std::abs(t); // guarantee progress
+  }
+  return cloudMajorant + airMajorant;
+}
+
+FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, PathState& state,
+  double& t, Scatterer& scatterer) const
+{
+  const int n = this->Wavelengths;
+  std::vector<double>& w = state.Weight;
+  t = 0.0;
+  for (;;)
+  {
+    // Sample the optical distance tau ~ Exp(1) against the piecewise majorant.
+    double tau = -std::log(1.0 - rng.Uniform());
+    double majorant = 0.0, cloudMajorant = 0.0, airMajorant = 0.0;
+    for (;;)
+    {
+      if (t >= tEnd)
+      {
+        return FlightEnd::Boundary;
+      }
+      double tNext;
+      majorant = this->Piece(ray, t, tEnd, true, tNext, cloudMajorant, airMajorant);
+      if (majorant > 0.0 && majorant * (tNext - t) > tau)
+      {
+        t += tau / majorant;
+        break;
+      }
+      if (majorant > 0.0)
+      {
+        tau -= majorant * (tNext - t);
+      }
+      t = tNext;
+    }
+    if (++state.Steps > kMaxTrackingStepsPerPath)
+    {
+      state.Truncated = true;
+      return FlightEnd::Truncated;
+    }
+    // Tentative collision at x_t. The majorant is a sum of a cloud and an
+    // atmosphere part, so the null-collision term splits as
+    //   sigma_bar - sigma_t = (sigma_bar_c - sigma_c) + (sigma_bar_a - sigma_a(lambda)):
+    // the collision is charged to the cloud with probability sigma_bar_c/sigma_bar
+    // (only its density is looked up), else to the atmosphere. Within a part,
+    // spectral tracking (Kutz et al. 2017, Eqs. 14-17, history-aware): event x with
+    // P_x = <sigma_x w> / sum_y <sigma_y w> (absorption has no emission and is not
+    // sampled), then w(lambda) *= sigma_x(lambda) / (sigma_bar_part P_x).
+    const Vector3 p = Along(ray.Origin, ray.Direction, t);
+    if (rng.Uniform() * majorant < cloudMajorant)
+    {
+      // Grey: every wavelength gets the same factor.
+      const double sigmaC = this->Context.CloudExtinction(p);
+      const double sigmaCs = this->CloudAlbedo * sigmaC;
+      const double sigmaCn = std::max(0.0, cloudMajorant - sigmaC);
+      const double total = sigmaCs + sigmaCn;
+      if (!(total > 0.0))
+      {
+        return FlightEnd::Absorbed;
+      }
+      const double k = total / cloudMajorant;
+      for (int i = 0; i < n; ++i)
+      {
+        w[i] *= k;
+      }
+      if (rng.Uniform() * total < sigmaCs)
+      {
+        scatterer = Scatterer::Cloud;
+        return FlightEnd::Collision;
+      }
+      continue;
+    }
+    const Vector3 q = Along(ray.EarthOrigin, ray.Direction, t);
+    const double h = this->Air->Altitude(q);
+    const double rhoR = this->Air->Density(h, this->ScaleHeightR);
+    const double rhoM = this->Air->Density(h, this->ScaleHeightM);
+    const double sigmaMs = this->BetaMs * rhoM, sigmaMt = this->BetaMt * rhoM;
+    double sumW = 0.0, aR = 0.0, aN = 0.0;
+    for (int i = 0; i < n; ++i)
+    {
+      const double sigmaR = this->BetaR[i] * rhoR;
+      sumW += w[i];
+      aR += sigmaR * w[i];
+      aN += std::max(0.0, airMajorant - sigmaR - sigmaMt) * w[i];
+    }
+    const double aM = sigmaMs * sumW;
+    // Cumulative sums in one order so that the selection below is consistent.
+    const double cN = aN, cR = cN + aR, total = cR + aM;
+    if (!(total > 0.0))
+    {
+      return FlightEnd::Absorbed;
+    }
+    const double u = rng.Uniform() * total;
+    const double scale = total / airMajorant;
+    if (aN > 0.0 && (u < cN || (aR <= 0.0 && aM <= 0.0)))
+    {
+      const double k = scale / aN;
+      for (int i = 0; i < n; ++i)
+      {
+        w[i] *= std::max(0.0, airMajorant - this->BetaR[i] * rhoR - sigmaMt) * k;
+      }
+      continue;
+    }
+    if (aR > 0.0 && (u < cR || aM <= 0.0))
+    {
+      const double k = scale * rhoR / aR;
+      for (int i = 0; i < n; ++i)
+      {
+        w[i] *= this->BetaR[i] * k;
+      }
+      scatterer = Scatterer::Rayleigh;
+    }
+    else
+    {
+      const double k = scale * sigmaMs / aM;
+      for (int i = 0; i < n; ++i)
+      {
+        w[i] *= k;
+      }
+      scatterer = Scatterer::Mie;
+    }
+    return FlightEnd::Collision;
+  }
+}
+
+double Integrator::CloudTransmittance(
+  const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state) const
+{
+  if (!this->HasCloud)
+  {
+    return 1.0;
+  }
+  Ray ray;
+  ray.Origin = p;
+  ray.Direction = direction;
+  ray.EarthOrigin = p;
+  ray.CrossesCloud = this->Grid.IntersectRay(p, direction, 0.0, ray.CloudNear, ray.CloudFar);
+  if (!ray.CrossesCloud)
+  {
+    return 1.0;
+  }
+  // Ratio tracking (Novak et al. 2014): T = prod (1 - sigma_t(x_i)/sigma_bar)
+  // over the tentative collisions x_i; Russian roulette below the threshold.
+  double transmittance = 1.0;
+  double t = ray.CloudNear;
+  for (;;)
+  {
+    double tau = -std::log(1.0 - rng.Uniform());
+    bool collided = false;
+    double majorant = 0.0, cloudMajorant, airMajorant;
+    while (t < ray.CloudFar)
+    {
+      double tNext;
+      majorant = this->Piece(ray, t, ray.CloudFar, false, tNext, cloudMajorant, airMajorant);
+      if (majorant > 0.0 && majorant * (tNext - t) > tau)
+      {
+        t += tau / majorant;
+        collided = true;
+        break;
+      }
+      if (majorant > 0.0)
+      {
+        tau -= majorant * (tNext - t);
+      }
+      t = tNext;
+    }
+    if (!collided)
+    {
+      return transmittance;
+    }
+    if (++state.Steps > kMaxTrackingStepsPerPath)
+    {
+      state.Truncated = true;
+      return 0.0;
+    }
+    const double sigma = this->Context.CloudExtinction(Along(p, direction, t));
+    transmittance *= std::max(0.0, 1.0 - sigma / majorant);
+    if (transmittance < kRatioTrackingRouletteThreshold)
+    {
+      if (!(transmittance > 0.0) ||
+        rng.Uniform() * kRatioTrackingRouletteThreshold >= transmittance)
+      {
+        return 0.0;
+      }
+      transmittance = kRatioTrackingRouletteThreshold;
+    }
+  }
+}
+
+void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer,
+  PathRandom& rng, PathState& state) const
+{
+  // Radiance toward -d from the sun's irradiance E(lambda) arriving along -s:
+  //   L = f * E * T_cloud * T_atm(lambda),
+  // f = phase function p(mu), mu = dot(-s, -d) = dot(s, d) for a medium event
+  // (sigma_s is in the path weight), f = albedo/pi * cos(theta_s) at the ground.
+  const Vector3& s = this->Sun;
+  double f;
+  const double mu = Dot(s, d);
+  switch (scatterer)
+  {
+    case Scatterer::Cloud:
+      f = this->Context.GetCloudPhase().Evaluate(mu);
+      break;
+    case Scatterer::Rayleigh:
+      f = this->Air->RayleighPhase(mu);
+      break;
+    case Scatterer::Mie:
+      f = this->Air->MiePhase(mu);
+      break;
+    case Scatterer::Ground:
+      f = this->Context.GetGroundAlbedo() / kPi * std::max(0.0, s[2]);
+      break;
+    default:
+      f = 0.0;
+  }
+  if (!(f > 0.0))
+  {
+    return;
+  }
+  // Without atmosphere the ground plane hides a sun below the horizon from points
+  // above it; with the atmosphere the spherical earth decides (inside the sun
+  // transmittance), so twilight still reaches the upper air (the same convention
+  // as SingleScatteringRenderer).
+  if (scatterer != Scatterer::Ground && !this->Air && this->Context.HasGround() && s[2] < 0.0 &&
+    p[2] >= this->Context.GetGroundHeight())
+  {
+    return;
+  }
+  const double cloud = this->CloudTransmittance(p, s, rng, state);
+  if (!(cloud > 0.0))
+  {
+    return;
+  }
+  std::vector<double>& transmittance = state.SunTransmittance;
+  double lR, lM;
+  const Vector3 q = this->Air ? this->Context.EarthCentred(p) : p;
+  const double r = std::sqrt(Dot(q, q));
+  if (this->Air && this->SunLengths.Lookup(r, Dot(q, s) / r, lR, lM))
+  {
+    // tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M (Atmosphere.h).
+    transmittance.resize(this->Wavelengths);
+    for (int i = 0; i < this->Wavelengths; ++i)
+    {
+      transmittance[i] = std::exp(-(this->BetaR[i] * lR + this->BetaMt * lM));
+    }
+  }
+  else
+  {
+    this->Context.SunAtmosphereTransmittance(p, transmittance);
+  }
+  const double k = f * cloud;
+  for (int i = 0; i < this->Wavelengths; ++i)
+  {
+    state.Radiance[i] +=
+      state.Weight[i] * k * this->SunIrradiance[i] * state.SunTransmittance[i];
+  }
+}
+
+void Integrator::TracePath(
+  double x, double y, PathRandom& rng, PathState& state, double rgb[3]) const
+{
+  const int n = this->Wavelengths;
+  state.Weight.assign(n, 1.0);
+  state.Radiance.assign(n, 0.0);
+  state.Steps = 0;
+  state.Truncated = false;
+  const Camera& camera = this->Context.GetCamera();
+  Ray ray = this->MakeRay(camera.GetPosition(), camera.RayDirection(x, y));
+  const int maxOrder = this->Settings.MaxScatteringOrder;
+  const int rouletteOrder = this->Settings.RussianRouletteOrder;
+  for (int order = 0;;)
+  {
+    // Where the ray leaves the scene or meets the ground.
+    const double tGround = this->Context.IntersectGround(ray.Origin, ray.Direction, 0.0);
+    double tEnd = tGround;
+    enum class End
+    {
+      Leaves, // background
+      Ground,
+      Earth // black (the same convention as SingleScatteringRenderer)
+    } endKind = std::isfinite(tGround) ? End::Ground : End::Leaves;
+    if (this->Air)
+    {
+      const double tTop = this->Context.DistanceToTopOfAtmosphere(ray.Origin, ray.Direction);
+      // Earth sphere (reached only with the ground plane disabled or beyond the
+      // plane's hit): the path ends there with no radiance.
+      const Vector3& q = ray.EarthOrigin;
+      const double r = std::sqrt(Dot(q, q));
+      const double c = (r - this->EarthRadius) * (r + this->EarthRadius);
+      const double b = Dot(q, ray.Direction);
+      double tEarth = kInfinity;
+      if (c > 0.0 && b < 0.0 && b * b - c >= 0.0)
+      {
+        tEarth = c / (-b + std::sqrt(b * b - c));
+      }
+      if (tTop < tEnd)
+      {
+        tEnd = tTop;
+        endKind = End::Leaves;
+      }
+      if (tEarth < tEnd)
+      {
+        tEnd = tEarth;
+        endKind = End::Earth;
+      }
+    }
+    double t;
+    Scatterer scatterer = Scatterer::None;
+    const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer);
+    if (end == FlightEnd::Truncated || end == FlightEnd::Absorbed)
+    {
+      break;
+    }
+    Vector3 p;
+    if (end == FlightEnd::Boundary)
+    {
+      if (endKind == End::Earth)
+      {
+        break;
+      }
+      if (endKind == End::Leaves)
+      {
+        for (int i = 0; i < n; ++i)
+        {
+          state.Radiance[i] += state.Weight[i] * this->Background[i];
+        }
+        break;
+      }
+      p = Along(ray.Origin, ray.Direction, tEnd);
+      p[2] = this->Context.GetGroundHeight();
+      scatterer = Scatterer::Ground;
+      if (++state.Steps > kMaxTrackingStepsPerPath)
+      {
+        state.Truncated = true;
+        break;
+      }
+    }
+    else
+    {
+      p = Along(ray.Origin, ray.Direction, t);
+    }
+    ++order;
+    if (this->SunOn)
+    {
+      this->SunNextEvent(p, ray.Direction, scatterer, rng, state);
+      if (state.Truncated)
+      {
+        break;
+      }
+    }
+    if (maxOrder > 0 && order >= maxOrder)
+    {
+      break;
+    }
+    // Next direction.
+    Vector3 direction;
+    auto uniform = [&rng]() { return rng.Uniform(); };
+    switch (scatterer)
+    {
+      case Scatterer::Ground:
+      {
+        // Cosine-weighted hemisphere about +z: pdf cos/pi, so the weight of the
+        // Lambertian BRDF albedo/pi times cos over the pdf is the albedo.
+        const double u1 = rng.Uniform(), u2 = rng.Uniform();
+        const double radius = std::sqrt(u1), phi = 2.0 * kPi * u2;
+        direction = { { radius * std::cos(phi), radius * std::sin(phi),
+          std::sqrt(std::max(0.0, 1.0 - u1)) } };
+        if (!(direction[2] > 0.0))
+        {
+          direction[2] = 1e-12;
+        }
+        const double albedo = this->Context.GetGroundAlbedo();
+        for (int i = 0; i < n; ++i)
+        {
+          state.Weight[i] *= albedo;
+        }
+        break;
+      }
+      case Scatterer::Rayleigh:
+        direction = DirectionFromCosine(ray.Direction, SampleRayleigh(rng.Uniform()), rng.Uniform());
+        break;
+      case Scatterer::Mie:
+        direction =
+          DirectionFromCosine(ray.Direction, SampleCornetteShanks(this->MieG, uniform), rng.Uniform());
+        break;
+      case Scatterer::Cloud:
+      default:
+        direction =
+          DirectionFromCosine(ray.Direction, this->Context.GetCloudPhase().Sample(uniform), rng.Uniform());
+        break;
+    }
+    // Russian roulette on the largest spectral weight.
+    if (rouletteOrder >= 0 && order >= rouletteOrder)
+    {
+      const double survive = std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
+      if (!(survive > 0.0) || rng.Uniform() >= survive)
+      {
+        break;
+      }
+      for (int i = 0; i < n; ++i)
+      {
+        state.Weight[i] /= survive;
+      }
+    }
+    ray = this->MakeRay(p, direction);
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i)
+    {
+      sum += this->ToRgb[c * n + i] * state.Radiance[i];
+    }
+    rgb[c] = sum;
+  }
+}
+
+/// Running mean and M2 (Welford 1962) of the three channels and their mean.
+struct PixelStatistics
+{
+  std::uint64_t Count = 0;
+  double Mean[4] = { 0, 0, 0, 0 };
+  double M2[4] = { 0, 0, 0, 0 };
+  bool Done = false;
+
+  void Add(const double rgb[3])
+  {
+    const double v[4] = { rgb[0], rgb[1], rgb[2], (rgb[0] + rgb[1] + rgb[2]) / 3.0 };
+    ++this->Count;
+    for (int c = 0; c < 4; ++c)
+    {
+      const double delta = v[c] - this->Mean[c];
+      this->Mean[c] += delta / static_cast<double>(this->Count);
+      this->M2[c] += delta * (v[c] - this->Mean[c]);
+    }
+  }
+  /// Standard error of the mean of channel c.
+  double StandardError(int c) const
+  {
+    if (this->Count < 2)
+    {
+      return 0.0;
+    }
+    const double n = static_cast<double>(this->Count);
+    return std::sqrt(std::max(0.0, this->M2[c]) / (n * (n - 1.0)));
+  }
+};
+} // namespace
+
+PathTracingResult RenderPathTraced(const RenderContext& context,
+  const PathTracingSettings& settings, const std::function<void(double)>& progress)
+{
+  if (settings.MinSamplesPerPixel < 1 || settings.MaxSamplesPerPixel < settings.MinSamplesPerPixel)
+  {
+    throw std::invalid_argument(
+      "RenderPathTraced: need 1 <= MinSamplesPerPixel <= MaxSamplesPerPixel");
+  }
+  if (!(settings.TargetRelativeError >= 0.0))
+  {
+    throw std::invalid_argument("RenderPathTraced: TargetRelativeError must be >= 0");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const Integrator integrator(context, settings);
+  const Camera& camera = context.GetCamera();
+  const int width = camera.GetWidth(), height = camera.GetHeight();
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  std::vector<PixelStatistics> statistics(pixels);
+
+  int threads = settings.Threads > 0 ? settings.Threads
+                                     : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::max(1, threads);
+
+  std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
+  std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
+  const std::uint64_t maxSamples = static_cast<std::uint64_t>(settings.MaxSamplesPerPixel);
+  for (;;)
+  {
+    std::vector<std::size_t> active;
+    for (std::size_t k = 0; k < pixels; ++k)
+    {
+      if (!statistics[k].Done)
+      {
+        active.push_back(k);
+      }
+    }
+    if (active.empty())
+    {
+      break;
+    }
+    // One round: every active pixel is brought to `target` samples; pixels are
+    // handed out dynamically, but each is worked on by exactly one thread.
+    std::atomic<std::size_t> next{ 0 };
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    auto worker = [&]() {
+      PathState state;
+      std::uint64_t localPaths = 0, localTruncated = 0;
+      try
+      {
+        for (;;)
+        {
+          const std::size_t slot = next.fetch_add(1);
+          if (slot >= active.size())
+          {
+            break;
+          }
+          const std::size_t k = active[slot];
+          PixelStatistics& stats = statistics[k];
+          const int i = static_cast<int>(k % static_cast<std::size_t>(width));
+          const int j = static_cast<int>(k / static_cast<std::size_t>(width));
+          while (stats.Count < target)
+          {
+            PathRandom rng(settings.Seed, k, stats.Count);
+            double x = i + 0.5, y = j + 0.5;
+            if (settings.PixelJitter)
+            {
+              x = i + rng.Uniform();
+              y = j + rng.Uniform();
+            }
+            double rgb[3];
+            integrator.TracePath(x, y, rng, state, rgb);
+            stats.Add(rgb);
+            ++localPaths;
+            localTruncated += state.Truncated ? 1 : 0;
+          }
+          if (stats.Count >= maxSamples)
+          {
+            stats.Done = true;
+          }
+          else if (settings.TargetRelativeError > 0.0)
+          {
+            const double mean = std::abs(stats.Mean[3]);
+            const double error = stats.StandardError(3);
+            if (error < settings.TargetRelativeError * mean || (mean == 0.0 && error == 0.0))
+            {
+              stats.Done = true;
+            }
+          }
+        }
+      }
+      catch (...)
+      {
+        std::lock_guard<std::mutex> lock(failureMutex);
+        if (!failure)
+        {
+          failure = std::current_exception();
+        }
+        next.store(active.size());
+      }
+      paths += localPaths;
+      truncated += localTruncated;
+    };
+    const int used = static_cast<int>(std::min<std::size_t>(threads, active.size()));
+    std::vector<std::thread> pool;
+    for (int w = 1; w < used; ++w)
+    {
+      pool.emplace_back(worker);
+    }
+    worker();
+    for (std::thread& thread : pool)
+    {
+      thread.join();
+    }
+    if (failure)
+    {
+      std::rethrow_exception(failure);
+    }
+    if (progress)
+    {
+      progress(std::min(1.0,
+        static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+    }
+    if (target >= maxSamples)
+    {
+      break;
+    }
+    target = std::min(maxSamples, 2 * target);
+  }
+
+  PathTracingResult result;
+  result.Image = FloatImage(width, height);
+  result.StandardError = FloatImage(width, height);
+  for (std::size_t k = 0; k < pixels; ++k)
+  {
+    const int i = static_cast<int>(k % static_cast<std::size_t>(width));
+    const int j = static_cast<int>(k / static_cast<std::size_t>(width));
+    for (int c = 0; c < 3; ++c)
+    {
+      result.Image.At(i, j)[c] = static_cast<float>(statistics[k].Mean[c]);
+      result.StandardError.At(i, j)[c] = static_cast<float>(statistics[k].StandardError(c));
+    }
+  }
+  result.Paths = paths.load();
+  result.TruncatedPaths = truncated.load();
+  result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
+  result.Seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return result;
+}
+
+} // namespace nimbus

@@ -1,0 +1,126 @@
+// Monte Carlo volumetric path tracer: the full-multiple-scattering ground truth
+// for the scenes of RenderContext (cloud + Rayleigh/Mie atmosphere + Lambertian
+// ground + background + directional sun). Everything physical comes from the
+// RenderContext; this file only integrates the radiative transfer equation
+//     L(x, w) = int_0^d T(x, x_t) [sigma_s(x_t) int p(w', w) L(x_t, w') dw'] dt + T(x, x_d) L_d
+// (no emission), with T = exp(-int sigma_t), by unbiased estimators:
+//
+//  - Free flights: delta tracking against a piecewise-constant majorant
+//    sigma_bar(t) = cloud macro-cell majorant (max density of a 4^3-voxel block,
+//    dilated by one grid point, x ExtinctionPerDensity) + atmosphere majorant
+//    (max over wavelengths of beta_R(lambda) rho_R(h_min) + beta_M,ext rho_M(h_min),
+//    h_min the lowest altitude on the piece: pieces of <= 50 km outside the cloud
+//    box, the box's lowest altitude inside it). Majorants bound sigma_t: no bias.
+//    A tentative collision is charged to the cloud or to the atmosphere in
+//    proportion to their majorants, so only one of the two is evaluated.
+//  - Spectral: one path carries a throughput vector over all wavelength samples
+//    of the context (spectral tracking with history-aware collision
+//    probabilities, Kutz et al., "Spectral and Decomposition Tracking for
+//    Rendering Heterogeneous Volumes", SIGGRAPH 2017, Eqs. 14-17). The cloud is
+//    grey, so cloud-only paths have identical weights at all wavelengths (no
+//    colour noise); the atmosphere's lambda^-4 extinction makes the weights
+//    differ. Cost: O(N_lambda) per tentative collision.
+//  - Next-event estimation to the sun at every real scattering event and ground
+//    hit: cloud transmittance by ratio tracking (with Russian roulette below
+//    0.1) x the atmosphere's sun transmittance (RenderContext::
+//    SunAtmosphereTransmittance; 0 where the earth hides the sun; inside the
+//    cloud box from a (r, mu_s) table of the exact optical lengths whose
+//    interpolation error is verified < 1e-6 in ln T, else exact) x 0 if the
+//    sun is below the horizon of the enabled ground plane without atmosphere.
+//  - New directions: phase-function sampling of the component that scattered
+//    (cloud mixture, Rayleigh, Cornette-Shanks g = mie_g); cosine-weighted at the
+//    ground (weight *= albedo).
+//  - Russian roulette from RussianRouletteOrder bounces on: survive with
+//    probability min(1, max_lambda weight).
+//
+// Phase-function convention (PhaseFunctions.h): mu = dot(propagation direction
+// of the incident light, scattered direction). For NEE the light propagates
+// along -sunDirection and leaves toward the camera along -d (d: path direction
+// away from the camera), so mu = dot(sunDirection, d): looking toward the sun
+// through the cloud is forward scattering.
+//
+// Termination of a path: it leaves the scene or passes the top of the
+// atmosphere (background radiance), hits the ground plane (reflects), hits the
+// earth sphere of an enabled atmosphere (reached only with the ground plane
+// disabled: black, no radiance), or is killed by Russian roulette /
+// MaxScatteringOrder. Sun occlusion: without atmosphere the enabled ground plane
+// hides a sun below the horizon; with the atmosphere the spherical earth does
+// (twilight reaches the upper air). Both as in SingleScatteringRenderer. A path
+// that exceeds kMaxTrackingStepsPerPath tentative collisions (free-flight +
+// ratio-tracking steps + ground hits together) is truncated (contribution so far
+// kept, slightly biased low) and counted in PathTracingResult::TruncatedPaths.
+//
+// Measured (g++ 12 -O2, 2 shared cores): a 49^3 puff cloud, 2 km wide, optical
+// depth ~50, albedo 0.99, with atmosphere and ground, 64x64: ~15 us per path;
+// per-path relative standard deviation ~2.5 (sky pixels ~1.7: an optically thin
+// atmosphere collides rarely; cloud pixels 3-5: NEE of a delta sun through a
+// peaked phase function), so 1 % relative RMSE takes ~6e4 paths per pixel,
+// ~20-25 min on 2 cores.
+//
+// Determinism: sample k of pixel (i, j) draws from a counter-based generator
+// seeded by (Seed, pixel index, k) and each pixel's running statistics are
+// updated in sample order by one thread, so results are bit-identical for any
+// thread count.
+#ifndef NimbusPathTracer_h
+#define NimbusPathTracer_h
+
+#include "NimbusRepresentationsModule.h"
+
+#include "FloatImage.h"
+#include "RenderContext.h"
+
+#include <cstdint>
+#include <functional>
+
+namespace nimbus
+{
+
+/// Free-flight + ratio-tracking steps (tentative collisions) allowed per path.
+/// Reached only in near-conservative media of optical thickness >~ 1e3, where
+/// a diffusing path needs ~tau^2 steps; the path is then cut (see above).
+constexpr std::uint64_t kMaxTrackingStepsPerPath = std::uint64_t(1) << 20;
+
+struct NIMBUSREPRESENTATIONS_EXPORT PathTracingSettings
+{
+  int MinSamplesPerPixel = 16;
+  int MaxSamplesPerPixel = 1024;
+  /// Stop a pixel when its standard error / mean < target (0 = run to Max).
+  /// Measured on the mean of the three linear sRGB channels; a pixel whose
+  /// samples are all exactly 0 counts as converged after MinSamplesPerPixel.
+  double TargetRelativeError = 0.0;
+  /// 0 = unlimited; 1 = single scattering only (NEE at the first scattering event
+  /// or ground hit; the background seen directly, attenuated, is order 0).
+  int MaxScatteringOrder = 0;
+  std::uint64_t Seed = 1;
+  /// 0 = std::thread::hardware_concurrency().
+  int Threads = 0;
+  /// Russian roulette at scattering orders >= this (negative: never).
+  int RussianRouletteOrder = 5;
+  /// Extension: true = uniform jitter over the pixel (box filter); false = every
+  /// path through the pixel centre, like the deterministic renderers.
+  bool PixelJitter = true;
+};
+
+struct NIMBUSREPRESENTATIONS_EXPORT PathTracingResult
+{
+  FloatImage Image;         // linear sRGB radiance, the scene's relative units
+  FloatImage StandardError; // per pixel and channel, same units
+  double MeanSamplesPerPixel = 0.0;
+  double Seconds = 0.0;
+  // Extensions.
+  std::uint64_t Paths = 0;          // paths traced in total
+  std::uint64_t TruncatedPaths = 0; // paths cut at kMaxTrackingStepsPerPath
+};
+
+/// Renders the context's camera view progressively: rounds of samples (first
+/// MinSamplesPerPixel, then doubling up to MaxSamplesPerPixel), per-pixel
+/// running mean and variance (Welford), per-pixel stop on TargetRelativeError.
+/// progress(fraction in [0, 1]) is called from the calling thread after each
+/// round. Throws std::invalid_argument for MinSamplesPerPixel < 1 or
+/// MaxSamplesPerPixel < MinSamplesPerPixel or a negative / NaN target.
+NIMBUSREPRESENTATIONS_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
+  const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
+
+} // namespace nimbus
+
+#endif

@@ -1,0 +1,1111 @@
+#include "SceneJson.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace nimbus
+{
+
+namespace
+{
+// Insertion-ordered objects: SceneToJson's key order is the documented order.
+using Json = nlohmann::ordered_json;
+
+constexpr double kDegree = 3.14159265358979323846 / 180.0;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+[[noreturn]] void Fail(const std::string& path, const std::string& what)
+{
+  throw std::invalid_argument(path + ": " + what);
+}
+
+std::string Join(const std::vector<std::string>& words)
+{
+  std::string s;
+  for (const auto& w : words)
+  {
+    s += (s.empty() ? "" : ", ") + w;
+  }
+  return s;
+}
+
+/// A number for a message: JSON's shortest round-trip form, without a trailing ".0".
+std::string FormatNumber(double x)
+{
+  if (std::isnan(x))
+  {
+    return "nan";
+  }
+  if (std::isinf(x))
+  {
+    return x > 0 ? "inf" : "-inf";
+  }
+  std::string text = Json(x).dump();
+  if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0)
+  {
+    text.resize(text.size() - 2); // messages say 90, not 90.0
+  }
+  return text;
+}
+
+/// What a value is, for "expected X, got Y" messages.
+std::string Describe(const Json& v)
+{
+  if (v.is_number())
+  {
+    return v.dump();
+  }
+  std::string text = v.dump();
+  if (text.size() > 40)
+  {
+    text = text.substr(0, 37) + "...";
+  }
+  if (v.is_string())
+  {
+    return "the string " + text;
+  }
+  if (v.is_null())
+  {
+    return "null";
+  }
+  return std::string(v.is_boolean() ? "the boolean " : (v.is_array() ? "the array " : "the object ")) +
+    text;
+}
+
+//------------------------------------------------------------------------------
+// Scalar readers.
+
+struct Range
+{
+  double Low = -kInf;
+  double High = kInf;
+  bool LowOpen = false;
+  bool HighOpen = false;
+
+  bool Contains(double x) const
+  {
+    return std::isfinite(x) && (LowOpen ? x > Low : x >= Low) && (HighOpen ? x < High : x <= High);
+  }
+  std::string Text() const
+  {
+    const bool hasLow = std::isfinite(Low), hasHigh = std::isfinite(High);
+    if (hasLow && hasHigh)
+    {
+      return std::string("in ") + (LowOpen ? "(" : "[") + FormatNumber(Low) + ", " +
+        FormatNumber(High) + (HighOpen ? ")" : "]");
+    }
+    if (hasLow)
+    {
+      return (LowOpen ? "> " : ">= ") + FormatNumber(Low);
+    }
+    if (hasHigh)
+    {
+      return (HighOpen ? "< " : "<= ") + FormatNumber(High);
+    }
+    return "";
+  }
+};
+
+Range Finite()
+{
+  return Range{};
+}
+Range AtLeast(double low)
+{
+  return Range{ low, kInf, false, false };
+}
+Range Above(double low)
+{
+  return Range{ low, kInf, true, false };
+}
+Range Closed(double low, double high)
+{
+  return Range{ low, high, false, false };
+}
+Range Open(double low, double high)
+{
+  return Range{ low, high, true, true };
+}
+
+std::string NumberNoun(const Range& range)
+{
+  const std::string text = range.Text();
+  return text.empty() ? "a finite number" : "a number " + text;
+}
+
+double ReadNumber(const Json& v, const std::string& path, const Range& range)
+{
+  if (!v.is_number())
+  {
+    Fail(path, "expected " + NumberNoun(range) + ", got " + Describe(v));
+  }
+  const double x = v.get<double>();
+  if (!range.Contains(x))
+  {
+    Fail(path, "expected " + NumberNoun(range) + ", got " + FormatNumber(x));
+  }
+  return x;
+}
+
+long long ReadInteger(const Json& v, const std::string& path, long long low, long long high)
+{
+  const std::string noun =
+    "an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "]";
+  if (!v.is_number())
+  {
+    Fail(path, "expected " + noun + ", got " + Describe(v));
+  }
+  if (v.is_number_integer() || v.is_number_unsigned())
+  {
+    // Out of long long range (huge unsigned) falls through to the double test.
+    if (v.is_number_integer() && !v.is_number_unsigned())
+    {
+      const long long n = v.get<long long>();
+      if (n < low || n > high)
+      {
+        Fail(path, "expected " + noun + ", got " + std::to_string(n));
+      }
+      return n;
+    }
+    const auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(high) || static_cast<long long>(u) < low)
+    {
+      Fail(path, "expected " + noun + ", got " + std::to_string(u));
+    }
+    return static_cast<long long>(u);
+  }
+  const double x = v.get<double>();
+  if (!(std::isfinite(x) && x == std::floor(x) && x >= static_cast<double>(low) &&
+        x <= static_cast<double>(high)))
+  {
+    Fail(path, "expected " + noun + ", got " + FormatNumber(x));
+  }
+  return static_cast<long long>(x);
+}
+
+bool ReadBool(const Json& v, const std::string& path)
+{
+  if (!v.is_boolean())
+  {
+    Fail(path, "expected true or false, got " + Describe(v));
+  }
+  return v.get<bool>();
+}
+
+std::string ReadString(const Json& v, const std::string& path, bool allowEmpty = true)
+{
+  if (!v.is_string())
+  {
+    Fail(path, "expected a string, got " + Describe(v));
+  }
+  std::string s = v.get<std::string>();
+  if (!allowEmpty && s.empty())
+  {
+    Fail(path, "expected a non-empty string");
+  }
+  return s;
+}
+
+std::string ReadEnum(const Json& v, const std::string& path, const std::vector<std::string>& known)
+{
+  if (!v.is_string())
+  {
+    Fail(path, "expected one of " + Join(known) + " (a string), got " + Describe(v));
+  }
+  const std::string s = v.get<std::string>();
+  if (std::find(known.begin(), known.end(), s) == known.end())
+  {
+    Fail(path, "unknown value \"" + s + "\" (known: " + Join(known) + ")");
+  }
+  return s;
+}
+
+/// An array of exactly `count` numbers, each in `range`.
+std::vector<double> ReadNumbers(
+  const Json& v, const std::string& path, std::size_t count, const Range& range)
+{
+  const std::string noun = "an array of " + std::to_string(count) + " numbers";
+  if (!v.is_array())
+  {
+    Fail(path, "expected " + noun + ", got " + Describe(v));
+  }
+  if (v.size() != count)
+  {
+    Fail(path, "expected " + noun + ", got " + std::to_string(v.size()) + " element" +
+        (v.size() == 1 ? "" : "s"));
+  }
+  std::vector<double> values;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    values.push_back(ReadNumber(v[i], path + "[" + std::to_string(i) + "]", range));
+  }
+  return values;
+}
+
+std::array<double, 3> ReadVector3(const Json& v, const std::string& path)
+{
+  const std::vector<double> x = ReadNumbers(v, path, 3, Finite());
+  return { { x[0], x[1], x[2] } };
+}
+
+//------------------------------------------------------------------------------
+/// An object whose keys are all known; missing optional keys keep the defaults.
+class ObjectReader
+{
+public:
+  ObjectReader(const Json& object, std::string path, std::vector<std::string> known)
+    : Object(object)
+    , Path(std::move(path))
+    , Known(std::move(known))
+  {
+    if (!this->Object.is_object())
+    {
+      Fail(this->Path, "expected an object, got " + Describe(this->Object));
+    }
+    for (const auto& item : this->Object.items())
+    {
+      if (std::find(this->Known.begin(), this->Known.end(), item.key()) == this->Known.end())
+      {
+        Fail(this->Key(item.key()), "unknown key (known: " + Join(this->Known) + ")");
+      }
+    }
+  }
+
+  std::string Key(const std::string& key) const { return this->Path + "." + key; }
+  const std::string& GetPath() const { return this->Path; }
+  bool Has(const std::string& key) const { return this->Object.contains(key); }
+  const Json& operator[](const std::string& key) const { return this->Object.at(key); }
+  const Json& Require(const std::string& key) const
+  {
+    if (!this->Has(key))
+    {
+      Fail(this->Path, "missing required key \"" + key + "\"");
+    }
+    return this->Object.at(key);
+  }
+
+  void Number(const std::string& key, double& target, const Range& range) const
+  {
+    if (this->Has(key))
+    {
+      target = ReadNumber(this->Object.at(key), this->Key(key), range);
+    }
+  }
+  void RequiredNumber(const std::string& key, double& target, const Range& range) const
+  {
+    target = ReadNumber(this->Require(key), this->Key(key), range);
+  }
+  void Integer(const std::string& key, int& target, int low, int high) const
+  {
+    if (this->Has(key))
+    {
+      target = static_cast<int>(ReadInteger(this->Object.at(key), this->Key(key), low, high));
+    }
+  }
+  void Bool(const std::string& key, bool& target) const
+  {
+    if (this->Has(key))
+    {
+      target = ReadBool(this->Object.at(key), this->Key(key));
+    }
+  }
+  void Vector3(const std::string& key, std::array<double, 3>& target) const
+  {
+    if (this->Has(key))
+    {
+      target = ReadVector3(this->Object.at(key), this->Key(key));
+    }
+  }
+
+private:
+  const Json& Object;
+  std::string Path;
+  std::vector<std::string> Known;
+};
+
+//------------------------------------------------------------------------------
+// Metaball cloud parameters: the vtkNimbusMetaballCloudSource properties.
+
+enum class ParameterKind
+{
+  Integer,
+  Real,
+  Bool
+};
+
+struct ParameterSpec
+{
+  const char* Name;
+  std::size_t Count;
+  ParameterKind Kind;
+  Range Values;     // per component
+  long long IntLow; // for Integer
+  long long IntHigh;
+};
+
+const std::vector<ParameterSpec>& MetaballParameters()
+{
+  // Limits follow vtkNimbusMetaballCloudSource::CheckParameters, plus upper bounds
+  // that keep a scene renderable (grid size, growth levels, ball counts).
+  static const std::vector<ParameterSpec> specs = {
+    { "Dimensions", 3, ParameterKind::Integer, Finite(), 1, 2048 },
+    { "Bounds", 6, ParameterKind::Real, Finite(), 0, 0 },
+    { "Seed", 1, ParameterKind::Integer, Finite(), std::numeric_limits<std::int32_t>::min(),
+      std::numeric_limits<std::int32_t>::max() },
+    { "NumberOfLevels", 1, ParameterKind::Integer, Finite(), 0, 10 },
+    { "NumberOfBaseBalls", 1, ParameterKind::Integer, Finite(), 1, 100000 },
+    { "BaseBallRadiusRange", 2, ParameterKind::Real, Above(0.0), 0, 0 },
+    { "FootprintRadius", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+    { "TowerHeight", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+    { "BallsPerLevel", 1, ParameterKind::Integer, Finite(), 0, 1000000 },
+    { "BallCountFactor", 1, ParameterKind::Real, Above(0.0), 0, 0 },
+    { "RadiusScalePerLevel", 1, ParameterKind::Real, Above(0.0), 0, 0 },
+    { "BallDensity", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+    { "IsoValue", 1, ParameterKind::Real, Finite(), 0, 0 },
+    { "FlatBase", 1, ParameterKind::Bool, Finite(), 0, 0 },
+    { "BaseHeight", 1, ParameterKind::Real, Finite(), 0, 0 },
+    { "BaseTransitionThickness", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+  };
+  return specs;
+}
+
+std::vector<std::string> MetaballParameterNames()
+{
+  std::vector<std::string> names;
+  for (const auto& spec : MetaballParameters())
+  {
+    names.emplace_back(spec.Name);
+  }
+  return names;
+}
+
+double ReadParameterComponent(const Json& v, const std::string& path, const ParameterSpec& spec)
+{
+  switch (spec.Kind)
+  {
+    case ParameterKind::Integer:
+      return static_cast<double>(ReadInteger(v, path, spec.IntLow, spec.IntHigh));
+    case ParameterKind::Bool:
+      if (v.is_number() && (v.get<double>() == 0.0 || v.get<double>() == 1.0))
+      {
+        return v.get<double>();
+      }
+      return ReadBool(v, path) ? 1.0 : 0.0;
+    case ParameterKind::Real:
+      break;
+  }
+  return ReadNumber(v, path, spec.Values);
+}
+
+std::vector<double> ReadParameter(const Json& v, const std::string& path, const ParameterSpec& spec)
+{
+  std::vector<double> values;
+  if (v.is_array())
+  {
+    if (v.size() != spec.Count)
+    {
+      Fail(path, "expected " + std::to_string(spec.Count) + " value" +
+          (spec.Count == 1 ? "" : "s") + ", got " + std::to_string(v.size()));
+    }
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+      values.push_back(ReadParameterComponent(v[i], path + "[" + std::to_string(i) + "]", spec));
+    }
+  }
+  else if (spec.Count == 1)
+  {
+    values.push_back(ReadParameterComponent(v, path, spec));
+  }
+  else
+  {
+    Fail(path, "expected an array of " + std::to_string(spec.Count) + " numbers, got " +
+        Describe(v));
+  }
+
+  const std::string name = spec.Name;
+  if (name == "Bounds")
+  {
+    static const char* axes[] = { "x", "y", "z" };
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!(values[2 * a] < values[2 * a + 1]))
+      {
+        Fail(path, std::string("expected min < max on every axis, axis ") + axes[a] + " has (" +
+            FormatNumber(values[2 * a]) + ", " + FormatNumber(values[2 * a + 1]) + ")");
+      }
+    }
+  }
+  else if (name == "BaseBallRadiusRange" && !(values[0] <= values[1]))
+  {
+    Fail(path, "expected min <= max, got (" + FormatNumber(values[0]) + ", " +
+        FormatNumber(values[1]) + ")");
+  }
+  else if (name == "Dimensions" && values[0] * values[1] * values[2] > 1073741824.0)
+  {
+    Fail(path, "too many grid points (" + FormatNumber(values[0] * values[1] * values[2]) +
+        " > 2^30)");
+  }
+  return values;
+}
+
+std::vector<std::pair<std::string, std::vector<double>>> ReadMetaballParameters(
+  const Json& v, const std::string& path)
+{
+  const std::vector<std::string> names = MetaballParameterNames();
+  if (!v.is_object())
+  {
+    Fail(path, "expected an object of vtkNimbusMetaballCloudSource properties, got " +
+        Describe(v));
+  }
+  for (const auto& item : v.items())
+  {
+    if (std::find(names.begin(), names.end(), item.key()) == names.end())
+    {
+      Fail(path + "." + item.key(),
+        "unknown metaball_cloud parameter (known: " + Join(names) + ")");
+    }
+  }
+  // Stored in the source's property order: the canonical form does not depend on
+  // the order in the text.
+  std::vector<std::pair<std::string, std::vector<double>>> parameters;
+  for (const auto& spec : MetaballParameters())
+  {
+    if (v.contains(spec.Name))
+    {
+      parameters.emplace_back(
+        spec.Name, ReadParameter(v.at(spec.Name), path + "." + spec.Name, spec));
+    }
+  }
+  return parameters;
+}
+
+//------------------------------------------------------------------------------
+// Sections.
+
+const std::vector<std::string> kPhaseTypes = { "isotropic", "rayleigh", "henyey_greenstein",
+  "cornette_shanks" };
+const std::vector<std::string> kDensityTypes = { "file", "metaball_cloud" };
+const std::vector<std::string> kBackgroundTypes = { "black", "constant", "atmosphere" };
+
+std::array<double, 3> Subtract(const std::array<double, 3>& a, const std::array<double, 3>& b)
+{
+  return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
+}
+
+double Norm(const std::array<double, 3>& a)
+{
+  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+
+CameraDescription ReadCamera(const Json& v, const std::string& path)
+{
+  const ObjectReader r(
+    v, path, { "position", "focal_point", "view_up", "view_angle", "width", "height" });
+  CameraDescription c;
+  c.Position = ReadVector3(r.Require("position"), r.Key("position"));
+  c.FocalPoint = ReadVector3(r.Require("focal_point"), r.Key("focal_point"));
+  r.Vector3("view_up", c.ViewUp);
+  r.Number("view_angle", c.ViewAngle, Open(0.0, 180.0));
+  r.Integer("width", c.Width, 1, 16384);
+  r.Integer("height", c.Height, 1, 16384);
+
+  const std::array<double, 3> view = Subtract(c.FocalPoint, c.Position);
+  const double viewLength = Norm(view);
+  if (!(viewLength > 0.0) || !std::isfinite(viewLength))
+  {
+    Fail(r.Key("focal_point"), "must differ from camera.position");
+  }
+  const std::array<double, 3>& up = c.ViewUp;
+  const std::array<double, 3> cross{ { view[1] * up[2] - view[2] * up[1],
+    view[2] * up[0] - view[0] * up[2], view[0] * up[1] - view[1] * up[0] } };
+  if (!(Norm(cross) > 1e-6 * viewLength * Norm(up)) || !std::isfinite(Norm(cross)))
+  {
+    Fail(r.Key("view_up"), "must be non-zero and not parallel to the view direction");
+  }
+  return c;
+}
+
+DensitySourceDescription ReadDensity(const Json& v, const std::string& path, const std::string& base)
+{
+  const ObjectReader r(v, path, { "type", "path", "array", "parameters" });
+  DensitySourceDescription d;
+  d.Type = ReadEnum(r.Require("type"), r.Key("type"), kDensityTypes);
+  if (r.Has("array"))
+  {
+    d.ArrayName = ReadString(r["array"], r.Key("array"), false);
+  }
+  if (d.Type == "file")
+  {
+    const std::string given = ReadString(r.Require("path"), r.Key("path"), false);
+    namespace fs = std::filesystem;
+    fs::path p(given);
+    if (p.is_relative())
+    {
+      p = (base.empty() ? fs::current_path() : fs::absolute(fs::path(base))) / p;
+    }
+    d.Path = p.lexically_normal().string();
+    if (r.Has("parameters") && !(r["parameters"].is_object() && r["parameters"].empty()))
+    {
+      Fail(r.Key("parameters"), "only used by type \"metaball_cloud\" (this density is \"file\")");
+    }
+  }
+  else // metaball_cloud
+  {
+    if (r.Has("path") && !(r["path"].is_string() && r["path"].get<std::string>().empty()))
+    {
+      Fail(r.Key("path"), "only used by type \"file\" (this density is \"metaball_cloud\")");
+    }
+    if (d.ArrayName != "density")
+    {
+      Fail(r.Key("array"), "a metaball_cloud's array is always \"density\", got \"" +
+          d.ArrayName + "\"");
+    }
+    if (r.Has("parameters"))
+    {
+      d.Parameters = ReadMetaballParameters(r["parameters"], r.Key("parameters"));
+    }
+  }
+  return d;
+}
+
+PhaseComponentDescription ReadPhaseComponent(const Json& v, const std::string& path)
+{
+  const ObjectReader r(v, path, { "type", "g", "weight" });
+  PhaseComponentDescription c;
+  c.Type = ReadEnum(r.Require("type"), r.Key("type"), kPhaseTypes);
+  if (c.Type == "henyey_greenstein" || c.Type == "cornette_shanks")
+  {
+    r.RequiredNumber("g", c.G, Closed(-1.0, 1.0));
+  }
+  else
+  {
+    r.Number("g", c.G, Closed(-1.0, 1.0)); // ignored by isotropic and rayleigh
+  }
+  r.Number("weight", c.Weight, AtLeast(0.0));
+  return c;
+}
+
+MediumDescription ReadMedium(const Json& v, const std::string& path, const std::string& base)
+{
+  const ObjectReader r(
+    v, path, { "density", "extinction_per_density", "single_scattering_albedo", "phase" });
+  MediumDescription m;
+  m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
+  r.RequiredNumber("extinction_per_density", m.ExtinctionPerDensity, AtLeast(0.0));
+  r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
+  if (r.Has("phase"))
+  {
+    const Json& phase = r["phase"];
+    const std::string phasePath = r.Key("phase");
+    m.Phase.clear();
+    if (phase.is_object())
+    {
+      m.Phase.push_back(ReadPhaseComponent(phase, phasePath));
+    }
+    else if (phase.is_array())
+    {
+      if (phase.empty())
+      {
+        Fail(phasePath, "expected at least one phase component, got an empty array");
+      }
+      for (std::size_t i = 0; i < phase.size(); ++i)
+      {
+        m.Phase.push_back(ReadPhaseComponent(phase[i], phasePath + "[" + std::to_string(i) + "]"));
+      }
+    }
+    else
+    {
+      Fail(phasePath, "expected a phase component (object) or an array of them, got " +
+          Describe(phase));
+    }
+    double total = 0.0;
+    for (const auto& c : m.Phase)
+    {
+      total += c.Weight;
+    }
+    if (!(total > 0.0) || !std::isfinite(total))
+    {
+      Fail(phasePath, "the weights must not all be zero");
+    }
+  }
+  return m;
+}
+
+SunDescription ReadSun(const Json& v, const std::string& path)
+{
+  const ObjectReader r(
+    v, path, { "azimuth", "elevation", "direction", "illuminance", "temperature" });
+  SunDescription s;
+  if (r.Has("direction"))
+  {
+    if (r.Has("azimuth") || r.Has("elevation"))
+    {
+      Fail(r.Key("direction"), "give either direction or azimuth and elevation, not both");
+    }
+    const std::array<double, 3> d = ReadVector3(r["direction"], r.Key("direction"));
+    const double horizontal = std::hypot(d[0], d[1]);
+    if (!(Norm(d) > 0.0) || !std::isfinite(Norm(d)))
+    {
+      Fail(r.Key("direction"), "must be a non-zero vector (toward the sun)");
+    }
+    s.Elevation = std::atan2(d[2], horizontal) / kDegree;
+    double azimuth = horizontal > 0.0 ? std::atan2(d[0], d[1]) / kDegree : 0.0;
+    if (azimuth < 0.0)
+    {
+      azimuth += 360.0;
+    }
+    if (azimuth >= 360.0)
+    {
+      azimuth -= 360.0;
+    }
+    s.Azimuth = azimuth + 0.0; // no -0
+  }
+  else
+  {
+    r.RequiredNumber("elevation", s.Elevation, Closed(-90.0, 90.0));
+    r.RequiredNumber("azimuth", s.Azimuth, Closed(-360.0, 360.0));
+  }
+  r.Number("illuminance", s.Illuminance, AtLeast(0.0));
+  r.Number("temperature", s.Temperature, Closed(1000.0, 100000.0));
+  return s;
+}
+
+AtmosphereDescription ReadAtmosphere(const Json& v, const std::string& path)
+{
+  const ObjectReader r(v, path,
+    { "enabled", "scene_altitude", "earth_radius", "top_radius", "rayleigh_scattering_550",
+      "rayleigh_scale_height", "mie_scattering", "mie_scale_height", "mie_albedo", "mie_g" });
+  AtmosphereDescription a;
+  r.Bool("enabled", a.Enabled);
+  r.Number("scene_altitude", a.SceneAltitude, AtLeast(0.0));
+  r.Number("earth_radius", a.EarthRadius, Above(0.0));
+  r.Number("top_radius", a.TopRadius, Above(0.0));
+  r.Number("rayleigh_scattering_550", a.RayleighScattering550, AtLeast(0.0));
+  r.Number("rayleigh_scale_height", a.RayleighScaleHeight, Above(0.0));
+  r.Number("mie_scattering", a.MieScattering, AtLeast(0.0));
+  r.Number("mie_scale_height", a.MieScaleHeight, Above(0.0));
+  r.Number("mie_albedo", a.MieAlbedo, Range{ 0.0, 1.0, true, false });
+  r.Number("mie_g", a.MieG, Open(-1.0, 1.0));
+  if (!(a.TopRadius > a.EarthRadius))
+  {
+    Fail(r.Key("top_radius"), "must be greater than earth_radius (" +
+        FormatNumber(a.EarthRadius) + "), got " + FormatNumber(a.TopRadius));
+  }
+  if (!(a.SceneAltitude < a.TopRadius - a.EarthRadius))
+  {
+    Fail(r.Key("scene_altitude"), "must be below the top of the atmosphere (" +
+        FormatNumber(a.TopRadius - a.EarthRadius) + " m), got " + FormatNumber(a.SceneAltitude));
+  }
+  return a;
+}
+
+GroundDescription ReadGround(const Json& v, const std::string& path)
+{
+  const ObjectReader r(v, path, { "enabled", "height", "albedo" });
+  GroundDescription g;
+  r.Bool("enabled", g.Enabled);
+  r.Number("height", g.Height, Finite());
+  r.Number("albedo", g.Albedo, Closed(0.0, 1.0));
+  return g;
+}
+
+BackgroundDescription ReadBackground(const Json& v, const std::string& path)
+{
+  const ObjectReader r(v, path, { "type", "radiance" });
+  BackgroundDescription b;
+  if (r.Has("type"))
+  {
+    b.Type = ReadEnum(r["type"], r.Key("type"), kBackgroundTypes);
+  }
+  r.Number("radiance", b.Radiance, AtLeast(0.0));
+  return b;
+}
+
+//------------------------------------------------------------------------------
+/// Rejects duplicate keys (the JSON library would silently keep one) and keeps
+/// track of where the parser is, to name the key path of a syntax error.
+class ParseTracker
+{
+public:
+  bool operator()(int, nlohmann::detail::parse_event_t event, Json& parsed)
+  {
+    using Event = nlohmann::detail::parse_event_t;
+    switch (event)
+    {
+      case Event::object_start:
+      case Event::array_start:
+        this->Stack.push_back(Frame{ this->CurrentPath(), event == Event::array_start, 0, {}, {} });
+        break;
+      case Event::key:
+      {
+        Frame& frame = this->Stack.back();
+        frame.Key = parsed.get<std::string>();
+        if (!frame.Keys.insert(frame.Key).second)
+        {
+          Fail(frame.Path + "." + frame.Key, "duplicate key");
+        }
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        this->Stack.pop_back();
+        this->AfterValue();
+        break;
+      case Event::value:
+        this->AfterValue();
+        break;
+    }
+    return true;
+  }
+
+  /// The path of the value being parsed now.
+  std::string CurrentPath() const
+  {
+    if (this->Stack.empty())
+    {
+      return "scene";
+    }
+    const Frame& frame = this->Stack.back();
+    if (frame.IsArray)
+    {
+      return frame.Path + "[" + std::to_string(frame.Index) + "]";
+    }
+    return frame.Key.empty() ? frame.Path : frame.Path + "." + frame.Key;
+  }
+
+private:
+  struct Frame
+  {
+    std::string Path;
+    bool IsArray;
+    std::size_t Index;
+    std::set<std::string> Keys;
+    std::string Key;
+  };
+
+  void AfterValue()
+  {
+    if (this->Stack.empty())
+    {
+      return;
+    }
+    Frame& frame = this->Stack.back();
+    if (frame.IsArray)
+    {
+      ++frame.Index;
+    }
+    else
+    {
+      frame.Key.clear(); // between members: an error there belongs to the object
+    }
+  }
+
+  std::vector<Frame> Stack;
+};
+
+std::string WithoutJsonPrefix(const std::string& what)
+{
+  // "[json.exception.parse_error.101] parse error at line 1, ..." -> "parse error at ..."
+  const auto end = what.find("] ");
+  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2)
+                                                                            : what;
+}
+
+//------------------------------------------------------------------------------
+// Writing.
+
+Json Vector3Json(const std::array<double, 3>& v)
+{
+  return Json::array({ v[0], v[1], v[2] });
+}
+
+Json ParameterJson(const std::string& name, const std::vector<double>& values)
+{
+  ParameterKind kind = ParameterKind::Real;
+  std::size_t count = 0;
+  for (const auto& spec : MetaballParameters())
+  {
+    if (name == spec.Name)
+    {
+      kind = spec.Kind;
+      count = spec.Count;
+    }
+  }
+  auto component = [kind](double x) -> Json {
+    if (kind == ParameterKind::Bool && (x == 0.0 || x == 1.0))
+    {
+      return Json(x != 0.0);
+    }
+    if (kind == ParameterKind::Integer && std::isfinite(x) && x == std::floor(x) &&
+      std::abs(x) < 9.0e15)
+    {
+      return Json(static_cast<long long>(x));
+    }
+    return Json(x);
+  };
+  if (count == 1 && values.size() == 1)
+  {
+    return component(values[0]);
+  }
+  Json array = Json::array();
+  for (double x : values)
+  {
+    array.push_back(component(x));
+  }
+  return array;
+}
+
+Json ToJson(const SceneDescription& s)
+{
+  Json j;
+  j["nimbus_scene"] = SceneDescription::kFormatVersion;
+  j["name"] = s.Name;
+  j["description"] = s.Description;
+
+  const CameraDescription& c = s.Camera;
+  j["camera"] = Json::object();
+  j["camera"]["position"] = Vector3Json(c.Position);
+  j["camera"]["focal_point"] = Vector3Json(c.FocalPoint);
+  j["camera"]["view_up"] = Vector3Json(c.ViewUp);
+  j["camera"]["view_angle"] = c.ViewAngle;
+  j["camera"]["width"] = c.Width;
+  j["camera"]["height"] = c.Height;
+
+  const MediumDescription& m = s.Medium;
+  Json density;
+  density["type"] = m.Density.Type;
+  density["path"] = m.Density.Path;
+  density["array"] = m.Density.ArrayName;
+  density["parameters"] = Json::object();
+  // Canonical order: the source's property order, then any others as stored.
+  std::vector<std::pair<std::string, std::vector<double>>> parameters = m.Density.Parameters;
+  const std::vector<std::string> names = MetaballParameterNames();
+  auto rank = [&names](const std::string& name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  std::stable_sort(parameters.begin(), parameters.end(),
+    [&rank](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
+  for (const auto& p : parameters)
+  {
+    density["parameters"][p.first] = ParameterJson(p.first, p.second);
+  }
+  j["medium"]["density"] = density;
+  j["medium"]["extinction_per_density"] = m.ExtinctionPerDensity;
+  j["medium"]["single_scattering_albedo"] = m.SingleScatteringAlbedo;
+  j["medium"]["phase"] = Json::array();
+  for (const auto& p : m.Phase)
+  {
+    Json component;
+    component["type"] = p.Type;
+    component["g"] = p.G;
+    component["weight"] = p.Weight;
+    j["medium"]["phase"].push_back(component);
+  }
+
+  j["sun"]["azimuth"] = s.Sun.Azimuth;
+  j["sun"]["elevation"] = s.Sun.Elevation;
+  j["sun"]["illuminance"] = s.Sun.Illuminance;
+  j["sun"]["temperature"] = s.Sun.Temperature;
+
+  const AtmosphereDescription& a = s.Atmosphere;
+  j["atmosphere"]["enabled"] = a.Enabled;
+  j["atmosphere"]["scene_altitude"] = a.SceneAltitude;
+  j["atmosphere"]["earth_radius"] = a.EarthRadius;
+  j["atmosphere"]["top_radius"] = a.TopRadius;
+  j["atmosphere"]["rayleigh_scattering_550"] = a.RayleighScattering550;
+  j["atmosphere"]["rayleigh_scale_height"] = a.RayleighScaleHeight;
+  j["atmosphere"]["mie_scattering"] = a.MieScattering;
+  j["atmosphere"]["mie_scale_height"] = a.MieScaleHeight;
+  j["atmosphere"]["mie_albedo"] = a.MieAlbedo;
+  j["atmosphere"]["mie_g"] = a.MieG;
+
+  j["ground"]["enabled"] = s.Ground.Enabled;
+  j["ground"]["height"] = s.Ground.Height;
+  j["ground"]["albedo"] = s.Ground.Albedo;
+
+  j["background"]["type"] = s.Background.Type;
+  j["background"]["radiance"] = s.Background.Radiance;
+
+  j["spectral_samples"] = s.SpectralSamples;
+  return j;
+}
+
+/// 2-space indent; arrays of scalars on one line ("position": [0.0, -6000.0, 1500.0]).
+void WritePretty(const Json& v, int indent, std::string& out)
+{
+  const std::string inner(static_cast<std::size_t>(indent + 2), ' ');
+  if (v.is_object() && !v.empty())
+  {
+    out += "{\n";
+    std::size_t i = 0;
+    for (const auto& item : v.items())
+    {
+      out += inner + Json(item.key()).dump() + ": ";
+      WritePretty(item.value(), indent + 2, out);
+      out += ++i < v.size() ? ",\n" : "\n";
+    }
+    out += std::string(static_cast<std::size_t>(indent), ' ') + "}";
+  }
+  else if (v.is_array() && std::any_of(v.begin(), v.end(),
+                             [](const Json& x) { return x.is_structured(); }))
+  {
+    out += "[\n";
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+      out += inner;
+      WritePretty(v[i], indent + 2, out);
+      out += i + 1 < v.size() ? ",\n" : "\n";
+    }
+    out += std::string(static_cast<std::size_t>(indent), ' ') + "]";
+  }
+  else if (v.is_array())
+  {
+    out += "[";
+    for (std::size_t i = 0; i < v.size(); ++i)
+    {
+      out += (i ? ", " : "") + v[i].dump();
+    }
+    out += "]";
+  }
+  else
+  {
+    out += v.dump(); // scalars, {} and []
+  }
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+SceneDescription ParseScene(const std::string& jsonText, const std::string& baseDirectory)
+{
+  Json root;
+  ParseTracker tracker;
+  try
+  {
+    root = Json::parse(jsonText, std::ref(tracker));
+  }
+  catch (const nlohmann::json::exception& error)
+  {
+    Fail(tracker.CurrentPath(), "invalid JSON: " + WithoutJsonPrefix(error.what()));
+  }
+
+  const std::string path = "scene";
+  if (!root.is_object())
+  {
+    Fail(path, "expected an object, got " + Describe(root));
+  }
+  // The version first: a newer file may have keys this reader does not know.
+  if (!root.contains("nimbus_scene"))
+  {
+    Fail(path, "missing required key \"nimbus_scene\" (the format version; this build reads "
+               "version " + std::to_string(SceneDescription::kFormatVersion) + ")");
+  }
+  const Json& version = root.at("nimbus_scene");
+  if (!(version.is_number_integer() || version.is_number_unsigned()))
+  {
+    Fail(path + ".nimbus_scene", "expected the format version, an integer (this build reads " +
+        std::to_string(SceneDescription::kFormatVersion) + "), got " + Describe(version));
+  }
+  if (version.dump() != std::to_string(SceneDescription::kFormatVersion))
+  {
+    Fail(path + ".nimbus_scene", "unsupported format version " + version.dump() +
+        "; this build of Nimbus reads version " +
+        std::to_string(SceneDescription::kFormatVersion));
+  }
+
+  const ObjectReader r(root, path,
+    { "nimbus_scene", "name", "description", "camera", "medium", "sun", "atmosphere", "ground",
+      "background", "spectral_samples" });
+  SceneDescription s;
+  if (r.Has("name"))
+  {
+    s.Name = ReadString(r["name"], r.Key("name"));
+  }
+  if (r.Has("description"))
+  {
+    s.Description = ReadString(r["description"], r.Key("description"));
+  }
+  s.Camera = ReadCamera(r.Require("camera"), r.Key("camera"));
+  s.Medium = ReadMedium(r.Require("medium"), r.Key("medium"), baseDirectory);
+  s.Sun = ReadSun(r.Require("sun"), r.Key("sun"));
+  if (r.Has("atmosphere"))
+  {
+    s.Atmosphere = ReadAtmosphere(r["atmosphere"], r.Key("atmosphere"));
+  }
+  if (r.Has("ground"))
+  {
+    s.Ground = ReadGround(r["ground"], r.Key("ground"));
+  }
+  if (r.Has("background"))
+  {
+    s.Background = ReadBackground(r["background"], r.Key("background"));
+  }
+  r.Integer("spectral_samples", s.SpectralSamples, 3, 256);
+
+  if (s.Background.Type == "atmosphere" && !s.Atmosphere.Enabled)
+  {
+    Fail(r.Key("background.type"), "\"atmosphere\" needs atmosphere.enabled = true (use "
+                                   "\"black\" or \"constant\" without an atmosphere)");
+  }
+  return s;
+}
+
+SceneDescription LoadScene(const std::string& path)
+{
+  std::error_code ignored;
+  std::ifstream file(path, std::ios::binary);
+  if (!file || std::filesystem::is_directory(path, ignored))
+  {
+    throw std::runtime_error(path + ": cannot read the scene file");
+  }
+  std::ostringstream text;
+  text << file.rdbuf();
+  if (file.bad())
+  {
+    throw std::runtime_error(path + ": error while reading the scene file");
+  }
+  const std::filesystem::path directory =
+    std::filesystem::absolute(std::filesystem::path(path)).parent_path();
+  try
+  {
+    return ParseScene(text.str(), directory.string());
+  }
+  catch (const std::invalid_argument& error)
+  {
+    throw std::invalid_argument(path + ": " + error.what());
+  }
+}
+
+std::string SceneToJson(const SceneDescription& scene)
+{
+  std::string text;
+  WritePretty(ToJson(scene), 0, text);
+  return text + "\n";
+}
+
+std::string SceneHash(const SceneDescription& scene)
+{
+  std::uint64_t hash = 14695981039346656037ull; // FNV-1a 64 offset basis
+  for (const unsigned char byte : SceneToJson(scene))
+  {
+    hash ^= byte;
+    hash *= 1099511628211ull; // FNV prime
+  }
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+} // namespace nimbus

@@ -1,0 +1,274 @@
+#include "vtkNimbusReferenceRenderer.h"
+
+#include "DensityGrid.h"
+#include "PathTracer.h"
+#include "RenderContext.h"
+#include "SceneJson.h"
+#include "SingleScatteringRenderer.h"
+#include "vtkNimbusSceneDensitySource.h"
+
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+vtkStandardNewMacro(vtkNimbusReferenceRenderer);
+
+namespace
+{
+// vtkImageData point array -> DensityGrid (float), placed by origin, spacing and extent.
+nimbus::DensityGrid ToDensityGrid(vtkImageData* image, vtkDataArray* values)
+{
+  int extent[6];
+  image->GetExtent(extent);
+  double origin[3], spacing[3];
+  image->GetOrigin(origin);
+  image->GetSpacing(spacing);
+  std::array<int, 3> dims;
+  nimbus::DensityGrid::Vector3 first, step;
+  for (int a = 0; a < 3; ++a)
+  {
+    dims[a] = extent[2 * a + 1] - extent[2 * a] + 1;
+    first[a] = origin[a] + extent[2 * a] * spacing[a];
+    step[a] = spacing[a];
+  }
+  std::vector<float> density(static_cast<std::size_t>(values->GetNumberOfTuples()));
+  for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
+  {
+    density[static_cast<std::size_t>(i)] = static_cast<float>(values->GetComponent(i, 0));
+  }
+  return nimbus::DensityGrid(dims, first, step, std::move(density));
+}
+
+vtkSmartPointer<vtkFloatArray> ToArray(const nimbus::FloatImage& image, const char* name)
+{
+  auto array = vtkSmartPointer<vtkFloatArray>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(3);
+  array->SetNumberOfTuples(static_cast<vtkIdType>(image.Width) * image.Height);
+  std::copy(image.Pixels.begin(), image.Pixels.end(), array->GetPointer(0));
+  return array;
+}
+
+void AddFieldValue(vtkFieldData* fieldData, const char* name, double value)
+{
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name);
+  array->InsertNextValue(value);
+  fieldData->AddArray(array);
+}
+}
+
+vtkNimbusReferenceRenderer::vtkNimbusReferenceRenderer()
+{
+  this->SetNumberOfInputPorts(1);
+}
+
+int vtkNimbusReferenceRenderer::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+int vtkNimbusReferenceRenderer::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  if (this->SceneFileName.empty())
+  {
+    vtkErrorMacro(<< "No SceneFileName given.");
+    return 0;
+  }
+  nimbus::SceneDescription scene;
+  try
+  {
+    scene = nimbus::LoadScene(this->SceneFileName);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+    return 0;
+  }
+  const int extent[6] = { 0, scene.Camera.Width - 1, 0, scene.Camera.Height - 1, 0, 0 };
+  const double origin[3] = { 0.0, 0.0, 0.0 };
+  const double spacing[3] = { 1.0, 1.0, 1.0 };
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
+  outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 3);
+  return 1;
+}
+
+int vtkNimbusReferenceRenderer::RequestUpdateExtent(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector*)
+{
+  // The whole density volume, whatever part of the image is asked for.
+  if (vtkInformation* inInfo = inputVector[0]->GetInformationObject(0))
+  {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+  }
+  return 1;
+}
+
+int vtkNimbusReferenceRenderer::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  output->Initialize();
+
+  nimbus::SceneDescription scene;
+  try
+  {
+    scene = nimbus::LoadScene(this->SceneFileName);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+    return 0;
+  }
+
+  // The density: the connected image, or the scene's own.
+  vtkSmartPointer<vtkImageData> volume = vtkImageData::GetData(inputVector[0], 0);
+  std::string arrayName = this->DensityArrayName;
+  if (!volume)
+  {
+    vtkNew<vtkNimbusSceneDensitySource> sceneDensity;
+    sceneDensity->SetSceneFileName(this->SceneFileName.c_str());
+    sceneDensity->Update();
+    volume = sceneDensity->GetOutput();
+    arrayName = "density";
+    if (volume->GetNumberOfPoints() == 0)
+    {
+      vtkErrorMacro(<< this->SceneFileName << ": no density volume (see the errors above).");
+      return 0;
+    }
+  }
+  vtkDataArray* values = volume->GetPointData()->GetArray(arrayName.c_str());
+  if (!values || values->GetNumberOfComponents() != 1)
+  {
+    vtkErrorMacro(<< "The density input has no one-component point array '" << arrayName << "'.");
+    return 0;
+  }
+
+  std::unique_ptr<nimbus::RenderContext> context;
+  try
+  {
+    nimbus::DensityGrid grid;
+    try
+    {
+      grid = ToDensityGrid(volume, values);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      throw std::invalid_argument("density array '" + arrayName + "': " + error.what());
+    }
+    context = std::make_unique<nimbus::RenderContext>(scene, std::move(grid));
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+    return 0;
+  }
+
+  // Progress comes from worker threads too; only the calling thread reports it.
+  const std::thread::id caller = std::this_thread::get_id();
+  auto progress = [this, caller](double fraction)
+  {
+    if (std::this_thread::get_id() == caller)
+    {
+      this->UpdateProgress(std::min(1.0, std::max(0.0, fraction)));
+    }
+  };
+
+  nimbus::FloatImage radiance, standardError;
+  double estimatedError = 0.0, seconds = 0.0, samplesPerPixel = 0.0;
+  try
+  {
+    if (this->Mode == SINGLE_SCATTERING)
+    {
+      nimbus::SingleScatteringSettings settings;
+      settings.StepScale = this->StepScale;
+      settings.RelativeTolerance = this->RelativeTolerance;
+      settings.MaxRefinements = this->MaxRefinements;
+      settings.Threads = this->NumberOfThreads;
+      nimbus::SingleScatteringResult result =
+        nimbus::RenderSingleScattering(*context, settings, progress);
+      radiance = std::move(result.Image);
+      estimatedError = result.EstimatedRelativeError;
+      seconds = result.Seconds;
+    }
+    else
+    {
+      nimbus::PathTracingSettings settings;
+      settings.MinSamplesPerPixel = this->MinSamplesPerPixel;
+      settings.MaxSamplesPerPixel = this->MaxSamplesPerPixel;
+      settings.TargetRelativeError = this->TargetRelativeError;
+      settings.MaxScatteringOrder = this->MaxScatteringOrder;
+      settings.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
+      settings.Threads = this->NumberOfThreads;
+      nimbus::PathTracingResult result = nimbus::RenderPathTraced(*context, settings, progress);
+      radiance = std::move(result.Image);
+      standardError = std::move(result.StandardError);
+      samplesPerPixel = result.MeanSamplesPerPixel;
+      seconds = result.Seconds;
+      // Image-wide relative error: RMS standard error over RMS radiance.
+      double sumError = 0.0, sumValue = 0.0;
+      for (std::size_t i = 0; i < radiance.Pixels.size(); ++i)
+      {
+        sumError += static_cast<double>(standardError.Pixels[i]) * standardError.Pixels[i];
+        sumValue += static_cast<double>(radiance.Pixels[i]) * radiance.Pixels[i];
+      }
+      estimatedError = sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+    }
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< "rendering failed: " << error.what());
+    return 0;
+  }
+
+  output->SetExtent(0, radiance.Width - 1, 0, radiance.Height - 1, 0, 0);
+  output->GetPointData()->SetScalars(ToArray(radiance, "radiance"));
+  if (!standardError.Pixels.empty())
+  {
+    output->GetPointData()->AddArray(ToArray(standardError, "standard_error"));
+  }
+  vtkFieldData* fieldData = output->GetFieldData();
+  AddFieldValue(fieldData, "EstimatedRelativeError", estimatedError);
+  AddFieldValue(fieldData, "RenderSeconds", seconds);
+  AddFieldValue(fieldData, "SamplesPerPixel", samplesPerPixel);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SceneFileName: " << this->SceneFileName << "\n";
+  os << indent << "DensityArrayName: " << this->DensityArrayName << "\n";
+  os << indent << "Mode: " << (this->Mode == SINGLE_SCATTERING ? "SingleScattering" : "PathTracing")
+     << "\n";
+  os << indent << "StepScale: " << this->StepScale << "\n";
+  os << indent << "RelativeTolerance: " << this->RelativeTolerance << "\n";
+  os << indent << "MaxRefinements: " << this->MaxRefinements << "\n";
+  os << indent << "MinSamplesPerPixel: " << this->MinSamplesPerPixel << "\n";
+  os << indent << "MaxSamplesPerPixel: " << this->MaxSamplesPerPixel << "\n";
+  os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
+  os << indent << "MaxScatteringOrder: " << this->MaxScatteringOrder << "\n";
+  os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+}

@@ -1,0 +1,126 @@
+/**
+ * @class   vtkNimbusReferenceRenderer
+ * @brief   Ground-truth renderer of a Nimbus scene: float linear-sRGB image.
+ *
+ * Thin VTK glue around the plain-C++ reference renderers in Reference/:
+ * - SingleScattering (deterministic): integrates 000 Eq. 1 per pixel (cloud +
+ *   atmosphere + ground + background), halving the step until the estimated
+ *   relative error is below RelativeTolerance.
+ * - PathTracing (Monte Carlo, full multiple scattering): progressive, per-pixel
+ *   standard error, stops at TargetRelativeError or MaxSamplesPerPixel;
+ *   deterministic for a Seed.
+ *
+ * The scene comes from SceneFileName (JSON, docs/scene-format.md). Its density
+ * is the scene's own (a .vti file or the metaball source) unless a vtkImageData
+ * is connected to input port 0 (optional), whose array DensityArrayName (point
+ * data, any numeric type) is used instead, placed by its origin and spacing.
+ * NaN, infinite or negative densities are an error naming the array.
+ *
+ * Output: vtkImageData of Width x Height points with the 3-component float
+ * point array "radiance" (linear sRGB, relative units: the sun's illuminance is
+ * the scene's sun.illuminance) and, for path tracing, "standard_error"; field
+ * data "EstimatedRelativeError", "RenderSeconds", "SamplesPerPixel".
+ */
+#ifndef vtkNimbusReferenceRenderer_h
+#define vtkNimbusReferenceRenderer_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkImageAlgorithm.h"
+
+#include <string> // for std::string
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusReferenceRenderer : public vtkImageAlgorithm
+{
+public:
+  static vtkNimbusReferenceRenderer* New();
+  vtkTypeMacro(vtkNimbusReferenceRenderer, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Modes
+  {
+    SINGLE_SCATTERING = 0,
+    PATH_TRACING = 1
+  };
+
+  ///@{
+  /// The scene file (JSON). Required.
+  vtkSetStdStringFromCharMacro(SceneFileName);
+  vtkGetCharFromStdStringMacro(SceneFileName);
+  ///@}
+
+  ///@{
+  /// Point-data array of the optional input image used as density. Default "density".
+  vtkSetStdStringFromCharMacro(DensityArrayName);
+  vtkGetCharFromStdStringMacro(DensityArrayName);
+  ///@}
+
+  ///@{
+  /// SINGLE_SCATTERING (default) or PATH_TRACING.
+  vtkSetClampMacro(Mode, int, SINGLE_SCATTERING, PATH_TRACING);
+  vtkGetMacro(Mode, int);
+  void SetModeToSingleScattering() { this->SetMode(SINGLE_SCATTERING); }
+  void SetModeToPathTracing() { this->SetMode(PATH_TRACING); }
+  ///@}
+
+  ///@{
+  /// Single scattering: initial step as a fraction of the grid's smallest
+  /// spacing, the relative error to converge to, and the most step halvings.
+  /// Defaults 0.5, 1e-3, 6.
+  vtkSetMacro(StepScale, double);
+  vtkGetMacro(StepScale, double);
+  vtkSetMacro(RelativeTolerance, double);
+  vtkGetMacro(RelativeTolerance, double);
+  vtkSetMacro(MaxRefinements, int);
+  vtkGetMacro(MaxRefinements, int);
+  ///@}
+
+  ///@{
+  /// Path tracing: samples per pixel (min, max), the per-pixel relative standard
+  /// error to stop at (0: run to the max), the highest scattering order (0:
+  /// unlimited, 1: single scattering) and the seed. Defaults 16, 256, 0, 0, 1.
+  vtkSetMacro(MinSamplesPerPixel, int);
+  vtkGetMacro(MinSamplesPerPixel, int);
+  vtkSetMacro(MaxSamplesPerPixel, int);
+  vtkGetMacro(MaxSamplesPerPixel, int);
+  vtkSetMacro(TargetRelativeError, double);
+  vtkGetMacro(TargetRelativeError, double);
+  vtkSetMacro(MaxScatteringOrder, int);
+  vtkGetMacro(MaxScatteringOrder, int);
+  vtkSetMacro(Seed, int);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /// Worker threads (0: all cores). Default 0.
+  vtkSetMacro(NumberOfThreads, int);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
+protected:
+  vtkNimbusReferenceRenderer();
+  ~vtkNimbusReferenceRenderer() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  std::string SceneFileName;
+  std::string DensityArrayName = "density";
+  int Mode = SINGLE_SCATTERING;
+  double StepScale = 0.5;
+  double RelativeTolerance = 1e-3;
+  int MaxRefinements = 6;
+  int MinSamplesPerPixel = 16;
+  int MaxSamplesPerPixel = 256;
+  double TargetRelativeError = 0.0;
+  int MaxScatteringOrder = 0;
+  int Seed = 1;
+  int NumberOfThreads = 0;
+
+private:
+  vtkNimbusReferenceRenderer(const vtkNimbusReferenceRenderer&) = delete;
+  void operator=(const vtkNimbusReferenceRenderer&) = delete;
+};
+
+#endif

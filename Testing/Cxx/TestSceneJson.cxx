@@ -1,0 +1,669 @@
+// The versioned JSON scene file (Representations/Reference/SceneJson.h,
+// docs/scene-format.md): the project's scenes parse, round trip, hashing,
+// error messages (each starts with the key path), sun.direction, relative paths.
+#include "SceneJson.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#ifndef NIMBUS_SCENES_DIR
+#error "NIMBUS_SCENES_DIR must name Data/Scenes"
+#endif
+
+namespace
+{
+namespace fs = std::filesystem;
+using nimbus::SceneDescription;
+using Json = nlohmann::ordered_json;
+
+/// Field-by-field comparison (SceneDescription has no operator==).
+void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
+{
+  EXPECT_EQ(a.Name, b.Name);
+  EXPECT_EQ(a.Description, b.Description);
+  EXPECT_EQ(a.Camera.Position, b.Camera.Position);
+  EXPECT_EQ(a.Camera.FocalPoint, b.Camera.FocalPoint);
+  EXPECT_EQ(a.Camera.ViewUp, b.Camera.ViewUp);
+  EXPECT_EQ(a.Camera.ViewAngle, b.Camera.ViewAngle);
+  EXPECT_EQ(a.Camera.Width, b.Camera.Width);
+  EXPECT_EQ(a.Camera.Height, b.Camera.Height);
+  EXPECT_EQ(a.Medium.Density.Type, b.Medium.Density.Type);
+  EXPECT_EQ(a.Medium.Density.Path, b.Medium.Density.Path);
+  EXPECT_EQ(a.Medium.Density.ArrayName, b.Medium.Density.ArrayName);
+  EXPECT_EQ(a.Medium.Density.Parameters, b.Medium.Density.Parameters);
+  EXPECT_EQ(a.Medium.ExtinctionPerDensity, b.Medium.ExtinctionPerDensity);
+  EXPECT_EQ(a.Medium.SingleScatteringAlbedo, b.Medium.SingleScatteringAlbedo);
+  ASSERT_EQ(a.Medium.Phase.size(), b.Medium.Phase.size());
+  for (std::size_t i = 0; i < a.Medium.Phase.size(); ++i)
+  {
+    EXPECT_EQ(a.Medium.Phase[i].Type, b.Medium.Phase[i].Type);
+    EXPECT_EQ(a.Medium.Phase[i].G, b.Medium.Phase[i].G);
+    EXPECT_EQ(a.Medium.Phase[i].Weight, b.Medium.Phase[i].Weight);
+  }
+  EXPECT_EQ(a.Sun.Azimuth, b.Sun.Azimuth);
+  EXPECT_EQ(a.Sun.Elevation, b.Sun.Elevation);
+  EXPECT_EQ(a.Sun.Illuminance, b.Sun.Illuminance);
+  EXPECT_EQ(a.Sun.Temperature, b.Sun.Temperature);
+  const auto &x = a.Atmosphere, &y = b.Atmosphere;
+  EXPECT_EQ(x.Enabled, y.Enabled);
+  EXPECT_EQ(x.SceneAltitude, y.SceneAltitude);
+  EXPECT_EQ(x.EarthRadius, y.EarthRadius);
+  EXPECT_EQ(x.TopRadius, y.TopRadius);
+  EXPECT_EQ(x.RayleighScattering550, y.RayleighScattering550);
+  EXPECT_EQ(x.RayleighScaleHeight, y.RayleighScaleHeight);
+  EXPECT_EQ(x.MieScattering, y.MieScattering);
+  EXPECT_EQ(x.MieScaleHeight, y.MieScaleHeight);
+  EXPECT_EQ(x.MieAlbedo, y.MieAlbedo);
+  EXPECT_EQ(x.MieG, y.MieG);
+  EXPECT_EQ(a.Ground.Enabled, b.Ground.Enabled);
+  EXPECT_EQ(a.Ground.Height, b.Ground.Height);
+  EXPECT_EQ(a.Ground.Albedo, b.Ground.Albedo);
+  EXPECT_EQ(a.Background.Type, b.Background.Type);
+  EXPECT_EQ(a.Background.Radiance, b.Background.Radiance);
+  EXPECT_EQ(a.SpectralSamples, b.SpectralSamples);
+}
+
+/// The smallest valid scene text.
+Json MinimalJson()
+{
+  return Json::parse(R"({
+    "nimbus_scene": 1,
+    "camera": { "position": [0, -6000, 1500], "focal_point": [0, 0, 1600] },
+    "medium": { "density": { "type": "metaball_cloud" }, "extinction_per_density": 0.02 },
+    "sun": { "azimuth": 135, "elevation": 45 }
+  })");
+}
+
+SceneDescription Parse(const Json& j, const std::string& base = "/scenes")
+{
+  return nimbus::ParseScene(j.dump(), base);
+}
+
+/// A scene in which every field differs from the struct defaults.
+SceneDescription NonDefaultScene()
+{
+  SceneDescription s;
+  s.Name = "everything";
+  s.Description = "Every field set; \"quotes\", unicode \u00b0 and\nnewlines.";
+  s.Camera.Position = { { 1.25, -7000.5, 1234.0 } };
+  s.Camera.FocalPoint = { { 10.0, 20.0, 1700.0 } };
+  s.Camera.ViewUp = { { 0.1, 0.0, 1.0 } };
+  s.Camera.ViewAngle = 27.5;
+  s.Camera.Width = 320;
+  s.Camera.Height = 240;
+  s.Medium.Density.Type = "file";
+  s.Medium.Density.Path = "/data/clouds/cloud.vti";
+  s.Medium.Density.ArrayName = "lwc";
+  s.Medium.ExtinctionPerDensity = 0.0375;
+  s.Medium.SingleScatteringAlbedo = 0.999;
+  s.Medium.Phase = { { "henyey_greenstein", 0.9, 0.7 }, { "henyey_greenstein", -0.3, 0.3 },
+    { "isotropic", 0.85, 0.1 } };
+  s.Sun = { 271.5, 12.25, 3.5, 6000.0 };
+  s.Atmosphere.Enabled = false;
+  s.Atmosphere.SceneAltitude = 250.0;
+  s.Atmosphere.EarthRadius = 6371000.0;
+  s.Atmosphere.TopRadius = 6471000.0;
+  s.Atmosphere.RayleighScattering550 = 1.1e-5;
+  s.Atmosphere.RayleighScaleHeight = 8500.0;
+  s.Atmosphere.MieScattering = 1.0e-4;
+  s.Atmosphere.MieScaleHeight = 900.0;
+  s.Atmosphere.MieAlbedo = 0.95;
+  s.Atmosphere.MieG = 0.7;
+  s.Ground = { false, 12.0, 0.35 };
+  s.Background = { "constant", 0.125 };
+  s.SpectralSamples = 24;
+  return s;
+}
+
+SceneDescription MetaballScene()
+{
+  SceneDescription s;
+  s.Name = "metaballs";
+  s.Medium.Density.Parameters = { { "Dimensions", { 64, 48, 32 } },
+    { "Bounds", { -1000, 1000, -900, 900, 700, 2500 } }, { "Seed", { -7 } },
+    { "NumberOfLevels", { 2 } }, { "NumberOfBaseBalls", { 12 } },
+    { "BaseBallRadiusRange", { 300, 550.5 } }, { "FootprintRadius", { 650 } },
+    { "TowerHeight", { 500 } }, { "BallsPerLevel", { 40 } }, { "BallCountFactor", { 1.5 } },
+    { "RadiusScalePerLevel", { 0.45 } }, { "BallDensity", { 0.8 } }, { "IsoValue", { 0.4 } },
+    { "FlatBase", { 0 } }, { "BaseHeight", { 900 } }, { "BaseTransitionThickness", { 80 } } };
+  return s;
+}
+
+/// Expects ParseScene to throw std::invalid_argument whose message starts with `prefix`.
+void ExpectErrorText(const std::string& text, const std::string& prefix)
+{
+  try
+  {
+    nimbus::ParseScene(text, "/scenes");
+    ADD_FAILURE() << "no error; expected one starting with '" << prefix << "' for\n" << text;
+  }
+  catch (const std::invalid_argument& error)
+  {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind(prefix, 0), 0u)
+      << "message: " << message << "\nexpected prefix: " << prefix;
+  }
+}
+
+void ExpectError(const Json& j, const std::string& prefix)
+{
+  ExpectErrorText(j.dump(), prefix);
+}
+
+/// MinimalJson with one value set (JSON pointer) or removed (value omitted).
+Json With(const std::string& pointer, const Json& value)
+{
+  Json j = MinimalJson();
+  j[Json::json_pointer(pointer)] = value;
+  return j;
+}
+
+Json Without(const std::string& pointer)
+{
+  Json j = MinimalJson();
+  const Json::json_pointer p(pointer);
+  j[p.parent_pointer()].erase(p.back());
+  return j;
+}
+
+fs::path MakeTemporaryDirectory(const std::string& name)
+{
+  const fs::path dir = fs::temp_directory_path() /
+    (name + "-" + std::to_string(std::random_device{}()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+TEST(SceneJson, ProjectScenesParse)
+{
+  const std::set<std::string> expected = { "cumulus_noon", "cumulus_sunset", "silver_lining",
+    "haze_shafts", "cumulonimbus" };
+  std::set<std::string> found;
+  for (const auto& entry : fs::directory_iterator(NIMBUS_SCENES_DIR))
+  {
+    if (entry.path().extension() != ".json")
+    {
+      continue;
+    }
+    SCOPED_TRACE(entry.path().string());
+    SceneDescription scene;
+    ASSERT_NO_THROW(scene = nimbus::LoadScene(entry.path().string()));
+    found.insert(entry.path().stem().string());
+    EXPECT_EQ(scene.Name, entry.path().stem().string());
+    EXPECT_FALSE(scene.Description.empty());
+    // Small by default, everything generated (no data file needed).
+    EXPECT_LE(scene.Camera.Width * scene.Camera.Height, 320 * 256);
+    EXPECT_EQ(scene.SpectralSamples, 16);
+    EXPECT_EQ(scene.Medium.Density.Type, "metaball_cloud");
+    for (const auto& p : scene.Medium.Density.Parameters)
+    {
+      if (p.first == "Dimensions")
+      {
+        EXPECT_LE(p.second[0] * p.second[1] * p.second[2], 1.0e6) << "grid too large to render fast";
+      }
+    }
+    ExpectSameScene(nimbus::ParseScene(nimbus::SceneToJson(scene), ""), scene);
+  }
+  EXPECT_EQ(found, expected);
+}
+
+TEST(SceneJson, ProjectScenesPhysics)
+{
+  const std::string dir = NIMBUS_SCENES_DIR;
+  const SceneDescription noon = nimbus::LoadScene(dir + "/cumulus_noon.json");
+  const SceneDescription sunset = nimbus::LoadScene(dir + "/cumulus_sunset.json");
+  const SceneDescription silver = nimbus::LoadScene(dir + "/silver_lining.json");
+  const SceneDescription haze = nimbus::LoadScene(dir + "/haze_shafts.json");
+  const SceneDescription cb = nimbus::LoadScene(dir + "/cumulonimbus.json");
+  EXPECT_NEAR(noon.Sun.Elevation, 65.0, 5.0);
+  EXPECT_NEAR(sunset.Sun.Elevation, 5.0, 0.5);
+  EXPECT_EQ(noon.Medium.Density.Parameters, sunset.Medium.Density.Parameters); // same cloud
+  EXPECT_EQ(noon.Camera.Position, sunset.Camera.Position);
+  EXPECT_TRUE(noon.Atmosphere.Enabled && noon.Ground.Enabled);
+  EXPECT_EQ(noon.Background.Type, "atmosphere");
+  // Silver lining: the camera looks toward the sun.
+  const double kDegree = 3.14159265358979323846 / 180.0;
+  const double sunToward[3] = { std::cos(silver.Sun.Elevation * kDegree) *
+      std::sin(silver.Sun.Azimuth * kDegree),
+    std::cos(silver.Sun.Elevation * kDegree) * std::cos(silver.Sun.Azimuth * kDegree),
+    std::sin(silver.Sun.Elevation * kDegree) };
+  double view[3], length = 0.0, dot = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    view[a] = silver.Camera.FocalPoint[a] - silver.Camera.Position[a];
+    length += view[a] * view[a];
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    dot += view[a] / std::sqrt(length) * sunToward[a];
+  }
+  EXPECT_GT(dot, std::cos(15.0 * kDegree));
+  EXPECT_GE(silver.Medium.Phase.at(0).G, 0.8);
+  EXPECT_GE(haze.Atmosphere.MieScattering, 5.0e-5);
+  EXPECT_LT(haze.Atmosphere.MieScaleHeight, 1200.0);
+  EXPECT_GE(cb.Medium.ExtinctionPerDensity, 0.1);
+  EXPECT_NE(cb.Description.find("optical thickness"), std::string::npos);
+}
+
+TEST(SceneJson, RoundTrip)
+{
+  for (const SceneDescription& s : { SceneDescription{}, NonDefaultScene(), MetaballScene() })
+  {
+    SCOPED_TRACE(s.Name);
+    const std::string text = nimbus::SceneToJson(s);
+    const SceneDescription back = nimbus::ParseScene(text, "/elsewhere");
+    ExpectSameScene(back, s);
+    EXPECT_EQ(nimbus::SceneToJson(back), text);
+  }
+}
+
+TEST(SceneJson, DefaultsOfOptionalKeys)
+{
+  const SceneDescription s = Parse(MinimalJson());
+  const SceneDescription d;
+  SceneDescription expected = d;
+  expected.Camera.FocalPoint = { { 0.0, 0.0, 1600.0 } };
+  ExpectSameScene(s, expected);
+  EXPECT_TRUE(s.Medium.Density.Parameters.empty());
+}
+
+TEST(SceneJson, CanonicalForm)
+{
+  const std::string text = nimbus::SceneToJson(MetaballScene());
+  // Fixed key order, integers and booleans where the property is one.
+  EXPECT_LT(text.find("\"nimbus_scene\": 1"), text.find("\"camera\""));
+  EXPECT_NE(text.find("\"Seed\": -7"), std::string::npos);
+  EXPECT_NE(text.find("\"FlatBase\": false"), std::string::npos);
+  EXPECT_NE(text.find("\"width\": 256"), std::string::npos);
+  EXPECT_EQ(text.back(), '\n');
+  // Parameters are stored in the source's property order, whatever the text's order.
+  Json j = With("/medium/density/parameters", Json::parse(R"({"Seed": 4, "Dimensions": [8, 8, 8]})"));
+  const SceneDescription s = Parse(j);
+  ASSERT_EQ(s.Medium.Density.Parameters.size(), 2u);
+  EXPECT_EQ(s.Medium.Density.Parameters[0].first, "Dimensions");
+  EXPECT_EQ(s.Medium.Density.Parameters[1].first, "Seed");
+  j = With("/medium/density/parameters", Json::parse(R"({"Dimensions": [8, 8, 8], "Seed": [4]})"));
+  EXPECT_EQ(nimbus::SceneHash(Parse(j)), nimbus::SceneHash(s));
+}
+
+TEST(SceneJson, HashStable)
+{
+  const SceneDescription s = NonDefaultScene();
+  const std::string hash = nimbus::SceneHash(s);
+  ASSERT_EQ(hash.size(), 16u);
+  EXPECT_EQ(hash.find_first_not_of("0123456789abcdef"), std::string::npos);
+  EXPECT_EQ(nimbus::SceneHash(s), hash);
+  // Pinned: the canonical form (and so every cached reference image's key) changes only
+  // on purpose. Update this when a field is added or the format changes deliberately.
+  EXPECT_EQ(hash, "5884e4b0bb036ec3");
+  EXPECT_EQ(nimbus::SceneHash(nimbus::ParseScene(nimbus::SceneToJson(s), "")), hash);
+  // Formatting and key order of the text do not matter, only the description.
+  Json a = MinimalJson(), b = Json::parse(R"({
+    "sun": {"elevation": 45.0, "azimuth": 135},
+    "medium": {"extinction_per_density": 2e-2, "density": {"type": "metaball_cloud"}},
+    "camera": {"focal_point": [0, 0, 1600], "position": [0.0, -6000, 1.5e3]},
+    "nimbus_scene": 1})");
+  EXPECT_EQ(nimbus::SceneHash(Parse(a)), nimbus::SceneHash(Parse(b)));
+}
+
+TEST(SceneJson, HashSensitiveToEveryField)
+{
+  using Mutation = std::pair<const char*, std::function<void(SceneDescription&)>>;
+  const std::vector<Mutation> mutations = {
+    { "Name", [](SceneDescription& s) { s.Name += "x"; } },
+    { "Description", [](SceneDescription& s) { s.Description += "x"; } },
+    { "Camera.Position", [](SceneDescription& s) { s.Camera.Position[0] += 1; } },
+    { "Camera.Position[2]", [](SceneDescription& s) { s.Camera.Position[2] += 1e-9; } },
+    { "Camera.FocalPoint", [](SceneDescription& s) { s.Camera.FocalPoint[1] += 1; } },
+    { "Camera.ViewUp", [](SceneDescription& s) { s.Camera.ViewUp[0] += 0.1; } },
+    { "Camera.ViewAngle", [](SceneDescription& s) { s.Camera.ViewAngle += 1; } },
+    { "Camera.Width", [](SceneDescription& s) { s.Camera.Width += 1; } },
+    { "Camera.Height", [](SceneDescription& s) { s.Camera.Height += 1; } },
+    { "Density.Type", [](SceneDescription& s) { s.Medium.Density.Type = "metaball_cloud"; } },
+    { "Density.Path", [](SceneDescription& s) { s.Medium.Density.Path += "x"; } },
+    { "Density.ArrayName", [](SceneDescription& s) { s.Medium.Density.ArrayName += "x"; } },
+    { "Density.Parameters",
+      [](SceneDescription& s) { s.Medium.Density.Parameters.push_back({ "Seed", { 2 } }); } },
+    { "ExtinctionPerDensity", [](SceneDescription& s) { s.Medium.ExtinctionPerDensity *= 1.01; } },
+    { "SingleScatteringAlbedo",
+      [](SceneDescription& s) { s.Medium.SingleScatteringAlbedo -= 0.001; } },
+    { "Phase.size", [](SceneDescription& s) { s.Medium.Phase.pop_back(); } },
+    { "Phase.Type", [](SceneDescription& s) { s.Medium.Phase[0].Type = "cornette_shanks"; } },
+    { "Phase.G", [](SceneDescription& s) { s.Medium.Phase[1].G += 0.01; } },
+    { "Phase.Weight", [](SceneDescription& s) { s.Medium.Phase[2].Weight += 0.01; } },
+    { "Sun.Azimuth", [](SceneDescription& s) { s.Sun.Azimuth += 1; } },
+    { "Sun.Elevation", [](SceneDescription& s) { s.Sun.Elevation += 1; } },
+    { "Sun.Illuminance", [](SceneDescription& s) { s.Sun.Illuminance += 1; } },
+    { "Sun.Temperature", [](SceneDescription& s) { s.Sun.Temperature += 1; } },
+    { "Atmosphere.Enabled", [](SceneDescription& s) { s.Atmosphere.Enabled = true; } },
+    { "Atmosphere.SceneAltitude", [](SceneDescription& s) { s.Atmosphere.SceneAltitude += 1; } },
+    { "Atmosphere.EarthRadius", [](SceneDescription& s) { s.Atmosphere.EarthRadius += 1; } },
+    { "Atmosphere.TopRadius", [](SceneDescription& s) { s.Atmosphere.TopRadius += 1; } },
+    { "Atmosphere.RayleighScattering550",
+      [](SceneDescription& s) { s.Atmosphere.RayleighScattering550 *= 1.01; } },
+    { "Atmosphere.RayleighScaleHeight",
+      [](SceneDescription& s) { s.Atmosphere.RayleighScaleHeight += 1; } },
+    { "Atmosphere.MieScattering", [](SceneDescription& s) { s.Atmosphere.MieScattering *= 1.01; } },
+    { "Atmosphere.MieScaleHeight", [](SceneDescription& s) { s.Atmosphere.MieScaleHeight += 1; } },
+    { "Atmosphere.MieAlbedo", [](SceneDescription& s) { s.Atmosphere.MieAlbedo -= 0.01; } },
+    { "Atmosphere.MieG", [](SceneDescription& s) { s.Atmosphere.MieG += 0.01; } },
+    { "Ground.Enabled", [](SceneDescription& s) { s.Ground.Enabled = true; } },
+    { "Ground.Height", [](SceneDescription& s) { s.Ground.Height += 1; } },
+    { "Ground.Albedo", [](SceneDescription& s) { s.Ground.Albedo += 0.01; } },
+    { "Background.Type", [](SceneDescription& s) { s.Background.Type = "black"; } },
+    { "Background.Radiance", [](SceneDescription& s) { s.Background.Radiance += 0.01; } },
+    { "SpectralSamples", [](SceneDescription& s) { s.SpectralSamples += 1; } },
+  };
+  const SceneDescription base = NonDefaultScene();
+  std::set<std::string> hashes = { nimbus::SceneHash(base) };
+  for (const auto& mutation : mutations)
+  {
+    SceneDescription changed = base;
+    mutation.second(changed);
+    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
+      << "changing " << mutation.first << " did not change the hash";
+  }
+  // And each metaball parameter's value.
+  const SceneDescription metaballs = MetaballScene();
+  hashes = { nimbus::SceneHash(metaballs) };
+  for (std::size_t i = 0; i < metaballs.Medium.Density.Parameters.size(); ++i)
+  {
+    SceneDescription changed = metaballs;
+    auto& values = changed.Medium.Density.Parameters[i].second;
+    values.back() = values.back() == 0.0 ? 1.0 : values.back() + 1.0;
+    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
+      << "changing " << metaballs.Medium.Density.Parameters[i].first;
+  }
+}
+
+TEST(SceneJson, Errors)
+{
+  // Syntax, top level and version.
+  ExpectErrorText("{\"nimbus_scene\": 1,", "scene");
+  ExpectErrorText("[1, 2]", "scene: expected an object");
+  ExpectError(Without("/nimbus_scene"), "scene: missing required key \"nimbus_scene\"");
+  ExpectError(With("/nimbus_scene", 2), "scene.nimbus_scene: unsupported format version 2");
+  ExpectError(With("/nimbus_scene", 0), "scene.nimbus_scene: unsupported format version 0");
+  ExpectError(With("/nimbus_scene", "1"), "scene.nimbus_scene: expected the format version");
+  ExpectError(With("/nimbus_scene", 1.5), "scene.nimbus_scene: expected the format version");
+  ExpectError(With("/colour", 1), "scene.colour: unknown key (known: nimbus_scene, name,");
+  ExpectErrorText(R"({"nimbus_scene": 1, "nimbus_scene": 1})", "scene.nimbus_scene: duplicate key");
+  ExpectErrorText(R"({"nimbus_scene": 1, "sun": {"elevation": 1, "elevation": 2}})",
+    "scene.sun.elevation: duplicate key");
+  ExpectError(With("/name", 3), "scene.name: expected a string, got 3");
+  ExpectError(With("/spectral_samples", 2), "scene.spectral_samples: expected an integer in [3, 256], got 2");
+  ExpectError(With("/spectral_samples", 16.5), "scene.spectral_samples: expected an integer");
+  // Huge numbers (JSON cannot hold NaN or Inf; 1e999 overflows).
+  {
+    std::string text = MinimalJson().dump();
+    const std::string key = "\"elevation\":45";
+    ASSERT_NE(text.find(key), std::string::npos);
+    text.replace(text.find(key), key.size(), "\"elevation\":1e999");
+    ExpectErrorText(text, "scene.sun.elevation: invalid JSON");
+  }
+
+  // Required sections and keys.
+  ExpectError(Without("/camera"), "scene: missing required key \"camera\"");
+  ExpectError(Without("/medium"), "scene: missing required key \"medium\"");
+  ExpectError(Without("/sun"), "scene: missing required key \"sun\"");
+  ExpectError(Without("/sun/elevation"), "scene.sun: missing required key \"elevation\"");
+  ExpectError(Without("/sun/azimuth"), "scene.sun: missing required key \"azimuth\"");
+  ExpectError(Without("/camera/position"), "scene.camera: missing required key \"position\"");
+  ExpectError(Without("/medium/density"), "scene.medium: missing required key \"density\"");
+  ExpectError(Without("/medium/density/type"), "scene.medium.density: missing required key \"type\"");
+  ExpectError(Without("/medium/extinction_per_density"),
+    "scene.medium: missing required key \"extinction_per_density\"");
+
+  // Camera.
+  ExpectError(With("/camera/posiiton", Json::array({ 0, 0, 0 })),
+    "scene.camera.posiiton: unknown key (known: position, focal_point, view_up, view_angle, width, height)");
+  ExpectError(With("/camera", 5), "scene.camera: expected an object, got 5");
+  ExpectError(With("/camera/position", Json::array({ 0, 0 })),
+    "scene.camera.position: expected an array of 3 numbers, got 2 elements");
+  ExpectError(With("/camera/position", Json::array({ 0, "a", 0 })),
+    "scene.camera.position[1]: expected a finite number, got the string \"a\"");
+  ExpectError(With("/camera/focal_point", Json::array({ 0, -6000, 1500 })),
+    "scene.camera.focal_point: must differ from camera.position");
+  ExpectError(With("/camera/view_up", Json::array({ 0, 6000, 100 })), "scene.camera.view_up:");
+  ExpectError(With("/camera/view_up", Json::array({ 0, 0, 0 })), "scene.camera.view_up:");
+  ExpectError(With("/camera/view_angle", 180), "scene.camera.view_angle: expected a number in (0, 180), got 180");
+  ExpectError(With("/camera/width", 0), "scene.camera.width: expected an integer in [1, 16384], got 0");
+  ExpectError(With("/camera/height", -5), "scene.camera.height: expected an integer in [1, 16384], got -5");
+  ExpectError(With("/camera/width", true), "scene.camera.width: expected an integer in [1, 16384], got the boolean true");
+
+  // Medium.
+  ExpectError(With("/medium/extinction_per_density", -1),
+    "scene.medium.extinction_per_density: expected a number >= 0, got -1");
+  ExpectError(With("/medium/extinction_per_density", "0.02"),
+    "scene.medium.extinction_per_density: expected a number >= 0, got the string \"0.02\"");
+  ExpectError(With("/medium/single_scattering_albedo", 1.01),
+    "scene.medium.single_scattering_albedo: expected a number in [0, 1], got 1.01");
+  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "cornette_shanks", "g": 1.5}])")),
+    "scene.medium.phase[0].g: expected a number in [-1, 1], got 1.5");
+  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic"}, {"type": "mie", "g": 0.5}])")),
+    "scene.medium.phase[1].type: unknown value \"mie\" (known: isotropic, rayleigh, henyey_greenstein, cornette_shanks)");
+  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "henyey_greenstein"}])")),
+    "scene.medium.phase[0]: missing required key \"g\"");
+  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic", "weight": -1}])")),
+    "scene.medium.phase[0].weight: expected a number >= 0, got -1");
+  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic", "weight": 0}])")),
+    "scene.medium.phase: the weights must not all be zero");
+  ExpectError(With("/medium/phase", Json::array()), "scene.medium.phase: expected at least one");
+  ExpectError(With("/medium/phase", "isotropic"), "scene.medium.phase: expected a phase component");
+  ExpectError(With("/medium/phase", Json::parse(R"({"type": "isotropic", "gg": 1})")),
+    "scene.medium.phase.gg: unknown key");
+  ExpectError(With("/medium/density/type", "vdb"),
+    "scene.medium.density.type: unknown value \"vdb\" (known: file, metaball_cloud)");
+  ExpectError(With("/medium/density", Json::parse(R"({"type": "file"})")),
+    "scene.medium.density: missing required key \"path\"");
+  ExpectError(With("/medium/density", Json::parse(R"({"type": "file", "path": ""})")),
+    "scene.medium.density.path: expected a non-empty string");
+  ExpectError(With("/medium/density", Json::parse(R"({"type": "file", "path": "a.vti", "parameters": {"Seed": 1}})")),
+    "scene.medium.density.parameters: only used by type \"metaball_cloud\"");
+  ExpectError(With("/medium/density/path", "a.vti"), "scene.medium.density.path: only used by type \"file\"");
+  ExpectError(With("/medium/density/array", "lwc"), "scene.medium.density.array:");
+
+  // Metaball parameters: names, counts, values.
+  const std::string parameters = "/medium/density/parameters";
+  ExpectError(With(parameters + "/Dimension", Json::array({ 8, 8, 8 })),
+    "scene.medium.density.parameters.Dimension: unknown metaball_cloud parameter (known: Dimensions, Bounds, Seed,");
+  ExpectError(With(parameters + "/Dimensions", Json::array({ 8, 8 })),
+    "scene.medium.density.parameters.Dimensions: expected 3 values, got 2");
+  ExpectError(With(parameters + "/Dimensions", 8),
+    "scene.medium.density.parameters.Dimensions: expected an array of 3 numbers, got 8");
+  ExpectError(With(parameters + "/Dimensions", Json::array({ 8, 0, 8 })),
+    "scene.medium.density.parameters.Dimensions[1]: expected an integer in [1, 2048], got 0");
+  ExpectError(With(parameters + "/Dimensions", Json::array({ 8, 8.5, 8 })),
+    "scene.medium.density.parameters.Dimensions[1]: expected an integer");
+  ExpectError(With(parameters + "/Dimensions", Json::array({ 2048, 2048, 2048 })),
+    "scene.medium.density.parameters.Dimensions: too many grid points");
+  ExpectError(With(parameters + "/Bounds", Json::array({ 0, 1, 0, 1, 0 })),
+    "scene.medium.density.parameters.Bounds: expected 6 values, got 5");
+  ExpectError(With(parameters + "/Bounds", Json::array({ 0, 1, 0, 1, 5, 2 })),
+    "scene.medium.density.parameters.Bounds: expected min < max on every axis, axis z has (5, 2)");
+  ExpectError(With(parameters + "/BaseBallRadiusRange", Json::array({ 600, 300 })),
+    "scene.medium.density.parameters.BaseBallRadiusRange: expected min <= max");
+  ExpectError(With(parameters + "/BaseBallRadiusRange", Json::array({ 0, 300 })),
+    "scene.medium.density.parameters.BaseBallRadiusRange[0]: expected a number > 0, got 0");
+  ExpectError(With(parameters + "/Seed", Json::array({ 1, 2 })),
+    "scene.medium.density.parameters.Seed: expected 1 value, got 2");
+  ExpectError(With(parameters + "/Seed", 1e10), "scene.medium.density.parameters.Seed: expected an integer");
+  ExpectError(With(parameters + "/NumberOfBaseBalls", 0),
+    "scene.medium.density.parameters.NumberOfBaseBalls: expected an integer in [1, 100000], got 0");
+  ExpectError(With(parameters + "/TowerHeight", -1),
+    "scene.medium.density.parameters.TowerHeight: expected a number >= 0, got -1");
+  ExpectError(With(parameters + "/RadiusScalePerLevel", 0),
+    "scene.medium.density.parameters.RadiusScalePerLevel: expected a number > 0, got 0");
+  ExpectError(With(parameters + "/FlatBase", "yes"),
+    "scene.medium.density.parameters.FlatBase: expected true or false");
+  ExpectError(With(parameters + "/IsoValue", true),
+    "scene.medium.density.parameters.IsoValue: expected a finite number, got the boolean true");
+  ExpectError(With(parameters, Json::array()), "scene.medium.density.parameters: expected an object");
+
+  // Sun.
+  ExpectError(With("/sun/elevation", 91), "scene.sun.elevation: expected a number in [-90, 90], got 91");
+  ExpectError(With("/sun/azimuth", 1000), "scene.sun.azimuth: expected a number in [-360, 360], got 1000");
+  ExpectError(With("/sun/illuminance", -1), "scene.sun.illuminance: expected a number >= 0, got -1");
+  ExpectError(With("/sun/temperature", 500), "scene.sun.temperature: expected a number in [1000, 100000], got 500");
+  ExpectError(With("/sun/direction", Json::array({ 0, 1, 1 })),
+    "scene.sun.direction: give either direction or azimuth and elevation, not both");
+  {
+    Json j = MinimalJson();
+    j["sun"] = Json::parse(R"({"direction": [0, 0, 0]})");
+    ExpectError(j, "scene.sun.direction: must be a non-zero vector");
+    j["sun"] = Json::parse(R"({"direction": [0, 1]})");
+    ExpectError(j, "scene.sun.direction: expected an array of 3 numbers, got 2 elements");
+    j["sun"] = Json::parse(R"({"direction": [0, 1, 1], "azimuth": 3})");
+    ExpectError(j, "scene.sun.direction: give either");
+  }
+
+  // Atmosphere, ground, background.
+  ExpectError(With("/atmosphere/enabled", 1), "scene.atmosphere.enabled: expected true or false, got 1");
+  ExpectError(With("/atmosphere/top_radius", 6000000), "scene.atmosphere.top_radius: must be greater than earth_radius");
+  ExpectError(With("/atmosphere/earth_radius", 0), "scene.atmosphere.earth_radius: expected a number > 0, got 0");
+  ExpectError(With("/atmosphere/scene_altitude", -1), "scene.atmosphere.scene_altitude: expected a number >= 0, got -1");
+  ExpectError(With("/atmosphere/scene_altitude", 70000), "scene.atmosphere.scene_altitude: must be below the top");
+  ExpectError(With("/atmosphere/mie_scattering", -1e-5), "scene.atmosphere.mie_scattering: expected a number >= 0");
+  ExpectError(With("/atmosphere/mie_scale_height", 0), "scene.atmosphere.mie_scale_height: expected a number > 0");
+  ExpectError(With("/atmosphere/rayleigh_scale_height", -8000), "scene.atmosphere.rayleigh_scale_height: expected a number > 0");
+  ExpectError(With("/atmosphere/mie_albedo", 0), "scene.atmosphere.mie_albedo: expected a number in (0, 1], got 0");
+  ExpectError(With("/atmosphere/mie_g", 1), "scene.atmosphere.mie_g: expected a number in (-1, 1), got 1");
+  ExpectError(With("/atmosphere/ozone", 1), "scene.atmosphere.ozone: unknown key");
+  ExpectError(With("/ground/albedo", 1.5), "scene.ground.albedo: expected a number in [0, 1], got 1.5");
+  ExpectError(With("/ground/height", nullptr), "scene.ground.height: expected a finite number, got null");
+  ExpectError(With("/background/type", "sky"),
+    "scene.background.type: unknown value \"sky\" (known: black, constant, atmosphere)");
+  ExpectError(With("/background/radiance", -0.5), "scene.background.radiance: expected a number >= 0, got -0.5");
+  ExpectError(With("/atmosphere/enabled", false), "scene.background.type: \"atmosphere\" needs atmosphere.enabled");
+}
+
+TEST(SceneJson, PhaseAsSingleObject)
+{
+  const SceneDescription s =
+    Parse(With("/medium/phase", Json::parse(R"({"type": "henyey_greenstein", "g": 0.6})")));
+  ASSERT_EQ(s.Medium.Phase.size(), 1u);
+  EXPECT_EQ(s.Medium.Phase[0].Type, "henyey_greenstein");
+  EXPECT_EQ(s.Medium.Phase[0].G, 0.6);
+  EXPECT_EQ(s.Medium.Phase[0].Weight, 1.0);
+  const SceneDescription iso = Parse(With("/medium/phase", Json::parse(R"({"type": "isotropic"})")));
+  EXPECT_EQ(iso.Medium.Phase[0].Type, "isotropic");
+}
+
+TEST(SceneJson, SunDirection)
+{
+  struct Case
+  {
+    std::array<double, 3> Direction;
+    double Azimuth, Elevation;
+  };
+  const std::vector<Case> cases = {
+    { { { 0, 1, 0 } }, 0, 0 },    // north, on the horizon
+    { { { 1, 0, 0 } }, 90, 0 },   // east
+    { { { 0, -1, 1 } }, 180, 45 }, // south, 45 degrees up
+    { { { -2, 0, 0 } }, 270, 0 }, // west, not unit length
+    { { { 0, 0, 5 } }, 0, 90 },   // zenith: azimuth 0 by convention
+    { { { 1, 1, 0 } }, 45, 0 },
+    { { { 0, 1, -1 } }, 0, -45 }, // below the horizon
+  };
+  for (const Case& c : cases)
+  {
+    Json j = MinimalJson();
+    j["sun"] = Json{ { "direction", c.Direction }, { "illuminance", 2.0 } };
+    const SceneDescription s = Parse(j);
+    EXPECT_NEAR(s.Sun.Azimuth, c.Azimuth, 1e-12) << c.Direction[0] << " " << c.Direction[1];
+    EXPECT_NEAR(s.Sun.Elevation, c.Elevation, 1e-12);
+    EXPECT_EQ(s.Sun.Illuminance, 2.0);
+    EXPECT_FALSE(std::signbit(s.Sun.Azimuth));
+  }
+  // Inverse of RenderContext's (cos e sin a, cos e cos a, sin e).
+  const double kDegree = 3.14159265358979323846 / 180.0;
+  const std::array<double, 3> d{ { 0.3, -0.5, 0.4 } };
+  Json j = MinimalJson();
+  j["sun"] = Json{ { "direction", d } };
+  const SceneDescription s = Parse(j);
+  const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  const double e = s.Sun.Elevation * kDegree, a = s.Sun.Azimuth * kDegree;
+  EXPECT_NEAR(std::cos(e) * std::sin(a), d[0] / n, 1e-12);
+  EXPECT_NEAR(std::cos(e) * std::cos(a), d[1] / n, 1e-12);
+  EXPECT_NEAR(std::sin(e), d[2] / n, 1e-12);
+  // Written back as azimuth/elevation.
+  const std::string text = nimbus::SceneToJson(s);
+  EXPECT_EQ(text.find("direction"), std::string::npos);
+  ExpectSameScene(nimbus::ParseScene(text, ""), s);
+}
+
+TEST(SceneJson, RelativePaths)
+{
+  auto fileScene = [](const std::string& path) {
+    return With("/medium/density", Json{ { "type", "file" }, { "path", path } });
+  };
+  EXPECT_EQ(Parse(fileScene("clouds/a.vti"), "/data/scenes").Medium.Density.Path,
+    "/data/scenes/clouds/a.vti");
+  EXPECT_EQ(Parse(fileScene("../clouds/./a.vti"), "/data/scenes/").Medium.Density.Path,
+    "/data/clouds/a.vti");
+  EXPECT_EQ(Parse(fileScene("/abs/x/../a.vti"), "/data/scenes").Medium.Density.Path, "/abs/a.vti");
+  EXPECT_EQ(Parse(fileScene("a.vti"), "").Medium.Density.Path,
+    (fs::current_path() / "a.vti").lexically_normal().string());
+  const SceneDescription s = Parse(fileScene("a.vti"), "/d");
+  EXPECT_EQ(s.Medium.Density.ArrayName, "density");
+  EXPECT_TRUE(s.Medium.Density.Parameters.empty());
+
+  // LoadScene resolves against the file's directory, wherever the caller is.
+  const fs::path dir = MakeTemporaryDirectory("nimbus-scene-json");
+  fs::create_directories(dir / "scenes");
+  const fs::path file = dir / "scenes" / "s.json";
+  {
+    std::ofstream out(file);
+    out << fileScene("../grids/cloud.vti").dump(2);
+  }
+  EXPECT_EQ(nimbus::LoadScene(file.string()).Medium.Density.Path,
+    (dir / "grids" / "cloud.vti").lexically_normal().string());
+  const fs::path previous = fs::current_path();
+  fs::current_path(dir);
+  EXPECT_EQ(nimbus::LoadScene("scenes/s.json").Medium.Density.Path,
+    (dir / "grids" / "cloud.vti").lexically_normal().string());
+  fs::current_path(previous);
+
+  // LoadScene's errors name the file.
+  const std::string missing = (dir / "missing.json").string();
+  try
+  {
+    nimbus::LoadScene(missing);
+    ADD_FAILURE() << "no error for a missing file";
+  }
+  catch (const std::runtime_error& error)
+  {
+    EXPECT_EQ(std::string(error.what()).rfind(missing + ": ", 0), 0u) << error.what();
+  }
+  {
+    std::ofstream out(dir / "bad.json");
+    out << With("/sun/elevation", 100).dump();
+  }
+  try
+  {
+    nimbus::LoadScene((dir / "bad.json").string());
+    ADD_FAILURE() << "no error for an invalid scene";
+  }
+  catch (const std::invalid_argument& error)
+  {
+    EXPECT_EQ(std::string(error.what()), (dir / "bad.json").string() +
+        ": scene.sun.elevation: expected a number in [-90, 90], got 100");
+  }
+  fs::remove_all(dir);
+}

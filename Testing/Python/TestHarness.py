@@ -1,0 +1,53 @@
+"""The trade harness runs end to end on a tiny scene: reference (cached on the
+second run), VTK's GPU mapper and the reference renderer's own trade curve, CSV
+with every metric, plots."""
+import csv
+import math
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+from nimbus import harness
+
+SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "tiny_scene.json")
+
+
+class HarnessTest(unittest.TestCase):
+    def setUp(self):
+        self.output = tempfile.mkdtemp(prefix="nimbus-harness-")
+
+    def tearDown(self):
+        shutil.rmtree(self.output, ignore_errors=True)
+
+    def run_harness(self, *extra):
+        return harness.run([SCENE, "--renderer", "vtk-gpu", "--renderer", "single",
+                            "--repeats", "1", "--output-dir", self.output, *extra])
+
+    def test_csv_plot_and_cache(self):
+        self.assertEqual(self.run_harness("--markdown", os.path.join(self.output, "t.md")), 0)
+        with open(os.path.join(self.output, "trade.csv")) as stream:
+            rows = list(csv.DictReader(stream))
+        expected = len(harness.DEFAULT_SETTINGS["vtk-gpu"]) + len(harness.DEFAULT_SETTINGS["single"])
+        self.assertEqual(len(rows), expected)
+        for row in rows:
+            for field in ("median_seconds", "rmse", "relative_l1", "max_abs"):
+                self.assertTrue(math.isfinite(float(row[field])), (field, row))
+                self.assertGreaterEqual(float(row[field]), 0.0)
+        single = [float(r["rmse"]) for r in rows if r["renderer"] == "single"]
+        # Finer steps approach the reference (the last one is the reference's own step).
+        self.assertEqual(single, sorted(single, reverse=True))
+        for name in ("trade.png", "tiny_scene-trade.png", "tiny_scene-reference.png", "t.md"):
+            self.assertTrue(os.path.getsize(os.path.join(self.output, name)) > 0, name)
+        cache = os.listdir(os.path.join(self.output, "reference-cache"))
+        self.assertEqual(len(cache), 2)  # the reference and the sky-only reference
+        # A second run takes the references from the cache.
+        self.assertEqual(self.run_harness(), 0)
+        self.assertEqual(sorted(os.listdir(os.path.join(self.output, "reference-cache"))),
+                         sorted(cache))
+
+
+if __name__ == "__main__":
+    result = unittest.main(exit=False, verbosity=2).result
+    sys.exit(0 if result.wasSuccessful() else 1)
