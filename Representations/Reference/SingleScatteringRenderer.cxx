@@ -34,21 +34,33 @@
 //      extinction × step length, exact in homogeneous media) until it leaves the
 //      grid box; stops with T_cloud = 0 as soon as the optical depth exceeds
 //      -ln(1e-7) = 16.12 (the truncated light is < 1e-7 of the unshadowed sun).
+//      Every cloud sample and every air sample outside the box (light shafts) gets
+//      its own march. Inside the box the air term (β ~ 1e-5 /m) uses T_cloud
+//      interpolated linearly between exact marches at every 8th node of the view
+//      march (O((8h)²), seen by the Richardson estimate); this removes most marches
+//      from the empty parts of the box.
 //      Without atmosphere (no earth sphere), the ground plane, when enabled, blocks
 //      a sun below the horizon (s_z < 0) for every point above it; with the
 //      atmosphere the spherical earth blocks it (twilight reaches the upper air).
+//    - Empty-space skipping (exact): macro blocks of 4³ grid cells whose grid points
+//      are all 0 have zero trilinear density everywhere inside; marches jump over
+//      the midpoints that fall inside such a block (same nodes, same sums).
 //    - T_atm: RenderContext::SunAtmosphereTransmittance would cost ~3 µs per
 //      sample (adaptive Gauss-Kronrod); instead the exact optical lengths
 //      (Atmosphere::OpticalLengthsToTop, Rayleigh and Mie) are computed at knots
-//      t_k = min(k Δ_knot, t_end) along the ray and ln(L + 1 m) is interpolated
-//      linearly in t. For a plane-parallel exponential atmosphere ln L is exactly
-//      linear along a ray (L = H e^{-z/H}/μ_s); the spherical earth adds the
-//      change of the local sun zenith angle over the horizontal distance δ,
-//      δθ = δ/R, with d²ln L/dθ² ≈ 1/μ_s² (at most ~R/H_M near the horizon), so
-//      Δ_knot = R sqrt(8e-5 / min(1/μ_s², R/H_M)) bounds the interpolation error
-//      of ln L by ~1e-5 (clamped to [200 m, 10 km]; 10 km for μ_s >= 0.35, ~0.8 km at
-//      the horizon). An interval whose knot is blocked by the earth is evaluated
-//      exactly per sample. Checked against the exact function in
+//      t_k = min(k Δ_knot, t_end) along the ray and interpolated as
+//        ln(L + L0)(t) = lerp_t(ln(L + L0)) - (h(t) - lerp_t(h)) / H,
+//      h the exact altitude. For a plane-parallel exponential atmosphere clipped at
+//      the top, L + L0 with L0 = (H/μ_s) e^{-h_top/H} is exactly ∝ e^{-h/H}, so this
+//      is exact; the altitude term removes the earth's curvature along the ray
+//      (d²h/dt² ≈ 1/R), which dominates otherwise. What remains is the change of the
+//      local sun zenith angle over the horizontal distance δ, δθ = δ/R, with
+//      d²ln L/dθ² ≈ 1/μ_s² (at most ~R/H_M near the horizon):
+//      Δ_knot = R sqrt(8e-5 / min(1/μ_s², R/H_M)) bounds that error by ~1e-5,
+//      clamped to [200 m, 50 km] (~40 km at μ_s = 0.7, 5 km at 5°, 0.8 km at the
+//      horizon), and at most 8 km of altitude change between knots (L must stay
+//      >> L0). Measured |ΔT| <= 2.5e-5 for sun elevations 60…-5°. An interval whose
+//      knot is blocked by the earth is evaluated exactly per sample. Checked in
 //      TestSingleScattering (SunAtmosphereKnots).
 // 4. The view march stops once max_λ T(λ) < 1e-7 (nothing behind can contribute more
 //    than 1e-7 of its own radiance), including the ground / background term.
@@ -92,6 +104,8 @@ constexpr double kMaxKnotSpacing = 50000.0;
 constexpr double kMaxKnotRise = 8000.0;
 // Edge (grid cells) of the macro blocks used to skip empty space.
 constexpr int kBlockCells = 4;
+// Air shadow knots inside the cloud box: every K-th cloud step (see CloudSegmentSpectral).
+constexpr long long kAirShadowKnotSteps = 8;
 
 inline Vector3 PointAt(const Vector3& o, const Vector3& d, double t)
 {
@@ -183,7 +197,7 @@ public:
 
   struct Workspace
   {
-    std::vector<double> T, L, Tsun, J;
+    std::vector<double> T, L, Tsun;
   };
 
   /// Ray-local cache of the atmosphere's sun optical lengths at knots.
@@ -387,7 +401,6 @@ public:
     w.T.assign(n, 1.0);
     w.L.assign(n, 0.0);
     w.Tsun.assign(n, 1.0);
-    w.J.assign(n, 0.0);
 
     // Scattering angle: light propagates along -s, leaves toward the camera along -v.
     const double mu = std::max(-1.0, std::min(1.0, Dot(this->Sun, d)));
@@ -634,14 +647,14 @@ private:
   /// One step [ta, tb] of the spectral march with cloud extinction sigmaC at the
   /// midpoint x. Returns false once every T(λ) < cutoff.
   bool SpectralStep(const Vector3& x, double tm, double dt, double sigmaC,
-    double scatterPerExtinction, double rayleighPhase, double miePhase, SunKnots& knots,
-    Workspace& w) const
+    double scatterPerExtinction, double cloudSunT, double airSunT, double rayleighPhase,
+    double miePhase, SunKnots& knots, Workspace& w) const
   {
     const double altitude = this->Air->Altitude(this->Ctx.EarthCentred(x));
     const double rhoR = this->Air->Density(altitude, this->HR);
     const double rhoM = this->Air->Density(altitude, this->HM);
-    const double tCloud = this->SunCloudTransmittance(x);
-    if (tCloud > 0.0)
+    const bool lit = cloudSunT > 0.0 || airSunT > 0.0;
+    if (lit)
     {
       knots.Evaluate(tm, x, w.Tsun.data());
     }
@@ -653,9 +666,9 @@ private:
     {
       const double betaR = this->BetaR[i] * rhoR;
       const double sigma = sigmaC + betaR + mieExt;
-      const double J = tCloud > 0.0
-        ? this->E[i] * tCloud * w.Tsun[i] * (cloudSource + betaR * rayleighPhase + mieSource)
-        : 0.0;
+      const double J = lit ? this->E[i] * w.Tsun[i] *
+          (cloudSunT * cloudSource + airSunT * (betaR * rayleighPhase + mieSource))
+                           : 0.0;
       const double xo = sigma * dt;
       const double e = std::exp(-xo);
       w.L[i] += w.T[i] * J * dt * ExpWeight(xo, e);
@@ -665,23 +678,53 @@ private:
     return maxT >= kViewCutoff;
   }
 
+  /// Cloud box with atmosphere. The cloud source uses the exact sun march at each
+  /// midpoint; the air source (β ~ 1e-5 /m, 1e-3 of a cloud's) uses the cloud
+  /// transmittance interpolated linearly between exact marches at every
+  /// kAirShadowKnotSteps-th node (and at b): O((K h)²) like the rest, and K times
+  /// fewer marches through the empty parts of the box.
   bool CloudSegmentSpectral(const Vector3& o, const Vector3& d, double a, double b,
     double scatterPerExtinction, double rayleighPhase, double miePhase, SunKnots& knots,
     Workspace& w) const
   {
     const double h = this->Step;
-    for (long long k = 0;; ++k)
+    const long long last = LastStep(b - a, h);
+    long long knot = -1;
+    double tLeft = a, tRight = a, shadowLeft = 1.0, shadowRight = 1.0;
+    for (long long k = 0; k <= last; ++k)
     {
       const double ta = a + static_cast<double>(k) * h;
-      if (!(ta < b))
-      {
-        break;
-      }
-      const double tb = std::min(ta + h, b);
+      const double tb = k == last ? b : std::min(ta + h, b);
       const double tm = 0.5 * (ta + tb);
       const Vector3 x = PointAt(o, d, tm);
-      if (!this->SpectralStep(x, tm, tb - ta, this->Ctx.CloudExtinction(x),
-            scatterPerExtinction, rayleighPhase, miePhase, knots, w))
+      const long long j = k / kAirShadowKnotSteps;
+      if (j != knot)
+      {
+        if (j == knot + 1 && knot >= 0)
+        {
+          tLeft = tRight;
+          shadowLeft = shadowRight;
+        }
+        else
+        {
+          tLeft = a + static_cast<double>(j * kAirShadowKnotSteps) * h;
+          shadowLeft = this->SunCloudTransmittance(PointAt(o, d, tLeft));
+        }
+        tRight = std::min(b, a + static_cast<double>((j + 1) * kAirShadowKnotSteps) * h);
+        if ((j + 1) * kAirShadowKnotSteps > last)
+        {
+          tRight = b;
+        }
+        shadowRight = this->SunCloudTransmittance(PointAt(o, d, tRight));
+        knot = j;
+      }
+      const double wRight = tRight > tLeft ? (tm - tLeft) / (tRight - tLeft) : 0.0;
+      const double airSunT = shadowLeft + wRight * (shadowRight - shadowLeft);
+      const double sigmaC = this->Ctx.CloudExtinction(x);
+      const double cloudSunT =
+        sigmaC * scatterPerExtinction > 0.0 ? this->SunCloudTransmittance(x) : 0.0;
+      if (!this->SpectralStep(x, tm, tb - ta, sigmaC, scatterPerExtinction, cloudSunT, airSunT,
+            rayleighPhase, miePhase, knots, w))
       {
         return false;
       }
@@ -723,8 +766,9 @@ private:
         continue;
       }
       const double tm = 0.5 * (ta + tb);
-      if (!this->SpectralStep(PointAt(o, d, tm), tm, tb - ta, 0.0, 0.0, rayleighPhase,
-            miePhase, knots, w))
+      const Vector3 x = PointAt(o, d, tm);
+      if (!this->SpectralStep(x, tm, tb - ta, 0.0, 0.0, 0.0, this->SunCloudTransmittance(x),
+            rayleighPhase, miePhase, knots, w))
       {
         return false;
       }
