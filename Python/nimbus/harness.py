@@ -188,7 +188,7 @@ class VtkGpuRenderer:
       reference (the scene rendered with zero density) in the upper half of the image.
     - Background: VTK has no sky, so its cloud (RGBA, premultiplied) is composited
       over the sky-only reference image.
-    - "shading": absorption (no lighting: emission = albedo x ambient), gradient
+    - "shading": absorption (no lighting: emission = albedo x sky ambient), gradient
       (Phong on the density gradient), volumetric (VTK's volumetric scattering,
       blending 1, GlobalIlluminationReach = "reach", anisotropy = the cloud's first
       phase component's g).
@@ -218,9 +218,9 @@ class VtkGpuRenderer:
         for i in range(33):
             rho = max_density * i / 32.0
             opacity.AddPoint(rho, 1.0 - math.exp(-sigma_per_density * rho * self.spacing))
+        self.albedo = albedo
+        self.max_density = max_density
         color = vtkColorTransferFunction()
-        color.AddRGBPoint(0.0, albedo, albedo, albedo)
-        color.AddRGBPoint(max_density, albedo, albedo, albedo)
 
         self.property = vtkVolumeProperty()
         self.property.SetScalarOpacity(opacity)
@@ -269,7 +269,8 @@ class VtkGpuRenderer:
         self.light.SetIntensity(brightest)
         height = sky_image.shape[0]
         sky_mean = sky_image[height // 2:].reshape(-1, 3).mean(axis=0) * VTK_SCALE
-        self.light.SetAmbientColor(*[float(min(1.0, c)) for c in sky_mean])
+        self.ambient = [float(min(1.0, c)) for c in sky_mean]
+        self.light.SetAmbientColor(*self.ambient)
 
         self.renderer = vtkRenderer()
         self.renderer.AddVolume(self.volume)
@@ -296,6 +297,12 @@ class VtkGpuRenderer:
         shading = settings.get("shading", "gradient")
         self.mapper.SetSampleDistance(float(settings.get("sample_distance", 0.5) * self.spacing))
         self.property.SetShade(shading != "absorption")
+        # Unlit, VTK emits the colour itself: make it the sky-lit albedo.
+        tint = self.ambient if shading == "absorption" else [1.0, 1.0, 1.0]
+        color = self.property.GetRGBTransferFunction()
+        color.RemoveAllPoints()
+        for rho in (0.0, self.max_density):
+            color.AddRGBPoint(rho, *[self.albedo * t for t in tint])
         self.property.SetAmbient(1.0)
         self.property.SetDiffuse(0.0 if shading == "absorption" else 1.0)
         self.property.SetSpecular(0.0)
@@ -390,6 +397,40 @@ def write_png(image, path):
     writer.Write()
 
 
+def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
+    """Time to `target` relative RMSE of the path tracer, per scene.
+
+    Renders with `samples_per_pixel` samples, takes the image's relative error
+    from the per-pixel standard errors (RMS standard error / RMS radiance; the
+    tests show them calibrated) and extrapolates with the N^-1/2 law the tests
+    measured (slope -0.486): t_target = t * (error / target)^2.
+    """
+    rows = []
+    for scene_path in scene_paths:
+        scene_name = os.path.splitext(os.path.basename(scene_path))[0]
+        settings = {"mode": "path", "min_spp": samples_per_pixel, "max_spp": samples_per_pixel,
+                    "seed": 1}
+        _, output = render_reference_mode(os.path.abspath(scene_path), settings)
+        seconds = output.GetFieldData().GetArray("RenderSeconds").GetValue(0)
+        error = output.GetFieldData().GetArray("EstimatedRelativeError").GetValue(0)
+        factor = (error / target) ** 2
+        row = {"scene": scene_name, "samples_per_pixel": samples_per_pixel,
+               "seconds": seconds, "relative_error": error,
+               "samples_per_pixel_for_target": samples_per_pixel * factor,
+               "seconds_for_target": seconds * factor}
+        rows.append(row)
+        print(f"{scene_name}: path tracing {samples_per_pixel} spp in {seconds:.1f} s, relative "
+              f"error {error:.3f} -> {target:.0%} needs ~{row['samples_per_pixel_for_target']:.3g}"
+              f" spp, ~{row['seconds_for_target'] / 3600:.2g} h", flush=True)
+    path = os.path.join(output_dir, "path-convergence.csv")
+    with open(path, "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(path)
+    return rows
+
+
 def run(arguments):
     parser = argparse.ArgumentParser(prog="python3 -m nimbus.harness", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -406,7 +447,14 @@ def run(arguments):
     parser.add_argument("--cache-dir", default=None,
                         help="reference cache (default: OUTPUT_DIR/reference-cache)")
     parser.add_argument("--markdown", help="also write the table as Markdown to this file")
+    parser.add_argument("--path-convergence", type=int, metavar="SPP",
+                        help="instead: measure the path tracer at SPP samples per pixel on each "
+                             "scene and extrapolate its time to 1%% relative RMSE")
     args = parser.parse_args(arguments)
+    if args.path_convergence:
+        os.makedirs(args.output_dir, exist_ok=True)
+        path_convergence(args.scenes, args.path_convergence, args.output_dir)
+        return 0
     renderers = args.renderer or ["vtk-gpu"]
     if args.settings and len(renderers) != 1:
         parser.error("--settings needs exactly one --renderer")

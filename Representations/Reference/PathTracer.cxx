@@ -248,14 +248,10 @@ public:
       this->ScaleHeightR = a.rayleighScaleHeight;
       this->ScaleHeightM = a.mieScaleHeight;
       this->MieG = a.mieG;
-      for (double lambda : context.GetWavelengths())
-      {
-        this->BetaR.push_back(this->Air->RayleighScattering(lambda));
-        this->BetaRMax = std::max(this->BetaRMax, this->BetaR.back());
-      }
-      // As RenderContext::AtmosphereCoefficients: Mie at 550 nm (grey).
-      this->BetaMs = this->Air->MieScattering(550.0);
-      this->BetaMt = this->Air->MieExtinction(550.0);
+      this->BetaR = context.GetRayleighScatteringSeaLevel();
+      this->BetaRMax = *std::max_element(this->BetaR.begin(), this->BetaR.end());
+      this->BetaMs = context.GetMieScatteringSeaLevel();
+      this->BetaMt = context.GetMieExtinctionSeaLevel();
       if (this->HasCloud)
       {
         // Lowest altitude of the box: distance from the earth centre to the box.

@@ -126,6 +126,13 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid)
     {
       throw std::invalid_argument(std::string("scene: atmosphere: ") + error.what());
     }
+    for (double lambda : this->Wavelengths)
+    {
+      this->BetaRayleigh.push_back(this->Air->RayleighScattering(lambda));
+    }
+    // Mie is grey: its coefficients do not depend on the wavelength.
+    this->BetaMieScattering = this->Air->MieScattering(550.0);
+    this->BetaMieExtinction = this->Air->MieExtinction(550.0);
   }
 
   const BackgroundDescription& background = scene.Background;
@@ -171,10 +178,10 @@ void RenderContext::AtmosphereCoefficients(const Vector3& p,
   const double rhoM = this->Air->Density(altitude, a.mieScaleHeight);
   for (std::size_t i = 0; i < this->Wavelengths.size(); ++i)
   {
-    rayleighScattering[i] = this->Air->RayleighScattering(this->Wavelengths[i]) * rhoR;
+    rayleighScattering[i] = this->BetaRayleigh[i] * rhoR;
   }
-  mieScattering = this->Air->MieScattering(550.0) * rhoM;
-  mieExtinction = this->Air->MieExtinction(550.0) * rhoM;
+  mieScattering = this->BetaMieScattering * rhoM;
+  mieExtinction = this->BetaMieExtinction * rhoM;
 }
 
 void RenderContext::SunAtmosphereTransmittance(

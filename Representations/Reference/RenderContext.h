@@ -67,6 +67,12 @@ public:
   bool HasAtmosphere() const { return this->Air != nullptr; }
   const Atmosphere* GetAtmosphere() const { return this->Air.get(); }
   Vector3 EarthCentred(const Vector3& p) const;
+  /// Sea-level coefficients (1/m): Rayleigh scattering (= extinction) per
+  /// wavelength sample, and the grey Mie scattering and extinction. Multiply by
+  /// Atmosphere::Density(h, H) for altitude h. Empty / 0 without atmosphere.
+  const std::vector<double>& GetRayleighScatteringSeaLevel() const { return this->BetaRayleigh; }
+  double GetMieScatteringSeaLevel() const { return this->BetaMieScattering; }
+  double GetMieExtinctionSeaLevel() const { return this->BetaMieExtinction; }
   /// Per wavelength sample at scene point p (1/m): Rayleigh scattering (=
   /// extinction), Mie scattering, Mie extinction. Zero without atmosphere.
   void AtmosphereCoefficients(const Vector3& p, std::vector<double>& rayleighScattering,
@@ -105,6 +111,9 @@ private:
   double ExtinctionPerDensity;
   PhaseFunctionMixture CloudPhase;
   std::unique_ptr<Atmosphere> Air;
+  std::vector<double> BetaRayleigh;
+  double BetaMieScattering = 0.0;
+  double BetaMieExtinction = 0.0;
   std::vector<double> BackgroundRadiance;
 };
 

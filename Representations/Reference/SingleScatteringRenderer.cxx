@@ -164,14 +164,9 @@ public:
     if (this->Air)
     {
       const AtmosphereParameters& a = this->Air->GetParameters();
-      this->BetaR.resize(this->N);
-      for (int i = 0; i < this->N; ++i)
-      {
-        this->BetaR[i] = this->Air->RayleighScattering(this->Ctx.GetWavelengths()[i]);
-      }
-      // As RenderContext::AtmosphereCoefficients: Mie at 550 nm (wavelength independent).
-      this->BetaMs = this->Air->MieScattering(550.0);
-      this->BetaMext = this->Air->MieExtinction(550.0);
+      this->BetaR = this->Ctx.GetRayleighScatteringSeaLevel();
+      this->BetaMs = this->Ctx.GetMieScatteringSeaLevel();
+      this->BetaMext = this->Ctx.GetMieExtinctionSeaLevel();
       this->HR = a.rayleighScaleHeight;
       this->HM = a.mieScaleHeight;
       this->EarthRadius = a.earthRadius;
