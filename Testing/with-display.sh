@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Runs a command that needs an X display (OpenGL rendering).
 # With DISPLAY set, the command runs as it is. Without one (CI, ssh, containers)
-# it gets a private Xvfb with Mesa's llvmpipe (OpenGL 4.5 core): Xvfb picks a
-# free display number itself (-displayfd) and reports it once it accepts
-# connections, so parallel tests cannot race for a number.
+# it gets a private Xvfb with Mesa's llvmpipe (OpenGL 4.5 core) on a random display
+# number (retried if taken), reported through -displayfd once the server accepts
+# connections. Not the lowest free number: a server shutting down removes its socket
+# late, and a new server reusing that number at that moment would lose its own.
 set -u
 if [ -n "${DISPLAY:-}" ]; then
   exec "$@"
@@ -14,28 +15,48 @@ if ! command -v Xvfb >/dev/null 2>&1; then
 fi
 
 scratch="$(mktemp -d)"
-Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3>"$scratch/display" 2>"$scratch/xvfb.log" &
-xvfb_pid=$!
+xvfb_pid=""
 cleanup() {
-  kill "$xvfb_pid" 2>/dev/null
-  wait "$xvfb_pid" 2>/dev/null
+  if [ -n "$xvfb_pid" ]; then
+    kill "$xvfb_pid" 2>/dev/null
+    wait "$xvfb_pid" 2>/dev/null
+  fi
   rm -rf "$scratch"
 }
 trap cleanup EXIT
 
-for _ in $(seq 200); do # up to 20 s
-  [ -s "$scratch/display" ] && break
-  if ! kill -0 "$xvfb_pid" 2>/dev/null; then
-    echo "with-display.sh: Xvfb failed to start:" >&2
-    cat "$scratch/xvfb.log" >&2
-    exit 1
+started=""
+for attempt in 1 2 3 4 5 6 7 8; do
+  number=$((1000 + RANDOM % 30000))
+  [ -e "/tmp/.X${number}-lock" ] && continue
+  : >"$scratch/display"
+  Xvfb ":$number" -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp \
+    3>"$scratch/display" 2>"$scratch/xvfb.log" &
+  xvfb_pid=$!
+  for _ in $(seq 200); do # up to 20 s
+    [ -s "$scratch/display" ] && break
+    kill -0 "$xvfb_pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  if [ -s "$scratch/display" ]; then
+    started=yes
+    break
   fi
-  sleep 0.1
+  kill "$xvfb_pid" 2>/dev/null
+  wait "$xvfb_pid" 2>/dev/null
+  xvfb_pid=""
 done
-if [ ! -s "$scratch/display" ]; then
-  echo "with-display.sh: Xvfb did not report a display within 20 s" >&2
+if [ -z "$started" ]; then
+  echo "with-display.sh: Xvfb failed to start:" >&2
+  cat "$scratch/xvfb.log" >&2
   exit 1
 fi
 DISPLAY=":$(head -n 1 "$scratch/display")"
 export DISPLAY
 "$@"
+status=$?
+if [ "$status" -ne 0 ] && [ -s "$scratch/xvfb.log" ]; then
+  echo "with-display.sh: the command failed ($status) on $DISPLAY; Xvfb said:" >&2
+  cat "$scratch/xvfb.log" >&2
+fi
+exit "$status"
