@@ -26,6 +26,11 @@
 
 vtkStandardNewMacro(vtkNimbusReferenceRenderer);
 
+struct vtkNimbusReferenceRenderer::vtkInternals
+{
+  std::unique_ptr<nimbus::SceneDescription> Scene;
+};
+
 namespace
 {
 // vtkImageData point array -> DensityGrid (float), placed by origin, spacing and extent.
@@ -72,9 +77,12 @@ void AddFieldValue(vtkFieldData* fieldData, const char* name, double value)
 }
 
 vtkNimbusReferenceRenderer::vtkNimbusReferenceRenderer()
+  : Internals(new vtkInternals)
 {
   this->SetNumberOfInputPorts(1);
 }
+
+vtkNimbusReferenceRenderer::~vtkNimbusReferenceRenderer() = default;
 
 int vtkNimbusReferenceRenderer::FillInputPortInformation(int, vtkInformation* info)
 {
@@ -86,21 +94,23 @@ int vtkNimbusReferenceRenderer::FillInputPortInformation(int, vtkInformation* in
 int vtkNimbusReferenceRenderer::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
+  this->Internals->Scene.reset();
   if (this->SceneFileName.empty())
   {
     vtkErrorMacro(<< "No SceneFileName given.");
     return 0;
   }
-  nimbus::SceneDescription scene;
   try
   {
-    scene = nimbus::LoadScene(this->SceneFileName);
+    this->Internals->Scene =
+      std::make_unique<nimbus::SceneDescription>(nimbus::LoadScene(this->SceneFileName));
   }
   catch (const std::exception& error)
   {
     vtkErrorMacro(<< error.what());
     return 0;
   }
+  const nimbus::SceneDescription& scene = *this->Internals->Scene;
   const int extent[6] = { 0, scene.Camera.Width - 1, 0, scene.Camera.Height - 1, 0, 0 };
   const double origin[3] = { 0.0, 0.0, 0.0 };
   const double spacing[3] = { 1.0, 1.0, 1.0 };
@@ -129,17 +139,11 @@ int vtkNimbusReferenceRenderer::RequestData(
 {
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   output->Initialize();
-
-  nimbus::SceneDescription scene;
-  try
+  if (!this->Internals->Scene)
   {
-    scene = nimbus::LoadScene(this->SceneFileName);
+    return 0; // RequestInformation reported why
   }
-  catch (const std::exception& error)
-  {
-    vtkErrorMacro(<< error.what());
-    return 0;
-  }
+  const nimbus::SceneDescription& scene = *this->Internals->Scene;
 
   // The density: the connected image, or the scene's own.
   vtkSmartPointer<vtkImageData> volume = vtkImageData::GetData(inputVector[0], 0);

@@ -27,6 +27,7 @@
 #include "NimbusRepresentationsModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
+#include <memory> // for std::unique_ptr
 #include <string> // for std::string
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusReferenceRenderer : public vtkImageAlgorithm
@@ -98,7 +99,7 @@ public:
 
 protected:
   vtkNimbusReferenceRenderer();
-  ~vtkNimbusReferenceRenderer() override = default;
+  ~vtkNimbusReferenceRenderer() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
@@ -119,6 +120,10 @@ protected:
   int NumberOfThreads = 0;
 
 private:
+  // The scene parsed by RequestInformation, rendered by RequestData.
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
+
   vtkNimbusReferenceRenderer(const vtkNimbusReferenceRenderer&) = delete;
   void operator=(const vtkNimbusReferenceRenderer&) = delete;
 };
