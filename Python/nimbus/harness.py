@@ -55,6 +55,7 @@ DEFAULT_SETTINGS = {
         {"shading": "volumetric", "sample_distance": 0.5, "reach": 1.0},
         {"shading": "volumetric", "sample_distance": 0.25, "reach": 1.0},
     ],
+    "svs": [{"slices": n} for n in (32, 64, 128, 256, 512)],
     "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }
@@ -331,6 +332,110 @@ class VtkGpuRenderer:
         self.window.Finalize()
 
 
+class SvsRenderer:
+    """Nimbus's shadow-view-slice mapper (vtkNimbusCloudVolumeMapper, paper 000).
+
+    The scene maps one to one onto the mapper: extinction, albedo, the first
+    phase component's g (Cornette-Shanks), k_multi, sun, atmosphere, ground.
+    Backgrounds "black" and "atmosphere" are a black framebuffer (the mapper
+    draws the atmosphere itself); "constant" is that radiance. The framebuffer is
+    8-bit: radiance x VTK_SCALE is written and read back (quantisation <= 6.5e-4).
+    Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
+    atmosphere_steps, unlit (the unlit compositing floor, for timing only).
+    """
+
+    def __init__(self, scene_path):
+        from vtkmodules.vtkRenderingCore import (vtkRenderWindow, vtkRenderer, vtkVolume,
+                                                 vtkWindowToImageFilter)
+        import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
+
+        scene = load_scene(scene_path)
+        density = nimbus.vtkNimbusSceneDensitySource()
+        density.SetSceneFileName(scene_path)
+        density.Update()
+        self.mapper = configure_svs_mapper(nimbus.vtkNimbusCloudVolumeMapper(), scene)
+        self.mapper.SetInputConnection(density.GetOutputPort())
+        self.mapper.SetExposure(VTK_SCALE)
+        self.volume = vtkVolume()
+        self.volume.SetMapper(self.mapper)
+        self.renderer = vtkRenderer()
+        self.renderer.AddVolume(self.volume)
+        background = scene.get("background", {})
+        grey = 0.0
+        if background.get("type") == "constant":
+            grey = min(1.0, background.get("radiance", 0.0) * VTK_SCALE)
+        self.renderer.SetBackground(grey, grey, grey)
+        camera_description = scene["camera"]
+        camera = self.renderer.GetActiveCamera()
+        camera.SetPosition(*camera_description["position"])
+        camera.SetFocalPoint(*camera_description["focal_point"])
+        camera.SetViewUp(*camera_description.get("view_up", [0, 0, 1]))
+        camera.SetViewAngle(camera_description.get("view_angle", 30.0))
+        camera.SetClippingRange(1.0, 1e6)
+        self.window = vtkRenderWindow()
+        self.window.SetOffScreenRendering(1)
+        self.window.SetMultiSamples(0)
+        self.window.SetSize(camera_description["width"], camera_description["height"])
+        self.window.AddRenderer(self.renderer)
+        self.capture_class = vtkWindowToImageFilter
+
+    def render(self, settings):
+        self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
+        self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
+        self.mapper.SetShadowSurfaceSize(int(settings.get("shadow", 512)))
+        self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 64)))
+        self.mapper.SetUnlit(bool(settings.get("unlit", False)))
+        self.window.Render()
+        capture = self.capture_class()
+        capture.SetInput(self.window)
+        capture.SetInputBufferTypeToRGB()
+        capture.ReadFrontBufferOff()
+        capture.Update()
+        image = capture.GetOutput()
+        width, height, _ = image.GetDimensions()
+        rgb = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, 3)
+        return rgb.astype(np.float32) / 255.0 / VTK_SCALE
+
+    def close(self):
+        self.window.Finalize()
+
+
+def configure_svs_mapper(mapper, scene):
+    """Sets a vtkNimbusCloudVolumeMapper's optics from a scene (JSON dict)."""
+    medium = scene["medium"]
+    mapper.SetExtinctionPerDensity(medium.get("extinction_per_density", 0.02))
+    mapper.SetAlbedo(medium.get("single_scattering_albedo", 0.99))
+    phase = medium.get("phase", [{}])
+    phase = phase if isinstance(phase, list) else [phase]
+    if len(phase) != 1 or phase[0].get("type", "cornette_shanks") != "cornette_shanks":
+        print("svs: the mapper has one Cornette-Shanks phase function; using the first "
+              "component's g", file=sys.stderr)
+    mapper.SetCloudG(float(phase[0].get("g", 0.85)))
+    mapper.SetMultipleScattering(medium.get("multiple_scattering_constant", 0.0))
+    sun = scene["sun"]
+    if "direction" in sun:
+        dx, dy, dz = sun["direction"]
+        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+        mapper.SetSunElevation(math.degrees(math.asin(dz / norm)))
+        mapper.SetSunAzimuth(math.degrees(math.atan2(dx, dy)))
+    else:
+        mapper.SetSunElevation(sun["elevation"])
+        mapper.SetSunAzimuth(sun.get("azimuth", 0.0))
+    mapper.SetSunIlluminance(sun.get("illuminance", 1.0))
+    mapper.SetSunTemperature(sun.get("temperature", 5778.0))
+    atmosphere = scene.get("atmosphere", {})
+    mapper.SetAtmosphere(bool(atmosphere.get("enabled", True)))
+    mapper.SetSceneAltitude(atmosphere.get("scene_altitude", 0.0))
+    mapper.SetRayleighScattering(atmosphere.get("rayleigh_scattering_550", 13.5e-6))
+    mapper.SetHazeDensity(atmosphere.get("mie_scattering", 2.0e-5))
+    mapper.SetHazeG(atmosphere.get("mie_g", 0.76))
+    ground = scene.get("ground", {})
+    mapper.SetGround(bool(ground.get("enabled", True)))
+    mapper.SetGroundHeight(ground.get("height", 0.0))
+    mapper.SetGroundAlbedo(ground.get("albedo", 0.2))
+    return mapper
+
+
 # --- the harness ------------------------------------------------------------------------------
 
 def setting_label(settings):
@@ -502,6 +607,8 @@ def run(arguments):
                 sky, _ = cached_image(cache_dir, f"{scene_name}-sky-{args.reference}-{sky_key}",
                                       compute_sky)
                 renderer = VtkGpuRenderer(scene_path, sky)
+            elif renderer_name == "svs":
+                renderer = SvsRenderer(scene_path)
             else:
                 renderer = ReferenceModeRenderer(scene_path, renderer_name)
             try:

@@ -52,6 +52,12 @@ struct MediumDescription
   DensitySourceDescription Density;
   double ExtinctionPerDensity = 0.02;  // sigma_t per unit density, 1/m
   double SingleScatteringAlbedo = 0.99; // sigma_s / sigma_t
+  /// k_multi of 000 Eq. 1: a constant added to the 4pi-normalised cloud phase
+  /// function that stands in for multiple scattering (dimensionless, >= 0; 0 =
+  /// pure single scattering). The single-scattering reference includes it so that
+  /// fast renderers with the same term are compared like for like; the path
+  /// tracer simulates multiple scattering itself and ignores it.
+  double MultipleScatteringConstant = 0.0;
   std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
 };
 

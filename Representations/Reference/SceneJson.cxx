@@ -600,11 +600,13 @@ PhaseComponentDescription ReadPhaseComponent(const Json& v, const std::string& p
 MediumDescription ReadMedium(const Json& v, const std::string& path, const std::string& base)
 {
   const ObjectReader r(
-    v, path, { "density", "extinction_per_density", "single_scattering_albedo", "phase" });
+    v, path, { "density", "extinction_per_density", "single_scattering_albedo", "phase",
+               "multiple_scattering_constant" });
   MediumDescription m;
   m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
   r.RequiredNumber("extinction_per_density", m.ExtinctionPerDensity, AtLeast(0.0));
   r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
+  r.Number("multiple_scattering_constant", m.MultipleScatteringConstant, Closed(0.0, 100.0));
   if (r.Has("phase"))
   {
     const Json& phase = r["phase"];
@@ -904,6 +906,10 @@ Json ToJson(const SceneDescription& s)
   j["medium"]["density"] = density;
   j["medium"]["extinction_per_density"] = m.ExtinctionPerDensity;
   j["medium"]["single_scattering_albedo"] = m.SingleScatteringAlbedo;
+  if (m.MultipleScatteringConstant != 0.0)
+  {
+    j["medium"]["multiple_scattering_constant"] = m.MultipleScatteringConstant;
+  }
   j["medium"]["phase"] = Json::array();
   for (const auto& p : m.Phase)
   {

@@ -154,6 +154,7 @@ public:
     this->Step = stepScale * spacing;   // m
     this->AirFirstStep = spacing;       // g0, m (times s)
     this->Albedo = this->Ctx.GetCloudAlbedo();
+    this->MultipleScattering = this->Ctx.GetScene().Medium.MultipleScatteringConstant;
     this->E = this->Ctx.GetSunIrradiance();
     this->Background = this->Ctx.GetBackgroundRadiance();
     this->BuildEmptyBlocks();
@@ -400,7 +401,9 @@ public:
     // Scattering angle: light propagates along -s, leaves toward the camera along -v.
     const double mu = std::max(-1.0, std::min(1.0, Dot(this->Sun, d)));
     const double cloudPhase = this->Ctx.GetCloudPhase().Evaluate(mu);
-    const double cloudScatterPerExtinction = this->Albedo * cloudPhase; // σ_s p / σ_t, 1/sr
+    // 000 Eq. 1: (beta_cl + k_multi) with beta 4pi-normalised -> p + k_multi/(4 pi) here.
+    const double cloudScatterPerExtinction =
+      this->Albedo * (cloudPhase + this->MultipleScattering / (4.0 * kPi)); // σ_s p / σ_t, 1/sr
     double rayleighPhase = 0.0, miePhase = 0.0;
     if (this->Air)
     {
@@ -780,6 +783,7 @@ private:
   double Step = 1.0;
   double AirFirstStep = 1.0;
   double Albedo = 0.0;
+  double MultipleScattering = 0.0; // k_multi (000 Eq. 1)
   std::vector<double> E, Background;
   bool GroundBlocksSun = false;
   const Atmosphere* Air = nullptr;

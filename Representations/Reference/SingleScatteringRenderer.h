@@ -3,7 +3,9 @@
 //
 // Per ray it integrates 000 Eq. 1 (with 000 Eq. 2 for the attenuations; the
 // cloud part is 004 §3.2 Eqs. 1-2), generalised to a spectral cloud + Rayleigh +
-// Mie medium, without the k_multi term (single scattering only):
+// Mie medium, with the k_multi term of 000 Eq. 1 when the scene sets
+// medium.multiple_scattering_constant (0 by default: single scattering only;
+// p_cl below then reads p_cl + k_multi/(4 pi)):
 //
 //   L(λ) = L_b(λ) T_v(t_end, λ)
 //        + ∫_0^t_end T_v(t, λ) [σ_s,cl(x) p_cl(μ) + β_R(λ, x) p_R(μ) + β_M,s(x) p_M(μ)]

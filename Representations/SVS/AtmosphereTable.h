@@ -1,0 +1,60 @@
+// The "atmosphere texture" of 000 §3/§4.1: per height, the atmosphere's density
+// rho_atm(h) and the sun attenuation g_sun_atm(h), here folded with the sun's
+// spectrum and converted to linear sRGB once on the CPU, so the GPU shaders work
+// in RGB with the same physics as the spectral reference (RenderContext).
+//
+// Rows (each `Samples` heights, z from ZMin to ZMax in scene metres, linear):
+//   0 SunIrradiance      E_sun(z)         = rgb( E(l) T_sun,atm(l, z) )                     000 Eq. 7
+//   1 RayleighSource     beta_R rho_R E   = rgb( beta_R(l) rho_R(h) E(l) T(l, z) )   [1/m] 000 Eq. 5
+//   2 MieSource          beta_M rho_M E   = beta_M,s rho_M(h) E_sun(z)               [1/m] 000 Eq. 5
+//   3 Extinction         k_atm rho_atm    = beta_R,eff rho_R(h) + beta_M,ext rho_M(h) [1/m] 000 Eq. 6
+// with h = SceneAltitude + z. The sun transmittance is that of the spherical
+// atmosphere at the point (0, 0, z) (the horizontal offset of a scene of tens of
+// km changes the local sun elevation by < 0.5 deg; ignored).
+//
+// RGB extinction: the per-channel Rayleigh coefficient is the sun-weighted mean
+// beta_R,eff,c = rgb(beta_R E)_c / rgb(E)_c at the top of the atmosphere. This is
+// the one RGB approximation of the GPU path; its error is part of the measured
+// error against the spectral reference.
+#ifndef nimbus_AtmosphereTable_h
+#define nimbus_AtmosphereTable_h
+
+#include "NimbusRepresentationsModule.h"
+#include "SceneDescription.h"
+
+#include <array>
+#include <vector>
+
+namespace nimbus
+{
+struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable
+{
+  static constexpr int kRows = 4;
+  int Samples = 0;
+  double ZMin = 0.0, ZMax = 0.0;  // scene z of the first and last sample [m]
+  /// Row-major float RGBA texels: Data[(row * Samples + i) * 4 + c]; alpha = 1.
+  std::vector<float> Data;
+  /// Sun irradiance above the atmosphere in linear sRGB (used without atmosphere).
+  std::array<double, 3> SunIrradianceTop{ { 0.0, 0.0, 0.0 } };
+  /// Sea-level coefficients for analytic view transmittance [1/m] and scale heights [m].
+  std::array<double, 3> RayleighExtinctionSeaLevel{ { 0.0, 0.0, 0.0 } };
+  double MieExtinctionSeaLevel = 0.0;
+  double MieScatteringSeaLevel = 0.0;
+  double RayleighScaleHeight = 8000.0, MieScaleHeight = 1200.0;
+  double SceneAltitude = 0.0, EarthRadius = 6360000.0, TopRadius = 6420000.0;
+  bool HasAtmosphere = false;
+
+  /// Linear interpolation in z of one row (clamped at the ends), like the GPU's
+  /// linear texture filter.
+  std::array<double, 3> Lookup(int row, double z) const;
+};
+
+/// Builds the table for the sun and atmosphere of `scene` (Sun, Atmosphere,
+/// SpectralSamples are used) over z in [zMin, zMax] with `samples` >= 2 heights.
+/// With the atmosphere disabled only SunIrradianceTop is filled (Samples = 0).
+/// Throws std::invalid_argument for invalid parameters (the scene's messages).
+NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable BuildAtmosphereTable(
+  const SceneDescription& scene, double zMin, double zMax, int samples);
+} // namespace nimbus
+
+#endif

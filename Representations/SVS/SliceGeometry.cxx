@@ -1,0 +1,129 @@
+#include "SliceGeometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace nimbus
+{
+
+double Dot(const Vec3& a, const Vec3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+Vec3 Cross(const Vec3& a, const Vec3& b)
+{
+  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
+}
+
+Vec3 Normalized(const Vec3& v)
+{
+  const double length = std::sqrt(Dot(v, v));
+  if (!(length > 0.0) || !std::isfinite(length))
+  {
+    throw std::invalid_argument("direction must be finite and non-zero");
+  }
+  return { { v[0] / length, v[1] / length, v[2] / length } };
+}
+
+SliceAxis ComputeSliceAxis(const Vec3& view, const Vec3& toSun, double a)
+{
+  const Vec3 v = Normalized(view);
+  const Vec3 l = Normalized(toSun);
+  if (!std::isfinite(a))
+  {
+    throw std::invalid_argument("slice angle ratio a must be finite");
+  }
+  a = std::clamp(a, 0.01, 100.0);
+  const Vec3 away = { { -l[0], -l[1], -l[2] } }; // direction sunlight travels
+  SliceAxis axis;
+  // Sun behind the camera (dot(V, L) < 0): moving away from the sun moves away
+  // from the eye -> front to back along +V. Otherwise back to front along -V.
+  axis.BackToFront = Dot(v, l) >= 0.0;
+  const Vec3 e = axis.BackToFront ? Vec3{ { -v[0], -v[1], -v[2] } } : v;
+  // Angle between e and -L is in [0, pi/2] by the choice of sign.
+  const double c = std::clamp(Dot(e, away), -1.0, 1.0);
+  const double total = std::acos(c);
+  axis.ThetaView = total / (1.0 + a); // theta_e : theta_s = 1 : a
+  axis.ThetaSun = total - axis.ThetaView;
+  if (total < 1e-9)
+  {
+    axis.Normal = away; // view (anti-)parallel to the sun: both slices coincide
+  }
+  else
+  {
+    // slerp(e -> away, t) with t = ThetaView / total.
+    const double s = std::sin(total);
+    const double we = std::sin(total - axis.ThetaView) / s;
+    const double wa = std::sin(axis.ThetaView) / s;
+    axis.Normal = Normalized(
+      { { we * e[0] + wa * away[0], we * e[1] + wa * away[1], we * e[2] + wa * away[2] } });
+  }
+  axis.SunCosine = Dot(axis.Normal, away);
+  return axis;
+}
+
+std::array<double, 2> ProjectedRange(const std::vector<Vec3>& corners, const Vec3& n)
+{
+  std::array<double, 2> range{ { std::numeric_limits<double>::infinity(),
+    -std::numeric_limits<double>::infinity() } };
+  for (const Vec3& corner : corners)
+  {
+    const double d = Dot(corner, n);
+    range[0] = std::min(range[0], d);
+    range[1] = std::max(range[1], d);
+  }
+  return range;
+}
+
+SlicePlanes MakeSlicePlanes(double dMin, double dMax, int count)
+{
+  if (count < 1 || !std::isfinite(dMin) || !std::isfinite(dMax) || dMax < dMin)
+  {
+    throw std::invalid_argument("slice planes need count >= 1 and a finite range");
+  }
+  SlicePlanes planes;
+  planes.Spacing = (dMax - dMin) / count;
+  planes.Offsets.resize(count);
+  for (int i = 0; i < count; ++i)
+  {
+    planes.Offsets[i] = dMin + (i + 0.5) * planes.Spacing;
+  }
+  return planes;
+}
+
+ShadowFrame ComputeShadowFrame(const std::vector<Vec3>& corners, const Vec3& toSun, double margin)
+{
+  const Vec3 l = Normalized(toSun);
+  // Any axis not parallel to L seeds the basis.
+  const Vec3 seed = std::abs(l[2]) < 0.9 ? Vec3{ { 0.0, 0.0, 1.0 } } : Vec3{ { 1.0, 0.0, 0.0 } };
+  ShadowFrame frame;
+  frame.U = Normalized(Cross(seed, l));
+  frame.W = Cross(l, frame.U);
+  double uMin = std::numeric_limits<double>::infinity(), uMax = -uMin, wMin = uMin, wMax = -uMin;
+  for (const Vec3& corner : corners)
+  {
+    const double u = Dot(corner, frame.U), w = Dot(corner, frame.W);
+    uMin = std::min(uMin, u);
+    uMax = std::max(uMax, u);
+    wMin = std::min(wMin, w);
+    wMax = std::max(wMax, w);
+  }
+  const double extent = std::max({ uMax - uMin, wMax - wMin, 1e-12 });
+  const double pad = margin * extent;
+  uMin -= pad;
+  uMax += pad;
+  wMin -= pad;
+  wMax += pad;
+  frame.Width = std::max(uMax - uMin, 1e-12);
+  frame.Height = std::max(wMax - wMin, 1e-12);
+  for (int k = 0; k < 3; ++k)
+  {
+    frame.Origin[k] = uMin * frame.U[k] + wMin * frame.W[k];
+  }
+  return frame;
+}
+
+} // namespace nimbus

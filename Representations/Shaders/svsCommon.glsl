@@ -1,0 +1,164 @@
+// Shared GLSL of the shadow-view-slice mapper (000). Prepended to each pass's
+// fragment shader by vtkNimbusCloudVolumeMapper. World frame: z is up; lengths in
+// world units, converted to metres with lengthUnit. Radiometry: linear sRGB,
+// relative to the sun (see Representations/Reference/SceneDescription.h).
+uniform mat4 inverseViewProjection; // NDC -> world
+uniform vec3 toSun;                 // L, unit
+uniform vec3 sliceNormal;           // n, unit, dot(n, -L) > 0
+uniform float lengthUnit;           // metres per world unit
+
+uniform sampler3D density;          // cloud density volume
+uniform mat4 worldToTexture;        // world -> density texture coordinates
+uniform mat4 worldToBox;            // world -> [0,1]^3 over the density's box
+uniform float extinctionPerDensity; // k_cl [1/m per density unit]
+uniform float cloudAlbedo;          // sigma_s / sigma_t
+
+uniform sampler2D shadowSurface;    // accumulated cloud optical depth toward the sun
+uniform vec3 shadowOrigin;
+uniform vec3 shadowU;
+uniform vec3 shadowW;
+uniform vec2 shadowExtent;
+
+uniform int atmosphereOn;
+uniform sampler2D atmosphereTable;  // rows: sun, Rayleigh source, Mie source, extinction
+uniform vec2 atmosphereZRange;      // z of the first and last column [m]
+uniform vec3 rayleighExtinction0;   // sea level [1/m], per channel
+uniform float mieExtinction0;       // sea level [1/m]
+uniform float rayleighScaleHeight;  // [m]
+uniform float mieScaleHeight;       // [m]
+uniform float sceneAltitude;        // [m] above sea level of z = 0
+uniform float earthRadius;          // [m]
+uniform float topRadius;            // [m]
+uniform vec3 sunIrradianceTop;      // without atmosphere
+
+uniform int groundOn;
+uniform float groundZ;              // world z of the ground plane
+uniform float groundAlbedo;
+
+uniform sampler2D sceneDepth;       // depth of the opaque geometry already drawn
+
+const float kInfinity = 1e30;
+
+void ViewRay(vec2 uv, out vec3 origin, out vec3 direction)
+{
+  vec2 ndc = 2.0 * uv - 1.0;
+  vec4 nearPoint = inverseViewProjection * vec4(ndc, -1.0, 1.0);
+  vec4 farPoint = inverseViewProjection * vec4(ndc, 1.0, 1.0);
+  origin = nearPoint.xyz / nearPoint.w;
+  direction = normalize(farPoint.xyz / farPoint.w - origin);
+}
+
+// Distance along the ray to the opaque geometry (infinity where none was drawn).
+float OpaqueDistance(vec2 uv, vec3 origin, vec3 direction)
+{
+  float depth = texture(sceneDepth, uv).r;
+  if (depth >= 1.0)
+  {
+    return kInfinity;
+  }
+  vec4 p = inverseViewProjection * vec4(2.0 * uv - 1.0, 2.0 * depth - 1.0, 1.0);
+  return max(dot(p.xyz / p.w - origin, direction), 0.0);
+}
+
+float GroundDistance(vec3 origin, vec3 direction)
+{
+  if (groundOn == 0 || direction.z >= 0.0 || origin.z < groundZ)
+  {
+    return kInfinity;
+  }
+  return (groundZ - origin.z) / direction.z;
+}
+
+// Altitude above sea level over the spherical earth [m] of world point p.
+float Altitude(vec3 p)
+{
+  vec3 q = vec3(p.xy * lengthUnit, earthRadius + sceneAltitude + p.z * lengthUnit);
+  return length(q) - earthRadius;
+}
+
+// Distance (world units) to the top of the atmosphere from the ray origin.
+float TopDistance(vec3 origin, vec3 direction)
+{
+  if (atmosphereOn == 0)
+  {
+    return kInfinity;
+  }
+  float r0 = earthRadius + sceneAltitude + origin.z * lengthUnit;
+  float b = direction.z * r0;
+  float c = (r0 - topRadius) * (r0 + topRadius);
+  float disc = b * b - c;
+  if (disc < 0.0)
+  {
+    return 0.0;
+  }
+  return max(-b + sqrt(disc), 0.0) / lengthUnit;
+}
+
+// Atmosphere table row at altitude h [m] (000: the "atmosphere texture").
+vec3 AtmosphereRow(int row, float altitude)
+{
+  float z = altitude - sceneAltitude;
+  float x = clamp((z - atmosphereZRange.x) / (atmosphereZRange.y - atmosphereZRange.x), 0.0, 1.0);
+  ivec2 size = textureSize(atmosphereTable, 0);
+  float u = (0.5 + x * float(size.x - 1)) / float(size.x);
+  return texture(atmosphereTable, vec2(u, (float(row) + 0.5) / 4.0)).rgb;
+}
+
+vec3 SunIrradiance(float altitude)
+{
+  return atmosphereOn != 0 ? max(AtmosphereRow(0, altitude), vec3(0.0)) : sunIrradianceTop;
+}
+
+// Sea-level-equivalent length of an exponential layer along the straight ray
+// over [0, t] (flat earth; 000 Eq. 6 in closed form) [m].
+float LayerLength(float h0, float dz, float tMetres, float scaleHeight)
+{
+  float x = tMetres * dz / scaleHeight;
+  float factor = abs(x) < 1e-3 ? tMetres * (1.0 - 0.5 * x + x * x / 6.0)
+                               : scaleHeight * (1.0 - exp(-x)) / dz;
+  return exp(-max(h0, 0.0) / scaleHeight) * factor;
+}
+
+// Atmospheric transmittance g_view_atm between the ray origin and distance t (000 Eq. 6).
+vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
+{
+  if (atmosphereOn == 0)
+  {
+    return vec3(1.0);
+  }
+  float h0 = sceneAltitude + origin.z * lengthUnit;
+  float tm = min(t, 1e7) * lengthUnit;
+  float lr = LayerLength(h0, direction.z, tm, rayleighScaleHeight);
+  float lm = LayerLength(h0, direction.z, tm, mieScaleHeight);
+  return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
+}
+
+float CloudDensity(vec3 p)
+{
+  vec3 box = (worldToBox * vec4(p, 1.0)).xyz;
+  if (any(lessThan(box, vec3(0.0))) || any(greaterThan(box, vec3(1.0))))
+  {
+    return 0.0;
+  }
+  return max(texture(density, (worldToTexture * vec4(p, 1.0)).xyz).r, 0.0);
+}
+
+// Cloud optical depth toward the sun accumulated on the shadow surface so far.
+float ShadowDepth(vec3 p)
+{
+  vec3 q = p - shadowOrigin;
+  vec2 st = vec2(dot(q, shadowU), dot(q, shadowW)) / shadowExtent;
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0))))
+  {
+    return 0.0;
+  }
+  return texture(shadowSurface, st).r;
+}
+
+// Radiance of the Lambertian ground at g, toward the eye, before view attenuation.
+vec3 GroundRadiance(vec3 g, float cloudDepthToSun)
+{
+  float cosSun = max(toSun.z, 0.0);
+  return groundAlbedo / 3.14159265358979 * cosSun * SunIrradiance(Altitude(g)) *
+    exp(-cloudDepthToSun);
+}

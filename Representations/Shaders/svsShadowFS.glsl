@@ -1,0 +1,17 @@
+// Shadow-surface update for slice i (000 Eq. 10): the shadow surface faces the sun;
+// each texel adds the cloud optical depth of the slab along its sun ray,
+// k_cl rho_cl(P_i) Delta s, by additive blending into a float target, so the
+// product of Eq. 7 becomes a sum of optical depths (exact, and no underflow).
+in vec2 texCoord;
+uniform float sliceOffset;
+uniform float sunStepMetres;
+
+void main()
+{
+  // Point of this texel's sun ray on the slice plane dot(x, n) = d_i.
+  vec3 base = shadowOrigin + texCoord.x * shadowExtent.x * shadowU +
+    texCoord.y * shadowExtent.y * shadowW;
+  float lambda = (sliceOffset - dot(base, sliceNormal)) / dot(-toSun, sliceNormal);
+  vec3 p = base - lambda * toSun;
+  gl_FragData[0] = vec4(extinctionPerDensity * CloudDensity(p) * sunStepMetres, 0.0, 0.0, 0.0);
+}

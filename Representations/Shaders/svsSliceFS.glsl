@@ -1,0 +1,79 @@
+// One shadow-view slice seen from the camera (000 Eqs. 5, 8, 9; §4.3 blending is
+// the fixed-function blend set by the mapper). Output: rgb = C_i, the radiance the
+// slab around slice i sends toward the eye (already multiplied by the atmosphere's
+// view transmittance in front of it), a = alpha_i, the slab's cloud transmittance
+// Delta g_view_cl. Opaque things in the slab (the ground) give alpha 0.
+in vec2 texCoord;
+uniform sampler2D intervalPhase;  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
+uniform float sliceOffset;        // d_i: the slice plane is dot(x, n) = d_i
+uniform float sliceSpacing;       // Delta d (world)
+uniform float sunStepMetres;      // Delta s = Delta d / dot(n, -L) [m] (000 Eq. 10)
+uniform int shaftsOn;             // atmosphere in cloud shadow
+uniform int unlit;                // benchmark floor: composite the slices without lighting
+
+void main()
+{
+  vec3 origin, direction;
+  ViewRay(texCoord, origin, direction);
+  vec4 intervalAndPhase = texture(intervalPhase, texCoord);
+  float vn = dot(direction, sliceNormal);
+  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
+    GroundDistance(origin, direction));
+  float t = abs(vn) > 1e-7 ? (sliceOffset - dot(origin, sliceNormal)) / vn : -1.0;
+  bool medium = t >= 0.0 && t < tEnd;
+
+  // The ground closes the ray inside this slab?
+  float tGround = GroundDistance(origin, direction);
+  bool ground = false;
+  if (unlit == 0 && tGround < kInfinity && tGround <= tEnd)
+  {
+    float dGround = dot(origin + tGround * direction, sliceNormal);
+    ground = abs(dGround - sliceOffset) <= 0.5 * sliceSpacing;
+  }
+  if (!medium && !ground)
+  {
+    discard;
+  }
+
+  vec3 color = vec3(0.0);
+  float alpha = 1.0;
+  if (medium)
+  {
+    vec3 p = origin + t * direction;
+    float stepMetres = sliceSpacing * intervalAndPhase.x * lengthUnit; // Delta t(p) [m]
+    float sigma = extinctionPerDensity * CloudDensity(p);              // k_cl rho_cl [1/m]
+    alpha = exp(-sigma * stepMetres);                                  // 000 Eq. 9 (cloud part)
+    // Exact integral of a constant source over the slab: (1 - alpha) / sigma.
+    float slabLength = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
+    vec3 source;
+    if (unlit != 0)
+    {
+      source = vec3(sigma);
+    }
+    else
+    {
+      float altitude = Altitude(p);
+      // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
+      float sunTransmittance = exp(-(ShadowDepth(p) + 0.5 * sigma * sunStepMetres));
+      source = cloudAlbedo * sigma * intervalAndPhase.y * sunTransmittance *
+        SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
+      if (atmosphereOn != 0)
+      {
+        vec3 air = AtmosphereRow(1, altitude) * intervalAndPhase.z +
+          AtmosphereRow(2, altitude) * intervalAndPhase.w;             // 000 Eq. 8, atmosphere
+        source += air * (shaftsOn != 0 ? sunTransmittance : 1.0);
+      }
+      source *= AtmosphereViewTransmittance(origin, direction, t);
+    }
+    color = source * slabLength;
+  }
+  if (ground && (!medium || t < tGround))
+  {
+    vec3 g = origin + tGround * direction;
+    vec3 groundColor = GroundRadiance(g, ShadowDepth(g)) *
+      AtmosphereViewTransmittance(origin, direction, tGround);
+    color += alpha * groundColor;
+    alpha = 0.0;
+  }
+  gl_FragData[0] = vec4(color, alpha);
+}

@@ -1,0 +1,808 @@
+#include "vtkNimbusCloudVolumeMapper.h"
+
+#include "AtmosphereTable.h"
+#include "SceneDescription.h"
+#include "SliceGeometry.h"
+
+#include "svsCommon.h"
+#include "svsCompositeFS.h"
+#include "svsIntervalPhaseFS.h"
+#include "svsMarchFS.h"
+#include "svsShadowFS.h"
+#include "svsSliceFS.h"
+
+#include "vtkCamera.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLFramebufferObject.h"
+#include "vtkOpenGLQuadHelper.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkPointData.h"
+#include "vtkCellData.h"
+#include "vtkRenderer.h"
+#include "vtkShaderProgram.h"
+#include "vtkTextureObject.h"
+#include "vtkVolume.h"
+#include "vtk_glew.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
+
+namespace
+{
+constexpr double kDegree = 3.14159265358979323846 / 180.0;
+
+// Column-major float copy of a VTK (row-major) matrix, for glUniformMatrix4fv.
+std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
+{
+  std::array<float, 16> out{};
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      out[c * 4 + r] = static_cast<float>(m->GetElement(r, c));
+    }
+  }
+  return out;
+}
+
+std::string FragmentSource(const char* pass)
+{
+  return std::string("//VTK::System::Dec\n//VTK::Output::Dec\n") + svsCommon + "\n" + pass;
+}
+}
+
+struct vtkNimbusCloudVolumeMapper::Internals
+{
+  vtkOpenGLRenderWindow* Window = nullptr;
+
+  // Density volume (000: the "volume texture").
+  vtkNew<vtkTextureObject> Density;
+  vtkTimeStamp DensityUploadTime;
+  vtkDataArray* UploadedArray = nullptr;
+  vtkImageData* UploadedImage = nullptr;
+  int UploadedMaximumSize = -1;
+  int TextureDims[3] = { 0, 0, 0 };
+  double BoxToTexScale[3] = { 1, 1, 1 };
+  double BoxToTexOffset[3] = { 0, 0, 0 };
+  double BoxOrigin[3] = { 0, 0, 0 };  // data coordinates of the density box
+  double BoxSize[3] = { 1, 1, 1 };
+  bool HasDensity = false;
+
+  // Atmosphere texture (000 §3), keyed by the parameters it depends on.
+  vtkNew<vtkTextureObject> AtmosphereTexture;
+  std::vector<double> AtmosphereKey;
+  nimbus::AtmosphereTable Table;
+
+  // Sampling-interval and Mie-phase texture (000 §4.4), keyed likewise.
+  vtkNew<vtkTextureObject> IntervalPhase;
+  vtkNew<vtkOpenGLFramebufferObject> IntervalPhaseFramebuffer;
+  std::vector<double> IntervalPhaseKey;
+
+  // Accumulation (S, alpha) at the viewport size, and copies of the scene's colour and depth.
+  vtkNew<vtkTextureObject> Accumulation;
+  vtkNew<vtkOpenGLFramebufferObject> AccumulationFramebuffer;
+  vtkNew<vtkTextureObject> SceneColor;
+  vtkNew<vtkTextureObject> SceneDepth;
+
+  // Shadow surface facing the sun (000 Eq. 10).
+  vtkNew<vtkTextureObject> Shadow;
+  vtkNew<vtkOpenGLFramebufferObject> ShadowFramebuffer;
+
+  std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
+    CompositePass;
+
+  int VolumeUploads = 0;
+  int AtmosphereBuilds = 0;
+  int IntervalPhaseBuilds = 0;
+  int PassesLastRender = 0;
+  bool LastBackToFront = false;
+
+  void Release(vtkWindow* window)
+  {
+    for (vtkTextureObject* t : { Density.GetPointer(), AtmosphereTexture.GetPointer(),
+           IntervalPhase.GetPointer(), Accumulation.GetPointer(), SceneColor.GetPointer(),
+           SceneDepth.GetPointer(), Shadow.GetPointer() })
+    {
+      t->ReleaseGraphicsResources(window);
+    }
+    for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
+           AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer() })
+    {
+      f->ReleaseGraphicsResources(window);
+    }
+    for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass })
+    {
+      if (*pass)
+      {
+        (*pass)->ReleaseGraphicsResources(window);
+        pass->reset();
+      }
+    }
+    UploadedArray = nullptr;
+    UploadedImage = nullptr;
+    HasDensity = false;
+    AtmosphereKey.clear();
+    IntervalPhaseKey.clear();
+    Window = nullptr;
+  }
+
+  vtkShaderProgram* Ready(std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source)
+  {
+    if (!pass)
+    {
+      const std::string fs = FragmentSource(source);
+      pass = std::make_unique<vtkOpenGLQuadHelper>(Window, nullptr, fs.c_str(), "");
+    }
+    else
+    {
+      Window->GetShaderCache()->ReadyShaderProgram(pass->Program);
+    }
+    return pass->Program;
+  }
+};
+
+vtkNimbusCloudVolumeMapper::vtkNimbusCloudVolumeMapper()
+  : Internal(new Internals)
+{
+}
+
+vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper() = default;
+
+int vtkNimbusCloudVolumeMapper::GetNumberOfVolumeUploads() const
+{
+  return this->Internal->VolumeUploads;
+}
+int vtkNimbusCloudVolumeMapper::GetNumberOfAtmosphereBuilds() const
+{
+  return this->Internal->AtmosphereBuilds;
+}
+int vtkNimbusCloudVolumeMapper::GetNumberOfIntervalPhaseBuilds() const
+{
+  return this->Internal->IntervalPhaseBuilds;
+}
+int vtkNimbusCloudVolumeMapper::GetNumberOfPassesLastRender() const
+{
+  return this->Internal->PassesLastRender;
+}
+bool vtkNimbusCloudVolumeMapper::GetLastBackToFront() const
+{
+  return this->Internal->LastBackToFront;
+}
+void vtkNimbusCloudVolumeMapper::GetTextureDimensions(int dims[3]) const
+{
+  std::copy(this->Internal->TextureDims, this->Internal->TextureDims + 3, dims);
+}
+
+void vtkNimbusCloudVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
+{
+  this->Internal->Release(window);
+}
+
+//------------------------------------------------------------------------------
+void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
+{
+  Internals& in = *this->Internal;
+  in.PassesLastRender = 0;
+  auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
+  if (!window)
+  {
+    vtkErrorMacro("vtkNimbusCloudVolumeMapper needs an OpenGL render window.");
+    return;
+  }
+  if (in.Window && in.Window != window)
+  {
+    in.Release(in.Window);
+  }
+  in.Window = window;
+  vtkImageData* image = vtkImageData::SafeDownCast(this->GetInput());
+  if (!image)
+  {
+    vtkErrorMacro("No input image: connect a vtkImageData with a density array.");
+    return;
+  }
+  this->GetInputAlgorithm()->UpdateInformation();
+  this->GetInputAlgorithm()->Update();
+  image = vtkImageData::SafeDownCast(this->GetInput());
+
+  // --- density texture: uploaded only when the data (not the lighting) changed.
+  int cellFlag = 0;
+  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, this->ScalarMode,
+    this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  if (!scalars)
+  {
+    vtkErrorMacro("The input image has no scalar array to render as density (set one with "
+                  "SelectScalarArray, or give the image active point scalars).");
+    return;
+  }
+  const int maxSize = this->MaximumTextureSize > 0
+    ? std::min(this->MaximumTextureSize, vtkTextureObject::GetMaximumTextureSize3D(window))
+    : vtkTextureObject::GetMaximumTextureSize3D(window);
+  if (!in.HasDensity || in.UploadedArray != scalars || in.UploadedImage != image ||
+    scalars->GetMTime() > in.DensityUploadTime || image->GetMTime() > in.DensityUploadTime ||
+    in.UploadedMaximumSize != maxSize)
+  {
+    int pointDims[3];
+    image->GetDimensions(pointDims);
+    int dims[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      dims[k] = cellFlag ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    }
+    if (static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] != scalars->GetNumberOfTuples())
+    {
+      vtkErrorMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)")
+                              << "' has " << scalars->GetNumberOfTuples()
+                              << " values, but the image needs " << dims[0] * dims[1] * dims[2]);
+      return;
+    }
+    if (scalars->GetNumberOfComponents() != 1)
+    {
+      vtkWarningMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)")
+                                << "' has " << scalars->GetNumberOfComponents()
+                                << " components; rendering its first as the density.");
+    }
+    // Downsample by an integer factor per axis (box average) above the texture limit.
+    int factor[3], texDims[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      factor[k] = (dims[k] + maxSize - 1) / maxSize;
+      texDims[k] = (dims[k] + factor[k] - 1) / factor[k];
+    }
+    if (factor[0] > 1 || factor[1] > 1 || factor[2] > 1)
+    {
+      vtkWarningMacro("Density " << dims[0] << "x" << dims[1] << "x" << dims[2]
+                                 << " exceeds the texture limit of " << maxSize
+                                 << " per side; downsampled to " << texDims[0] << "x"
+                                 << texDims[1] << "x" << texDims[2] << " by averaging.");
+    }
+    std::vector<float> values(static_cast<size_t>(texDims[0]) * texDims[1] * texDims[2], 0.0f);
+    std::vector<float> counts(values.size(), 0.0f);
+    vtkIdType nonFinite = 0;
+    for (int z = 0; z < dims[2]; ++z)
+    {
+      for (int y = 0; y < dims[1]; ++y)
+      {
+        for (int x = 0; x < dims[0]; ++x)
+        {
+          const vtkIdType id = x + static_cast<vtkIdType>(dims[0]) * (y + static_cast<vtkIdType>(dims[1]) * z);
+          double v = scalars->GetComponent(id, 0);
+          if (!std::isfinite(v))
+          {
+            ++nonFinite;
+            v = 0.0;
+          }
+          const size_t t = (x / factor[0]) +
+            static_cast<size_t>(texDims[0]) * ((y / factor[1]) + static_cast<size_t>(texDims[1]) * (z / factor[2]));
+          values[t] += static_cast<float>(std::max(v, 0.0));
+          counts[t] += 1.0f;
+        }
+      }
+    }
+    for (size_t i = 0; i < values.size(); ++i)
+    {
+      values[i] = counts[i] > 0.0f ? values[i] / counts[i] : 0.0f;
+    }
+    if (nonFinite > 0)
+    {
+      vtkWarningMacro(<< nonFinite << " density values are NaN or infinite; rendered as 0.");
+    }
+    in.Density->SetContext(window);
+    in.Density->ReleaseGraphicsResources(window);
+    in.Density->SetWrapS(vtkTextureObject::ClampToEdge);
+    in.Density->SetWrapT(vtkTextureObject::ClampToEdge);
+    in.Density->SetWrapR(vtkTextureObject::ClampToEdge);
+    in.Density->SetMinificationFilter(vtkTextureObject::Linear);
+    in.Density->SetMagnificationFilter(vtkTextureObject::Linear);
+    if (!in.Density->Create3DFromRaw(texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
+    {
+      vtkErrorMacro("Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
+                                            << " density texture.");
+      return;
+    }
+    // Box of the density in data coordinates and the box -> texture-coordinate map.
+    double origin[3], spacing[3];
+    int extent[6];
+    image->GetOrigin(origin);
+    image->GetSpacing(spacing);
+    image->GetExtent(extent);
+    for (int k = 0; k < 3; ++k)
+    {
+      const double first = origin[k] + extent[2 * k] * spacing[k];
+      const int cells = cellFlag ? dims[k] : std::max(dims[k] - 1, 0);
+      in.BoxOrigin[k] = first;
+      in.BoxSize[k] = cells * spacing[k];
+      const double texels = static_cast<double>(texDims[k]) * factor[k]; // in input samples
+      if (cellFlag)
+      {
+        in.BoxToTexScale[k] = dims[k] / texels;
+        in.BoxToTexOffset[k] = 0.0;
+      }
+      else
+      {
+        // Point sample j sits at the centre of input texel j: (j + 0.5) / texels.
+        in.BoxToTexScale[k] = (dims[k] - 1) / texels;
+        in.BoxToTexOffset[k] = 0.5 / texels;
+      }
+      if (in.BoxSize[k] == 0.0)
+      {
+        // A single sample thick: give the box one spacing (or unit) of thickness around it.
+        const double thickness = spacing[k] != 0.0 ? std::abs(spacing[k]) : 1.0;
+        in.BoxOrigin[k] = first - 0.5 * thickness;
+        in.BoxSize[k] = thickness;
+        in.BoxToTexScale[k] = 0.0;
+        in.BoxToTexOffset[k] = 0.5;
+      }
+    }
+    std::copy(texDims, texDims + 3, in.TextureDims);
+    in.UploadedArray = scalars;
+    in.UploadedImage = image;
+    in.UploadedMaximumSize = maxSize;
+    in.DensityUploadTime.Modified();
+    in.HasDensity = true;
+    ++in.VolumeUploads;
+  }
+
+  // --- geometry: sun, view, slice axis, box corners in world coordinates.
+  vtkCamera* camera = renderer->GetActiveCamera();
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  if (width < 1 || height < 1)
+  {
+    return;
+  }
+  const double elevation = this->SunElevation * kDegree, azimuth = this->SunAzimuth * kDegree;
+  const nimbus::Vec3 toSun = { { std::cos(elevation) * std::sin(azimuth),
+    std::cos(elevation) * std::cos(azimuth), std::sin(elevation) } };
+  double projection[3];
+  camera->GetDirectionOfProjection(projection);
+  const nimbus::Vec3 view = { { projection[0], projection[1], projection[2] } };
+  const nimbus::SliceAxis axis = nimbus::ComputeSliceAxis(view, toSun, this->SliceAngleRatio);
+  in.LastBackToFront = axis.BackToFront;
+
+  vtkMatrix4x4* dataToWorld = volume->GetMatrix();
+  std::vector<nimbus::Vec3> corners;
+  for (int c = 0; c < 8; ++c)
+  {
+    const double p[4] = { in.BoxOrigin[0] + ((c & 1) ? in.BoxSize[0] : 0.0),
+      in.BoxOrigin[1] + ((c & 2) ? in.BoxSize[1] : 0.0),
+      in.BoxOrigin[2] + ((c & 4) ? in.BoxSize[2] : 0.0), 1.0 };
+    double w[4];
+    dataToWorld->MultiplyPoint(p, w);
+    corners.push_back({ { w[0] / w[3], w[1] / w[3], w[2] / w[3] } });
+  }
+  const std::array<double, 2> range = nimbus::ProjectedRange(corners, axis.Normal);
+  const nimbus::SlicePlanes planes =
+    nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), this->NumberOfSlices);
+  const nimbus::ShadowFrame frame = nimbus::ComputeShadowFrame(corners, toSun, 0.02);
+  const double sunStepMetres = planes.Spacing / axis.SunCosine * this->LengthUnit;
+
+  // world -> box [0,1]^3 -> density texture coordinates.
+  vtkNew<vtkMatrix4x4> worldToData;
+  vtkMatrix4x4::Invert(dataToWorld, worldToData);
+  vtkNew<vtkMatrix4x4> dataToTexture;
+  for (int k = 0; k < 3; ++k)
+  {
+    dataToTexture->SetElement(k, k, in.BoxToTexScale[k] / in.BoxSize[k]);
+    dataToTexture->SetElement(
+      k, 3, in.BoxToTexOffset[k] - in.BoxToTexScale[k] * in.BoxOrigin[k] / in.BoxSize[k]);
+  }
+  vtkNew<vtkMatrix4x4> worldToTexture;
+  vtkMatrix4x4::Multiply4x4(dataToTexture, worldToData, worldToTexture);
+  // Texture coordinates are tested against [0,1] for "inside the box": with the
+  // half-texel offsets of point data, map the box itself to [0,1] for that test.
+  vtkNew<vtkMatrix4x4> worldToBox;
+  {
+    vtkNew<vtkMatrix4x4> dataToBox;
+    for (int k = 0; k < 3; ++k)
+    {
+      dataToBox->SetElement(k, k, 1.0 / in.BoxSize[k]);
+      dataToBox->SetElement(k, 3, -in.BoxOrigin[k] / in.BoxSize[k]);
+    }
+    vtkMatrix4x4::Multiply4x4(dataToBox, worldToData, worldToBox);
+  }
+
+  const double aspect = static_cast<double>(width) / height;
+  vtkNew<vtkMatrix4x4> inverseViewProjection;
+  inverseViewProjection->DeepCopy(camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1));
+  inverseViewProjection->Invert();
+
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglViewport savedViewport(state);
+  vtkOpenGLState::ScopedglBlendFuncSeparate savedBlend(state);
+  vtkOpenGLState::ScopedglEnableDisable savedBlendEnable(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable savedDepthTest(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable savedScissor(state, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglEnableDisable savedCull(state, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglDepthMask savedDepthMask(state);
+  vtkOpenGLState::ScopedglColorMask savedColorMask(state);
+  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  state->vtkglDisable(GL_CULL_FACE);
+  state->vtkglDisable(GL_SCISSOR_TEST);
+
+  // --- copies of the scene's colour and depth (the background and the opaque depth).
+  GLint drawFramebuffer = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
+  state->PushFramebufferBindings();
+  state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
+  auto ensure2D = [&](vtkTextureObject* texture, int w, int h, int components, bool depth) {
+    texture->SetContext(window);
+    if (static_cast<int>(texture->GetWidth()) != w || static_cast<int>(texture->GetHeight()) != h ||
+      !texture->GetHandle())
+    {
+      texture->ReleaseGraphicsResources(window);
+      texture->SetWrapS(vtkTextureObject::ClampToEdge);
+      texture->SetWrapT(vtkTextureObject::ClampToEdge);
+      texture->SetMinificationFilter(vtkTextureObject::Nearest);
+      texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+      if (depth)
+      {
+        texture->AllocateDepth(w, h, vtkTextureObject::Float32);
+      }
+      else
+      {
+        texture->Allocate2D(w, h, components, VTK_FLOAT);
+      }
+    }
+  };
+  ensure2D(in.SceneColor, width, height, 4, false);
+  ensure2D(in.SceneDepth, width, height, 1, true);
+  in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+  in.SceneDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+
+  // --- atmosphere texture (only with an atmosphere; rebuilt when sun or air change).
+  const bool atmosphere = this->Atmosphere && !this->Unlit;
+  const bool ground = this->Ground && !this->Unlit;
+  double boxZMin = std::numeric_limits<double>::infinity();
+  for (const auto& corner : corners)
+  {
+    boxZMin = std::min(boxZMin, corner[2]);
+  }
+  const double zLow = (std::min(boxZMin, ground ? this->GroundHeight : boxZMin)) * this->LengthUnit;
+  nimbus::SceneDescription scene;
+  scene.Sun.Azimuth = this->SunAzimuth;
+  scene.Sun.Elevation = this->SunElevation;
+  scene.Sun.Illuminance = this->SunIlluminance;
+  scene.Sun.Temperature = this->SunTemperature;
+  scene.Atmosphere.Enabled = atmosphere;
+  scene.Atmosphere.SceneAltitude = this->SceneAltitude;
+  scene.Atmosphere.RayleighScattering550 = this->RayleighScattering;
+  scene.Atmosphere.MieScattering = this->HazeDensity;
+  scene.Atmosphere.MieG = this->HazeG;
+  const double zHigh = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - this->SceneAltitude;
+  const std::vector<double> atmosphereKey = { this->SunAzimuth, this->SunElevation,
+    this->SunIlluminance, this->SunTemperature, atmosphere ? 1.0 : 0.0, this->SceneAltitude,
+    this->RayleighScattering, this->HazeDensity, this->HazeG, zLow };
+  if (atmosphereKey != in.AtmosphereKey)
+  {
+    try
+    {
+      in.Table = nimbus::BuildAtmosphereTable(scene, std::min(zLow, zHigh - 1.0), zHigh, 1024);
+    }
+    catch (const std::exception& error)
+    {
+      vtkErrorMacro("Invalid sun or atmosphere: " << error.what());
+      state->PopFramebufferBindings();
+      return;
+    }
+    if (in.Table.HasAtmosphere)
+    {
+      in.AtmosphereTexture->SetContext(window);
+      in.AtmosphereTexture->ReleaseGraphicsResources(window);
+      in.AtmosphereTexture->SetWrapS(vtkTextureObject::ClampToEdge);
+      in.AtmosphereTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+      in.AtmosphereTexture->SetMinificationFilter(vtkTextureObject::Linear);
+      in.AtmosphereTexture->SetMagnificationFilter(vtkTextureObject::Linear);
+      in.AtmosphereTexture->Create2DFromRaw(in.Table.Samples, nimbus::AtmosphereTable::kRows, 4,
+        VTK_FLOAT, in.Table.Data.data());
+      ++in.AtmosphereBuilds;
+    }
+    in.AtmosphereKey = atmosphereKey;
+  }
+
+  // Uniforms every pass shares.
+  const std::array<float, 16> ivp = ColumnMajor(inverseViewProjection);
+  const std::array<float, 16> w2t = ColumnMajor(worldToTexture);
+  const std::array<float, 16> w2b = ColumnMajor(worldToBox);
+  auto setCommon = [&](vtkShaderProgram* program) {
+    program->SetUniformMatrix4x4("inverseViewProjection", const_cast<float*>(ivp.data()));
+    program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(w2t.data()));
+    program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(w2b.data()));
+    program->SetUniform3f("toSun", toSun.data());
+    program->SetUniform3f("sliceNormal", axis.Normal.data());
+    program->SetUniformf("lengthUnit", static_cast<float>(this->LengthUnit));
+    program->SetUniformi("density", in.Density->GetTextureUnit());
+    program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
+    program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
+    program->SetUniformi("shadowSurface", in.Shadow->GetTextureUnit());
+    program->SetUniform3f("shadowOrigin", frame.Origin.data());
+    program->SetUniform3f("shadowU", frame.U.data());
+    program->SetUniform3f("shadowW", frame.W.data());
+    const float extent[2] = { static_cast<float>(frame.Width), static_cast<float>(frame.Height) };
+    program->SetUniform2f("shadowExtent", extent);
+    program->SetUniformi("atmosphereOn", atmosphere ? 1 : 0);
+    if (atmosphere)
+    {
+      program->SetUniformi("atmosphereTable", in.AtmosphereTexture->GetTextureUnit());
+    }
+    else
+    {
+      program->SetUniformi("atmosphereTable", in.Density->GetTextureUnit()); // unused
+    }
+    const float zRange[2] = { static_cast<float>(in.Table.ZMin), static_cast<float>(in.Table.ZMax) };
+    program->SetUniform2f("atmosphereZRange", zRange);
+    program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
+    program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
+    program->SetUniformf("rayleighScaleHeight", static_cast<float>(in.Table.RayleighScaleHeight));
+    program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.MieScaleHeight));
+    program->SetUniformf("sceneAltitude", static_cast<float>(this->SceneAltitude));
+    program->SetUniformf("earthRadius", static_cast<float>(scene.Atmosphere.EarthRadius));
+    program->SetUniformf("topRadius", static_cast<float>(scene.Atmosphere.TopRadius));
+    program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
+    program->SetUniformi("groundOn", ground ? 1 : 0);
+    program->SetUniformf("groundZ", static_cast<float>(this->GroundHeight));
+    program->SetUniformf("groundAlbedo", static_cast<float>(this->GroundAlbedo));
+    program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
+  };
+
+  in.Density->Activate();
+  in.SceneDepth->Activate();
+  if (atmosphere)
+  {
+    in.AtmosphereTexture->Activate();
+  }
+
+  // --- shadow surface, cleared to optical depth 0.
+  in.Shadow->SetContext(window);
+  if (static_cast<int>(in.Shadow->GetWidth()) != this->ShadowSurfaceSize || !in.Shadow->GetHandle())
+  {
+    in.Shadow->ReleaseGraphicsResources(window);
+    in.Shadow->SetWrapS(vtkTextureObject::ClampToEdge);
+    in.Shadow->SetWrapT(vtkTextureObject::ClampToEdge);
+    in.Shadow->SetMinificationFilter(vtkTextureObject::Linear);
+    in.Shadow->SetMagnificationFilter(vtkTextureObject::Linear);
+    in.Shadow->Allocate2D(this->ShadowSurfaceSize, this->ShadowSurfaceSize, 1, VTK_FLOAT);
+  }
+  in.ShadowFramebuffer->SetContext(window);
+  in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
+  in.ShadowFramebuffer->AddColorAttachment(0, in.Shadow);
+  in.ShadowFramebuffer->ActivateDrawBuffer(0);
+  state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  state->vtkglClear(GL_COLOR_BUFFER_BIT);
+
+  // --- sampling-interval and Mie-phase texture (rebuilt when camera or sun change).
+  const bool unlit = this->Unlit;
+  std::vector<double> intervalKey(ivp.begin(), ivp.end());
+  intervalKey.insert(intervalKey.end(), { static_cast<double>(width), static_cast<double>(height),
+    toSun[0], toSun[1], toSun[2], axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG,
+    this->HazeG, this->MultipleScattering });
+  state->vtkglDisable(GL_DEPTH_TEST);
+  state->vtkglDepthMask(GL_FALSE);
+  if (intervalKey != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
+  {
+    ensure2D(in.IntervalPhase, width, height, 4, false);
+    in.IntervalPhaseFramebuffer->SetContext(window);
+    in.IntervalPhaseFramebuffer->Bind(GL_FRAMEBUFFER);
+    in.IntervalPhaseFramebuffer->AddColorAttachment(0, in.IntervalPhase);
+    in.IntervalPhaseFramebuffer->ActivateDrawBuffer(0);
+    state->vtkglViewport(0, 0, width, height);
+    state->vtkglDisable(GL_BLEND);
+    vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
+    setCommon(program);
+    program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+    program->SetUniformf("hazeG", static_cast<float>(this->HazeG));
+    program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
+    in.IntervalPhasePass->Render();
+    ++in.PassesLastRender;
+    ++in.IntervalPhaseBuilds;
+    in.IntervalPhaseKey = intervalKey;
+  }
+  in.IntervalPhase->Activate();
+  in.Shadow->Activate();
+
+  // --- accumulation (S, cloud transmittance), cleared to (0, 0, 0, 1).
+  ensure2D(in.Accumulation, width, height, 4, false);
+  in.AccumulationFramebuffer->SetContext(window);
+  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+  in.AccumulationFramebuffer->AddColorAttachment(0, in.Accumulation);
+  in.AccumulationFramebuffer->ActivateDrawBuffer(0);
+  state->vtkglViewport(0, 0, width, height);
+  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  state->vtkglClear(GL_COLOR_BUFFER_BIT);
+
+  // 000 §4.3: back-to-front S_i = C_i + alpha_i S_{i-1}; front-to-back
+  // S_i = S_{i-1} + alpha*_i C_i with alpha* the transmittance so far (kept in alpha).
+  auto useSliceBlend = [&]() {
+    state->vtkglEnable(GL_BLEND);
+    if (axis.BackToFront)
+    {
+      state->vtkglBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_SRC_ALPHA);
+    }
+    else
+    {
+      state->vtkglBlendFuncSeparate(GL_DST_ALPHA, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
+    }
+  };
+
+  const bool outsideRegions = atmosphere || ground;
+  auto drawRegion = [&](double start, double end, bool useShadow) {
+    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+    state->vtkglViewport(0, 0, width, height);
+    useSliceBlend();
+    vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
+    setCommon(program);
+    program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+    program->SetUniformf("regionStart", static_cast<float>(start));
+    program->SetUniformf("regionEnd", static_cast<float>(end));
+    program->SetUniformi("useShadow", useShadow ? 1 : 0);
+    program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
+    program->SetUniformi("steps", this->AtmosphereSteps);
+    in.MarchPass->Render();
+    ++in.PassesLastRender;
+  };
+  const double firstStart = planes.Offsets.front() - 0.5 * planes.Spacing;
+  const double lastEnd = planes.Offsets.back() + 0.5 * planes.Spacing;
+  if (outsideRegions)
+  {
+    drawRegion(-1e30, firstStart, false); // sunward of the cloud: unshadowed
+  }
+
+  // Screen rectangle of the box when nothing outside it is drawn (scissor).
+  bool scissor = false;
+  int scissorBox[4] = { 0, 0, width, height };
+  if (!outsideRegions)
+  {
+    vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
+    double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+    bool allInFront = true;
+    for (const auto& corner : corners)
+    {
+      const double p[4] = { corner[0], corner[1], corner[2], 1.0 };
+      double q[4];
+      worldToNdc->MultiplyPoint(p, q);
+      if (q[3] <= 1e-9)
+      {
+        allInFront = false;
+        break;
+      }
+      for (int k = 0; k < 2; ++k)
+      {
+        lo[k] = std::min(lo[k], q[k] / q[3]);
+        hi[k] = std::max(hi[k], q[k] / q[3]);
+      }
+    }
+    if (allInFront)
+    {
+      const int px0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
+      const int py0 = std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
+      const int px1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
+      const int py1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
+      scissorBox[0] = px0;
+      scissorBox[1] = py0;
+      scissorBox[2] = std::max(px1 - px0, 0);
+      scissorBox[3] = std::max(py1 - py0, 0);
+      scissor = true;
+    }
+  }
+
+  // --- the slices: eye pass with the shadow so far, then the shadow update.
+  vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
+  setCommon(sliceProgram);
+  sliceProgram->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+  sliceProgram->SetUniformf("sliceSpacing", static_cast<float>(planes.Spacing));
+  sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(sunStepMetres));
+  sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
+  sliceProgram->SetUniformi("unlit", unlit ? 1 : 0);
+  vtkShaderProgram* shadowProgram = nullptr;
+  if (!unlit)
+  {
+    shadowProgram = in.Ready(in.ShadowPass, svsShadowFS);
+    setCommon(shadowProgram);
+    shadowProgram->SetUniformf("sunStepMetres", static_cast<float>(sunStepMetres));
+  }
+  for (size_t i = 0; i < planes.Offsets.size(); ++i)
+  {
+    const float offset = static_cast<float>(planes.Offsets[i]);
+    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+    state->vtkglViewport(0, 0, width, height);
+    if (scissor)
+    {
+      state->vtkglEnable(GL_SCISSOR_TEST);
+      state->vtkglScissor(scissorBox[0], scissorBox[1], scissorBox[2], scissorBox[3]);
+    }
+    useSliceBlend();
+    window->GetShaderCache()->ReadyShaderProgram(sliceProgram);
+    sliceProgram->SetUniformf("sliceOffset", offset);
+    in.SlicePass->Render();
+    ++in.PassesLastRender;
+    if (scissor)
+    {
+      state->vtkglDisable(GL_SCISSOR_TEST);
+    }
+    if (shadowProgram)
+    {
+      in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
+      state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+      state->vtkglEnable(GL_BLEND);
+      state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+      window->GetShaderCache()->ReadyShaderProgram(shadowProgram);
+      shadowProgram->SetUniformf("sliceOffset", offset);
+      in.ShadowPass->Render();
+      ++in.PassesLastRender;
+    }
+  }
+  if (outsideRegions)
+  {
+    drawRegion(lastEnd, 1e30, true); // beyond the cloud: the finished shadow surface
+  }
+
+  // --- composite over the scene in the renderer's framebuffer (000 Eq. 4).
+  state->PopFramebufferBindings();
+  state->vtkglViewport(x0, y0, width, height);
+  state->vtkglDisable(GL_BLEND);
+  in.Accumulation->Activate();
+  in.SceneColor->Activate();
+  vtkShaderProgram* composite = in.Ready(in.CompositePass, svsCompositeFS);
+  setCommon(composite);
+  composite->SetUniformi("accumulation", in.Accumulation->GetTextureUnit());
+  composite->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
+  composite->SetUniformf("exposure", static_cast<float>(this->Exposure));
+  composite->SetUniformi("encodeSrgb", this->EncodeSrgb ? 1 : 0);
+  in.CompositePass->Render();
+  ++in.PassesLastRender;
+
+  for (vtkTextureObject* t : { in.Density.GetPointer(), in.SceneDepth.GetPointer(),
+         in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(), in.Accumulation.GetPointer(),
+         in.SceneColor.GetPointer() })
+  {
+    t->Deactivate();
+  }
+  if (atmosphere)
+  {
+    in.AtmosphereTexture->Deactivate();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "ExtinctionPerDensity: " << this->ExtinctionPerDensity << " 1/m\n";
+  os << indent << "Albedo: " << this->Albedo << "\n";
+  os << indent << "CloudG: " << this->CloudG << "\n";
+  os << indent << "MultipleScattering (k_multi): " << this->MultipleScattering << "\n";
+  os << indent << "SunAzimuth: " << this->SunAzimuth << " deg\n";
+  os << indent << "SunElevation: " << this->SunElevation << " deg\n";
+  os << indent << "SunIlluminance: " << this->SunIlluminance << "\n";
+  os << indent << "SunTemperature: " << this->SunTemperature << " K\n";
+  os << indent << "Atmosphere: " << this->Atmosphere << "\n";
+  os << indent << "HazeDensity: " << this->HazeDensity << " 1/m\n";
+  os << indent << "HazeG: " << this->HazeG << "\n";
+  os << indent << "RayleighScattering: " << this->RayleighScattering << " 1/m\n";
+  os << indent << "SceneAltitude: " << this->SceneAltitude << " m\n";
+  os << indent << "Ground: " << this->Ground << "\n";
+  os << indent << "GroundHeight: " << this->GroundHeight << "\n";
+  os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
+  os << indent << "Shafts: " << this->Shafts << "\n";
+  os << indent << "NumberOfSlices: " << this->NumberOfSlices << "\n";
+  os << indent << "SliceAngleRatio (a): " << this->SliceAngleRatio << "\n";
+  os << indent << "ShadowSurfaceSize: " << this->ShadowSurfaceSize << "\n";
+  os << indent << "AtmosphereSteps: " << this->AtmosphereSteps << "\n";
+  os << indent << "LengthUnit: " << this->LengthUnit << " m\n";
+  os << indent << "Exposure: " << this->Exposure << "\n";
+  os << indent << "EncodeSrgb: " << this->EncodeSrgb << "\n";
+  os << indent << "Unlit: " << this->Unlit << "\n";
+  os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
+}

@@ -1,0 +1,221 @@
+/**
+ * @class   vtkNimbusCloudVolumeMapper
+ * @brief   GPU cloud renderer with shadow-view slices (Miyazaki, Dobashi, Nishita; paper 000).
+ *
+ * Renders a scalar density vtkImageData (point or cell data, any numeric type,
+ * converted once to a float 3-D texture on upload) with the whole method of 000:
+ *
+ *  - Shadow-view slices (000 §4.2): planes whose normal lies between the view
+ *    and the sun directions with theta_e : theta_s = 1 : a (SliceAngleRatio),
+ *    NumberOfSlices over the cloud box, traversed back-to-front when the camera
+ *    looks toward the sun and front-to-back otherwise, blended as in §4.3.
+ *  - The shadow surface (000 Eq. 10): a float render target facing the sun that
+ *    accumulates the cloud's optical depth slice by slice (no temporary volume).
+ *  - The atmosphere texture (rho_atm(h), g_sun_atm(h); rebuilt only when the sun
+ *    or the atmosphere change) and the sampling-interval and Mie-phase textures
+ *    (000 §4.4; rebuilt only when the camera or the sun change).
+ *  - Scattering (000 Eqs. 5-10): cloud and atmosphere single scattering with
+ *    Cornette-Shanks phase functions, the k_multi term, the sun reddened by the
+ *    atmosphere, the background attenuated by g_view.
+ *  - A ground plane lit by the attenuated sun and shadowed through the shadow
+ *    surface, and shafts of light in the atmosphere beyond the cloud box.
+ *
+ * Frame and units: world z is up; LengthUnit metres per world unit (1 by
+ * default); extinction in 1/m per unit density; radiance relative to the sun
+ * (SunIlluminance = luminance of its irradiance above the atmosphere), in linear
+ * sRGB, times Exposure in the framebuffer (EncodeSrgb applies the display
+ * transfer function). The physics matches the CPU reference renderer
+ * (vtkNimbusReferenceRenderer) for the same scene; see docs/svs-mapper.md for the
+ * measured errors and costs.
+ *
+ * Only what the scene needs runs: without atmosphere no atmosphere texture and
+ * no atmosphere pass; without ground and atmosphere no passes outside the cloud
+ * slices; without shafts no shadow look-ups in the atmosphere.
+ */
+#ifndef vtkNimbusCloudVolumeMapper_h
+#define vtkNimbusCloudVolumeMapper_h
+
+#include "NimbusRepresentationsModule.h"
+#include "vtkVolumeMapper.h"
+
+#include <memory>
+
+class vtkImageData;
+class vtkRenderer;
+class vtkVolume;
+class vtkWindow;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusCloudVolumeMapper : public vtkVolumeMapper
+{
+public:
+  static vtkNimbusCloudVolumeMapper* New();
+  vtkTypeMacro(vtkNimbusCloudVolumeMapper, vtkVolumeMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Cloud optics. ExtinctionPerDensity k_cl: sigma_t = k_cl * density [1/m];
+  /// Albedo: sigma_s / sigma_t; CloudG: Cornette-Shanks asymmetry (000 Eq. 3);
+  /// MultipleScattering: k_multi of 000 Eq. 1 (dimensionless; added to the
+  /// 4pi-normalised phase function, i.e. k_multi/4pi per steradian here).
+  vtkSetClampMacro(ExtinctionPerDensity, double, 0.0, 1e6);
+  vtkGetMacro(ExtinctionPerDensity, double);
+  vtkSetClampMacro(Albedo, double, 0.0, 1.0);
+  vtkGetMacro(Albedo, double);
+  vtkSetClampMacro(CloudG, double, -0.999, 0.999);
+  vtkGetMacro(CloudG, double);
+  vtkSetClampMacro(MultipleScattering, double, 0.0, 100.0);
+  vtkGetMacro(MultipleScattering, double);
+  ///@}
+
+  ///@{
+  /// Sun: azimuth in degrees from north (+y) toward east (+x), elevation in
+  /// degrees above the horizon (below it the sun is blocked by the earth when the
+  /// atmosphere is on), illuminance above the atmosphere (relative units) and
+  /// blackbody temperature in K.
+  vtkSetMacro(SunAzimuth, double);
+  vtkGetMacro(SunAzimuth, double);
+  vtkSetClampMacro(SunElevation, double, -90.0, 90.0);
+  vtkGetMacro(SunElevation, double);
+  vtkSetClampMacro(SunIlluminance, double, 0.0, 1e9);
+  vtkGetMacro(SunIlluminance, double);
+  vtkSetClampMacro(SunTemperature, double, 1000.0, 40000.0);
+  vtkGetMacro(SunTemperature, double);
+  ///@}
+
+  ///@{
+  /// Atmosphere (Rayleigh + Mie, exponential densities over a spherical earth,
+  /// the optics core's model). HazeDensity is the Mie scattering coefficient at
+  /// sea level [1/m]; HazeG its Cornette-Shanks asymmetry; SceneAltitude the
+  /// altitude of world z = 0 [m].
+  vtkSetMacro(Atmosphere, bool);
+  vtkGetMacro(Atmosphere, bool);
+  vtkBooleanMacro(Atmosphere, bool);
+  vtkSetClampMacro(HazeDensity, double, 0.0, 1.0);
+  vtkGetMacro(HazeDensity, double);
+  vtkSetClampMacro(HazeG, double, -0.999, 0.999);
+  vtkGetMacro(HazeG, double);
+  vtkSetClampMacro(RayleighScattering, double, 0.0, 1.0);
+  vtkGetMacro(RayleighScattering, double);
+  vtkSetClampMacro(SceneAltitude, double, 0.0, 50000.0);
+  vtkGetMacro(SceneAltitude, double);
+  ///@}
+
+  ///@{
+  /// Ground plane z = GroundHeight (world units) with a grey Lambertian albedo.
+  vtkSetMacro(Ground, bool);
+  vtkGetMacro(Ground, bool);
+  vtkBooleanMacro(Ground, bool);
+  vtkSetMacro(GroundHeight, double);
+  vtkGetMacro(GroundHeight, double);
+  vtkSetClampMacro(GroundAlbedo, double, 0.0, 1.0);
+  vtkGetMacro(GroundAlbedo, double);
+  ///@}
+
+  ///@{
+  /// Shafts of light: the atmosphere is shadowed by the cloud (needs Atmosphere).
+  vtkSetMacro(Shafts, bool);
+  vtkGetMacro(Shafts, bool);
+  vtkBooleanMacro(Shafts, bool);
+  ///@}
+
+  ///@{
+  /// Quality knobs. NumberOfSlices: shadow-view slices over the cloud box (the
+  /// main knob); SliceAngleRatio: a of theta_e : theta_s = 1 : a (000 §4.2);
+  /// ShadowSurfaceSize: texels per side of the shadow surface; AtmosphereSteps:
+  /// samples per pixel of the atmosphere outside the cloud slices.
+  vtkSetClampMacro(NumberOfSlices, int, 1, 8192);
+  vtkGetMacro(NumberOfSlices, int);
+  vtkSetClampMacro(SliceAngleRatio, double, 0.01, 100.0);
+  vtkGetMacro(SliceAngleRatio, double);
+  vtkSetClampMacro(ShadowSurfaceSize, int, 1, 16384);
+  vtkGetMacro(ShadowSurfaceSize, int);
+  vtkSetClampMacro(AtmosphereSteps, int, 1, 4096);
+  vtkGetMacro(AtmosphereSteps, int);
+  ///@}
+
+  ///@{
+  /// Metres per world unit (distances and heights are converted with it).
+  vtkSetClampMacro(LengthUnit, double, 1e-9, 1e9);
+  vtkGetMacro(LengthUnit, double);
+  ///@}
+
+  ///@{
+  /// Framebuffer value = Exposure * radiance (+ attenuated background); with
+  /// EncodeSrgb the result (and the background read from the framebuffer) is
+  /// treated as display-encoded sRGB.
+  vtkSetClampMacro(Exposure, double, 0.0, 1e9);
+  vtkGetMacro(Exposure, double);
+  vtkSetMacro(EncodeSrgb, bool);
+  vtkGetMacro(EncodeSrgb, bool);
+  vtkBooleanMacro(EncodeSrgb, bool);
+  ///@}
+
+  ///@{
+  /// Benchmark floor: composite the same slices without any lighting (no shadow
+  /// surface, no atmosphere, no ground). Not for pictures.
+  vtkSetMacro(Unlit, bool);
+  vtkGetMacro(Unlit, bool);
+  ///@}
+
+  ///@{
+  /// Largest texture side used for the density (0: the GL limit). Larger volumes
+  /// are downsampled with a warning. Lower it to save GPU memory.
+  vtkSetClampMacro(MaximumTextureSize, int, 0, 1 << 16);
+  vtkGetMacro(MaximumTextureSize, int);
+  ///@}
+
+  /// Counters of the last render and of the uploads so far (for tests and
+  /// benchmarks): volume uploads, atmosphere-table builds, interval/phase builds,
+  /// passes drawn in the last frame.
+  int GetNumberOfVolumeUploads() const;
+  int GetNumberOfAtmosphereBuilds() const;
+  int GetNumberOfIntervalPhaseBuilds() const;
+  int GetNumberOfPassesLastRender() const;
+  /// Whether the last render traversed the slices back to front.
+  bool GetLastBackToFront() const;
+  /// Dimensions of the density texture last uploaded.
+  void GetTextureDimensions(int dims[3]) const;
+
+  void Render(vtkRenderer* renderer, vtkVolume* volume) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+protected:
+  vtkNimbusCloudVolumeMapper();
+  ~vtkNimbusCloudVolumeMapper() override;
+
+  double ExtinctionPerDensity = 0.02;
+  double Albedo = 0.99;
+  double CloudG = 0.85;
+  double MultipleScattering = 0.0;
+  double SunAzimuth = 135.0;
+  double SunElevation = 45.0;
+  double SunIlluminance = 1.0;
+  double SunTemperature = 5778.0;
+  bool Atmosphere = true;
+  double HazeDensity = 2.0e-5;
+  double HazeG = 0.76;
+  double RayleighScattering = 13.5e-6;
+  double SceneAltitude = 0.0;
+  bool Ground = true;
+  double GroundHeight = 0.0;
+  double GroundAlbedo = 0.2;
+  bool Shafts = true;
+  int NumberOfSlices = 256;
+  double SliceAngleRatio = 1.0;
+  int ShadowSurfaceSize = 512;
+  int AtmosphereSteps = 64;
+  double LengthUnit = 1.0;
+  double Exposure = 1.0;
+  bool EncodeSrgb = false;
+  bool Unlit = false;
+  int MaximumTextureSize = 0;
+
+private:
+  vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;
+  void operator=(const vtkNimbusCloudVolumeMapper&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
