@@ -8,11 +8,13 @@
 #include "svsCompositeFS.h"
 #include "svsIntervalPhaseFS.h"
 #include "svsMarchFS.h"
+#include "svsRayEndsFS.h"
 #include "svsShadowFS.h"
 #include "svsSliceFS.h"
 
 #include "vtkCamera.h"
 #include "vtkDataArray.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
@@ -95,13 +97,18 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkOpenGLFramebufferObject> AccumulationFramebuffer;
   vtkNew<vtkTextureObject> SceneColor;
   vtkNew<vtkTextureObject> SceneDepth;
+  bool WarnedMultisampling = false;
+  vtkNew<vtkOpenGLFramebufferObject> SceneFramebuffer;
+  vtkNew<vtkTextureObject> RayEnds;
+  vtkNew<vtkOpenGLFramebufferObject> RayEndsFramebuffer;
+  vtkNew<vtkImageData> Radiance; // float copy of the last accumulation (CaptureRadiance)
 
   // Shadow surface facing the sun (000 Eq. 10).
   vtkNew<vtkTextureObject> Shadow;
   vtkNew<vtkOpenGLFramebufferObject> ShadowFramebuffer;
 
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass;
+    CompositePass, RayEndsPass;
 
   int VolumeUploads = 0;
   int AtmosphereBuilds = 0;
@@ -113,16 +120,19 @@ struct vtkNimbusCloudVolumeMapper::Internals
   {
     for (vtkTextureObject* t : { Density.GetPointer(), AtmosphereTexture.GetPointer(),
            IntervalPhase.GetPointer(), Accumulation.GetPointer(), SceneColor.GetPointer(),
-           SceneDepth.GetPointer(), Shadow.GetPointer() })
+           SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
     for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
+           SceneFramebuffer.GetPointer(),
+           RayEndsFramebuffer.GetPointer(),
            AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
-    for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass })
+    for (auto* pass :
+      { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass, &RayEndsPass })
     {
       if (*pass)
       {
@@ -179,6 +189,10 @@ int vtkNimbusCloudVolumeMapper::GetNumberOfPassesLastRender() const
 bool vtkNimbusCloudVolumeMapper::GetLastBackToFront() const
 {
   return this->Internal->LastBackToFront;
+}
+vtkImageData* vtkNimbusCloudVolumeMapper::GetRadianceImage()
+{
+  return this->Internal->Radiance;
 }
 void vtkNimbusCloudVolumeMapper::GetTextureDimensions(int dims[3]) const
 {
@@ -456,10 +470,39 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
       }
     }
   };
+  // Copy the viewport's colour and depth into our textures. A multisampled
+  // framebuffer cannot be copied from (GL_INVALID_OPERATION): then the colour is
+  // resolved by a blit and the depth is treated as empty, with a warning.
   ensure2D(in.SceneColor, width, height, 4, false);
   ensure2D(in.SceneDepth, width, height, 1, true);
-  in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
-  in.SceneDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+  GLint samples = 0;
+  glGetIntegerv(GL_SAMPLES, &samples);
+  if (samples > 0)
+  {
+    in.SceneFramebuffer->SetContext(window);
+    in.SceneFramebuffer->Bind(GL_DRAW_FRAMEBUFFER);
+    in.SceneFramebuffer->AddColorAttachment(0, in.SceneColor);
+    in.SceneFramebuffer->AddDepthAttachment(in.SceneDepth);
+    in.SceneFramebuffer->ActivateDrawBuffer(0);
+    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
+    glBlitFramebuffer(x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_COLOR_BUFFER_BIT,
+      GL_NEAREST);
+    state->vtkglClearDepth(1.0);
+    state->vtkglClear(GL_DEPTH_BUFFER_BIT);
+    in.SceneFramebuffer->RemoveDepthAttachment();
+    in.SceneFramebuffer->RemoveColorAttachments(1);
+    if (!in.WarnedMultisampling)
+    {
+      vtkWarningMacro("The render window is multisampled (MultiSamples = "
+        << samples << "): opaque geometry will not cut the clouds. Set MultiSamples to 0.");
+      in.WarnedMultisampling = true;
+    }
+  }
+  else
+  {
+    in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+    in.SceneDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+  }
 
   // --- atmosphere texture (only with an atmosphere; rebuilt when sun or air change).
   const bool atmosphere = this->Atmosphere && !this->Unlit;
@@ -480,6 +523,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   scene.Atmosphere.RayleighScattering550 = this->RayleighScattering;
   scene.Atmosphere.MieScattering = this->HazeDensity;
   scene.Atmosphere.MieG = this->HazeG;
+  scene.Background.Type = "black"; // the framebuffer is the background
   const double zHigh = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - this->SceneAltitude;
   const std::vector<double> atmosphereKey = { this->SunAzimuth, this->SunElevation,
     this->SunIlluminance, this->SunTemperature, atmosphere ? 1.0 : 0.0, this->SceneAltitude,
@@ -538,7 +582,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     }
     else
     {
-      program->SetUniformi("atmosphereTable", in.Density->GetTextureUnit()); // unused
+      // Unused, but a sampler2D must not share a unit with the 3-D density texture.
+      program->SetUniformi("atmosphereTable", in.SceneDepth->GetTextureUnit());
     }
     const float zRange[2] = { static_cast<float>(in.Table.ZMin), static_cast<float>(in.Table.ZMax) };
     program->SetUniform2f("atmosphereZRange", zRange);
@@ -611,6 +656,22 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   }
   in.IntervalPhase->Activate();
   in.Shadow->Activate();
+
+  // --- where each view ray ends this frame (opaque depth, ground, top of the atmosphere).
+  ensure2D(in.RayEnds, width, height, 4, false);
+  in.RayEndsFramebuffer->SetContext(window);
+  in.RayEndsFramebuffer->Bind(GL_FRAMEBUFFER);
+  in.RayEndsFramebuffer->AddColorAttachment(0, in.RayEnds);
+  in.RayEndsFramebuffer->ActivateDrawBuffer(0);
+  state->vtkglViewport(0, 0, width, height);
+  state->vtkglDisable(GL_BLEND);
+  {
+    vtkShaderProgram* program = in.Ready(in.RayEndsPass, svsRayEndsFS);
+    setCommon(program);
+    in.RayEndsPass->Render();
+    ++in.PassesLastRender;
+  }
+  in.RayEnds->Activate();
 
   // --- accumulation (S, cloud transmittance), cleared to (0, 0, 0, 1).
   ensure2D(in.Accumulation, width, height, 4, false);
@@ -701,6 +762,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
   setCommon(sliceProgram);
   sliceProgram->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+  sliceProgram->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
   sliceProgram->SetUniformf("sliceSpacing", static_cast<float>(planes.Spacing));
   sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(sunStepMetres));
   sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
@@ -748,6 +810,22 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     drawRegion(lastEnd, 1e30, true); // beyond the cloud: the finished shadow surface
   }
 
+  if (this->CaptureRadiance)
+  {
+    // Float copy of the sum of the slices (radiance and cloud transmittance).
+    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+    in.AccumulationFramebuffer->ActivateReadBuffer(0);
+    vtkNew<vtkFloatArray> values;
+    values->SetName("radiance");
+    values->SetNumberOfComponents(4);
+    values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
+    in.Radiance->Initialize();
+    in.Radiance->SetDimensions(width, height, 1);
+    in.Radiance->GetPointData()->SetScalars(values);
+  }
+
   // --- composite over the scene in the renderer's framebuffer (000 Eq. 4).
   state->PopFramebufferBindings();
   state->vtkglViewport(x0, y0, width, height);
@@ -764,6 +842,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   ++in.PassesLastRender;
 
   for (vtkTextureObject* t : { in.Density.GetPointer(), in.SceneDepth.GetPointer(),
+         in.RayEnds.GetPointer(),
          in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(), in.Accumulation.GetPointer(),
          in.SceneColor.GetPointer() })
   {
@@ -804,5 +883,6 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "EncodeSrgb: " << this->EncodeSrgb << "\n";
   os << indent << "Unlit: " << this->Unlit << "\n";
+  os << indent << "CaptureRadiance: " << this->CaptureRadiance << "\n";
   os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
 }

@@ -164,6 +164,17 @@ public:
   vtkGetMacro(MaximumTextureSize, int);
   ///@}
 
+  ///@{
+  /// Keep a float copy of each frame's radiance (before Exposure and the
+  /// background): an image of the viewport size with the 4-component point array
+  /// "radiance" = (linear sRGB radiance, cloud transmittance). For measurements
+  /// that must not be limited by an 8-bit framebuffer.
+  vtkSetMacro(CaptureRadiance, bool);
+  vtkGetMacro(CaptureRadiance, bool);
+  vtkBooleanMacro(CaptureRadiance, bool);
+  vtkImageData* GetRadianceImage();
+  ///@}
+
   /// Counters of the last render and of the uploads so far (for tests and
   /// benchmarks): volume uploads, atmosphere-table builds, interval/phase builds,
   /// passes drawn in the last frame.
@@ -209,6 +220,7 @@ protected:
   bool EncodeSrgb = false;
   bool Unlit = false;
   int MaximumTextureSize = 0;
+  bool CaptureRadiance = false;
 
 private:
   vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;

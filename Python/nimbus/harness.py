@@ -338,8 +338,9 @@ class SvsRenderer:
     The scene maps one to one onto the mapper: extinction, albedo, the first
     phase component's g (Cornette-Shanks), k_multi, sun, atmosphere, ground.
     Backgrounds "black" and "atmosphere" are a black framebuffer (the mapper
-    draws the atmosphere itself); "constant" is that radiance. The framebuffer is
-    8-bit: radiance x VTK_SCALE is written and read back (quantisation <= 6.5e-4).
+    draws the atmosphere itself) and the image is read back in float from the
+    mapper (CaptureRadiance); "constant" is that radiance in the 8-bit
+    framebuffer (radiance x VTK_SCALE, quantisation <= 6.5e-4).
     Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
     atmosphere_steps, unlit (the unlit compositing floor, for timing only).
     """
@@ -365,6 +366,10 @@ class SvsRenderer:
         if background.get("type") == "constant":
             grey = min(1.0, background.get("radiance", 0.0) * VTK_SCALE)
         self.renderer.SetBackground(grey, grey, grey)
+        # With a black background the image is the slices' float sum: read it in
+        # float (no 8-bit floor); otherwise read the 8-bit framebuffer.
+        self.float_capture = grey == 0.0
+        self.mapper.SetCaptureRadiance(self.float_capture)
         camera_description = scene["camera"]
         camera = self.renderer.GetActiveCamera()
         camera.SetPosition(*camera_description["position"])
@@ -386,6 +391,11 @@ class SvsRenderer:
         self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 64)))
         self.mapper.SetUnlit(bool(settings.get("unlit", False)))
         self.window.Render()
+        if self.float_capture:
+            radiance = self.mapper.GetRadianceImage()
+            width, height, _ = radiance.GetDimensions()
+            rgba = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
+            return rgba[..., :3].astype(np.float32).copy()
         capture = self.capture_class()
         capture.SetInput(self.window)
         capture.SetInputBufferTypeToRGB()

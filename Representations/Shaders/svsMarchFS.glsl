@@ -40,16 +40,19 @@ void main()
   }
   vec3 color = vec3(0.0);
   float alpha = 1.0;
+  // View transmittance: closed form (flat layers) up to the region's start, then
+  // accumulated step by step with the altitude over the spherical earth, because
+  // the region can reach the top of the atmosphere along rays near the horizon.
+  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
   if (t1 > t0 && atmosphereOn != 0)
   {
-    // Quadratic spacing: dense near the region's start (the camera side when the
-    // region starts at the eye), sparse toward the top of the atmosphere.
+    // Quadratic spacing: dense at the region's start, sparse toward its far end.
     float span = t1 - t0;
     for (int k = 0; k < steps; ++k)
     {
       float u = (float(k) + 0.5) / float(steps);
       float t = t0 + span * u * u;
-      float dt = span * 2.0 * u / float(steps);
+      float dt = span * 2.0 * u / float(steps) * lengthUnit;
       vec3 p = origin + t * direction;
       float altitude = Altitude(p);
       vec3 air = AtmosphereRow(1, altitude) * intervalAndPhase.z +
@@ -58,7 +61,13 @@ void main()
       {
         air *= exp(-ShadowDepth(p));
       }
-      color += air * AtmosphereViewTransmittance(origin, direction, t) * dt * lengthUnit;
+      vec3 stepTransmittance = exp(-AtmosphereRow(3, altitude) * dt);
+      // Exact for constant coefficients over the step: (1 - T_step) / k_atm.
+      vec3 extinction = AtmosphereRow(3, altitude);
+      vec3 weight = mix(vec3(dt), (1.0 - stepTransmittance) / max(extinction, vec3(1e-30)),
+        step(vec3(1e-4), extinction * dt));
+      color += air * viewTransmittance * weight;
+      viewTransmittance *= stepTransmittance;
     }
   }
   if (tGround < kInfinity && tGround <= tEnd)
@@ -67,8 +76,9 @@ void main()
     if (dGround >= regionStart && dGround < regionEnd)
     {
       vec3 g = origin + tGround * direction;
-      color += GroundRadiance(g, useShadow != 0 ? ShadowDepth(g) : 0.0) *
-        AtmosphereViewTransmittance(origin, direction, tGround);
+      vec3 groundTransmittance = (t1 > t0 && atmosphereOn != 0)
+        ? viewTransmittance : AtmosphereViewTransmittance(origin, direction, tGround);
+      color += GroundRadiance(g, useShadow != 0 ? ShadowDepth(g) : 0.0) * groundTransmittance;
       alpha = 0.0;
     }
   }

@@ -4,7 +4,8 @@
 // view transmittance in front of it), a = alpha_i, the slab's cloud transmittance
 // Delta g_view_cl. Opaque things in the slab (the ground) give alpha 0.
 in vec2 texCoord;
-uniform sampler2D intervalPhase;  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
+uniform sampler2D intervalPhase;
+uniform sampler2D rayEnds;        // (t_end, t_ground) per pixel, this frame  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
 uniform float sliceOffset;        // d_i: the slice plane is dot(x, n) = d_i
 uniform float sliceSpacing;       // Delta d (world)
 uniform float sunStepMetres;      // Delta s = Delta d / dot(n, -L) [m] (000 Eq. 10)
@@ -17,13 +18,13 @@ void main()
   ViewRay(texCoord, origin, direction);
   vec4 intervalAndPhase = texture(intervalPhase, texCoord);
   float vn = dot(direction, sliceNormal);
-  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-    GroundDistance(origin, direction));
+  vec2 ends = texture(rayEnds, texCoord).rg;
+  float tEnd = ends.x;
   float t = abs(vn) > 1e-7 ? (sliceOffset - dot(origin, sliceNormal)) / vn : -1.0;
   bool medium = t >= 0.0 && t < tEnd;
 
   // The ground closes the ray inside this slab?
-  float tGround = GroundDistance(origin, direction);
+  float tGround = ends.y;
   bool ground = false;
   if (unlit == 0 && tGround < kInfinity && tGround <= tEnd)
   {

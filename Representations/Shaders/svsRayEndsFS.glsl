@@ -1,0 +1,14 @@
+// Per-frame ray ends (one pass, so the slices need not recompute them): r = the
+// distance at which the view ray stops (opaque geometry, ground, or the top of the
+// atmosphere), g = the distance to the ground (infinity when it misses).
+in vec2 texCoord;
+
+void main()
+{
+  vec3 origin, direction;
+  ViewRay(texCoord, origin, direction);
+  float tGround = GroundDistance(origin, direction);
+  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
+    tGround);
+  gl_FragData[0] = vec4(tEnd, tGround, 0.0, 0.0);
+}

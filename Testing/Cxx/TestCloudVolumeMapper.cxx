@@ -1,0 +1,471 @@
+// Image and stability tests of the shadow-view-slice mapper (vtkNimbusCloudVolumeMapper, 000).
+//
+//   TestCloudVolumeMapper <case> <baseline dir> <output dir>
+//
+// Image cases render a small metaball cumulus (or variants) and compare with
+// <baseline dir>/TestCloudVolumeMapper_<case>.png (criteria: ImageComparison.h).
+// Stability cases check finite, sensible images at the extremes.
+#include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusMetaballCloudSource.h"
+
+#include "ImageComparison.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPNGWriter.h"
+#include "vtkPointData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
+#include "vtkSphereSource.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+#include "vtkWindowToImageFilter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace
+{
+constexpr int kWidth = 200;
+constexpr int kHeight = 150;
+
+vtkSmartPointer<vtkImageData> MakeCloud(int seed = 1)
+{
+  vtkNew<vtkNimbusMetaballCloudSource> source;
+  source->SetDimensions(48, 48, 32);
+  source->SetBounds(-1500, 1500, -1500, 1500, 800, 2800);
+  source->SetSeed(seed);
+  source->SetFootprintRadius(700);
+  source->SetBaseBallRadiusRange(350, 600);
+  source->SetTowerHeight(600);
+  source->SetBaseHeight(1000);
+  source->Update();
+  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
+  image->DeepCopy(source->GetOutput());
+  return image;
+}
+
+/// A scene: the mapper, one renderer, a window; Render() returns RGB bytes.
+struct Scene
+{
+  vtkNew<vtkNimbusCloudVolumeMapper> Mapper;
+  vtkNew<vtkVolume> Volume;
+  vtkNew<vtkRenderer> Renderer;
+  vtkNew<vtkRenderWindow> Window;
+
+  explicit Scene(vtkImageData* density)
+  {
+    this->Mapper->SetInputData(density);
+    this->Mapper->SetExposure(4.0);
+    this->Mapper->SetEncodeSrgb(true);
+    this->Volume->SetMapper(this->Mapper);
+    this->Renderer->AddVolume(this->Volume);
+    this->Renderer->SetBackground(0, 0, 0);
+    this->Window->SetOffScreenRendering(1);
+    this->Window->SetMultiSamples(0);
+    this->Window->SetSize(kWidth, kHeight);
+    this->Window->AddRenderer(this->Renderer);
+    this->LookFrom({ 0, -6000, 1500 }, { 0, 0, 1600 }, 35);
+  }
+  void LookFrom(std::vector<double> position, std::vector<double> focal, double angle)
+  {
+    vtkCamera* camera = this->Renderer->GetActiveCamera();
+    camera->SetPosition(position.data());
+    camera->SetFocalPoint(focal.data());
+    camera->SetViewUp(0, 0, 1);
+    camera->SetViewAngle(angle);
+    camera->SetClippingRange(10.0, 1e6);
+  }
+  std::vector<unsigned char> Render(const std::string& pngPath = "")
+  {
+    this->Window->Render();
+    vtkNew<vtkWindowToImageFilter> capture;
+    capture->SetInput(this->Window);
+    capture->SetInputBufferTypeToRGB();
+    capture->ReadFrontBufferOff();
+    capture->Update();
+    if (!pngPath.empty())
+    {
+      vtkNew<vtkPNGWriter> writer;
+      writer->SetInputConnection(capture->GetOutputPort());
+      writer->SetFileName(pngPath.c_str());
+      writer->Write();
+    }
+    auto* bytes = vtkUnsignedCharArray::SafeDownCast(capture->GetOutput()->GetPointData()->GetScalars());
+    return std::vector<unsigned char>(bytes->GetPointer(0), bytes->GetPointer(0) + bytes->GetNumberOfValues());
+  }
+};
+
+double Rmse(const std::vector<unsigned char>& a, const std::vector<unsigned char>& b)
+{
+  double sum = 0.0;
+  for (size_t i = 0; i < a.size(); ++i)
+  {
+    const double d = static_cast<double>(a[i]) - b[i];
+    sum += d * d;
+  }
+  return std::sqrt(sum / a.size());
+}
+
+double Mean(const std::vector<unsigned char>& a)
+{
+  double sum = 0.0;
+  for (unsigned char v : a)
+  {
+    sum += v;
+  }
+  return sum / a.size();
+}
+
+struct Context
+{
+  std::string Case, BaselineDir, OutputDir;
+  std::string Png() const { return OutputDir + "/TestCloudVolumeMapper_" + Case + ".png"; }
+  bool CompareWithBaseline() const
+  {
+    return nimbus::testing::CompareImageFiles(Png(),
+      BaselineDir + "/TestCloudVolumeMapper_" + Case + ".png", OutputDir,
+      nimbus::testing::ImageComparisonLimits(), std::cout);
+  }
+};
+
+bool Check(bool condition, const std::string& what)
+{
+  std::cout << (condition ? "ok:   " : "FAIL: ") << what << "\n";
+  return condition;
+}
+
+// --- image cases --------------------------------------------------------------------------
+bool Noon(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(135);
+  s.Mapper->SetSunElevation(65);
+  s.Render(c.Png());
+  return Check(!s.Mapper->GetLastBackToFront(), "sun behind the camera: front to back") &&
+    c.CompareWithBaseline();
+}
+
+bool Sunset(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(250);
+  s.Mapper->SetSunElevation(3);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool SilverLining(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(0); // north, behind the cloud seen from the south
+  s.Mapper->SetSunElevation(14);
+  s.Render(c.Png());
+  return Check(s.Mapper->GetLastBackToFront(), "camera faces the sun: back to front") &&
+    c.CompareWithBaseline();
+}
+
+bool FacingSun(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(12); // in view, to the right of the cloud
+  s.Mapper->SetSunElevation(9);
+  s.Render(c.Png());
+  return Check(s.Mapper->GetLastBackToFront(), "camera faces the sun: back to front") &&
+    c.CompareWithBaseline();
+}
+
+bool GroundShadows(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(285);
+  s.Mapper->SetSunElevation(35);
+  s.Mapper->SetGroundAlbedo(0.4);
+  s.LookFrom({ 0, -7000, 5000 }, { 0, -800, 300 }, 50);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool ShaftsThroughGap(const Context& c)
+{
+  // Two cloud banks side by side with a gap between them; a low sun behind them
+  // and thick haze: bright shafts through the gap, dark ones under the clouds.
+  vtkSmartPointer<vtkImageData> left = MakeCloud(1);
+  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(96, 48, 32);
+  image->SetOrigin(-3000, -1500, 800);
+  double spacing[3];
+  left->GetSpacing(spacing);
+  image->SetSpacing(6000.0 / 95, spacing[1], spacing[2]);
+  vtkNew<vtkFloatArray> density;
+  density->SetName("density");
+  density->SetNumberOfTuples(96 * 48 * 32);
+  density->Fill(0.0);
+  vtkDataArray* source = left->GetPointData()->GetScalars();
+  for (int z = 0; z < 32; ++z)
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 96; ++x)
+      {
+        // Left bank: x in [0, 40), right bank: x in [56, 96): a gap of 16 samples.
+        int sx = -1;
+        if (x < 40)
+          sx = x + 4;
+        else if (x >= 56)
+          sx = x - 52;
+        if (sx >= 0 && sx < 48)
+          density->SetValue(x + 96 * (y + 48 * z), source->GetComponent(sx + 48 * (y + 48 * z), 0));
+      }
+  image->GetPointData()->SetScalars(density);
+  Scene s(image);
+  s.Mapper->SetSunAzimuth(0);
+  s.Mapper->SetSunElevation(30);
+  s.Mapper->SetHazeDensity(1.0e-4);
+  s.LookFrom({ 0, -4500, 200 }, { 0, 0, 1200 }, 70);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool HazeOnly(const Context& c)
+{
+  vtkSmartPointer<vtkImageData> image = MakeCloud();
+  image->GetPointData()->GetScalars()->Fill(0.0);
+  Scene s(image);
+  s.Mapper->SetSunAzimuth(200);
+  s.Mapper->SetSunElevation(20);
+  s.Mapper->SetHazeDensity(6e-5);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool OpaqueInside(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(135);
+  s.Mapper->SetSunElevation(40);
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(300, -200, 1600);
+  sphere->SetRadius(500);
+  sphere->SetThetaResolution(48);
+  sphere->SetPhiResolution(48);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(sphere->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.9, 0.2, 0.1);
+  s.Renderer->AddActor(actor);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+// --- stability cases ----------------------------------------------------------------------
+// Sun exactly along / against the view direction: the half-angle construction is
+// degenerate there; the image must equal (nearly) the one for a sun 0.5 deg away.
+bool SunAlongAndAgainstView(const Context&)
+{
+  bool ok = true;
+  for (double sign : { 1.0, -1.0 })
+  {
+    Scene s(MakeCloud());
+    s.Mapper->SetAtmosphere(false);
+    s.Mapper->SetGround(false);
+    // Camera on the sun's line through the cloud centre, elevation 20 deg.
+    const double e = 20.0 * M_PI / 180.0, d = 7000.0;
+    const std::vector<double> focal = { 0, 0, 1600 };
+    const std::vector<double> position = { 0, -sign * d * std::cos(e), 1600 - sign * d * std::sin(e) };
+    s.LookFrom(position, focal, 35);
+    s.Mapper->SetSunAzimuth(0);
+    s.Mapper->SetSunElevation(sign > 0 ? 20 : -20);
+    if (sign < 0)
+    {
+      s.Mapper->SetSunAzimuth(180);
+      s.Mapper->SetSunElevation(-20);
+    }
+    const auto exact = s.Render();
+    s.Mapper->SetSunElevation(s.Mapper->GetSunElevation() + 0.5);
+    const auto near = s.Render();
+    const double rmse = Rmse(exact, near);
+    ok &= Check(Mean(exact) > 1.0, std::string(sign > 0 ? "facing" : "back to") +
+        " the sun: the cloud is visible (mean " + std::to_string(Mean(exact)) + ")");
+    ok &= Check(rmse < 3.0, "sun exactly on the view axis vs 0.5 deg off: RMSE " +
+        std::to_string(rmse) + " < 3 (of 255)");
+  }
+  return ok;
+}
+
+bool SunAtAndBelowHorizon(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(90);
+  s.Mapper->SetSunElevation(0.0);
+  const auto horizon = s.Render();
+  s.Mapper->SetSunElevation(-5.0);
+  const auto below = s.Render();
+  s.Mapper->SetSunElevation(10.0);
+  const auto above = s.Render();
+  // Below the horizon the earth blocks the sun for the ground and the cloud (the
+  // bottom of the image, ground, is black); only the high atmosphere is still lit
+  // (a dim twilight sky).
+  double groundMax = 0.0;
+  for (size_t i = 0; i < below.size() / 5; ++i) // bottom fifth of the rows: ground
+  {
+    groundMax = std::max(groundMax, static_cast<double>(below[i]));
+  }
+  bool ok = Check(groundMax <= 1.0, "sun 5 deg below the horizon: the ground is black (max " +
+      std::to_string(groundMax) + ")");
+  ok &= Check(Mean(below) < 0.1 * Mean(above), "sun 5 deg below: twilight sky, mean " +
+      std::to_string(Mean(below)) + " < 10 % of the image at 10 deg (" + std::to_string(Mean(above)) + ")");
+  ok &= Check(Mean(horizon) <= Mean(above), "sun at the horizon no brighter than at 10 deg");
+  ok &= Check(Mean(above) > 5.0, "sun at 10 deg lights the scene");
+  return ok;
+}
+
+bool SliceRatioOneAndTwo(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(60);
+  s.Mapper->SetSunElevation(30);
+  s.Mapper->SetSliceAngleRatio(1.0);
+  const auto one = s.Render();
+  s.Mapper->SetSliceAngleRatio(2.0);
+  const auto two = s.Render();
+  const double rmse = Rmse(one, two);
+  return Check(Mean(one) > 5 && Mean(two) > 5, "a = 1 and a = 2 render") &&
+    Check(rmse < 4.0, "a = 1 vs a = 2: RMSE " + std::to_string(rmse) + " < 4 (of 255)");
+}
+
+bool OneVoxelAndEmpty(const Context&)
+{
+  vtkSmartPointer<vtkImageData> empty = MakeCloud();
+  empty->GetPointData()->GetScalars()->Fill(0.0);
+  Scene reference(empty);
+  const auto none = reference.Render();
+  vtkNew<vtkImageData> voxel;
+  voxel->SetDimensions(1, 1, 1);
+  voxel->SetOrigin(0, 0, 1600);
+  vtkNew<vtkFloatArray> value;
+  value->SetName("density");
+  value->InsertNextValue(1.0f);
+  voxel->GetPointData()->SetScalars(value);
+  Scene single(voxel);
+  const auto one = single.Render();
+  const double rmse = Rmse(none, one);
+  return Check(Mean(none) > 5.0, "all-zero density: sky and ground only") &&
+    Check(rmse < 1.0, "one-voxel volume vs empty: RMSE " + std::to_string(rmse) + " < 1");
+}
+
+bool HugeOpticalThickness(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(135);
+  s.Mapper->SetSunElevation(45);
+  s.Mapper->SetExtinctionPerDensity(0.02 * 1e4 / 50.0); // tau ~ 1e4 through the core
+  const auto thick = s.Render();
+  s.Mapper->SetExtinctionPerDensity(0.02 * 1e3 / 50.0);
+  const auto thinner = s.Render();
+  const double rmse = Rmse(thick, thinner);
+  return Check(Mean(thick) > 5.0, "tau 1e4: image not black (mean " + std::to_string(Mean(thick)) + ")") &&
+    Check(rmse < 6.0, "tau 1e4 vs 1e3 (both opaque): RMSE " + std::to_string(rmse) + " < 6");
+}
+
+bool CameraInsideVolume(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetSunAzimuth(135);
+  s.Mapper->SetSunElevation(45);
+  // Optical thickness ~5 through the core: single scattering still lights the inside.
+  s.Mapper->SetExtinctionPerDensity(0.002);
+  s.LookFrom({ 0, 0, 1500 }, { 0, 1000, 1600 }, 60);
+  const auto inside = s.Render();
+  s.Mapper->SetExtinctionPerDensity(0.0);
+  const auto clear = s.Render();
+  return Check(Mean(inside) > 1.0 && Mean(inside) < 254.0, "inside the cloud: a grey fog, mean " +
+      std::to_string(Mean(inside))) &&
+    Check(Rmse(inside, clear) > 5.0, "the cloud around the camera changes the image");
+}
+
+bool LightingChangeKeepsVolume(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Render();
+  s.Mapper->SetSunElevation(20);
+  s.Mapper->SetCloudG(0.5);
+  s.Render();
+  const int uploads = s.Mapper->GetNumberOfVolumeUploads();
+  const int atmospheres = s.Mapper->GetNumberOfAtmosphereBuilds();
+  const int phases = s.Mapper->GetNumberOfIntervalPhaseBuilds();
+  s.Render(); // nothing changed
+  bool ok = Check(uploads == 1, "lighting changes do not re-upload the volume (uploads " +
+      std::to_string(uploads) + ")");
+  ok &= Check(atmospheres == 2, "sun change rebuilt the atmosphere table once (builds " +
+      std::to_string(atmospheres) + ")");
+  ok &= Check(s.Mapper->GetNumberOfAtmosphereBuilds() == atmospheres &&
+      s.Mapper->GetNumberOfIntervalPhaseBuilds() == phases, "an unchanged frame rebuilds nothing");
+  s.Mapper->SetAtmosphere(false);
+  s.Mapper->SetGround(false);
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfPassesLastRender() == 2 * s.Mapper->GetNumberOfSlices() + 2,
+    "without atmosphere and ground: only ray ends, slices, shadow updates and the composite (" +
+      std::to_string(s.Mapper->GetNumberOfPassesLastRender()) + " passes)");
+  vtkNew<vtkImageData> changed;
+  changed->DeepCopy(s.Mapper->GetInput());
+  s.Mapper->SetInputData(changed);
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfVolumeUploads() == 2, "a new time step re-uploads");
+  return ok;
+}
+
+bool Downsampling(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMaximumTextureSize(16);
+  const auto small = s.Render();
+  int dims[3];
+  s.Mapper->GetTextureDimensions(dims);
+  Scene full(MakeCloud());
+  const auto reference = full.Render();
+  return Check(dims[0] == 16 && dims[1] == 16 && dims[2] == 16,
+           "48x48x32 with a 16-texel limit -> " + std::to_string(dims[0]) + "x" +
+             std::to_string(dims[1]) + "x" + std::to_string(dims[2])) &&
+    Check(Rmse(small, reference) < 20.0, "downsampled render resembles the full one (RMSE " +
+        std::to_string(Rmse(small, reference)) + ")");
+}
+}
+
+int main(int argc, char* argv[])
+{
+  const std::map<std::string, std::function<bool(const Context&)>> cases = { { "Noon", Noon },
+    { "Sunset", Sunset }, { "SilverLining", SilverLining }, { "FacingSun", FacingSun },
+    { "GroundShadows", GroundShadows }, { "ShaftsThroughGap", ShaftsThroughGap },
+    { "HazeOnly", HazeOnly }, { "OpaqueInside", OpaqueInside },
+    { "SunAlongAndAgainstView", SunAlongAndAgainstView },
+    { "SunAtAndBelowHorizon", SunAtAndBelowHorizon },
+    { "SliceRatioOneAndTwo", SliceRatioOneAndTwo }, { "OneVoxelAndEmpty", OneVoxelAndEmpty },
+    { "HugeOpticalThickness", HugeOpticalThickness },
+    { "CameraInsideVolume", CameraInsideVolume },
+    { "LightingChangeKeepsVolume", LightingChangeKeepsVolume },
+    { "Downsampling", Downsampling } };
+  if (argc != 4 || !cases.count(argv[1]))
+  {
+    std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";
+    for (const auto& entry : cases)
+    {
+      std::cerr << " " << entry.first;
+    }
+    std::cerr << "\n";
+    return EXIT_FAILURE;
+  }
+  const Context context{ argv[1], argv[2], argv[3] };
+  return cases.at(argv[1])(context) ? EXIT_SUCCESS : EXIT_FAILURE;
+}
