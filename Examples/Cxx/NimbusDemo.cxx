@@ -1,30 +1,23 @@
 // nimbus-demo: renders the Nimbus demo scene to a PNG and prints the file's path.
 //
 //   nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG] [--sun-azimuth DEG]
-//               [--seed N]
+//               [--seed N] [--k-multi K] [--exposure E]
 //
 // Scene: a metaball cumulus (vtkNimbusMetaballCloudSource, 004 §4) over a ground
 // plane, lit by the sun whose colour comes from the atmosphere model
-// (vtkNimbusSunlight). Rendered with VTK's own vtkGPUVolumeRayCastMapper until
-// Nimbus's own mappers land. Units: metres; z up.
+// through the atmosphere, rendered with Nimbus's shadow-view-slice mapper
+// (vtkNimbusCloudVolumeMapper, paper 000): cloud and ground shadows, the sky
+// colour of the atmosphere, shafts of light. Units: metres; z up.
+#include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
-#include "vtkNimbusSunlight.h"
 
-#include "vtkActor.h"
 #include "vtkCamera.h"
-#include "vtkColorTransferFunction.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkLight.h"
+#include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
-#include "vtkPiecewiseFunction.h"
-#include "vtkPlaneSource.h"
-#include "vtkPolyDataMapper.h"
-#include "vtkProperty.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 #include "vtkWindowToImageFilter.h"
 
 #include <cmath>
@@ -37,7 +30,7 @@ namespace
 void Usage()
 {
   std::cout << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
-               " [--sun-azimuth DEG] [--seed N]\n";
+               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E]\n";
 }
 
 bool ParseNumber(const char* text, double& value)
@@ -51,7 +44,8 @@ bool ParseNumber(const char* text, double& value)
 int main(int argc, char* argv[])
 {
   std::string output = "nimbus-demo.png";
-  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7;
+  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7,
+         kMulti = 3.0, exposure = 8.0;
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
@@ -80,6 +74,14 @@ int main(int argc, char* argv[])
     {
       ok = ParseNumber(argv[++i], sunAzimuth);
     }
+    else if (arg == "--k-multi" && hasValue)
+    {
+      ok = ParseNumber(argv[++i], kMulti) && kMulti >= 0.0 && kMulti <= 100.0;
+    }
+    else if (arg == "--exposure" && hasValue)
+    {
+      ok = ParseNumber(argv[++i], exposure) && exposure >= 0.0;
+    }
     else if (arg == "--seed" && hasValue)
     {
       ok = ParseNumber(argv[++i], seed);
@@ -105,92 +107,38 @@ int main(int argc, char* argv[])
     return 1;
   }
 
-  // Optics of the cloud mapped onto VTK's transfer functions: extinction
-  // sigma_t = kExtinction * density (1/m); opacity over one voxel-sized step u is
-  // 1 - exp(-sigma_t u) (Beer-Lambert, 000 Eq. 2), sampled at a few densities.
-  constexpr double kExtinction = 0.02; // 1/m per unit density: a cumulus
-  const double unitDistance = cloud->GetOutput()->GetSpacing()[0];
-  vtkNew<vtkPiecewiseFunction> opacity;
-  for (double density : { 0.0, 0.05, 0.1, 0.2, 0.4, 0.7, 1.0, 1.5, 2.5 })
-  {
-    opacity->AddPoint(density, 1.0 - std::exp(-kExtinction * density * unitDistance));
-  }
-  vtkNew<vtkColorTransferFunction> albedo; // white droplets: albedo ~1
-  albedo->AddRGBPoint(0.0, 1.0, 1.0, 1.0);
-  albedo->AddRGBPoint(2.5, 1.0, 1.0, 1.0);
-
-  vtkNew<vtkVolumeProperty> volumeProperty;
-  volumeProperty->SetScalarOpacity(opacity);
-  volumeProperty->SetColor(albedo);
-  volumeProperty->SetScalarOpacityUnitDistance(unitDistance);
-  volumeProperty->SetInterpolationTypeToLinear();
-  volumeProperty->ShadeOn();
-  volumeProperty->SetAmbient(0.5);
-  volumeProperty->SetDiffuse(0.5);
-  volumeProperty->SetSpecular(0.0);
-
-  vtkNew<vtkGPUVolumeRayCastMapper> volumeMapper;
-  volumeMapper->SetInputConnection(cloud->GetOutputPort(0));
-  volumeMapper->SetSampleDistance(static_cast<float>(0.5 * unitDistance));
-  volumeMapper->AutoAdjustSampleDistancesOff();
-  // VTK's volumetric shadows blended with gradient shading (0 = gradient only,
-  // 1 = volumetric single scattering only). Pure single scattering leaves a
-  // front-lit cumulus dark (it lacks multiple scattering), so the demo blends.
-  volumeMapper->SetVolumetricScatteringBlending(0.3f);
-  volumeMapper->SetGlobalIlluminationReach(0.3f);
-  volumeProperty->SetScatteringAnisotropy(0.2f);
+  // The cloud rendered with Nimbus's shadow-view-slice mapper (000): single
+  // scattering with the k_multi term, sun shadows (also on the ground), the
+  // atmosphere (sky colour, reddened sun, haze) and shafts of light.
+  vtkNew<vtkNimbusCloudVolumeMapper> cloudMapper;
+  cloudMapper->SetInputConnection(cloud->GetOutputPort(0));
+  cloudMapper->SetExtinctionPerDensity(0.02); // 1/m per unit density: a cumulus
+  cloudMapper->SetAlbedo(0.99);
+  cloudMapper->SetCloudG(0.85);
+  cloudMapper->SetMultipleScattering(kMulti);
+  cloudMapper->SetSunElevation(sunElevation);
+  cloudMapper->SetSunAzimuth(sunAzimuth);
+  cloudMapper->SetGroundAlbedo(0.25);
+  cloudMapper->SetNumberOfSlices(256);
+  cloudMapper->SetExposure(exposure);
+  cloudMapper->SetEncodeSrgb(true);
   vtkNew<vtkVolume> volume;
-  volume->SetMapper(volumeMapper);
-  volume->SetProperty(volumeProperty);
-
-  // Ground: 30 km square at z = 0, grassy.
-  vtkNew<vtkPlaneSource> ground;
-  ground->SetOrigin(-15000.0, -15000.0, 0.0);
-  ground->SetPoint1(15000.0, -15000.0, 0.0);
-  ground->SetPoint2(-15000.0, 15000.0, 0.0);
-  vtkNew<vtkPolyDataMapper> groundMapper;
-  groundMapper->SetInputConnection(ground->GetOutputPort());
-  vtkNew<vtkActor> groundActor;
-  groundActor->SetMapper(groundMapper);
-  groundActor->GetProperty()->SetColor(0.30, 0.36, 0.22);
-  groundActor->GetProperty()->SetAmbient(0.3);
-  groundActor->GetProperty()->SetDiffuse(0.7);
-
-  // The sun, attenuated by the atmosphere.
-  vtkNew<vtkNimbusSunlight> sun;
-  sun->SetSunElevation(sunElevation);
-  sun->SetSunAzimuth(sunAzimuth);
-  vtkNew<vtkLight> sunLight;
-  sun->ApplyToLight(sunLight);
-  // Sky light stand-in until the sky model lands: a bluish light from the zenith,
-  // and VTK's ambient term (which takes the lights' ambient colour).
-  vtkNew<vtkLight> skyLight;
-  skyLight->SetLightTypeToSceneLight();
-  skyLight->PositionalOff();
-  skyLight->SetPosition(0.0, 0.0, 1.0);
-  skyLight->SetFocalPoint(0.0, 0.0, 0.0);
-  skyLight->SetColor(0.55, 0.68, 0.95);
-  skyLight->SetIntensity(0.5);
-  sunLight->SetAmbientColor(0.6, 0.68, 0.8);
+  volume->SetMapper(cloudMapper);
 
   vtkNew<vtkRenderer> renderer;
-  renderer->AddActor(groundActor);
   renderer->AddVolume(volume);
-  renderer->AddLight(sunLight);
-  renderer->AddLight(skyLight);
-  renderer->GradientBackgroundOn(); // a placeholder sky until the sky model lands
-  renderer->SetBackground(0.62, 0.74, 0.88);
-  renderer->SetBackground2(0.22, 0.40, 0.70);
+  renderer->SetBackground(0.0, 0.0, 0.0); // space: the mapper draws the atmosphere
 
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->SetPosition(0.0, -5600.0, 600.0);
   camera->SetFocalPoint(0.0, 0.0, 1500.0);
   camera->SetViewUp(0.0, 0.0, 1.0);
   camera->SetViewAngle(40.0);
-  camera->SetClippingRange(100.0, 40000.0);
+  camera->SetClippingRange(10.0, 1e6);
 
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0); // the mapper composites with the scene's depth
   window->SetSize(static_cast<int>(width), static_cast<int>(height));
   window->AddRenderer(renderer);
   window->Render();

@@ -1,0 +1,210 @@
+// Benchmark (not a test) of the shadow-view-slice mapper: frame time against the
+// slice count and the volume size, the cost of each optional component, and the
+// ratio to the floor (the same slices composited unlit) and to VTK's
+// vtkGPUVolumeRayCastMapper with volumetric scattering (GlobalIlluminationReach 1).
+//
+//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240]
+//
+// Prints one table; every ratio compares timings taken in this one run. Run it
+// under Testing/with-display.sh (needs an OpenGL context).
+#include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusMetaballCloudSource.h"
+
+#include "vtkCamera.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkGPUVolumeRayCastMapper.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace
+{
+int Frames = 5;
+int Width = 320;
+int Height = 240;
+
+vtkSmartPointer<vtkImageData> Cloud(int nx, int ny, int nz)
+{
+  vtkNew<vtkNimbusMetaballCloudSource> source;
+  source->SetDimensions(nx, ny, nz);
+  source->SetBounds(-1500, 1500, -1500, 1500, 800, 2800);
+  source->SetFootprintRadius(700);
+  source->SetBaseBallRadiusRange(350, 600);
+  source->SetTowerHeight(600);
+  source->SetBaseHeight(1000);
+  source->Update();
+  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
+  image->ShallowCopy(source->GetOutput());
+  return image;
+}
+
+struct Bench
+{
+  vtkNew<vtkRenderer> Renderer;
+  vtkNew<vtkRenderWindow> Window;
+  vtkNew<vtkVolume> Volume;
+  Bench()
+  {
+    this->Renderer->AddVolume(this->Volume);
+    this->Window->SetOffScreenRendering(1);
+    this->Window->SetMultiSamples(0);
+    this->Window->SetSize(Width, Height);
+    this->Window->AddRenderer(this->Renderer);
+    vtkCamera* camera = this->Renderer->GetActiveCamera();
+    camera->SetPosition(0, -6000, 1500);
+    camera->SetFocalPoint(0, 0, 1600);
+    camera->SetViewUp(0, 0, 1);
+    camera->SetViewAngle(35);
+    camera->SetClippingRange(10, 1e6);
+  }
+  /// Median frame time in ms after one warm-up frame.
+  double Time()
+  {
+    this->Window->Render();
+    this->Window->WaitForCompletion();
+    std::vector<double> times;
+    for (int i = 0; i < Frames; ++i)
+    {
+      // Move the camera a little so nothing is cached between frames except what
+      // the mapper caches on purpose (the interval/phase texture is rebuilt).
+      this->Renderer->GetActiveCamera()->Azimuth(i % 2 ? 0.01 : -0.01);
+      const auto start = std::chrono::steady_clock::now();
+      this->Window->Render();
+      this->Window->WaitForCompletion();
+      times.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    }
+    std::sort(times.begin(), times.end());
+    return times[times.size() / 2];
+  }
+};
+
+// One window for the whole run (a window per measurement exhausted Xvfb's client
+// connections after a few dozen).
+Bench* TheBench = nullptr;
+
+double TimeSvs(vtkImageData* image, int slices, const std::function<void(vtkNimbusCloudVolumeMapper*)>& configure)
+{
+  Bench& bench = *TheBench;
+  vtkNew<vtkNimbusCloudVolumeMapper> mapper;
+  mapper->SetInputData(image);
+  mapper->SetNumberOfSlices(slices);
+  mapper->SetSunAzimuth(135);
+  mapper->SetSunElevation(65);
+  configure(mapper);
+  bench.Volume->SetMapper(mapper);
+  const double t = bench.Time();
+  bench.Volume->SetMapper(nullptr);
+  mapper->ReleaseGraphicsResources(bench.Window);
+  return t;
+}
+
+double TimeVtkGpu(vtkImageData* image, double reach)
+{
+  Bench& bench = *TheBench;
+  vtkNew<vtkGPUVolumeRayCastMapper> mapper;
+  mapper->SetInputData(image);
+  mapper->AutoAdjustSampleDistancesOff();
+  const double spacing = image->GetSpacing()[0];
+  mapper->SetSampleDistance(0.5 * spacing);
+  mapper->SetVolumetricScatteringBlending(1.0);
+  mapper->SetGlobalIlluminationReach(reach);
+  vtkNew<vtkPiecewiseFunction> opacity;
+  opacity->AddPoint(0.0, 0.0);
+  opacity->AddPoint(3.0, 1.0 - std::exp(-0.02 * 3.0 * spacing));
+  vtkNew<vtkColorTransferFunction> color;
+  color->AddRGBPoint(0.0, 1, 1, 1);
+  vtkNew<vtkVolumeProperty> property;
+  property->SetScalarOpacity(opacity);
+  property->SetColor(color);
+  property->SetScalarOpacityUnitDistance(spacing);
+  property->SetInterpolationTypeToLinear();
+  property->ShadeOn();
+  property->SetScatteringAnisotropy(0.85);
+  bench.Volume->SetProperty(property);
+  bench.Volume->SetMapper(mapper);
+  const double t = bench.Time();
+  bench.Volume->SetMapper(nullptr);
+  mapper->ReleaseGraphicsResources(bench.Window);
+  return t;
+}
+}
+
+int main(int argc, char* argv[])
+{
+  if (argc > 1)
+    Frames = std::max(1, std::atoi(argv[1]));
+  if (argc > 2)
+    Width = std::max(16, std::atoi(argv[2]));
+  if (argc > 3)
+    Height = std::max(16, std::atoi(argv[3]));
+  std::printf("BenchCloudVolumeMapper: %dx%d pixels, median of %d frames, times in ms\n", Width,
+    Height, Frames);
+  Bench bench;
+  TheBench = &bench;
+  const auto none = [](vtkNimbusCloudVolumeMapper*) {};
+  const auto cloudOnly = [](vtkNimbusCloudVolumeMapper* m) {
+    m->SetAtmosphere(false);
+    m->SetGround(false);
+  };
+  const auto unlit = [](vtkNimbusCloudVolumeMapper* m) { m->SetUnlit(true); };
+
+  vtkSmartPointer<vtkImageData> c128 = Cloud(128, 128, 128);
+  std::printf("\n| volume | slices | full scene | cloud only (no air, no ground) | unlit floor | cloud only / floor | full / floor |\n|---|---|---|---|---|---|---|\n");
+  for (int slices : { 64, 128, 256, 512 })
+  {
+    const double full = TimeSvs(c128, slices, none);
+    const double cloud = TimeSvs(c128, slices, cloudOnly);
+    const double floor = TimeSvs(c128, slices, unlit);
+    std::printf("| 128^3 | %d | %.1f | %.1f | %.1f | %.2f | %.2f |\n", slices, full, cloud, floor,
+      cloud / floor, full / floor);
+  }
+  for (const auto& dims : std::vector<std::array<int, 3>>{ { 64, 64, 64 }, { 256, 256, 64 } })
+  {
+    vtkSmartPointer<vtkImageData> c = Cloud(dims[0], dims[1], dims[2]);
+    const double full = TimeSvs(c, 256, none);
+    const double cloud = TimeSvs(c, 256, cloudOnly);
+    const double floor = TimeSvs(c, 256, unlit);
+    std::printf("| %dx%dx%d | 256 | %.1f | %.1f | %.1f | %.2f | %.2f |\n", dims[0], dims[1], dims[2],
+      full, cloud, floor, cloud / floor, full / floor);
+  }
+
+  std::printf("\nComponents (128^3, 256 slices): each switched off alone\n\n| configuration | ms | saving vs full |\n|---|---|---|\n");
+  const double full = TimeSvs(c128, 256, none);
+  std::printf("| full (atmosphere, ground, shafts) | %.1f | |\n", full);
+  const std::vector<std::pair<std::string, std::function<void(vtkNimbusCloudVolumeMapper*)>>> parts = {
+    { "no shafts", [](vtkNimbusCloudVolumeMapper* m) { m->SetShafts(false); } },
+    { "no ground", [](vtkNimbusCloudVolumeMapper* m) { m->SetGround(false); } },
+    { "no atmosphere", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphere(false); } },
+    { "no atmosphere, no ground", cloudOnly },
+    { "atmosphere steps 16 (default 64)", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphereSteps(16); } },
+    { "shadow surface 256 (default 512)", [](vtkNimbusCloudVolumeMapper* m) { m->SetShadowSurfaceSize(256); } },
+  };
+  for (const auto& part : parts)
+  {
+    const double t = TimeSvs(c128, 256, part.second);
+    std::printf("| %s | %.1f | %.0f %% |\n", part.first.c_str(), t, 100.0 * (full - t) / full);
+  }
+
+  std::printf("\nVTK's vtkGPUVolumeRayCastMapper, volumetric scattering, sample distance 0.5 voxel (128^3)\n\n| GlobalIlluminationReach | ms | / SVS 256 slices full |\n|---|---|---|\n");
+  for (double reach : { 0.0, 0.5, 1.0 })
+  {
+    const double t = TimeVtkGpu(c128, reach);
+    std::printf("| %.1f | %.1f | %.2f |\n", reach, t, t / full);
+  }
+  return EXIT_SUCCESS;
+}
