@@ -743,6 +743,7 @@ TEST(CloudAutomatonRules, PackedMatchesNaiveCellByCell)
         p.Wind[1] = wind.second;
         p.Seed = static_cast<std::uint64_t>(nx);
         CloudAutomaton ca(p);
+        ca.Set(Field::Act, nx / 2, 3, 2, true); // at least one act on the tiny grids
         NaiveState naive{ nx, 6, 5, boundary == CloudBoundary::Periodic, {}, {}, {} };
         const int cells = nx * 6 * 5;
         naive.hum.resize(cells);
