@@ -113,12 +113,9 @@ double BlockMean(const std::vector<double>& values, int nx, const Site& site)
 }
 }
 
-ImageCloud BuildImageCloud(
-  const std::vector<double>& opticalDepth, int nx, int ny, const ImageCloudParameters& p)
+GridGeometry ImageCloudGrid(int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& p)
 {
   Require(nx >= 1 && ny >= 1, "BuildImageCloud: the image must have at least 1 x 1 pixels.");
-  Require(opticalDepth.size() == static_cast<std::size_t>(nx) * ny,
-    "BuildImageCloud: the optical-depth map must have nx * ny values.");
   Require(p.PixelSize > 0.0 && std::isfinite(p.PixelSize), "PixelSize must be finite and > 0.");
   Require(p.VerticalSpacing > 0.0 && std::isfinite(p.VerticalSpacing),
     "VerticalSpacing must be finite and > 0.");
@@ -136,22 +133,17 @@ ImageCloud BuildImageCloud(
   Require(p.MinimumOpticalDepth >= 0.0 && std::isfinite(p.MinimumOpticalDepth),
     "MinimumOpticalDepth must be finite and >= 0.");
   Require(p.Iterations >= 0, "Iterations must be >= 0.");
-  double maxTau = 0.0;
-  for (const double t : opticalDepth)
-  {
-    Require(t >= 0.0 && std::isfinite(t), "BuildImageCloud: optical depths must be finite, >= 0.");
-    maxTau = std::max(maxTau, t);
-  }
+  Require(p.GridOpticalDepth >= 0.0 && std::isfinite(p.GridOpticalDepth),
+    "GridOpticalDepth must be finite and >= 0.");
+  Require(maximumOpticalDepth >= 0.0 && std::isfinite(maximumOpticalDepth),
+    "BuildImageCloud: optical depths must be finite, >= 0.");
 
-  const double sigma = p.ExtinctionCoefficient;
-  const double rho = p.NominalDensity;
   const double radius = p.BallRadiusFactor * p.BallSpacing * p.PixelSize; // m
-  const double maxThickness = maxTau / (sigma * rho);                     // m
-
-  // Grid: pixels in x, y (centred on 0); z from one layer below the base to above the
-  // highest possible top (thickness + rough top ball).
-  ImageCloud cloud;
-  GridGeometry& grid = cloud.Grid;
+  const double maxThickness = std::max(maximumOpticalDepth, p.GridOpticalDepth) /
+    (p.ExtinctionCoefficient * p.NominalDensity); // m
+  // x, y: pixels centred on 0; z from one layer below the base to above the highest
+  // possible top (thickness + rough top ball).
+  GridGeometry grid;
   grid.Dimensions = { { nx, ny, 1 } };
   grid.Spacing = { { p.PixelSize, p.PixelSize, p.VerticalSpacing } };
   grid.Origin = { { -0.5 * (nx - 1) * p.PixelSize, -0.5 * (ny - 1) * p.PixelSize,
@@ -161,13 +153,34 @@ ImageCloud BuildImageCloud(
   if (layers > 4096.0 || static_cast<double>(nx) * ny * layers > 2.0e9)
   {
     std::ostringstream message;
-    message << "BuildImageCloud: the cloud would need " << layers
-            << " layers (thickness " << maxThickness << " m at spacing " << p.VerticalSpacing
+    message << "BuildImageCloud: the cloud would need " << layers << " layers (thickness "
+            << maxThickness << " m at spacing " << p.VerticalSpacing
             << " m); raise VerticalSpacing, ExtinctionCoefficient or NominalDensity, or lower "
                "the maximum optical depth.";
     throw std::invalid_argument(message.str());
   }
   grid.Dimensions[2] = static_cast<int>(layers);
+  return grid;
+}
+
+ImageCloud BuildImageCloud(
+  const std::vector<double>& opticalDepth, int nx, int ny, const ImageCloudParameters& p)
+{
+  Require(opticalDepth.size() == static_cast<std::size_t>(nx < 0 ? 0 : nx) * (ny < 0 ? 0 : ny),
+    "BuildImageCloud: the optical-depth map must have nx * ny values.");
+  double maxTau = 0.0;
+  for (const double t : opticalDepth)
+  {
+    Require(t >= 0.0 && std::isfinite(t), "BuildImageCloud: optical depths must be finite, >= 0.");
+    maxTau = std::max(maxTau, t);
+  }
+  ImageCloud cloud;
+  cloud.Grid = ImageCloudGrid(nx, ny, maxTau, p);
+  const GridGeometry& grid = cloud.Grid;
+  cloud.Density.assign(grid.NumberOfPoints(), 0.0f);
+  const double sigma = p.ExtinctionCoefficient;
+  const double rho = p.NominalDensity;
+  const double radius = p.BallRadiusFactor * p.BallSpacing * p.PixelSize; // m
 
   // Ball columns.
   Random random(p.Seed);

@@ -60,6 +60,9 @@ struct ImageCloudParameters
   double TopRoughness = 0.6;            // random variation of the top balls (fraction of R)
   double MinimumOpticalDepth = 0.05;     // columns thinner than this get no balls
   int Iterations = 10;                   // density-fitting iterations
+  /// The grid is made tall enough for this optical depth (0: the map's maximum), so that a
+  /// pipeline can know the grid before it sees the image.
+  double GridOpticalDepth = 0.0;
   std::uint64_t Seed = 1;
 };
 
@@ -70,6 +73,12 @@ struct ImageCloud
   std::vector<Metaball> Balls;            // the fitted metaballs
   std::vector<double> ColumnOpticalDepth; // achieved tau per pixel, sigma * sum(density) dz
 };
+
+/// The grid BuildImageCloud uses for an nx x ny map whose largest optical depth is
+/// maximumOpticalDepth. Throws std::invalid_argument for unusable parameters or a grid of
+/// more than 4096 layers.
+NIMBUSFILTERS_EXPORT GridGeometry ImageCloudGrid(
+  int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& parameters);
 
 /// Builds the cloud over an nx x ny map of target optical depths (tau[x + nx y] >= 0).
 /// Grid x/y points sit on the pixels, centred on x = y = 0. Ball columns sit every
