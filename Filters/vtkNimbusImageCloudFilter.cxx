@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusImageCloudFilter);
@@ -167,10 +168,25 @@ int vtkNimbusImageCloudFilter::RequestData(
     return 1;
   }
   vtkDataArray* intensity = this->GetInputArrayToProcess(0, inputVector);
+  vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+  const char* arrayName = arrayInfo->Has(vtkDataObject::FIELD_NAME())
+    ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  if (!intensity && (!arrayName || !*arrayName))
+  {
+    // No array chosen (an empty name, as ParaView may send before its domain is filled):
+    // the active scalars, else the first point array.
+    intensity = input->GetPointData()->GetScalars();
+    if (!intensity && input->GetPointData()->GetNumberOfArrays() > 0)
+    {
+      intensity = input->GetPointData()->GetArray(0);
+    }
+  }
   if (!intensity)
   {
-    vtkErrorMacro(<< "The input image has no point scalars to read intensities from (set the "
-                     "array with SetInputArrayToProcess).");
+    vtkErrorMacro(<< "The input image has no point array "
+                  << (arrayName && *arrayName ? std::string("\"") + arrayName + "\"" : "")
+                  << " to read intensities from (choose one with SetInputArrayToProcess).");
     return 1;
   }
   if (!(this->IntensityRange[1] > this->IntensityRange[0]) ||
