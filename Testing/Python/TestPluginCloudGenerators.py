@@ -88,12 +88,12 @@ def main():
     target = vtk_to_numpy(depth.GetPointData().GetArray("optical_depth"))
     achieved = vtk_to_numpy(depth.GetPointData().GetArray("column_optical_depth"))
     # On this textured image the edges of clouds smear over one ball radius (600 m), so the
-    # achieved map is a blurred copy: measured mean 8.84 vs 8.16 (+8.4 %), correlation 0.96.
+    # achieved map is a blurred copy: measured mean 8.84 vs 8.16 (+8.4 %), correlation 0.985.
     # The precise check (uniform regions, 6 %) is TestImageClouds / TestImageCloudFilter.
     correlation = float(np.corrcoef(target, achieved)[0, 1])
     ok &= check(target.max() > 5.0 and abs(achieved.mean() / target.mean() - 1.0) < 0.10,
                 "mean column optical depth %.3f vs image %.3f" % (achieved.mean(), target.mean()))
-    ok &= check(correlation > 0.93, "achieved vs image optical depth correlation %.3f" % correlation)
+    ok &= check(correlation > 0.95, "achieved vs image optical depth correlation %.3f" % correlation)
     return 0 if ok else 1
 
 
