@@ -123,8 +123,8 @@ int vtkNimbusCloudAutomatonSource::RequestInformation(
     {
       extent[2 * a + 1] = d[a] - 1;
       spacing[a] = AxisSpacing(d[a], this->Bounds[2 * a], this->Bounds[2 * a + 1]);
-      origin[a] = d[a] > 1 ? this->Bounds[2 * a]
-                           : 0.5 * (this->Bounds[2 * a] + this->Bounds[2 * a + 1]);
+      origin[a] =
+        d[a] > 1 ? this->Bounds[2 * a] : 0.5 * (this->Bounds[2 * a] + this->Bounds[2 * a + 1]);
     }
   }
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
@@ -141,8 +141,8 @@ int vtkNimbusCloudAutomatonSource::RequestInformation(
     {
       times[k] = static_cast<double>(k) * this->StepDuration;
     }
-    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(),
-      static_cast<int>(times.size()));
+    outInfo->Set(
+      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
     const double range[2] = { 0.0, times.back() };
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
@@ -169,8 +169,9 @@ int vtkNimbusCloudAutomatonSource::RequestData(
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   output->Initialize();
-  vtkImageData* input =
-    inputVector[0]->GetNumberOfInformationObjects() > 0 ? vtkImageData::GetData(inputVector[0], 0) : nullptr;
+  vtkImageData* input = inputVector[0]->GetNumberOfInformationObjects() > 0
+    ? vtkImageData::GetData(inputVector[0], 0)
+    : nullptr;
   auto& internals = *this->Internals;
 
   // --- parameters ---------------------------------------------------------------------------
@@ -268,7 +269,7 @@ int vtkNimbusCloudAutomatonSource::RequestData(
           values[i] = static_cast<float>(array->GetComponent(i, 0));
         }
         *fields[f] = volume ? nimbus::ProbabilityField::Volume(std::move(values))
-          : nimbus::ProbabilityField::Plane(std::move(values));
+                            : nimbus::ProbabilityField::Plane(std::move(values));
       }
     }
     try
@@ -395,8 +396,7 @@ int vtkNimbusCloudAutomatonSource::RequestData(
     {
       auto first = internals.Densities.begin();
       auto last = std::prev(internals.Densities.end());
-      internals.Densities.erase(
-        (step - first->first) > (last->first - step) ? first : last);
+      internals.Densities.erase((step - first->first) > (last->first - step) ? first : last);
     }
   }
 

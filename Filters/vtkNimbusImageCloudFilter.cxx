@@ -93,7 +93,8 @@ nimbus::ImageCloudParameters MakeParameters(const vtkNimbusImageCloudFilter* sel
   return p;
 }
 
-void SetGeometry(vtkInformation* info, const nimbus::GridGeometry& grid, bool map, double baseHeight)
+void SetGeometry(
+  vtkInformation* info, const nimbus::GridGeometry& grid, bool map, double baseHeight)
 {
   int extent[6] = { 0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0,
     map ? 0 : grid.Dimensions[2] - 1 };
@@ -241,7 +242,8 @@ int vtkNimbusImageCloudFilter::RequestData(
   this->UpdateProgress(0.9);
 
   const nimbus::GridGeometry& grid = cloud.Grid;
-  output->SetExtent(0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0, grid.Dimensions[2] - 1);
+  output->SetExtent(
+    0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0, grid.Dimensions[2] - 1);
   output->SetOrigin(grid.Origin.data());
   output->SetSpacing(grid.Spacing.data());
   vtkNew<vtkFloatArray> density;

@@ -227,8 +227,8 @@ std::vector<std::uint32_t> MakeThresholds(
     std::ostringstream message;
     message << name << ": a " << (field.Type == ProbabilityField::Kind::Plane ? "2-D" : "3-D")
             << " probability field needs " << expected << " values (the grid's "
-            << (field.Type == ProbabilityField::Kind::Plane ? "nx*ny" : "nx*ny*nz")
-            << "), got " << field.Values.size() << ".";
+            << (field.Type == ProbabilityField::Kind::Plane ? "nx*ny" : "nx*ny*nz") << "), got "
+            << field.Values.size() << ".";
     throw std::invalid_argument(message.str());
   }
   std::vector<std::uint32_t> thresholds(expected);
@@ -238,8 +238,7 @@ std::vector<std::uint32_t> MakeThresholds(
     if (!(p >= 0.0 && p <= 1.0))
     {
       std::ostringstream message;
-      message << name << ": value " << p << " at index " << i
-              << " is not a probability in [0, 1].";
+      message << name << ": value " << p << " at index " << i << " is not a probability in [0, 1].";
       throw std::invalid_argument(message.str());
     }
     thresholds[i] = ToThreshold(p);
@@ -610,7 +609,8 @@ bool CloudAutomaton::StepTo(std::int64_t step, const std::function<bool(double)>
   while (this->Current.Step < step)
   {
     if (progress &&
-      !progress(static_cast<double>(this->Current.Step - first) / static_cast<double>(step - first)))
+      !progress(
+        static_cast<double>(this->Current.Step - first) / static_cast<double>(step - first)))
     {
       return false;
     }

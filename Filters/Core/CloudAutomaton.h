@@ -72,8 +72,8 @@ struct CloudAutomatonParameters
 {
   int Dimensions[3] = { 64, 64, 16 }; // cells along x, y, z (each >= 1)
   std::uint64_t Seed = 1;
-  ProbabilityField Extinction = ProbabilityField::Uniform(0.1); // p_ext
-  ProbabilityField HumiditySupply = ProbabilityField::Uniform(0.001); // p_hum
+  ProbabilityField Extinction = ProbabilityField::Uniform(0.1);          // p_ext
+  ProbabilityField HumiditySupply = ProbabilityField::Uniform(0.001);    // p_hum
   ProbabilityField ActivationSupply = ProbabilityField::Uniform(0.0005); // p_act
   /// Probabilities of hum and act at step 0 (cld starts empty).
   double InitialHumidity = 0.3;

@@ -113,7 +113,8 @@ double BlockMean(const std::vector<double>& values, int nx, const Site& site)
 }
 }
 
-GridGeometry ImageCloudGrid(int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& p)
+GridGeometry ImageCloudGrid(
+  int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& p)
 {
   Require(nx >= 1 && ny >= 1, "BuildImageCloud: the image must have at least 1 x 1 pixels.");
   Require(p.PixelSize > 0.0 && std::isfinite(p.PixelSize), "PixelSize must be finite and > 0.");
@@ -148,7 +149,8 @@ GridGeometry ImageCloudGrid(int nx, int ny, double maximumOpticalDepth, const Im
   grid.Spacing = { { p.PixelSize, p.PixelSize, p.VerticalSpacing } };
   grid.Origin = { { -0.5 * (nx - 1) * p.PixelSize, -0.5 * (ny - 1) * p.PixelSize,
     p.BaseHeight - p.VerticalSpacing } };
-  const double top = p.BaseHeight + std::max(maxThickness, radius) + radius * (1.0 + p.TopRoughness);
+  const double top =
+    p.BaseHeight + std::max(maxThickness, radius) + radius * (1.0 + p.TopRoughness);
   const double layers = std::ceil((top - grid.Origin[2]) / p.VerticalSpacing) + 1.0;
   if (layers > 4096.0 || static_cast<double>(nx) * ny * layers > 2.0e9)
   {
@@ -209,7 +211,8 @@ ImageCloud BuildImageCloud(
       const double thickness = site.Target / (sigma * rho);
       const double zFirst = p.BaseHeight + 0.5 * std::min(radius, thickness);
       const double zLast = std::max(zFirst, p.BaseHeight + thickness - 0.5 * radius);
-      const int count = std::min(30, 1 + static_cast<int>(std::ceil((zLast - zFirst) / (0.5 * radius))));
+      const int count =
+        std::min(30, 1 + static_cast<int>(std::ceil((zLast - zFirst) / (0.5 * radius))));
       const double cx = grid.Origin[0] + (0.5 * (site.X0 + site.X1) - 0.5) * p.PixelSize;
       const double cy = grid.Origin[1] + (0.5 * (site.Y0 + site.Y1) - 0.5) * p.PixelSize;
       site.FirstBall = balls.size();

@@ -25,9 +25,9 @@ namespace nimbus
 ///   TwoStream: tau = min(MaximumOpticalDepth, 2 u / ((1 - g)(1 - u)))
 /// TwoStream inverts the reflectance of a non-absorbing plane-parallel cloud in the
 /// two-stream approximation, R = (1 - g) tau / (2 + (1 - g) tau) (the two-stream result, e.g.
-/// Bohren 1987, Am. J. Phys. 55, "Multiple scattering of light and some of its observable consequences"),
-/// reading the normalised intensity as the cloud's reflectance: bright pixels become
-/// optically much thicker than a linear map would make them, as in satellite retrievals.
+/// Bohren 1987, Am. J. Phys. 55, "Multiple scattering of light and some of its observable
+/// consequences"), reading the normalised intensity as the cloud's reflectance: bright pixels
+/// become optically much thicker than a linear map would make them, as in satellite retrievals.
 struct OpticalDepthMapping
 {
   enum class Kind
@@ -57,7 +57,7 @@ struct ImageCloudParameters
   double BaseTransitionThickness = 50.0; // m, density fades in over this above the base
   int BallSpacing = 2;                   // pixels between columns of metaballs (>= 1)
   double BallRadiusFactor = 3.0;         // ball radius = factor * BallSpacing * PixelSize
-  double TopRoughness = 0.6;            // random variation of the top balls (fraction of R)
+  double TopRoughness = 0.6;             // random variation of the top balls (fraction of R)
   double MinimumOpticalDepth = 0.05;     // columns thinner than this get no balls
   int Iterations = 10;                   // density-fitting iterations
   /// The grid is made tall enough for this optical depth (0: the map's maximum), so that a

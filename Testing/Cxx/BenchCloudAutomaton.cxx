@@ -68,7 +68,8 @@ void BM_Smooth(benchmark::State& state)
     nimbus::SmoothCloud(automaton, smoothing, density);
     benchmark::DoNotOptimize(density.data());
   }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * static_cast<double>(nx) * ny * nz));
+  state.SetItemsProcessed(
+    static_cast<int64_t>(state.iterations() * static_cast<double>(nx) * ny * nz));
 }
 }
 

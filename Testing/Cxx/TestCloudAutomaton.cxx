@@ -254,7 +254,8 @@ TEST(CloudAutomatonSupply, FrequenciesMatchProbabilities)
       if (asField)
       {
         p.HumiditySupply = ProbabilityField::Plane(std::vector<float>(nx * ny, float(prob)));
-        p.ActivationSupply = ProbabilityField::Volume(std::vector<float>(nx * ny * nz, float(prob)));
+        p.ActivationSupply =
+          ProbabilityField::Volume(std::vector<float>(nx * ny * nz, float(prob)));
         p.Extinction = ProbabilityField::Plane(std::vector<float>(nx * ny, float(prob)));
       }
       else
@@ -336,12 +337,12 @@ TEST(CloudAutomatonWind, FieldsMoveWithTheWind)
 {
   // Quiet rules: the only change is the shift. nx = 130 so shifts cross words.
   const int nx = 130, ny = 11, nz = 3;
-  const std::vector<std::tuple<int, int, int>> cells = { { 0, 0, 0 }, { 63, 5, 1 },
-    { 64, 10, 2 }, { 129, 3, 1 }, { 127, 0, 0 } };
+  const std::vector<std::tuple<int, int, int>> cells = { { 0, 0, 0 }, { 63, 5, 1 }, { 64, 10, 2 },
+    { 129, 3, 1 }, { 127, 0, 0 } };
   for (const auto boundary : { CloudBoundary::Periodic, CloudBoundary::Open })
   {
-    for (const auto& wind : std::vector<std::pair<int, int>>{ { 3, -2 }, { -67, 1 }, { 0, 4 },
-           { 200, 0 } })
+    for (const auto& wind :
+      std::vector<std::pair<int, int>>{ { 3, -2 }, { -67, 1 }, { 0, 4 }, { 200, 0 } })
     {
       auto p = Quiet(nx, ny, nz, boundary);
       p.Wind[0] = wind.first;
@@ -520,7 +521,8 @@ TEST(CloudSmoothing, FullCloudIsOneExceptAtOpenFaces)
   // (w0 + w1 + w2) = (1 + 0.655420 + 0.092736) / 2.496312 = 0.700296.
   for (int z = 0; z < 6; ++z)
   {
-    const double expected = (z == 0 || z == 5) ? 0.700296 : ((z == 1 || z == 4) ? 1 - 0.092736 / 2.496312 : 1.0);
+    const double expected =
+      (z == 0 || z == 5) ? 0.700296 : ((z == 1 || z == 4) ? 1 - 0.092736 / 2.496312 : 1.0);
     EXPECT_NEAR(density[3 + 20 * (4 + 9 * z)], expected, 2e-6) << "layer " << z;
     EXPECT_NEAR(density[19 + 20 * (0 + 9 * z)], expected, 2e-6) << "layer " << z;
   }
@@ -553,7 +555,8 @@ TEST(CloudSmoothing, RadiusOneIsTheIdentityAndInterpolationIsLinear)
     ASSERT_FLOAT_EQ(mid[i], 0.75f * a[i] + 0.25f * b[i]);
   }
   EXPECT_THROW(nimbus::InterpolateDensity(a, b, 1.5, mid), std::invalid_argument);
-  EXPECT_THROW(nimbus::InterpolateDensity(a, std::vector<float>(3), 0.5, mid), std::invalid_argument);
+  EXPECT_THROW(
+    nimbus::InterpolateDensity(a, std::vector<float>(3), 0.5, mid), std::invalid_argument);
 }
 
 // --- extremes and errors ------------------------------------------------------------------
@@ -606,8 +609,8 @@ TEST(CloudAutomatonExtremes, OneVoxelGrid)
 TEST(CloudAutomatonExtremes, FlatGridsAndLongRuns)
 {
   // 1 x N x 1 and N x 1 x 1 lines and a 1-layer sheet run with every process on.
-  for (const auto& dims : std::vector<std::tuple<int, int, int>>{ { 1, 50, 1 }, { 50, 1, 1 },
-         { 64, 64, 1 }, { 1, 1, 40 } })
+  for (const auto& dims : std::vector<std::tuple<int, int, int>>{
+         { 1, 50, 1 }, { 50, 1, 1 }, { 64, 64, 1 }, { 1, 1, 40 } })
   {
     auto p = Busy(2);
     p.Dimensions[0] = std::get<0>(dims);

@@ -76,7 +76,8 @@ std::vector<float> DensityAt(vtkNimbusCloudAutomatonSource* source, double time)
   {
     return {};
   }
-  return std::vector<float>(array->GetPointer(0), array->GetPointer(0) + array->GetNumberOfTuples());
+  return std::vector<float>(
+    array->GetPointer(0), array->GetPointer(0) + array->GetNumberOfTuples());
 }
 
 // The same run through the core, for comparison.
@@ -201,7 +202,7 @@ TEST(CloudAutomatonSource, ComputesIncrementallyFromCachedStates)
   DensityAt(source, 2.0 * 40);
   EXPECT_EQ(source->GetNumberOfStepsComputed(), 40);
   EXPECT_GT(catcher.ProgressEvents, 10); // progress while stepping
-  DensityAt(source, 2.0 * 41); // one more step
+  DensityAt(source, 2.0 * 41);           // one more step
   EXPECT_EQ(source->GetNumberOfStepsComputed(), 41);
   DensityAt(source, 2.0 * 41.5); // needs step 42 only
   EXPECT_EQ(source->GetNumberOfStepsComputed(), 42);
@@ -257,7 +258,7 @@ TEST(CloudAutomatonSource, InputMapsShapeWhereCloudsForm)
         if (r < 8.0)
           inside += d;
         else if (r >= 10.0 + 2.0 * std::sqrt(2.0)) // beyond the disc and the kernel's
-                                                     // reach (|dx|, |dy| <= 2)
+                                                   // reach (|dx|, |dy| <= 2)
           outside += d;
       }
   EXPECT_GT(inside, 100.0);

@@ -29,7 +29,8 @@ public:
   {
     this->Callback->SetClientData(this);
     this->Callback->SetCallback([](vtkObject*, unsigned long, void* self, void* text) {
-      static_cast<ErrorCatcher*>(self)->Errors.emplace_back(text ? static_cast<const char*>(text) : "");
+      static_cast<ErrorCatcher*>(self)->Errors.emplace_back(
+        text ? static_cast<const char*>(text) : "");
     });
     object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
   }

@@ -18,7 +18,7 @@ TEST(ImageCloudMapping, LinearAndTwoStream)
   linear.ClearIntensity = 0.2;
   linear.WhiteIntensity = 0.9;
   linear.MaximumOpticalDepth = 40.0;
-  EXPECT_EQ(nimbus::IntensityToOpticalDepth(0.1, linear), 0.0);  // darker than clear sky
+  EXPECT_EQ(nimbus::IntensityToOpticalDepth(0.1, linear), 0.0); // darker than clear sky
   EXPECT_EQ(nimbus::IntensityToOpticalDepth(0.2, linear), 0.0);
   EXPECT_NEAR(nimbus::IntensityToOpticalDepth(0.55, linear), 20.0, 1e-12); // halfway
   EXPECT_NEAR(nimbus::IntensityToOpticalDepth(0.9, linear), 40.0, 1e-12);
@@ -99,7 +99,8 @@ TEST(ImageCloud, ColumnOpticalDepthMatchesTheDiscs)
     nimbus::ColumnOpticalDepth(grid, cloud.Density, parameters.ExtinctionCoefficient);
   // Interior of each disc: farther than one ball radius plus one block (6 + 2 px) from the
   // edge, where the image is uniform over every ball's reach.
-  const double reach = parameters.BallRadiusFactor * parameters.BallSpacing + parameters.BallSpacing;
+  const double reach =
+    parameters.BallRadiusFactor * parameters.BallSpacing + parameters.BallSpacing;
   std::vector<double> topHeights(discs.size());
   for (std::size_t n = 0; n < discs.size(); ++n)
   {
@@ -139,8 +140,8 @@ TEST(ImageCloud, ColumnOpticalDepthMatchesTheDiscs)
     const double topMean = topSum / count;
     const double topSpread = std::sqrt(std::max(0.0, topSquares / count - topMean * topMean));
     std::cout << "disc tau " << d.Tau << ": " << count << " interior columns, relative error of "
-              << "the column optical depth: max " << worst << ", rms " << rms << "; top "
-              << topMean << " m +- " << topSpread << " m\n";
+              << "the column optical depth: max " << worst << ", rms " << rms << "; top " << topMean
+              << " m +- " << topSpread << " m\n";
     // Measured with the defaults: max 0.035 / 0.047 / 0.034, rms 0.013 / 0.015 / 0.011
     // (tau 4 / 15 / 30); the ripple comes from the discrete, jittered ball columns.
     EXPECT_LT(worst, 0.06) << "tau " << d.Tau;
@@ -148,8 +149,8 @@ TEST(ImageCloud, ColumnOpticalDepthMatchesTheDiscs)
     // Flat base: every interior column starts in the same layer, just above the base.
     EXPECT_TRUE(flatBase) << "tau " << d.Tau;
     EXPECT_EQ(grid.Origin[2] + baseLayer * grid.Spacing[2] > parameters.BaseHeight, true);
-    EXPECT_LE(grid.Origin[2] + baseLayer * grid.Spacing[2],
-      parameters.BaseHeight + grid.Spacing[2]);
+    EXPECT_LE(
+      grid.Origin[2] + baseLayer * grid.Spacing[2], parameters.BaseHeight + grid.Spacing[2]);
     topHeights[n] = topMean;
     if (d.Tau >= 15.0)
     {
@@ -189,7 +190,8 @@ TEST(ImageCloud, ExtremesAndErrors)
 {
   nimbus::ImageCloudParameters parameters;
   // All clear: an empty (all-zero) cloud, no balls.
-  const nimbus::ImageCloud clear = nimbus::BuildImageCloud(std::vector<double>(12, 0.0), 4, 3, parameters);
+  const nimbus::ImageCloud clear =
+    nimbus::BuildImageCloud(std::vector<double>(12, 0.0), 4, 3, parameters);
   EXPECT_TRUE(clear.Balls.empty());
   for (float v : clear.Density)
     ASSERT_EQ(v, 0.0f);
