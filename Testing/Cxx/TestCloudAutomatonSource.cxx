@@ -189,6 +189,20 @@ TEST(CloudAutomatonSource, SameOutputWhateverTheRequestOrder)
   {
     EXPECT_EQ(DensityAt(reversed, times[i]), reference[i]) << "t = " << times[i];
   }
+  // Tiny caches: no checkpoints at all (every backwards jump restarts from step 0), and a
+  // checkpoint every step thinned to 3 (the eviction path), give the same bytes.
+  for (const int maximum : { 0, 3 })
+  {
+    vtkNew<vtkNimbusCloudAutomatonSource> small;
+    Configure(small);
+    small->SetCheckpointInterval(1);
+    small->SetMaximumNumberOfCheckpoints(maximum);
+    for (std::size_t i = 0; i < reference.size(); ++i)
+    {
+      EXPECT_EQ(DensityAt(small, times[i]), reference[i])
+        << "t = " << times[i] << ", at most " << maximum << " checkpoints";
+    }
+  }
   // Out-of-range times clamp to the advertised range.
   EXPECT_EQ(reference[8], reference[7]); // 500 s -> 120 s
   EXPECT_EQ(reference[9], reference[0]); // -3 s -> 0 s
