@@ -26,6 +26,7 @@ packages=(
   libgl-dev python3-dev python3-mpi4py python3-numpy
   # build tools and tests
   cmake ninja-build g++ make libgtest-dev nlohmann-json3-dev python3-matplotlib
+  libbenchmark-dev
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
 )

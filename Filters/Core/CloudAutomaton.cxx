@@ -1,0 +1,836 @@
+#include "CloudAutomaton.h"
+
+#include "Metaballs.h" // WyvillFalloff
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+
+namespace nimbus
+{
+
+ProbabilityField ProbabilityField::Uniform(double value)
+{
+  ProbabilityField field;
+  field.Type = Kind::Uniform;
+  field.Value = value;
+  return field;
+}
+
+ProbabilityField ProbabilityField::Plane(std::vector<float> values)
+{
+  ProbabilityField field;
+  field.Type = Kind::Plane;
+  field.Values = std::move(values);
+  return field;
+}
+
+ProbabilityField ProbabilityField::Volume(std::vector<float> values)
+{
+  ProbabilityField field;
+  field.Type = Kind::Volume;
+  field.Values = std::move(values);
+  return field;
+}
+
+std::int64_t WindShift(double cellsPerStep, std::int64_t step)
+{
+  // The shifts of steps 0..n-1 telescope to floor(v n) - floor(0) = floor(v n).
+  const double v = cellsPerStep;
+  return static_cast<std::int64_t>(std::floor(v * static_cast<double>(step + 1))) -
+    static_cast<std::int64_t>(std::floor(v * static_cast<double>(step)));
+}
+
+namespace
+{
+using Word = std::uint64_t;
+constexpr int Bits = 64;
+constexpr std::uint32_t ThresholdOne = 1u << 24; // probability 1 on the 24-bit scale
+
+// Random streams: one per use, so that no two uses share numbers.
+enum Stream : std::uint64_t
+{
+  StreamHumidity = 1,
+  StreamActivation = 2,
+  StreamExtinction = 3,
+  StreamInitialHumidity = 4,
+  StreamInitialActivation = 5
+};
+
+// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
+inline Word Mix(Word z)
+{
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// Counter-based random numbers: key(seed, step, stream), then hash(key, counter).
+inline Word StreamKey(std::uint64_t seed, std::int64_t step, Stream stream)
+{
+  return Mix(Mix(Mix(seed) + static_cast<Word>(step)) + static_cast<Word>(stream));
+}
+
+inline Word Hash(Word key, Word counter)
+{
+  return Mix(key ^ (counter * 0xD6E8FEB86659FD93ull));
+}
+
+std::uint32_t ToThreshold(double p)
+{
+  return static_cast<std::uint32_t>(std::llround(std::clamp(p, 0.0, 1.0) * ThresholdOne));
+}
+
+// 64 independent Bernoulli bits of probability threshold / 2^24 from
+// 24 - ctz(threshold) random words: processing the binary digits of the
+// probability from the least significant, OR where the digit is 1 and AND where it
+// is 0 gives P(bit) = sum_j digit_j 2^(j-24) exactly.
+inline Word BernoulliWord(Word key, Word wordIndex, std::uint32_t threshold)
+{
+  if (threshold == 0)
+  {
+    return 0;
+  }
+  if (threshold >= ThresholdOne)
+  {
+    return ~Word(0);
+  }
+  Word mask = 0;
+  int j = 0;
+  while (((threshold >> j) & 1u) == 0)
+  {
+    ++j;
+  }
+  for (; j < 24; ++j)
+  {
+    const Word random = Hash(key, wordIndex * 24 + static_cast<Word>(j));
+    mask = ((threshold >> j) & 1u) ? (mask | random) : (mask & random);
+  }
+  return mask;
+}
+
+// Runs body(begin, end) over [0, count) split into contiguous slabs, one per thread.
+template <typename Body>
+void ParallelFor(int count, int threads, const Body& body)
+{
+  threads = std::max(1, std::min(threads, count));
+  if (threads == 1)
+  {
+    body(0, count);
+    return;
+  }
+  std::vector<std::thread> workers;
+  workers.reserve(static_cast<std::size_t>(threads - 1));
+  for (int t = 1; t < threads; ++t)
+  {
+    const int begin = static_cast<int>(static_cast<long long>(count) * t / threads);
+    const int end = static_cast<int>(static_cast<long long>(count) * (t + 1) / threads);
+    workers.emplace_back([&body, begin, end]() { body(begin, end); });
+  }
+  body(0, static_cast<int>(static_cast<long long>(count) / threads));
+  for (auto& worker : workers)
+  {
+    worker.join();
+  }
+}
+
+int ResolveThreads(int requested)
+{
+  if (requested > 0)
+  {
+    return requested;
+  }
+  const unsigned hardware = std::thread::hardware_concurrency();
+  return hardware > 0 ? static_cast<int>(hardware) : 1;
+}
+
+inline int Wrap(long long i, int n)
+{
+  long long r = i % n;
+  return static_cast<int>(r < 0 ? r + n : r);
+}
+
+inline bool GetBit(const Word* row, int x)
+{
+  return (row[x / Bits] >> (x % Bits)) & 1u;
+}
+
+// Word w of the row shifted by s >= 0 cells towards +x (cells leave at the top).
+inline Word ShiftedUp(const Word* row, int words, int w, long long s)
+{
+  const long long ws = s / Bits;
+  const int bs = static_cast<int>(s % Bits);
+  const long long i = w - ws;
+  Word v = 0;
+  if (i >= 0 && i < words)
+  {
+    v = row[i] << bs;
+  }
+  if (bs != 0 && i - 1 >= 0 && i - 1 < words)
+  {
+    v |= row[i - 1] >> (Bits - bs);
+  }
+  return v;
+}
+
+// Word w of the row shifted by s >= 0 cells towards -x.
+inline Word ShiftedDown(const Word* row, int words, int w, long long s)
+{
+  const long long ws = s / Bits;
+  const int bs = static_cast<int>(s % Bits);
+  const long long i = w + ws;
+  Word v = 0;
+  if (i >= 0 && i < words)
+  {
+    v = row[i] >> bs;
+  }
+  if (bs != 0 && i + 1 < words)
+  {
+    v |= row[i + 1] << (Bits - bs);
+  }
+  return v;
+}
+
+void CheckProbability(double p, const char* name)
+{
+  if (!(p >= 0.0 && p <= 1.0))
+  {
+    std::ostringstream message;
+    message << name << " must be a probability in [0, 1], got " << p << ".";
+    throw std::invalid_argument(message.str());
+  }
+}
+
+std::vector<std::uint32_t> MakeThresholds(
+  const ProbabilityField& field, std::size_t planeSize, std::size_t volumeSize, const char* name)
+{
+  std::size_t expected = 0;
+  switch (field.Type)
+  {
+    case ProbabilityField::Kind::Uniform:
+      CheckProbability(field.Value, name);
+      return { ToThreshold(field.Value) };
+    case ProbabilityField::Kind::Plane:
+      expected = planeSize;
+      break;
+    case ProbabilityField::Kind::Volume:
+      expected = volumeSize;
+      break;
+  }
+  if (field.Values.size() != expected)
+  {
+    std::ostringstream message;
+    message << name << ": a " << (field.Type == ProbabilityField::Kind::Plane ? "2-D" : "3-D")
+            << " probability field needs " << expected << " values (the grid's "
+            << (field.Type == ProbabilityField::Kind::Plane ? "nx*ny" : "nx*ny*nz") << "), got "
+            << field.Values.size() << ".";
+    throw std::invalid_argument(message.str());
+  }
+  std::vector<std::uint32_t> thresholds(expected);
+  for (std::size_t i = 0; i < expected; ++i)
+  {
+    const double p = field.Values[i];
+    if (!(p >= 0.0 && p <= 1.0))
+    {
+      std::ostringstream message;
+      message << name << ": value " << p << " at index " << i << " is not a probability in [0, 1].";
+      throw std::invalid_argument(message.str());
+    }
+    thresholds[i] = ToThreshold(p);
+  }
+  return thresholds;
+}
+
+// The random event mask of one word: bits of `candidates` whose cell draws r < p.
+// Uniform fields use the word-at-a-time Bernoulli bits; spatial fields draw one
+// 24-bit number per candidate cell keyed by the cell's linear index.
+struct EventSampler
+{
+  const ProbabilityField* Field;
+  const std::vector<std::uint32_t>* Thresholds;
+  Word Key;
+  int Nx, Ny;
+
+  Word operator()(Word candidates, Word wordIndex, int w, int y, int z) const
+  {
+    if (candidates == 0)
+    {
+      return 0;
+    }
+    const auto& t = *this->Thresholds;
+    if (this->Field->Type == ProbabilityField::Kind::Uniform)
+    {
+      return BernoulliWord(this->Key, wordIndex, t[0]) & candidates;
+    }
+    const std::size_t planeIndex = static_cast<std::size_t>(y) * this->Nx;
+    const std::size_t base = this->Field->Type == ProbabilityField::Kind::Plane
+      ? planeIndex
+      : planeIndex + static_cast<std::size_t>(z) * this->Nx * this->Ny;
+    const std::size_t cellBase = planeIndex + static_cast<std::size_t>(z) * this->Nx * this->Ny;
+    Word events = 0;
+    Word remaining = candidates;
+    while (remaining)
+    {
+      const int b = __builtin_ctzll(remaining);
+      remaining &= remaining - 1;
+      const std::size_t x = static_cast<std::size_t>(w) * Bits + b;
+      const std::uint32_t threshold = t[base + x];
+      if (threshold == 0)
+      {
+        continue;
+      }
+      const std::uint32_t r = static_cast<std::uint32_t>(Hash(this->Key, cellBase + x) >> 40);
+      if (r < threshold)
+      {
+        events |= Word(1) << b;
+      }
+    }
+    return events;
+  }
+};
+} // namespace
+
+CloudAutomaton::CloudAutomaton(const CloudAutomatonParameters& parameters)
+  : Parameters(parameters)
+{
+  this->ValidateAndPrepare();
+  this->InitialState();
+}
+
+void CloudAutomaton::ValidateAndPrepare()
+{
+  const auto& p = this->Parameters;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (p.Dimensions[a] < 1)
+    {
+      std::ostringstream message;
+      message << "Dimensions must be >= 1 cell along every axis, got (" << p.Dimensions[0] << ", "
+              << p.Dimensions[1] << ", " << p.Dimensions[2] << ").";
+      throw std::invalid_argument(message.str());
+    }
+  }
+  const std::size_t nx = p.Dimensions[0], ny = p.Dimensions[1], nz = p.Dimensions[2];
+  const double cells = static_cast<double>(nx) * ny * nz;
+  if (cells > 4.0e9)
+  {
+    std::ostringstream message;
+    message << "Dimensions: " << cells << " cells is more than the limit of 4e9.";
+    throw std::invalid_argument(message.str());
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    if (!std::isfinite(p.Wind[a]) || !std::isfinite(p.Shear[a]) || std::abs(p.Wind[a]) > 1.0e6 ||
+      std::abs(p.Shear[a]) > 1.0e6)
+    {
+      throw std::invalid_argument(
+        "Wind and Shear must be finite and at most 1e6 cells per step in magnitude.");
+    }
+  }
+  if (p.NumberOfThreads < 0)
+  {
+    throw std::invalid_argument("NumberOfThreads must be >= 0 (0: one per hardware thread).");
+  }
+  CheckProbability(p.InitialHumidity, "InitialHumidity");
+  CheckProbability(p.InitialActivation, "InitialActivation");
+  this->ExtinctionThresholds = MakeThresholds(p.Extinction, nx * ny, nx * ny * nz, "Extinction");
+  this->HumidityThresholds =
+    MakeThresholds(p.HumiditySupply, nx * ny, nx * ny * nz, "HumiditySupply");
+  this->ActivationThresholds =
+    MakeThresholds(p.ActivationSupply, nx * ny, nx * ny * nz, "ActivationSupply");
+
+  this->RowWords = static_cast<int>((nx + Bits - 1) / Bits);
+  const int tailBits = static_cast<int>(nx % Bits);
+  this->TailMask = tailBits == 0 ? ~Word(0) : ((Word(1) << tailBits) - 1);
+  this->Threads = ResolveThreads(p.NumberOfThreads);
+  const std::size_t words = static_cast<std::size_t>(this->RowWords) * ny * nz;
+  for (auto* state : { &this->Current, &this->Scratch })
+  {
+    state->Hum.assign(words, 0);
+    state->Act.assign(words, 0);
+    state->Cld.assign(words, 0);
+  }
+}
+
+void CloudAutomaton::InitialState()
+{
+  const auto& p = this->Parameters;
+  const int ny = p.Dimensions[1], nz = p.Dimensions[2], W = this->RowWords;
+  const Word humKey = StreamKey(p.Seed, -1, StreamInitialHumidity);
+  const Word actKey = StreamKey(p.Seed, -1, StreamInitialActivation);
+  const std::uint32_t humThreshold = ToThreshold(p.InitialHumidity);
+  const std::uint32_t actThreshold = ToThreshold(p.InitialActivation);
+  auto& s = this->Current;
+  s.Step = 0;
+  ParallelFor(nz, this->Threads, [&](int z0, int z1) {
+    for (int z = z0; z < z1; ++z)
+    {
+      for (int y = 0; y < ny; ++y)
+      {
+        for (int w = 0; w < W; ++w)
+        {
+          const std::size_t i = (static_cast<std::size_t>(z) * ny + y) * W + w;
+          const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
+          s.Hum[i] = BernoulliWord(humKey, i, humThreshold) & tail;
+          s.Act[i] = BernoulliWord(actKey, i, actThreshold) & tail;
+          s.Cld[i] = 0;
+        }
+      }
+    }
+  });
+}
+
+void CloudAutomaton::Reset()
+{
+  this->InitialState();
+}
+
+void CloudAutomaton::Clear()
+{
+  std::fill(this->Current.Hum.begin(), this->Current.Hum.end(), 0);
+  std::fill(this->Current.Act.begin(), this->Current.Act.end(), 0);
+  std::fill(this->Current.Cld.begin(), this->Current.Cld.end(), 0);
+}
+
+void CloudAutomaton::Step()
+{
+  const auto& p = this->Parameters;
+  const int nx = p.Dimensions[0], ny = p.Dimensions[1], nz = p.Dimensions[2];
+  const int W = this->RowWords;
+  const bool periodic = p.Boundary == CloudBoundary::Periodic;
+  const std::int64_t n = this->Current.Step;
+  const CloudAutomatonState& in = this->Current;
+  CloudAutomatonState& out = this->Scratch;
+
+  const EventSampler humidity{ &p.HumiditySupply, &this->HumidityThresholds,
+    StreamKey(p.Seed, n, StreamHumidity), nx, ny };
+  const EventSampler activation{ &p.ActivationSupply, &this->ActivationThresholds,
+    StreamKey(p.Seed, n, StreamActivation), nx, ny };
+  const EventSampler extinction{ &p.Extinction, &this->ExtinctionThresholds,
+    StreamKey(p.Seed, n, StreamExtinction), nx, ny };
+
+  // Row (y, z) of a field, nullptr outside the grid (open) -- y wraps when periodic.
+  auto row = [&](const std::vector<Word>& field, int y, int z) -> const Word* {
+    if (z < 0 || z >= nz)
+    {
+      return nullptr;
+    }
+    if (y < 0 || y >= ny)
+    {
+      if (!periodic)
+      {
+        return nullptr;
+      }
+      y = Wrap(y, ny);
+    }
+    return field.data() + (static_cast<std::size_t>(z) * ny + y) * W;
+  };
+
+  // The cells whose x +-1, +-2 neighbours wrap around (periodic boundary).
+  std::vector<int> edges;
+  for (const int x : { 0, 1, nx - 2, nx - 1 })
+  {
+    if (x >= 0 && x < nx && std::find(edges.begin(), edges.end(), x) == edges.end())
+    {
+      edges.push_back(x);
+    }
+  }
+
+  // 1. growth and 2. extinction/supply: in -> out.
+  ParallelFor(nz, this->Threads, [&](int z0, int z1) {
+    for (int z = z0; z < z1; ++z)
+    {
+      for (int y = 0; y < ny; ++y)
+      {
+        const Word* act = row(in.Act, y, z);
+        // f_act's neighbourhood (README): y +-1, +-2 and z +1, -1, -2 ...
+        const Word* others[7] = { row(in.Act, y - 1, z), row(in.Act, y + 1, z),
+          row(in.Act, y - 2, z), row(in.Act, y + 2, z), row(in.Act, y, z + 1),
+          row(in.Act, y, z - 1), row(in.Act, y, z - 2) };
+        const std::size_t rowStart = (static_cast<std::size_t>(z) * ny + y) * W;
+        for (int w = 0; w < W; ++w)
+        {
+          const std::size_t i = rowStart + w;
+          const Word a = act[w];
+          const Word prev = w > 0 ? act[w - 1] : 0;
+          const Word next = w + 1 < W ? act[w + 1] : 0;
+          // ... and x +-1, +-2: bit x of (a << d) is cell x - d, of (a >> d) cell x + d.
+          Word f = (a << 1) | (prev >> 63) | (a << 2) | (prev >> 62) | (a >> 1) | (next << 63) |
+            (a >> 2) | (next << 62);
+          if (periodic)
+          {
+            // Wrap-around in x: cells x < 2 see x - d from the far end, cells x >= nx - 2
+            // see x + d from the start (the shifts above read 0 there).
+            for (const int x : edges)
+            {
+              if (x / Bits != w)
+              {
+                continue;
+              }
+              bool any = false;
+              for (int d = 1; d <= 2; ++d)
+              {
+                any = any || (x - d < 0 && GetBit(act, Wrap(x - d, nx))) ||
+                  (x + d >= nx && GetBit(act, Wrap(x + d, nx)));
+              }
+              if (any)
+              {
+                f |= Word(1) << (x % Bits);
+              }
+            }
+          }
+          for (const Word* other : others)
+          {
+            if (other)
+            {
+              f |= other[w];
+            }
+          }
+          const Word h = in.Hum[i];
+          const Word c = in.Cld[i];
+          // 002 §3 (README): growth.
+          Word hum = h & ~a;
+          Word cld = c | a;
+          Word newAct = ~a & h & f;
+          // Extinction and supply.
+          const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
+          cld &= ~extinction(cld & tail, i, w, y, z);
+          hum |= humidity(~hum & tail, i, w, y, z);
+          newAct |= activation(~newAct & tail, i, w, y, z);
+          out.Hum[i] = hum & tail;
+          out.Act[i] = newAct & tail;
+          out.Cld[i] = cld & tail;
+        }
+      }
+    }
+  });
+
+  // 3. wind: out -> in (shifted), or just swap when no layer moves this step.
+  bool anyShift = false;
+  for (int z = 0; z < nz && !anyShift; ++z)
+  {
+    anyShift = WindShift(p.Wind[0] + z * p.Shear[0], n) != 0 ||
+      WindShift(p.Wind[1] + z * p.Shear[1], n) != 0;
+  }
+  if (!anyShift)
+  {
+    std::swap(this->Current.Hum, this->Scratch.Hum);
+    std::swap(this->Current.Act, this->Scratch.Act);
+    std::swap(this->Current.Cld, this->Scratch.Cld);
+  }
+  else
+  {
+    CloudAutomatonState& dst = this->Current;
+    const CloudAutomatonState& src = this->Scratch;
+    ParallelFor(nz, this->Threads, [&](int z0, int z1) {
+      for (int z = z0; z < z1; ++z)
+      {
+        const long long sx = WindShift(p.Wind[0] + z * p.Shear[0], n);
+        const long long sy = WindShift(p.Wind[1] + z * p.Shear[1], n);
+        long long up = 0, down = 0; // shifts towards +x and -x combined by OR
+        bool useUp = false, useDown = false;
+        if (periodic)
+        {
+          const int s = Wrap(sx, nx);
+          up = s;
+          down = nx - s;
+          useUp = true;
+          useDown = s != 0;
+        }
+        else if (sx >= 0)
+        {
+          up = sx;
+          useUp = true;
+        }
+        else
+        {
+          down = -sx;
+          useDown = true;
+        }
+        for (int y = 0; y < ny; ++y)
+        {
+          long long sourceY = y - sy;
+          const bool inside = sourceY >= 0 && sourceY < ny;
+          if (!inside && !periodic)
+          {
+            sourceY = -1;
+          }
+          else if (!inside)
+          {
+            sourceY = Wrap(sourceY, ny);
+          }
+          const std::size_t dstStart = (static_cast<std::size_t>(z) * ny + y) * W;
+          for (int f = 0; f < 3; ++f)
+          {
+            const std::vector<Word>& from = f == 0 ? src.Hum : (f == 1 ? src.Act : src.Cld);
+            std::vector<Word>& to = f == 0 ? dst.Hum : (f == 1 ? dst.Act : dst.Cld);
+            if (sourceY < 0)
+            {
+              std::fill_n(to.begin() + static_cast<std::ptrdiff_t>(dstStart), W, Word(0));
+              continue;
+            }
+            const Word* source = from.data() + (static_cast<std::size_t>(z) * ny + sourceY) * W;
+            for (int w = 0; w < W; ++w)
+            {
+              Word v = 0;
+              if (useUp)
+              {
+                v |= ShiftedUp(source, W, w, up);
+              }
+              if (useDown)
+              {
+                v |= ShiftedDown(source, W, w, down);
+              }
+              to[dstStart + w] = v & ((w == W - 1) ? this->TailMask : ~Word(0));
+            }
+          }
+        }
+      }
+    });
+  }
+  this->Current.Step = n + 1;
+}
+
+bool CloudAutomaton::StepTo(std::int64_t step, const std::function<bool(double)>& progress)
+{
+  if (step < this->Current.Step)
+  {
+    std::ostringstream message;
+    message << "StepTo(" << step << "): the automaton is already at step " << this->Current.Step
+            << " and cannot go back; restore an earlier state with SetState or Reset.";
+    throw std::invalid_argument(message.str());
+  }
+  const std::int64_t first = this->Current.Step;
+  while (this->Current.Step < step)
+  {
+    if (progress &&
+      !progress(
+        static_cast<double>(this->Current.Step - first) / static_cast<double>(step - first)))
+    {
+      return false;
+    }
+    this->Step();
+  }
+  return true;
+}
+
+void CloudAutomaton::SetState(const CloudAutomatonState& state)
+{
+  const std::size_t words = this->Current.Hum.size();
+  if (state.Hum.size() != words || state.Act.size() != words || state.Cld.size() != words ||
+    state.Step < 0)
+  {
+    throw std::invalid_argument(
+      "SetState: the state comes from an automaton of another size (or has a negative step).");
+  }
+  this->Current = state;
+}
+
+std::vector<std::uint64_t>& CloudAutomaton::Data(Field field)
+{
+  return field == Field::Hum ? this->Current.Hum
+                             : (field == Field::Act ? this->Current.Act : this->Current.Cld);
+}
+
+const std::vector<std::uint64_t>& CloudAutomaton::Data(Field field) const
+{
+  return field == Field::Hum ? this->Current.Hum
+                             : (field == Field::Act ? this->Current.Act : this->Current.Cld);
+}
+
+bool CloudAutomaton::Get(Field field, int x, int y, int z) const
+{
+  const int* d = this->Parameters.Dimensions;
+  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2])
+  {
+    throw std::out_of_range("CloudAutomaton::Get: cell outside the grid.");
+  }
+  const std::size_t i = (static_cast<std::size_t>(z) * d[1] + y) * this->RowWords + x / Bits;
+  return (this->Data(field)[i] >> (x % Bits)) & 1u;
+}
+
+void CloudAutomaton::Set(Field field, int x, int y, int z, bool value)
+{
+  const int* d = this->Parameters.Dimensions;
+  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2])
+  {
+    throw std::out_of_range("CloudAutomaton::Set: cell outside the grid.");
+  }
+  const std::size_t i = (static_cast<std::size_t>(z) * d[1] + y) * this->RowWords + x / Bits;
+  const Word bit = Word(1) << (x % Bits);
+  auto& data = this->Data(field);
+  data[i] = value ? (data[i] | bit) : (data[i] & ~bit);
+}
+
+std::size_t CloudAutomaton::Count(Field field) const
+{
+  std::size_t count = 0;
+  for (const Word word : this->Data(field))
+  {
+    count += static_cast<std::size_t>(__builtin_popcountll(word));
+  }
+  return count;
+}
+
+void SmoothCloud(const CloudAutomaton& automaton, const CloudSmoothingParameters& smoothing,
+  std::vector<float>& density)
+{
+  SmoothCloud(automaton.GetParameters(), automaton.GetState(), smoothing, density);
+}
+
+void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomatonState& state,
+  const CloudSmoothingParameters& smoothing, std::vector<float>& density)
+{
+  const int nx = parameters.Dimensions[0], ny = parameters.Dimensions[1],
+            nz = parameters.Dimensions[2];
+  const int W = (nx + Bits - 1) / Bits;
+  const std::size_t plane = static_cast<std::size_t>(nx) * ny;
+  const std::size_t count = plane * nz;
+  if (state.Cld.size() != static_cast<std::size_t>(W) * ny * nz)
+  {
+    throw std::invalid_argument("SmoothCloud: the state does not match the parameters' grid.");
+  }
+  if (!std::isfinite(smoothing.Radius) || smoothing.Radius < 0.0 || smoothing.Radius > 64.0)
+  {
+    throw std::invalid_argument("SmoothCloud: Radius must be in [0, 64] cells.");
+  }
+  const bool periodic = parameters.Boundary == CloudBoundary::Periodic;
+  const int threads = ResolveThreads(smoothing.NumberOfThreads);
+
+  // Kernel taps d = -K..K with |d| < R, w(d) = Wyvill falloff (004 §4), sum 1.
+  const double R = std::max(1.0, smoothing.Radius);
+  const int K = static_cast<int>(std::ceil(R)) - 1;
+  std::vector<float> weights(static_cast<std::size_t>(2 * K + 1));
+  double sum = 0.0;
+  for (int d = -K; d <= K; ++d)
+  {
+    sum += WyvillFalloff(static_cast<double>(d) * d, R * R);
+  }
+  for (int d = -K; d <= K; ++d)
+  {
+    weights[d + K] = static_cast<float>(WyvillFalloff(static_cast<double>(d) * d, R * R) / sum);
+  }
+
+  density.assign(count, 0.0f);
+  std::vector<float> scratch(count);
+  // Bits -> 0/1 floats, into `density`.
+  ParallelFor(nz, threads, [&](int z0, int z1) {
+    for (int z = z0; z < z1; ++z)
+    {
+      for (int y = 0; y < ny; ++y)
+      {
+        const Word* row = state.Cld.data() + (static_cast<std::size_t>(z) * ny + y) * W;
+        float* out = density.data() + plane * z + static_cast<std::size_t>(nx) * y;
+        for (int x = 0; x < nx; ++x)
+        {
+          out[x] = GetBit(row, x) ? 1.0f : 0.0f;
+        }
+      }
+    }
+  });
+  if (K == 0)
+  {
+    return;
+  }
+  // One separable pass along `axis` from `src` into `dst`. Along y and z whole rows are
+  // combined (contiguous, vectorisable); along x the interior skips the boundary tests.
+  auto pass = [&](const std::vector<float>& src, std::vector<float>& dst, int axis) {
+    const int n = parameters.Dimensions[axis];
+    const bool wraps = periodic && axis < 2;
+    ParallelFor(nz, threads, [&](int z0, int z1) {
+      for (int z = z0; z < z1; ++z)
+      {
+        for (int y = 0; y < ny; ++y)
+        {
+          const std::size_t rowStart = plane * z + static_cast<std::size_t>(nx) * y;
+          float* out = dst.data() + rowStart;
+          if (axis == 0)
+          {
+            const float* in = src.data() + rowStart;
+            for (int x = 0; x < nx; ++x)
+            {
+              float value = 0.0f;
+              if (x >= K && x + K < nx)
+              {
+                for (int d = -K; d <= K; ++d)
+                {
+                  value += weights[d + K] * in[x + d];
+                }
+              }
+              else
+              {
+                for (int d = -K; d <= K; ++d)
+                {
+                  int j = x + d;
+                  if (j < 0 || j >= n)
+                  {
+                    if (!wraps)
+                    {
+                      continue;
+                    }
+                    j = Wrap(j, n);
+                  }
+                  value += weights[d + K] * in[j];
+                }
+              }
+              out[x] = value;
+            }
+            continue;
+          }
+          std::fill(out, out + nx, 0.0f);
+          const int c = axis == 1 ? y : z;
+          for (int d = -K; d <= K; ++d)
+          {
+            int j = c + d;
+            if (j < 0 || j >= n)
+            {
+              if (!wraps)
+              {
+                continue;
+              }
+              j = Wrap(j, n);
+            }
+            const float* in = src.data() +
+              (axis == 1 ? plane * z + static_cast<std::size_t>(nx) * j
+                         : plane * j + static_cast<std::size_t>(nx) * y);
+            const float w = weights[d + K];
+            for (int x = 0; x < nx; ++x)
+            {
+              out[x] += w * in[x];
+            }
+          }
+        }
+      }
+    });
+  };
+  pass(density, scratch, 0);
+  pass(scratch, density, 1);
+  pass(density, scratch, 2);
+  density.swap(scratch);
+}
+
+void InterpolateDensity(
+  const std::vector<float>& a, const std::vector<float>& b, double t, std::vector<float>& out)
+{
+  if (a.size() != b.size())
+  {
+    throw std::invalid_argument("InterpolateDensity: the two densities differ in size.");
+  }
+  if (!(t >= 0.0 && t <= 1.0))
+  {
+    throw std::invalid_argument("InterpolateDensity: t must be in [0, 1].");
+  }
+  out.resize(a.size());
+  const float s = static_cast<float>(t);
+  for (std::size_t i = 0; i < a.size(); ++i)
+  {
+    out[i] = a[i] + s * (b[i] - a[i]);
+  }
+}
+
+} // namespace nimbus

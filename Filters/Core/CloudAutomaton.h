@@ -1,0 +1,187 @@
+// Cloud cellular automaton (002 §3; Dobashi et al., SIGGRAPH 2000). The rules the
+// extracted text of 002 lost are written out in shared/papers/README.md.
+//
+// Three boolean fields live on an nx x ny x nz grid of cells (x fastest, z up):
+//   hum  water vapour,  act  phase-transition factor,  cld  cloud.
+// One step n -> n+1 is, in this order:
+//   1. growth (002 §3, README):
+//        hum' = hum AND NOT act
+//        cld' = cld OR act
+//        act' = NOT act AND hum AND f_act
+//      f_act(x,y,z) is true when act is set in any of the cells at offsets
+//      (+-1,0,0), (+-2,0,0), (0,+-1,0), (0,+-2,0), (0,0,+1), (0,0,-1), (0,0,-2)
+//      (evaluated on the state before the step);
+//   2. extinction and supply, with per-cell probabilities:
+//        cld' = cld' AND NOT (rnd < p_ext),  hum' = hum' OR (rnd < p_hum),
+//        act' = act' OR (rnd < p_act);
+//   3. wind: every field moves by the whole-cell shift of step n along x and y
+//      (see WindShift: fractional winds accumulate exactly, shear makes the wind
+//      grow with height).
+//
+// Bit-packed: 64 cells per std::uint64_t along x, rows padded to whole words (the
+// padding bits are always 0). Steps are multithreaded over z slabs.
+//
+// Determinism: every random number is a counter-based hash of (seed, step,
+// stream, cell or word index), so a state depends only on the parameters, the
+// seed and the step number -- not on the number of threads, nor on how the steps
+// were split between calls. Checkpoints (State) can be taken and restored.
+//
+// Units: lengths in cells, time in steps, wind in cells per step, shear in cells
+// per step per cell of height; probabilities are per cell and per step.
+#ifndef NimbusCloudAutomaton_h
+#define NimbusCloudAutomaton_h
+
+#include "NimbusFiltersModule.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace nimbus
+{
+
+/// A per-cell probability: one value everywhere, a 2-D map over (x, y) applied to
+/// every height, or a full 3-D field. Values must lie in [0, 1].
+struct ProbabilityField
+{
+  enum class Kind
+  {
+    Uniform, // Value everywhere
+    Plane,   // Values[x + nx * y], the same at every z
+    Volume   // Values[x + nx * (y + ny * z)]
+  };
+  Kind Type = Kind::Uniform;
+  double Value = 0.0;
+  std::vector<float> Values;
+
+  static ProbabilityField Uniform(double value);
+  static ProbabilityField Plane(std::vector<float> values);
+  static ProbabilityField Volume(std::vector<float> values);
+};
+
+/// How the automaton treats the x and y faces of the grid. z is always open:
+/// nothing is above the top layer or below the bottom one.
+enum class CloudBoundary
+{
+  Open,    // outside cells are empty; wind carries empty cells in
+  Periodic // the grid wraps around in x and y
+};
+
+struct CloudAutomatonParameters
+{
+  int Dimensions[3] = { 64, 64, 16 }; // cells along x, y, z (each >= 1)
+  std::uint64_t Seed = 1;
+  ProbabilityField Extinction = ProbabilityField::Uniform(0.1);          // p_ext
+  ProbabilityField HumiditySupply = ProbabilityField::Uniform(0.001);    // p_hum
+  ProbabilityField ActivationSupply = ProbabilityField::Uniform(0.0005); // p_act
+  /// Probabilities of hum and act at step 0 (cld starts empty).
+  double InitialHumidity = 0.3;
+  double InitialActivation = 0.001;
+  /// Wind at the bottom layer (z = 0), cells per step, and its growth per layer of
+  /// height: the wind of layer z is Wind + z * Shear.
+  double Wind[2] = { 0.0, 0.0 };
+  double Shear[2] = { 0.0, 0.0 };
+  CloudBoundary Boundary = CloudBoundary::Periodic;
+  /// Worker threads; 0 = std::thread::hardware_concurrency(). Results do not depend on it.
+  int NumberOfThreads = 0;
+};
+
+/// The whole automaton state at one step (a checkpoint).
+struct CloudAutomatonState
+{
+  std::int64_t Step = 0;
+  std::vector<std::uint64_t> Hum, Act, Cld;
+};
+
+/// Whole-cell shift of step n for a wind of `cellsPerStep`: floor(v (n+1)) - floor(v n),
+/// so the shifts of steps 0..n-1 add up to floor(v n) -- a fractional wind moves
+/// the field on average v cells per step, with no rounding drift.
+NIMBUSFILTERS_EXPORT std::int64_t WindShift(double cellsPerStep, std::int64_t step);
+
+class NIMBUSFILTERS_EXPORT CloudAutomaton
+{
+public:
+  enum class Field
+  {
+    Hum,
+    Act,
+    Cld
+  };
+
+  /// Validates the parameters (throws std::invalid_argument with a message naming
+  /// the parameter) and sets up step 0.
+  explicit CloudAutomaton(const CloudAutomatonParameters& parameters);
+
+  const CloudAutomatonParameters& GetParameters() const { return this->Parameters; }
+  std::int64_t GetStep() const { return this->Current.Step; }
+
+  /// Back to the seeded initial state of step 0.
+  void Reset();
+
+  /// Advances one step.
+  void Step();
+
+  /// Advances to `step` (>= GetStep()). `progress(fraction)` is called between
+  /// steps; returning false stops early (GetStep() tells where). Returns true when
+  /// `step` was reached.
+  bool StepTo(std::int64_t step, const std::function<bool(double)>& progress = nullptr);
+
+  const CloudAutomatonState& GetState() const { return this->Current; }
+  /// Restores a state taken from an automaton with the same parameters (sizes checked).
+  void SetState(const CloudAutomatonState& state);
+
+  bool Get(Field field, int x, int y, int z) const;
+  void Set(Field field, int x, int y, int z, bool value);
+  /// Clears all three fields (for hand-built test states).
+  void Clear();
+  std::size_t Count(Field field) const;
+
+  int WordsPerRow() const { return this->RowWords; }
+
+private:
+  void ValidateAndPrepare();
+  void InitialState();
+  std::vector<std::uint64_t>& Data(Field field);
+  const std::vector<std::uint64_t>& Data(Field field) const;
+
+  CloudAutomatonParameters Parameters;
+  int RowWords = 1;
+  std::uint64_t TailMask = ~std::uint64_t(0);
+  int Threads = 1;
+  // Probability thresholds on a 24-bit uniform integer: event when r < threshold.
+  std::vector<std::uint32_t> ExtinctionThresholds, HumidityThresholds, ActivationThresholds;
+  CloudAutomatonState Current;
+  CloudAutomatonState Scratch;
+};
+
+/// Options of the smoothing of cld into a continuous density.
+struct CloudSmoothingParameters
+{
+  /// Kernel radius in cells: the separable product kernel
+  /// w(dx) w(dy) w(dz), w(d) = WyvillFalloff(d^2, R^2) (004 §4's degree-6 field),
+  /// normalised to sum 1. R <= 1 means no smoothing.
+  double Radius = 2.5;
+  int NumberOfThreads = 0;
+};
+
+/// Density in [0, 1]: the cld field smoothed by the kernel above (002 §3, README:
+/// "the boolean cld field smoothed over a small 3-D neighbourhood with a smooth
+/// kernel"). x/y boundaries follow the automaton's, z is open. `density` is
+/// resized to nx*ny*nz (x fastest).
+NIMBUSFILTERS_EXPORT void SmoothCloud(const CloudAutomaton& automaton,
+  const CloudSmoothingParameters& smoothing, std::vector<float>& density);
+
+/// Same, for a stored state of an automaton with these parameters.
+NIMBUSFILTERS_EXPORT void SmoothCloud(const CloudAutomatonParameters& parameters,
+  const CloudAutomatonState& state, const CloudSmoothingParameters& smoothing,
+  std::vector<float>& density);
+
+/// Linear interpolation in time between the densities of two consecutive steps:
+/// out = (1 - t) a + t b, t in [0, 1] (002 §3: no flicker between steps).
+NIMBUSFILTERS_EXPORT void InterpolateDensity(
+  const std::vector<float>& a, const std::vector<float>& b, double t, std::vector<float>& out);
+
+} // namespace nimbus
+
+#endif

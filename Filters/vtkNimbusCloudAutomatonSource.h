@@ -1,0 +1,181 @@
+/**
+ * @class   vtkNimbusCloudAutomatonSource
+ * @brief   Animated cloud density from the cloud cellular automaton (002 §3).
+ *
+ * Runs the three-field (hum/act/cld) cellular automaton of Dobashi et al. (see
+ * Filters/Core/CloudAutomaton.h and shared/papers/README.md for the rules) on a grid of
+ * Dimensions cells covering Bounds, and outputs vtkImageData with a float point array
+ * "density" in [0, 1]: the cld field smoothed by a degree-6 kernel of SmoothingRadius cells
+ * and interpolated linearly in time between automaton steps.
+ *
+ * Time: one automaton step lasts StepDuration seconds. The source advertises TIME_STEPS
+ * 0, dt, ..., NumberOfTimeSteps dt and TIME_RANGE, so ParaView's animation steps through
+ * it. A requested time t is computed from the nearest cached state at or before step
+ * floor(t / dt): the source keeps checkpoints every CheckpointInterval steps (at most
+ * MaximumNumberOfCheckpoints) and the last smoothed densities, so stepping forward costs
+ * one automaton step and jumping back costs at most CheckpointInterval steps. The output
+ * for a given time depends only on the parameters, the input and Seed -- never on the
+ * order times were requested.
+ *
+ * Optional input (port 0): vtkImageData whose point arrays "p_ext", "p_hum", "p_act"
+ * (one component, values in [0, 1]) replace the scalar ExtinctionProbability,
+ * HumidityProbability, ActivationProbability per cell. The input must have the source's
+ * Dimensions (a 3-D field) or Dimensions[0] x Dimensions[1] x 1 (a 2-D map used at every
+ * height). Its geometry is ignored; cell (i, j, k) of the automaton is point (i, j, k).
+ *
+ * Units: Bounds in metres; Wind in m/s (x, y) at the bottom of the grid, Shear in
+ * (m/s) per metre of height; StepDuration in seconds; probabilities per cell per step.
+ * The field data holds "AutomatonStep" (the fractional step shown).
+ */
+#ifndef vtkNimbusCloudAutomatonSource_h
+#define vtkNimbusCloudAutomatonSource_h
+
+#include "NimbusFiltersModule.h" // for export macro
+#include "vtkImageAlgorithm.h"
+
+#include <memory> // for std::unique_ptr
+
+class NIMBUSFILTERS_EXPORT vtkNimbusCloudAutomatonSource : public vtkImageAlgorithm
+{
+public:
+  static vtkNimbusCloudAutomatonSource* New();
+  vtkTypeMacro(vtkNimbusCloudAutomatonSource, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Number of cells (= output points) along x, y, z, each >= 1. Default 128 x 128 x 32.
+  vtkSetVector3Macro(Dimensions, int);
+  vtkGetVector3Macro(Dimensions, int);
+  ///@}
+
+  ///@{
+  /// Region covered by the grid (xmin, xmax, ymin, ymax, zmin, zmax), metres, z up.
+  /// Default (-6400, 6400, -6400, 6400, 1000, 2600).
+  vtkSetVector6Macro(Bounds, double);
+  vtkGetVector6Macro(Bounds, double);
+  ///@}
+
+  ///@{
+  /// Seed of every random draw. Default 1.
+  vtkSetMacro(Seed, int);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /// Per-step probabilities used where the input has no array: cloud extinction p_ext,
+  /// vapour supply p_hum, activation supply p_act (002 §3). Defaults 0.05, 0.002, 0.0002.
+  vtkSetClampMacro(ExtinctionProbability, double, 0.0, 1.0);
+  vtkGetMacro(ExtinctionProbability, double);
+  vtkSetClampMacro(HumidityProbability, double, 0.0, 1.0);
+  vtkGetMacro(HumidityProbability, double);
+  vtkSetClampMacro(ActivationProbability, double, 0.0, 1.0);
+  vtkGetMacro(ActivationProbability, double);
+  ///@}
+
+  ///@{
+  /// Probabilities of hum and act in each cell at time 0 (cld starts empty).
+  /// Defaults 0.3 and 0.001.
+  vtkSetClampMacro(InitialHumidity, double, 0.0, 1.0);
+  vtkGetMacro(InitialHumidity, double);
+  vtkSetClampMacro(InitialActivation, double, 0.0, 1.0);
+  vtkGetMacro(InitialActivation, double);
+  ///@}
+
+  ///@{
+  /// Wind (m/s, x and y) at the bottom of the grid, and its increase per metre of height
+  /// ((m/s)/m). The fields move by whole cells; fractional motion accumulates exactly.
+  /// Defaults (0, 0) and (0, 0).
+  vtkSetVector2Macro(Wind, double);
+  vtkGetVector2Macro(Wind, double);
+  vtkSetVector2Macro(Shear, double);
+  vtkGetVector2Macro(Shear, double);
+  ///@}
+
+  ///@{
+  /// On: the grid wraps around in x and y (clouds blown out come back in). Off: open
+  /// faces, clear air blows in. z is always open. Default on.
+  vtkSetMacro(PeriodicBoundary, bool);
+  vtkGetMacro(PeriodicBoundary, bool);
+  vtkBooleanMacro(PeriodicBoundary, bool);
+  ///@}
+
+  ///@{
+  /// Seconds per automaton step (> 0) and number of steps advertised as TIME_STEPS
+  /// (>= 0). Defaults 1 and 100.
+  vtkSetMacro(StepDuration, double);
+  vtkGetMacro(StepDuration, double);
+  vtkSetClampMacro(NumberOfTimeSteps, int, 0, 1000000);
+  vtkGetMacro(NumberOfTimeSteps, int);
+  ///@}
+
+  ///@{
+  /// Radius (cells) of the smoothing kernel; <= 1 gives the raw 0/1 cld field. Default 2.5.
+  vtkSetClampMacro(SmoothingRadius, double, 0.0, 16.0);
+  vtkGetMacro(SmoothingRadius, double);
+  ///@}
+
+  ///@{
+  /// Interpolate linearly between the two steps around the requested time (on), or show
+  /// the step at or before it (off). Default on.
+  vtkSetMacro(InterpolateInTime, bool);
+  vtkGetMacro(InterpolateInTime, bool);
+  vtkBooleanMacro(InterpolateInTime, bool);
+  ///@}
+
+  ///@{
+  /// Worker threads of the automaton and smoothing (0: one per hardware thread). The
+  /// result does not depend on it. Default 0.
+  vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
+  vtkGetMacro(NumberOfThreads, int);
+  ///@}
+
+  ///@{
+  /// Checkpoints: a copy of the state every CheckpointInterval steps, at most
+  /// MaximumNumberOfCheckpoints kept (step 0 is always recomputable). Defaults 10 and 16.
+  vtkSetClampMacro(CheckpointInterval, int, 1, 1000000);
+  vtkGetMacro(CheckpointInterval, int);
+  vtkSetClampMacro(MaximumNumberOfCheckpoints, int, 0, 100000);
+  vtkGetMacro(MaximumNumberOfCheckpoints, int);
+  ///@}
+
+  /// Automaton steps run since the cache was last reset (for tests and timings).
+  vtkGetMacro(NumberOfStepsComputed, vtkIdType);
+
+protected:
+  vtkNimbusCloudAutomatonSource();
+  ~vtkNimbusCloudAutomatonSource() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  int Dimensions[3];
+  double Bounds[6];
+  int Seed;
+  double ExtinctionProbability;
+  double HumidityProbability;
+  double ActivationProbability;
+  double InitialHumidity;
+  double InitialActivation;
+  double Wind[2];
+  double Shear[2];
+  bool PeriodicBoundary;
+  double StepDuration;
+  int NumberOfTimeSteps;
+  double SmoothingRadius;
+  bool InterpolateInTime;
+  int NumberOfThreads;
+  int CheckpointInterval;
+  int MaximumNumberOfCheckpoints;
+  vtkIdType NumberOfStepsComputed;
+
+private:
+  vtkNimbusCloudAutomatonSource(const vtkNimbusCloudAutomatonSource&) = delete;
+  void operator=(const vtkNimbusCloudAutomatonSource&) = delete;
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
+};
+
+#endif

@@ -1,0 +1,152 @@
+/**
+ * @class   vtkNimbusImageCloudFilter
+ * @brief   3-D cloud density from a 2-D image, e.g. a satellite picture (002 §3).
+ *
+ * Input: a 2-D vtkImageData (one slice, nx x ny x 1), its active point scalars (or the
+ * array chosen with SetInputArrayToProcess) read as intensity; RGB(A) images use the
+ * luminance 0.2126 R + 0.7152 G + 0.0722 B. Intensities are normalised with IntensityRange
+ * (default 0..255, for 8-bit images), then mapped to optical depth tau
+ * (Filters/Core/ImageClouds.h, OpticalDepthMapping):
+ *   u = clamp((I - ClearIntensity) / (WhiteIntensity - ClearIntensity), 0, 1)
+ *   Linear (MappingType 0):    tau = MaximumOpticalDepth * u^Gamma
+ *   TwoStream (MappingType 1): tau = min(MaximumOpticalDepth, 2 u / ((1 - g)(1 - u))),
+ *     the inverse of a non-absorbing cloud's two-stream reflectance.
+ * Columns of metaballs (Wyvill's degree-6 field, 004 §4) stand on a flat base at BaseHeight,
+ * as tall as tau / (ExtinctionCoefficient * NominalDensity), with rough top balls; their
+ * densities are fitted so that each column's optical depth
+ * ExtinctionCoefficient * sum(density dz) matches tau (measured: within 5 % inside uniform
+ * regions, see Testing/Cxx/TestImageClouds.cxx).
+ *
+ * Output port 0: vtkImageData, one point per pixel in x and y (PixelSize metres apart,
+ * centred on x = y = 0), VerticalSpacing metres in z, float point array "density"
+ * (dimensionless; a renderer's extinction is ExtinctionCoefficient * density, 1/m).
+ * Output port 1: the 2-D map at z = BaseHeight with "optical_depth" (the image's target
+ * tau) and "column_optical_depth" (the achieved tau of the density).
+ */
+#ifndef vtkNimbusImageCloudFilter_h
+#define vtkNimbusImageCloudFilter_h
+
+#include "NimbusFiltersModule.h" // for export macro
+#include "vtkImageAlgorithm.h"
+
+class vtkImageData;
+
+class NIMBUSFILTERS_EXPORT vtkNimbusImageCloudFilter : public vtkImageAlgorithm
+{
+public:
+  static vtkNimbusImageCloudFilter* New();
+  vtkTypeMacro(vtkNimbusImageCloudFilter, vtkImageAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum MappingTypes
+  {
+    LINEAR = 0,
+    TWO_STREAM = 1
+  };
+
+  ///@{
+  /// Raw intensities mapped to 0 and 1 before the mapping. Default (0, 255).
+  vtkSetVector2Macro(IntensityRange, double);
+  vtkGetVector2Macro(IntensityRange, double);
+  ///@}
+
+  ///@{
+  /// Intensity -> optical depth mapping (see the class description). Defaults: Linear,
+  /// ClearIntensity 0.1, WhiteIntensity 1, Gamma 1, MaximumOpticalDepth 30,
+  /// AsymmetryParameter 0.85.
+  vtkSetClampMacro(MappingType, int, LINEAR, TWO_STREAM);
+  vtkGetMacro(MappingType, int);
+  void SetMappingTypeToLinear() { this->SetMappingType(LINEAR); }
+  void SetMappingTypeToTwoStream() { this->SetMappingType(TWO_STREAM); }
+  vtkSetMacro(ClearIntensity, double);
+  vtkGetMacro(ClearIntensity, double);
+  vtkSetMacro(WhiteIntensity, double);
+  vtkGetMacro(WhiteIntensity, double);
+  vtkSetClampMacro(Gamma, double, 0.01, 100.0);
+  vtkGetMacro(Gamma, double);
+  vtkSetClampMacro(MaximumOpticalDepth, double, 0.0, 1000.0);
+  vtkGetMacro(MaximumOpticalDepth, double);
+  vtkSetClampMacro(AsymmetryParameter, double, 0.0, 0.99);
+  vtkGetMacro(AsymmetryParameter, double);
+  ///@}
+
+  ///@{
+  /// Grid: metres per pixel (x, y) and between layers (z). Defaults 100 and 50.
+  vtkSetMacro(PixelSize, double);
+  vtkGetMacro(PixelSize, double);
+  vtkSetMacro(VerticalSpacing, double);
+  vtkGetMacro(VerticalSpacing, double);
+  ///@}
+
+  ///@{
+  /// Extinction coefficient per unit density (1/m) and the density of the cloud body:
+  /// a column of optical depth tau is about tau / (ExtinctionCoefficient * NominalDensity)
+  /// metres thick. Defaults 0.02 and 1.
+  vtkSetMacro(ExtinctionCoefficient, double);
+  vtkGetMacro(ExtinctionCoefficient, double);
+  vtkSetMacro(NominalDensity, double);
+  vtkGetMacro(NominalDensity, double);
+  ///@}
+
+  ///@{
+  /// Flat base: height (m) and the thickness (m) the density fades in over. Defaults 1000, 50.
+  vtkSetMacro(BaseHeight, double);
+  vtkGetMacro(BaseHeight, double);
+  vtkSetMacro(BaseTransitionThickness, double);
+  vtkGetMacro(BaseTransitionThickness, double);
+  ///@}
+
+  ///@{
+  /// Metaballs: one column every BallSpacing pixels, radius BallRadiusFactor * BallSpacing
+  /// * PixelSize, top balls varied by TopRoughness (0..1), Iterations of density fitting,
+  /// Seed of the jitter. Defaults 2, 3, 0.6, 10, 1.
+  vtkSetClampMacro(BallSpacing, int, 1, 64);
+  vtkGetMacro(BallSpacing, int);
+  vtkSetClampMacro(BallRadiusFactor, double, 0.1, 20.0);
+  vtkGetMacro(BallRadiusFactor, double);
+  vtkSetClampMacro(TopRoughness, double, 0.0, 1.0);
+  vtkGetMacro(TopRoughness, double);
+  vtkSetClampMacro(Iterations, int, 0, 100);
+  vtkGetMacro(Iterations, int);
+  vtkSetMacro(Seed, int);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  /// Port 1's data: target and achieved optical depth maps.
+  vtkImageData* GetOpticalDepthMap();
+
+protected:
+  vtkNimbusImageCloudFilter();
+  ~vtkNimbusImageCloudFilter() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double IntensityRange[2];
+  int MappingType;
+  double ClearIntensity;
+  double WhiteIntensity;
+  double Gamma;
+  double MaximumOpticalDepth;
+  double AsymmetryParameter;
+  double PixelSize;
+  double VerticalSpacing;
+  double ExtinctionCoefficient;
+  double NominalDensity;
+  double BaseHeight;
+  double BaseTransitionThickness;
+  int BallSpacing;
+  double BallRadiusFactor;
+  double TopRoughness;
+  int Iterations;
+  int Seed;
+
+private:
+  vtkNimbusImageCloudFilter(const vtkNimbusImageCloudFilter&) = delete;
+  void operator=(const vtkNimbusImageCloudFilter&) = delete;
+};
+
+#endif

@@ -1,0 +1,334 @@
+// Data tests of vtkNimbusCloudAutomatonSource: time steps advertised, the output equals the
+// core automaton's smoothed field at each step and its linear interpolation between steps,
+// the same bytes whatever order times are requested in, checkpoints are used, probability
+// maps from an input image shape where clouds form, and bad input gives clear errors.
+#include "CloudAutomaton.h"
+#include "vtkNimbusCloudAutomatonSource.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace
+{
+class MessageCatcher
+{
+public:
+  explicit MessageCatcher(vtkObject* object)
+  {
+    this->Callback->SetClientData(this);
+    this->Callback->SetCallback(&MessageCatcher::Catch);
+    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
+    object->AddObserver(vtkCommand::WarningEvent, this->Callback);
+    object->AddObserver(vtkCommand::ProgressEvent, this->Callback);
+  }
+  std::vector<std::string> Errors;
+  int ProgressEvents = 0;
+
+private:
+  static void Catch(vtkObject*, unsigned long event, void* clientData, void* callData)
+  {
+    auto* self = static_cast<MessageCatcher*>(clientData);
+    if (event == vtkCommand::ProgressEvent)
+    {
+      ++self->ProgressEvents;
+      return;
+    }
+    if (event == vtkCommand::ErrorEvent)
+    {
+      self->Errors.emplace_back(callData ? static_cast<const char*>(callData) : "");
+    }
+  }
+  vtkNew<vtkCallbackCommand> Callback;
+};
+
+void Configure(vtkNimbusCloudAutomatonSource* source)
+{
+  source->SetDimensions(40, 36, 12);
+  source->SetBounds(0, 3900, 0, 3500, 1000, 2100); // 100 m cells
+  source->SetSeed(5);
+  source->SetStepDuration(2.0);
+  source->SetNumberOfTimeSteps(60);
+  source->SetWind(30.0, -10.0); // 0.6 and -0.2 cells per step
+  source->SetShear(0.05, 0.0);  // +0.1 cell/step per layer
+  source->SetCheckpointInterval(8);
+}
+
+std::vector<float> DensityAt(vtkNimbusCloudAutomatonSource* source, double time)
+{
+  source->UpdateTimeStep(time);
+  auto* array =
+    vtkFloatArray::SafeDownCast(source->GetOutput()->GetPointData()->GetArray("density"));
+  if (!array)
+  {
+    return {};
+  }
+  return std::vector<float>(
+    array->GetPointer(0), array->GetPointer(0) + array->GetNumberOfTuples());
+}
+
+// The same run through the core, for comparison.
+nimbus::CloudAutomatonParameters CoreParameters()
+{
+  nimbus::CloudAutomatonParameters p;
+  p.Dimensions[0] = 40;
+  p.Dimensions[1] = 36;
+  p.Dimensions[2] = 12;
+  p.Seed = 5;
+  p.Extinction = nimbus::ProbabilityField::Uniform(0.05);
+  p.HumiditySupply = nimbus::ProbabilityField::Uniform(0.002);
+  p.ActivationSupply = nimbus::ProbabilityField::Uniform(0.0002);
+  p.InitialHumidity = 0.3;
+  p.InitialActivation = 0.001;
+  p.Wind[0] = 30.0 * 2.0 / 100.0;
+  p.Wind[1] = -10.0 * 2.0 / 100.0;
+  p.Shear[0] = 0.05 * 100.0 * 2.0 / 100.0;
+  p.Boundary = nimbus::CloudBoundary::Periodic;
+  return p;
+}
+}
+
+TEST(CloudAutomatonSource, AdvertisesTimeStepsAndGeometry)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  source->UpdateInformation();
+  vtkInformation* info = source->GetOutputInformation(0);
+  ASSERT_TRUE(info->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS()));
+  ASSERT_EQ(info->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()), 61);
+  const double* times = info->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  EXPECT_EQ(times[0], 0.0);
+  EXPECT_EQ(times[60], 120.0);
+  EXPECT_EQ(times[7], 14.0);
+  const double* range = info->Get(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  EXPECT_EQ(range[0], 0.0);
+  EXPECT_EQ(range[1], 120.0);
+  source->UpdateTimeStep(0.0);
+  vtkImageData* image = source->GetOutput();
+  int dims[3];
+  image->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 40);
+  EXPECT_EQ(dims[2], 12);
+  double spacing[3];
+  image->GetSpacing(spacing);
+  EXPECT_DOUBLE_EQ(spacing[0], 100.0);
+  EXPECT_DOUBLE_EQ(spacing[2], 100.0);
+}
+
+TEST(CloudAutomatonSource, MatchesTheCoreAtStepsAndInterpolatesBetween)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  source->SetNumberOfThreads(2);
+  nimbus::CloudAutomaton core(CoreParameters());
+  std::vector<float> expected, next, mixed;
+  for (const int step : { 0, 5, 17 })
+  {
+    core.StepTo(step);
+    nimbus::SmoothCloud(core, nimbus::CloudSmoothingParameters(), expected);
+    EXPECT_EQ(DensityAt(source, 2.0 * step), expected) << "step " << step;
+    EXPECT_DOUBLE_EQ(
+      source->GetOutput()->GetFieldData()->GetArray("AutomatonStep")->GetComponent(0, 0), step);
+  }
+  // t = 17.25 steps: a quarter of the way from step 17 to 18.
+  nimbus::CloudAutomaton later(CoreParameters());
+  later.StepTo(18);
+  nimbus::SmoothCloud(later, nimbus::CloudSmoothingParameters(), next);
+  nimbus::InterpolateDensity(expected, next, 0.25, mixed);
+  const std::vector<float> got = DensityAt(source, 2.0 * 17.25);
+  ASSERT_EQ(got.size(), mixed.size());
+  double cloud = 0.0;
+  for (std::size_t i = 0; i < got.size(); ++i)
+  {
+    ASSERT_FLOAT_EQ(got[i], mixed[i]);
+    cloud += got[i];
+  }
+  EXPECT_GT(cloud, 1.0); // there is cloud to compare
+  // InterpolateInTime off: the step at or before the time.
+  source->InterpolateInTimeOff();
+  EXPECT_EQ(DensityAt(source, 2.0 * 17.25), expected);
+}
+
+TEST(CloudAutomatonSource, SameOutputWhateverTheRequestOrder)
+{
+  const double times[] = { 0.0, 33.0, 12.5, 119.0, 47.3, 12.5, 2.0, 120.0, 500.0, -3.0 };
+  // Reference: a fresh source per time (always from step 0).
+  std::vector<std::vector<float>> reference;
+  for (const double t : times)
+  {
+    vtkNew<vtkNimbusCloudAutomatonSource> fresh;
+    Configure(fresh);
+    reference.push_back(DensityAt(fresh, t));
+  }
+  // One source, times in the order above (backwards jumps use checkpoints), then reversed,
+  // with a different number of threads.
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  source->SetNumberOfThreads(1);
+  for (std::size_t i = 0; i < reference.size(); ++i)
+  {
+    EXPECT_EQ(DensityAt(source, times[i]), reference[i]) << "t = " << times[i];
+  }
+  vtkNew<vtkNimbusCloudAutomatonSource> reversed;
+  Configure(reversed);
+  reversed->SetNumberOfThreads(3);
+  for (std::size_t i = reference.size(); i-- > 0;)
+  {
+    EXPECT_EQ(DensityAt(reversed, times[i]), reference[i]) << "t = " << times[i];
+  }
+  // Tiny caches: no checkpoints at all (every backwards jump restarts from step 0), and a
+  // checkpoint every step thinned to 3 (the eviction path), give the same bytes.
+  for (const int maximum : { 0, 3 })
+  {
+    vtkNew<vtkNimbusCloudAutomatonSource> small;
+    Configure(small);
+    small->SetCheckpointInterval(1);
+    small->SetMaximumNumberOfCheckpoints(maximum);
+    for (std::size_t i = 0; i < reference.size(); ++i)
+    {
+      EXPECT_EQ(DensityAt(small, times[i]), reference[i])
+        << "t = " << times[i] << ", at most " << maximum << " checkpoints";
+    }
+  }
+  // Out-of-range times clamp to the advertised range.
+  EXPECT_EQ(reference[8], reference[7]); // 500 s -> 120 s
+  EXPECT_EQ(reference[9], reference[0]); // -3 s -> 0 s
+}
+
+TEST(CloudAutomatonSource, ComputesIncrementallyFromCachedStates)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  MessageCatcher catcher(source);
+  DensityAt(source, 2.0 * 40);
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 40);
+  EXPECT_GT(catcher.ProgressEvents, 10); // progress while stepping
+  DensityAt(source, 2.0 * 41);           // one more step
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 41);
+  DensityAt(source, 2.0 * 41.5); // needs step 42 only
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 42);
+  DensityAt(source, 2.0 * 41.0); // cached
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 42);
+  DensityAt(source, 2.0 * 19); // back: from the checkpoint at 16, 3 steps
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 45);
+  DensityAt(source, 2.0 * 3); // before any checkpoint: from step 0
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 48);
+  // A parameter change resets the cache.
+  source->SetExtinctionProbability(0.1);
+  DensityAt(source, 2.0 * 4);
+  EXPECT_EQ(source->GetNumberOfStepsComputed(), 4);
+  EXPECT_TRUE(catcher.Errors.empty());
+}
+
+TEST(CloudAutomatonSource, InputMapsShapeWhereCloudsForm)
+{
+  // A 2-D map: supply of vapour and activation only in a disc of radius 10 cells; no
+  // vapour at the start. Clouds then stay within the disc plus the smoothing radius.
+  vtkNew<vtkImageData> map;
+  map->SetDimensions(40, 36, 1);
+  vtkNew<vtkFloatArray> pHum, pAct;
+  pHum->SetName("p_hum");
+  pAct->SetName("p_act");
+  for (int y = 0; y < 36; ++y)
+  {
+    for (int x = 0; x < 40; ++x)
+    {
+      const bool inside = std::hypot(x - 20.0, y - 18.0) < 10.0;
+      pHum->InsertNextValue(inside ? 0.05f : 0.0f);
+      pAct->InsertNextValue(inside ? 0.01f : 0.0f);
+    }
+  }
+  map->GetPointData()->AddArray(pHum);
+  map->GetPointData()->AddArray(pAct);
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  source->SetWind(0.0, 0.0);
+  source->SetShear(0.0, 0.0);
+  source->SetInitialHumidity(0.0);
+  source->SetInitialActivation(0.0);
+  source->SetInputData(map);
+  const std::vector<float> density = DensityAt(source, 2.0 * 30);
+  ASSERT_EQ(density.size(), 40u * 36 * 12);
+  double inside = 0.0, outside = 0.0;
+  for (int z = 0; z < 12; ++z)
+    for (int y = 0; y < 36; ++y)
+      for (int x = 0; x < 40; ++x)
+      {
+        const double r = std::hypot(x - 20.0, y - 18.0);
+        const float d = density[x + 40 * (y + 36 * z)];
+        if (r < 8.0)
+          inside += d;
+        else if (r >= 10.0 + 2.0 * std::sqrt(2.0)) // beyond the disc and the kernel's
+                                                   // reach (|dx|, |dy| <= 2)
+          outside += d;
+      }
+  EXPECT_GT(inside, 100.0);
+  EXPECT_EQ(outside, 0.0);
+}
+
+TEST(CloudAutomatonSource, BadInputGivesClearErrors)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  MessageCatcher catcher(source);
+  vtkNew<vtkImageData> wrong;
+  wrong->SetDimensions(10, 10, 1);
+  vtkNew<vtkFloatArray> p;
+  p->SetName("p_ext");
+  p->SetNumberOfTuples(100);
+  p->FillValue(0.1f);
+  wrong->GetPointData()->AddArray(p);
+  source->SetInputData(wrong);
+  EXPECT_TRUE(DensityAt(source, 0.0).empty());
+  ASSERT_EQ(catcher.Errors.size(), 1u);
+  EXPECT_NE(catcher.Errors[0].find("40 x 36"), std::string::npos) << catcher.Errors[0];
+
+  vtkNew<vtkImageData> outOfRange;
+  outOfRange->SetDimensions(40, 36, 1);
+  vtkNew<vtkFloatArray> q;
+  q->SetName("p_act");
+  q->SetNumberOfTuples(40 * 36);
+  q->FillValue(255.0f); // an 8-bit image given as is
+  outOfRange->GetPointData()->AddArray(q);
+  source->SetInputData(outOfRange);
+  EXPECT_TRUE(DensityAt(source, 0.0).empty());
+  ASSERT_EQ(catcher.Errors.size(), 2u);
+  EXPECT_NE(catcher.Errors[1].find("ActivationSupply"), std::string::npos) << catcher.Errors[1];
+  EXPECT_NE(catcher.Errors[1].find("255"), std::string::npos) << catcher.Errors[1];
+
+  source->SetInputData(nullptr);
+  source->SetStepDuration(0.0);
+  source->Update();
+  ASSERT_EQ(catcher.Errors.size(), 3u);
+  EXPECT_NE(catcher.Errors[2].find("StepDuration"), std::string::npos);
+  EXPECT_EQ(source->GetOutput()->GetNumberOfPoints(), 0);
+
+  source->SetStepDuration(1.0);
+  source->SetDimensions(0, 5, 5);
+  source->Update();
+  ASSERT_EQ(catcher.Errors.size(), 4u);
+  EXPECT_NE(catcher.Errors[3].find("Dimensions"), std::string::npos);
+
+  // Extremes run: one cell, probabilities 1.
+  source->SetDimensions(1, 1, 1);
+  source->SetExtinctionProbability(1.0);
+  source->SetHumidityProbability(1.0);
+  source->SetActivationProbability(1.0);
+  const std::vector<float> one = DensityAt(source, 7.5);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_TRUE(std::isfinite(one[0]));
+  EXPECT_EQ(catcher.Errors.size(), 4u);
+}
