@@ -48,7 +48,7 @@
 //    at the observer's horizon (no row straddles it, so no interpolation across
 //    it); above it row s in [0,1] has zenith theta_h (1 - s^3) (rows crowd at the
 //    horizon, where the sky changes fastest: measured better than s^2), below it
-//    theta_h + s^2 (pi - theta_h).
+//    theta_h + s^3 (pi - theta_h).
 //  - aerial perspective (per sun elevation and camera altitude): A_R, A_M, A_I and
 //    the transmittance (rgb) from the camera to distance d, same directions, d sqrt-spaced.
 //
