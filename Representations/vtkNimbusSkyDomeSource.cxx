@@ -9,6 +9,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMath.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
@@ -24,7 +25,25 @@ vtkCxxSetObjectMacro(vtkNimbusSkyDomeSource, Sky, vtkNimbusSky);
 vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
 {
   this->SetNumberOfInputPorts(0);
+  vtkNew<vtkNimbusSky> sky;
+  this->SetSky(sky);
 }
+
+#define NIMBUS_FORWARD(name)                                                                      \
+  void vtkNimbusSkyDomeSource::Set##name(double v)                                                \
+  {                                                                                               \
+    if (this->Sky)                                                                                \
+    {                                                                                             \
+      this->Sky->Set##name(v);                                                                    \
+    }                                                                                             \
+  }
+NIMBUS_FORWARD(SunElevation)
+NIMBUS_FORWARD(SunAzimuth)
+NIMBUS_FORWARD(AerosolDensity)
+NIMBUS_FORWARD(GroundAlbedo)
+NIMBUS_FORWARD(Exposure)
+NIMBUS_FORWARD(ObserverAltitude)
+#undef NIMBUS_FORWARD
 
 vtkNimbusSkyDomeSource::~vtkNimbusSkyDomeSource()
 {
@@ -46,10 +65,14 @@ int vtkNimbusSkyDomeSource::RequestData(
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   vtkNimbusSky* sky = this->Sky;
-  vtkNew<vtkNimbusSky> fallback;
   if (!sky)
   {
-    sky = fallback;
+    vtkErrorMacro("Sky is null: set a vtkNimbusSky");
+    return 0;
+  }
+  if (this->Preset >= 0)
+  {
+    sky->SetPreset(this->Preset);
   }
   const int rings = this->ElevationResolution, columns = this->AzimuthResolution;
   vtkNew<vtkPoints> points;
@@ -124,6 +147,7 @@ void vtkNimbusSkyDomeSource::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Sky: " << this->Sky << "\n";
+  os << indent << "Preset: " << this->Preset << "\n";
   os << indent << "Radius: " << this->Radius << "\n";
   os << indent << "Center: " << this->Center[0] << " " << this->Center[1] << " " << this->Center[2]
      << "\n";

@@ -28,9 +28,27 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
-  /// The sky whose colours are used (an internal default sky when not set).
+  /// The sky whose colours are used (the source starts with its own sky; share
+  /// one with a vtkNimbusSkyPass / cloud mapper by setting it). Null is an error.
   void SetSky(vtkNimbusSky* sky);
   vtkGetObjectMacro(Sky, vtkNimbusSky);
+  ///@}
+
+  ///@{
+  /// Preset applied to the sky at every update (vtkNimbusSky::Presets), or -1
+  /// (custom: the sun angles below). For ParaView's Preset drop-down. Default -1.
+  vtkSetClampMacro(Preset, int, -1, 3);
+  vtkGetMacro(Preset, int);
+  ///@}
+
+  ///@{
+  /// Forwarded to the sky (one place for ParaView's properties).
+  void SetSunElevation(double v);
+  void SetSunAzimuth(double v);
+  void SetAerosolDensity(double v);
+  void SetGroundAlbedo(double v);
+  void SetExposure(double v);
+  void SetObserverAltitude(double v);
   ///@}
 
   ///@{
@@ -64,6 +82,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   vtkNimbusSky* Sky = nullptr;
+  int Preset = -1;
   double Radius = 10000.0;
   double Center[3] = { 0.0, 0.0, 0.0 };
   int ElevationResolution = 32;
