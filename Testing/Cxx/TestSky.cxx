@@ -132,7 +132,7 @@ TEST(Sky, TransmittanceTableInterpolation)
   }
   std::printf("  transmittance table %dx%d: max |dT| = %.2e, max relative d(tau) = %.2e\n",
     model.GetTransmittanceMuSize(), model.GetTransmittanceRSize(), worstT, worstTau);
-  EXPECT_LT(worstT, 2e-3);
+  EXPECT_LT(worstT, 1e-3); // measured 5.8e-4 (grazing rays near the top)
 }
 
 // Single scattering, LUT path (sky-view table of a K = 1 model) against the reference
