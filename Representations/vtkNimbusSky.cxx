@@ -1,0 +1,233 @@
+#include "vtkNimbusSky.h"
+
+#include "Sky.h"
+
+#include "vtkMath.h"
+#include "vtkObjectFactory.h"
+
+#include <cmath>
+#include <stdexcept>
+
+vtkStandardNewMacro(vtkNimbusSky);
+
+struct vtkNimbusSky::Internals
+{
+  std::unique_ptr<nimbus::SkyModel> Model;
+  double ModelAerosol = -1.0, ModelAlbedo = -1.0;
+  int ModelOrders = -1;
+  int ModelGeneration = 0;
+
+  std::unique_ptr<nimbus::SkyViewLut> SkyView;
+  double SkyViewElevation = 0.0, SkyViewAltitude = 0.0;
+  int SkyViewGeneration = -1;
+
+  std::unique_ptr<nimbus::AerialPerspectiveLut> Aerial;
+  double AerialElevation = 0.0, AerialAltitude = 0.0, AerialRange = 0.0;
+  int AerialGeneration = -1;
+};
+
+vtkNimbusSky::vtkNimbusSky()
+  : Internal(new Internals)
+{
+}
+
+vtkNimbusSky::~vtkNimbusSky() = default;
+
+void vtkNimbusSky::SetPreset(int preset)
+{
+  switch (preset)
+  {
+    case Noon:
+      this->SetSunElevation(60.0);
+      this->SetSunAzimuth(180.0);
+      break;
+    case Afternoon:
+      this->SetSunElevation(30.0);
+      this->SetSunAzimuth(240.0);
+      break;
+    case Sunset:
+      this->SetSunElevation(2.0);
+      this->SetSunAzimuth(270.0);
+      break;
+    case Twilight:
+      this->SetSunElevation(-4.0);
+      this->SetSunAzimuth(270.0);
+      break;
+    default:
+      vtkErrorMacro("SetPreset: unknown preset " << preset
+                                                 << " (0 Noon, 1 Afternoon, 2 Sunset, 3 Twilight)");
+  }
+}
+
+void vtkNimbusSky::GetSunDirection(double direction[3])
+{
+  const auto s = nimbus::SunDirectionFromAngles(this->SunElevation, this->SunAzimuth);
+  for (int i = 0; i < 3; ++i)
+  {
+    direction[i] = s[i];
+  }
+}
+
+const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
+{
+  Internals& in = *this->Internal;
+  if (!in.Model || in.ModelAerosol != this->AerosolDensity || in.ModelAlbedo != this->GroundAlbedo ||
+    in.ModelOrders != this->ScatteringOrders)
+  {
+    nimbus::SkyParameters p;
+    p.Atmosphere.mieScattering *= this->AerosolDensity;
+    p.GroundAlbedo = this->GroundAlbedo;
+    p.ScatteringOrders = this->ScatteringOrders;
+    in.SkyView.reset();
+    in.Aerial.reset();
+    in.Model = std::make_unique<nimbus::SkyModel>(p);
+    in.ModelAerosol = this->AerosolDensity;
+    in.ModelAlbedo = this->GroundAlbedo;
+    in.ModelOrders = this->ScatteringOrders;
+    ++in.ModelGeneration;
+    ++this->ModelBuilds;
+  }
+  return *in.Model;
+}
+
+const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLut()
+{
+  const nimbus::SkyModel& model = this->GetSkyModel();
+  Internals& in = *this->Internal;
+  if (!in.SkyView || in.SkyViewGeneration != in.ModelGeneration ||
+    in.SkyViewElevation != this->SunElevation || in.SkyViewAltitude != this->ObserverAltitude)
+  {
+    in.SkyView = std::make_unique<nimbus::SkyViewLut>(model, this->SunElevation, this->ObserverAltitude);
+    in.SkyViewGeneration = in.ModelGeneration;
+    in.SkyViewElevation = this->SunElevation;
+    in.SkyViewAltitude = this->ObserverAltitude;
+    ++this->SkyViewBuilds;
+  }
+  return *in.SkyView;
+}
+
+const nimbus::AerialPerspectiveLut& vtkNimbusSky::GetAerialPerspectiveLut(double cameraAltitude)
+{
+  const nimbus::SkyModel& model = this->GetSkyModel();
+  Internals& in = *this->Internal;
+  cameraAltitude = std::max(0.0, cameraAltitude);
+  const double tolerance = std::max(10.0, 0.01 * cameraAltitude);
+  if (!in.Aerial || in.AerialGeneration != in.ModelGeneration ||
+    in.AerialElevation != this->SunElevation || in.AerialRange != this->MaxAerialDistance ||
+    std::abs(in.AerialAltitude - cameraAltitude) > tolerance)
+  {
+    in.Aerial = std::make_unique<nimbus::AerialPerspectiveLut>(
+      model, this->SunElevation, cameraAltitude, this->MaxAerialDistance);
+    in.AerialGeneration = in.ModelGeneration;
+    in.AerialElevation = this->SunElevation;
+    in.AerialAltitude = cameraAltitude;
+    in.AerialRange = this->MaxAerialDistance;
+    ++this->AerialBuilds;
+  }
+  return *in.Aerial;
+}
+
+void vtkNimbusSky::GetRadiance(const double direction[3], double rgb[3])
+{
+  const double n = std::sqrt(
+    direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+  if (!(n > 0.0) || !std::isfinite(n))
+  {
+    vtkErrorMacro("GetRadiance: direction must be finite and non-zero");
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    return;
+  }
+  const auto L = this->GetSkyViewLut().Radiance(
+    { { direction[0] / n, direction[1] / n, direction[2] / n } }, this->SunAzimuth);
+  for (int i = 0; i < 3; ++i)
+  {
+    rgb[i] = L[i];
+  }
+}
+
+void vtkNimbusSky::GetDisplayScale(double scale[3])
+{
+  const nimbus::SkyModel& model = this->GetSkyModel();
+  const auto sun = model.GetSpectrum().ToLinearSrgb(model.GetSunIrradiance());
+  for (int i = 0; i < 3; ++i)
+  {
+    scale[i] = this->Exposure / (this->WhiteBalance && sun[i] > 0.0 ? sun[i] : 1.0);
+  }
+}
+
+void vtkNimbusSky::GetDisplayColor(const double direction[3], double rgb[3])
+{
+  double scale[3];
+  this->GetDisplayScale(scale);
+  this->GetRadiance(direction, rgb);
+  for (int i = 0; i < 3; ++i)
+  {
+    rgb[i] *= scale[i];
+  }
+}
+
+void vtkNimbusSky::AerialPerspective(
+  const double camera[3], const double point[3], double transmittance[3], double inscatter[3])
+{
+  const nimbus::SkyModel& model = this->GetSkyModel();
+  const double base = model.GetParameters().Atmosphere.earthRadius + this->ObserverAltitude;
+  const double m = this->MetresPerUnit;
+  const nimbus::SkyModel::Vector3 p0{ { camera[0] * m, camera[1] * m, base + camera[2] * m } };
+  const nimbus::SkyModel::Vector3 p1{ { point[0] * m, point[1] * m, base + point[2] * m } };
+  std::array<double, 3> t, l;
+  try
+  {
+    model.AerialPerspective(
+      p0, p1, nimbus::SunDirectionFromAngles(this->SunElevation, this->SunAzimuth), t, l);
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro("AerialPerspective: " << e.what());
+    t = { { 1.0, 1.0, 1.0 } };
+    l = { { 0.0, 0.0, 0.0 } };
+  }
+  for (int i = 0; i < 3; ++i)
+  {
+    transmittance[i] = t[i];
+    inscatter[i] = l[i];
+  }
+}
+
+void vtkNimbusSky::GetSunDiscRadiance(double rgb[3])
+{
+  const nimbus::SkyModel& model = this->GetSkyModel();
+  const double r = model.GetParameters().Atmosphere.earthRadius + this->ObserverAltitude;
+  std::vector<double> T(model.GetSunIrradiance().size());
+  model.SunTransmittance(r, std::sin(this->SunElevation * vtkMath::Pi() / 180.0), T.data());
+  std::vector<double> spectrum(T.size());
+  for (std::size_t i = 0; i < T.size(); ++i)
+  {
+    spectrum[i] = model.GetSunIrradiance()[i] * T[i];
+  }
+  const auto c = model.GetSpectrum().ToLinearSrgb(spectrum);
+  // Uniform disc of the same irradiance: E / (pi r^2) (the limb darkening in the
+  // shader is normalised to keep the mean).
+  const double solidAngle = vtkMath::Pi() * GetSunAngularRadius() * GetSunAngularRadius();
+  for (int i = 0; i < 3; ++i)
+  {
+    rgb[i] = std::max(0.0, c[i]) / solidAngle;
+  }
+}
+
+void vtkNimbusSky::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SunElevation: " << this->SunElevation << "\n";
+  os << indent << "SunAzimuth: " << this->SunAzimuth << "\n";
+  os << indent << "AerosolDensity: " << this->AerosolDensity << "\n";
+  os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
+  os << indent << "Exposure: " << this->Exposure << "\n";
+  os << indent << "ObserverAltitude: " << this->ObserverAltitude << "\n";
+  os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
+  os << indent << "MaxAerialDistance: " << this->MaxAerialDistance << "\n";
+  os << indent << "ScatteringOrders: " << this->ScatteringOrders << "\n";
+  os << indent << "WhiteBalance: " << this->WhiteBalance << "\n";
+  os << indent << "SunDisc: " << this->SunDisc << "\n";
+  os << indent << "ModelBuilds: " << this->ModelBuilds << " SkyViewBuilds: " << this->SkyViewBuilds
+     << " AerialBuilds: " << this->AerialBuilds << "\n";
+}

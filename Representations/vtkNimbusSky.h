@@ -1,0 +1,182 @@
+/**
+ * @class   vtkNimbusSky
+ * @brief   Shared sky parameters and their look-up tables (issue 6).
+ *
+ * One object that the sky background / aerial-perspective pass
+ * (vtkNimbusSkyPass), the sky dome (vtkNimbusSkyDomeSource) and a cloud mapper
+ * share, so that sky, haze and clouds agree. It is thin glue around
+ * Optics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
+ * and rebuilds each only when what it depends on changed (cache keys):
+ *  - SkyModel (transmittance + multiple scattering): AerosolDensity, GroundAlbedo;
+ *  - sky-view table: the model, SunElevation, ObserverAltitude;
+ *  - aerial-perspective table: the model, SunElevation, the camera altitude,
+ *    MaxAerialDistance.
+ * SunAzimuth, Exposure and WhiteBalance never rebuild anything.
+ *
+ * Radiance is relative to the sun: the solar irradiance outside the atmosphere
+ * has luminance Y = 1 (so a white Lambertian plane facing the sun there has
+ * radiance 1/pi). Display value = Exposure x radiance, then (WhiteBalance) each
+ * linear sRGB channel divided by that of the sun outside the atmosphere (as
+ * vtkNimbusSunlight).
+ *
+ * Scene frame: z up, y north, x east; scene lengths x MetresPerUnit = metres;
+ * scene z = 0 is at ObserverAltitude above sea level.
+ *
+ * For a GL mapper: GetTransmittanceTable / GetMultipleScatteringTable give the
+ * atmosphere's float tables, GetSkyViewTable / GetAerialPerspectiveTable the
+ * per-sun tables, with their sizes and parametrisations documented in Sky.h.
+ */
+#ifndef vtkNimbusSky_h
+#define vtkNimbusSky_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkObject.h"
+
+#include <memory> // for std::unique_ptr
+
+namespace nimbus
+{
+class SkyModel;
+class SkyViewLut;
+class AerialPerspectiveLut;
+}
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSky : public vtkObject
+{
+public:
+  static vtkNimbusSky* New();
+  vtkTypeMacro(vtkNimbusSky, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum Presets
+  {
+    Noon = 0,      ///< sun 60 deg, south
+    Afternoon = 1, ///< sun 30 deg, south-west
+    Sunset = 2,    ///< sun 2 deg, west
+    Twilight = 3   ///< sun -4 deg, west (civil twilight)
+  };
+  /// Sets SunElevation and SunAzimuth from a preset (an error for an unknown one).
+  void SetPreset(int preset);
+
+  ///@{
+  /// Sun elevation above the horizon, degrees, [-90, 90]. Default 45.
+  vtkSetClampMacro(SunElevation, double, -90.0, 90.0);
+  vtkGetMacro(SunElevation, double);
+  ///@}
+  ///@{
+  /// Sun azimuth from north (+y) toward east (+x), degrees. Default 135.
+  vtkSetMacro(SunAzimuth, double);
+  vtkGetMacro(SunAzimuth, double);
+  ///@}
+  ///@{
+  /// Aerosol (Mie) density relative to the default clear atmosphere
+  /// (beta_M,s = 2e-5 1/m at sea level), [0, 20]; the "turbidity" knob. Default 1.
+  vtkSetClampMacro(AerosolDensity, double, 0.0, 20.0);
+  vtkGetMacro(AerosolDensity, double);
+  ///@}
+  ///@{
+  /// Grey Lambertian albedo of the ground, [0, 1]. Default 0.3.
+  vtkSetClampMacro(GroundAlbedo, double, 0.0, 1.0);
+  vtkGetMacro(GroundAlbedo, double);
+  ///@}
+  ///@{
+  /// Display scale of the radiance, [0, 1e6]. Default 10.
+  vtkSetClampMacro(Exposure, double, 0.0, 1.0e6);
+  vtkGetMacro(Exposure, double);
+  ///@}
+  ///@{
+  /// Altitude of the scene's z = 0 (and of the dome's observer) above sea level,
+  /// metres, [0, 1e6]. Default 0.
+  vtkSetClampMacro(ObserverAltitude, double, 0.0, 1.0e6);
+  vtkGetMacro(ObserverAltitude, double);
+  ///@}
+  ///@{
+  /// Metres per scene unit, (0, 1e6]. Default 1.
+  vtkSetClampMacro(MetresPerUnit, double, 1e-6, 1.0e6);
+  vtkGetMacro(MetresPerUnit, double);
+  ///@}
+  ///@{
+  /// Range of the aerial-perspective table, metres, [100, 1e6]. Default 1e5.
+  vtkSetClampMacro(MaxAerialDistance, double, 100.0, 1.0e6);
+  vtkGetMacro(MaxAerialDistance, double);
+  ///@}
+  ///@{
+  /// Scattering orders K (1 = single scattering), [1, 10]. Default 4.
+  vtkSetClampMacro(ScatteringOrders, int, 1, 10);
+  vtkGetMacro(ScatteringOrders, int);
+  ///@}
+  ///@{
+  /// Divide colours by the sun's colour outside the atmosphere. Default on.
+  vtkSetMacro(WhiteBalance, bool);
+  vtkGetMacro(WhiteBalance, bool);
+  vtkBooleanMacro(WhiteBalance, bool);
+  ///@}
+  ///@{
+  /// Draw the limb-darkened sun disc in the background. Default on.
+  vtkSetMacro(SunDisc, bool);
+  vtkGetMacro(SunDisc, bool);
+  vtkBooleanMacro(SunDisc, bool);
+  ///@}
+
+  /// Unit vector toward the sun (scene frame).
+  void GetSunDirection(double direction[3]);
+
+  /// Sky radiance (linear sRGB, relative to the sun, no exposure) seen from the
+  /// observer (scene z = 0) along unit direction, from the sky-view table.
+  void GetRadiance(const double direction[3], double rgb[3]);
+  /// Display colour of that radiance: Exposure and white balance applied (linear).
+  void GetDisplayColor(const double direction[3], double rgb[3]);
+  /// Per-channel display factors: Exposure / sun colour (or Exposure).
+  void GetDisplayScale(double scale[3]);
+
+  /// Aerial perspective between two scene points (camera, point): transmittance
+  /// (linear sRGB factor) and in-scattered radiance (linear sRGB, relative to the
+  /// sun, no exposure), integrated directly (all scattering orders).
+  void AerialPerspective(
+    const double cameraPosition[3], const double point[3], double transmittance[3], double inscatter[3]);
+
+  /// Radiance of the sun's disc centre (linear sRGB, relative; 0 below the horizon)
+  /// at the observer, for a disc of angular radius GetSunAngularRadius().
+  void GetSunDiscRadiance(double rgb[3]);
+  static double GetSunAngularRadius() { return 0.004654; } // rad (0.2667 deg)
+
+  /// The tables (built on demand). Not wrapped; see Sky.h for the layouts.
+  const nimbus::SkyModel& GetSkyModel();
+  const nimbus::SkyViewLut& GetSkyViewLut();
+  /// Aerial-perspective table for a camera at the given altitude (m); rebuilt
+  /// when the altitude moves by more than 1 % (or 10 m).
+  const nimbus::AerialPerspectiveLut& GetAerialPerspectiveLut(double cameraAltitude);
+
+  /// Number of table builds so far (tests of the cache keys).
+  vtkGetMacro(ModelBuilds, int);
+  vtkGetMacro(SkyViewBuilds, int);
+  vtkGetMacro(AerialBuilds, int);
+
+protected:
+  vtkNimbusSky();
+  ~vtkNimbusSky() override;
+
+  double SunElevation = 45.0;
+  double SunAzimuth = 135.0;
+  double AerosolDensity = 1.0;
+  double GroundAlbedo = 0.3;
+  double Exposure = 10.0;
+  double ObserverAltitude = 0.0;
+  double MetresPerUnit = 1.0;
+  double MaxAerialDistance = 1.0e5;
+  int ScatteringOrders = 4;
+  bool WhiteBalance = true;
+  bool SunDisc = true;
+  int ModelBuilds = 0;
+  int SkyViewBuilds = 0;
+  int AerialBuilds = 0;
+
+private:
+  vtkNimbusSky(const vtkNimbusSky&) = delete;
+  void operator=(const vtkNimbusSky&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif

@@ -1,0 +1,156 @@
+#include "vtkNimbusSkyDomeSource.h"
+
+#include "vtkNimbusSky.h"
+
+#include "SpectralColor.h"
+
+#include "vtkCellArray.h"
+#include "vtkFloatArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMath.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <algorithm>
+#include <cmath>
+
+vtkStandardNewMacro(vtkNimbusSkyDomeSource);
+vtkCxxSetObjectMacro(vtkNimbusSkyDomeSource, Sky, vtkNimbusSky);
+
+vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
+{
+  this->SetNumberOfInputPorts(0);
+  vtkNew<vtkNimbusSky> sky;
+  this->SetSky(sky);
+}
+
+#define NIMBUS_FORWARD(name)                                                                      \
+  void vtkNimbusSkyDomeSource::Set##name(double v)                                                \
+  {                                                                                               \
+    if (this->Sky)                                                                                \
+    {                                                                                             \
+      this->Sky->Set##name(v);                                                                    \
+    }                                                                                             \
+  }
+NIMBUS_FORWARD(SunElevation)
+NIMBUS_FORWARD(SunAzimuth)
+NIMBUS_FORWARD(AerosolDensity)
+NIMBUS_FORWARD(GroundAlbedo)
+NIMBUS_FORWARD(Exposure)
+NIMBUS_FORWARD(ObserverAltitude)
+#undef NIMBUS_FORWARD
+
+vtkNimbusSkyDomeSource::~vtkNimbusSkyDomeSource()
+{
+  this->SetSky(nullptr);
+}
+
+vtkMTimeType vtkNimbusSkyDomeSource::GetMTime()
+{
+  vtkMTimeType t = this->Superclass::GetMTime();
+  if (this->Sky)
+  {
+    t = std::max(t, this->Sky->GetMTime());
+  }
+  return t;
+}
+
+int vtkNimbusSkyDomeSource::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkNimbusSky* sky = this->Sky;
+  if (!sky)
+  {
+    vtkErrorMacro("Sky is null: set a vtkNimbusSky");
+    return 0;
+  }
+  if (this->Preset >= 0)
+  {
+    sky->SetPreset(this->Preset);
+  }
+  const int rings = this->ElevationResolution, columns = this->AzimuthResolution;
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkUnsignedCharArray> colors;
+  colors->SetName("Colors");
+  colors->SetNumberOfComponents(3);
+  vtkNew<vtkFloatArray> radiance;
+  radiance->SetName("Radiance");
+  radiance->SetNumberOfComponents(3);
+  double scale[3];
+  sky->GetDisplayScale(scale);
+
+  auto addPoint = [&](double elevationDeg, double azimuthDeg) {
+    const double e = vtkMath::RadiansFromDegrees(elevationDeg);
+    const double a = vtkMath::RadiansFromDegrees(azimuthDeg);
+    const double d[3] = { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) };
+    points->InsertNextPoint(this->Center[0] + this->Radius * d[0],
+      this->Center[1] + this->Radius * d[1], this->Center[2] + this->Radius * d[2]);
+    double L[3];
+    sky->GetRadiance(d, L);
+    radiance->InsertNextTuple(L);
+    unsigned char c[3];
+    for (int i = 0; i < 3; ++i)
+    {
+      c[i] = static_cast<unsigned char>(std::lround(255.0 * nimbus::SrgbEncode(L[i] * scale[i])));
+    }
+    colors->InsertNextTypedTuple(c);
+  };
+  // Ring i (0 = horizon) at elevation 90 (i/n)^1.5; the zenith is one point.
+  for (int i = 0; i < rings; ++i)
+  {
+    if (i % 4 == 0)
+    {
+      this->UpdateProgress(static_cast<double>(i) / rings);
+    }
+    const double elevation = 90.0 * std::pow(static_cast<double>(i) / rings, 1.5);
+    for (int j = 0; j < columns; ++j)
+    {
+      addPoint(elevation, 360.0 * j / columns);
+    }
+  }
+  addPoint(90.0, 0.0);
+  const vtkIdType zenith = points->GetNumberOfPoints() - 1;
+
+  vtkNew<vtkCellArray> polys;
+  for (int i = 0; i + 1 < rings; ++i)
+  {
+    for (int j = 0; j < columns; ++j)
+    {
+      const vtkIdType a = static_cast<vtkIdType>(i) * columns + j;
+      const vtkIdType b = static_cast<vtkIdType>(i) * columns + (j + 1) % columns;
+      const vtkIdType quad[4] = { a, b, b + columns, a + columns };
+      polys->InsertNextCell(4, quad);
+    }
+  }
+  for (int j = 0; j < columns; ++j)
+  {
+    const vtkIdType a = static_cast<vtkIdType>(rings - 1) * columns + j;
+    const vtkIdType b = static_cast<vtkIdType>(rings - 1) * columns + (j + 1) % columns;
+    const vtkIdType tri[3] = { a, b, zenith };
+    polys->InsertNextCell(3, tri);
+  }
+  output->SetPoints(points);
+  output->SetPolys(polys);
+  output->GetPointData()->SetScalars(colors);
+  output->GetPointData()->AddArray(radiance);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkNimbusSkyDomeSource::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Sky: " << this->Sky << "\n";
+  os << indent << "Preset: " << this->Preset << "\n";
+  os << indent << "Radius: " << this->Radius << "\n";
+  os << indent << "Center: " << this->Center[0] << " " << this->Center[1] << " " << this->Center[2]
+     << "\n";
+  os << indent << "ElevationResolution: " << this->ElevationResolution << "\n";
+  os << indent << "AzimuthResolution: " << this->AzimuthResolution << "\n";
+}

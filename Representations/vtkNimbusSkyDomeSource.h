@@ -1,0 +1,96 @@
+/**
+ * @class   vtkNimbusSkyDomeSource
+ * @brief   Polygonised sky hemisphere with per-vertex sky colours (002 §2).
+ *
+ * As in 002 §2: "the sky is considered to be a hemisphere with a large radius;
+ * the hemisphere is polygonised and the colour of the sky at each vertex is
+ * obtained by using the look-up table". Colours come from a vtkNimbusSky (its
+ * sky-view table); the output has point arrays "Colors" (unsigned char RGB,
+ * display colour: Exposure, white balance, clamp, sRGB encoding) and "Radiance"
+ * (float RGB, linear sRGB relative to the sun, no exposure). Rings crowd toward
+ * the horizon (elevation = 90 deg (i/n)^1.5 ... measured from the horizon), where
+ * the sky changes fastest. Render it with the mapper's scalar colouring and
+ * lighting off (vtkProperty::LightingOff) so the colours are shown as they are.
+ */
+#ifndef vtkNimbusSkyDomeSource_h
+#define vtkNimbusSkyDomeSource_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkPolyDataAlgorithm.h"
+
+class vtkNimbusSky;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyDomeSource : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkNimbusSkyDomeSource* New();
+  vtkTypeMacro(vtkNimbusSkyDomeSource, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The sky whose colours are used (the source starts with its own sky; share
+  /// one with a vtkNimbusSkyPass / cloud mapper by setting it). Null is an error.
+  void SetSky(vtkNimbusSky* sky);
+  vtkGetObjectMacro(Sky, vtkNimbusSky);
+  ///@}
+
+  ///@{
+  /// Preset applied to the sky at every update (vtkNimbusSky::Presets), or -1
+  /// (custom: the sun angles below). For ParaView's Preset drop-down. Default -1.
+  vtkSetClampMacro(Preset, int, -1, 3);
+  vtkGetMacro(Preset, int);
+  ///@}
+
+  ///@{
+  /// Forwarded to the sky (one place for ParaView's properties).
+  void SetSunElevation(double v);
+  void SetSunAzimuth(double v);
+  void SetAerosolDensity(double v);
+  void SetGroundAlbedo(double v);
+  void SetExposure(double v);
+  void SetObserverAltitude(double v);
+  ///@}
+
+  ///@{
+  /// Radius of the dome, scene units, > 0. Default 10000.
+  vtkSetClampMacro(Radius, double, 1e-6, 1e30);
+  vtkGetMacro(Radius, double);
+  ///@}
+  ///@{
+  /// Centre of the dome (the observer), scene units. Default (0, 0, 0).
+  vtkSetVector3Macro(Center, double);
+  vtkGetVector3Macro(Center, double);
+  ///@}
+  ///@{
+  /// Rings from the horizon to the zenith, [2, 1024]. Default 32.
+  vtkSetClampMacro(ElevationResolution, int, 2, 1024);
+  vtkGetMacro(ElevationResolution, int);
+  ///@}
+  ///@{
+  /// Vertices per ring, [3, 4096]. Default 64.
+  vtkSetClampMacro(AzimuthResolution, int, 3, 4096);
+  vtkGetMacro(AzimuthResolution, int);
+  ///@}
+
+  /// Includes the sky's modification time.
+  vtkMTimeType GetMTime() override;
+
+protected:
+  vtkNimbusSkyDomeSource();
+  ~vtkNimbusSkyDomeSource() override;
+
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  vtkNimbusSky* Sky = nullptr;
+  int Preset = -1;
+  double Radius = 10000.0;
+  double Center[3] = { 0.0, 0.0, 0.0 };
+  int ElevationResolution = 32;
+  int AzimuthResolution = 64;
+
+private:
+  vtkNimbusSkyDomeSource(const vtkNimbusSkyDomeSource&) = delete;
+  void operator=(const vtkNimbusSkyDomeSource&) = delete;
+};
+
+#endif

@@ -1,0 +1,78 @@
+/**
+ * @class   vtkNimbusSkyPass
+ * @brief   Sky background and aerial perspective as a render pass (issue 6).
+ *
+ * Renders its delegate (e.g. vtkRenderStepsPass) into a colour + depth
+ * framebuffer, then draws one full-screen quad that
+ *  - where nothing was drawn (depth = 1): the sky from the vtkNimbusSky's
+ *    sky-view table for the view ray (and the limb-darkened sun disc), and
+ *  - where opaque geometry was drawn: colour x T + Exposure x in-scattering,
+ *    T and the in-scattering from the sky's aerial-perspective table at the
+ *    pixel's distance (depth buffer -> world position).
+ * Framebuffer colours are taken as display (sRGB-encoded) values and composited
+ * in linear sRGB. The depth is written back, so later passes can use it.
+ * Translucent geometry and volumes write no depth and get no aerial perspective;
+ * they are composited over the sky by their alpha (the delegate renders on
+ * transparent black: the renderer's background is ignored while the pass is on).
+ * The camera's altitude is the sky's ObserverAltitude + camera z x MetresPerUnit;
+ * the sky-view table is the sky's (at ObserverAltitude), so cameras far above
+ * z = 0 should raise ObserverAltitude.
+ *
+ * GLSL: SkyShaders/vtkNimbusSkyPassFS.glsl, the GPU twin of
+ * nimbus::SkyViewLut::Radiance / AerialPerspectiveLut::Lookup (Optics/Sky.cxx).
+ *
+ * @code
+ * vtkNew<vtkNimbusSkyPass> pass;  pass->SetSky(sky);
+ * vtkNew<vtkRenderStepsPass> steps;  pass->SetDelegatePass(steps);
+ * vtkOpenGLRenderer::SafeDownCast(renderer)->SetPass(pass);
+ * @endcode
+ */
+#ifndef vtkNimbusSkyPass_h
+#define vtkNimbusSkyPass_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkImageProcessingPass.h"
+
+#include <memory> // for std::unique_ptr
+
+class vtkNimbusSky;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyPass : public vtkImageProcessingPass
+{
+public:
+  static vtkNimbusSkyPass* New();
+  vtkTypeMacro(vtkNimbusSkyPass, vtkImageProcessingPass);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The sky (parameters and tables). Required.
+  void SetSky(vtkNimbusSky* sky);
+  vtkGetObjectMacro(Sky, vtkNimbusSky);
+  ///@}
+
+  ///@{
+  /// Apply aerial perspective to opaque geometry. Default on.
+  vtkSetMacro(AerialPerspective, bool);
+  vtkGetMacro(AerialPerspective, bool);
+  vtkBooleanMacro(AerialPerspective, bool);
+  ///@}
+
+  void Render(const vtkRenderState* s) override;
+  void ReleaseGraphicsResources(vtkWindow* w) override;
+
+protected:
+  vtkNimbusSkyPass();
+  ~vtkNimbusSkyPass() override;
+
+  vtkNimbusSky* Sky = nullptr;
+  bool AerialPerspective = true;
+
+private:
+  vtkNimbusSkyPass(const vtkNimbusSkyPass&) = delete;
+  void operator=(const vtkNimbusSkyPass&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
