@@ -621,6 +621,9 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   }
   in.ShadowFramebuffer->SetContext(window);
   in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
+  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
+  // skips attaching the same object again.
+  in.ShadowFramebuffer->RemoveColorAttachment(0);
   in.ShadowFramebuffer->AddColorAttachment(0, in.Shadow);
   in.ShadowFramebuffer->ActivateDrawBuffer(0);
   state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
@@ -640,6 +643,9 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     ensure2D(in.IntervalPhase, width, height, 4, false);
     in.IntervalPhaseFramebuffer->SetContext(window);
     in.IntervalPhaseFramebuffer->Bind(GL_FRAMEBUFFER);
+    // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
+    // skips attaching the same object again.
+    in.IntervalPhaseFramebuffer->RemoveColorAttachment(0);
     in.IntervalPhaseFramebuffer->AddColorAttachment(0, in.IntervalPhase);
     in.IntervalPhaseFramebuffer->ActivateDrawBuffer(0);
     state->vtkglViewport(0, 0, width, height);
@@ -661,6 +667,9 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   ensure2D(in.RayEnds, width, height, 4, false);
   in.RayEndsFramebuffer->SetContext(window);
   in.RayEndsFramebuffer->Bind(GL_FRAMEBUFFER);
+  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
+  // skips attaching the same object again.
+  in.RayEndsFramebuffer->RemoveColorAttachment(0);
   in.RayEndsFramebuffer->AddColorAttachment(0, in.RayEnds);
   in.RayEndsFramebuffer->ActivateDrawBuffer(0);
   state->vtkglViewport(0, 0, width, height);
@@ -677,6 +686,9 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   ensure2D(in.Accumulation, width, height, 4, false);
   in.AccumulationFramebuffer->SetContext(window);
   in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
+  // skips attaching the same object again.
+  in.AccumulationFramebuffer->RemoveColorAttachment(0);
   in.AccumulationFramebuffer->AddColorAttachment(0, in.Accumulation);
   in.AccumulationFramebuffer->ActivateDrawBuffer(0);
   state->vtkglViewport(0, 0, width, height);

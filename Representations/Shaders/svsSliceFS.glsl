@@ -43,6 +43,10 @@ void main()
     vec3 p = origin + t * direction;
     float stepMetres = sliceSpacing * intervalAndPhase.x * lengthUnit; // Delta t(p) [m]
     float sigma = extinctionPerDensity * CloudDensity(p);              // k_cl rho_cl [1/m]
+    if (sigma <= 0.0 && atmosphereOn == 0 && !ground)
+    {
+      discard; // empty space without air: nothing to add, nothing to attenuate
+    }
     alpha = exp(-sigma * stepMetres);                                  // 000 Eq. 9 (cloud part)
     // Exact integral of a constant source over the slab: (1 - alpha) / sigma.
     float slabLength = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;

@@ -426,6 +426,25 @@ bool LightingChangeKeepsVolume(const Context&)
   return ok;
 }
 
+// Reallocated render targets (new shadow-surface size, new viewport size) must be
+// re-attached: the result must equal a fresh mapper's (a regression: the FBO kept
+// the deleted texture and the shadows vanished).
+bool ReallocatedTargets(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Render();
+  s.Mapper->SetShadowSurfaceSize(256);
+  s.Window->SetSize(160, 120);
+  const auto changed = s.Render();
+  Scene fresh(MakeCloud());
+  fresh.Mapper->SetShadowSurfaceSize(256);
+  fresh.Window->SetSize(160, 120);
+  const auto expected = fresh.Render();
+  const double rmse = Rmse(changed, expected);
+  return Check(changed.size() == expected.size() && rmse == 0.0,
+    "after resizing targets the image equals a fresh render (RMSE " + std::to_string(rmse) + ")");
+}
+
 bool Downsampling(const Context&)
 {
   Scene s(MakeCloud());
@@ -455,7 +474,7 @@ int main(int argc, char* argv[])
     { "HugeOpticalThickness", HugeOpticalThickness },
     { "CameraInsideVolume", CameraInsideVolume },
     { "LightingChangeKeepsVolume", LightingChangeKeepsVolume },
-    { "Downsampling", Downsampling } };
+    { "Downsampling", Downsampling }, { "ReallocatedTargets", ReallocatedTargets } };
   if (argc != 4 || !cases.count(argv[1]))
   {
     std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";
