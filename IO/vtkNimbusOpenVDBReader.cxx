@@ -40,6 +40,11 @@ struct vtkNimbusOpenVDBReader::Internals
     const vdb::GridInfo* Reference = nullptr;
     vdb::IndexBox Box;
   };
+
+  // Reads the descriptors (if stale) and refreshes the selection list. Throws vdb::Error.
+  void Refresh(const std::string& path);
+  // Which grids to read, the reference transform and the index box. Throws vdb::Error.
+  Plan MakePlan(const char* boundsGrid, const std::string& path) const;
 };
 
 namespace
@@ -61,9 +66,11 @@ bool StatFile(const std::string& path, long long& mtime, long long& size)
   return true;
 }
 
-// Reads the descriptors (if stale) and refreshes the selection list. Throws vdb::Error.
-void Refresh(vtkNimbusOpenVDBReader::Internals& in, const std::string& path)
+}
+
+void vtkNimbusOpenVDBReader::Internals::Refresh(const std::string& path)
 {
+  Internals& in = *this;
   long long mtime = -1, size = -1;
   StatFile(path, mtime, size);
   if (path == in.CachedPath && mtime == in.CachedMTime && size == in.CachedSize && mtime >= 0)
@@ -97,7 +104,6 @@ void Refresh(vtkNimbusOpenVDBReader::Internals& in, const std::string& path)
       in.Selection->RemoveArrayByIndex(i);
     }
   }
-}
 }
 
 vtkStandardNewMacro(vtkNimbusOpenVDBReader);
@@ -171,13 +177,11 @@ vtkStringArray* vtkNimbusOpenVDBReader::GetGridNames()
   return this->Internal->Names;
 }
 
-namespace
+vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakePlan(
+  const char* boundsGrid, const std::string& path) const
 {
-// Which grids to read, the reference transform and the index box. Throws vdb::Error.
-vtkNimbusOpenVDBReader::Internals::Plan MakePlan(
-  const vtkNimbusOpenVDBReader::Internals& in, const char* boundsGrid, const std::string& path)
-{
-  vtkNimbusOpenVDBReader::Internals::Plan plan;
+  const Internals& in = *this;
+  Plan plan;
   std::vector<std::string> unsupported;
   std::set<std::string> taken;
   for (const auto& g : in.Grids)
@@ -255,6 +259,8 @@ vtkNimbusOpenVDBReader::Internals::Plan MakePlan(
   return plan;
 }
 
+namespace
+{
 void RowMajorDirection(const vdb::TransformInfo& t, double out[9])
 {
   for (int r = 0; r < 3; ++r)
@@ -278,8 +284,8 @@ int vtkNimbusOpenVDBReader::RequestInformation(
   Internals::Plan plan;
   try
   {
-    Refresh(*this->Internal, this->FileName);
-    plan = MakePlan(*this->Internal, this->BoundsGrid, this->FileName);
+    this->Internal->Refresh(this->FileName);
+    plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
   }
   catch (const vdb::Error& e)
   {
@@ -323,8 +329,8 @@ int vtkNimbusOpenVDBReader::RequestData(
   Internals::Plan plan;
   try
   {
-    Refresh(*this->Internal, this->FileName);
-    plan = MakePlan(*this->Internal, this->BoundsGrid, this->FileName);
+    this->Internal->Refresh(this->FileName);
+    plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
   }
   catch (const vdb::Error& e)
   {
@@ -417,10 +423,11 @@ int vtkNimbusOpenVDBReader::RequestData(
     arrays.push_back(array);
   }
   std::vector<std::string> resampled;
+  vdb::TransformInfo exact = t;
   try
   {
     vdb::ReadDense(this->FileName, names, t, plan.Box, targets, &resampled,
-      [this](double f) { this->UpdateProgress(f); });
+      [this](double f) { this->UpdateProgress(f); }, &exact);
   }
   catch (const vdb::Error& e)
   {
@@ -428,6 +435,11 @@ int vtkNimbusOpenVDBReader::RequestData(
     output->Initialize();
     return 0;
   }
+  // The transform read with the voxels (bit-exact; see ReadDense).
+  output->SetOrigin(exact.Origin.data());
+  output->SetSpacing(exact.Spacing.data());
+  RowMajorDirection(exact, direction);
+  output->SetDirectionMatrix(direction);
   for (const auto& name : resampled)
   {
     vtkWarningMacro(<< "grid " << Quote(name) << " has a different transform from the reference grid "

@@ -230,6 +230,20 @@ void CopyToDense(const GridT& grid, const openvdb::CoordBBox& bbox, float* targe
   openvdb::tools::copyToDense(grid, dense, /*serial=*/false);
 }
 
+inline float Element(float v, int)
+{
+  return v;
+}
+inline float Element(double v, int)
+{
+  return static_cast<float>(v);
+}
+template <typename T>
+inline float Element(const openvdb::math::Vec3<T>& v, int c)
+{
+  return static_cast<float>(v[c]);
+}
+
 /// Trilinear resampling of `grid` at the world positions of `reference`'s voxels in `box`.
 template <typename GridT>
 void ResampleToDense(
@@ -254,8 +268,7 @@ void ResampleToDense(
           const ValueT v = sampler.wsSample(openvdb::Vec3d(w[0], w[1], w[2]));
           for (int c = 0; c < components; ++c)
           {
-            out[components * i + c] =
-              static_cast<float>(openvdb::VecTraits<ValueT>::getElem(v, c));
+            out[components * i + c] = Element(v, c);
           }
         }
       }
@@ -265,13 +278,13 @@ void ResampleToDense(
 
 template <typename GridT, typename DenseValueT>
 void Extract(const openvdb::GridBase::Ptr& base, const TransformInfo& reference,
-  const IndexBox& box, float* target, bool& resampled)
+  const IndexBox& box, float* target, bool& resampled, TransformInfo& own)
 {
   const auto grid = openvdb::gridPtrCast<GridT>(base);
   const auto bbox = grid->evalActiveVoxelBoundingBox();
   const openvdb::Vec3d centre =
     bbox.empty() ? openvdb::Vec3d(0.0) : bbox.getCenter();
-  const TransformInfo own = AnalyseTransform(grid->transform(), centre);
+  own = AnalyseTransform(grid->transform(), centre);
   if (own.SameAs(reference))
   {
     CopyToDense<GridT, DenseValueT>(*grid, ToCoordBox(box), target);
@@ -298,6 +311,30 @@ void CheckTransformForWrite(const TransformInfo& t, const std::string& name)
 
 openvdb::math::Transform::Ptr ToVdbTransform(const TransformInfo& t)
 {
+  const openvdb::Vec3d origin(t.Origin[0], t.Origin[1], t.Origin[2]);
+  const openvdb::Vec3d spacing(t.Spacing[0], t.Spacing[1], t.Spacing[2]);
+  bool identity = true;
+  for (int i = 0; i < 9; ++i)
+  {
+    identity = identity && t.Direction[i] == (i % 4 == 0 ? 1.0 : 0.0);
+  }
+  if (identity)
+  {
+    // Axis-aligned: built from a unit uniform scale map by postScale and postTranslate,
+    // which keep origin and spacing bit-exact (the Transform(MapBase) constructor and
+    // createLinearTransform(Mat4) simplify through an affine map and lose the last bit).
+    auto transform = openvdb::math::Transform::createLinearTransform(1.0);
+    if (spacing[0] == spacing[1] && spacing[1] == spacing[2])
+    {
+      transform = openvdb::math::Transform::createLinearTransform(spacing[0]);
+    }
+    else
+    {
+      transform->postScale(spacing);
+    }
+    transform->postTranslate(origin);
+    return transform;
+  }
   openvdb::Mat4d m = openvdb::Mat4d::identity();
   for (int r = 0; r < 3; ++r) // row r = world image of index axis r
   {
@@ -616,9 +653,10 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
 
 void ReadDense(const std::string& path, const std::vector<std::string>& names,
   const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
-  std::vector<std::string>* resampled, const Progress& progress)
+  std::vector<std::string>* resampled, const Progress& progress, TransformInfo* exact)
 {
   Initialize();
+  bool haveExact = false;
   CheckReadable(path);
   if (target.size() != names.size())
   {
@@ -640,21 +678,22 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
       }
       const auto base = file.readGrid(names[g]);
       bool wasResampled = false;
+      TransformInfo own;
       switch (KindOf(*base))
       {
         case ValueKind::Float:
-          Extract<openvdb::FloatGrid, float>(base, reference, box, target[g], wasResampled);
+          Extract<openvdb::FloatGrid, float>(base, reference, box, target[g], wasResampled, own);
           break;
         case ValueKind::Double:
-          Extract<openvdb::DoubleGrid, float>(base, reference, box, target[g], wasResampled);
+          Extract<openvdb::DoubleGrid, float>(base, reference, box, target[g], wasResampled, own);
           break;
         case ValueKind::Vec3Float:
           Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(
-            base, reference, box, target[g], wasResampled);
+            base, reference, box, target[g], wasResampled, own);
           break;
         case ValueKind::Vec3Double:
           Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(
-            base, reference, box, target[g], wasResampled);
+            base, reference, box, target[g], wasResampled, own);
           break;
         default:
           throw Error("grid " + Quote(names[g]) + " has unsupported value type " +
@@ -663,6 +702,11 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
       if (wasResampled && resampled)
       {
         resampled->push_back(names[g]);
+      }
+      if (!wasResampled && exact && !haveExact)
+      {
+        *exact = own;
+        haveExact = true;
       }
       if (progress)
       {

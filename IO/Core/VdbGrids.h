@@ -125,10 +125,14 @@ using Progress = std::function<void(double)>;
 /// space. `target` points at caller-allocated storage of box.VoxelCount()*components
 /// floats per grid (the VTK array's buffer), in the order of `names`. Grids whose
 /// transform differs from `reference` are resampled trilinearly at the reference's
-/// voxel positions (`resampled` receives their names). Throws Error on read failure.
+/// voxel positions (`resampled` receives their names). `exact` receives the transform of
+/// the first grid copied without resampling, as read with its voxels: OpenVDB's
+/// metadata-only read (ReadFileInfo) can differ from it in the last bit of the voxel size.
+/// Throws Error on read failure.
 void ReadDense(const std::string& path, const std::vector<std::string>& names,
   const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
-  std::vector<std::string>* resampled = nullptr, const Progress& progress = nullptr);
+  std::vector<std::string>* resampled = nullptr, const Progress& progress = nullptr,
+  TransformInfo* exact = nullptr);
 
 /// The index box of grid `info` expressed in the index space of `reference` (the box of
 /// reference voxels whose points lie inside info's world-space active box, rounded out).
