@@ -36,7 +36,7 @@ struct vtkNimbusOpenVDBReader::Internals
   // The plan of the next read.
   struct Plan
   {
-    std::vector<const vdb::GridInfo*> Read; // selected supported grids, file order
+    std::vector<const vdb::GridInfo*> Read; // selected supported grids, OpenVDB's order (by name)
     const vdb::GridInfo* Reference = nullptr;
     vdb::IndexBox Box;
   };

@@ -11,7 +11,8 @@
  * world position of index (0, 0, 0) and the spacing the voxel size. Points outside a grid's
  * active voxels get the grid's own (inactive) value — its background for fog volumes.
  *
- * The reference grid (BoundsGrid, or the first selected grid in file order) gives the
+ * The reference grid (BoundsGrid, or the first selected non-empty grid in the order OpenVDB
+ * lists them, which is by name) gives the
  * transform; a grid with another transform is resampled trilinearly at the image points
  * (warned). Rotated transforms become the image's direction matrix; non-uniform voxel
  * sizes its per-axis spacing; sheared or non-linear (frustum) transforms are approximated
