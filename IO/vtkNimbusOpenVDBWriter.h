@@ -61,7 +61,8 @@ public:
   ///@}
 
   ///@{
-  /// Blosc compression (default on); off writes zip-compressed grids.
+  /// Blosc compression (default on); off writes uncompressed voxel values (faster to
+  /// write and read, larger files).
   vtkSetMacro(Compress, bool);
   vtkGetMacro(Compress, bool);
   vtkBooleanMacro(Compress, bool);

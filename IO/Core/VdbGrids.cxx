@@ -785,7 +785,7 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
     openvdb::io::File file(tmp);
     file.setCompression(compress
         ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
-        : (openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK));
+        : openvdb::io::COMPRESS_ACTIVE_MASK);
     openvdb::MetaMap meta;
     meta.insertMeta("creator", openvdb::StringMetadata("Nimbus vtkNimbusOpenVDBWriter"));
     file.write(grids, meta);

@@ -156,7 +156,7 @@ struct FieldToWrite
 /// Writes the fields as FloatGrid / Vec3SGrid to `path`. The file is written to
 /// `path + ".tmp-<pid>"` first and renamed over `path` only after a complete write, so a
 /// failure never leaves a partial or corrupted file. `compress` selects Blosc (else
-/// zip). Throws Error on failure. Returns the number of active voxels written.
+/// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the number of active voxels written.
 uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
   bool compress = true, const Progress& progress = nullptr);
 
