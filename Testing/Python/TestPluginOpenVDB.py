@@ -6,7 +6,8 @@ LoadPlugin, then SaveData('x.vdb') of a Wavelet image with a scalar and a vector
 (ParaView picks the writer from the WriterFactory hint), then OpenDataFile('x.vdb')
 (the ReaderFactory hint) and a comparison of the fetched arrays with the originals
 (float32-rounded: the writer stores floats), of extent, origin and spacing, and of the
-grid selection list.
+grid selection list; then a numbered series of three files opened as one reader with
+time steps 0, 1, 2, each step with its own extent.
 """
 import argparse
 import os
@@ -73,6 +74,25 @@ def main():
             only.GetPointData().GetArray("RTData") is None:
         failures.append("grid selection Grids=['RTData'] not honoured")
     Delete(reader)
+
+    # A numbered series is one reader with time steps; each step has its own extent
+    # (a cloud that moves or grows changes its active bounding box).
+    series = []
+    for step, half in enumerate((3, 5, 7)):
+        w = Wavelet(WholeExtent=[-half, half, -half, half, -half, half])
+        name = os.path.join(args.output_dir, f"paraview_series_{step}.vdb")
+        SaveData(name, proxy=w)
+        series.append(name)
+        Delete(w)
+    animated = OpenDataFile(series)
+    steps = list(animated.TimestepValues)
+    if steps != [0.0, 1.0, 2.0]:
+        failures.append(f"file series time steps {steps}")
+    for step, half in enumerate((3, 5, 7)):
+        animated.UpdatePipeline(time=float(step))
+        points = animated.GetDataInformation().GetNumberOfPoints()
+        if points != (2 * half + 1) ** 3:
+            failures.append(f"series step {step}: {points} points, expected {(2 * half + 1) ** 3}")
     for f in failures:
         print("FAIL:", f)
     if failures:
