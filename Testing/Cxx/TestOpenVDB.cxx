@@ -26,6 +26,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <fstream>
 #include <string>
 #include <sys/stat.h>
@@ -608,7 +609,11 @@ TEST(Read, DifferentTransformsResampledAndWarned)
         worst = std::max(worst,
           std::abs(c->GetTuple1(out->ComputePointId(ijk)) - (2.0 * i + 3.0 * j - k + 100.0)));
       }
-  EXPECT_LT(worst, 1e-4); // float rounding of values ~100 (ulp 7.6e-6) through 8 weights
+  std::cout << "worst trilinear error " << worst << "\n";
+  // Measured 0: the image points sit on coarse voxels or midway between them, where the
+  // trilinear weights (0, 1/2, 1) are exact; the bound is 1 float ulp at the largest value
+  // (~130, ulp 1.5e-5) to allow another summation order.
+  EXPECT_LE(worst, 1.6e-5);
 }
 
 TEST(Read, FrustumTransformWarns)
