@@ -178,7 +178,8 @@ vtkStringArray* vtkNimbusOpenVDBReader::GetGridNames()
 }
 
 vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakePlan(
-  const char* boundsGrid, const std::string& path) const
+  const char* boundsGrid,
+  const std::string& path) const
 {
   const Internals& in = *this;
   Plan plan;
@@ -223,8 +224,8 @@ vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakeP
     }
     if (!plan.Reference)
     {
-      throw vdb::Error("BoundsGrid " + Quote(boundsGrid) + " is not a float/double/Vec3 grid of " +
-        Quote(path));
+      throw vdb::Error(
+        "BoundsGrid " + Quote(boundsGrid) + " is not a float/double/Vec3 grid of " + Quote(path));
     }
     plan.Box = plan.Reference->ActiveBox;
     if (plan.Box.Empty())
@@ -273,8 +274,9 @@ void RowMajorDirection(const vdb::TransformInfo& t, double out[9])
 }
 }
 
-int vtkNimbusOpenVDBReader::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkNimbusOpenVDBReader::RequestInformation(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
 {
   if (!this->FileName || !*this->FileName)
   {
@@ -311,8 +313,9 @@ int vtkNimbusOpenVDBReader::RequestInformation(
   return 1;
 }
 
-int vtkNimbusOpenVDBReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkNimbusOpenVDBReader::RequestData(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
 {
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   if (!output)
@@ -364,8 +367,8 @@ int vtkNimbusOpenVDBReader::RequestData(
   const vdb::TransformInfo& t = plan.Reference->Transform;
   if (!t.Note.empty())
   {
-    vtkWarningMacro(<< "grid " << Quote(plan.Reference->Name) << " of " << this->FileName
-                    << ": " << t.Note);
+    vtkWarningMacro(<< "grid " << Quote(plan.Reference->Name) << " of " << this->FileName << ": "
+                    << t.Note);
   }
   std::string unsupported;
   for (const auto& g : this->Internal->Grids)
@@ -412,8 +415,8 @@ int vtkNimbusOpenVDBReader::RequestData(
     array->SetNumberOfComponents(g->Components);
     if (!array->Allocate(static_cast<vtkIdType>(voxels) * g->Components))
     {
-      vtkErrorMacro(<< "cannot allocate " << voxels << " x " << g->Components
-                    << " floats for grid " << Quote(g->Name));
+      vtkErrorMacro(<< "cannot allocate " << voxels << " x " << g->Components << " floats for grid "
+                    << Quote(g->Name));
       output->Initialize();
       return 0;
     }
@@ -426,8 +429,15 @@ int vtkNimbusOpenVDBReader::RequestData(
   vdb::TransformInfo exact = t;
   try
   {
-    vdb::ReadDense(this->FileName, names, t, plan.Box, targets, &resampled,
-      [this](double f) { this->UpdateProgress(f); }, &exact);
+    vdb::ReadDense(
+      this->FileName,
+      names,
+      t,
+      plan.Box,
+      targets,
+      &resampled,
+      [this](double f) { this->UpdateProgress(f); },
+      &exact);
   }
   catch (const vdb::Error& e)
   {
@@ -442,7 +452,8 @@ int vtkNimbusOpenVDBReader::RequestData(
   output->SetDirectionMatrix(direction);
   for (const auto& name : resampled)
   {
-    vtkWarningMacro(<< "grid " << Quote(name) << " has a different transform from the reference grid "
+    vtkWarningMacro(<< "grid " << Quote(name)
+                    << " has a different transform from the reference grid "
                     << Quote(plan.Reference->Name)
                     << ": resampled trilinearly at the image points (values are interpolated; "
                        "read it alone, or set BoundsGrid to it, for its own voxels)");

@@ -125,8 +125,10 @@ openvdb::CoordBBox ToCoordBox(const IndexBox& box)
     }
   }
   return openvdb::CoordBBox(openvdb::Coord(static_cast<int32_t>(box.Min[0]),
-                              static_cast<int32_t>(box.Min[1]), static_cast<int32_t>(box.Min[2])),
-    openvdb::Coord(static_cast<int32_t>(box.Max[0]), static_cast<int32_t>(box.Max[1]),
+                              static_cast<int32_t>(box.Min[1]),
+                              static_cast<int32_t>(box.Min[2])),
+    openvdb::Coord(static_cast<int32_t>(box.Max[0]),
+      static_cast<int32_t>(box.Max[1]),
       static_cast<int32_t>(box.Max[2])));
 }
 
@@ -186,8 +188,7 @@ TransformInfo AnalyseTransform(const openvdb::math::Transform& transform, const 
   std::ostringstream note;
   note << "non-linear (" << map->type()
        << ") transform: linearised at the centre of the active voxels, index "
-       << Vec3String({ { at[0], at[1], at[2] } })
-       << "; positions away from there are approximate";
+       << Vec3String({ { at[0], at[1], at[2] } }) << "; positions away from there are approximate";
   info.Note = note.str() + (info.Note.empty() ? "" : "; " + info.Note);
   return info;
 }
@@ -222,7 +223,7 @@ std::array<double, 3> WorldToIndex(const TransformInfo& t, const std::array<doub
   return ijk;
 }
 
-template <typename GridT, typename DenseValueT>
+template<typename GridT, typename DenseValueT>
 void CopyToDense(const GridT& grid, const openvdb::CoordBBox& bbox, float* target)
 {
   openvdb::tools::Dense<DenseValueT, openvdb::tools::LayoutXYZ> dense(
@@ -238,52 +239,59 @@ inline float Element(double v, int)
 {
   return static_cast<float>(v);
 }
-template <typename T>
+template<typename T>
 inline float Element(const openvdb::math::Vec3<T>& v, int c)
 {
   return static_cast<float>(v[c]);
 }
 
 /// Trilinear resampling of `grid` at the world positions of `reference`'s voxels in `box`.
-template <typename GridT>
-void ResampleToDense(
-  const GridT& grid, const TransformInfo& reference, const IndexBox& box, float* target)
+template<typename GridT>
+void ResampleToDense(const GridT& grid,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  float* target)
 {
   using ValueT = typename GridT::ValueType;
   constexpr int components = openvdb::VecTraits<ValueT>::Size;
   const int64_t nx = box.Max[0] - box.Min[0] + 1;
   const int64_t ny = box.Max[1] - box.Min[1] + 1;
   const int64_t nz = box.Max[2] - box.Min[2] + 1;
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, nz), [&](const tbb::blocked_range<int64_t>& r) {
-    openvdb::tools::GridSampler<GridT, openvdb::tools::BoxSampler> sampler(grid);
-    for (int64_t k = r.begin(); k != r.end(); ++k)
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, nz),
+    [&](const tbb::blocked_range<int64_t>& r)
     {
-      for (int64_t j = 0; j < ny; ++j)
+      openvdb::tools::GridSampler<GridT, openvdb::tools::BoxSampler> sampler(grid);
+      for (int64_t k = r.begin(); k != r.end(); ++k)
       {
-        float* out = target + components * (nx * (j + ny * k));
-        for (int64_t i = 0; i < nx; ++i)
+        for (int64_t j = 0; j < ny; ++j)
         {
-          const auto w = IndexToWorld(reference,
-            { { double(box.Min[0] + i), double(box.Min[1] + j), double(box.Min[2] + k) } });
-          const ValueT v = sampler.wsSample(openvdb::Vec3d(w[0], w[1], w[2]));
-          for (int c = 0; c < components; ++c)
+          float* out = target + components * (nx * (j + ny * k));
+          for (int64_t i = 0; i < nx; ++i)
           {
-            out[components * i + c] = Element(v, c);
+            const auto w = IndexToWorld(reference,
+              { { double(box.Min[0] + i), double(box.Min[1] + j), double(box.Min[2] + k) } });
+            const ValueT v = sampler.wsSample(openvdb::Vec3d(w[0], w[1], w[2]));
+            for (int c = 0; c < components; ++c)
+            {
+              out[components * i + c] = Element(v, c);
+            }
           }
         }
       }
-    }
-  });
+    });
 }
 
-template <typename GridT, typename DenseValueT>
-void Extract(const openvdb::GridBase::Ptr& base, const TransformInfo& reference,
-  const IndexBox& box, float* target, bool& resampled, TransformInfo& own)
+template<typename GridT, typename DenseValueT>
+void Extract(const openvdb::GridBase::Ptr& base,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  float* target,
+  bool& resampled,
+  TransformInfo& own)
 {
   const auto grid = openvdb::gridPtrCast<GridT>(base);
   const auto bbox = grid->evalActiveVoxelBoundingBox();
-  const openvdb::Vec3d centre =
-    bbox.empty() ? openvdb::Vec3d(0.0) : bbox.getCenter();
+  const openvdb::Vec3d centre = bbox.empty() ? openvdb::Vec3d(0.0) : bbox.getCenter();
   own = AnalyseTransform(grid->transform(), centre);
   if (own.SameAs(reference))
   {
@@ -303,8 +311,8 @@ void CheckTransformForWrite(const TransformInfo& t, const std::string& name)
   {
     if (!(t.Spacing[c] > 0.0) || !std::isfinite(t.Spacing[c]) || !std::isfinite(t.Origin[c]))
     {
-      throw Error("field " + Quote(name) + ": spacing " + Vec3String(t.Spacing) +
-        " and origin " + Vec3String(t.Origin) + " must be finite with spacing > 0");
+      throw Error("field " + Quote(name) + ": spacing " + Vec3String(t.Spacing) + " and origin " +
+        Vec3String(t.Origin) + " must be finite with spacing > 0");
     }
   }
 }
@@ -347,15 +355,15 @@ openvdb::math::Transform::Ptr ToVdbTransform(const TransformInfo& t)
   return openvdb::math::Transform::createLinearTransform(m);
 }
 
-template <typename GridT>
+template<typename GridT>
 typename GridT::Ptr BuildGrid(const FieldToWrite& field)
 {
   using ValueT = typename GridT::ValueType;
   const ValueT background(field.Background);
   const ValueT tolerance(field.Tolerance);
   auto grid = GridT::create(background);
-  openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(ToCoordBox(field.Box),
-    reinterpret_cast<ValueT*>(const_cast<float*>(field.Values)));
+  openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(
+    ToCoordBox(field.Box), reinterpret_cast<ValueT*>(const_cast<float*>(field.Values)));
   openvdb::tools::copyFromDense(dense, *grid, tolerance, /*serial=*/false);
   grid->setName(field.Name);
   grid->setTransform(ToVdbTransform(field.Transform));
@@ -449,8 +457,8 @@ TransformInfo AnalyseLinearMatrix(const std::array<std::array<double, 4>, 4>& m)
     const double len = std::sqrt(m[r][0] * m[r][0] + m[r][1] * m[r][1] + m[r][2] * m[r][2]);
     if (!(len > 0.0) || !std::isfinite(len))
     {
-      throw Error("degenerate transform: index axis " + std::to_string(r) +
-        " has world length " + std::to_string(len));
+      throw Error("degenerate transform: index axis " + std::to_string(r) + " has world length " +
+        std::to_string(len));
     }
     info.Spacing[r] = len;
     info.Origin[r] = m[3][r];
@@ -557,12 +565,12 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
       info.Kind = KindOf(*grid);
       info.Components = ComponentsOf(info.Kind);
       info.GridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
-      const auto bmin = grid->getMetadata<openvdb::Vec3IMetadata>(
-        openvdb::GridBase::META_FILE_BBOX_MIN);
-      const auto bmax = grid->getMetadata<openvdb::Vec3IMetadata>(
-        openvdb::GridBase::META_FILE_BBOX_MAX);
-      const auto count = grid->getMetadata<openvdb::Int64Metadata>(
-        openvdb::GridBase::META_FILE_VOXEL_COUNT);
+      const auto bmin =
+        grid->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+      const auto bmax =
+        grid->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+      const auto count =
+        grid->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
       if (bmin && bmax && info.Supported())
       {
         for (int c = 0; c < 3; ++c)
@@ -607,8 +615,8 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
   }
   catch (const std::exception& e)
   {
-    throw Error("cannot read OpenVDB file " + Quote(path) +
-      " (truncated or corrupt?): " + e.what());
+    throw Error(
+      "cannot read OpenVDB file " + Quote(path) + " (truncated or corrupt?): " + e.what());
   }
   return result;
 }
@@ -621,7 +629,8 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
   }
   IndexBox box;
   std::array<double, 3> lo{ { std::numeric_limits<double>::max(),
-    std::numeric_limits<double>::max(), std::numeric_limits<double>::max() } };
+    std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max() } };
   std::array<double, 3> hi{ { -lo[0], -lo[1], -lo[2] } };
   for (int corner = 0; corner < 8; ++corner)
   {
@@ -642,8 +651,8 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
     const double limit = double(std::numeric_limits<int32_t>::max() / 2);
     if (!(std::abs(lo[c]) < limit && std::abs(hi[c]) < limit))
     {
-      throw Error("grid " + Quote(info.Name) +
-        " lies outside the 32-bit index range of the reference grid");
+      throw Error(
+        "grid " + Quote(info.Name) + " lies outside the 32-bit index range of the reference grid");
     }
     box.Min[c] = static_cast<int64_t>(std::floor(lo[c] + 1e-6));
     box.Max[c] = static_cast<int64_t>(std::ceil(hi[c] - 1e-6));
@@ -651,9 +660,14 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
   return box;
 }
 
-void ReadDense(const std::string& path, const std::vector<std::string>& names,
-  const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
-  std::vector<std::string>* resampled, const Progress& progress, TransformInfo* exact)
+void ReadDense(const std::string& path,
+  const std::vector<std::string>& names,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  const std::vector<float*>& target,
+  std::vector<std::string>* resampled,
+  const Progress& progress,
+  TransformInfo* exact)
 {
   Initialize();
   bool haveExact = false;
@@ -696,8 +710,8 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
             base, reference, box, target[g], wasResampled, own);
           break;
         default:
-          throw Error("grid " + Quote(names[g]) + " has unsupported value type " +
-            Quote(base->valueType()));
+          throw Error(
+            "grid " + Quote(names[g]) + " has unsupported value type " + Quote(base->valueType()));
       }
       if (wasResampled && resampled)
       {
@@ -726,8 +740,10 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
   }
 }
 
-uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
-  bool compress, const Progress& progress)
+uint64_t WriteFields(const std::string& path,
+  const std::vector<FieldToWrite>& fields,
+  bool compress,
+  const Progress& progress)
 {
   Initialize();
   if (path.empty())
@@ -783,9 +799,8 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
   try
   {
     openvdb::io::File file(tmp);
-    file.setCompression(compress
-        ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
-        : openvdb::io::COMPRESS_ACTIVE_MASK);
+    file.setCompression(compress ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
+                                 : openvdb::io::COMPRESS_ACTIVE_MASK);
     openvdb::MetaMap meta;
     meta.insertMeta("creator", openvdb::StringMetadata("Nimbus vtkNimbusOpenVDBWriter"));
     file.write(grids, meta);
@@ -800,8 +815,8 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
   {
     const std::string reason = std::strerror(errno);
     std::remove(tmp.c_str());
-    throw Error("cannot rename the written temporary " + Quote(tmp) + " to " + Quote(path) +
-      ": " + reason);
+    throw Error(
+      "cannot rename the written temporary " + Quote(tmp) + " to " + Quote(path) + ": " + reason);
   }
   if (progress)
   {

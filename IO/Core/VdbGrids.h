@@ -93,7 +93,7 @@ struct GridInfo
   std::string TypeName;  // OpenVDB's type name, e.g. "Tree_float_5_4_3"
   std::string ValueType; // "float", "double", "vec3s", "bool", ...
   ValueKind Kind = ValueKind::Unsupported;
-  int Components = 0; // 1 or 3 when supported
+  int Components = 0;    // 1 or 3 when supported
   std::string GridClass; // "fog volume", "level set", "staggered", "unknown"
   /// Active-voxel index box from the file's statistics metadata (file_bbox_min/max),
   /// or computed from the tree when the file has none (then TreeRead is true).
@@ -129,9 +129,13 @@ using Progress = std::function<void(double)>;
 /// the first grid copied without resampling, as read with its voxels: OpenVDB's
 /// metadata-only read (ReadFileInfo) can differ from it in the last bit of the voxel size.
 /// Throws Error on read failure.
-void ReadDense(const std::string& path, const std::vector<std::string>& names,
-  const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
-  std::vector<std::string>* resampled = nullptr, const Progress& progress = nullptr,
+void ReadDense(const std::string& path,
+  const std::vector<std::string>& names,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  const std::vector<float*>& target,
+  std::vector<std::string>* resampled = nullptr,
+  const Progress& progress = nullptr,
   TransformInfo* exact = nullptr);
 
 /// The index box of grid `info` expressed in the index space of `reference` (the box of
@@ -156,9 +160,12 @@ struct FieldToWrite
 /// Writes the fields as FloatGrid / Vec3SGrid to `path`. The file is written to
 /// `path + ".tmp-<pid>"` first and renamed over `path` only after a complete write, so a
 /// failure never leaves a partial or corrupted file. `compress` selects Blosc (else
-/// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the number of active voxels written.
-uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
-  bool compress = true, const Progress& progress = nullptr);
+/// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the
+/// number of active voxels written.
+uint64_t WriteFields(const std::string& path,
+  const std::vector<FieldToWrite>& fields,
+  bool compress = true,
+  const Progress& progress = nullptr);
 
 /// OpenVDB's version string, e.g. "10.0.1".
 std::string LibraryVersion();

@@ -26,8 +26,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <fstream>
+#include <iostream>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -95,8 +95,10 @@ std::string TempPath(const std::string& name)
 
 // An image with `n` points per axis over `extent`, a float array "density" = f(i,j,k) and
 // a 3-component float array "velocity".
-vtkSmartPointer<vtkImageData> MakeImage(const int extent[6], const double origin[3],
-  const double spacing[3], bool sparse)
+vtkSmartPointer<vtkImageData> MakeImage(const int extent[6],
+  const double origin[3],
+  const double spacing[3],
+  bool sparse)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetExtent(const_cast<int*>(extent));
@@ -123,7 +125,9 @@ vtkSmartPointer<vtkImageData> MakeImage(const int extent[6], const double origin
           d = 0.0f;
         }
         density->SetValue(id, d);
-        const float v[3] = { 1.0f + 0.1f * i, -2.0f + 0.01f * j * k, 0.5f * std::cos(float(i + k)) };
+        const float v[3] = {
+          1.0f + 0.1f * i, -2.0f + 0.01f * j * k, 0.5f * std::cos(float(i + k))
+        };
         velocity->SetTypedTuple(id, v);
       }
     }
@@ -133,7 +137,9 @@ vtkSmartPointer<vtkImageData> MakeImage(const int extent[6], const double origin
   return image;
 }
 
-bool Write(vtkImageData* image, const std::string& path, double tolerance = 0.0,
+bool Write(vtkImageData* image,
+  const std::string& path,
+  double tolerance = 0.0,
   MessageCatcher** catcherOut = nullptr)
 {
   vtkNew<vtkNimbusOpenVDBWriter> writer;
@@ -173,8 +179,11 @@ void WriteGrids(const std::string& path, const openvdb::GridPtrVec& grids, bool 
   file.close();
 }
 
-openvdb::FloatGrid::Ptr FloatBlock(const std::string& name, openvdb::Coord lo, openvdb::Coord hi,
-  double voxelSize, float value)
+openvdb::FloatGrid::Ptr FloatBlock(const std::string& name,
+  openvdb::Coord lo,
+  openvdb::Coord hi,
+  double voxelSize,
+  float value)
 {
   openvdb::initialize();
   auto grid = openvdb::FloatGrid::create(0.0f);
@@ -188,7 +197,9 @@ openvdb::FloatGrid::Ptr FloatBlock(const std::string& name, openvdb::Coord lo, o
   return grid;
 }
 
-std::string ReadErrors(const std::string& path, vtkIdType limit = 0, int* ok = nullptr,
+std::string ReadErrors(const std::string& path,
+  vtkIdType limit = 0,
+  int* ok = nullptr,
   std::string* warnings = nullptr)
 {
   vtkNew<vtkNimbusOpenVDBReader> reader;
@@ -340,8 +351,10 @@ TEST(RoundTrip, DenseFloatAndVec3Identical)
     EXPECT_EQ(out->GetOrigin()[c], origin[c]);
     EXPECT_EQ(out->GetSpacing()[c], spacing[c]);
   }
-  ExpectSameArray(image->GetPointData()->GetArray("density"), out->GetPointData()->GetArray("density"));
-  ExpectSameArray(image->GetPointData()->GetArray("velocity"), out->GetPointData()->GetArray("velocity"));
+  ExpectSameArray(
+    image->GetPointData()->GetArray("density"), out->GetPointData()->GetArray("density"));
+  ExpectSameArray(
+    image->GetPointData()->GetArray("velocity"), out->GetPointData()->GetArray("velocity"));
   // Non-uniform spacing is exact, and said so.
   EXPECT_TRUE(Contains(catcher.AllWarnings(), "non-uniform voxel size")) << catcher.AllWarnings();
 }
@@ -469,14 +482,16 @@ TEST(RoundTrip, RotatedImageKeepsDirection)
   vtkImageData* out = reader->GetOutput();
   for (int i = 0; i < 9; ++i)
   {
-    EXPECT_NEAR(out->GetDirectionMatrix()->GetData()[i], image->GetDirectionMatrix()->GetData()[i], 1e-15);
+    EXPECT_NEAR(
+      out->GetDirectionMatrix()->GetData()[i], image->GetDirectionMatrix()->GetData()[i], 1e-15);
   }
   for (int c = 0; c < 3; ++c)
   {
     EXPECT_NEAR(out->GetSpacing()[c], 1.5, 1e-14);
     EXPECT_NEAR(out->GetOrigin()[c], origin[c], 1e-14);
   }
-  ExpectSameArray(image->GetPointData()->GetArray("density"), out->GetPointData()->GetArray("density"));
+  ExpectSameArray(
+    image->GetPointData()->GetArray("density"), out->GetPointData()->GetArray("density"));
   EXPECT_TRUE(Contains(catcher.AllWarnings(), "direction matrix")) << catcher.AllWarnings();
 }
 
@@ -486,8 +501,8 @@ TEST(Read, InformationWithoutVoxels)
 {
   // A far, sparse block: the information pass knows the extent from the metadata alone,
   // proven by a file whose voxel data is cut off (information works, the read fails).
-  auto grid = FloatBlock("smoke", openvdb::Coord(10000, -5000, 3000),
-    openvdb::Coord(10003, -4998, 3004), 0.2, 1.0f);
+  auto grid = FloatBlock(
+    "smoke", openvdb::Coord(10000, -5000, 3000), openvdb::Coord(10003, -4998, 3004), 0.2, 1.0f);
   const std::string path = TempPath("far.vdb");
   WriteGrids(path, { grid });
   const std::string cut = TempPath("far-cut.vdb");
@@ -514,8 +529,8 @@ TEST(Read, InformationWithoutVoxels)
 
 TEST(Read, FarSparseGridValuesAndPositions)
 {
-  auto grid = FloatBlock("smoke", openvdb::Coord(10000, -5000, 3000),
-    openvdb::Coord(10003, -4998, 3004), 0.2, 1.0f);
+  auto grid = FloatBlock(
+    "smoke", openvdb::Coord(10000, -5000, 3000), openvdb::Coord(10003, -4998, 3004), 0.2, 1.0f);
   const std::string path = TempPath("far-ok.vdb");
   WriteGrids(path, { grid });
   vtkNew<vtkNimbusOpenVDBReader> reader;
@@ -632,7 +647,8 @@ TEST(Read, FrustumTransformWarns)
   EXPECT_TRUE(Contains(warnings, "non-linear")) << warnings;
 }
 
-// --- Bad inputs: clear errors, no crash -----------------------------------------------------------
+// --- Bad inputs: clear errors, no crash
+// -----------------------------------------------------------
 
 TEST(BadInput, MissingFile)
 {
@@ -701,7 +717,8 @@ TEST(BadInput, UnsupportedGridTypes)
 
   // Mixed with a float grid: the float grid is read, the others named in a warning.
   const std::string mixed = TempPath("mixed-types.vdb");
-  WriteGrids(mixed, { mask, FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f) });
+  WriteGrids(
+    mixed, { mask, FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f) });
   std::string warnings;
   errors = ReadErrors(mixed, 0, &ok, &warnings);
   EXPECT_EQ(ok, 1) << errors;
@@ -724,7 +741,8 @@ TEST(BadInput, EmptyGrids)
     << errors;
 
   const std::string mixed = TempPath("empty-and-full.vdb");
-  WriteGrids(mixed, { empty, FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f) });
+  WriteGrids(
+    mixed, { empty, FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f) });
   std::string warnings;
   errors = ReadErrors(mixed, 0, &ok, &warnings);
   EXPECT_EQ(ok, 1) << errors;
