@@ -211,7 +211,7 @@ vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakeP
   {
     throw vdb::Error("no grid selected (enable at least one in GridSelection)");
   }
-  const bool byGrid = boundsGrid && *boundsGrid;
+  bool byGrid = boundsGrid && *boundsGrid;
   if (byGrid)
   {
     for (const auto& g : in.Grids)
@@ -222,6 +222,10 @@ vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakeP
         break;
       }
     }
+    byGrid = plan.Reference || std::string(boundsGrid) != "(union)";
+  }
+  if (byGrid)
+  {
     if (!plan.Reference)
     {
       throw vdb::Error(

@@ -65,7 +65,8 @@ public:
 
   ///@{
   /// When set to a grid's name, the image covers that grid's active bounding box and that
-  /// grid's transform is the reference; empty (default): the union of the selected grids.
+  /// grid's transform is the reference; empty (default) or "(union)" (ParaView's drop-down
+  /// entry), unless a grid has that name: the union of the selected grids.
   vtkSetStringMacro(BoundsGrid);
   vtkGetStringMacro(BoundsGrid);
   ///@}

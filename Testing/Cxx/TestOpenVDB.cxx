@@ -632,6 +632,36 @@ TEST(Read, DifferentTransformsResampledAndWarned)
   EXPECT_LE(worst, 3.1e-5);
 }
 
+TEST(Read, BoundsGridChoosesTheBox)
+{
+  const std::string path = TempPath("two-boxes.vdb");
+  WriteGrids(path,
+    { FloatBlock("small", openvdb::Coord(2), openvdb::Coord(4), 1.0, 1.0f),
+      FloatBlock("large", openvdb::Coord(0), openvdb::Coord(9), 1.0, 2.0f) });
+  vtkNew<vtkNimbusOpenVDBReader> reader;
+  reader->SetFileName(path.c_str());
+  for (const char* bounds : { "", "(union)" })
+  {
+    reader->SetBoundsGrid(bounds);
+    reader->Update();
+    EXPECT_EQ(reader->GetOutput()->GetNumberOfPoints(), 1000) << bounds;
+  }
+  reader->SetBoundsGrid("small");
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfPoints(), 27);
+  EXPECT_EQ(reader->GetOutput()->GetExtent()[0], 2);
+  ASSERT_NE(reader->GetOutput()->GetPointData()->GetArray("large"), nullptr);
+  int ok = 1;
+  vtkNew<vtkNimbusOpenVDBReader> bad;
+  bad->SetFileName(path.c_str());
+  bad->SetBoundsGrid("missing");
+  MessageCatcher catcher(bad);
+  bad->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, vtkNew<vtkCallbackCommand>());
+  ok = bad->GetExecutive()->Update();
+  EXPECT_EQ(ok, 0);
+  EXPECT_TRUE(Contains(catcher.AllErrors(), "BoundsGrid 'missing' is not")) << catcher.AllErrors();
+}
+
 TEST(Read, FrustumTransformWarns)
 {
   openvdb::initialize();

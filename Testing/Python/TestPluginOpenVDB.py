@@ -66,6 +66,17 @@ def main():
         if a.shape != b.shape or not np.array_equal(a, b):
             failures.append(f"{name} differs (max {np.max(np.abs(a - b)) if a.shape == b.shape else a.shape})")
 
+    # BoundsGrid: a drop-down of "(union)" and the grid names.
+    domain = reader.GetProperty("BoundsGrid").SMProperty.FindDomain("vtkSMStringListDomain")
+    choices = [domain.GetString(i) for i in range(domain.GetNumberOfStrings())]
+    if choices != ["(union)", "RTData", "velocity"]:
+        failures.append(f"BoundsGrid choices {choices}")
+    reader.BoundsGrid = "velocity"
+    reader.UpdatePipeline()
+    if reader.GetDataInformation().GetNumberOfPoints() != source.GetNumberOfPoints():
+        failures.append("BoundsGrid='velocity' changed the image")
+    reader.BoundsGrid = "(union)"
+
     # Grid selection: only RTData.
     reader.Grids = ["RTData"]
     reader.UpdatePipeline()
