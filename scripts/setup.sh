@@ -27,6 +27,8 @@ packages=(
   # build tools and tests
   cmake ninja-build g++ make libgtest-dev nlohmann-json3-dev python3-matplotlib
   libbenchmark-dev
+  # OpenVDB reader/writer (IO/) and the tests' independent .vdb producer
+  libopenvdb-dev python3-openvdb
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
 )

@@ -8,5 +8,9 @@ The VTK classes of the Nimbus modules are re-exported here; VTK itself comes fro
 """
 from .NimbusFilters import *  # noqa: F401,F403
 from .NimbusRepresentations import *  # noqa: F401,F403
+try:  # vtkNimbusOpenVDBReader/Writer: built only when OpenVDB was found
+    from .NimbusIOOpenVDB import *  # noqa: F401,F403
+except ModuleNotFoundError:
+    pass
 
 __version__ = "0.1.0"

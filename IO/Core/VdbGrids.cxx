@@ -1,0 +1,829 @@
+// VdbGrids: every OpenVDB call of Nimbus's .vdb reader and writer (see VdbGrids.h).
+#include "VdbGrids.h"
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+#include <openvdb/tools/Interpolation.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace nimbus
+{
+namespace vdb
+{
+namespace
+{
+
+void Initialize()
+{
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+std::string Quote(const std::string& s)
+{
+  return "'" + s + "'";
+}
+
+std::string Vec3String(const std::array<double, 3>& v)
+{
+  std::ostringstream out;
+  out.precision(9);
+  out << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+  return out.str();
+}
+
+/// Fails with a clear message when `path` cannot be read as a regular file.
+void CheckReadable(const std::string& path)
+{
+  struct stat st;
+  if (path.empty())
+  {
+    throw Error("no file name given");
+  }
+  if (::stat(path.c_str(), &st) != 0)
+  {
+    throw Error("cannot open " + Quote(path) + ": " + std::strerror(errno));
+  }
+  if (!S_ISREG(st.st_mode))
+  {
+    throw Error(Quote(path) + " is not a regular file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    throw Error("cannot open " + Quote(path) + " for reading: " + std::strerror(errno));
+  }
+  // OpenVDB files start with the 64-bit magic number 0x56444220 ("VDB " little-endian).
+  unsigned char magic[8] = { 0 };
+  in.read(reinterpret_cast<char*>(magic), 8);
+  if (in.gcount() < 8 || magic[0] != 0x20 || magic[1] != 0x42 || magic[2] != 0x44 ||
+    magic[3] != 0x56)
+  {
+    throw Error(Quote(path) + " is not an OpenVDB file (no 'VDB' magic number at its start)");
+  }
+}
+
+ValueKind KindOf(const openvdb::GridBase& grid)
+{
+  if (grid.isType<openvdb::FloatGrid>())
+  {
+    return ValueKind::Float;
+  }
+  if (grid.isType<openvdb::DoubleGrid>())
+  {
+    return ValueKind::Double;
+  }
+  if (grid.isType<openvdb::Vec3SGrid>())
+  {
+    return ValueKind::Vec3Float;
+  }
+  if (grid.isType<openvdb::Vec3DGrid>())
+  {
+    return ValueKind::Vec3Double;
+  }
+  return ValueKind::Unsupported;
+}
+
+int ComponentsOf(ValueKind kind)
+{
+  switch (kind)
+  {
+    case ValueKind::Float:
+    case ValueKind::Double:
+      return 1;
+    case ValueKind::Vec3Float:
+    case ValueKind::Vec3Double:
+      return 3;
+    default:
+      return 0;
+  }
+}
+
+openvdb::CoordBBox ToCoordBox(const IndexBox& box)
+{
+  for (int c = 0; c < 3; ++c)
+  {
+    if (box.Min[c] < std::numeric_limits<int32_t>::min() ||
+      box.Max[c] > std::numeric_limits<int32_t>::max())
+    {
+      throw Error("index box outside OpenVDB's 32-bit coordinate range");
+    }
+  }
+  return openvdb::CoordBBox(openvdb::Coord(static_cast<int32_t>(box.Min[0]),
+                              static_cast<int32_t>(box.Min[1]),
+                              static_cast<int32_t>(box.Min[2])),
+    openvdb::Coord(static_cast<int32_t>(box.Max[0]),
+      static_cast<int32_t>(box.Max[1]),
+      static_cast<int32_t>(box.Max[2])));
+}
+
+IndexBox FromCoordBox(const openvdb::CoordBBox& bbox)
+{
+  IndexBox box;
+  if (bbox.empty())
+  {
+    return box;
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    box.Min[c] = bbox.min()[c];
+    box.Max[c] = bbox.max()[c];
+  }
+  return box;
+}
+
+/// The grid's transform as TransformInfo; non-linear maps are linearised at `at` (index).
+TransformInfo AnalyseTransform(const openvdb::math::Transform& transform, const openvdb::Vec3d& at)
+{
+  std::array<std::array<double, 4>, 4> m{};
+  if (transform.isLinear())
+  {
+    const openvdb::Mat4d mat = transform.baseMap()->getAffineMap()->getMat4();
+    for (int r = 0; r < 4; ++r)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        m[r][c] = mat(r, c);
+      }
+    }
+    return AnalyseLinearMatrix(m);
+  }
+  // Frustum (or other non-linear) map: its Jacobian at `at` gives the local index axes.
+  const auto map = transform.baseMap();
+  const openvdb::Vec3d centre = map->applyMap(at);
+  openvdb::Vec3d origin = centre;
+  for (int r = 0; r < 3; ++r)
+  {
+    openvdb::Vec3d axis(0.0);
+    axis[r] = 1.0;
+    const openvdb::Vec3d row = map->applyJacobian(axis, at);
+    for (int c = 0; c < 3; ++c)
+    {
+      m[r][c] = row[c];
+    }
+    origin -= row * at[r];
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    m[3][c] = origin[c];
+  }
+  m[3][3] = 1.0;
+  TransformInfo info = AnalyseLinearMatrix(m);
+  info.Linear = false;
+  std::ostringstream note;
+  note << "non-linear (" << map->type()
+       << ") transform: linearised at the centre of the active voxels, index "
+       << Vec3String({ { at[0], at[1], at[2] } }) << "; positions away from there are approximate";
+  info.Note = note.str() + (info.Note.empty() ? "" : "; " + info.Note);
+  return info;
+}
+
+std::array<double, 3> IndexToWorld(const TransformInfo& t, const std::array<double, 3>& ijk)
+{
+  std::array<double, 3> w = t.Origin;
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      w[r] += t.Direction[3 * c + r] * t.Spacing[c] * ijk[c];
+    }
+  }
+  return w;
+}
+
+std::array<double, 3> WorldToIndex(const TransformInfo& t, const std::array<double, 3>& w)
+{
+  // Direction is orthonormal (or the identity when sheared), so its inverse is its transpose.
+  std::array<double, 3> d{ { w[0] - t.Origin[0], w[1] - t.Origin[1], w[2] - t.Origin[2] } };
+  std::array<double, 3> ijk{};
+  for (int c = 0; c < 3; ++c)
+  {
+    double v = 0.0;
+    for (int r = 0; r < 3; ++r)
+    {
+      v += t.Direction[3 * c + r] * d[r];
+    }
+    ijk[c] = v / t.Spacing[c];
+  }
+  return ijk;
+}
+
+template<typename GridT, typename DenseValueT>
+void CopyToDense(const GridT& grid, const openvdb::CoordBBox& bbox, float* target)
+{
+  openvdb::tools::Dense<DenseValueT, openvdb::tools::LayoutXYZ> dense(
+    bbox, reinterpret_cast<DenseValueT*>(target));
+  openvdb::tools::copyToDense(grid, dense, /*serial=*/false);
+}
+
+inline float Element(float v, int)
+{
+  return v;
+}
+inline float Element(double v, int)
+{
+  return static_cast<float>(v);
+}
+template<typename T>
+inline float Element(const openvdb::math::Vec3<T>& v, int c)
+{
+  return static_cast<float>(v[c]);
+}
+
+/// Trilinear resampling of `grid` at the world positions of `reference`'s voxels in `box`.
+template<typename GridT>
+void ResampleToDense(const GridT& grid,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  float* target)
+{
+  using ValueT = typename GridT::ValueType;
+  constexpr int components = openvdb::VecTraits<ValueT>::Size;
+  const int64_t nx = box.Max[0] - box.Min[0] + 1;
+  const int64_t ny = box.Max[1] - box.Min[1] + 1;
+  const int64_t nz = box.Max[2] - box.Min[2] + 1;
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, nz),
+    [&](const tbb::blocked_range<int64_t>& r)
+    {
+      openvdb::tools::GridSampler<GridT, openvdb::tools::BoxSampler> sampler(grid);
+      for (int64_t k = r.begin(); k != r.end(); ++k)
+      {
+        for (int64_t j = 0; j < ny; ++j)
+        {
+          float* out = target + components * (nx * (j + ny * k));
+          for (int64_t i = 0; i < nx; ++i)
+          {
+            const auto w = IndexToWorld(reference,
+              { { double(box.Min[0] + i), double(box.Min[1] + j), double(box.Min[2] + k) } });
+            const ValueT v = sampler.wsSample(openvdb::Vec3d(w[0], w[1], w[2]));
+            for (int c = 0; c < components; ++c)
+            {
+              out[components * i + c] = Element(v, c);
+            }
+          }
+        }
+      }
+    });
+}
+
+template<typename GridT, typename DenseValueT>
+void Extract(const openvdb::GridBase::Ptr& base,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  float* target,
+  bool& resampled,
+  TransformInfo& own)
+{
+  const auto grid = openvdb::gridPtrCast<GridT>(base);
+  const auto bbox = grid->evalActiveVoxelBoundingBox();
+  const openvdb::Vec3d centre = bbox.empty() ? openvdb::Vec3d(0.0) : bbox.getCenter();
+  own = AnalyseTransform(grid->transform(), centre);
+  if (own.SameAs(reference))
+  {
+    CopyToDense<GridT, DenseValueT>(*grid, ToCoordBox(box), target);
+    resampled = false;
+  }
+  else
+  {
+    ResampleToDense(*grid, reference, box, target);
+    resampled = true;
+  }
+}
+
+void CheckTransformForWrite(const TransformInfo& t, const std::string& name)
+{
+  for (int c = 0; c < 3; ++c)
+  {
+    if (!(t.Spacing[c] > 0.0) || !std::isfinite(t.Spacing[c]) || !std::isfinite(t.Origin[c]))
+    {
+      throw Error("field " + Quote(name) + ": spacing " + Vec3String(t.Spacing) + " and origin " +
+        Vec3String(t.Origin) + " must be finite with spacing > 0");
+    }
+  }
+}
+
+openvdb::math::Transform::Ptr ToVdbTransform(const TransformInfo& t)
+{
+  const openvdb::Vec3d origin(t.Origin[0], t.Origin[1], t.Origin[2]);
+  const openvdb::Vec3d spacing(t.Spacing[0], t.Spacing[1], t.Spacing[2]);
+  bool identity = true;
+  for (int i = 0; i < 9; ++i)
+  {
+    identity = identity && t.Direction[i] == (i % 4 == 0 ? 1.0 : 0.0);
+  }
+  if (identity)
+  {
+    // Axis-aligned: built from a unit uniform scale map by postScale and postTranslate,
+    // which keep origin and spacing bit-exact (the Transform(MapBase) constructor and
+    // createLinearTransform(Mat4) simplify through an affine map and lose the last bit).
+    auto transform = openvdb::math::Transform::createLinearTransform(1.0);
+    if (spacing[0] == spacing[1] && spacing[1] == spacing[2])
+    {
+      transform = openvdb::math::Transform::createLinearTransform(spacing[0]);
+    }
+    else
+    {
+      transform->postScale(spacing);
+    }
+    transform->postTranslate(origin);
+    return transform;
+  }
+  openvdb::Mat4d m = openvdb::Mat4d::identity();
+  for (int r = 0; r < 3; ++r) // row r = world image of index axis r
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      m(r, c) = t.Direction[3 * r + c] * t.Spacing[r];
+    }
+    m(3, r) = t.Origin[r];
+  }
+  return openvdb::math::Transform::createLinearTransform(m);
+}
+
+template<typename GridT>
+typename GridT::Ptr BuildGrid(const FieldToWrite& field)
+{
+  using ValueT = typename GridT::ValueType;
+  const ValueT background(field.Background);
+  const ValueT tolerance(field.Tolerance);
+  auto grid = GridT::create(background);
+  openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(
+    ToCoordBox(field.Box), reinterpret_cast<ValueT*>(const_cast<float*>(field.Values)));
+  openvdb::tools::copyFromDense(dense, *grid, tolerance, /*serial=*/false);
+  grid->setName(field.Name);
+  grid->setTransform(ToVdbTransform(field.Transform));
+  grid->setSaveFloatAsHalf(false);
+  return grid;
+}
+
+} // namespace
+
+uint64_t IndexBox::VoxelCount() const
+{
+  if (Empty())
+  {
+    return 0;
+  }
+  uint64_t n = 1;
+  for (int c = 0; c < 3; ++c)
+  {
+    const uint64_t d = static_cast<uint64_t>(Max[c] - Min[c]) + 1;
+    if (d != 0 && n > std::numeric_limits<uint64_t>::max() / d)
+    {
+      return std::numeric_limits<uint64_t>::max();
+    }
+    n *= d;
+  }
+  return n;
+}
+
+IndexBox IndexBox::Union(const IndexBox& other) const
+{
+  if (Empty())
+  {
+    return other;
+  }
+  if (other.Empty())
+  {
+    return *this;
+  }
+  IndexBox u;
+  for (int c = 0; c < 3; ++c)
+  {
+    u.Min[c] = std::min(Min[c], other.Min[c]);
+    u.Max[c] = std::max(Max[c], other.Max[c]);
+  }
+  return u;
+}
+
+IndexBox IndexBox::Intersection(const IndexBox& other) const
+{
+  IndexBox u;
+  if (Empty() || other.Empty())
+  {
+    return u;
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    u.Min[c] = std::max(Min[c], other.Min[c]);
+    u.Max[c] = std::min(Max[c], other.Max[c]);
+  }
+  return u.Empty() ? IndexBox() : u;
+}
+
+bool TransformInfo::SameAs(const TransformInfo& other) const
+{
+  const double scale = std::max({ Spacing[0], Spacing[1], Spacing[2] });
+  const double eps = 1e-9 * scale;
+  for (int c = 0; c < 3; ++c)
+  {
+    if (std::abs(Spacing[c] - other.Spacing[c]) > eps ||
+      std::abs(Origin[c] - other.Origin[c]) > eps * std::max(1.0, std::abs(Origin[c]) / scale))
+    {
+      return false;
+    }
+  }
+  for (int i = 0; i < 9; ++i)
+  {
+    if (std::abs(Direction[i] - other.Direction[i]) > 1e-9)
+    {
+      return false;
+    }
+  }
+  return Linear == other.Linear;
+}
+
+TransformInfo AnalyseLinearMatrix(const std::array<std::array<double, 4>, 4>& m)
+{
+  TransformInfo info;
+  std::array<std::array<double, 3>, 3> axis{};
+  for (int r = 0; r < 3; ++r)
+  {
+    const double len = std::sqrt(m[r][0] * m[r][0] + m[r][1] * m[r][1] + m[r][2] * m[r][2]);
+    if (!(len > 0.0) || !std::isfinite(len))
+    {
+      throw Error("degenerate transform: index axis " + std::to_string(r) + " has world length " +
+        std::to_string(len));
+    }
+    info.Spacing[r] = len;
+    info.Origin[r] = m[3][r];
+    for (int c = 0; c < 3; ++c)
+    {
+      axis[r][c] = m[r][c] / len;
+    }
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    if (!std::isfinite(info.Origin[c]))
+    {
+      throw Error("transform with a non-finite translation");
+    }
+  }
+  // Orthogonality of the index axes in world space (cosine of the angle between them).
+  const double tol = 1e-6;
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = a + 1; b < 3; ++b)
+    {
+      const double cosine =
+        axis[a][0] * axis[b][0] + axis[a][1] * axis[b][1] + axis[a][2] * axis[b][2];
+      if (std::abs(cosine) > tol)
+      {
+        info.Sheared = true;
+      }
+    }
+  }
+  std::vector<std::string> notes;
+  if (info.Sheared)
+  {
+    notes.push_back("index axes are not orthogonal in world space (sheared transform), which an "
+                    "image cannot represent: the image is axis-aligned with origin = world "
+                    "position of index (0,0,0) " +
+      Vec3String(info.Origin) + " and spacing = world lengths of the index axes " +
+      Vec3String(info.Spacing) + "; the shear and any rotation are dropped");
+  }
+  else
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      for (int r = 0; r < 3; ++r)
+      {
+        info.Direction[3 * c + r] = axis[c][r];
+        if (std::abs(axis[c][r] - (r == c ? 1.0 : 0.0)) > 1e-12)
+        {
+          info.Rotated = true;
+        }
+      }
+    }
+    if (info.Rotated)
+    {
+      std::ostringstream s;
+      s.precision(9);
+      s << "rotated (or mirrored) transform: kept exactly as the image's direction matrix [";
+      for (int r = 0; r < 3; ++r)
+      {
+        s << (r ? "; " : "") << info.Direction[r] << " " << info.Direction[3 + r] << " "
+          << info.Direction[6 + r];
+      }
+      s << "], origin " << Vec3String(info.Origin) << ", spacing " << Vec3String(info.Spacing)
+        << " (ParaView filters and mappers that ignore the direction matrix show it "
+           "axis-aligned)";
+      notes.push_back(s.str());
+    }
+  }
+  const double smin = std::min({ info.Spacing[0], info.Spacing[1], info.Spacing[2] });
+  const double smax = std::max({ info.Spacing[0], info.Spacing[1], info.Spacing[2] });
+  if (smax - smin > 1e-9 * smax)
+  {
+    info.Anisotropic = true;
+    notes.push_back("non-uniform voxel size " + Vec3String(info.Spacing) +
+      ": kept exactly as the image's per-axis spacing");
+  }
+  for (size_t i = 0; i < notes.size(); ++i)
+  {
+    info.Note += (i ? "; " : "") + notes[i];
+  }
+  return info;
+}
+
+std::string LibraryVersion()
+{
+  return openvdb::getLibraryVersionString();
+}
+
+std::vector<GridInfo> ReadFileInfo(const std::string& path)
+{
+  Initialize();
+  CheckReadable(path);
+  std::vector<GridInfo> result;
+  try
+  {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/false);
+    const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+    for (const auto& grid : *grids)
+    {
+      GridInfo info;
+      info.Name = grid->getName();
+      info.TypeName = grid->type();
+      info.ValueType = grid->valueType();
+      info.Kind = KindOf(*grid);
+      info.Components = ComponentsOf(info.Kind);
+      info.GridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
+      const auto bmin =
+        grid->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+      const auto bmax =
+        grid->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+      const auto count =
+        grid->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
+      if (bmin && bmax && info.Supported())
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          info.ActiveBox.Min[c] = bmin->value()[c];
+          info.ActiveBox.Max[c] = bmax->value()[c];
+        }
+        if (info.ActiveBox.Empty())
+        {
+          info.ActiveBox = IndexBox();
+        }
+        info.ActiveVoxelCount = count ? count->value() : -1;
+      }
+      else if (info.Supported())
+      {
+        // No statistics metadata: read this grid's tree to find its active box.
+        const auto full = file.readGrid(grid->getName());
+        info.ActiveBox = FromCoordBox(full->evalActiveVoxelBoundingBox());
+        info.ActiveVoxelCount = static_cast<int64_t>(full->activeVoxelCount());
+        info.TreeRead = true;
+      }
+      if (info.ActiveVoxelCount == 0)
+      {
+        info.ActiveBox = IndexBox();
+      }
+      const openvdb::Vec3d centre = info.ActiveBox.Empty()
+        ? openvdb::Vec3d(0.0)
+        : openvdb::Vec3d(0.5 * double(info.ActiveBox.Min[0] + info.ActiveBox.Max[0]),
+            0.5 * double(info.ActiveBox.Min[1] + info.ActiveBox.Max[1]),
+            0.5 * double(info.ActiveBox.Min[2] + info.ActiveBox.Max[2]));
+      if (info.Supported())
+      {
+        info.Transform = AnalyseTransform(grid->transform(), centre);
+      }
+      result.push_back(std::move(info));
+    }
+    file.close();
+  }
+  catch (const Error&)
+  {
+    throw;
+  }
+  catch (const std::exception& e)
+  {
+    throw Error(
+      "cannot read OpenVDB file " + Quote(path) + " (truncated or corrupt?): " + e.what());
+  }
+  return result;
+}
+
+IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
+{
+  if (info.ActiveBox.Empty() || info.Transform.SameAs(reference))
+  {
+    return info.ActiveBox;
+  }
+  IndexBox box;
+  std::array<double, 3> lo{ { std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max() } };
+  std::array<double, 3> hi{ { -lo[0], -lo[1], -lo[2] } };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    std::array<double, 3> ijk{};
+    for (int c = 0; c < 3; ++c)
+    {
+      ijk[c] = double((corner >> c) & 1 ? info.ActiveBox.Max[c] : info.ActiveBox.Min[c]);
+    }
+    const auto r = WorldToIndex(reference, IndexToWorld(info.Transform, ijk));
+    for (int c = 0; c < 3; ++c)
+    {
+      lo[c] = std::min(lo[c], r[c]);
+      hi[c] = std::max(hi[c], r[c]);
+    }
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    const double limit = double(std::numeric_limits<int32_t>::max() / 2);
+    if (!(std::abs(lo[c]) < limit && std::abs(hi[c]) < limit))
+    {
+      throw Error(
+        "grid " + Quote(info.Name) + " lies outside the 32-bit index range of the reference grid");
+    }
+    box.Min[c] = static_cast<int64_t>(std::floor(lo[c] + 1e-6));
+    box.Max[c] = static_cast<int64_t>(std::ceil(hi[c] - 1e-6));
+  }
+  return box;
+}
+
+void ReadDense(const std::string& path,
+  const std::vector<std::string>& names,
+  const TransformInfo& reference,
+  const IndexBox& box,
+  const std::vector<float*>& target,
+  std::vector<std::string>* resampled,
+  const Progress& progress,
+  TransformInfo* exact)
+{
+  Initialize();
+  bool haveExact = false;
+  CheckReadable(path);
+  if (target.size() != names.size())
+  {
+    throw Error("ReadDense: one target buffer per grid name is needed");
+  }
+  if (box.Empty())
+  {
+    throw Error("ReadDense: empty index box");
+  }
+  try
+  {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/false);
+    for (size_t g = 0; g < names.size(); ++g)
+    {
+      if (!file.hasGrid(names[g]))
+      {
+        throw Error("no grid named " + Quote(names[g]) + " in " + Quote(path));
+      }
+      const auto base = file.readGrid(names[g]);
+      bool wasResampled = false;
+      TransformInfo own;
+      switch (KindOf(*base))
+      {
+        case ValueKind::Float:
+          Extract<openvdb::FloatGrid, float>(base, reference, box, target[g], wasResampled, own);
+          break;
+        case ValueKind::Double:
+          Extract<openvdb::DoubleGrid, float>(base, reference, box, target[g], wasResampled, own);
+          break;
+        case ValueKind::Vec3Float:
+          Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(
+            base, reference, box, target[g], wasResampled, own);
+          break;
+        case ValueKind::Vec3Double:
+          Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(
+            base, reference, box, target[g], wasResampled, own);
+          break;
+        default:
+          throw Error(
+            "grid " + Quote(names[g]) + " has unsupported value type " + Quote(base->valueType()));
+      }
+      if (wasResampled && resampled)
+      {
+        resampled->push_back(names[g]);
+      }
+      if (!wasResampled && exact && !haveExact)
+      {
+        *exact = own;
+        haveExact = true;
+      }
+      if (progress)
+      {
+        progress(double(g + 1) / double(names.size()));
+      }
+    }
+    file.close();
+  }
+  catch (const Error&)
+  {
+    throw;
+  }
+  catch (const std::exception& e)
+  {
+    throw Error("cannot read the voxels of OpenVDB file " + Quote(path) +
+      " (truncated or corrupt?): " + e.what());
+  }
+}
+
+uint64_t WriteFields(const std::string& path,
+  const std::vector<FieldToWrite>& fields,
+  bool compress,
+  const Progress& progress)
+{
+  Initialize();
+  if (path.empty())
+  {
+    throw Error("no file name given");
+  }
+  if (fields.empty())
+  {
+    throw Error("nothing to write: no float point or cell arrays with 1 or 3 components");
+  }
+  openvdb::GridPtrVec grids;
+  uint64_t active = 0;
+  for (size_t f = 0; f < fields.size(); ++f)
+  {
+    const FieldToWrite& field = fields[f];
+    if (field.Box.Empty() || !field.Values)
+    {
+      throw Error("field " + Quote(field.Name) + " is empty");
+    }
+    if (!(field.Tolerance >= 0.0f))
+    {
+      throw Error("tolerance must be >= 0 (got " + std::to_string(field.Tolerance) + ")");
+    }
+    CheckTransformForWrite(field.Transform, field.Name);
+    openvdb::GridBase::Ptr grid;
+    if (field.Components == 1)
+    {
+      grid = BuildGrid<openvdb::FloatGrid>(field);
+    }
+    else if (field.Components == 3)
+    {
+      grid = BuildGrid<openvdb::Vec3SGrid>(field);
+    }
+    else
+    {
+      throw Error("field " + Quote(field.Name) + " has " + std::to_string(field.Components) +
+        " components; only 1 (FloatGrid) and 3 (Vec3SGrid) are written");
+    }
+    if (field.FogVolume)
+    {
+      grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    }
+    grid->setCreator("Nimbus (vtkNimbusOpenVDBWriter)");
+    active += grid->activeVoxelCount();
+    grids.push_back(grid);
+    if (progress)
+    {
+      progress(0.8 * double(f + 1) / double(fields.size()));
+    }
+  }
+
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  try
+  {
+    openvdb::io::File file(tmp);
+    file.setCompression(compress ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
+                                 : openvdb::io::COMPRESS_ACTIVE_MASK);
+    openvdb::MetaMap meta;
+    meta.insertMeta("creator", openvdb::StringMetadata("Nimbus vtkNimbusOpenVDBWriter"));
+    file.write(grids, meta);
+    file.close();
+  }
+  catch (const std::exception& e)
+  {
+    std::remove(tmp.c_str());
+    throw Error("cannot write " + Quote(path) + " (temporary " + Quote(tmp) + "): " + e.what());
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  {
+    const std::string reason = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw Error(
+      "cannot rename the written temporary " + Quote(tmp) + " to " + Quote(path) + ": " + reason);
+  }
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return active;
+}
+
+} // namespace vdb
+} // namespace nimbus

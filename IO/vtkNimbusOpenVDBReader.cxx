@@ -1,0 +1,496 @@
+#include "vtkNimbusOpenVDBReader.h"
+
+#include "VdbGrids.h"
+
+#include "vtkCommand.h"
+#include "vtkDataArraySelection.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+
+#include <sys/stat.h>
+
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace vdb = nimbus::vdb;
+
+struct vtkNimbusOpenVDBReader::Internals
+{
+  // The file's grid descriptors, re-read when the file name or its time stamp changes.
+  std::string CachedPath;
+  long long CachedMTime = -1;
+  long long CachedSize = -1;
+  std::vector<vdb::GridInfo> Grids;
+
+  vtkNew<vtkDataArraySelection> Selection;
+  vtkNew<vtkStringArray> Names;
+
+  // The plan of the next read.
+  struct Plan
+  {
+    std::vector<const vdb::GridInfo*> Read; // selected supported grids, OpenVDB's order (by name)
+    const vdb::GridInfo* Reference = nullptr;
+    vdb::IndexBox Box;
+  };
+
+  // Reads the descriptors (if stale) and refreshes the selection list. Throws vdb::Error.
+  void Refresh(const std::string& path);
+  // Which grids to read, the reference transform and the index box. Throws vdb::Error.
+  Plan MakePlan(const char* boundsGrid, const std::string& path) const;
+};
+
+namespace
+{
+std::string Quote(const std::string& s)
+{
+  return "'" + s + "'";
+}
+
+bool StatFile(const std::string& path, long long& mtime, long long& size)
+{
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0)
+  {
+    return false;
+  }
+  mtime = static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;
+  size = static_cast<long long>(st.st_size);
+  return true;
+}
+
+}
+
+void vtkNimbusOpenVDBReader::Internals::Refresh(const std::string& path)
+{
+  Internals& in = *this;
+  long long mtime = -1, size = -1;
+  StatFile(path, mtime, size);
+  if (path == in.CachedPath && mtime == in.CachedMTime && size == in.CachedSize && mtime >= 0)
+  {
+    return;
+  }
+  in.CachedPath.clear();
+  in.Grids = vdb::ReadFileInfo(path);
+  in.CachedPath = path;
+  in.CachedMTime = mtime;
+  in.CachedSize = size;
+
+  std::set<std::string> present;
+  in.Names->Reset();
+  for (const auto& g : in.Grids)
+  {
+    if (g.Supported() && present.insert(g.Name).second)
+    {
+      in.Names->InsertNextValue(g.Name);
+      if (!in.Selection->ArrayExists(g.Name.c_str()))
+      {
+        in.Selection->AddArray(g.Name.c_str(), true);
+      }
+    }
+  }
+  // Forget grids of a previous file (keeps the user's choices for grids still present).
+  for (int i = in.Selection->GetNumberOfArrays() - 1; i >= 0; --i)
+  {
+    if (!present.count(in.Selection->GetArrayName(i)))
+    {
+      in.Selection->RemoveArrayByIndex(i);
+    }
+  }
+}
+
+vtkStandardNewMacro(vtkNimbusOpenVDBReader);
+
+vtkNimbusOpenVDBReader::vtkNimbusOpenVDBReader()
+  : Internal(new Internals)
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetNumberOfOutputPorts(1);
+  // Selection changes must re-execute the reader.
+  this->Internal->Selection->AddObserver(vtkCommand::ModifiedEvent, this, &vtkObject::Modified);
+}
+
+vtkNimbusOpenVDBReader::~vtkNimbusOpenVDBReader()
+{
+  this->SetFileName(nullptr);
+  this->SetBoundsGrid(nullptr);
+}
+
+int vtkNimbusOpenVDBReader::CanReadFile(const char* fileName)
+{
+  if (!fileName)
+  {
+    return 0;
+  }
+  FILE* f = std::fopen(fileName, "rb");
+  if (!f)
+  {
+    return 0;
+  }
+  unsigned char magic[4] = { 0, 0, 0, 0 };
+  const size_t n = std::fread(magic, 1, 4, f);
+  std::fclose(f);
+  return n == 4 && magic[0] == 0x20 && magic[1] == 0x42 && magic[2] == 0x44 && magic[3] == 0x56;
+}
+
+vtkDataArraySelection* vtkNimbusOpenVDBReader::GetGridSelection()
+{
+  return this->Internal->Selection;
+}
+
+int vtkNimbusOpenVDBReader::GetNumberOfGridArrays()
+{
+  return this->Internal->Selection->GetNumberOfArrays();
+}
+
+const char* vtkNimbusOpenVDBReader::GetGridArrayName(int index)
+{
+  return this->Internal->Selection->GetArrayName(index);
+}
+
+int vtkNimbusOpenVDBReader::GetGridArrayStatus(const char* name)
+{
+  return this->Internal->Selection->ArrayIsEnabled(name);
+}
+
+void vtkNimbusOpenVDBReader::SetGridArrayStatus(const char* name, int status)
+{
+  if (status)
+  {
+    this->Internal->Selection->EnableArray(name);
+  }
+  else
+  {
+    this->Internal->Selection->DisableArray(name);
+  }
+}
+
+vtkStringArray* vtkNimbusOpenVDBReader::GetGridNames()
+{
+  return this->Internal->Names;
+}
+
+vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakePlan(
+  const char* boundsGrid,
+  const std::string& path) const
+{
+  const Internals& in = *this;
+  Plan plan;
+  std::vector<std::string> unsupported;
+  std::set<std::string> taken;
+  for (const auto& g : in.Grids)
+  {
+    if (!g.Supported())
+    {
+      unsupported.push_back(Quote(g.Name) + " (" + g.ValueType + ")");
+      continue;
+    }
+    if (in.Selection->ArrayIsEnabled(g.Name.c_str()) && taken.insert(g.Name).second)
+    {
+      plan.Read.push_back(&g);
+    }
+  }
+  if (taken.empty() && in.Names->GetNumberOfValues() == 0)
+  {
+    std::string found;
+    for (const auto& u : unsupported)
+    {
+      found += (found.empty() ? "" : ", ") + u;
+    }
+    throw vdb::Error(Quote(path) + " has no float, double, Vec3s or Vec3d grid to read" +
+      (found.empty() ? std::string(" (it has no grids)") : " (found: " + found + ")"));
+  }
+  if (plan.Read.empty())
+  {
+    throw vdb::Error("no grid selected (enable at least one in GridSelection)");
+  }
+  bool byGrid = boundsGrid && *boundsGrid;
+  if (byGrid)
+  {
+    for (const auto& g : in.Grids)
+    {
+      if (g.Supported() && g.Name == boundsGrid)
+      {
+        plan.Reference = &g;
+        break;
+      }
+    }
+    byGrid = plan.Reference || std::string(boundsGrid) != "(union)";
+  }
+  if (byGrid)
+  {
+    if (!plan.Reference)
+    {
+      throw vdb::Error(
+        "BoundsGrid " + Quote(boundsGrid) + " is not a float/double/Vec3 grid of " + Quote(path));
+    }
+    plan.Box = plan.Reference->ActiveBox;
+    if (plan.Box.Empty())
+    {
+      throw vdb::Error("BoundsGrid " + Quote(boundsGrid) + " is empty (no active voxels)");
+    }
+    return plan;
+  }
+  // Reference: the first selected grid with active voxels (else the first selected).
+  plan.Reference = plan.Read.front();
+  for (const auto* g : plan.Read)
+  {
+    if (!g->ActiveBox.Empty())
+    {
+      plan.Reference = g;
+      break;
+    }
+  }
+  for (const auto* g : plan.Read)
+  {
+    plan.Box = plan.Box.Union(vdb::BoxInReference(*g, plan.Reference->Transform));
+  }
+  if (plan.Box.Empty())
+  {
+    std::string names;
+    for (const auto* g : plan.Read)
+    {
+      names += (names.empty() ? "" : ", ") + Quote(g->Name);
+    }
+    throw vdb::Error("every selected grid is empty (no active voxels): " + names);
+  }
+  return plan;
+}
+
+namespace
+{
+void RowMajorDirection(const vdb::TransformInfo& t, double out[9])
+{
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      out[3 * r + c] = t.Direction[3 * c + r];
+    }
+  }
+}
+}
+
+int vtkNimbusOpenVDBReader::RequestInformation(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
+{
+  if (!this->FileName || !*this->FileName)
+  {
+    vtkErrorMacro("FileName is not set: give the .vdb file to read");
+    return 0;
+  }
+  Internals::Plan plan;
+  try
+  {
+    this->Internal->Refresh(this->FileName);
+    plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
+  }
+  catch (const vdb::Error& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return 0;
+  }
+  const vdb::TransformInfo& t = plan.Reference->Transform;
+  int extent[6];
+  for (int c = 0; c < 3; ++c)
+  {
+    extent[2 * c] = static_cast<int>(plan.Box.Min[c]);
+    extent[2 * c + 1] = static_cast<int>(plan.Box.Max[c]);
+  }
+  double direction[9];
+  RowMajorDirection(t, direction);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  outInfo->Set(vtkDataObject::ORIGIN(), t.Origin.data(), 3);
+  outInfo->Set(vtkDataObject::SPACING(), t.Spacing.data(), 3);
+  outInfo->Set(vtkDataObject::DIRECTION(), direction, 9);
+  // The whole image is produced in one piece.
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 0);
+  return 1;
+}
+
+int vtkNimbusOpenVDBReader::RequestData(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
+{
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  if (!output)
+  {
+    vtkErrorMacro("no vtkImageData output");
+    return 0;
+  }
+  output->Initialize();
+  if (!this->FileName || !*this->FileName)
+  {
+    vtkErrorMacro("FileName is not set: give the .vdb file to read");
+    return 0;
+  }
+  Internals::Plan plan;
+  try
+  {
+    this->Internal->Refresh(this->FileName);
+    plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
+  }
+  catch (const vdb::Error& e)
+  {
+    vtkErrorMacro(<< e.what());
+    return 0;
+  }
+
+  // Refuse absurd images before allocating anything.
+  const uint64_t voxels = plan.Box.VoxelCount();
+  int components = 0;
+  for (const auto* g : plan.Read)
+  {
+    components += g->Components;
+  }
+  if (voxels > static_cast<uint64_t>(this->MaximumNumberOfVoxels))
+  {
+    std::ostringstream dims;
+    dims << (plan.Box.Max[0] - plan.Box.Min[0] + 1) << " x "
+         << (plan.Box.Max[1] - plan.Box.Min[1] + 1) << " x "
+         << (plan.Box.Max[2] - plan.Box.Min[2] + 1);
+    vtkErrorMacro(<< "refusing to read " << this->FileName << ": the image would have "
+                  << dims.str() << " = " << voxels << " points (" << components
+                  << " float components, "
+                  << (static_cast<double>(voxels) * components * 4.0 / (1024.0 * 1024.0))
+                  << " MiB), more than MaximumNumberOfVoxels = " << this->MaximumNumberOfVoxels
+                  << "; raise MaximumNumberOfVoxels, select fewer grids or set BoundsGrid");
+    return 0;
+  }
+
+  // Say what happened to transforms, empty grids and unsupported grids.
+  const vdb::TransformInfo& t = plan.Reference->Transform;
+  if (!t.Note.empty())
+  {
+    vtkWarningMacro(<< "grid " << Quote(plan.Reference->Name) << " of " << this->FileName << ": "
+                    << t.Note);
+  }
+  std::string unsupported;
+  for (const auto& g : this->Internal->Grids)
+  {
+    if (!g.Supported())
+    {
+      unsupported += (unsupported.empty() ? "" : ", ") + Quote(g.Name) + " (" + g.ValueType + ")";
+    }
+  }
+  if (!unsupported.empty())
+  {
+    vtkWarningMacro(<< "skipped grids of unsupported value type in " << this->FileName << ": "
+                    << unsupported << "; only float, double, Vec3s and Vec3d grids are read");
+  }
+  for (const auto* g : plan.Read)
+  {
+    if (g->ActiveBox.Empty())
+    {
+      vtkWarningMacro(<< "grid " << Quote(g->Name)
+                      << " has no active voxels: its array holds the grid's background value");
+    }
+  }
+
+  int extent[6];
+  for (int c = 0; c < 3; ++c)
+  {
+    extent[2 * c] = static_cast<int>(plan.Box.Min[c]);
+    extent[2 * c + 1] = static_cast<int>(plan.Box.Max[c]);
+  }
+  output->SetExtent(extent);
+  output->SetOrigin(t.Origin.data());
+  output->SetSpacing(t.Spacing.data());
+  double direction[9];
+  RowMajorDirection(t, direction);
+  output->SetDirectionMatrix(direction);
+
+  std::vector<std::string> names;
+  std::vector<float*> targets;
+  std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
+  for (const auto* g : plan.Read)
+  {
+    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    array->SetName(g->Name.c_str());
+    array->SetNumberOfComponents(g->Components);
+    if (!array->Allocate(static_cast<vtkIdType>(voxels) * g->Components))
+    {
+      vtkErrorMacro(<< "cannot allocate " << voxels << " x " << g->Components << " floats for grid "
+                    << Quote(g->Name));
+      output->Initialize();
+      return 0;
+    }
+    array->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
+    names.push_back(g->Name);
+    targets.push_back(array->GetPointer(0));
+    arrays.push_back(array);
+  }
+  std::vector<std::string> resampled;
+  vdb::TransformInfo exact = t;
+  try
+  {
+    vdb::ReadDense(
+      this->FileName,
+      names,
+      t,
+      plan.Box,
+      targets,
+      &resampled,
+      [this](double f) { this->UpdateProgress(f); },
+      &exact);
+  }
+  catch (const vdb::Error& e)
+  {
+    vtkErrorMacro(<< e.what());
+    output->Initialize();
+    return 0;
+  }
+  // The transform read with the voxels (bit-exact; see ReadDense).
+  output->SetOrigin(exact.Origin.data());
+  output->SetSpacing(exact.Spacing.data());
+  RowMajorDirection(exact, direction);
+  output->SetDirectionMatrix(direction);
+  for (const auto& name : resampled)
+  {
+    vtkWarningMacro(<< "grid " << Quote(name)
+                    << " has a different transform from the reference grid "
+                    << Quote(plan.Reference->Name)
+                    << ": resampled trilinearly at the image points (values are interpolated; "
+                       "read it alone, or set BoundsGrid to it, for its own voxels)");
+  }
+  for (size_t i = 0; i < arrays.size(); ++i)
+  {
+    output->GetPointData()->AddArray(arrays[i]);
+    if (i == 0)
+    {
+      if (arrays[i]->GetNumberOfComponents() == 1)
+      {
+        output->GetPointData()->SetActiveScalars(arrays[i]->GetName());
+      }
+    }
+    if (arrays[i]->GetNumberOfComponents() == 3 && !output->GetPointData()->GetVectors())
+    {
+      output->GetPointData()->SetActiveVectors(arrays[i]->GetName());
+    }
+  }
+  return 1;
+}
+
+void vtkNimbusOpenVDBReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "BoundsGrid: " << (this->BoundsGrid ? this->BoundsGrid : "(union)") << "\n";
+  os << indent << "MaximumNumberOfVoxels: " << this->MaximumNumberOfVoxels << "\n";
+  os << indent << "Grids:";
+  for (int i = 0; i < this->Internal->Selection->GetNumberOfArrays(); ++i)
+  {
+    os << " " << this->Internal->Selection->GetArrayName(i)
+       << (this->Internal->Selection->GetArraySetting(i) ? "(on)" : "(off)");
+  }
+  os << "\n";
+}

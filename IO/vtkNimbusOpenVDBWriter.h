@@ -1,0 +1,95 @@
+/**
+ * @class   vtkNimbusOpenVDBWriter
+ * @brief   Writes the point (and cell) arrays of a vtkImageData as OpenVDB (.vdb) grids.
+ *
+ * The reverse of vtkNimbusOpenVDBReader. Each 1-component numeric array becomes a
+ * FloatGrid and each 3-component array a Vec3SGrid named after the array (non-float arrays
+ * are converted to float; other component counts and non-numeric arrays are skipped with a
+ * warning). Image point (i, j, k) of the extent is VDB voxel (i, j, k); the grid transform
+ * maps it to the image's world position (origin, spacing and direction matrix). Cell arrays
+ * (when WriteCellData is on) are grids whose voxel (i, j, k) is cell (i, j, k), so their
+ * transform is shifted by half a voxel; a cell array whose name is also a point array's is
+ * written as "<name>_cells".
+ *
+ * Voxels whose value differs from Background by at most Tolerance (per component) are
+ * inactive and not stored: Tolerance 0 keeps every voxel that is not exactly the
+ * background. Scalar grids whose values are all >= 0 with Background 0 are tagged as fog
+ * volumes (OpenVDB's class for density). The file is written under a temporary name and
+ * renamed when complete, so a failed write never leaves a partial file or damages an
+ * existing one. Errors set the error code and Write() returns 0.
+ */
+#ifndef vtkNimbusOpenVDBWriter_h
+#define vtkNimbusOpenVDBWriter_h
+
+#include "NimbusIOOpenVDBModule.h" // export macro
+#include "vtkWriter.h"
+
+class vtkImageData;
+
+class NIMBUSIOOPENVDB_EXPORT vtkNimbusOpenVDBWriter : public vtkWriter
+{
+public:
+  static vtkNimbusOpenVDBWriter* New();
+  vtkTypeMacro(vtkNimbusOpenVDBWriter, vtkWriter);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The .vdb file to write.
+  vtkSetFilePathMacro(FileName);
+  vtkGetFilePathMacro(FileName);
+  ///@}
+
+  ///@{
+  /// Voxels within this distance of Background (per component, in the array's units) are
+  /// inactive and not stored. Default 0 (only exact background values are dropped).
+  vtkSetClampMacro(Tolerance, double, 0.0, VTK_FLOAT_MAX);
+  vtkGetMacro(Tolerance, double);
+  ///@}
+
+  ///@{
+  /// The grids' background (the value of inactive voxels; every component for Vec3 grids).
+  /// Default 0.
+  vtkSetMacro(Background, double);
+  vtkGetMacro(Background, double);
+  ///@}
+
+  ///@{
+  /// Also write cell arrays (default on).
+  vtkSetMacro(WriteCellData, bool);
+  vtkGetMacro(WriteCellData, bool);
+  vtkBooleanMacro(WriteCellData, bool);
+  ///@}
+
+  ///@{
+  /// Blosc compression (default on); off writes uncompressed voxel values (faster to
+  /// write and read, larger files).
+  vtkSetMacro(Compress, bool);
+  vtkGetMacro(Compress, bool);
+  vtkBooleanMacro(Compress, bool);
+  ///@}
+
+  /// Active voxels in the last file written (all grids together).
+  vtkGetMacro(NumberOfActiveVoxels, vtkIdType);
+
+  vtkImageData* GetInput();
+
+protected:
+  vtkNimbusOpenVDBWriter();
+  ~vtkNimbusOpenVDBWriter() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  void WriteData() override;
+
+  char* FileName = nullptr;
+  double Tolerance = 0.0;
+  double Background = 0.0;
+  bool WriteCellData = true;
+  bool Compress = true;
+  vtkIdType NumberOfActiveVoxels = 0;
+
+private:
+  vtkNimbusOpenVDBWriter(const vtkNimbusOpenVDBWriter&) = delete;
+  void operator=(const vtkNimbusOpenVDBWriter&) = delete;
+};
+
+#endif
