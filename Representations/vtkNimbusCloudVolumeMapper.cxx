@@ -561,6 +561,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   const std::array<float, 16> w2b = ColumnMajor(worldToBox);
   auto setCommon = [&](vtkShaderProgram* program) {
     program->SetUniformMatrix4x4("inverseViewProjection", const_cast<float*>(ivp.data()));
+    program->SetUniformi("perspective", camera->GetParallelProjection() ? 0 : 1);
+    program->SetUniform3f("eyePosition", camera->GetPosition());
     program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(w2t.data()));
     program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(w2b.data()));
     program->SetUniform3f("toSun", toSun.data());

@@ -55,7 +55,7 @@ DEFAULT_SETTINGS = {
         {"shading": "volumetric", "sample_distance": 0.5, "reach": 1.0},
         {"shading": "volumetric", "sample_distance": 0.25, "reach": 1.0},
     ],
-    "svs": [{"slices": n} for n in (32, 64, 128, 256, 512)],
+    "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)],
     "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }

@@ -3,6 +3,8 @@
 // world units, converted to metres with lengthUnit. Radiometry: linear sRGB,
 // relative to the sun (see Representations/Reference/SceneDescription.h).
 uniform mat4 inverseViewProjection; // NDC -> world
+uniform int perspective;            // 1: rays start at the eye, 0: on the near plane
+uniform vec3 eyePosition;           // world position of the eye (perspective)
 uniform vec3 toSun;                 // L, unit
 uniform vec3 sliceNormal;           // n, unit, dot(n, -L) > 0
 uniform float lengthUnit;           // metres per world unit
@@ -45,6 +47,13 @@ void ViewRay(vec2 uv, out vec3 origin, out vec3 direction)
   vec4 nearPoint = inverseViewProjection * vec4(ndc, -1.0, 1.0);
   vec4 farPoint = inverseViewProjection * vec4(ndc, 1.0, 1.0);
   origin = nearPoint.xyz / nearPoint.w;
+  // Perspective rays start at the eye, not on the near plane: the camera's
+  // clipping range (ParaView fits it to the props' bounds) must not cut the
+  // ground or the air between the eye and the cloud.
+  if (perspective != 0)
+  {
+    origin = eyePosition;
+  }
   direction = normalize(farPoint.xyz / farPoint.w - origin);
 }
 
