@@ -11,14 +11,16 @@ Checks, through paraview.simple only:
      atmosphere, ground) matches the baseline image;
   3. changing SunElevation re-renders and changes the image (a low sun is
      redder and darker), and does not upload the density volume again;
-  4. changing the input (a new metaball seed) uploads the volume exactly once.
+  4. changing the input (a new metaball seed) uploads the volume exactly once;
+  5. a two-step time series (.vti files) uploads once per change of time step,
+     never for a re-render or a lighting change at the same step.
 """
 import argparse
 import os
 import sys
 
-from paraview.simple import (ColorBy, CreateRenderView, Delete, LoadPlugin, Render,
-                             SaveScreenshot, Show)
+from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
+                             SaveData, SaveScreenshot, Show, XMLImageDataReader)
 from vtkmodules.vtkIOImage import vtkPNGReader
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
@@ -38,7 +40,7 @@ def read_png(path):
 
 
 def cloud_mapper(view):
-    """The vtkNimbusCloudVolumeMapper in the view, or None without `import nimbus`."""
+    """The visible vtkNimbusCloudVolumeMapper in the view (None without `import nimbus`)."""
     try:
         import nimbus  # noqa: F401 (registers the mapper's Python class)
     except ImportError:
@@ -48,7 +50,8 @@ def cloud_mapper(view):
     for _ in range(volumes.GetNumberOfItems()):
         volume = volumes.GetNextVolume()
         mapper = volume.GetMapper()
-        if mapper is not None and mapper.IsA("vtkNimbusCloudVolumeMapper"):
+        if volume.GetVisibility() and mapper is not None and \
+                mapper.IsA("vtkNimbusCloudVolumeMapper"):
             return mapper
     return None
 
@@ -137,6 +140,33 @@ def main():
         print("volume uploads after a new input and two renders:", changed)
         if changed != uploads + 1:
             failures.append("a new input should upload once (%d -> %d)" % (uploads, changed))
+
+        # A time series: step files written from two seeds, read back as one source.
+        steps = []
+        for step, seed in enumerate((3, 4)):
+            cloud.Seed = seed
+            path = os.path.join(args.output_dir, "CloudRepresentationStep_%d.vti" % step)
+            SaveData(path, proxy=cloud)
+            steps.append(path)
+        Hide(cloud, view)
+        series = XMLImageDataReader(FileName=steps)
+        series_display = Show(series, view)
+        series_display.SetRepresentationType("Cloud")
+        ColorBy(series_display, ("POINTS", "density"))
+        counts = []
+        for time, lighting in ((0.0, None), (0.0, None), (1.0, None), (1.0, 30.0), (0.0, None)):
+            view.ViewTime = time
+            if lighting is not None:
+                series_display.SunElevation = lighting
+            Render(view)
+            series_mapper = cloud_mapper(view)
+            counts.append(series_mapper.GetNumberOfVolumeUploads())
+        print("time series uploads after t=0, t=0, t=1, t=1 + sun change, t=0:", counts)
+        if [c - counts[0] for c in counts] != [0, 0, 1, 1, 2]:
+            failures.append("time series: expected one upload per change of time step, got %s"
+                            % counts)
+        Delete(series_display)
+        del series_display
 
     for failure in failures:
         print("FAILED:", failure)
