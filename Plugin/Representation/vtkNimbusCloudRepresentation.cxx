@@ -1,0 +1,77 @@
+#include "vtkNimbusCloudRepresentation.h"
+
+#include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkObjectFactory.h"
+
+vtkStandardNewMacro(vtkNimbusCloudRepresentation);
+
+vtkNimbusCloudRepresentation::vtkNimbusCloudRepresentation()
+{
+  // Replace the superclass's vtkMultiBlockVolumeMapper; the superclass connects
+  // the delivered data to VolumeMapper at each render request.
+  this->CloudMapper = vtkNimbusCloudVolumeMapper::New();
+  this->VolumeMapper.TakeReference(this->CloudMapper);
+}
+
+vtkNimbusCloudRepresentation::~vtkNimbusCloudRepresentation() = default;
+
+vtkNimbusCloudVolumeMapper* vtkNimbusCloudRepresentation::GetCloudMapper()
+{
+  return this->CloudMapper;
+}
+
+void vtkNimbusCloudRepresentation::UpdateMapperParameters()
+{
+  // Selects the density array (ColorArrayName, point or cell data) on the
+  // mapper, sets the actor's mapper and hides it while no array is selected.
+  // The branches for ParaView's own mappers are no-ops for this mapper.
+  this->Superclass::UpdateMapperParameters();
+}
+
+// Setters forward to the mapper without MarkModified(): the mapper's own
+// Modified() makes the next render use the value, and the delivered data (and
+// the uploaded density texture) stay as they are.
+#define NIMBUS_FORWARD(name, type)                                                                 \
+  void vtkNimbusCloudRepresentation::Set##name(type value)                                         \
+  {                                                                                                \
+    this->CloudMapper->Set##name(value);                                                           \
+  }                                                                                                \
+  type vtkNimbusCloudRepresentation::Get##name()                                                   \
+  {                                                                                                \
+    return this->CloudMapper->Get##name();                                                         \
+  }
+
+NIMBUS_FORWARD(ExtinctionPerDensity, double)
+NIMBUS_FORWARD(Albedo, double)
+NIMBUS_FORWARD(CloudG, double)
+NIMBUS_FORWARD(MultipleScattering, double)
+NIMBUS_FORWARD(SunAzimuth, double)
+NIMBUS_FORWARD(SunElevation, double)
+NIMBUS_FORWARD(SunIlluminance, double)
+NIMBUS_FORWARD(SunTemperature, double)
+NIMBUS_FORWARD(Atmosphere, bool)
+NIMBUS_FORWARD(HazeDensity, double)
+NIMBUS_FORWARD(HazeG, double)
+NIMBUS_FORWARD(RayleighScattering, double)
+NIMBUS_FORWARD(SceneAltitude, double)
+NIMBUS_FORWARD(Ground, bool)
+NIMBUS_FORWARD(GroundHeight, double)
+NIMBUS_FORWARD(GroundAlbedo, double)
+NIMBUS_FORWARD(Shafts, bool)
+NIMBUS_FORWARD(NumberOfSlices, int)
+NIMBUS_FORWARD(SliceAngleRatio, double)
+NIMBUS_FORWARD(ShadowSurfaceSize, int)
+NIMBUS_FORWARD(AtmosphereSteps, int)
+NIMBUS_FORWARD(MaximumTextureSize, int)
+NIMBUS_FORWARD(LengthUnit, double)
+NIMBUS_FORWARD(Exposure, double)
+NIMBUS_FORWARD(EncodeSrgb, bool)
+
+#undef NIMBUS_FORWARD
+
+void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "CloudMapper:\n";
+  this->CloudMapper->PrintSelf(os, indent.GetNextIndent());
+}

@@ -1,0 +1,133 @@
+/**
+ * @class   vtkNimbusCloudRepresentation
+ * @brief   ParaView volume representation that renders image data as a cloud.
+ *
+ * The "Cloud" representation type of image data in ParaView: ParaView's own
+ * vtkImageVolumeRepresentation (data delivery, outline LOD, scalar array
+ * selection through ColorArrayName) with its volume mapper replaced by
+ * vtkNimbusCloudVolumeMapper (shadow-view slices, paper 000). The selected
+ * point or cell array is the cloud density; the colour and opacity transfer
+ * functions are not used.
+ *
+ * The cloud, sun, atmosphere, ground and quality parameters are forwarded to
+ * the mapper as they are set (see vtkNimbusCloudVolumeMapper for their units
+ * and the equations they enter). Like the mapper settings of the superclass
+ * (e.g. SetBlendMode) they do not call MarkModified(): a lighting change
+ * re-renders the delivered data and never re-executes the representation, so
+ * the density texture is not uploaded again.
+ */
+#ifndef vtkNimbusCloudRepresentation_h
+#define vtkNimbusCloudRepresentation_h
+
+#include "NimbusCloudRepresentationModule.h" // for export macro
+#include "vtkImageVolumeRepresentation.h"
+
+class vtkNimbusCloudVolumeMapper;
+
+class NIMBUSCLOUDREPRESENTATION_EXPORT vtkNimbusCloudRepresentation
+  : public vtkImageVolumeRepresentation
+{
+public:
+  static vtkNimbusCloudRepresentation* New();
+  vtkTypeMacro(vtkNimbusCloudRepresentation, vtkImageVolumeRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The mapper this representation renders with (owned by the representation).
+  vtkNimbusCloudVolumeMapper* GetCloudMapper();
+
+  ///@{
+  /// Cloud optics: extinction per unit density [1/m], single-scattering albedo,
+  /// Cornette-Shanks g of the cloud, k_multi (000 Eq. 1).
+  void SetExtinctionPerDensity(double value);
+  double GetExtinctionPerDensity();
+  void SetAlbedo(double value);
+  double GetAlbedo();
+  void SetCloudG(double value);
+  double GetCloudG();
+  void SetMultipleScattering(double value);
+  double GetMultipleScattering();
+  ///@}
+
+  ///@{
+  /// Sun: azimuth [deg from +y toward +x], elevation [deg], illuminance above
+  /// the atmosphere (relative), blackbody temperature [K].
+  void SetSunAzimuth(double value);
+  double GetSunAzimuth();
+  void SetSunElevation(double value);
+  double GetSunElevation();
+  void SetSunIlluminance(double value);
+  double GetSunIlluminance();
+  void SetSunTemperature(double value);
+  double GetSunTemperature();
+  ///@}
+
+  ///@{
+  /// Atmosphere: on/off, haze (Mie) scattering at sea level [1/m], haze g,
+  /// Rayleigh scattering at sea level [1/m], altitude of z = 0 [m].
+  void SetAtmosphere(bool value);
+  bool GetAtmosphere();
+  void SetHazeDensity(double value);
+  double GetHazeDensity();
+  void SetHazeG(double value);
+  double GetHazeG();
+  void SetRayleighScattering(double value);
+  double GetRayleighScattering();
+  void SetSceneAltitude(double value);
+  double GetSceneAltitude();
+  ///@}
+
+  ///@{
+  /// Ground plane z = GroundHeight (world units), Lambertian albedo; shafts of light.
+  void SetGround(bool value);
+  bool GetGround();
+  void SetGroundHeight(double value);
+  double GetGroundHeight();
+  void SetGroundAlbedo(double value);
+  double GetGroundAlbedo();
+  void SetShafts(bool value);
+  bool GetShafts();
+  ///@}
+
+  ///@{
+  /// Quality: slice count, a of theta_e : theta_s = 1 : a (000 §4.2), shadow
+  /// surface texels per side, atmosphere samples per pixel, largest density
+  /// texture side (0: the GL limit).
+  void SetNumberOfSlices(int value);
+  int GetNumberOfSlices();
+  void SetSliceAngleRatio(double value);
+  double GetSliceAngleRatio();
+  void SetShadowSurfaceSize(int value);
+  int GetShadowSurfaceSize();
+  void SetAtmosphereSteps(int value);
+  int GetAtmosphereSteps();
+  void SetMaximumTextureSize(int value);
+  int GetMaximumTextureSize();
+  ///@}
+
+  ///@{
+  /// Metres per world unit; framebuffer = Exposure * radiance; sRGB encoding.
+  void SetLengthUnit(double value);
+  double GetLengthUnit();
+  void SetExposure(double value);
+  double GetExposure();
+  void SetEncodeSrgb(bool value);
+  bool GetEncodeSrgb();
+  ///@}
+
+protected:
+  vtkNimbusCloudRepresentation();
+  ~vtkNimbusCloudRepresentation() override;
+
+  /// The superclass's array selection and actor set-up; nothing that needs
+  /// ParaView's own mappers.
+  void UpdateMapperParameters() override;
+
+  /// Owned through the superclass's VolumeMapper.
+  vtkNimbusCloudVolumeMapper* CloudMapper = nullptr;
+
+private:
+  vtkNimbusCloudRepresentation(const vtkNimbusCloudRepresentation&) = delete;
+  void operator=(const vtkNimbusCloudRepresentation&) = delete;
+};
+
+#endif

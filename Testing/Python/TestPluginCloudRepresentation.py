@@ -1,0 +1,182 @@
+"""pvpython test of the plugin's "Cloud" representation (vtkNimbusCloudRepresentation).
+
+    pvpython TestPluginCloudRepresentation.py --plugin Nimbus.so --baseline B.png \
+        --output-dir DIR --compare-tool build/bin/nimbus-compare-images
+
+With `import nimbus` on PYTHONPATH the mapper's upload counter is checked too.
+
+Checks, through paraview.simple only:
+  1. "Cloud" is one of the representation types offered for image data;
+  2. the metaball cloud shown as "Cloud" with the XML defaults (noon-like sun,
+     atmosphere, ground) matches the baseline image;
+  3. changing SunElevation re-renders and changes the image (a low sun is
+     redder and darker), and does not upload the density volume again;
+  4. changing the input (a new metaball seed) uploads the volume exactly once;
+  5. a two-step time series (.vti files) uploads once per change of time step,
+     never for a re-render or a lighting change at the same step.
+"""
+import argparse
+import os
+import sys
+
+from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
+                             SaveData, SaveScreenshot, Show, XMLImageDataReader)
+from vtkmodules.vtkIOImage import vtkPNGReader
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from image_compare import compare_with_baseline  # noqa: E402
+
+SIZE = [320, 240]
+
+
+def read_png(path):
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    image = reader.GetOutput()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
+    return pixels[:, :3].astype(float)
+
+
+def cloud_mapper(view):
+    """The visible vtkNimbusCloudVolumeMapper in the view (None without `import nimbus`)."""
+    try:
+        import nimbus  # noqa: F401 (registers the mapper's Python class)
+    except ImportError:
+        return None
+    volumes = view.SMProxy.GetRenderer().GetVolumes()
+    volumes.InitTraversal()
+    for _ in range(volumes.GetNumberOfItems()):
+        volume = volumes.GetNextVolume()
+        mapper = volume.GetMapper()
+        if volume.GetVisibility() and mapper is not None and \
+                mapper.IsA("vtkNimbusCloudVolumeMapper"):
+            return mapper
+    return None
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--plugin", required=True)
+    parser.add_argument("--baseline", required=True)
+    parser.add_argument("--output-dir", required=True)
+    parser.add_argument("--compare-tool", required=True)
+    args = parser.parse_args()
+    os.makedirs(args.output_dir, exist_ok=True)
+    failures = []
+
+    LoadPlugin(args.plugin, ns=globals())
+    cloud = NimbusMetaballCloud(Dimensions=[64, 64, 44], Seed=3)  # noqa: F821 (from the plugin)
+
+    view = CreateRenderView()
+    view.ViewSize = SIZE
+    view.OrientationAxesVisibility = 0
+    view.UseColorPaletteForBackground = 0
+    # Black: the mapper draws the sky (atmosphere) over the framebuffer background.
+    view.Background = [0.0, 0.0, 0.0]
+    view.EnableRenderOnInteraction = 0
+    # The camera of the mapper's own image tests (TestCloudVolumeMapper).
+    view.CameraPosition = [0.0, -6000.0, 1500.0]
+    view.CameraFocalPoint = [0.0, 0.0, 1600.0]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.CameraViewAngle = 35.0
+
+    display = Show(cloud, view)
+    available = list(display.GetProperty("Representation").Available)
+    print("representation types:", available)
+    if "Cloud" not in available:
+        failures.append("'Cloud' is not among the representation types %s" % available)
+
+    display.SetRepresentationType("Cloud")
+    ColorBy(display, ("POINTS", "density"))
+    # A few properties set through the proxy (the others keep the XML defaults).
+    display.SunAzimuth = 135.0
+    display.SunElevation = 60.0
+    display.NumberOfSlices = 192
+    print("defaults: k_multi %g, Exposure %g, CloudG %g, HazeG %g, slices %d" % (
+        display.MultipleScattering, display.Exposure, display.CloudG, display.HazeG,
+        display.NumberOfSlices))
+
+    noon = os.path.join(args.output_dir, "TestPluginCloudRepresentation.png")
+    SaveScreenshot(noon, view, ImageResolution=SIZE)
+    if not compare_with_baseline(noon, args.baseline, args.output_dir, args.compare_tool):
+        failures.append("the noon image differs from the baseline")
+
+    mapper = cloud_mapper(view)
+    uploads = mapper.GetNumberOfVolumeUploads() if mapper else None
+    print("volume uploads after the first render:", uploads)
+    if mapper is not None and uploads != 1:
+        failures.append("expected 1 volume upload after the first render, got %s" % uploads)
+
+    # A lighting change: re-render, new picture, no new upload.
+    display.SunElevation = 8.0
+    Render(view)
+    low_sun = os.path.join(args.output_dir, "TestPluginCloudRepresentation-lowsun.png")
+    SaveScreenshot(low_sun, view, ImageResolution=SIZE)
+    a, b = read_png(noon), read_png(low_sun)
+    change = abs(a - b).mean()
+    print("mean |noon - low sun| = %.2f (of 255)" % change)
+    if change < 5.0:
+        failures.append("changing SunElevation changed the image by only %.2f" % change)
+    # The low sun through the atmosphere is redder relative to blue.
+    red_blue_noon = a[:, 0].mean() / max(a[:, 2].mean(), 1e-6)
+    red_blue_low = b[:, 0].mean() / max(b[:, 2].mean(), 1e-6)
+    print("mean red/blue: noon %.3f, low sun %.3f" % (red_blue_noon, red_blue_low))
+    if not red_blue_low > red_blue_noon:
+        failures.append("the low sun is not redder than noon")
+    if mapper is not None:
+        after = mapper.GetNumberOfVolumeUploads()
+        print("volume uploads after the lighting change:", after)
+        if after != uploads:
+            failures.append("a lighting change uploaded the volume again (%d -> %d)"
+                            % (uploads, after))
+
+        # A data change: exactly one more upload.
+        cloud.Seed = 4
+        Render(view)
+        Render(view)
+        changed = mapper.GetNumberOfVolumeUploads()
+        print("volume uploads after a new input and two renders:", changed)
+        if changed != uploads + 1:
+            failures.append("a new input should upload once (%d -> %d)" % (uploads, changed))
+
+        # A time series: step files written from two seeds, read back as one source.
+        steps = []
+        for step, seed in enumerate((3, 4)):
+            cloud.Seed = seed
+            path = os.path.join(args.output_dir, "CloudRepresentationStep_%d.vti" % step)
+            SaveData(path, proxy=cloud)
+            steps.append(path)
+        Hide(cloud, view)
+        series = XMLImageDataReader(FileName=steps)
+        series_display = Show(series, view)
+        series_display.SetRepresentationType("Cloud")
+        ColorBy(series_display, ("POINTS", "density"))
+        counts = []
+        for time, lighting in ((0.0, None), (0.0, None), (1.0, None), (1.0, 30.0), (0.0, None)):
+            view.ViewTime = time
+            if lighting is not None:
+                series_display.SunElevation = lighting
+            Render(view)
+            series_mapper = cloud_mapper(view)
+            counts.append(series_mapper.GetNumberOfVolumeUploads())
+        print("time series uploads after t=0, t=0, t=1, t=1 + sun change, t=0:", counts)
+        if [c - counts[0] for c in counts] != [0, 0, 1, 1, 2]:
+            failures.append("time series: expected one upload per change of time step, got %s"
+                            % counts)
+        Delete(series_display)
+        del series_display
+
+    for failure in failures:
+        print("FAILED:", failure)
+    print("cloud representation test", "FAILED" if failures else "passed")
+    # Release the view's OpenGL context while the X connection is still open.
+    Delete(display)
+    Delete(view)
+    del display, view
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
