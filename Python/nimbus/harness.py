@@ -176,6 +176,22 @@ class ReferenceModeRenderer:
         pass
 
 
+def read_framebuffer(window, capture_class, components):
+    """The window's back buffer as an H x W x components float32 array in [0, 1]."""
+    capture = capture_class()
+    capture.SetInput(window)
+    if components == 4:
+        capture.SetInputBufferTypeToRGBA()
+    else:
+        capture.SetInputBufferTypeToRGB()
+    capture.ReadFrontBufferOff()
+    capture.Update()
+    image = capture.GetOutput()
+    width, height, _ = image.GetDimensions()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, components)
+    return pixels.astype(np.float32) / 255.0
+
+
 class VtkGpuRenderer:
     """VTK's vtkGPUVolumeRayCastMapper with the scene mapped as faithfully as it allows.
 
@@ -315,15 +331,7 @@ class VtkGpuRenderer:
             self.mapper.SetVolumetricScatteringBlending(0.0)
             self.mapper.SetGlobalIlluminationReach(0.0)
         self.window.Render()
-        capture = self.capture_class()
-        capture.SetInput(self.window)
-        capture.SetInputBufferTypeToRGBA()
-        capture.ReadFrontBufferOff()
-        capture.Update()
-        image = capture.GetOutput()
-        width, height, _ = image.GetDimensions()
-        rgba = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, 4)
-        rgba = rgba.astype(np.float32) / 255.0
+        rgba = read_framebuffer(self.window, self.capture_class, 4)
         cloud = rgba[..., :3] / VTK_SCALE  # back to the scene's linear radiance units
         alpha = rgba[..., 3:4]
         return cloud + (1.0 - alpha) * self.sky
@@ -396,15 +404,7 @@ class SvsRenderer:
             width, height, _ = radiance.GetDimensions()
             rgba = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
             return rgba[..., :3].astype(np.float32).copy()
-        capture = self.capture_class()
-        capture.SetInput(self.window)
-        capture.SetInputBufferTypeToRGB()
-        capture.ReadFrontBufferOff()
-        capture.Update()
-        image = capture.GetOutput()
-        width, height, _ = image.GetDimensions()
-        rgb = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, 3)
-        return rgb.astype(np.float32) / 255.0 / VTK_SCALE
+        return read_framebuffer(self.window, self.capture_class, 3) / VTK_SCALE
 
     def close(self):
         self.window.Finalize()
