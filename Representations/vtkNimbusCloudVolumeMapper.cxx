@@ -438,6 +438,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   vtkOpenGLState::ScopedglEnableDisable savedBlendEnable(state, GL_BLEND);
   vtkOpenGLState::ScopedglEnableDisable savedDepthTest(state, GL_DEPTH_TEST);
   vtkOpenGLState::ScopedglEnableDisable savedScissor(state, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglScissor savedScissorBox(state);
   vtkOpenGLState::ScopedglEnableDisable savedCull(state, GL_CULL_FACE);
   vtkOpenGLState::ScopedglDepthMask savedDepthMask(state);
   vtkOpenGLState::ScopedglColorMask savedColorMask(state);
@@ -734,23 +735,21 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     drawRegion(-1e30, firstStart, false); // sunward of the cloud: unshadowed
   }
 
-  // Screen rectangle of the box when nothing outside it is drawn (scissor).
-  bool scissor = false;
-  int scissorBox[4] = { 0, 0, width, height };
-  if (!outsideRegions)
-  {
-    vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
+  // Scissor rectangles: each slice's passes only touch the pixels (and shadow
+  // texels) onto which the polygon "slice plane cut by the box" projects; outside
+  // it the density is zero. On screen this holds only when nothing outside the
+  // box is drawn (no atmosphere, no ground).
+  vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
+  auto screenRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4]) {
     double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
-    bool allInFront = true;
-    for (const auto& corner : corners)
+    for (const auto& point : points)
     {
-      const double p[4] = { corner[0], corner[1], corner[2], 1.0 };
+      const double p[4] = { point[0], point[1], point[2], 1.0 };
       double q[4];
       worldToNdc->MultiplyPoint(p, q);
       if (q[3] <= 1e-9)
       {
-        allInFront = false;
-        break;
+        return false; // behind the eye: no finite rectangle
       }
       for (int k = 0; k < 2; ++k)
       {
@@ -758,19 +757,40 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
         hi[k] = std::max(hi[k], q[k] / q[3]);
       }
     }
-    if (allInFront)
+    const int px0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
+    const int py0 = std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
+    const int px1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
+    const int py1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
+    rect[0] = px0;
+    rect[1] = py0;
+    rect[2] = std::max(px1 - px0, 0);
+    rect[3] = std::max(py1 - py0, 0);
+    return true;
+  };
+  auto shadowRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4]) {
+    const int size = this->ShadowSurfaceSize;
+    double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+    for (const auto& point : points)
     {
-      const int px0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
-      const int py0 = std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
-      const int px1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
-      const int py1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
-      scissorBox[0] = px0;
-      scissorBox[1] = py0;
-      scissorBox[2] = std::max(px1 - px0, 0);
-      scissorBox[3] = std::max(py1 - py0, 0);
-      scissor = true;
+      const nimbus::Vec3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
+        point[2] - frame.Origin[2] } };
+      const double st[2] = { nimbus::Dot(q, frame.U) / frame.Width * size,
+        nimbus::Dot(q, frame.W) / frame.Height * size };
+      for (int k = 0; k < 2; ++k)
+      {
+        lo[k] = std::min(lo[k], st[k]);
+        hi[k] = std::max(hi[k], st[k]);
+      }
     }
-  }
+    const int x0s = std::clamp(static_cast<int>(std::floor(lo[0])) - 1, 0, size);
+    const int y0s = std::clamp(static_cast<int>(std::floor(lo[1])) - 1, 0, size);
+    const int x1s = std::clamp(static_cast<int>(std::ceil(hi[0])) + 1, 0, size);
+    const int y1s = std::clamp(static_cast<int>(std::ceil(hi[1])) + 1, 0, size);
+    rect[0] = x0s;
+    rect[1] = y0s;
+    rect[2] = std::max(x1s - x0s, 0);
+    rect[3] = std::max(y1s - y0s, 0);
+  };
 
   // --- the slices: eye pass with the shadow so far, then the shadow update.
   vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
@@ -791,8 +811,16 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   for (size_t i = 0; i < planes.Offsets.size(); ++i)
   {
     const float offset = static_cast<float>(planes.Offsets[i]);
+    const std::vector<nimbus::Vec3> polygon =
+      nimbus::SlicePolygon(corners, axis.Normal, planes.Offsets[i]);
+    if (polygon.empty())
+    {
+      continue;
+    }
     in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
     state->vtkglViewport(0, 0, width, height);
+    int scissorBox[4];
+    const bool scissor = !outsideRegions && screenRect(polygon, scissorBox);
     if (scissor)
     {
       state->vtkglEnable(GL_SCISSOR_TEST);
@@ -811,11 +839,16 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     {
       in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
       state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+      int texels[4];
+      shadowRect(polygon, texels);
+      state->vtkglEnable(GL_SCISSOR_TEST);
+      state->vtkglScissor(texels[0], texels[1], texels[2], texels[3]);
       state->vtkglEnable(GL_BLEND);
       state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
       window->GetShaderCache()->ReadyShaderProgram(shadowProgram);
       shadowProgram->SetUniformf("sliceOffset", offset);
       in.ShadowPass->Render();
+      state->vtkglDisable(GL_SCISSOR_TEST);
       ++in.PassesLastRender;
     }
   }

@@ -94,6 +94,36 @@ SlicePlanes MakeSlicePlanes(double dMin, double dMax, int count)
   return planes;
 }
 
+std::vector<Vec3> SlicePolygon(const std::vector<Vec3>& corners, const Vec3& n, double d)
+{
+  std::vector<Vec3> points;
+  if (corners.size() != 8)
+  {
+    throw std::invalid_argument("SlicePolygon needs the 8 corners of a box");
+  }
+  for (int c = 0; c < 8; ++c)
+  {
+    for (int bit : { 1, 2, 4 })
+    {
+      if (c & bit)
+      {
+        continue;
+      }
+      const Vec3& a = corners[c];
+      const Vec3& b = corners[c | bit];
+      const double da = Dot(a, n) - d, db = Dot(b, n) - d;
+      if ((da < 0.0 && db < 0.0) || (da > 0.0 && db > 0.0))
+      {
+        continue;
+      }
+      const double t = da == db ? 0.0 : da / (da - db);
+      points.push_back({ { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]),
+        a[2] + t * (b[2] - a[2]) } });
+    }
+  }
+  return points;
+}
+
 ShadowFrame ComputeShadowFrame(const std::vector<Vec3>& corners, const Vec3& toSun, double margin)
 {
   const Vec3 l = Normalized(toSun);

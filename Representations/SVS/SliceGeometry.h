@@ -57,6 +57,13 @@ struct NIMBUSREPRESENTATIONS_EXPORT SlicePlanes
 };
 NIMBUSREPRESENTATIONS_EXPORT SlicePlanes MakeSlicePlanes(double dMin, double dMax, int count);
 
+/// Vertices of the polygon where the plane dot(x, n) = d cuts the box whose 8
+/// corners are given in the order corner c = (c & 1 ? x1 : x0, c & 2 ? y1 : y0,
+/// c & 4 ? z1 : z0) (any affine image of such a box). Empty when the plane misses
+/// the box. Used to scissor each slice's passes to the pixels it can touch.
+NIMBUSREPRESENTATIONS_EXPORT std::vector<Vec3> SlicePolygon(
+  const std::vector<Vec3>& corners, const Vec3& n, double d);
+
 /// Orthographic frame of the shadow surface: it faces the sun (normal -L) and
 /// covers the projection of the box corners. A point x maps to texture
 /// coordinates ((dot(x - Origin, U)) / Width, (dot(x - Origin, W)) / Height).

@@ -169,3 +169,30 @@ TEST(AtmosphereTable, RowsFollowTheAtmosphere)
   EXPECT_LT(worst, 2e-4); // measured 9.6e-5
   EXPECT_THROW(nimbus::BuildAtmosphereTable(scene, 10.0, 0.0, 16), std::invalid_argument);
 }
+
+TEST(SliceGeometry, SlicePolygonCutsTheBox)
+{
+  std::vector<Vec3> cube;
+  for (int c = 0; c < 8; ++c)
+  {
+    cube.push_back({ { (c & 1) ? 1.0 : 0.0, (c & 2) ? 1.0 : 0.0, (c & 4) ? 1.0 : 0.0 } });
+  }
+  const auto square = nimbus::SlicePolygon(cube, { { 0, 0, 1 } }, 0.25);
+  ASSERT_EQ(square.size(), 4u);
+  for (const Vec3& p : square)
+  {
+    EXPECT_DOUBLE_EQ(p[2], 0.25);
+  }
+  // The plane through the centre with normal (1,1,1) cuts a regular hexagon.
+  const Vec3 diagonal = nimbus::Normalized({ { 1, 1, 1 } });
+  const auto hexagon = nimbus::SlicePolygon(cube, diagonal, nimbus::Dot(diagonal, { { 0.5, 0.5, 0.5 } }));
+  ASSERT_EQ(hexagon.size(), 6u);
+  for (const Vec3& p : hexagon)
+  {
+    EXPECT_NEAR(p[0] + p[1] + p[2], 1.5, 1e-12);
+    EXPECT_NEAR(std::sqrt((p[0] - 0.5) * (p[0] - 0.5) + (p[1] - 0.5) * (p[1] - 0.5) + (p[2] - 0.5) * (p[2] - 0.5)),
+      std::sqrt(0.5), 1e-12);
+  }
+  EXPECT_TRUE(nimbus::SlicePolygon(cube, { { 0, 0, 1 } }, 2.0).empty());
+  EXPECT_THROW(nimbus::SlicePolygon({ { { 0, 0, 0 } } }, { { 0, 0, 1 } }, 0.0), std::invalid_argument);
+}
