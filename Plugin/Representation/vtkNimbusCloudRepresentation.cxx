@@ -1,5 +1,9 @@
 #include "vtkNimbusCloudRepresentation.h"
 
+#include "vtkDataObject.h"
+#include "vtkInformation.h"
+#include "vtkPVLODVolume.h"
+
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkObjectFactory.h"
 
@@ -26,6 +30,19 @@ void vtkNimbusCloudRepresentation::UpdateMapperParameters()
   // mapper, sets the actor's mapper and hides it while no array is selected.
   // The branches for ParaView's own mappers are no-ops for this mapper.
   this->Superclass::UpdateMapperParameters();
+  // ParaView picks a colour array by itself only for the types it knows by name
+  // ("Volume", "Slice"); with "Cloud" chosen while colouring is Solid Color there
+  // is none, and the superclass hides the actor. A density has an obvious default:
+  // the active scalars (point, else cell), as a standalone vtkVolumeMapper uses.
+  vtkInformation* info = this->GetInputArrayInformation(0);
+  const bool hasArray = info && info->Has(vtkDataObject::FIELD_NAME()) &&
+    info->Get(vtkDataObject::FIELD_NAME()) && info->Get(vtkDataObject::FIELD_NAME())[0] != 0;
+  if (!hasArray)
+  {
+    this->CloudMapper->SelectScalarArray(static_cast<const char*>(nullptr));
+    this->CloudMapper->SetScalarModeToDefault();
+    this->Actor->SetVisibility(this->GetVisibility());
+  }
 }
 
 // Setters forward to the mapper without MarkModified(): the mapper's own

@@ -168,6 +168,31 @@ def main():
         Delete(series_display)
         del series_display
 
+    # "Cloud" chosen while colouring is Solid Color: ParaView picks an array only for
+    # "Volume"/"Slice"; the representation falls back to the active scalars.
+    Hide(cloud, view)
+    plain = NimbusMetaballCloud(Dimensions=[64, 64, 44], Seed=3)  # noqa: F821
+    plain_display = Show(plain, view)
+    ColorBy(plain_display, None)
+    plain_display.SetRepresentationType("Cloud")
+    Render(view)
+    solid_path = os.path.join(args.output_dir, "TestPluginCloudRepresentation_solid.png")
+    SaveScreenshot(solid_path, view, ImageResolution=SIZE)
+    ColorBy(plain_display, ("POINTS", "density"))
+    Render(view)
+    coloured_path = os.path.join(args.output_dir, "TestPluginCloudRepresentation_coloured.png")
+    SaveScreenshot(coloured_path, view, ImageResolution=SIZE)
+    solid, coloured = read_png(solid_path), read_png(coloured_path)
+    difference = float(abs(solid - coloured).mean())
+    print("Solid Color vs density-coloured Cloud: mean |difference| %.3f" % difference)
+    if difference > 0.5:
+        failures.append("Cloud without a chosen array does not render the active scalars "
+                        "(mean difference %.3f)" % difference)
+    Hide(plain, view)
+    Show(cloud, view)
+    Delete(plain_display)
+    del plain_display
+
     for failure in failures:
         print("FAILED:", failure)
     print("cloud representation test", "FAILED" if failures else "passed")
