@@ -63,6 +63,33 @@ std::string FragmentSource(const char* pass)
 {
   return std::string("//VTK::System::Dec\n//VTK::Output::Dec\n") + svsCommon + "\n" + pass;
 }
+
+// Frees a texture's storage and sets clamp-to-edge wrapping and its filter, ready
+// for a new allocation.
+void ResetTexture(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, bool linear)
+{
+  texture->SetContext(window);
+  texture->ReleaseGraphicsResources(window);
+  texture->SetWrapS(vtkTextureObject::ClampToEdge);
+  texture->SetWrapT(vtkTextureObject::ClampToEdge);
+  texture->SetWrapR(vtkTextureObject::ClampToEdge);
+  const int filter = linear ? vtkTextureObject::Linear : vtkTextureObject::Nearest;
+  texture->SetMinificationFilter(filter);
+  texture->SetMagnificationFilter(filter);
+}
+
+// Binds the framebuffer with `target` as its only draw buffer. The attachment is
+// renewed every time: a reallocated texture keeps its vtkTextureObject, and
+// vtkOpenGLFramebufferObject skips attaching the same object again.
+void DrawInto(
+  vtkOpenGLFramebufferObject* framebuffer, vtkTextureObject* target, vtkOpenGLRenderWindow* window)
+{
+  framebuffer->SetContext(window);
+  framebuffer->Bind(GL_FRAMEBUFFER);
+  framebuffer->RemoveColorAttachment(0);
+  framebuffer->AddColorAttachment(0, target);
+  framebuffer->ActivateDrawBuffer(0);
+}
 }
 
 struct vtkNimbusCloudVolumeMapper::Internals
@@ -312,13 +339,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     {
       vtkWarningMacro(<< nonFinite << " density values are NaN or infinite; rendered as 0.");
     }
-    in.Density->SetContext(window);
-    in.Density->ReleaseGraphicsResources(window);
-    in.Density->SetWrapS(vtkTextureObject::ClampToEdge);
-    in.Density->SetWrapT(vtkTextureObject::ClampToEdge);
-    in.Density->SetWrapR(vtkTextureObject::ClampToEdge);
-    in.Density->SetMinificationFilter(vtkTextureObject::Linear);
-    in.Density->SetMagnificationFilter(vtkTextureObject::Linear);
+    ResetTexture(in.Density, window, true);
     if (!in.Density->Create3DFromRaw(texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
     {
       vtkErrorMacro("Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
@@ -456,11 +477,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     if (static_cast<int>(texture->GetWidth()) != w || static_cast<int>(texture->GetHeight()) != h ||
       !texture->GetHandle())
     {
-      texture->ReleaseGraphicsResources(window);
-      texture->SetWrapS(vtkTextureObject::ClampToEdge);
-      texture->SetWrapT(vtkTextureObject::ClampToEdge);
-      texture->SetMinificationFilter(vtkTextureObject::Nearest);
-      texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+      ResetTexture(texture, window, false);
       if (depth)
       {
         texture->AllocateDepth(w, h, vtkTextureObject::Float32);
@@ -543,12 +560,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     }
     if (in.Table.HasAtmosphere)
     {
-      in.AtmosphereTexture->SetContext(window);
-      in.AtmosphereTexture->ReleaseGraphicsResources(window);
-      in.AtmosphereTexture->SetWrapS(vtkTextureObject::ClampToEdge);
-      in.AtmosphereTexture->SetWrapT(vtkTextureObject::ClampToEdge);
-      in.AtmosphereTexture->SetMinificationFilter(vtkTextureObject::Linear);
-      in.AtmosphereTexture->SetMagnificationFilter(vtkTextureObject::Linear);
+      ResetTexture(in.AtmosphereTexture, window, true);
       in.AtmosphereTexture->Create2DFromRaw(in.Table.Samples, nimbus::AtmosphereTable::kRows, 4,
         VTK_FLOAT, in.Table.Data.data());
       ++in.AtmosphereBuilds;
@@ -615,20 +627,10 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   in.Shadow->SetContext(window);
   if (static_cast<int>(in.Shadow->GetWidth()) != this->ShadowSurfaceSize || !in.Shadow->GetHandle())
   {
-    in.Shadow->ReleaseGraphicsResources(window);
-    in.Shadow->SetWrapS(vtkTextureObject::ClampToEdge);
-    in.Shadow->SetWrapT(vtkTextureObject::ClampToEdge);
-    in.Shadow->SetMinificationFilter(vtkTextureObject::Linear);
-    in.Shadow->SetMagnificationFilter(vtkTextureObject::Linear);
+    ResetTexture(in.Shadow, window, true);
     in.Shadow->Allocate2D(this->ShadowSurfaceSize, this->ShadowSurfaceSize, 1, VTK_FLOAT);
   }
-  in.ShadowFramebuffer->SetContext(window);
-  in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
-  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
-  // skips attaching the same object again.
-  in.ShadowFramebuffer->RemoveColorAttachment(0);
-  in.ShadowFramebuffer->AddColorAttachment(0, in.Shadow);
-  in.ShadowFramebuffer->ActivateDrawBuffer(0);
+  DrawInto(in.ShadowFramebuffer, in.Shadow, window);
   state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
   state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
   state->vtkglClear(GL_COLOR_BUFFER_BIT);
@@ -644,13 +646,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   if (intervalKey != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
   {
     ensure2D(in.IntervalPhase, width, height, 4, false);
-    in.IntervalPhaseFramebuffer->SetContext(window);
-    in.IntervalPhaseFramebuffer->Bind(GL_FRAMEBUFFER);
-    // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
-    // skips attaching the same object again.
-    in.IntervalPhaseFramebuffer->RemoveColorAttachment(0);
-    in.IntervalPhaseFramebuffer->AddColorAttachment(0, in.IntervalPhase);
-    in.IntervalPhaseFramebuffer->ActivateDrawBuffer(0);
+    DrawInto(in.IntervalPhaseFramebuffer, in.IntervalPhase, window);
     state->vtkglViewport(0, 0, width, height);
     state->vtkglDisable(GL_BLEND);
     vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
@@ -668,13 +664,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
 
   // --- where each view ray ends this frame (opaque depth, ground, top of the atmosphere).
   ensure2D(in.RayEnds, width, height, 4, false);
-  in.RayEndsFramebuffer->SetContext(window);
-  in.RayEndsFramebuffer->Bind(GL_FRAMEBUFFER);
-  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
-  // skips attaching the same object again.
-  in.RayEndsFramebuffer->RemoveColorAttachment(0);
-  in.RayEndsFramebuffer->AddColorAttachment(0, in.RayEnds);
-  in.RayEndsFramebuffer->ActivateDrawBuffer(0);
+  DrawInto(in.RayEndsFramebuffer, in.RayEnds, window);
   state->vtkglViewport(0, 0, width, height);
   state->vtkglDisable(GL_BLEND);
   {
@@ -687,13 +677,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
 
   // --- accumulation (S, cloud transmittance), cleared to (0, 0, 0, 1).
   ensure2D(in.Accumulation, width, height, 4, false);
-  in.AccumulationFramebuffer->SetContext(window);
-  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-  // Re-attach: a reallocated texture keeps its vtkTextureObject, and the FBO
-  // skips attaching the same object again.
-  in.AccumulationFramebuffer->RemoveColorAttachment(0);
-  in.AccumulationFramebuffer->AddColorAttachment(0, in.Accumulation);
-  in.AccumulationFramebuffer->ActivateDrawBuffer(0);
+  DrawInto(in.AccumulationFramebuffer, in.Accumulation, window);
   state->vtkglViewport(0, 0, width, height);
   state->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   state->vtkglClear(GL_COLOR_BUFFER_BIT);
@@ -720,6 +704,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
     setCommon(program);
     program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+    program->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
     program->SetUniformf("regionStart", static_cast<float>(start));
     program->SetUniformf("regionEnd", static_cast<float>(end));
     program->SetUniformi("useShadow", useShadow ? 1 : 0);
@@ -883,6 +868,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   setCommon(composite);
   composite->SetUniformi("accumulation", in.Accumulation->GetTextureUnit());
   composite->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
+  composite->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
   composite->SetUniformf("exposure", static_cast<float>(this->Exposure));
   composite->SetUniformi("encodeSrgb", this->EncodeSrgb ? 1 : 0);
   in.CompositePass->Render();

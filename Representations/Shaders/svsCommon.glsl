@@ -113,6 +113,14 @@ vec3 AtmosphereRow(int row, float altitude)
   return texture(atmosphereTable, vec2(u, (float(row) + 0.5) / 4.0)).rgb;
 }
 
+// Sun light scattered by the air per metre at altitude h toward the pixel's view
+// direction, given the pixel's (Rayleigh, haze) phase values (000 Eq. 8, atmosphere).
+vec3 AirSource(float altitude, vec2 rayleighAndHazePhase)
+{
+  return AtmosphereRow(1, altitude) * rayleighAndHazePhase.x +
+    AtmosphereRow(2, altitude) * rayleighAndHazePhase.y;
+}
+
 vec3 SunIrradiance(float altitude)
 {
   return atmosphereOn != 0 ? max(AtmosphereRow(0, altitude), vec3(0.0)) : sunIrradianceTop;

@@ -6,6 +6,7 @@
 in vec2 texCoord;
 uniform sampler2D accumulation;
 uniform sampler2D sceneColor;
+uniform sampler2D rayEnds; // (t_end, t_ground) per pixel, this frame
 uniform float exposure;
 uniform int encodeSrgb;
 
@@ -25,8 +26,7 @@ void main()
   ViewRay(texCoord, origin, direction);
   vec4 sum = texture(accumulation, texCoord);
   vec4 background = texture(sceneColor, texCoord);
-  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-    GroundDistance(origin, direction));
+  float tEnd = texture(rayEnds, texCoord).r;
   vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
   vec3 result;
   if (encodeSrgb != 0)

@@ -9,6 +9,7 @@
 // toward the eye, a = 1, or 0 where the ground closes the ray in the region.
 in vec2 texCoord;
 uniform sampler2D intervalPhase;
+uniform sampler2D rayEnds;  // (t_end, t_ground) per pixel, this frame
 uniform float regionStart;  // d range of the region (dot(x, n)); +-1e30 for open ends
 uniform float regionEnd;
 uniform int useShadow;      // 1 after the cloud
@@ -20,9 +21,9 @@ void main()
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
   vec4 intervalAndPhase = texture(intervalPhase, texCoord);
-  float tGround = GroundDistance(origin, direction);
-  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-    tGround);
+  vec2 ends = texture(rayEnds, texCoord).rg;
+  float tEnd = ends.x;
+  float tGround = ends.y;
   float tEndMarch = min(tEnd, 1e9);
   // The part of [0, tEnd] where regionStart <= dot(x, n) < regionEnd.
   float d0 = dot(origin, sliceNormal);
@@ -55,8 +56,7 @@ void main()
       float dt = span * 2.0 * u / float(steps) * lengthUnit;
       vec3 p = origin + t * direction;
       float altitude = Altitude(p);
-      vec3 air = AtmosphereRow(1, altitude) * intervalAndPhase.z +
-        AtmosphereRow(2, altitude) * intervalAndPhase.w;
+      vec3 air = AirSource(altitude, intervalAndPhase.zw);
       if (useShadow != 0 && shaftsOn != 0)
       {
         air *= exp(-ShadowDepth(p));

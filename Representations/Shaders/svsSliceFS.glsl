@@ -64,8 +64,7 @@ void main()
         SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
       if (atmosphereOn != 0)
       {
-        vec3 air = AtmosphereRow(1, altitude) * intervalAndPhase.z +
-          AtmosphereRow(2, altitude) * intervalAndPhase.w;             // 000 Eq. 8, atmosphere
+        vec3 air = AirSource(altitude, intervalAndPhase.zw);            // 000 Eq. 8, atmosphere
         source += air * (shaftsOn != 0 ? sunTransmittance : 1.0);
       }
       source *= AtmosphereViewTransmittance(origin, direction, t);
