@@ -4,6 +4,7 @@
 #include "vtkNimbusSkyPassFS.h"
 
 #include "Sky.h"
+#include "SkyViewTextures.h"
 
 #include "vtkCamera.h"
 #include "vtkMath.h"
@@ -32,23 +33,15 @@ struct vtkNimbusSkyPass::Internals
   vtkOpenGLFramebufferObject* Framebuffer = nullptr;
   vtkTextureObject* Color = nullptr;
   vtkTextureObject* Depth = nullptr;
-  std::array<vtkTextureObject*, 3> SkyTextures{ { nullptr, nullptr, nullptr } };
+  nimbus::SkyViewTextures SkyView;
   std::array<vtkTextureObject*, 4> AerialTextures{ { nullptr, nullptr, nullptr, nullptr } };
-  const void* SkyTable = nullptr;    // identity of the uploaded tables
-  const void* AerialTable = nullptr;
-  int SkyBuilds = -1, AerialBuilds = -1;
+  const void* AerialTable = nullptr; // identity of the uploaded table
+  int AerialBuilds = -1;
   vtkOpenGLQuadHelper* Quad = nullptr;
 
   static vtkTextureObject* NewTexture(vtkOpenGLRenderWindow* window)
   {
-    vtkTextureObject* t = vtkTextureObject::New();
-    t->SetContext(window);
-    t->SetMinificationFilter(vtkTextureObject::Linear);
-    t->SetMagnificationFilter(vtkTextureObject::Linear);
-    t->SetWrapS(vtkTextureObject::ClampToEdge);
-    t->SetWrapT(vtkTextureObject::ClampToEdge);
-    t->SetWrapR(vtkTextureObject::ClampToEdge);
-    return t;
+    return nimbus::SkyViewTextures::NewLinearTexture(window);
   }
 
   void Release(vtkWindow* w)
@@ -63,10 +56,7 @@ struct vtkNimbusSkyPass::Internals
     };
     drop(this->Color);
     drop(this->Depth);
-    for (auto& t : this->SkyTextures)
-    {
-      drop(t);
-    }
+    this->SkyView.Release(w);
     for (auto& t : this->AerialTextures)
     {
       drop(t);
@@ -79,8 +69,8 @@ struct vtkNimbusSkyPass::Internals
     }
     delete this->Quad;
     this->Quad = nullptr;
-    this->SkyTable = this->AerialTable = nullptr;
-    this->SkyBuilds = this->AerialBuilds = -1;
+    this->AerialTable = nullptr;
+    this->AerialBuilds = -1;
   }
 };
 
@@ -168,33 +158,20 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   double eye[3];
   camera->GetPosition(eye);
   const double cameraAltitude = sky->GetObserverAltitude() + eye[2] * sky->GetMetresPerUnit();
-  const nimbus::SkyViewLut* skyView = nullptr;
   const nimbus::AerialPerspectiveLut* aerial = nullptr;
+  std::string tableError;
   try
   {
-    skyView = &sky->GetSkyViewLut();
     aerial = &sky->GetAerialPerspectiveLut(cameraAltitude);
   }
   catch (const std::exception& e)
   {
-    vtkErrorMacro("sky tables: " << e.what());
-    return;
+    tableError = e.what();
   }
-  const nimbus::SkyViewMapping& sm = skyView->GetMapping();
-  if (in.SkyBuilds != sky->GetSkyViewBuilds() || in.SkyTable != skyView)
+  if (!aerial || !in.SkyView.Update(window, sky, tableError))
   {
-    const std::size_t plane = static_cast<std::size_t>(sm.Rows()) * sm.Width * 3;
-    for (int k = 0; k < 3; ++k)
-    {
-      if (!in.SkyTextures[k])
-      {
-        in.SkyTextures[k] = Internals::NewTexture(window);
-      }
-      in.SkyTextures[k]->Create2DFromRaw(sm.Width, sm.Rows(), 3, VTK_FLOAT,
-        const_cast<float*>(skyView->GetTable().data() + k * plane));
-    }
-    in.SkyBuilds = sky->GetSkyViewBuilds();
-    in.SkyTable = skyView;
+    vtkErrorMacro("sky tables: " << tableError);
+    return;
   }
   const nimbus::SkyViewMapping& am = aerial->GetMapping();
   if (in.AerialBuilds != sky->GetAerialBuilds() || in.AerialTable != aerial)
@@ -225,7 +202,8 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   if (!in.Quad)
   {
     in.Quad = new vtkOpenGLQuadHelper(window,
-      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), vtkNimbusSkyPassFS, "");
+      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(),
+      nimbus::SkyViewTextures::Substitute(vtkNimbusSkyPassFS).c_str(), "");
   }
   else
   {
@@ -241,12 +219,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   in.Depth->Activate();
   program->SetUniformi("colorTexture", in.Color->GetTextureUnit());
   program->SetUniformi("depthTexture", in.Depth->GetTextureUnit());
-  const char* skyNames[3] = { "skyRayleigh", "skyMie", "skyIsotropic" };
-  for (int k = 0; k < 3; ++k)
-  {
-    in.SkyTextures[k]->Activate();
-    program->SetUniformi(skyNames[k], in.SkyTextures[k]->GetTextureUnit());
-  }
+  in.SkyView.Activate(program, sky);
   const char* aerialNames[4] = { "aerialRayleigh", "aerialMie", "aerialIsotropic",
     "aerialTransmittance" };
   for (int k = 0; k < 4; ++k)
@@ -261,17 +234,6 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   program->SetUniformMatrix("inverseViewProjection", inverse);
   program->SetUniform3f("cameraPosition", eye);
   program->SetUniformf("metresPerUnit", static_cast<float>(sky->GetMetresPerUnit()));
-  double sun[3], scale[3], disc[3];
-  sky->GetSunDirection(sun);
-  sky->GetDisplayScale(scale);
-  sky->GetSunDiscRadiance(disc);
-  program->SetUniform3f("sunDirection", sun);
-  program->SetUniformf("sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuth())));
-  program->SetUniformf("mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.mieG));
-  program->SetUniform3f("displayScale", scale);
-  const float skyTable[4] = { static_cast<float>(sm.HorizonZenith), static_cast<float>(sm.Width),
-    static_cast<float>(sm.AboveRows), static_cast<float>(sm.BelowRows) };
-  program->SetUniform4f("skyTable", skyTable);
   const float aerialTable[4] = { static_cast<float>(am.HorizonZenith), static_cast<float>(am.Width),
     static_cast<float>(am.AboveRows), static_cast<float>(am.BelowRows) };
   program->SetUniform4f("aerialTable", aerialTable);
@@ -279,9 +241,6 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
     static_cast<float>(aerial->GetMaxDistance()) };
   program->SetUniform2f("aerialSlices", slices);
   program->SetUniformi("aerialPerspective", this->AerialPerspective ? 1 : 0);
-  program->SetUniformi("sunDisc", sky->GetSunDisc() ? 1 : 0);
-  program->SetUniform3f("sunDiscRadiance", disc);
-  program->SetUniformf("sunRadius", static_cast<float>(vtkNimbusSky::GetSunAngularRadius()));
 
   vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
   vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
@@ -295,10 +254,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   in.Quad->Render();
   in.Color->Deactivate();
   in.Depth->Deactivate();
-  for (auto* t : in.SkyTextures)
-  {
-    t->Deactivate();
-  }
+  in.SkyView.Deactivate();
   for (auto* t : in.AerialTextures)
   {
     t->Deactivate();

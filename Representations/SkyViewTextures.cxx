@@ -1,0 +1,125 @@
+#include "SkyViewTextures.h"
+
+#include "Sky.h"
+#include "nimbusSkyView.h"
+#include "vtkMath.h"
+#include "vtkNimbusSky.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkShaderProgram.h"
+#include "vtkTextureObject.h"
+
+#include <exception>
+
+namespace nimbus
+{
+SkyViewTextures::~SkyViewTextures()
+{
+  this->Release(nullptr);
+}
+
+vtkTextureObject* SkyViewTextures::NewLinearTexture(vtkOpenGLRenderWindow* window)
+{
+  vtkTextureObject* t = vtkTextureObject::New();
+  t->SetContext(window);
+  t->SetMinificationFilter(vtkTextureObject::Linear);
+  t->SetMagnificationFilter(vtkTextureObject::Linear);
+  t->SetWrapS(vtkTextureObject::ClampToEdge);
+  t->SetWrapT(vtkTextureObject::ClampToEdge);
+  t->SetWrapR(vtkTextureObject::ClampToEdge);
+  return t;
+}
+
+std::string SkyViewTextures::Substitute(const char* source)
+{
+  std::string result(source);
+  vtkShaderProgram::Substitute(result, "//NIMBUS::SkyView", nimbusSkyView);
+  return result;
+}
+
+bool SkyViewTextures::Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, std::string& error)
+{
+  const SkyViewLut* table = nullptr;
+  try
+  {
+    table = &sky->GetSkyViewLut();
+  }
+  catch (const std::exception& e)
+  {
+    error = e.what();
+    return false;
+  }
+  if (this->Builds == sky->GetSkyViewBuilds() && this->Table == table && this->Textures[0])
+  {
+    return true;
+  }
+  const SkyViewMapping& m = table->GetMapping();
+  const std::size_t plane = static_cast<std::size_t>(m.Rows()) * m.Width * 3;
+  for (int k = 0; k < 3; ++k)
+  {
+    if (!this->Textures[k])
+    {
+      this->Textures[k] = NewLinearTexture(window);
+    }
+    this->Textures[k]->Create2DFromRaw(
+      m.Width, m.Rows(), 3, VTK_FLOAT, const_cast<float*>(table->GetTable().data() + k * plane));
+  }
+  this->Builds = sky->GetSkyViewBuilds();
+  this->Table = table;
+  return true;
+}
+
+void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
+{
+  const char* names[3] = { "skyRayleigh", "skyMie", "skyIsotropic" };
+  for (int k = 0; k < 3; ++k)
+  {
+    this->Textures[k]->Activate();
+    program->SetUniformi(names[k], this->Textures[k]->GetTextureUnit());
+  }
+  const SkyViewMapping& m = sky->GetSkyViewLut().GetMapping();
+  double sun[3], scale[3], disc[3];
+  sky->GetSunDirection(sun);
+  sky->GetDisplayScale(scale);
+  sky->GetSunDiscRadiance(disc);
+  program->SetUniform3f("sunDirection", sun);
+  program->SetUniformf(
+    "sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuth())));
+  program->SetUniformf("mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.mieG));
+  program->SetUniform3f("displayScale", scale);
+  const float skyTable[4] = { static_cast<float>(m.HorizonZenith), static_cast<float>(m.Width),
+    static_cast<float>(m.AboveRows), static_cast<float>(m.BelowRows) };
+  program->SetUniform4f("skyTable", skyTable);
+  program->SetUniformi("sunDisc", sky->GetSunDisc() ? 1 : 0);
+  program->SetUniform3f("sunDiscRadiance", disc);
+  program->SetUniformf("sunRadius", static_cast<float>(vtkNimbusSky::GetSunAngularRadius()));
+}
+
+void SkyViewTextures::Deactivate()
+{
+  for (vtkTextureObject* t : this->Textures)
+  {
+    if (t)
+    {
+      t->Deactivate();
+    }
+  }
+}
+
+void SkyViewTextures::Release(vtkWindow* window)
+{
+  for (vtkTextureObject*& t : this->Textures)
+  {
+    if (t)
+    {
+      if (window)
+      {
+        t->ReleaseGraphicsResources(window);
+      }
+      t->Delete();
+      t = nullptr;
+    }
+  }
+  this->Table = nullptr;
+  this->Builds = -1;
+}
+}

@@ -1,0 +1,47 @@
+// nimbus::SkyViewTextures — the sky-view table of a vtkNimbusSky as three GL
+// textures (A_R, A_M, A_I) and the uniforms of SkyShaders/nimbusSkyView.glsl.
+// Shared by vtkNimbusSkyPass and vtkNimbusSkyBackground so that both draw the
+// same sky. Uploads again only when the sky rebuilt its table.
+#ifndef nimbus_SkyViewTextures_h
+#define nimbus_SkyViewTextures_h
+
+#include <array>
+#include <string>
+
+class vtkNimbusSky;
+class vtkOpenGLRenderWindow;
+class vtkShaderProgram;
+class vtkTextureObject;
+class vtkWindow;
+
+namespace nimbus
+{
+class SkyViewTextures
+{
+public:
+  SkyViewTextures() = default;
+  ~SkyViewTextures();
+  SkyViewTextures(const SkyViewTextures&) = delete;
+  SkyViewTextures& operator=(const SkyViewTextures&) = delete;
+
+  /// Builds (through the sky's cache) and uploads the sky-view table when it
+  /// changed. False, with the reason in `error`, when the table cannot be built.
+  bool Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, std::string& error);
+  /// Binds the textures and sets the sky uniforms of nimbusSkyView.glsl.
+  void Activate(vtkShaderProgram* program, vtkNimbusSky* sky);
+  void Deactivate();
+  void Release(vtkWindow* window);
+
+  /// The GLSL of nimbusSkyView.glsl put where `//NIMBUS::SkyView` is in `source`.
+  static std::string Substitute(const char* source);
+  /// A float texture with linear filtering and clamp-to-edge wrapping.
+  static vtkTextureObject* NewLinearTexture(vtkOpenGLRenderWindow* window);
+
+private:
+  std::array<vtkTextureObject*, 3> Textures{ { nullptr, nullptr, nullptr } };
+  const void* Table = nullptr; // identity of the uploaded table
+  int Builds = -1;
+};
+}
+
+#endif

@@ -1,0 +1,162 @@
+#include "vtkNimbusSkyBackground.h"
+
+#include "SkyViewTextures.h"
+#include "vtkCamera.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackgroundFS.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLError.h"
+#include "vtkOpenGLQuadHelper.h"
+#include "vtkOpenGLRenderUtilities.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkRenderer.h"
+#include "vtkShaderProgram.h"
+
+#include <algorithm>
+#include <string>
+
+vtkStandardNewMacro(vtkNimbusSkyBackground);
+
+struct vtkNimbusSkyBackground::Internals
+{
+  nimbus::SkyViewTextures SkyView;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  vtkOpenGLRenderWindow* Window = nullptr;
+
+  void Release(vtkWindow* window)
+  {
+    this->SkyView.Release(window);
+    if (this->Quad)
+    {
+      this->Quad->ReleaseGraphicsResources(window);
+      this->Quad.reset();
+    }
+    this->Window = nullptr;
+  }
+};
+
+vtkNimbusSkyBackground::vtkNimbusSkyBackground()
+  : Internal(new Internals)
+{
+  this->Sky = vtkNimbusSky::New();
+  this->PickableOff();
+}
+
+vtkNimbusSkyBackground::~vtkNimbusSkyBackground()
+{
+  if (this->Sky)
+  {
+    this->Sky->Delete();
+  }
+}
+
+void vtkNimbusSkyBackground::SetSky(vtkNimbusSky* sky)
+{
+  if (!sky)
+  {
+    vtkErrorMacro("SetSky: a sky is required (keeping the current one).");
+    return;
+  }
+  if (sky == this->Sky)
+  {
+    return;
+  }
+  sky->Register(this);
+  this->Sky->UnRegister(this);
+  this->Sky = sky;
+  this->Modified();
+}
+
+vtkMTimeType vtkNimbusSkyBackground::GetMTime()
+{
+  return std::max(this->Superclass::GetMTime(), this->Sky->GetMTime());
+}
+
+void vtkNimbusSkyBackground::ReleaseGraphicsResources(vtkWindow* window)
+{
+  this->Internal->Release(window);
+  this->Superclass::ReleaseGraphicsResources(window);
+}
+
+int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
+{
+  auto* renderer = vtkRenderer::SafeDownCast(viewport);
+  if (!renderer || renderer->GetSelector())
+  {
+    return 0; // nothing to pick: the sky is not a selectable prop
+  }
+  auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
+  if (!window)
+  {
+    vtkErrorMacro("vtkNimbusSkyBackground needs an OpenGL render window.");
+    return 0;
+  }
+  vtkOpenGLClearErrorMacro();
+  Internals& in = *this->Internal;
+  if (in.Window && in.Window != window)
+  {
+    in.Release(in.Window);
+  }
+  in.Window = window;
+  std::string error;
+  if (!in.SkyView.Update(window, this->Sky, error))
+  {
+    vtkErrorMacro("Sky tables: " << error);
+    return 0;
+  }
+  if (!in.Quad)
+  {
+    in.Quad = std::make_unique<vtkOpenGLQuadHelper>(window,
+      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(),
+      nimbus::SkyViewTextures::Substitute(vtkNimbusSkyBackgroundFS).c_str(), "");
+  }
+  else
+  {
+    window->GetShaderCache()->ReadyShaderProgram(in.Quad->Program);
+  }
+  vtkShaderProgram* program = in.Quad->Program;
+  if (!program || !program->GetCompiled())
+  {
+    vtkErrorMacro("The sky background shader did not compile.");
+    return 0;
+  }
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  vtkCamera* camera = renderer->GetActiveCamera();
+  vtkNew<vtkMatrix4x4> inverse;
+  inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
+    static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
+  inverse->Invert();
+  program->SetUniformMatrix("inverseViewProjection", inverse);
+  program->SetUniform3f("cameraPosition", camera->GetPosition());
+  in.SkyView.Activate(program, this->Sky);
+
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(state);
+  vtkOpenGLState::ScopedglDepthMask depthMaskSaver(state);
+  state->vtkglDisable(GL_BLEND);
+  state->vtkglEnable(GL_DEPTH_TEST);
+  state->vtkglDepthFunc(GL_LEQUAL); // only where the depth is still the cleared 1
+  state->vtkglDepthMask(GL_FALSE);
+  in.Quad->Render();
+  in.SkyView.Deactivate();
+  ++this->NumberOfDraws;
+  vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyBackground::RenderOpaqueGeometry");
+  return 1;
+}
+
+void vtkNimbusSkyBackground::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Sky: " << this->Sky << "\n";
+  if (this->Sky)
+  {
+    this->Sky->PrintSelf(os, indent.GetNextIndent());
+  }
+  os << indent << "NumberOfDraws: " << this->NumberOfDraws << "\n";
+}

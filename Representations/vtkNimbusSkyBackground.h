@@ -1,0 +1,74 @@
+/**
+ * @class   vtkNimbusSkyBackground
+ * @brief   The sky as a renderer's background: a prop drawn behind everything (issue 6).
+ *
+ * Add it to a vtkRenderer (standalone VTK, Python, or a ParaView view through
+ * the "Sky Background" representation) and every pixel where nothing opaque is
+ * drawn shows the sky of its vtkNimbusSky, looked up per pixel in the sky-view
+ * table along the pixel's view ray, with the limb-darkened sun disc. It is drawn
+ * with the opaque props at the far plane (depth 1, depth test LEQUAL, no depth
+ * write), so the order of the props does not matter, it has no bounds (camera
+ * resets ignore it) and it is not pickable.
+ *
+ * Framebuffer values are display values: sRGB-encoded Exposure x radiance
+ * (white-balanced, see vtkNimbusSky). A vtkNimbusCloudVolumeMapper in the same
+ * renderer finds this prop and takes its sun, atmosphere and display settings,
+ * so that clouds, their shadows in the air and the sky agree (see
+ * vtkNimbusCloudVolumeMapper::UseSceneSky).
+ *
+ * The background is seen from the sky's observer (scene z = 0 at
+ * ObserverAltitude): the camera's height does not change it.
+ *
+ * GLSL: SkyShaders/vtkNimbusSkyBackgroundFS.glsl with nimbusSkyView.glsl (the
+ * twin of nimbus::SkyViewLut::Radiance), shared with vtkNimbusSkyPass.
+ */
+#ifndef vtkNimbusSkyBackground_h
+#define vtkNimbusSkyBackground_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkProp.h"
+
+#include <memory> // for std::unique_ptr
+
+class vtkNimbusSky;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyBackground : public vtkProp
+{
+public:
+  static vtkNimbusSkyBackground* New();
+  vtkTypeMacro(vtkNimbusSkyBackground, vtkProp);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The sky (parameters and tables). A default vtkNimbusSky is created with the
+  /// prop; setting nullptr is an error and keeps the current one.
+  void SetSky(vtkNimbusSky* sky);
+  vtkGetObjectMacro(Sky, vtkNimbusSky);
+  ///@}
+
+  /// Modified when the prop or its sky changed (the view re-renders).
+  vtkMTimeType GetMTime() override;
+
+  /// Number of sky frames drawn (tests).
+  vtkGetMacro(NumberOfDraws, int);
+
+  int RenderOpaqueGeometry(vtkViewport* viewport) override;
+  vtkTypeBool HasTranslucentPolygonalGeometry() override { return 0; }
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+
+protected:
+  vtkNimbusSkyBackground();
+  ~vtkNimbusSkyBackground() override;
+
+  vtkNimbusSky* Sky = nullptr;
+  int NumberOfDraws = 0;
+
+private:
+  vtkNimbusSkyBackground(const vtkNimbusSkyBackground&) = delete;
+  void operator=(const vtkNimbusSkyBackground&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
