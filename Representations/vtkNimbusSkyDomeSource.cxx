@@ -5,6 +5,8 @@
 #include "SpectralColor.h"
 
 #include "vtkCellArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -43,7 +45,104 @@ NIMBUS_FORWARD(AerosolDensity)
 NIMBUS_FORWARD(GroundAlbedo)
 NIMBUS_FORWARD(Exposure)
 NIMBUS_FORWARD(ObserverAltitude)
+NIMBUS_FORWARD(MetresPerUnit)
 #undef NIMBUS_FORWARD
+
+void vtkNimbusSkyDomeSource::SetScatteringOrders(int v)
+{
+  if (this->Sky)
+  {
+    this->Sky->SetScatteringOrders(v);
+  }
+}
+
+void vtkNimbusSkyDomeSource::SetWhiteBalance(bool v)
+{
+  if (this->Sky)
+  {
+    this->Sky->SetWhiteBalance(v);
+  }
+}
+
+void vtkNimbusSkyDomeSource::SetSunDisc(bool v)
+{
+  if (this->Sky)
+  {
+    this->Sky->SetSunDisc(v);
+  }
+}
+
+namespace
+{
+// The sky parameters carried in the output's field data: array name, read, write.
+struct SkyParameter
+{
+  const char* Name;
+  double (*Get)(vtkNimbusSky*);
+  void (*Set)(vtkNimbusSky*, double);
+};
+
+#define NIMBUS_PARAMETER(name, type)                                                               \
+  SkyParameter                                                                                     \
+  {                                                                                                \
+    #name, [](vtkNimbusSky* s) { return static_cast<double>(s->Get##name()); },                    \
+      [](vtkNimbusSky* s, double v) { s->Set##name(static_cast<type>(v)); }                        \
+  }
+const SkyParameter SkyParameters[] = {
+  NIMBUS_PARAMETER(SunElevation, double),
+  NIMBUS_PARAMETER(SunAzimuth, double),
+  NIMBUS_PARAMETER(AerosolDensity, double),
+  NIMBUS_PARAMETER(GroundAlbedo, double),
+  NIMBUS_PARAMETER(Exposure, double),
+  NIMBUS_PARAMETER(WhiteBalance, bool),
+  NIMBUS_PARAMETER(SunDisc, bool),
+  NIMBUS_PARAMETER(ObserverAltitude, double),
+  NIMBUS_PARAMETER(MetresPerUnit, double),
+  NIMBUS_PARAMETER(MaxAerialDistance, double),
+  NIMBUS_PARAMETER(ScatteringOrders, int),
+};
+#undef NIMBUS_PARAMETER
+}
+
+void vtkNimbusSkyDomeSource::AddSkyParameters(vtkNimbusSky* sky, vtkFieldData* fieldData)
+{
+  if (!sky || !fieldData)
+  {
+    return;
+  }
+  for (const SkyParameter& parameter : SkyParameters)
+  {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(parameter.Name);
+    array->SetNumberOfValues(1);
+    array->SetValue(0, parameter.Get(sky));
+    fieldData->AddArray(array); // replaces an array of the same name
+  }
+}
+
+int vtkNimbusSkyDomeSource::ApplySkyParameters(vtkFieldData* fieldData, vtkNimbusSky* sky)
+{
+  if (!sky)
+  {
+    return 0;
+  }
+  vtkNew<vtkNimbusSky> defaults;
+  int found = 0;
+  for (const SkyParameter& parameter : SkyParameters)
+  {
+    vtkDataArray* array = fieldData ? fieldData->GetArray(parameter.Name) : nullptr;
+    if (array && array->GetNumberOfTuples() > 0 && array->GetNumberOfComponents() > 0)
+    {
+      parameter.Set(sky, array->GetComponent(0, 0));
+      ++found;
+    }
+    else
+    {
+      parameter.Set(sky, parameter.Get(defaults));
+    }
+  }
+  return found;
+}
 
 vtkNimbusSkyDomeSource::~vtkNimbusSkyDomeSource()
 {
@@ -139,6 +238,7 @@ int vtkNimbusSkyDomeSource::RequestData(
   output->SetPolys(polys);
   output->GetPointData()->SetScalars(colors);
   output->GetPointData()->AddArray(radiance);
+  vtkNimbusSkyDomeSource::AddSkyParameters(sky, output->GetFieldData());
   this->UpdateProgress(1.0);
   return 1;
 }

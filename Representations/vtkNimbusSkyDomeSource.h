@@ -11,6 +11,17 @@
  * the horizon (elevation = 90 deg (i/n)^1.5 ... measured from the horizon), where
  * the sky changes fastest. Render it with the mapper's scalar colouring and
  * lighting off (vtkProperty::LightingOff) so the colours are shown as they are.
+ *
+ * The output's field data carries the sky's parameters, as they were when the
+ * colours were computed (after the Preset), one one-tuple vtkDoubleArray each,
+ * named as the vtkNimbusSky parameter (units as there):
+ *  - "SunElevation" (deg above the horizon), "SunAzimuth" (deg from +y toward +x),
+ *  - "AerosolDensity" (relative to the clear atmosphere), "GroundAlbedo",
+ *  - "Exposure", "WhiteBalance" (0/1), "SunDisc" (0/1),
+ *  - "ObserverAltitude" (m), "MetresPerUnit", "MaxAerialDistance" (m),
+ *  - "ScatteringOrders" (1 = single scattering).
+ * Consumers (ParaView's "Sky Background" representation) rebuild the same sky
+ * from them with ApplySkyParameters(); AddSkyParameters() writes them.
  */
 #ifndef vtkNimbusSkyDomeSource_h
 #define vtkNimbusSkyDomeSource_h
@@ -18,6 +29,7 @@
 #include "NimbusRepresentationsModule.h" // for export macro
 #include "vtkPolyDataAlgorithm.h"
 
+class vtkFieldData;
 class vtkNimbusSky;
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyDomeSource : public vtkPolyDataAlgorithm
@@ -49,7 +61,19 @@ public:
   void SetGroundAlbedo(double v);
   void SetExposure(double v);
   void SetObserverAltitude(double v);
+  void SetMetresPerUnit(double v);
+  void SetScatteringOrders(int v);
+  void SetWhiteBalance(bool v);
+  void SetSunDisc(bool v);
   ///@}
+
+  /// Writes the sky's parameters into field data (the arrays listed above,
+  /// replacing arrays of the same names).
+  static void AddSkyParameters(vtkNimbusSky* sky, vtkFieldData* fieldData);
+  /// Sets the sky's parameters from those arrays; a parameter whose array is
+  /// missing (or empty) gets the vtkNimbusSky default. Returns how many of the
+  /// arrays were found.
+  static int ApplySkyParameters(vtkFieldData* fieldData, vtkNimbusSky* sky);
 
   ///@{
   /// Radius of the dome, scene units, > 0. Default 10000.

@@ -27,7 +27,7 @@ def main():
     args = parser.parse_args()
 
     LoadPlugin(args.plugin, ns=globals())
-    dome = NimbusSkyDome(Preset="Sunset", Radius=1000.0, Exposure=25.0,  # noqa: F821
+    dome = NimbusSky(Preset="Sunset", Radius=1000.0, Exposure=25.0,  # noqa: F821 (proxy NimbusSkyDome)
                          ElevationResolution=24, AzimuthResolution=72,
                          SunElevation=70.0, SunAzimuth=0.0)  # overridden by the preset
     dome.UpdatePipeline()
@@ -60,6 +60,9 @@ def main():
     view.Background = [0.0, 0.0, 0.0]
     view.EnableRenderOnInteraction = 0
     display = Show(dome, view)
+    # In a render view the source shows as "Sky Background" by default; the dome is
+    # the Surface.
+    display.SetRepresentationType("Surface")
     display.MapScalars = 0
     display.ColorArrayName = ["POINTS", "Colors"]
     display.Ambient = 1.0

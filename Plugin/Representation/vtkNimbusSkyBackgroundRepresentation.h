@@ -1,0 +1,81 @@
+/**
+ * @class   vtkNimbusSkyBackgroundRepresentation
+ * @brief   ParaView representation that makes its input's sky the render view's background.
+ *
+ * The "Sky Background" representation type of polygonal data in ParaView. While
+ * it is visible in a render view, the view's renderer (vtkPVRenderView::GetRenderer())
+ * holds a vtkNimbusSkyBackground: every pixel where nothing opaque is drawn shows
+ * the sky; a vtkNimbusCloudVolumeMapper in the same renderer lights its clouds
+ * with that sky's sun. Hidden, or removed from the view, the plain view
+ * background shows again.
+ *
+ * The sky's parameters come from the input's field data: the one-tuple arrays
+ * that vtkNimbusSkyDomeSource writes ("SunElevation", "SunAzimuth",
+ * "AerosolDensity", "GroundAlbedo", "Exposure", "ObserverAltitude", ..., see
+ * vtkNimbusSkyDomeSource). A parameter without its array takes the vtkNimbusSky
+ * default, so any polygonal data can be shown as the default sky. The input's
+ * geometry is not drawn and not moved: only its field data is delivered (through
+ * vtkPVView::SetPiece / GetDeliveredPiece, like ParaView's own representations),
+ * and the sky has no bounds, so camera resets ignore it.
+ */
+#ifndef vtkNimbusSkyBackgroundRepresentation_h
+#define vtkNimbusSkyBackgroundRepresentation_h
+
+#include "NimbusCloudRepresentationModule.h" // for export macro
+#include "vtkNew.h"                          // for vtkNew
+#include "vtkPVDataRepresentation.h"
+#include "vtkSmartPointer.h" // for vtkSmartPointer
+
+class vtkNimbusSkyBackground;
+class vtkPolyData;
+
+class NIMBUSCLOUDREPRESENTATION_EXPORT vtkNimbusSkyBackgroundRepresentation
+  : public vtkPVDataRepresentation
+{
+public:
+  static vtkNimbusSkyBackgroundRepresentation* New();
+  vtkTypeMacro(vtkNimbusSkyBackgroundRepresentation, vtkPVDataRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Handles ParaView's view passes: REQUEST_UPDATE hands the parameters (field
+  /// data only) to the view for delivery, REQUEST_RENDER configures the sky from
+  /// the delivered parameters.
+  int ProcessViewRequest(vtkInformationRequestKey* requestType, vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+
+  /// Adds the sky background to / removes it from the render view's renderer.
+  bool AddToView(vtkView* view) override;
+  bool RemoveFromView(vtkView* view) override;
+
+  /// Shows or hides the sky background with the representation.
+  void SetVisibility(bool visible) override;
+
+  /// The prop added to the view's renderer (owned by the representation); its
+  /// vtkNimbusSky holds the parameters applied at the last render.
+  vtkNimbusSkyBackground* GetBackground();
+
+  /// Number of renders at which the sky's parameters were taken from delivered
+  /// data (tests).
+  vtkGetMacro(NumberOfParameterUpdates, int);
+
+protected:
+  vtkNimbusSkyBackgroundRepresentation();
+  ~vtkNimbusSkyBackgroundRepresentation() override;
+
+  /// Any vtkDataObject (optional: processes without the data have no input).
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  /// Keeps a data object with a shallow copy of the input's field data.
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+
+  vtkNew<vtkNimbusSkyBackground> Background;
+  /// What is delivered: an empty polydata with the input's field data.
+  vtkSmartPointer<vtkPolyData> Parameters;
+  int NumberOfParameterUpdates = 0;
+
+private:
+  vtkNimbusSkyBackgroundRepresentation(const vtkNimbusSkyBackgroundRepresentation&) = delete;
+  void operator=(const vtkNimbusSkyBackgroundRepresentation&) = delete;
+};
+
+#endif

@@ -1,0 +1,116 @@
+// The sky parameters that vtkNimbusSkyDomeSource writes into its output's field
+// data (what ParaView's "Sky Background" representation reads back): every
+// parameter round-trips exactly, presets are applied before they are written,
+// and a missing array means that parameter's vtkNimbusSky default.
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyDomeSource.h"
+
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkNew.h"
+#include "vtkPolyData.h"
+
+#include <gtest/gtest.h>
+
+namespace
+{
+void ExpectSameSky(vtkNimbusSky* a, vtkNimbusSky* b)
+{
+  EXPECT_EQ(a->GetSunElevation(), b->GetSunElevation());
+  EXPECT_EQ(a->GetSunAzimuth(), b->GetSunAzimuth());
+  EXPECT_EQ(a->GetAerosolDensity(), b->GetAerosolDensity());
+  EXPECT_EQ(a->GetGroundAlbedo(), b->GetGroundAlbedo());
+  EXPECT_EQ(a->GetExposure(), b->GetExposure());
+  EXPECT_EQ(a->GetWhiteBalance(), b->GetWhiteBalance());
+  EXPECT_EQ(a->GetSunDisc(), b->GetSunDisc());
+  EXPECT_EQ(a->GetObserverAltitude(), b->GetObserverAltitude());
+  EXPECT_EQ(a->GetMetresPerUnit(), b->GetMetresPerUnit());
+  EXPECT_EQ(a->GetMaxAerialDistance(), b->GetMaxAerialDistance());
+  EXPECT_EQ(a->GetScatteringOrders(), b->GetScatteringOrders());
+}
+}
+
+TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
+{
+  vtkNew<vtkNimbusSkyDomeSource> dome;
+  dome->SetElevationResolution(4);
+  dome->SetAzimuthResolution(8);
+  dome->SetPreset(vtkNimbusSky::Sunset);
+  dome->SetSunElevation(70.0); // overridden by the preset
+  dome->SetExposure(25.0);
+  dome->SetAerosolDensity(3.0);
+  dome->SetGroundAlbedo(0.1);
+  dome->SetObserverAltitude(1500.0);
+  dome->SetMetresPerUnit(1000.0);
+  dome->SetScatteringOrders(2);
+  dome->SetWhiteBalance(false);
+  dome->SetSunDisc(false);
+  dome->Update();
+  vtkFieldData* fields = dome->GetOutput()->GetFieldData();
+  const char* names[] = { "SunElevation", "SunAzimuth", "AerosolDensity", "GroundAlbedo",
+    "Exposure", "WhiteBalance", "SunDisc", "ObserverAltitude", "MetresPerUnit",
+    "MaxAerialDistance", "ScatteringOrders" };
+  for (const char* name : names)
+  {
+    vtkDataArray* array = fields->GetArray(name);
+    ASSERT_NE(array, nullptr) << name;
+    EXPECT_EQ(array->GetNumberOfTuples(), 1) << name;
+    EXPECT_EQ(array->GetNumberOfComponents(), 1) << name;
+    EXPECT_TRUE(vtkDoubleArray::SafeDownCast(array)) << name;
+  }
+  EXPECT_EQ(fields->GetNumberOfArrays(), 11);
+  EXPECT_EQ(fields->GetArray("SunElevation")->GetComponent(0, 0), 2.0);
+  EXPECT_EQ(fields->GetArray("SunAzimuth")->GetComponent(0, 0), 270.0);
+  EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 25.0);
+  EXPECT_EQ(fields->GetArray("ObserverAltitude")->GetComponent(0, 0), 1500.0);
+  EXPECT_EQ(fields->GetArray("ScatteringOrders")->GetComponent(0, 0), 2.0);
+  EXPECT_EQ(fields->GetArray("SunDisc")->GetComponent(0, 0), 0.0);
+
+  // Read back into another sky: the same parameters.
+  vtkNew<vtkNimbusSky> copy;
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(fields, copy), 11);
+  ExpectSameSky(dome->GetSky(), copy);
+
+  // A second update replaces the arrays instead of adding more.
+  dome->SetExposure(5.0);
+  dome->Update();
+  fields = dome->GetOutput()->GetFieldData();
+  EXPECT_EQ(fields->GetNumberOfArrays(), 11);
+  EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 5.0);
+}
+
+TEST(SkyDomeParameters, MissingArraysMeanDefaults)
+{
+  vtkNew<vtkNimbusSky> defaults;
+  vtkNew<vtkNimbusSky> sky;
+  sky->SetPreset(vtkNimbusSky::Twilight);
+  sky->SetExposure(400.0);
+  sky->SunDiscOff();
+  sky->SetScatteringOrders(7);
+
+  vtkNew<vtkFieldData> empty;
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(empty, sky), 0);
+  ExpectSameSky(sky, defaults);
+
+  vtkNew<vtkFieldData> one;
+  vtkNew<vtkDoubleArray> elevation;
+  elevation->SetName("SunElevation");
+  elevation->InsertNextValue(12.5);
+  one->AddArray(elevation);
+  sky->SetExposure(400.0);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(one, sky), 1);
+  EXPECT_EQ(sky->GetSunElevation(), 12.5);
+  EXPECT_EQ(sky->GetExposure(), defaults->GetExposure());
+
+  // An empty array counts as missing; a null field data too.
+  vtkNew<vtkDoubleArray> emptyArray;
+  emptyArray->SetName("Exposure");
+  one->AddArray(emptyArray);
+  sky->SetExposure(400.0);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(one, sky), 1);
+  EXPECT_EQ(sky->GetExposure(), defaults->GetExposure());
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(nullptr, sky), 0);
+  ExpectSameSky(sky, defaults);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(one, nullptr), 0);
+}
