@@ -8,6 +8,7 @@
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 
+#include <algorithm>
 #include <exception>
 
 namespace nimbus
@@ -36,18 +37,25 @@ std::string SkyViewTextures::Substitute(const char* source)
   return result;
 }
 
-bool SkyViewTextures::Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, std::string& error)
+double SkyViewTextures::CameraAltitude(vtkNimbusSky* sky, double z)
+{
+  return std::max(0.0, sky->GetObserverAltitude() + z * sky->GetMetresPerUnit());
+}
+
+bool SkyViewTextures::Update(
+  vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, double altitude, std::string& error)
 {
   const SkyViewLut* table = nullptr;
   try
   {
-    table = &sky->GetSkyViewLut();
+    table = &sky->GetSkyViewLutAt(altitude);
   }
   catch (const std::exception& e)
   {
     error = e.what();
     return false;
   }
+  this->Mapping = table;
   if (this->Builds == sky->GetSkyViewBuilds() && this->Table == table && this->Textures[0])
   {
     return true;
@@ -76,7 +84,7 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
     this->Textures[k]->Activate();
     program->SetUniformi(names[k], this->Textures[k]->GetTextureUnit());
   }
-  const SkyViewMapping& m = sky->GetSkyViewLut().GetMapping();
+  const SkyViewMapping& m = static_cast<const SkyViewLut*>(this->Mapping)->GetMapping();
   double sun[3], scale[3], disc[3];
   sky->GetSunDirection(sun);
   sky->GetDisplayScale(scale);

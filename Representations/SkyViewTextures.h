@@ -24,11 +24,15 @@ public:
   SkyViewTextures(const SkyViewTextures&) = delete;
   SkyViewTextures& operator=(const SkyViewTextures&) = delete;
 
-  /// Builds (through the sky's cache) and uploads the sky-view table when it
-  /// changed. False, with the reason in `error`, when the table cannot be built.
-  bool Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, std::string& error);
+  /// Builds (through the sky's cache) and uploads the sky-view table seen from
+  /// `altitude` (m; see vtkNimbusSky::GetSkyViewLutAt) when it changed. False,
+  /// with the reason in `error`, when the table cannot be built.
+  bool Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, double altitude, std::string& error);
   /// Binds the textures and sets the sky uniforms of nimbusSkyView.glsl.
   void Activate(vtkShaderProgram* program, vtkNimbusSky* sky);
+  /// The altitude a camera at scene height z sees the sky from:
+  /// ObserverAltitude + z MetresPerUnit, at least 0.
+  static double CameraAltitude(vtkNimbusSky* sky, double z);
   void Deactivate();
   void Release(vtkWindow* window);
 
@@ -41,6 +45,7 @@ private:
   std::array<vtkTextureObject*, 3> Textures{ { nullptr, nullptr, nullptr } };
   const void* Table = nullptr; // identity of the uploaded table
   int Builds = -1;
+  const void* Mapping = nullptr; // the table the uniforms describe
 };
 }
 

@@ -12,6 +12,10 @@
 #include "svsShadowFS.h"
 #include "svsSliceFS.h"
 
+#include "Sky.h"
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackground.h"
+
 #include "vtkCamera.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
@@ -24,6 +28,7 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPointData.h"
+#include "vtkPropCollection.h"
 #include "vtkCellData.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
@@ -78,6 +83,35 @@ void ResetTexture(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, bool
   texture->SetMagnificationFilter(filter);
 }
 
+// The sun, air, ground and display parameters of one frame: the mapper's own, or
+// those of the Nimbus sky drawn behind it (see UseSceneSky).
+struct FrameSettings
+{
+  double SunAzimuth, SunElevation, SunIlluminance, SunTemperature; // deg, deg, relative, K
+  double HazeDensity, HazeG, RayleighScattering;                   // 1/m, -, 1/m
+  double SceneAltitude, GroundHeight, GroundAlbedo, LengthUnit;     // m, world, -, m/unit
+  double DisplayScale[3];                                           // per channel
+  bool EncodeSrgb;
+  bool OverSky;
+};
+
+// The sky of the first visible vtkNimbusSkyBackground among the renderer's props.
+vtkNimbusSky* FindSceneSky(vtkRenderer* renderer)
+{
+  vtkPropCollection* props = renderer->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
+    if (background && background->GetVisibility())
+    {
+      return background->GetSky();
+    }
+  }
+  return nullptr;
+}
+
 // Binds the framebuffer with `target` as its only draw buffer. The attachment is
 // renewed every time: a reallocated texture keeps its vtkTextureObject, and
 // vtkOpenGLFramebufferObject skips attaching the same object again.
@@ -121,6 +155,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
 
   // Accumulation (S, alpha) at the viewport size, and copies of the scene's colour and depth.
   vtkNew<vtkTextureObject> Accumulation;
+  vtkNew<vtkTextureObject> ClearAccumulation; // S without the cloud (over a sky)
   vtkNew<vtkOpenGLFramebufferObject> AccumulationFramebuffer;
   vtkNew<vtkTextureObject> SceneColor;
   vtkNew<vtkTextureObject> SceneDepth;
@@ -142,11 +177,14 @@ struct vtkNimbusCloudVolumeMapper::Internals
   int IntervalPhaseBuilds = 0;
   int PassesLastRender = 0;
   bool LastBackToFront = false;
+  bool LastOverSky = false;
+  double LastSunElevation = 0.0;
 
   void Release(vtkWindow* window)
   {
     for (vtkTextureObject* t : { Density.GetPointer(), AtmosphereTexture.GetPointer(),
-           IntervalPhase.GetPointer(), Accumulation.GetPointer(), SceneColor.GetPointer(),
+           IntervalPhase.GetPointer(), Accumulation.GetPointer(), ClearAccumulation.GetPointer(),
+           SceneColor.GetPointer(),
            SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
@@ -212,6 +250,14 @@ int vtkNimbusCloudVolumeMapper::GetNumberOfIntervalPhaseBuilds() const
 int vtkNimbusCloudVolumeMapper::GetNumberOfPassesLastRender() const
 {
   return this->Internal->PassesLastRender;
+}
+bool vtkNimbusCloudVolumeMapper::GetLastRenderUsedSceneSky() const
+{
+  return this->Internal->LastOverSky;
+}
+double vtkNimbusCloudVolumeMapper::GetLastSunElevation() const
+{
+  return this->Internal->LastSunElevation;
 }
 bool vtkNimbusCloudVolumeMapper::GetLastBackToFront() const
 {
@@ -389,6 +435,41 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     ++in.VolumeUploads;
   }
 
+  // --- this frame's sun, air, ground and display: ours, or the sky's behind us.
+  FrameSettings settings{ this->SunAzimuth, this->SunElevation, this->SunIlluminance,
+    this->SunTemperature, this->HazeDensity, this->HazeG, this->RayleighScattering,
+    this->SceneAltitude, this->GroundHeight, this->GroundAlbedo, this->LengthUnit,
+    { this->Exposure, this->Exposure, this->Exposure }, this->EncodeSrgb, false };
+  if (vtkNimbusSky* sky = (this->UseSceneSky && !this->Unlit) ? FindSceneSky(renderer) : nullptr)
+  {
+    const nimbus::AtmosphereParameters* air = nullptr;
+    try
+    {
+      air = &sky->GetSkyModel().GetParameters().Atmosphere;
+    }
+    catch (const std::exception& error)
+    {
+      vtkErrorMacro("The scene's sky is invalid: " << error.what());
+      return;
+    }
+    settings.SunAzimuth = sky->GetSunAzimuth();
+    settings.SunElevation = sky->GetSunElevation();
+    settings.SunIlluminance = 1.0;   // the sky's sun: luminance 1 above the atmosphere
+    settings.SunTemperature = 5778.0; // and a 5778 K blackbody (Sky.h)
+    settings.HazeDensity = air->mieScattering;
+    settings.HazeG = air->mieG;
+    settings.RayleighScattering = air->rayleighScattering550;
+    settings.SceneAltitude = sky->GetObserverAltitude();
+    settings.LengthUnit = sky->GetMetresPerUnit();
+    settings.GroundHeight = -sky->GetObserverAltitude() / sky->GetMetresPerUnit(); // sea level
+    settings.GroundAlbedo = sky->GetGroundAlbedo();
+    sky->GetDisplayScale(settings.DisplayScale);
+    settings.EncodeSrgb = true; // the sky background is sRGB-encoded
+    settings.OverSky = true;
+  }
+  in.LastOverSky = settings.OverSky;
+  in.LastSunElevation = settings.SunElevation;
+
   // --- geometry: sun, view, slice axis, box corners in world coordinates.
   vtkCamera* camera = renderer->GetActiveCamera();
   int width = 0, height = 0, x0 = 0, y0 = 0;
@@ -397,7 +478,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   {
     return;
   }
-  const double elevation = this->SunElevation * kDegree, azimuth = this->SunAzimuth * kDegree;
+  const double elevation = settings.SunElevation * kDegree, azimuth = settings.SunAzimuth * kDegree;
   const nimbus::Vec3 toSun = { { std::cos(elevation) * std::sin(azimuth),
     std::cos(elevation) * std::cos(azimuth), std::sin(elevation) } };
   double projection[3];
@@ -421,7 +502,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   const nimbus::SlicePlanes planes =
     nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), this->NumberOfSlices);
   const nimbus::ShadowFrame frame = nimbus::ComputeShadowFrame(corners, toSun, 0.02);
-  const double sunStepMetres = planes.Spacing / axis.SunCosine * this->LengthUnit;
+  const double sunStepMetres = planes.Spacing / axis.SunCosine * settings.LengthUnit;
 
   // world -> box [0,1]^3 -> density texture coordinates.
   vtkNew<vtkMatrix4x4> worldToData;
@@ -530,22 +611,22 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   {
     boxZMin = std::min(boxZMin, corner[2]);
   }
-  const double zLow = (std::min(boxZMin, ground ? this->GroundHeight : boxZMin)) * this->LengthUnit;
+  const double zLow = (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.LengthUnit;
   nimbus::SceneDescription scene;
-  scene.Sun.Azimuth = this->SunAzimuth;
-  scene.Sun.Elevation = this->SunElevation;
-  scene.Sun.Illuminance = this->SunIlluminance;
-  scene.Sun.Temperature = this->SunTemperature;
+  scene.Sun.Azimuth = settings.SunAzimuth;
+  scene.Sun.Elevation = settings.SunElevation;
+  scene.Sun.Illuminance = settings.SunIlluminance;
+  scene.Sun.Temperature = settings.SunTemperature;
   scene.Atmosphere.Enabled = atmosphere;
-  scene.Atmosphere.SceneAltitude = this->SceneAltitude;
-  scene.Atmosphere.RayleighScattering550 = this->RayleighScattering;
-  scene.Atmosphere.MieScattering = this->HazeDensity;
-  scene.Atmosphere.MieG = this->HazeG;
+  scene.Atmosphere.SceneAltitude = settings.SceneAltitude;
+  scene.Atmosphere.RayleighScattering550 = settings.RayleighScattering;
+  scene.Atmosphere.MieScattering = settings.HazeDensity;
+  scene.Atmosphere.MieG = settings.HazeG;
   scene.Background.Type = "black"; // the framebuffer is the background
-  const double zHigh = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - this->SceneAltitude;
-  const std::vector<double> atmosphereKey = { this->SunAzimuth, this->SunElevation,
-    this->SunIlluminance, this->SunTemperature, atmosphere ? 1.0 : 0.0, this->SceneAltitude,
-    this->RayleighScattering, this->HazeDensity, this->HazeG, zLow };
+  const double zHigh = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - settings.SceneAltitude;
+  const std::vector<double> atmosphereKey = { settings.SunAzimuth, settings.SunElevation,
+    settings.SunIlluminance, settings.SunTemperature, atmosphere ? 1.0 : 0.0, settings.SceneAltitude,
+    settings.RayleighScattering, settings.HazeDensity, settings.HazeG, zLow };
   if (atmosphereKey != in.AtmosphereKey)
   {
     try
@@ -580,7 +661,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(w2b.data()));
     program->SetUniform3f("toSun", toSun.data());
     program->SetUniform3f("sliceNormal", axis.Normal.data());
-    program->SetUniformf("lengthUnit", static_cast<float>(this->LengthUnit));
+    program->SetUniformf("lengthUnit", static_cast<float>(settings.LengthUnit));
     program->SetUniformi("density", in.Density->GetTextureUnit());
     program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
     program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
@@ -606,14 +687,15 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
     program->SetUniformf("rayleighScaleHeight", static_cast<float>(in.Table.RayleighScaleHeight));
     program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.MieScaleHeight));
-    program->SetUniformf("sceneAltitude", static_cast<float>(this->SceneAltitude));
+    program->SetUniformf("sceneAltitude", static_cast<float>(settings.SceneAltitude));
     program->SetUniformf("earthRadius", static_cast<float>(scene.Atmosphere.EarthRadius));
     program->SetUniformf("topRadius", static_cast<float>(scene.Atmosphere.TopRadius));
     program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
     program->SetUniformi("groundOn", ground ? 1 : 0);
-    program->SetUniformf("groundZ", static_cast<float>(this->GroundHeight));
-    program->SetUniformf("groundAlbedo", static_cast<float>(this->GroundAlbedo));
+    program->SetUniformf("groundZ", static_cast<float>(settings.GroundHeight));
+    program->SetUniformf("groundAlbedo", static_cast<float>(settings.GroundAlbedo));
     program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
+    program->SetUniformi("overSky", settings.OverSky ? 1 : 0);
   };
 
   in.Density->Activate();
@@ -640,7 +722,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   std::vector<double> intervalKey(ivp.begin(), ivp.end());
   intervalKey.insert(intervalKey.end(), { static_cast<double>(width), static_cast<double>(height),
     toSun[0], toSun[1], toSun[2], axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG,
-    this->HazeG, this->MultipleScattering });
+    settings.HazeG, this->MultipleScattering });
   state->vtkglDisable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_FALSE);
   if (intervalKey != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
@@ -652,7 +734,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
     setCommon(program);
     program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
-    program->SetUniformf("hazeG", static_cast<float>(this->HazeG));
+    program->SetUniformf("hazeG", static_cast<float>(settings.HazeG));
     program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
     in.IntervalPhasePass->Render();
     ++in.PassesLastRender;
@@ -678,6 +760,14 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   // --- accumulation (S, cloud transmittance), cleared to (0, 0, 0, 1).
   ensure2D(in.Accumulation, width, height, 4, false);
   DrawInto(in.AccumulationFramebuffer, in.Accumulation, window);
+  in.AccumulationFramebuffer->RemoveColorAttachment(1);
+  if (settings.OverSky)
+  {
+    // Second target, S_clear: the same blend sums it (its alpha stays 1).
+    ensure2D(in.ClearAccumulation, width, height, 4, false);
+    in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
+    in.AccumulationFramebuffer->ActivateDrawBuffers(2);
+  }
   state->vtkglViewport(0, 0, width, height);
   state->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   state->vtkglClear(GL_COLOR_BUFFER_BIT);
@@ -869,8 +959,19 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   composite->SetUniformi("accumulation", in.Accumulation->GetTextureUnit());
   composite->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
   composite->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
-  composite->SetUniformf("exposure", static_cast<float>(this->Exposure));
-  composite->SetUniformi("encodeSrgb", this->EncodeSrgb ? 1 : 0);
+  composite->SetUniform3f("displayScale", settings.DisplayScale);
+  composite->SetUniformi("encodeSrgb", settings.EncodeSrgb ? 1 : 0);
+  composite->SetUniformi("skyBackground", settings.OverSky ? 1 : 0);
+  if (settings.OverSky)
+  {
+    in.ClearAccumulation->Activate();
+    composite->SetUniformi("clearAccumulation", in.ClearAccumulation->GetTextureUnit());
+  }
+  else
+  {
+    // Unused; a sampler must still name a 2-D texture unit.
+    composite->SetUniformi("clearAccumulation", in.Accumulation->GetTextureUnit());
+  }
   in.CompositePass->Render();
   ++in.PassesLastRender;
 
@@ -880,6 +981,10 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
          in.SceneColor.GetPointer() })
   {
     t->Deactivate();
+  }
+  if (settings.OverSky)
+  {
+    in.ClearAccumulation->Deactivate();
   }
   if (atmosphere)
   {
@@ -918,4 +1023,5 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Unlit: " << this->Unlit << "\n";
   os << indent << "CaptureRadiance: " << this->CaptureRadiance << "\n";
   os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
+  os << indent << "UseSceneSky: " << this->UseSceneSky << "\n";
 }

@@ -28,6 +28,13 @@
  * (vtkNimbusReferenceRenderer) for the same scene; see docs/svs-mapper.md for the
  * measured errors and costs.
  *
+ * Over a Nimbus sky (a visible vtkNimbusSkyBackground in the same renderer, and
+ * UseSceneSky on) the mapper takes that sky's sun, atmosphere, ground albedo,
+ * observer altitude, length unit and display settings instead of its own, and
+ * composites the cloud, its shadow on the ground and its shafts over the sky as
+ * a difference from the clear sky, so that where neither the cloud nor its
+ * shadow is the sky is left exactly as the sky background drew it.
+ *
  * Only what the scene needs runs: without atmosphere no atmosphere texture and
  * no atmosphere pass; without ground and atmosphere no passes outside the cloud
  * slices; without shafts no shadow look-ups in the atmosphere.
@@ -151,6 +158,24 @@ public:
   ///@}
 
   ///@{
+  /// Follow the sky of a visible vtkNimbusSkyBackground in the renderer (default
+  /// on): while one is there, its vtkNimbusSky replaces SunAzimuth, SunElevation,
+  /// SunIlluminance (1) and SunTemperature (5778 K), HazeDensity, HazeG,
+  /// RayleighScattering, SceneAltitude (= ObserverAltitude), GroundHeight (sea
+  /// level), GroundAlbedo, LengthUnit (= MetresPerUnit), Exposure and EncodeSrgb
+  /// (the sky's exposure and white balance, sRGB on); the background is the sky
+  /// and the cloud is composited over it as I = S - T_cl S_clear + T_cl L_sky
+  /// (svsCompositeFS.glsl), which costs a second accumulation target.
+  vtkSetMacro(UseSceneSky, bool);
+  vtkGetMacro(UseSceneSky, bool);
+  vtkBooleanMacro(UseSceneSky, bool);
+  /// Whether the last render followed a scene sky, and that sky's sun elevation
+  /// (degrees; the mapper's own when it did not).
+  bool GetLastRenderUsedSceneSky() const;
+  double GetLastSunElevation() const;
+  ///@}
+
+  ///@{
   /// Benchmark floor: composite the same slices without any lighting (no shadow
   /// surface, no atmosphere, no ground). Not for pictures.
   vtkSetMacro(Unlit, bool);
@@ -221,6 +246,7 @@ protected:
   bool Unlit = false;
   int MaximumTextureSize = 0;
   bool CaptureRadiance = false;
+  bool UseSceneSky = true;
 
 private:
   vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;

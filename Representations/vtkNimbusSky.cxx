@@ -20,6 +20,11 @@ struct vtkNimbusSky::Internals
   std::unique_ptr<nimbus::SkyViewLut> SkyView;
   double SkyViewElevation = 0.0, SkyViewAltitude = 0.0;
   int SkyViewGeneration = -1;
+  // A second sky-view table, for a camera (GetSkyViewLutAt), so that the
+  // observer's table of GetRadiance and the dome is not rebuilt as the camera moves.
+  std::unique_ptr<nimbus::SkyViewLut> CameraSkyView;
+  double CameraSkyViewElevation = 0.0, CameraSkyViewAltitude = 0.0;
+  int CameraSkyViewGeneration = -1;
 
   std::unique_ptr<nimbus::AerialPerspectiveLut> Aerial;
   double AerialElevation = 0.0, AerialAltitude = 0.0, AerialRange = 0.0;
@@ -79,6 +84,7 @@ const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
     p.GroundAlbedo = this->GroundAlbedo;
     p.ScatteringOrders = this->ScatteringOrders;
     in.SkyView.reset();
+    in.CameraSkyView.reset();
     in.Aerial.reset();
     in.Model = std::make_unique<nimbus::SkyModel>(p);
     in.ModelAerosol = this->AerosolDensity;
@@ -104,6 +110,30 @@ const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLut()
     ++this->SkyViewBuilds;
   }
   return *in.SkyView;
+}
+
+const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLutAt(double altitude)
+{
+  const nimbus::SkyViewLut& observer = this->GetSkyViewLut();
+  Internals& in = *this->Internal;
+  altitude = std::max(0.0, altitude);
+  const double tolerance = std::max(25.0, 0.02 * altitude);
+  if (std::abs(altitude - this->ObserverAltitude) <= tolerance)
+  {
+    return observer;
+  }
+  if (!in.CameraSkyView || in.CameraSkyViewGeneration != in.ModelGeneration ||
+    in.CameraSkyViewElevation != this->SunElevation ||
+    std::abs(in.CameraSkyViewAltitude - altitude) > tolerance)
+  {
+    in.CameraSkyView =
+      std::make_unique<nimbus::SkyViewLut>(this->GetSkyModel(), this->SunElevation, altitude);
+    in.CameraSkyViewGeneration = in.ModelGeneration;
+    in.CameraSkyViewElevation = this->SunElevation;
+    in.CameraSkyViewAltitude = altitude;
+    ++this->SkyViewBuilds;
+  }
+  return *in.CameraSkyView;
 }
 
 const nimbus::AerialPerspectiveLut& vtkNimbusSky::GetAerialPerspectiveLut(double cameraAltitude)

@@ -143,6 +143,12 @@ public:
   /// The tables (built on demand). Not wrapped; see Sky.h for the layouts.
   const nimbus::SkyModel& GetSkyModel();
   const nimbus::SkyViewLut& GetSkyViewLut();
+  /// Sky-view table seen from another altitude (m; a camera's): below the
+  /// horizon it holds the air between that altitude and the ground. The
+  /// observer's table when the altitude is within max(25 m, 2 %) of
+  /// ObserverAltitude; otherwise a second cached table, rebuilt when the altitude
+  /// moves by more than max(25 m, 2 %) (0.2 s at the default size).
+  const nimbus::SkyViewLut& GetSkyViewLutAt(double altitude);
   /// Aerial-perspective table for a camera at the given altitude (m); rebuilt
   /// when the altitude moves by more than 1 % (or 10 m).
   const nimbus::AerialPerspectiveLut& GetAerialPerspectiveLut(double cameraAltitude);

@@ -102,7 +102,9 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
   }
   in.Window = window;
   std::string error;
-  if (!in.SkyView.Update(window, this->Sky, error))
+  vtkCamera* camera = renderer->GetActiveCamera();
+  const double altitude = nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
+  if (!in.SkyView.Update(window, this->Sky, altitude, error))
   {
     vtkErrorMacro("Sky tables: " << error);
     return 0;
@@ -125,7 +127,6 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
   }
   int width = 0, height = 0, x0 = 0, y0 = 0;
   renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
-  vtkCamera* camera = renderer->GetActiveCamera();
   vtkNew<vtkMatrix4x4> inverse;
   inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
     static_cast<double>(width) / std::max(1, height), -1.0, 1.0));

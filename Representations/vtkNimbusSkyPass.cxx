@@ -168,7 +168,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   {
     tableError = e.what();
   }
-  if (!aerial || !in.SkyView.Update(window, sky, tableError))
+  if (!aerial || !in.SkyView.Update(window, sky, std::max(0.0, cameraAltitude), tableError))
   {
     vtkErrorMacro("sky tables: " << tableError);
     return;

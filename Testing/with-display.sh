@@ -3,7 +3,10 @@
 # With DISPLAY set, the command runs as it is. Without one (CI, ssh, containers)
 # it gets a private Xvfb with Mesa's llvmpipe (OpenGL 4.5 core) on a random display
 # number (retried if taken), reported through -displayfd once the server accepts
-# connections. Not the lowest free number: a server shutting down removes its socket
+# connections, with -noreset: by default the server resets when its last client
+# disconnects, and a program that closes its only render window and opens another
+# (TestCloudSky, pvpython) could then meet a server in mid-reset: "bad X server
+# connection", seen once in several runs. Not the lowest free number: a server shutting down removes its socket
 # late, and a new server reusing that number at that moment would lose its own.
 set -u
 if [ -n "${DISPLAY:-}" ]; then
@@ -30,7 +33,7 @@ for attempt in 1 2 3 4 5 6 7 8; do
   number=$((1000 + RANDOM % 30000))
   [ -e "/tmp/.X${number}-lock" ] && continue
   : >"$scratch/display"
-  Xvfb ":$number" -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp \
+  Xvfb ":$number" -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp -noreset \
     3>"$scratch/display" 2>"$scratch/xvfb.log" &
   xvfb_pid=$!
   for _ in $(seq 200); do # up to 20 s

@@ -1,15 +1,20 @@
 // nimbus-demo: renders the Nimbus demo scene to a PNG and prints the file's path.
 //
 //   nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG] [--sun-azimuth DEG]
-//               [--seed N] [--k-multi K] [--exposure E]
+//               [--seed N] [--k-multi K] [--exposure E] [--no-sky]
 //
 // Scene: a metaball cumulus (vtkNimbusMetaballCloudSource, 004 §4) over a ground
 // plane, lit by the sun whose colour comes from the atmosphere model
 // through the atmosphere, rendered with Nimbus's shadow-view-slice mapper
-// (vtkNimbusCloudVolumeMapper, paper 000): cloud and ground shadows, the sky
-// colour of the atmosphere, shafts of light. Units: metres; z up.
+// (vtkNimbusCloudVolumeMapper, paper 000): cloud and ground shadows, shafts of
+// light, in front of the Nimbus sky (vtkNimbusSkyBackground: Rayleigh + Mie
+// with multiple scattering, issue 6) whose sun and air the cloud mapper shares.
+// With --no-sky the mapper draws its own single-scattering atmosphere instead.
+// Units: metres; z up.
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackground.h"
 
 #include "vtkCamera.h"
 #include "vtkImageData.h"
@@ -30,7 +35,7 @@ namespace
 void Usage()
 {
   std::cout << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
-               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E]\n";
+               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E] [--no-sky]\n";
 }
 
 bool ParseNumber(const char* text, double& value)
@@ -46,6 +51,7 @@ int main(int argc, char* argv[])
   std::string output = "nimbus-demo.png";
   double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7,
          kMulti = 3.0, exposure = 8.0;
+  bool drawSky = true;
   for (int i = 1; i < argc; ++i)
   {
     const std::string arg = argv[i];
@@ -81,6 +87,10 @@ int main(int argc, char* argv[])
     else if (arg == "--exposure" && hasValue)
     {
       ok = ParseNumber(argv[++i], exposure) && exposure >= 0.0;
+    }
+    else if (arg == "--no-sky")
+    {
+      drawSky = false;
     }
     else if (arg == "--seed" && hasValue)
     {
@@ -128,6 +138,17 @@ int main(int argc, char* argv[])
   vtkNew<vtkRenderer> renderer;
   renderer->AddVolume(volume);
   renderer->SetBackground(0.0, 0.0, 0.0); // space: the mapper draws the atmosphere
+  if (drawSky)
+  {
+    // The sky behind everything; the cloud mapper finds it and takes its sun,
+    // air, ground albedo and exposure (UseSceneSky), so sky and cloud agree.
+    vtkNew<vtkNimbusSkyBackground> sky;
+    sky->GetSky()->SetSunElevation(sunElevation);
+    sky->GetSky()->SetSunAzimuth(sunAzimuth);
+    sky->GetSky()->SetGroundAlbedo(0.25);
+    sky->GetSky()->SetExposure(exposure);
+    renderer->AddViewProp(sky);
+  }
 
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->SetPosition(0.0, -5600.0, 600.0);

@@ -38,6 +38,10 @@ uniform float groundZ;              // world z of the ground plane
 uniform float groundAlbedo;
 
 uniform sampler2D sceneDepth;       // depth of the opaque geometry already drawn
+// Over a Nimbus sky the ground is the sky's too: it stays transparent in the
+// accumulation's alpha, which is then the cloud's transmittance alone (nothing
+// is accumulated behind the ground either way: rays end there).
+uniform int overSky;
 
 const float kInfinity = 1e30;
 

@@ -1,14 +1,30 @@
 // Final composite (000 Eq. 4): I_v = sum_i Delta I_v(t_i) + I_back g_view(T), with
 // the sum and the cloud part of g_view accumulated by the slices (rgb, a), the
 // atmosphere part of g_view computed here, and I_back the colour already in the
-// framebuffer (background or opaque geometry). Optionally exposure and sRGB
-// encoding for display.
+// framebuffer (background or opaque geometry). Display: displayScale per channel
+// (Exposure, or a sky's exposure and white balance), optionally sRGB encoded.
+//
+// Over a Nimbus sky (skyBackground = 1) the framebuffer's background already is
+// the sky L_sky of the sky-view table (all scattering orders, the whole ray), and
+// the accumulation has a second target with the mapper's own radiance without
+// the cloud, S_clear (unshadowed air and ground, same slices and steps). Where
+// no opaque geometry was drawn:
+//   I = S - T_cl S_clear + T_cl L_sky
+// i.e. the sky, attenuated by the cloud's transmittance T_cl, plus what the
+// cloud adds (its light, S - S_clear where T_cl = 1 inside the shafts' shadow:
+// the missing sunlight, negative). Without a cloud on or shadowing the ray
+// S = S_clear and T_cl = 1, so I = L_sky exactly: the sky is not changed where
+// the cloud is not. The approximation: the air in front of a cloud keeps only
+// its single scattering (the sky's multiple scattering is taken as hidden by
+// the cloud in proportion 1 - T_cl along the whole ray).
 in vec2 texCoord;
 uniform sampler2D accumulation;
+uniform sampler2D clearAccumulation; // S_clear (over a sky only)
 uniform sampler2D sceneColor;
 uniform sampler2D rayEnds; // (t_end, t_ground) per pixel, this frame
-uniform float exposure;
+uniform vec3 displayScale;
 uniform int encodeSrgb;
+uniform int skyBackground;
 
 vec3 ToLinear(vec3 c)
 {
@@ -26,17 +42,35 @@ void main()
   ViewRay(texCoord, origin, direction);
   vec4 sum = texture(accumulation, texCoord);
   vec4 background = texture(sceneColor, texCoord);
-  float tEnd = texture(rayEnds, texCoord).r;
-  vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
+  float depth = texture(sceneDepth, texCoord).r;
+  vec3 backgroundLinear = encodeSrgb != 0 ? ToLinear(background.rgb) : background.rgb;
   vec3 result;
-  if (encodeSrgb != 0)
+  if (skyBackground != 0 && depth >= 1.0)
   {
-    result = ToSrgb(exposure * sum.rgb + behind * ToLinear(background.rgb));
+    vec3 clearSum = texture(clearAccumulation, texCoord).rgb;
+    vec3 sky = sum.a * backgroundLinear;                       // T_cl L_sky (display)
+    vec3 deficit = displayScale * (sum.a * clearSum - sum.rgb); // > 0: light the cloud removes
+    // The mapper's RGB single scattering and the spectral sky differ by a few
+    // per cent (up to +7 % in red on sunlit ground with the sun 4 deg high,
+    // measured): a deep shadow's deficit may then exceed the sky in one channel.
+    // Scale it down as a whole there, so the shadow keeps its hue instead of
+    // clipping that channel to zero.
+    float fit = 1.0;
+    for (int c = 0; c < 3; ++c)
+    {
+      if (deficit[c] > sky[c])
+      {
+        fit = min(fit, sky[c] / deficit[c]);
+      }
+    }
+    result = max(sky - max(fit, 0.0) * deficit, 0.0);
   }
   else
   {
-    result = exposure * sum.rgb + behind * background.rgb;
+    float tEnd = texture(rayEnds, texCoord).r;
+    vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
+    result = displayScale * sum.rgb + behind * backgroundLinear;
   }
-  gl_FragData[0] = vec4(result, 1.0);
-  gl_FragDepth = texture(sceneDepth, texCoord).r;
+  gl_FragData[0] = vec4(encodeSrgb != 0 ? ToSrgb(result) : result, 1.0);
+  gl_FragDepth = depth;
 }

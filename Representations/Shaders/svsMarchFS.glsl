@@ -6,7 +6,9 @@
 // each, which is what drawing them one by one would compute, without a blend per
 // slice. Before the cloud (pre) the sun is unshadowed; after it (post) the
 // shadow surface holds the whole cloud. Output as for a slice: rgb = radiance
-// toward the eye, a = 1, or 0 where the ground closes the ray in the region.
+// toward the eye, a = 1, or 0 where the ground closes the ray in the region
+// (not over a sky, see overSky);
+// second output: the same without the cloud's shadow (see svsSliceFS.glsl).
 in vec2 texCoord;
 uniform sampler2D intervalPhase;
 uniform sampler2D rayEnds;  // (t_end, t_ground) per pixel, this frame
@@ -40,6 +42,7 @@ void main()
     discard;
   }
   vec3 color = vec3(0.0);
+  vec3 clearColor = vec3(0.0); // without the cloud's shadow
   float alpha = 1.0;
   // View transmittance: closed form (flat layers) up to the region's start, then
   // accumulated step by step with the altitude over the spherical earth, because
@@ -56,7 +59,8 @@ void main()
       float dt = span * 2.0 * u / float(steps) * lengthUnit;
       vec3 p = origin + t * direction;
       float altitude = Altitude(p);
-      vec3 air = AirSource(altitude, intervalAndPhase.zw);
+      vec3 clearAir = AirSource(altitude, intervalAndPhase.zw);
+      vec3 air = clearAir;
       if (useShadow != 0 && shaftsOn != 0)
       {
         air *= exp(-ShadowDepth(p));
@@ -67,6 +71,7 @@ void main()
       vec3 weight = mix(vec3(dt), (1.0 - stepTransmittance) / max(extinction, vec3(1e-30)),
         step(vec3(1e-4), extinction * dt));
       color += air * viewTransmittance * weight;
+      clearColor += clearAir * viewTransmittance * weight;
       viewTransmittance *= stepTransmittance;
     }
   }
@@ -79,8 +84,10 @@ void main()
       vec3 groundTransmittance = (t1 > t0 && atmosphereOn != 0)
         ? viewTransmittance : AtmosphereViewTransmittance(origin, direction, tGround);
       color += GroundRadiance(g, useShadow != 0 ? ShadowDepth(g) : 0.0) * groundTransmittance;
-      alpha = 0.0;
+      clearColor += GroundRadiance(g, 0.0) * groundTransmittance;
+      alpha = overSky != 0 ? 1.0 : 0.0;
     }
   }
   gl_FragData[0] = vec4(color, alpha);
+  gl_FragData[1] = vec4(clearColor, 1.0);
 }

@@ -2,7 +2,12 @@
 // the fixed-function blend set by the mapper). Output: rgb = C_i, the radiance the
 // slab around slice i sends toward the eye (already multiplied by the atmosphere's
 // view transmittance in front of it), a = alpha_i, the slab's cloud transmittance
-// Delta g_view_cl. Opaque things in the slab (the ground) give alpha 0.
+// Delta g_view_cl. Opaque things in the slab (the ground) give alpha 0 (not over
+// a sky, see overSky).
+// Second output (only bound when the mapper draws over a Nimbus sky): the same
+// slab's radiance without the cloud — unshadowed air and ground — with alpha 1,
+// which the same blend sums; the composite subtracts what the cloud hides and
+// shadows of it from the sky (see svsCompositeFS.glsl).
 in vec2 texCoord;
 uniform sampler2D intervalPhase;
 uniform sampler2D rayEnds;        // (t_end, t_ground) per pixel, this frame  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
@@ -37,6 +42,7 @@ void main()
   }
 
   vec3 color = vec3(0.0);
+  vec3 clearColor = vec3(0.0); // the slab without the cloud
   float alpha = 1.0;
   if (medium)
   {
@@ -66,6 +72,7 @@ void main()
       {
         vec3 air = AirSource(altitude, intervalAndPhase.zw);            // 000 Eq. 8, atmosphere
         source += air * (shaftsOn != 0 ? sunTransmittance : 1.0);
+        clearColor = air * AtmosphereViewTransmittance(origin, direction, t) * stepMetres;
       }
       source *= AtmosphereViewTransmittance(origin, direction, t);
     }
@@ -74,10 +81,11 @@ void main()
   if (ground && (!medium || t < tGround))
   {
     vec3 g = origin + tGround * direction;
-    vec3 groundColor = GroundRadiance(g, ShadowDepth(g)) *
-      AtmosphereViewTransmittance(origin, direction, tGround);
-    color += alpha * groundColor;
-    alpha = 0.0;
+    vec3 groundTransmittance = AtmosphereViewTransmittance(origin, direction, tGround);
+    color += alpha * GroundRadiance(g, ShadowDepth(g)) * groundTransmittance;
+    clearColor += GroundRadiance(g, 0.0) * groundTransmittance;
+    alpha = overSky != 0 ? alpha : 0.0;
   }
   gl_FragData[0] = vec4(color, alpha);
+  gl_FragData[1] = vec4(clearColor, 1.0);
 }
