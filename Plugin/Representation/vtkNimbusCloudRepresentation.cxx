@@ -83,6 +83,7 @@ NIMBUS_FORWARD(MaximumTextureSize, int)
 NIMBUS_FORWARD(LengthUnit, double)
 NIMBUS_FORWARD(Exposure, double)
 NIMBUS_FORWARD(EncodeSrgb, bool)
+NIMBUS_FORWARD(UseSceneSky, bool)
 
 #undef NIMBUS_FORWARD
 

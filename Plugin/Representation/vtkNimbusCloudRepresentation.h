@@ -114,6 +114,15 @@ public:
   bool GetEncodeSrgb();
   ///@}
 
+  ///@{
+  /// Follow a visible vtkNimbusSkyBackground in the same renderer (ParaView's
+  /// "Sky Background" representation): its sun, atmosphere, ground, length unit
+  /// and display settings replace the ones above (see
+  /// vtkNimbusCloudVolumeMapper::SetUseSceneSky). Default on.
+  void SetUseSceneSky(bool value);
+  bool GetUseSceneSky();
+  ///@}
+
 protected:
   vtkNimbusCloudRepresentation();
   ~vtkNimbusCloudRepresentation() override;

@@ -12,7 +12,10 @@ Checks, through paraview.simple only:
   4. the parameters reach the view: Sunset reddens the horizon toward the sun (R > B)
      and a lower Exposure darkens the sky;
   5. hiding the representation, switching to another type and deleting it each
-     bring back the plain view background; showing it again brings the sky back.
+     bring back the plain view background; showing it again brings the sky back;
+  6. a small metaball cloud (Cloud representation) under the sky takes the sky's sun
+     (vtkNimbusCloudVolumeMapper's UseSceneSky): the Noon scene matches the second
+     baseline, and under the Sunset preset the cloud's pixels redden (mean R/B rises).
 Every check compares pixels of the rendered images, so each fails when the sky is
 not drawn (the background is magenta: R = B).
 """
@@ -21,7 +24,7 @@ import os
 import sys
 
 from paraview import servermanager
-from paraview.simple import (CreateRenderView, Delete, Hide, LoadPlugin, Render,
+from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
                              SaveScreenshot, Show)
 from vtkmodules.vtkIOImage import vtkPNGReader
 from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -72,10 +75,66 @@ def field_parameters(source):
             for i in range(fields.GetNumberOfArrays())}
 
 
+def check_cloud_under_sky(view, check, sky, args):
+    """6. The Cloud representation lit by the Sky Background's sun."""
+    sky.Preset = "Noon"
+    sky_display = Show(sky, view)
+    cloud = NimbusMetaballCloud(Dimensions=[48, 48, 32], Seed=3)  # noqa: F821 (plugin)
+    cloud_display = Show(cloud, view)
+    cloud_display.SetRepresentationType("Cloud")
+    ColorBy(cloud_display, ("POINTS", "density"))
+    cloud_display.NumberOfSlices = 64
+    # From the south, looking north at the cloud; the sunset sun is on the left (west).
+    view.CameraPosition = [0.0, -6000.0, 1500.0]
+    view.CameraFocalPoint = [0.0, 0.0, 1600.0]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.CameraViewAngle = 35.0
+    Render(view)
+    noon_path, noon = check.shot("TestPluginSkyBackground_cloud")
+    check.expect(compare_with_baseline(noon_path, args.cloud_baseline, args.output_dir,
+                                       args.compare_tool),
+                 "the cloud under the noon sky differs from the baseline")
+    # The cloud's pixels: where the scene differs from the sky alone.
+    Hide(cloud, view)
+    Render(view)
+    _, sky_only = check.shot("TestPluginSkyBackground-cloud-skyonly")
+    cloud_display = Show(cloud, view)
+    mask = abs(noon - sky_only).max(axis=2) > 24.0
+    mask[175:] = False  # the cloud, not its shadow on the ground (rows 190-225)
+    check.expect(0.02 < mask.mean() < 0.5,
+                 "the cloud covers %.3f of the view (expected a small cloud)" % mask.mean())
+
+    sky.Preset = "Sunset"
+    Render(view)
+    _, sunset = check.shot("TestPluginSkyBackground-cloud-sunset")
+
+    def red_over_blue(pixels):
+        return pixels[mask][:, 0].mean() / max(pixels[mask][:, 2].mean(), 1e-6)
+
+    noon_ratio, sunset_ratio = red_over_blue(noon), red_over_blue(sunset)
+    print("cloud region %.3f of the view; mean R/B noon %.3f, sunset %.3f"
+          % (mask.mean(), noon_ratio, sunset_ratio))
+    check.expect(sunset_ratio > noon_ratio + 0.5,
+                 "the cloud did not redden under the sunset sky (R/B %.3f -> %.3f)"
+                 % (noon_ratio, sunset_ratio))
+    # Use Scene Sky off: the cloud takes its own sun again (60 deg by default).
+    cloud_display.UseSceneSky = 0
+    Render(view)
+    _, own_sun = check.shot("TestPluginSkyBackground-cloud-ownsun")
+    own_ratio = red_over_blue(own_sun)
+    print("Use Scene Sky off under the sunset sky: cloud R/B %.3f" % own_ratio)
+    check.expect(own_ratio < sunset_ratio - 0.5,
+                 "Use Scene Sky off still follows the sky's sun (R/B %.3f)" % own_ratio)
+    Delete(cloud_display)
+    Delete(sky_display)
+    Delete(cloud)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--baseline", required=True)
+    parser.add_argument("--cloud-baseline", required=True)
     parser.add_argument("--output-dir", required=True)
     parser.add_argument("--compare-tool", required=True)
     args = parser.parse_args()
@@ -190,6 +249,8 @@ def main():
     fraction = check.background_fraction(deleted)
     print("deleted: %.3f of the pixels are the view background" % fraction)
     check.expect(fraction == 1.0, "the sky outlived its representation (%.3f)" % fraction)
+
+    check_cloud_under_sky(view, check, sky, args)
 
     for failure in check.failures:
         print("FAILED:", failure)
