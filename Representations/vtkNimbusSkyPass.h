@@ -15,8 +15,9 @@
  * they are composited over the sky by their alpha (the delegate renders on
  * transparent black: the renderer's background is ignored while the pass is on).
  * The camera's altitude is the sky's ObserverAltitude + camera z x MetresPerUnit;
- * the sky-view table is the sky's (at ObserverAltitude), so cameras far above
- * z = 0 should raise ObserverAltitude.
+ * both the sky-view table (vtkNimbusSky::GetSkyViewLutAt) and the
+ * aerial-perspective table are seen from it. For the sky alone, without a pass,
+ * see vtkNimbusSkyBackground.
  *
  * GLSL: SkyShaders/vtkNimbusSkyPassFS.glsl, the GPU twin of
  * nimbus::SkyViewLut::Radiance / AerialPerspectiveLut::Lookup (Optics/Sky.cxx).

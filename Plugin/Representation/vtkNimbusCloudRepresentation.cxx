@@ -75,6 +75,7 @@ NIMBUS_FORWARD(Ground, bool)
 NIMBUS_FORWARD(GroundHeight, double)
 NIMBUS_FORWARD(GroundAlbedo, double)
 NIMBUS_FORWARD(Shafts, bool)
+NIMBUS_FORWARD(UseSceneSky, bool)
 NIMBUS_FORWARD(NumberOfSlices, int)
 NIMBUS_FORWARD(SliceAngleRatio, double)
 NIMBUS_FORWARD(ShadowSurfaceSize, int)
@@ -83,7 +84,6 @@ NIMBUS_FORWARD(MaximumTextureSize, int)
 NIMBUS_FORWARD(LengthUnit, double)
 NIMBUS_FORWARD(Exposure, double)
 NIMBUS_FORWARD(EncodeSrgb, bool)
-NIMBUS_FORWARD(UseSceneSky, bool)
 
 #undef NIMBUS_FORWARD
 

@@ -89,6 +89,14 @@ public:
   ///@}
 
   ///@{
+  /// Follow a Nimbus sky shown in the same view ("Sky Background"): its sun,
+  /// air, ground albedo and exposure replace the cloud's own (see
+  /// vtkNimbusCloudVolumeMapper::SetUseSceneSky). On by default.
+  void SetUseSceneSky(bool value);
+  bool GetUseSceneSky();
+  ///@}
+
+  ///@{
   /// Quality: slice count, a of theta_e : theta_s = 1 : a (000 §4.2), shadow
   /// surface texels per side, atmosphere samples per pixel, largest density
   /// texture side (0: the GL limit).
@@ -112,15 +120,6 @@ public:
   double GetExposure();
   void SetEncodeSrgb(bool value);
   bool GetEncodeSrgb();
-  ///@}
-
-  ///@{
-  /// Follow a visible vtkNimbusSkyBackground in the same renderer (ParaView's
-  /// "Sky Background" representation): its sun, atmosphere, ground, length unit
-  /// and display settings replace the ones above (see
-  /// vtkNimbusCloudVolumeMapper::SetUseSceneSky). Default on.
-  void SetUseSceneSky(bool value);
-  bool GetUseSceneSky();
   ///@}
 
 protected:

@@ -9,6 +9,7 @@
 //     - a real cloud leaves the sky unchanged away from it and its shadow,
 //     - the mapper takes the sky's sun (and a sky change re-lights the cloud:
 //       a low sun reddens it), and with UseSceneSky off it keeps its own,
+//     - the sun at the zenith and below the horizon: finite radiance,
 //     - aerial perspective: the same cloud 28 km away differs less from the sky
 //       behind it than at 4 km.
 #include "ImageComparison.h"
@@ -19,6 +20,7 @@
 #include "vtkNimbusSkyBackground.h"
 
 #include "vtkCamera.h"
+#include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
@@ -172,6 +174,23 @@ int RunChecks()
     ok &= Check(lowRedness > highRedness * 1.5,
       "a low sun reddens the cloud: R/B of its light " + std::to_string(highRedness) +
         " (sun 30 deg) -> " + std::to_string(lowRedness) + " (4 deg)");
+    // Extremes of the shared sun: at the zenith and 6 deg below the horizon the
+    // cloud's float radiance stays finite and non-negative.
+    scene.Mapper->CaptureRadianceOn();
+    for (double elevation : { 90.0, -6.0 })
+    {
+      scene.Sky->GetSky()->SetSunElevation(elevation);
+      Grab(scene.Window);
+      vtkDataArray* radiance = scene.Mapper->GetRadianceImage()->GetPointData()->GetArray("radiance");
+      bool finite = radiance && radiance->GetNumberOfTuples() == kWidth * kHeight;
+      for (vtkIdType i = 0; finite && i < radiance->GetNumberOfValues(); ++i)
+      {
+        const double v = radiance->GetVariantValue(i).ToDouble();
+        finite = std::isfinite(v) && v >= 0.0;
+      }
+      ok &= Check(finite, "sun at " + std::to_string(elevation) + " deg: finite, non-negative radiance");
+    }
+    scene.Mapper->CaptureRadianceOff();
     scene.Mapper->UseSceneSkyOff();
     scene.Mapper->SetSunElevation(60.0);
     Grab(scene.Window);

@@ -117,14 +117,14 @@ def check_cloud_under_sky(view, check, sky, args):
     check.expect(sunset_ratio > noon_ratio + 0.5,
                  "the cloud did not redden under the sunset sky (R/B %.3f -> %.3f)"
                  % (noon_ratio, sunset_ratio))
-    # Use Scene Sky off: the cloud takes its own sun again (60 deg by default).
+    # UseSceneSky off: the cloud takes its own sun again (60 deg by default).
     cloud_display.UseSceneSky = 0
     Render(view)
     _, own_sun = check.shot("TestPluginSkyBackground-cloud-ownsun")
     own_ratio = red_over_blue(own_sun)
-    print("Use Scene Sky off under the sunset sky: cloud R/B %.3f" % own_ratio)
+    print("UseSceneSky off under the sunset sky: cloud R/B %.3f" % own_ratio)
     check.expect(own_ratio < sunset_ratio - 0.5,
-                 "Use Scene Sky off still follows the sky's sun (R/B %.3f)" % own_ratio)
+                 "UseSceneSky off still follows the sky's sun (R/B %.3f)" % own_ratio)
     Delete(cloud_display)
     Delete(sky_display)
     Delete(cloud)
