@@ -55,8 +55,10 @@ bool SkyViewTextures::Update(
     error = e.what();
     return false;
   }
-  this->Mapping = table;
-  if (this->Builds == sky->GetSkyViewBuilds() && this->Table == table && this->Textures[0])
+  const bool uploaded =
+    this->Builds == sky->GetSkyViewBuilds() && this->Table == table && this->Textures[0];
+  this->Table = table;
+  if (uploaded)
   {
     return true;
   }
@@ -72,7 +74,6 @@ bool SkyViewTextures::Update(
       m.Width, m.Rows(), 3, VTK_FLOAT, const_cast<float*>(table->GetTable().data() + k * plane));
   }
   this->Builds = sky->GetSkyViewBuilds();
-  this->Table = table;
   return true;
 }
 
@@ -84,7 +85,7 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
     this->Textures[k]->Activate();
     program->SetUniformi(names[k], this->Textures[k]->GetTextureUnit());
   }
-  const SkyViewMapping& m = static_cast<const SkyViewLut*>(this->Mapping)->GetMapping();
+  const SkyViewMapping& m = this->Table->GetMapping();
   double sun[3], scale[3], disc[3];
   sky->GetSunDirection(sun);
   sky->GetDisplayScale(scale);

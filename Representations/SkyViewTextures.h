@@ -16,6 +16,8 @@ class vtkWindow;
 
 namespace nimbus
 {
+class SkyViewLut;
+
 class SkyViewTextures
 {
 public:
@@ -43,9 +45,8 @@ public:
 
 private:
   std::array<vtkTextureObject*, 3> Textures{ { nullptr, nullptr, nullptr } };
-  const void* Table = nullptr; // identity of the uploaded table
+  const SkyViewLut* Table = nullptr; // the uploaded table (its layout sets the uniforms)
   int Builds = -1;
-  const void* Mapping = nullptr; // the table the uniforms describe
 };
 }
 

@@ -39,11 +39,6 @@ struct vtkNimbusSkyPass::Internals
   int AerialBuilds = -1;
   vtkOpenGLQuadHelper* Quad = nullptr;
 
-  static vtkTextureObject* NewTexture(vtkOpenGLRenderWindow* window)
-  {
-    return nimbus::SkyViewTextures::NewLinearTexture(window);
-  }
-
   void Release(vtkWindow* w)
   {
     auto drop = [w](vtkTextureObject*& t) {
@@ -114,9 +109,9 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   // 1. The delegate into colour + depth textures.
   if (!in.Color)
   {
-    in.Color = Internals::NewTexture(window);
+    in.Color = nimbus::SkyViewTextures::NewLinearTexture(window);
     in.Color->Allocate2D(w, h, 4, VTK_UNSIGNED_CHAR);
-    in.Depth = Internals::NewTexture(window);
+    in.Depth = nimbus::SkyViewTextures::NewLinearTexture(window);
     in.Depth->SetMinificationFilter(vtkTextureObject::Nearest);
     in.Depth->SetMagnificationFilter(vtkTextureObject::Nearest);
     in.Depth->AllocateDepth(w, h, vtkTextureObject::Fixed24);
@@ -157,7 +152,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   vtkCamera* camera = r->GetActiveCamera();
   double eye[3];
   camera->GetPosition(eye);
-  const double cameraAltitude = sky->GetObserverAltitude() + eye[2] * sky->GetMetresPerUnit();
+  const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(sky, eye[2]);
   const nimbus::AerialPerspectiveLut* aerial = nullptr;
   std::string tableError;
   try
@@ -168,7 +163,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   {
     tableError = e.what();
   }
-  if (!aerial || !in.SkyView.Update(window, sky, std::max(0.0, cameraAltitude), tableError))
+  if (!aerial || !in.SkyView.Update(window, sky, cameraAltitude, tableError))
   {
     vtkErrorMacro("sky tables: " << tableError);
     return;
@@ -189,7 +184,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
       }
       if (!in.AerialTextures[k])
       {
-        in.AerialTextures[k] = Internals::NewTexture(window);
+        in.AerialTextures[k] = nimbus::SkyViewTextures::NewLinearTexture(window);
       }
       in.AerialTextures[k]->Create3DFromRaw(
         am.Width, am.Rows(), aerial->GetSlices(), 3, VTK_FLOAT, part.data());
