@@ -6,8 +6,8 @@
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
 #include "vtkDoubleArray.h"
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -353,9 +353,8 @@ int vtkNimbusMetaballCloudSource::RequestData(
       nimbus::GrowOnSurface(balls, points, triangles, growth, random);
     if (grown.empty())
     {
-      vtkWarningMacro(<< "Growth level " << level
-                      << ": the isosurface at IsoValue " << this->IsoValue
-                      << " has no upward-facing triangle; no balls added.");
+      vtkWarningMacro(<< "Growth level " << level << ": the isosurface at IsoValue "
+                      << this->IsoValue << " has no upward-facing triangle; no balls added.");
     }
     balls.insert(balls.end(), grown.begin(), grown.end());
     ballCount *= this->BallCountFactor;

@@ -178,8 +178,7 @@ vtkStringArray* vtkNimbusOpenVDBReader::GetGridNames()
 }
 
 vtkNimbusOpenVDBReader::Internals::Plan vtkNimbusOpenVDBReader::Internals::MakePlan(
-  const char* boundsGrid,
-  const std::string& path) const
+  const char* boundsGrid, const std::string& path) const
 {
   const Internals& in = *this;
   Plan plan;
@@ -278,9 +277,8 @@ void RowMajorDirection(const vdb::TransformInfo& t, double out[9])
 }
 }
 
-int vtkNimbusOpenVDBReader::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkNimbusOpenVDBReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   if (!this->FileName || !*this->FileName)
   {
@@ -317,9 +315,8 @@ int vtkNimbusOpenVDBReader::RequestInformation(vtkInformation*,
   return 1;
 }
 
-int vtkNimbusOpenVDBReader::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkNimbusOpenVDBReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   if (!output)
@@ -434,14 +431,8 @@ int vtkNimbusOpenVDBReader::RequestData(vtkInformation*,
   try
   {
     vdb::ReadDense(
-      this->FileName,
-      names,
-      t,
-      plan.Box,
-      targets,
-      &resampled,
-      [this](double f) { this->UpdateProgress(f); },
-      &exact);
+      this->FileName, names, t, plan.Box, targets, &resampled,
+      [this](double f) { this->UpdateProgress(f); }, &exact);
   }
   catch (const vdb::Error& e)
   {

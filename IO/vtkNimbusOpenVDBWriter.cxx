@@ -44,8 +44,8 @@ namespace
 {
 // Float values of `array` (its own buffer for a vtkFloatArray, else a converted copy kept
 // in `storage`).
-const float* FloatValues(vtkDataArray* array,
-  std::vector<std::unique_ptr<std::vector<float>>>& storage)
+const float* FloatValues(
+  vtkDataArray* array, std::vector<std::unique_ptr<std::vector<float>>>& storage)
 {
   if (auto* f = vtkFloatArray::SafeDownCast(array))
   {
@@ -124,10 +124,8 @@ void vtkNimbusOpenVDBWriter::WriteData()
   std::vector<std::unique_ptr<std::vector<float>>> storage;
   std::set<std::string> names;
   std::string skipped;
-  auto collect = [&](vtkDataSetAttributes* data,
-                   const vdb::IndexBox& box,
-                   const vdb::TransformInfo& transform,
-                   bool cells)
+  auto collect = [&](vtkDataSetAttributes* data, const vdb::IndexBox& box,
+                   const vdb::TransformInfo& transform, bool cells)
   {
     const vtkIdType expected = static_cast<vtkIdType>(box.VoxelCount());
     for (int i = 0; i < data->GetNumberOfArrays(); ++i)

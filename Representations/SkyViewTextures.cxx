@@ -93,7 +93,8 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
   program->SetUniform3f("sunDirection", sun);
   program->SetUniformf(
     "sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuth())));
-  program->SetUniformf("mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.mieG));
+  program->SetUniformf(
+    "mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.mieG));
   program->SetUniform3f("displayScale", scale);
   const float skyTable[4] = { static_cast<float>(m.HorizonZenith), static_cast<float>(m.Width),
     static_cast<float>(m.AboveRows), static_cast<float>(m.BelowRows) };

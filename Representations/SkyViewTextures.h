@@ -29,7 +29,8 @@ public:
   /// Builds (through the sky's cache) and uploads the sky-view table seen from
   /// `altitude` (m; see vtkNimbusSky::GetSkyViewLutAt) when it changed. False,
   /// with the reason in `error`, when the table cannot be built.
-  bool Update(vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, double altitude, std::string& error);
+  bool Update(
+    vtkOpenGLRenderWindow* window, vtkNimbusSky* sky, double altitude, std::string& error);
   /// Binds the textures and sets the sky uniforms of nimbusSkyView.glsl.
   void Activate(vtkShaderProgram* program, vtkNimbusSky* sky);
   /// The altitude a camera at scene height z sees the sky from:

@@ -17,6 +17,7 @@
 #include "vtkNimbusSkyBackground.h"
 
 #include "vtkCamera.h"
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -29,7 +30,6 @@
 #include "vtkOpenGLState.h"
 #include "vtkPointData.h"
 #include "vtkPropCollection.h"
-#include "vtkCellData.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
@@ -89,8 +89,8 @@ struct FrameSettings
 {
   double SunAzimuth, SunElevation, SunIlluminance, SunTemperature; // deg, deg, relative, K
   double HazeDensity, HazeG, RayleighScattering;                   // 1/m, -, 1/m
-  double SceneAltitude, GroundHeight, GroundAlbedo, LengthUnit;     // m, world, -, m/unit
-  double DisplayScale[3];                                           // per channel
+  double SceneAltitude, GroundHeight, GroundAlbedo, LengthUnit;    // m, world, -, m/unit
+  double DisplayScale[3];                                          // per channel
   bool EncodeSrgb;
   bool OverSky;
 };
@@ -139,7 +139,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   int TextureDims[3] = { 0, 0, 0 };
   double BoxToTexScale[3] = { 1, 1, 1 };
   double BoxToTexOffset[3] = { 0, 0, 0 };
-  double BoxOrigin[3] = { 0, 0, 0 };  // data coordinates of the density box
+  double BoxOrigin[3] = { 0, 0, 0 }; // data coordinates of the density box
   double BoxSize[3] = { 1, 1, 1 };
   bool HasDensity = false;
 
@@ -182,16 +182,15 @@ struct vtkNimbusCloudVolumeMapper::Internals
 
   void Release(vtkWindow* window)
   {
-    for (vtkTextureObject* t : { Density.GetPointer(), AtmosphereTexture.GetPointer(),
-           IntervalPhase.GetPointer(), Accumulation.GetPointer(), ClearAccumulation.GetPointer(),
-           SceneColor.GetPointer(),
-           SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
+    for (vtkTextureObject* t :
+      { Density.GetPointer(), AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
+        Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
+        SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
     for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
-           SceneFramebuffer.GetPointer(),
-           RayEndsFramebuffer.GetPointer(),
+           SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
            AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
@@ -305,8 +304,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
 
   // --- density texture: uploaded only when the data (not the lighting) changed.
   int cellFlag = 0;
-  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, this->ScalarMode,
-    this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
+    image, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
   if (!scalars)
   {
     vtkErrorMacro("The input image has no scalar array to render as density (set one with "
@@ -329,9 +328,9 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     }
     if (static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] != scalars->GetNumberOfTuples())
     {
-      vtkErrorMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)")
-                              << "' has " << scalars->GetNumberOfTuples()
-                              << " values, but the image needs " << dims[0] * dims[1] * dims[2]);
+      vtkErrorMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)") << "' has "
+                              << scalars->GetNumberOfTuples() << " values, but the image needs "
+                              << dims[0] * dims[1] * dims[2]);
       return;
     }
     if (scalars->GetNumberOfComponents() != 1)
@@ -351,8 +350,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     {
       vtkWarningMacro("Density " << dims[0] << "x" << dims[1] << "x" << dims[2]
                                  << " exceeds the texture limit of " << maxSize
-                                 << " per side; downsampled to " << texDims[0] << "x"
-                                 << texDims[1] << "x" << texDims[2] << " by averaging.");
+                                 << " per side; downsampled to " << texDims[0] << "x" << texDims[1]
+                                 << "x" << texDims[2] << " by averaging.");
     }
     std::vector<float> values(static_cast<size_t>(texDims[0]) * texDims[1] * texDims[2], 0.0f);
     std::vector<float> counts(values.size(), 0.0f);
@@ -363,7 +362,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
       {
         for (int x = 0; x < dims[0]; ++x)
         {
-          const vtkIdType id = x + static_cast<vtkIdType>(dims[0]) * (y + static_cast<vtkIdType>(dims[1]) * z);
+          const vtkIdType id =
+            x + static_cast<vtkIdType>(dims[0]) * (y + static_cast<vtkIdType>(dims[1]) * z);
           double v = scalars->GetComponent(id, 0);
           if (!std::isfinite(v))
           {
@@ -371,7 +371,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
             v = 0.0;
           }
           const size_t t = (x / factor[0]) +
-            static_cast<size_t>(texDims[0]) * ((y / factor[1]) + static_cast<size_t>(texDims[1]) * (z / factor[2]));
+            static_cast<size_t>(texDims[0]) *
+              ((y / factor[1]) + static_cast<size_t>(texDims[1]) * (z / factor[2]));
           values[t] += static_cast<float>(std::max(v, 0.0));
           counts[t] += 1.0f;
         }
@@ -386,7 +387,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
       vtkWarningMacro(<< nonFinite << " density values are NaN or infinite; rendered as 0.");
     }
     ResetTexture(in.Density, window, true);
-    if (!in.Density->Create3DFromRaw(texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
+    if (!in.Density->Create3DFromRaw(
+          texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
     {
       vtkErrorMacro("Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
                                             << " density texture.");
@@ -454,7 +456,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     }
     settings.SunAzimuth = sky->GetSunAzimuth();
     settings.SunElevation = sky->GetSunElevation();
-    settings.SunIlluminance = 1.0;   // the sky's sun: luminance 1 above the atmosphere
+    settings.SunIlluminance = 1.0;    // the sky's sun: luminance 1 above the atmosphere
     settings.SunTemperature = 5778.0; // and a 5778 K blackbody (Sky.h)
     settings.HazeDensity = air->mieScattering;
     settings.HazeG = air->mieG;
@@ -553,7 +555,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
   state->PushFramebufferBindings();
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
-  auto ensure2D = [&](vtkTextureObject* texture, int w, int h, int components, bool depth) {
+  auto ensure2D = [&](vtkTextureObject* texture, int w, int h, int components, bool depth)
+  {
     texture->SetContext(window);
     if (static_cast<int>(texture->GetWidth()) != w || static_cast<int>(texture->GetHeight()) != h ||
       !texture->GetHandle())
@@ -584,8 +587,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     in.SceneFramebuffer->AddDepthAttachment(in.SceneDepth);
     in.SceneFramebuffer->ActivateDrawBuffer(0);
     state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
-    glBlitFramebuffer(x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_COLOR_BUFFER_BIT,
-      GL_NEAREST);
+    glBlitFramebuffer(
+      x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     state->vtkglClearDepth(1.0);
     state->vtkglClear(GL_DEPTH_BUFFER_BIT);
     in.SceneFramebuffer->RemoveDepthAttachment();
@@ -611,7 +614,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   {
     boxZMin = std::min(boxZMin, corner[2]);
   }
-  const double zLow = (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.LengthUnit;
+  const double zLow =
+    (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.LengthUnit;
   nimbus::SceneDescription scene;
   scene.Sun.Azimuth = settings.SunAzimuth;
   scene.Sun.Elevation = settings.SunElevation;
@@ -623,10 +627,12 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   scene.Atmosphere.MieScattering = settings.HazeDensity;
   scene.Atmosphere.MieG = settings.HazeG;
   scene.Background.Type = "black"; // the framebuffer is the background
-  const double zHigh = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - settings.SceneAltitude;
+  const double zHigh =
+    scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - settings.SceneAltitude;
   const std::vector<double> atmosphereKey = { settings.SunAzimuth, settings.SunElevation,
-    settings.SunIlluminance, settings.SunTemperature, atmosphere ? 1.0 : 0.0, settings.SceneAltitude,
-    settings.RayleighScattering, settings.HazeDensity, settings.HazeG, zLow };
+    settings.SunIlluminance, settings.SunTemperature, atmosphere ? 1.0 : 0.0,
+    settings.SceneAltitude, settings.RayleighScattering, settings.HazeDensity, settings.HazeG,
+    zLow };
   if (atmosphereKey != in.AtmosphereKey)
   {
     try
@@ -642,8 +648,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     if (in.Table.HasAtmosphere)
     {
       ResetTexture(in.AtmosphereTexture, window, true);
-      in.AtmosphereTexture->Create2DFromRaw(in.Table.Samples, nimbus::AtmosphereTable::kRows, 4,
-        VTK_FLOAT, in.Table.Data.data());
+      in.AtmosphereTexture->Create2DFromRaw(
+        in.Table.Samples, nimbus::AtmosphereTable::kRows, 4, VTK_FLOAT, in.Table.Data.data());
       ++in.AtmosphereBuilds;
     }
     in.AtmosphereKey = atmosphereKey;
@@ -653,7 +659,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   const std::array<float, 16> ivp = ColumnMajor(inverseViewProjection);
   const std::array<float, 16> w2t = ColumnMajor(worldToTexture);
   const std::array<float, 16> w2b = ColumnMajor(worldToBox);
-  auto setCommon = [&](vtkShaderProgram* program) {
+  auto setCommon = [&](vtkShaderProgram* program)
+  {
     program->SetUniformMatrix4x4("inverseViewProjection", const_cast<float*>(ivp.data()));
     program->SetUniformi("perspective", camera->GetParallelProjection() ? 0 : 1);
     program->SetUniform3f("eyePosition", camera->GetPosition());
@@ -681,7 +688,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
       // Unused, but a sampler2D must not share a unit with the 3-D density texture.
       program->SetUniformi("atmosphereTable", in.SceneDepth->GetTextureUnit());
     }
-    const float zRange[2] = { static_cast<float>(in.Table.ZMin), static_cast<float>(in.Table.ZMax) };
+    const float zRange[2] = { static_cast<float>(in.Table.ZMin),
+      static_cast<float>(in.Table.ZMax) };
     program->SetUniform2f("atmosphereZRange", zRange);
     program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
     program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
@@ -720,9 +728,10 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   // --- sampling-interval and Mie-phase texture (rebuilt when camera or sun change).
   const bool unlit = this->Unlit;
   std::vector<double> intervalKey(ivp.begin(), ivp.end());
-  intervalKey.insert(intervalKey.end(), { static_cast<double>(width), static_cast<double>(height),
-    toSun[0], toSun[1], toSun[2], axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG,
-    settings.HazeG, this->MultipleScattering });
+  intervalKey.insert(intervalKey.end(),
+    { static_cast<double>(width), static_cast<double>(height), toSun[0], toSun[1], toSun[2],
+      axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG, settings.HazeG,
+      this->MultipleScattering });
   state->vtkglDisable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_FALSE);
   if (intervalKey != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
@@ -774,7 +783,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
 
   // 000 §4.3: back-to-front S_i = C_i + alpha_i S_{i-1}; front-to-back
   // S_i = S_{i-1} + alpha*_i C_i with alpha* the transmittance so far (kept in alpha).
-  auto useSliceBlend = [&]() {
+  auto useSliceBlend = [&]()
+  {
     state->vtkglEnable(GL_BLEND);
     if (axis.BackToFront)
     {
@@ -787,7 +797,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   };
 
   const bool outsideRegions = atmosphere || ground;
-  auto drawRegion = [&](double start, double end, bool useShadow) {
+  auto drawRegion = [&](double start, double end, bool useShadow)
+  {
     in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
     state->vtkglViewport(0, 0, width, height);
     useSliceBlend();
@@ -815,7 +826,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   // it the density is zero. On screen this holds only when nothing outside the
   // box is drawn (no atmosphere, no ground).
   vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
-  auto screenRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4]) {
+  auto screenRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4])
+  {
     double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
     for (const auto& point : points)
     {
@@ -832,17 +844,22 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
         hi[k] = std::max(hi[k], q[k] / q[3]);
       }
     }
-    const int px0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
-    const int py0 = std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
-    const int px1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
-    const int py1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
+    const int px0 =
+      std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
+    const int py0 =
+      std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
+    const int px1 =
+      std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
+    const int py1 =
+      std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
     rect[0] = px0;
     rect[1] = py0;
     rect[2] = std::max(px1 - px0, 0);
     rect[3] = std::max(py1 - py0, 0);
     return true;
   };
-  auto shadowRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4]) {
+  auto shadowRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4])
+  {
     const int size = this->ShadowSurfaceSize;
     double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
     for (const auto& point : points)
@@ -976,9 +993,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   ++in.PassesLastRender;
 
   for (vtkTextureObject* t : { in.Density.GetPointer(), in.SceneDepth.GetPointer(),
-         in.RayEnds.GetPointer(),
-         in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(), in.Accumulation.GetPointer(),
-         in.SceneColor.GetPointer() })
+         in.RayEnds.GetPointer(), in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(),
+         in.Accumulation.GetPointer(), in.SceneColor.GetPointer() })
   {
     t->Deactivate();
   }

@@ -31,8 +31,9 @@ const std::map<std::string, Setter>& MetaballSetters()
   using V = std::vector<double>;
   static const std::map<std::string, Setter> setters = {
     { "Dimensions",
-      [](S* s, const V& v)
-      { s->SetDimensions(static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2])); } },
+      [](S* s, const V& v) {
+        s->SetDimensions(static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2]));
+      } },
     { "Bounds", [](S* s, const V& v) { s->SetBounds(v[0], v[1], v[2], v[3], v[4], v[5]); } },
     { "Seed", [](S* s, const V& v) { s->SetSeed(static_cast<int>(v[0])); } },
     { "NumberOfLevels", [](S* s, const V& v) { s->SetNumberOfLevels(static_cast<int>(v[0])); } },
@@ -84,8 +85,8 @@ int vtkNimbusSceneDensitySource::RequestInformation(
     vtkNew<vtkXMLImageDataReader> reader;
     if (!reader->CanReadFile(density.Path.c_str()))
     {
-      vtkErrorMacro(<< this->SceneFileName << ": medium.density.path: cannot read '"
-                    << density.Path << "' as a VTK image (.vti)");
+      vtkErrorMacro(<< this->SceneFileName << ": medium.density.path: cannot read '" << density.Path
+                    << "' as a VTK image (.vti)");
       return 0;
     }
     reader->SetFileName(density.Path.c_str());
@@ -129,7 +130,8 @@ int vtkNimbusSceneDensitySource::RequestData(
     volume ? volume->GetPointData()->GetArray(this->InnerArrayName.c_str()) : nullptr;
   if (!values || values->GetNumberOfComponents() != 1 || volume->GetNumberOfPoints() == 0)
   {
-    vtkErrorMacro(<< this->SceneFileName << ": the density volume has no one-component point array '"
+    vtkErrorMacro(<< this->SceneFileName
+                  << ": the density volume has no one-component point array '"
                   << this->InnerArrayName << "'");
     return 0;
   }

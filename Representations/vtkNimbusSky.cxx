@@ -59,8 +59,8 @@ void vtkNimbusSky::SetPreset(int preset)
       this->SetSunAzimuth(270.0);
       break;
     default:
-      vtkErrorMacro("SetPreset: unknown preset " << preset
-                                                 << " (0 Noon, 1 Afternoon, 2 Sunset, 3 Twilight)");
+      vtkErrorMacro(
+        "SetPreset: unknown preset " << preset << " (0 Noon, 1 Afternoon, 2 Sunset, 3 Twilight)");
   }
 }
 
@@ -76,8 +76,8 @@ void vtkNimbusSky::GetSunDirection(double direction[3])
 const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
 {
   Internals& in = *this->Internal;
-  if (!in.Model || in.ModelAerosol != this->AerosolDensity || in.ModelAlbedo != this->GroundAlbedo ||
-    in.ModelOrders != this->ScatteringOrders)
+  if (!in.Model || in.ModelAerosol != this->AerosolDensity ||
+    in.ModelAlbedo != this->GroundAlbedo || in.ModelOrders != this->ScatteringOrders)
   {
     nimbus::SkyParameters p;
     p.Atmosphere.mieScattering *= this->AerosolDensity;
@@ -103,7 +103,8 @@ const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLut()
   if (!in.SkyView || in.SkyViewGeneration != in.ModelGeneration ||
     in.SkyViewElevation != this->SunElevation || in.SkyViewAltitude != this->ObserverAltitude)
   {
-    in.SkyView = std::make_unique<nimbus::SkyViewLut>(model, this->SunElevation, this->ObserverAltitude);
+    in.SkyView =
+      std::make_unique<nimbus::SkyViewLut>(model, this->SunElevation, this->ObserverAltitude);
     in.SkyViewGeneration = in.ModelGeneration;
     in.SkyViewElevation = this->SunElevation;
     in.SkyViewAltitude = this->ObserverAltitude;

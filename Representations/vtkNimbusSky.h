@@ -132,8 +132,8 @@ public:
   /// Aerial perspective between two scene points (camera, point): transmittance
   /// (linear sRGB factor) and in-scattered radiance (linear sRGB, relative to the
   /// sun, no exposure), integrated directly (all scattering orders).
-  void AerialPerspective(
-    const double cameraPosition[3], const double point[3], double transmittance[3], double inscatter[3]);
+  void AerialPerspective(const double cameraPosition[3], const double point[3],
+    double transmittance[3], double inscatter[3]);
 
   /// Radiance of the sun's disc centre (linear sRGB, relative; 0 below the horizon)
   /// at the observer, for a disc of angular radius GetSunAngularRadius().

@@ -103,7 +103,8 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
   in.Window = window;
   std::string error;
   vtkCamera* camera = renderer->GetActiveCamera();
-  const double altitude = nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
+  const double altitude =
+    nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
   if (!in.SkyView.Update(window, this->Sky, altitude, error))
   {
     vtkErrorMacro("Sky tables: " << error);

@@ -31,13 +31,13 @@ vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
   this->SetSky(sky);
 }
 
-#define NIMBUS_FORWARD(name)                                                                      \
-  void vtkNimbusSkyDomeSource::Set##name(double v)                                                \
-  {                                                                                               \
-    if (this->Sky)                                                                                \
-    {                                                                                             \
-      this->Sky->Set##name(v);                                                                    \
-    }                                                                                             \
+#define NIMBUS_FORWARD(name)                                                                       \
+  void vtkNimbusSkyDomeSource::Set##name(double v)                                                 \
+  {                                                                                                \
+    if (this->Sky)                                                                                 \
+    {                                                                                              \
+      this->Sky->Set##name(v);                                                                     \
+    }                                                                                              \
   }
 NIMBUS_FORWARD(SunElevation)
 NIMBUS_FORWARD(SunAzimuth)
@@ -85,8 +85,8 @@ struct SkyParameter
 #define NIMBUS_PARAMETER(name, type)                                                               \
   SkyParameter                                                                                     \
   {                                                                                                \
-    #name, [](vtkNimbusSky* s) { return static_cast<double>(s->Get##name()); },                    \
-      [](vtkNimbusSky* s, double v) { s->Set##name(static_cast<type>(v)); }                        \
+#name, [](vtkNimbusSky * s) { return static_cast<double>(s->Get##name()); },                   \
+      [](vtkNimbusSky * s, double v) { s->Set##name(static_cast<type>(v)); }                       \
   }
 const SkyParameter SkyParameters[] = {
   NIMBUS_PARAMETER(SunElevation, double),
@@ -184,7 +184,8 @@ int vtkNimbusSkyDomeSource::RequestData(
   double scale[3];
   sky->GetDisplayScale(scale);
 
-  auto addPoint = [&](double elevationDeg, double azimuthDeg) {
+  auto addPoint = [&](double elevationDeg, double azimuthDeg)
+  {
     const double e = vtkMath::RadiansFromDegrees(elevationDeg);
     const double a = vtkMath::RadiansFromDegrees(azimuthDeg);
     const double d[3] = { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) };

@@ -41,7 +41,8 @@ struct vtkNimbusSkyPass::Internals
 
   void Release(vtkWindow* w)
   {
-    auto drop = [w](vtkTextureObject*& t) {
+    auto drop = [w](vtkTextureObject*& t)
+    {
       if (t)
       {
         t->ReleaseGraphicsResources(w);
@@ -91,7 +92,8 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   this->NumberOfRenderedProps = 0;
   if (!this->DelegatePass)
   {
-    vtkErrorMacro("vtkNimbusSkyPass needs a delegate pass (SetDelegatePass, e.g. vtkRenderStepsPass)");
+    vtkErrorMacro(
+      "vtkNimbusSkyPass needs a delegate pass (SetDelegatePass, e.g. vtkRenderStepsPass)");
     return;
   }
   if (!this->Sky)

@@ -37,8 +37,8 @@ void vtkNimbusSunlight::ComputeXyz(double transmitted[3], double outside[3])
   // Observer on the z axis of an earth-centred frame; the local frame is the scene frame.
   const nimbus::Atmosphere::Vector3 observer{ { 0.0, 0.0,
     atmosphere.GetParameters().earthRadius + this->ObserverAltitude } };
-  const nimbus::OpticalLengths lengths = atmosphere.OpticalLengthsToTop(
-    observer, { { direction[0], direction[1], direction[2] } });
+  const nimbus::OpticalLengths lengths =
+    atmosphere.OpticalLengthsToTop(observer, { { direction[0], direction[1], direction[2] } });
 
   const auto solarSpectrum = samples.Sample(
     [](double lambda) { return nimbus::PlanckSpectralRadiance(lambda, SunTemperatureK); });

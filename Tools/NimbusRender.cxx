@@ -144,8 +144,8 @@ int main(int argc, char* argv[])
   int dims[3];
   image->GetDimensions(dims);
   nimbus::FloatImage linear(dims[0], dims[1]);
-  std::copy(radiance->GetPointer(0), radiance->GetPointer(0) + linear.Pixels.size(),
-    linear.Pixels.begin());
+  std::copy(
+    radiance->GetPointer(0), radiance->GetPointer(0) + linear.Pixels.size(), linear.Pixels.begin());
 
   try
   {
@@ -184,7 +184,7 @@ int main(int argc, char* argv[])
 
   std::cout << "{\"scene\": \"" << argv[1] << "\", \"mode\": \""
             << (renderer->GetMode() == vtkNimbusReferenceRenderer::SINGLE_SCATTERING ? "single"
-                                                                                      : "path")
+                                                                                     : "path")
             << "\", \"width\": " << dims[0] << ", \"height\": " << dims[1]
             << ", \"seconds\": " << FieldValue(image, "RenderSeconds")
             << ", \"estimated_relative_error\": " << FieldValue(image, "EstimatedRelativeError")

@@ -49,8 +49,8 @@ bool ParseNumber(const char* text, double& value)
 int main(int argc, char* argv[])
 {
   std::string output = "nimbus-demo.png";
-  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7,
-         kMulti = 3.0, exposure = 8.0;
+  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7, kMulti = 3.0,
+         exposure = 8.0;
   bool drawSky = true;
   for (int i = 1; i < argc; ++i)
   {

@@ -367,22 +367,24 @@ void CloudAutomaton::InitialState()
   const std::uint32_t actThreshold = ToThreshold(p.InitialActivation);
   auto& s = this->Current;
   s.Step = 0;
-  ParallelFor(nz, this->Threads, [&](int z0, int z1) {
-    for (int z = z0; z < z1; ++z)
+  ParallelFor(nz, this->Threads,
+    [&](int z0, int z1)
     {
-      for (int y = 0; y < ny; ++y)
+      for (int z = z0; z < z1; ++z)
       {
-        for (int w = 0; w < W; ++w)
+        for (int y = 0; y < ny; ++y)
         {
-          const std::size_t i = (static_cast<std::size_t>(z) * ny + y) * W + w;
-          const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
-          s.Hum[i] = BernoulliWord(humKey, i, humThreshold) & tail;
-          s.Act[i] = BernoulliWord(actKey, i, actThreshold) & tail;
-          s.Cld[i] = 0;
+          for (int w = 0; w < W; ++w)
+          {
+            const std::size_t i = (static_cast<std::size_t>(z) * ny + y) * W + w;
+            const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
+            s.Hum[i] = BernoulliWord(humKey, i, humThreshold) & tail;
+            s.Act[i] = BernoulliWord(actKey, i, actThreshold) & tail;
+            s.Cld[i] = 0;
+          }
         }
       }
-    }
-  });
+    });
 }
 
 void CloudAutomaton::Reset()
@@ -415,7 +417,8 @@ void CloudAutomaton::Step()
     StreamKey(p.Seed, n, StreamExtinction), nx, ny };
 
   // Row (y, z) of a field, nullptr outside the grid (open) -- y wraps when periodic.
-  auto row = [&](const std::vector<Word>& field, int y, int z) -> const Word* {
+  auto row = [&](const std::vector<Word>& field, int y, int z) -> const Word*
+  {
     if (z < 0 || z >= nz)
     {
       return nullptr;
@@ -442,73 +445,75 @@ void CloudAutomaton::Step()
   }
 
   // 1. growth and 2. extinction/supply: in -> out.
-  ParallelFor(nz, this->Threads, [&](int z0, int z1) {
-    for (int z = z0; z < z1; ++z)
+  ParallelFor(nz, this->Threads,
+    [&](int z0, int z1)
     {
-      for (int y = 0; y < ny; ++y)
+      for (int z = z0; z < z1; ++z)
       {
-        const Word* act = row(in.Act, y, z);
-        // f_act's neighbourhood (README): y +-1, +-2 and z +1, -1, -2 ...
-        const Word* others[7] = { row(in.Act, y - 1, z), row(in.Act, y + 1, z),
-          row(in.Act, y - 2, z), row(in.Act, y + 2, z), row(in.Act, y, z + 1),
-          row(in.Act, y, z - 1), row(in.Act, y, z - 2) };
-        const std::size_t rowStart = (static_cast<std::size_t>(z) * ny + y) * W;
-        for (int w = 0; w < W; ++w)
+        for (int y = 0; y < ny; ++y)
         {
-          const std::size_t i = rowStart + w;
-          const Word a = act[w];
-          const Word prev = w > 0 ? act[w - 1] : 0;
-          const Word next = w + 1 < W ? act[w + 1] : 0;
-          // ... and x +-1, +-2: bit x of (a << d) is cell x - d, of (a >> d) cell x + d.
-          Word f = (a << 1) | (prev >> 63) | (a << 2) | (prev >> 62) | (a >> 1) | (next << 63) |
-            (a >> 2) | (next << 62);
-          if (periodic)
+          const Word* act = row(in.Act, y, z);
+          // f_act's neighbourhood (README): y +-1, +-2 and z +1, -1, -2 ...
+          const Word* others[7] = { row(in.Act, y - 1, z), row(in.Act, y + 1, z),
+            row(in.Act, y - 2, z), row(in.Act, y + 2, z), row(in.Act, y, z + 1),
+            row(in.Act, y, z - 1), row(in.Act, y, z - 2) };
+          const std::size_t rowStart = (static_cast<std::size_t>(z) * ny + y) * W;
+          for (int w = 0; w < W; ++w)
           {
-            // Wrap-around in x: cells x < 2 see x - d from the far end, cells x >= nx - 2
-            // see x + d from the start (the shifts above read 0 there).
-            for (const int x : edges)
+            const std::size_t i = rowStart + w;
+            const Word a = act[w];
+            const Word prev = w > 0 ? act[w - 1] : 0;
+            const Word next = w + 1 < W ? act[w + 1] : 0;
+            // ... and x +-1, +-2: bit x of (a << d) is cell x - d, of (a >> d) cell x + d.
+            Word f = (a << 1) | (prev >> 63) | (a << 2) | (prev >> 62) | (a >> 1) | (next << 63) |
+              (a >> 2) | (next << 62);
+            if (periodic)
             {
-              if (x / Bits != w)
+              // Wrap-around in x: cells x < 2 see x - d from the far end, cells x >= nx - 2
+              // see x + d from the start (the shifts above read 0 there).
+              for (const int x : edges)
               {
-                continue;
-              }
-              bool any = false;
-              for (int d = 1; d <= 2; ++d)
-              {
-                any = any || (x - d < 0 && GetBit(act, Wrap(x - d, nx))) ||
-                  (x + d >= nx && GetBit(act, Wrap(x + d, nx)));
-              }
-              if (any)
-              {
-                f |= Word(1) << (x % Bits);
+                if (x / Bits != w)
+                {
+                  continue;
+                }
+                bool any = false;
+                for (int d = 1; d <= 2; ++d)
+                {
+                  any = any || (x - d < 0 && GetBit(act, Wrap(x - d, nx))) ||
+                    (x + d >= nx && GetBit(act, Wrap(x + d, nx)));
+                }
+                if (any)
+                {
+                  f |= Word(1) << (x % Bits);
+                }
               }
             }
-          }
-          for (const Word* other : others)
-          {
-            if (other)
+            for (const Word* other : others)
             {
-              f |= other[w];
+              if (other)
+              {
+                f |= other[w];
+              }
             }
+            const Word h = in.Hum[i];
+            const Word c = in.Cld[i];
+            // 002 §3 (README): growth.
+            Word hum = h & ~a;
+            Word cld = c | a;
+            Word newAct = ~a & h & f;
+            // Extinction and supply.
+            const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
+            cld &= ~extinction(cld & tail, i, w, y, z);
+            hum |= humidity(~hum & tail, i, w, y, z);
+            newAct |= activation(~newAct & tail, i, w, y, z);
+            out.Hum[i] = hum & tail;
+            out.Act[i] = newAct & tail;
+            out.Cld[i] = cld & tail;
           }
-          const Word h = in.Hum[i];
-          const Word c = in.Cld[i];
-          // 002 §3 (README): growth.
-          Word hum = h & ~a;
-          Word cld = c | a;
-          Word newAct = ~a & h & f;
-          // Extinction and supply.
-          const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
-          cld &= ~extinction(cld & tail, i, w, y, z);
-          hum |= humidity(~hum & tail, i, w, y, z);
-          newAct |= activation(~newAct & tail, i, w, y, z);
-          out.Hum[i] = hum & tail;
-          out.Act[i] = newAct & tail;
-          out.Cld[i] = cld & tail;
         }
       }
-    }
-  });
+    });
 
   // 3. wind: out -> in (shifted), or just swap when no layer moves this step.
   bool anyShift = false;
@@ -527,71 +532,73 @@ void CloudAutomaton::Step()
   {
     CloudAutomatonState& dst = this->Current;
     const CloudAutomatonState& src = this->Scratch;
-    ParallelFor(nz, this->Threads, [&](int z0, int z1) {
-      for (int z = z0; z < z1; ++z)
+    ParallelFor(nz, this->Threads,
+      [&](int z0, int z1)
       {
-        const long long sx = WindShift(p.Wind[0] + z * p.Shear[0], n);
-        const long long sy = WindShift(p.Wind[1] + z * p.Shear[1], n);
-        long long up = 0, down = 0; // shifts towards +x and -x combined by OR
-        bool useUp = false, useDown = false;
-        if (periodic)
+        for (int z = z0; z < z1; ++z)
         {
-          const int s = Wrap(sx, nx);
-          up = s;
-          down = nx - s;
-          useUp = true;
-          useDown = s != 0;
-        }
-        else if (sx >= 0)
-        {
-          up = sx;
-          useUp = true;
-        }
-        else
-        {
-          down = -sx;
-          useDown = true;
-        }
-        for (int y = 0; y < ny; ++y)
-        {
-          long long sourceY = y - sy;
-          const bool inside = sourceY >= 0 && sourceY < ny;
-          if (!inside && !periodic)
+          const long long sx = WindShift(p.Wind[0] + z * p.Shear[0], n);
+          const long long sy = WindShift(p.Wind[1] + z * p.Shear[1], n);
+          long long up = 0, down = 0; // shifts towards +x and -x combined by OR
+          bool useUp = false, useDown = false;
+          if (periodic)
           {
-            sourceY = -1;
+            const int s = Wrap(sx, nx);
+            up = s;
+            down = nx - s;
+            useUp = true;
+            useDown = s != 0;
           }
-          else if (!inside)
+          else if (sx >= 0)
           {
-            sourceY = Wrap(sourceY, ny);
+            up = sx;
+            useUp = true;
           }
-          const std::size_t dstStart = (static_cast<std::size_t>(z) * ny + y) * W;
-          for (int f = 0; f < 3; ++f)
+          else
           {
-            const std::vector<Word>& from = f == 0 ? src.Hum : (f == 1 ? src.Act : src.Cld);
-            std::vector<Word>& to = f == 0 ? dst.Hum : (f == 1 ? dst.Act : dst.Cld);
-            if (sourceY < 0)
+            down = -sx;
+            useDown = true;
+          }
+          for (int y = 0; y < ny; ++y)
+          {
+            long long sourceY = y - sy;
+            const bool inside = sourceY >= 0 && sourceY < ny;
+            if (!inside && !periodic)
             {
-              std::fill_n(to.begin() + static_cast<std::ptrdiff_t>(dstStart), W, Word(0));
-              continue;
+              sourceY = -1;
             }
-            const Word* source = from.data() + (static_cast<std::size_t>(z) * ny + sourceY) * W;
-            for (int w = 0; w < W; ++w)
+            else if (!inside)
             {
-              Word v = 0;
-              if (useUp)
+              sourceY = Wrap(sourceY, ny);
+            }
+            const std::size_t dstStart = (static_cast<std::size_t>(z) * ny + y) * W;
+            for (int f = 0; f < 3; ++f)
+            {
+              const std::vector<Word>& from = f == 0 ? src.Hum : (f == 1 ? src.Act : src.Cld);
+              std::vector<Word>& to = f == 0 ? dst.Hum : (f == 1 ? dst.Act : dst.Cld);
+              if (sourceY < 0)
               {
-                v |= ShiftedUp(source, W, w, up);
+                std::fill_n(to.begin() + static_cast<std::ptrdiff_t>(dstStart), W, Word(0));
+                continue;
               }
-              if (useDown)
+              const Word* source = from.data() + (static_cast<std::size_t>(z) * ny + sourceY) * W;
+              for (int w = 0; w < W; ++w)
               {
-                v |= ShiftedDown(source, W, w, down);
+                Word v = 0;
+                if (useUp)
+                {
+                  v |= ShiftedUp(source, W, w, up);
+                }
+                if (useDown)
+                {
+                  v |= ShiftedDown(source, W, w, down);
+                }
+                to[dstStart + w] = v & ((w == W - 1) ? this->TailMask : ~Word(0));
               }
-              to[dstStart + w] = v & ((w == W - 1) ? this->TailMask : ~Word(0));
             }
           }
         }
-      }
-    });
+      });
   }
   this->Current.Step = n + 1;
 }
@@ -719,94 +726,99 @@ void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomato
   density.assign(count, 0.0f);
   std::vector<float> scratch(count);
   // Bits -> 0/1 floats, into `density`.
-  ParallelFor(nz, threads, [&](int z0, int z1) {
-    for (int z = z0; z < z1; ++z)
+  ParallelFor(nz, threads,
+    [&](int z0, int z1)
     {
-      for (int y = 0; y < ny; ++y)
+      for (int z = z0; z < z1; ++z)
       {
-        const Word* row = state.Cld.data() + (static_cast<std::size_t>(z) * ny + y) * W;
-        float* out = density.data() + plane * z + static_cast<std::size_t>(nx) * y;
-        for (int x = 0; x < nx; ++x)
+        for (int y = 0; y < ny; ++y)
         {
-          out[x] = GetBit(row, x) ? 1.0f : 0.0f;
+          const Word* row = state.Cld.data() + (static_cast<std::size_t>(z) * ny + y) * W;
+          float* out = density.data() + plane * z + static_cast<std::size_t>(nx) * y;
+          for (int x = 0; x < nx; ++x)
+          {
+            out[x] = GetBit(row, x) ? 1.0f : 0.0f;
+          }
         }
       }
-    }
-  });
+    });
   if (K == 0)
   {
     return;
   }
   // One separable pass along `axis` from `src` into `dst`. Along y and z whole rows are
   // combined (contiguous, vectorisable); along x the interior skips the boundary tests.
-  auto pass = [&](const std::vector<float>& src, std::vector<float>& dst, int axis) {
+  auto pass = [&](const std::vector<float>& src, std::vector<float>& dst, int axis)
+  {
     const int n = parameters.Dimensions[axis];
     const bool wraps = periodic && axis < 2;
-    ParallelFor(nz, threads, [&](int z0, int z1) {
-      for (int z = z0; z < z1; ++z)
+    ParallelFor(nz, threads,
+      [&](int z0, int z1)
       {
-        for (int y = 0; y < ny; ++y)
+        for (int z = z0; z < z1; ++z)
         {
-          const std::size_t rowStart = plane * z + static_cast<std::size_t>(nx) * y;
-          float* out = dst.data() + rowStart;
-          if (axis == 0)
+          for (int y = 0; y < ny; ++y)
           {
-            const float* in = src.data() + rowStart;
-            for (int x = 0; x < nx; ++x)
+            const std::size_t rowStart = plane * z + static_cast<std::size_t>(nx) * y;
+            float* out = dst.data() + rowStart;
+            if (axis == 0)
             {
-              float value = 0.0f;
-              if (x >= K && x + K < nx)
+              const float* in = src.data() + rowStart;
+              for (int x = 0; x < nx; ++x)
               {
-                for (int d = -K; d <= K; ++d)
+                float value = 0.0f;
+                if (x >= K && x + K < nx)
                 {
-                  value += weights[d + K] * in[x + d];
-                }
-              }
-              else
-              {
-                for (int d = -K; d <= K; ++d)
-                {
-                  int j = x + d;
-                  if (j < 0 || j >= n)
+                  for (int d = -K; d <= K; ++d)
                   {
-                    if (!wraps)
-                    {
-                      continue;
-                    }
-                    j = Wrap(j, n);
+                    value += weights[d + K] * in[x + d];
                   }
-                  value += weights[d + K] * in[j];
                 }
+                else
+                {
+                  for (int d = -K; d <= K; ++d)
+                  {
+                    int j = x + d;
+                    if (j < 0 || j >= n)
+                    {
+                      if (!wraps)
+                      {
+                        continue;
+                      }
+                      j = Wrap(j, n);
+                    }
+                    value += weights[d + K] * in[j];
+                  }
+                }
+                out[x] = value;
               }
-              out[x] = value;
+              continue;
             }
-            continue;
-          }
-          std::fill(out, out + nx, 0.0f);
-          const int c = axis == 1 ? y : z;
-          for (int d = -K; d <= K; ++d)
-          {
-            int j = c + d;
-            if (j < 0 || j >= n)
+            std::fill(out, out + nx, 0.0f);
+            const int c = axis == 1 ? y : z;
+            for (int d = -K; d <= K; ++d)
             {
-              if (!wraps)
+              int j = c + d;
+              if (j < 0 || j >= n)
               {
-                continue;
+                if (!wraps)
+                {
+                  continue;
+                }
+                j = Wrap(j, n);
               }
-              j = Wrap(j, n);
-            }
-            const float* in = src.data() +
-              (axis == 1 ? plane * z + static_cast<std::size_t>(nx) * j
-                         : plane * j + static_cast<std::size_t>(nx) * y);
-            const float w = weights[d + K];
-            for (int x = 0; x < nx; ++x)
-            {
-              out[x] += w * in[x];
+              const float* in = src.data() +
+                (axis == 1 ? plane * z + static_cast<std::size_t>(nx) * j
+                           : plane * j + static_cast<std::size_t>(nx) * y);
+              const float w = weights[d + K];
+              for (int x = 0; x < nx; ++x)
+              {
+                out[x] += w * in[x];
+              }
             }
           }
         }
-      }
-    });
+      });
   };
   pass(density, scratch, 0);
   pass(scratch, density, 1);

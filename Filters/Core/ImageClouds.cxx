@@ -241,7 +241,8 @@ ImageCloud BuildImageCloud(
   }
 
   // Fit: rescale each column's balls by target / achieved optical depth over its block.
-  auto sample = [&]() {
+  auto sample = [&]()
+  {
     SampleMetaballs(balls, grid, cloud.Density);
     ApplyCloudBase(grid, p.BaseHeight, p.BaseTransitionThickness, cloud.Density);
     cloud.ColumnOpticalDepth = ColumnOpticalDepth(grid, cloud.Density, sigma);

@@ -186,8 +186,8 @@ std::vector<Metaball> GrowOnSurface(const std::vector<Metaball>& balls,
     {
       continue;
     }
-    const std::array<double, 3> centroid{ { (a[0] + b[0] + c[0]) / 3.0,
-      (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0 } };
+    const std::array<double, 3> centroid{ { (a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0,
+      (a[2] + b[2] + c[2]) / 3.0 } };
     const std::array<double, 3> gradient = MetaballDensityGradient(balls, centroid);
     const double gradientNorm =
       std::sqrt(gradient[0] * gradient[0] + gradient[1] * gradient[1] + gradient[2] * gradient[2]);

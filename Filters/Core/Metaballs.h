@@ -23,9 +23,9 @@ class Random;
 struct Metaball
 {
   std::array<double, 3> Center{ { 0.0, 0.0, 0.0 } }; // m
-  double Radius = 1.0;                                // m, the field is 0 beyond it
-  double Density = 1.0;                               // density at the centre
-  int Level = 0;                                      // 0: basic shape, k: k-th growth level
+  double Radius = 1.0;                               // m, the field is 0 beyond it
+  double Density = 1.0;                              // density at the centre
+  int Level = 0;                                     // 0: basic shape, k: k-th growth level
 };
 
 /// Wyvill, McPheeters & Wyvill's "soft object" falloff, a degree-6 polynomial of

@@ -125,10 +125,8 @@ openvdb::CoordBBox ToCoordBox(const IndexBox& box)
     }
   }
   return openvdb::CoordBBox(openvdb::Coord(static_cast<int32_t>(box.Min[0]),
-                              static_cast<int32_t>(box.Min[1]),
-                              static_cast<int32_t>(box.Min[2])),
-    openvdb::Coord(static_cast<int32_t>(box.Max[0]),
-      static_cast<int32_t>(box.Max[1]),
+                              static_cast<int32_t>(box.Min[1]), static_cast<int32_t>(box.Min[2])),
+    openvdb::Coord(static_cast<int32_t>(box.Max[0]), static_cast<int32_t>(box.Max[1]),
       static_cast<int32_t>(box.Max[2])));
 }
 
@@ -223,7 +221,7 @@ std::array<double, 3> WorldToIndex(const TransformInfo& t, const std::array<doub
   return ijk;
 }
 
-template<typename GridT, typename DenseValueT>
+template <typename GridT, typename DenseValueT>
 void CopyToDense(const GridT& grid, const openvdb::CoordBBox& bbox, float* target)
 {
   openvdb::tools::Dense<DenseValueT, openvdb::tools::LayoutXYZ> dense(
@@ -239,18 +237,16 @@ inline float Element(double v, int)
 {
   return static_cast<float>(v);
 }
-template<typename T>
+template <typename T>
 inline float Element(const openvdb::math::Vec3<T>& v, int c)
 {
   return static_cast<float>(v[c]);
 }
 
 /// Trilinear resampling of `grid` at the world positions of `reference`'s voxels in `box`.
-template<typename GridT>
-void ResampleToDense(const GridT& grid,
-  const TransformInfo& reference,
-  const IndexBox& box,
-  float* target)
+template <typename GridT>
+void ResampleToDense(
+  const GridT& grid, const TransformInfo& reference, const IndexBox& box, float* target)
 {
   using ValueT = typename GridT::ValueType;
   constexpr int components = openvdb::VecTraits<ValueT>::Size;
@@ -281,13 +277,9 @@ void ResampleToDense(const GridT& grid,
     });
 }
 
-template<typename GridT, typename DenseValueT>
-void Extract(const openvdb::GridBase::Ptr& base,
-  const TransformInfo& reference,
-  const IndexBox& box,
-  float* target,
-  bool& resampled,
-  TransformInfo& own)
+template <typename GridT, typename DenseValueT>
+void Extract(const openvdb::GridBase::Ptr& base, const TransformInfo& reference,
+  const IndexBox& box, float* target, bool& resampled, TransformInfo& own)
 {
   const auto grid = openvdb::gridPtrCast<GridT>(base);
   const auto bbox = grid->evalActiveVoxelBoundingBox();
@@ -355,7 +347,7 @@ openvdb::math::Transform::Ptr ToVdbTransform(const TransformInfo& t)
   return openvdb::math::Transform::createLinearTransform(m);
 }
 
-template<typename GridT>
+template <typename GridT>
 typename GridT::Ptr BuildGrid(const FieldToWrite& field)
 {
   using ValueT = typename GridT::ValueType;
@@ -629,8 +621,7 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
   }
   IndexBox box;
   std::array<double, 3> lo{ { std::numeric_limits<double>::max(),
-    std::numeric_limits<double>::max(),
-    std::numeric_limits<double>::max() } };
+    std::numeric_limits<double>::max(), std::numeric_limits<double>::max() } };
   std::array<double, 3> hi{ { -lo[0], -lo[1], -lo[2] } };
   for (int corner = 0; corner < 8; ++corner)
   {
@@ -660,14 +651,9 @@ IndexBox BoxInReference(const GridInfo& info, const TransformInfo& reference)
   return box;
 }
 
-void ReadDense(const std::string& path,
-  const std::vector<std::string>& names,
-  const TransformInfo& reference,
-  const IndexBox& box,
-  const std::vector<float*>& target,
-  std::vector<std::string>* resampled,
-  const Progress& progress,
-  TransformInfo* exact)
+void ReadDense(const std::string& path, const std::vector<std::string>& names,
+  const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
+  std::vector<std::string>* resampled, const Progress& progress, TransformInfo* exact)
 {
   Initialize();
   bool haveExact = false;
@@ -740,10 +726,8 @@ void ReadDense(const std::string& path,
   }
 }
 
-uint64_t WriteFields(const std::string& path,
-  const std::vector<FieldToWrite>& fields,
-  bool compress,
-  const Progress& progress)
+uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
+  bool compress, const Progress& progress)
 {
   Initialize();
   if (path.empty())

@@ -129,13 +129,9 @@ using Progress = std::function<void(double)>;
 /// the first grid copied without resampling, as read with its voxels: OpenVDB's
 /// metadata-only read (ReadFileInfo) can differ from it in the last bit of the voxel size.
 /// Throws Error on read failure.
-void ReadDense(const std::string& path,
-  const std::vector<std::string>& names,
-  const TransformInfo& reference,
-  const IndexBox& box,
-  const std::vector<float*>& target,
-  std::vector<std::string>* resampled = nullptr,
-  const Progress& progress = nullptr,
+void ReadDense(const std::string& path, const std::vector<std::string>& names,
+  const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
+  std::vector<std::string>* resampled = nullptr, const Progress& progress = nullptr,
   TransformInfo* exact = nullptr);
 
 /// The index box of grid `info` expressed in the index space of `reference` (the box of
@@ -162,10 +158,8 @@ struct FieldToWrite
 /// failure never leaves a partial or corrupted file. `compress` selects Blosc (else
 /// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the
 /// number of active voxels written.
-uint64_t WriteFields(const std::string& path,
-  const std::vector<FieldToWrite>& fields,
-  bool compress = true,
-  const Progress& progress = nullptr);
+uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
+  bool compress = true, const Progress& progress = nullptr);
 
 /// OpenVDB's version string, e.g. "10.0.1".
 std::string LibraryVersion();

@@ -181,9 +181,8 @@ double IntegrateDensity(const Ray& ray, double R, double H, double s0, double s1
     breaks.push_back(sStar);
   }
   breaks.push_back(s1);
-  const auto rho = [&](double s) {
-    return std::exp(-std::max(0.0, AltitudeAlongRay(ray, R, s)) / H);
-  };
+  const auto rho = [&](double s)
+  { return std::exp(-std::max(0.0, AltitudeAlongRay(ray, R, s)) / H); };
   return IntegrateAdaptive(rho, breaks);
 }
 
@@ -219,8 +218,8 @@ Atmosphere::Atmosphere(const AtmosphereParameters& p)
     p.earthRadius > 0.0 && p.topRadius > p.earthRadius && std::isfinite(p.rayleighScaleHeight) &&
     p.rayleighScaleHeight > 0.0 && std::isfinite(p.mieScaleHeight) && p.mieScaleHeight > 0.0 &&
     std::isfinite(p.rayleighScattering550) && p.rayleighScattering550 >= 0.0 &&
-    std::isfinite(p.mieScattering) && p.mieScattering >= 0.0 &&
-    p.mieSingleScatteringAlbedo > 0.0 && p.mieSingleScatteringAlbedo <= 1.0 && !std::isnan(p.mieG);
+    std::isfinite(p.mieScattering) && p.mieScattering >= 0.0 && p.mieSingleScatteringAlbedo > 0.0 &&
+    p.mieSingleScatteringAlbedo <= 1.0 && !std::isnan(p.mieG);
   if (!ok)
   {
     throw std::invalid_argument("nimbus::Atmosphere: invalid AtmosphereParameters");
@@ -303,7 +302,8 @@ OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& 
   {
     // Below the ground: clamp radially onto the ground (the earth centre maps to
     // the ground point along d).
-    const Vector3 up = ray.r0 > 0.0 ? Vector3{ p[0] / ray.r0, p[1] / ray.r0, p[2] / ray.r0 } : ray.d;
+    const Vector3 up =
+      ray.r0 > 0.0 ? Vector3{ p[0] / ray.r0, p[1] / ray.r0, p[2] / ray.r0 } : ray.d;
     ray.o = { R * up[0], R * up[1], R * up[2] };
     ray.r0 = R;
     ray.b = R * Dot(up, ray.d);

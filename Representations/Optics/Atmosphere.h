@@ -26,15 +26,15 @@ namespace nimbus
 /// Neyret 2008 values.
 struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereParameters
 {
-  double earthRadius = 6360000.0;          // R_e [m]
-  double topRadius = 6420000.0;            // R_top [m], 60 km thick atmosphere
-  double rayleighScaleHeight = 8000.0;     // H_R [m]
-  double mieScaleHeight = 1200.0;          // H_M [m]
-  double rayleighScattering550 = 13.5e-6;  // beta_R at sea level and 550 nm [1/m]
-                                           // (molecules do not absorb: extinction = scattering)
-  double mieScattering = 2.0e-5;           // beta_M,s at sea level [1/m], wavelength independent
-  double mieSingleScatteringAlbedo = 0.9;  // beta_M,s / beta_M,ext
-  double mieG = 0.76;                      // Cornette-Shanks asymmetry of the aerosol phase function
+  double earthRadius = 6360000.0;         // R_e [m]
+  double topRadius = 6420000.0;           // R_top [m], 60 km thick atmosphere
+  double rayleighScaleHeight = 8000.0;    // H_R [m]
+  double mieScaleHeight = 1200.0;         // H_M [m]
+  double rayleighScattering550 = 13.5e-6; // beta_R at sea level and 550 nm [1/m]
+                                          // (molecules do not absorb: extinction = scattering)
+  double mieScattering = 2.0e-5;          // beta_M,s at sea level [1/m], wavelength independent
+  double mieSingleScatteringAlbedo = 0.9; // beta_M,s / beta_M,ext
+  double mieG = 0.76;                     // Cornette-Shanks asymmetry of the aerosol phase function
 };
 
 /// Optical lengths (sea-level-equivalent column lengths, metres) along a ray.

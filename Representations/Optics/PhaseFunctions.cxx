@@ -129,7 +129,8 @@ std::array<double, 3> DirectionFromCosine(
     std::sqrt(incident[0] * incident[0] + incident[1] * incident[1] + incident[2] * incident[2]);
   if (!(len > 0.0) || !std::isfinite(len))
   {
-    throw std::invalid_argument("nimbus DirectionFromCosine: incident direction is zero or not finite");
+    throw std::invalid_argument(
+      "nimbus DirectionFromCosine: incident direction is zero or not finite");
   }
   const double w[3] = { incident[0] / len, incident[1] / len, incident[2] / len };
   // Orthonormal basis (t, b, w): Duff et al., "Building an Orthonormal Basis,

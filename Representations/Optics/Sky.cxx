@@ -52,7 +52,8 @@ void ParallelFor(int n, int threads, const F& f)
   int count = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
   count = std::max(1, std::min(count, n));
   std::atomic<int> next{ 0 };
-  auto work = [&]() {
+  auto work = [&]()
+  {
     for (int i = next++; i < n; i = next++)
     {
       f(i);
@@ -148,15 +149,15 @@ SkyModel::SkyModel(const SkyParameters& p)
   const auto start = std::chrono::steady_clock::now();
   Require(std::isfinite(p.GroundAlbedo) && p.GroundAlbedo >= 0.0 && p.GroundAlbedo <= 1.0,
     "GroundAlbedo", "must be in [0, 1]");
-  Require(p.ScatteringOrders >= 1 && p.ScatteringOrders <= 50, "ScatteringOrders",
-    "must be in [1, 50]");
+  Require(
+    p.ScatteringOrders >= 1 && p.ScatteringOrders <= 50, "ScatteringOrders", "must be in [1, 50]");
   Require(p.Wavelengths >= 3 && p.Wavelengths <= 256, "Wavelengths", "must be in [3, 256]");
   Require(std::isfinite(p.SunTemperature) && p.SunTemperature >= 1000.0, "SunTemperature",
     "must be >= 1000 K");
   Require(p.TransmittanceMuSize >= 2 && p.TransmittanceRSize >= 2, "TransmittanceMuSize/RSize",
     "must be >= 2");
-  Require(p.ScatteringMuSSize >= 2 && p.ScatteringRSize >= 2, "ScatteringMuSSize/RSize",
-    "must be >= 2");
+  Require(
+    p.ScatteringMuSSize >= 2 && p.ScatteringRSize >= 2, "ScatteringMuSSize/RSize", "must be >= 2");
   Require(p.ScatteringZenithDirections >= 2 && p.ScatteringAzimuthDirections >= 1,
     "ScatteringZenithDirections/AzimuthDirections", "must be >= 2 / >= 1");
   Require(p.ScatteringSteps >= 1 && p.ViewSteps >= 1, "ScatteringSteps/ViewSteps", "must be >= 1");
@@ -249,20 +250,23 @@ void SkyModel::BuildTransmittance()
   const double top = this->Parameters.Atmosphere.topRadius;
   const double H = std::sqrt(top * top - R * R);
   this->TransmittanceTable.assign(static_cast<std::size_t>(nmu) * nr * 2, 0.0f);
-  ParallelFor(nr, this->Parameters.Threads, [&](int j) {
-    const double rho = H * j / (nr - 1.0);
-    const double r = std::sqrt(rho * rho + R * R);
-    const double dmin = top - r, dmax = rho + H;
-    for (int i = 0; i < nmu; ++i)
+  ParallelFor(nr, this->Parameters.Threads,
+    [&](int j)
     {
-      const double d = dmin + (i / (nmu - 1.0)) * (dmax - dmin);
-      const double mu = d <= 0.0 ? 1.0 : Clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
-      const std::array<double, 2> lengths = this->ExactOpticalLengths(r, mu);
-      float* out = &this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2];
-      out[0] = static_cast<float>(lengths[0]);
-      out[1] = static_cast<float>(lengths[1]);
-    }
-  });
+      const double rho = H * j / (nr - 1.0);
+      const double r = std::sqrt(rho * rho + R * R);
+      const double dmin = top - r, dmax = rho + H;
+      for (int i = 0; i < nmu; ++i)
+      {
+        const double d = dmin + (i / (nmu - 1.0)) * (dmax - dmin);
+        const double mu =
+          d <= 0.0 ? 1.0 : Clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
+        const std::array<double, 2> lengths = this->ExactOpticalLengths(r, mu);
+        float* out = &this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2];
+        out[0] = static_cast<float>(lengths[0]);
+        out[1] = static_cast<float>(lengths[1]);
+      }
+    });
 }
 
 std::array<double, 2> SkyModel::ExactOpticalLengths(double r, double mu) const
@@ -299,8 +303,10 @@ std::array<double, 2> SkyModel::LookupOpticalLengths(double r, double mu) const
   std::array<double, 2> result{ { 0.0, 0.0 } };
   for (int c = 0; c < 2; ++c)
   {
-    auto at = [&](int j, int i) {
-      return static_cast<double>(this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2 + c]);
+    auto at = [&](int j, int i)
+    {
+      return static_cast<double>(
+        this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2 + c]);
     };
     result[c] = (1.0 - fj) * ((1.0 - fi) * at(j0, i0) + fi * at(j0, i0 + 1)) +
       fj * ((1.0 - fi) * at(j0 + 1, i0) + fi * at(j0 + 1, i0 + 1));
@@ -419,7 +425,8 @@ SkySpectra SkyModel::March(
   out.Mie.assign(n, 0.0);
   out.Isotropic.assign(n, 0.0);
   out.Transmittance.assign(n, 1.0);
-  auto record = [&](std::size_t count) {
+  auto record = [&](std::size_t count)
+  {
     if (o.Records)
     {
       while (o.Records->size() < count)
@@ -534,7 +541,8 @@ SkySpectra SkyModel::March(
   std::vector<double> Tsun(n), source(n, 0.0);
   std::vector<double>& T = out.Transmittance;
   std::size_t nextRecord = 0;
-  auto flushRecords = [&](std::size_t node) {
+  auto flushRecords = [&](std::size_t node)
+  {
     if (o.Records)
     {
       while (nextRecord < recordNode.size() && recordNode[nextRecord] <= node)
@@ -582,7 +590,8 @@ SkySpectra SkyModel::March(
         const double sigma = rayleigh + this->BetaMieExtinction * rhoM;
         const double x = sigma * dt;
         const double e = std::exp(-x);
-        const double weight = T[l] * (x < 1e-4 ? dt * (1.0 - 0.5 * x + x * x / 6.0) : (1.0 - e) / sigma);
+        const double weight =
+          T[l] * (x < 1e-4 ? dt * (1.0 - 0.5 * x + x * x / 6.0) : (1.0 - e) / sigma);
         if (o.Single)
         {
           const double sun = this->SunIrradiance[l] * Tsun[l] * weight;
@@ -671,54 +680,57 @@ void SkyModel::BuildMultipleScattering()
   for (int order = 1; order < orders; ++order)
   {
     std::vector<float> mean(tableSize, 0.0f), ground(static_cast<std::size_t>(nmus) * n, 0.0f);
-    ParallelFor(nr * nmus, this->Parameters.Threads, [&](int node) {
-      const int j = node / nmus, i = node % nmus;
-      const double rho = H * j / (nr - 1.0);
-      const double r = std::sqrt(rho * rho + R * R);
-      const double muS = XToMus(i / (nmus - 1.0));
-      const Vector3 x{ { 0.0, 0.0, r } };
-      const Vector3 s{ { std::sqrt(std::max(0.0, 1.0 - muS * muS)), 0.0, muS } };
-      MarchOptions o;
-      o.Steps = this->Parameters.ScatteringSteps;
-      o.Single = order == 1;
-      o.GroundDirect = order == 1;
-      o.Source = order == 1 ? nullptr : &previous;
-      o.GroundSky = order == 1 ? nullptr : &previousGround;
-      std::vector<double> sphere(n, 0.0), up(n, 0.0);
-      for (std::size_t a = 0; a < gx.size(); ++a)
+    ParallelFor(nr * nmus, this->Parameters.Threads,
+      [&](int node)
       {
-        const double mu = gx[a];
-        const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-        for (int b = 0; b < nphi; ++b)
+        const int j = node / nmus, i = node % nmus;
+        const double rho = H * j / (nr - 1.0);
+        const double r = std::sqrt(rho * rho + R * R);
+        const double muS = XToMus(i / (nmus - 1.0));
+        const Vector3 x{ { 0.0, 0.0, r } };
+        const Vector3 s{ { std::sqrt(std::max(0.0, 1.0 - muS * muS)), 0.0, muS } };
+        MarchOptions o;
+        o.Steps = this->Parameters.ScatteringSteps;
+        o.Single = order == 1;
+        o.GroundDirect = order == 1;
+        o.Source = order == 1 ? nullptr : &previous;
+        o.GroundSky = order == 1 ? nullptr : &previousGround;
+        std::vector<double> sphere(n, 0.0), up(n, 0.0);
+        for (std::size_t a = 0; a < gx.size(); ++a)
         {
-          const double phi = (b + 0.5) * kPi / nphi;
-          const Vector3 w{ { sinTheta * std::cos(phi), sinTheta * std::sin(phi), mu } };
-          const SkySpectra L = this->March(x, w, s, o);
-          const double nu = Dot(w, s);
-          const double pR = o.Single ? this->RayleighPhase(nu) : 0.0;
-          const double pM = o.Single ? this->MiePhase(nu) : 0.0;
-          // dw weight: Gauss weight x (pi / nphi) x 2 (the mirrored half).
-          const double weight = gw[a] * (2.0 * kPi / nphi);
-          for (int l = 0; l < n; ++l)
+          const double mu = gx[a];
+          const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+          for (int b = 0; b < nphi; ++b)
           {
-            const double radiance = pR * L.Rayleigh[l] + pM * L.Mie[l] + L.Isotropic[l];
-            sphere[l] += weight * radiance;
-            if (mu > 0.0)
+            const double phi = (b + 0.5) * kPi / nphi;
+            const Vector3 w{ { sinTheta * std::cos(phi), sinTheta * std::sin(phi), mu } };
+            const SkySpectra L = this->March(x, w, s, o);
+            const double nu = Dot(w, s);
+            const double pR = o.Single ? this->RayleighPhase(nu) : 0.0;
+            const double pM = o.Single ? this->MiePhase(nu) : 0.0;
+            // dw weight: Gauss weight x (pi / nphi) x 2 (the mirrored half).
+            const double weight = gw[a] * (2.0 * kPi / nphi);
+            for (int l = 0; l < n; ++l)
             {
-              up[l] += weight * mu * radiance;
+              const double radiance = pR * L.Rayleigh[l] + pM * L.Mie[l] + L.Isotropic[l];
+              sphere[l] += weight * radiance;
+              if (mu > 0.0)
+              {
+                up[l] += weight * mu * radiance;
+              }
             }
           }
         }
-      }
-      for (int l = 0; l < n; ++l)
-      {
-        mean[(static_cast<std::size_t>(j) * nmus + i) * n + l] = static_cast<float>(sphere[l] / (4.0 * kPi));
-        if (j == 0)
+        for (int l = 0; l < n; ++l)
         {
-          ground[static_cast<std::size_t>(i) * n + l] = static_cast<float>(up[l]);
+          mean[(static_cast<std::size_t>(j) * nmus + i) * n + l] =
+            static_cast<float>(sphere[l] / (4.0 * kPi));
+          if (j == 0)
+          {
+            ground[static_cast<std::size_t>(i) * n + l] = static_cast<float>(up[l]);
+          }
         }
-      }
-    });
+      });
     for (std::size_t k = 0; k < tableSize; ++k)
     {
       sumMean[k] += mean[k];
@@ -727,7 +739,8 @@ void SkyModel::BuildMultipleScattering()
     {
       sumGround[k] += ground[k];
     }
-    this->OrderMeans.emplace_back(mean.begin(), mean.begin() + static_cast<std::ptrdiff_t>(nmus) * n);
+    this->OrderMeans.emplace_back(
+      mean.begin(), mean.begin() + static_cast<std::ptrdiff_t>(nmus) * n);
     previous = std::move(mean);
     previousGround = std::move(ground);
   }
@@ -844,8 +857,10 @@ namespace
 {
 SkyViewMapping MakeMapping(const SkyModel& model, double altitude, int width, int above, int below)
 {
-  Require(width >= 2 && above >= 2 && below >= 2, "sky-view size", "must be >= 2 in every direction");
-  Require(std::isfinite(altitude) && altitude >= 0.0, "observer altitude", "must be finite and >= 0");
+  Require(
+    width >= 2 && above >= 2 && below >= 2, "sky-view size", "must be >= 2 in every direction");
+  Require(
+    std::isfinite(altitude) && altitude >= 0.0, "observer altitude", "must be finite and >= 0");
   SkyViewMapping m;
   m.Width = width;
   m.AboveRows = above;
@@ -856,8 +871,8 @@ SkyViewMapping MakeMapping(const SkyModel& model, double altitude, int width, in
 }
 
 /// Column (continuous, [0, width-1]) and row (continuous) of direction w for the sun azimuth.
-void DirectionToTexel(const SkyViewMapping& m, const Vector3& w, double sunAzimuthDeg, double& col,
-  double& row)
+void DirectionToTexel(
+  const SkyViewMapping& m, const Vector3& w, double sunAzimuthDeg, double& col, double& row)
 {
   const double zenith = std::acos(Clamp(w[2], -1.0, 1.0));
   row = m.Row(zenith);
@@ -872,7 +887,8 @@ void DirectionToTexel(const SkyViewMapping& m, const Vector3& w, double sunAzimu
 }
 
 /// Bilinear texel corners without crossing the horizon between the row halves.
-void Corners(const SkyViewMapping& m, double col, double row, int& c0, double& fc, int& r0, double& fr)
+void Corners(
+  const SkyViewMapping& m, double col, double row, int& c0, double& fc, int& r0, double& fr)
 {
   c0 = std::min(m.Width - 2, static_cast<int>(std::floor(col)));
   fc = col - c0;
@@ -903,32 +919,36 @@ SkyViewLut::SkyViewLut(const SkyModel& model, double sunElevationDeg, double obs
   this->Table.assign(plane * 3, 0.0f);
   const Vector3 s = SunDirectionFromAngles(sunElevationDeg, 0.0);
   const Vector3 x{ { 0.0, 0.0, model.GetParameters().Atmosphere.earthRadius + observerAltitude } };
-  ParallelFor(rows, model.GetParameters().Threads, [&](int row) {
-    const double zenith = this->Mapping.ZenithOfRow(row);
-    SkyModel::MarchOptions o;
-    o.Ground = row < this->Mapping.AboveRows ? SkyModel::GroundMode::Miss : SkyModel::GroundMode::Hit;
-    if (includeMultiple && model.GetParameters().ScatteringOrders > 1)
+  ParallelFor(rows, model.GetParameters().Threads,
+    [&](int row)
     {
-      o.Source = &model.GetMultipleScatteringTable();
-      o.GroundSky = &model.GetGroundSkyTable();
-    }
-    for (int col = 0; col < cols; ++col)
-    {
-      const double phi = kPi * col / (cols - 1.0); // azimuth from the sun (sun at azimuth 0 = +y)
-      const Vector3 w{ { std::sin(zenith) * std::sin(phi), std::sin(zenith) * std::cos(phi),
-        std::cos(zenith) } };
-      const SkySpectra spectra = model.March(x, w, s, o);
-      const SkyRgbParts parts = model.ToRgb(spectra);
-      const std::size_t at = (static_cast<std::size_t>(row) * cols + col) * 3;
-      for (int c = 0; c < 3; ++c)
+      const double zenith = this->Mapping.ZenithOfRow(row);
+      SkyModel::MarchOptions o;
+      o.Ground =
+        row < this->Mapping.AboveRows ? SkyModel::GroundMode::Miss : SkyModel::GroundMode::Hit;
+      if (includeMultiple && model.GetParameters().ScatteringOrders > 1)
       {
-        this->Table[at + c] = static_cast<float>(parts.Rayleigh[c]);
-        this->Table[plane + at + c] = static_cast<float>(parts.Mie[c]);
-        this->Table[2 * plane + at + c] = static_cast<float>(parts.Isotropic[c]);
+        o.Source = &model.GetMultipleScatteringTable();
+        o.GroundSky = &model.GetGroundSkyTable();
       }
-    }
-  });
-  this->BuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      for (int col = 0; col < cols; ++col)
+      {
+        const double phi = kPi * col / (cols - 1.0); // azimuth from the sun (sun at azimuth 0 = +y)
+        const Vector3 w{ { std::sin(zenith) * std::sin(phi), std::sin(zenith) * std::cos(phi),
+          std::cos(zenith) } };
+        const SkySpectra spectra = model.March(x, w, s, o);
+        const SkyRgbParts parts = model.ToRgb(spectra);
+        const std::size_t at = (static_cast<std::size_t>(row) * cols + col) * 3;
+        for (int c = 0; c < 3; ++c)
+        {
+          this->Table[at + c] = static_cast<float>(parts.Rayleigh[c]);
+          this->Table[plane + at + c] = static_cast<float>(parts.Mie[c]);
+          this->Table[2 * plane + at + c] = static_cast<float>(parts.Isotropic[c]);
+        }
+      }
+    });
+  this->BuildSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 SkyRgbParts SkyViewLut::Parts(const Vector3& w, double sunAzimuthDeg) const
@@ -947,7 +967,8 @@ SkyRgbParts SkyViewLut::Parts(const Vector3& w, double sunAzimuthDeg) const
     const float* t = &this->Table[k * plane];
     for (int c = 0; c < 3; ++c)
     {
-      auto at = [&](int rr, int cc) { return static_cast<double>(t[(static_cast<std::size_t>(rr) * cols + cc) * 3 + c]); };
+      auto at = [&](int rr, int cc)
+      { return static_cast<double>(t[(static_cast<std::size_t>(rr) * cols + cc) * 3 + c]); };
       (*out[k])[c] = (1 - fr) * ((1 - fc) * at(r0, c0) + fc * at(r0, c0 + 1)) +
         fr * ((1 - fc) * at(r0 + 1, c0) + fc * at(r0 + 1, c0 + 1));
     }
@@ -992,41 +1013,44 @@ AerialPerspectiveLut::AerialPerspectiveLut(const SkyModel& model, double sunElev
   }
   const Vector3 s = SunDirectionFromAngles(sunElevationDeg, 0.0);
   const Vector3 x{ { 0.0, 0.0, model.GetParameters().Atmosphere.earthRadius + cameraAltitude } };
-  ParallelFor(rows, model.GetParameters().Threads, [&](int row) {
-    const double zenith = this->Mapping.ZenithOfRow(row);
-    for (int col = 0; col < cols; ++col)
+  ParallelFor(rows, model.GetParameters().Threads,
+    [&](int row)
     {
-      const double phi = kPi * col / (cols - 1.0);
-      const Vector3 w{ { std::sin(zenith) * std::sin(phi), std::sin(zenith) * std::cos(phi),
-        std::cos(zenith) } };
-      SkyModel::MarchOptions o;
-      o.Steps = 4; // per slice
-      o.GroundDirect = false;
-      o.Ground = SkyModel::GroundMode::Miss;
-      if (model.GetParameters().ScatteringOrders > 1)
+      const double zenith = this->Mapping.ZenithOfRow(row);
+      for (int col = 0; col < cols; ++col)
       {
-        o.Source = &model.GetMultipleScatteringTable();
-      }
-      std::vector<SkySpectra> records;
-      o.RecordAt = &distances;
-      o.Records = &records;
-      model.March(x, w, s, o);
-      for (int k = 0; k < slices && k < static_cast<int>(records.size()); ++k)
-      {
-        const SkyRgbParts parts = model.ToRgb(records[k]);
-        const std::array<double, 3> t = model.TransmittanceRgb(records[k].Transmittance);
-        float* out = &this->Table[((static_cast<std::size_t>(k) * rows + row) * cols + col) * 12];
-        for (int c = 0; c < 3; ++c)
+        const double phi = kPi * col / (cols - 1.0);
+        const Vector3 w{ { std::sin(zenith) * std::sin(phi), std::sin(zenith) * std::cos(phi),
+          std::cos(zenith) } };
+        SkyModel::MarchOptions o;
+        o.Steps = 4; // per slice
+        o.GroundDirect = false;
+        o.Ground = SkyModel::GroundMode::Miss;
+        if (model.GetParameters().ScatteringOrders > 1)
         {
-          out[c] = static_cast<float>(parts.Rayleigh[c]);
-          out[3 + c] = static_cast<float>(parts.Mie[c]);
-          out[6 + c] = static_cast<float>(parts.Isotropic[c]);
-          out[9 + c] = static_cast<float>(t[c]);
+          o.Source = &model.GetMultipleScatteringTable();
+        }
+        std::vector<SkySpectra> records;
+        o.RecordAt = &distances;
+        o.Records = &records;
+        model.March(x, w, s, o);
+        for (int k = 0; k < slices && k < static_cast<int>(records.size()); ++k)
+        {
+          const SkyRgbParts parts = model.ToRgb(records[k]);
+          const std::array<double, 3> t = model.TransmittanceRgb(records[k].Transmittance);
+          float* out = &this->Table[((static_cast<std::size_t>(k) * rows + row) * cols + col) * 12];
+          for (int c = 0; c < 3; ++c)
+          {
+            out[c] = static_cast<float>(parts.Rayleigh[c]);
+            out[3 + c] = static_cast<float>(parts.Mie[c]);
+            out[6 + c] = static_cast<float>(parts.Isotropic[c]);
+            out[9 + c] = static_cast<float>(t[c]);
+          }
         }
       }
-    }
-  });
-  this->BuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
+  this->BuildSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void AerialPerspectiveLut::Lookup(const Vector3& w, double distance, double sunAzimuthDeg,
@@ -1053,9 +1077,10 @@ void AerialPerspectiveLut::Lookup(const Vector3& w, double distance, double sunA
     {
       for (int dc = 0; dc < 2; ++dc)
       {
-        const double weight =
-          (dk ? fk : 1 - fk) * (dr ? fr : 1 - fr) * (dc ? fc : 1 - fc);
-        const float* t = &this->Table[((static_cast<std::size_t>(k0 + dk) * rows + r0 + dr) * cols + c0 + dc) * 12];
+        const double weight = (dk ? fk : 1 - fk) * (dr ? fr : 1 - fr) * (dc ? fc : 1 - fc);
+        const float* t =
+          &this
+             ->Table[((static_cast<std::size_t>(k0 + dk) * rows + r0 + dr) * cols + c0 + dc) * 12];
         for (int i = 0; i < 12; ++i)
         {
           v[i] += weight * t[i];

@@ -71,9 +71,9 @@ namespace nimbus
 struct NIMBUSREPRESENTATIONS_EXPORT SkyParameters
 {
   AtmosphereParameters Atmosphere;
-  double GroundAlbedo = 0.3;     // grey Lambertian albedo of the earth's surface, [0, 1]
-  int ScatteringOrders = 4;      // K >= 1; 1 = single scattering only
-  int Wavelengths = 16;          // spectral samples (SpectralSamples; >= 8 uses the spline)
+  double GroundAlbedo = 0.3;      // grey Lambertian albedo of the earth's surface, [0, 1]
+  int ScatteringOrders = 4;       // K >= 1; 1 = single scattering only
+  int Wavelengths = 16;           // spectral samples (SpectralSamples; >= 8 uses the spline)
   double SunTemperature = 5778.0; // K, blackbody spectrum of the sun
   // Table sizes (nodes).
   int TransmittanceMuSize = 256;
@@ -169,8 +169,8 @@ public:
   /// and the ground's sky-lit term (else single scattering and the sunlit ground).
   /// exactSunTransmittance: use Atmosphere's exact optical lengths instead of the
   /// table (tests).
-  SkySpectra IntegrateRay(const Vector3& x, const Vector3& w, const Vector3& s,
-    double maxDistance, int steps, bool includeMultiple, bool exactSunTransmittance = false) const;
+  SkySpectra IntegrateRay(const Vector3& x, const Vector3& w, const Vector3& s, double maxDistance,
+    int steps, bool includeMultiple, bool exactSunTransmittance = false) const;
   /// Linear sRGB radiance toward an observer at altitude h (m) looking along the
   /// unit direction w (local frame: z up), sun direction s (local frame).
   std::array<double, 3> Radiance(double altitude, const Vector3& w, const Vector3& s,
@@ -202,20 +202,20 @@ public:
   /// What a march integrates (internal, public for the LUT builders).
   struct MarchOptions
   {
-    int Steps = 0;                          // 0 = ViewSteps
-    double MaxDistance = -1.0;              // < 0: to the end of the ray
-    bool Single = true;                     // Rayleigh and Mie parts of single scattering
-    bool GroundDirect = true;               // sunlit ground (order 1)
-    const std::vector<float>* Source = nullptr;       // isotropic source table [x_r][x_mus][lambda]
-    const std::vector<float>* GroundSky = nullptr;    // ground sky irradiance [x_mus][lambda]
+    int Steps = 0;                                 // 0 = ViewSteps
+    double MaxDistance = -1.0;                     // < 0: to the end of the ray
+    bool Single = true;                            // Rayleigh and Mie parts of single scattering
+    bool GroundDirect = true;                      // sunlit ground (order 1)
+    const std::vector<float>* Source = nullptr;    // isotropic source table [x_r][x_mus][lambda]
+    const std::vector<float>* GroundSky = nullptr; // ground sky irradiance [x_mus][lambda]
     bool ExactSun = false;
     GroundMode Ground = GroundMode::Automatic;
     /// Called after each step with (distance reached, accumulated spectra) when set.
-    const std::vector<double>* RecordAt = nullptr;    // sorted distances to record at
+    const std::vector<double>* RecordAt = nullptr; // sorted distances to record at
     std::vector<SkySpectra>* Records = nullptr;
   };
-  SkySpectra March(const Vector3& x, const Vector3& w, const Vector3& s,
-    const MarchOptions& options) const;
+  SkySpectra March(
+    const Vector3& x, const Vector3& w, const Vector3& s, const MarchOptions& options) const;
 
 private:
   void BuildTransmittance();
@@ -230,8 +230,8 @@ private:
   std::vector<double> BetaRayleigh; // per wavelength, 1/m
   double BetaMieScattering = 0.0, BetaMieExtinction = 0.0;
   std::vector<float> TransmittanceTable;
-  std::vector<float> MultipleTable;      // M_ms
-  std::vector<float> GroundSkyTable;     // E_sky by x_mus (r = R)
+  std::vector<float> MultipleTable;            // M_ms
+  std::vector<float> GroundSkyTable;           // E_sky by x_mus (r = R)
   std::vector<std::vector<double>> OrderMeans; // per order: spectral mean of M_k at r = R by x_mus
   double BuildSeconds = 0.0;
 };
@@ -244,9 +244,9 @@ NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> SunDirectionFromAngles(
 /// Maps of the sky-view rows: view zenith angle <-> row coordinate, split at the horizon.
 struct NIMBUSREPRESENTATIONS_EXPORT SkyViewMapping
 {
-  int Width = 64;       // azimuth nodes over [0, pi]
-  int AboveRows = 64;   // rows from the horizon (row 0) up to the zenith
-  int BelowRows = 32;   // rows from the horizon down to the nadir
+  int Width = 64;             // azimuth nodes over [0, pi]
+  int AboveRows = 64;         // rows from the horizon (row 0) up to the zenith
+  int BelowRows = 32;         // rows from the horizon down to the nadir
   double HorizonZenith = 0.0; // zenith angle of the horizon [rad], >= pi/2
 
   /// Continuous row coordinate in [0, AboveRows - 1] (above) or

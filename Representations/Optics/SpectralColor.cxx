@@ -100,9 +100,9 @@ std::array<double, 2> XyzToChromaticity(const std::array<double, 3>& xyz)
 
 double PlanckSpectralRadiance(double lambdaNm, double T)
 {
-  constexpr double h = 6.62607015e-34;  // Planck constant [J s]
-  constexpr double c = 299792458.0;     // speed of light [m/s]
-  constexpr double kB = 1.380649e-23;   // Boltzmann constant [J/K]
+  constexpr double h = 6.62607015e-34;   // Planck constant [J s]
+  constexpr double c = 299792458.0;      // speed of light [m/s]
+  constexpr double kB = 1.380649e-23;    // Boltzmann constant [J/K]
   const double lambda = lambdaNm * 1e-9; // [m]
   const double l5 = std::pow(lambda, 5);
   // B = 2 h c^2 / lambda^5 / (exp(h c / (lambda kB T)) - 1)  [W m^-2 sr^-1 m^-1]
@@ -117,7 +117,8 @@ SpectralSamples::SpectralSamples(
 {
   if (n < 2 || !(lambdaMin > 0.0) || !(lambdaMax > lambdaMin) || !std::isfinite(lambdaMax))
   {
-    throw std::invalid_argument("nimbus::SpectralSamples: need n >= 2 and 0 < lambdaMin < lambdaMax");
+    throw std::invalid_argument(
+      "nimbus::SpectralSamples: need n >= 2 and 0 < lambdaMin < lambdaMax");
   }
   const double h = (lambdaMax - lambdaMin) / (n - 1); // sample spacing [nm]
   for (int i = 0; i < n; ++i)
@@ -163,8 +164,10 @@ SpectralSamples::SpectralSamples(
     const double a = this->Wavelengths[i];
     const double b = this->Wavelengths[i + 1];
     const double len = b - a;
-    const auto basisTimesCmf = [&](int which) {
-      return [&, which](double l) {
+    const auto basisTimesCmf = [&](int which)
+    {
+      return [&, which](double l)
+      {
         const std::array<double, 3> cmf = CieXyzBar1931(l);
         const double A = (b - l) / len;
         const double B = 1.0 - A;

@@ -31,12 +31,14 @@ NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> CieXyzBar1931(double lambdaNm
 
 /// CIE XYZ -> linear sRGB (D65 white, ITU-R BT.709 primaries), matrix of
 /// IEC 61966-2-1.  No clamping: out-of-gamut colours give components < 0 or > 1.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> XyzToLinearSrgb(const std::array<double, 3>& xyz);
+NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> XyzToLinearSrgb(
+  const std::array<double, 3>& xyz);
 /// sRGB transfer function (IEC 61966-2-1) linear -> encoded, input clamped to
 /// [0, 1]: 12.92 c for c <= 0.0031308, else 1.055 c^(1/2.4) - 0.055.
 NIMBUSREPRESENTATIONS_EXPORT double SrgbEncode(double linear);
 /// Chromaticity (x, y) = (X, Y) / (X + Y + Z); (0, 0) for X + Y + Z = 0.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 2> XyzToChromaticity(const std::array<double, 3>& xyz);
+NIMBUSREPRESENTATIONS_EXPORT std::array<double, 2> XyzToChromaticity(
+  const std::array<double, 3>& xyz);
 
 /// Planck's law: blackbody spectral radiance B(lambda, T) in W m^-2 sr^-1 nm^-1.
 /// Use T = 5778 K for the sun.

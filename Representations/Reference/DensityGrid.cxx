@@ -107,8 +107,8 @@ double DensityGrid::Sample(const Vector3& p) const
   return c0 + f[2] * (c1 - c0);
 }
 
-bool DensityGrid::IntersectRay(const Vector3& origin, const Vector3& direction, double tMin,
-  double& tNear, double& tFar) const
+bool DensityGrid::IntersectRay(
+  const Vector3& origin, const Vector3& direction, double tMin, double& tNear, double& tFar) const
 {
   if (this->Values.empty())
   {

@@ -25,7 +25,10 @@ struct NIMBUSREPRESENTATIONS_EXPORT FloatImage
     , Pixels(static_cast<std::size_t>(width) * height * 3, 0.0f)
   {
   }
-  float* At(int x, int y) { return &this->Pixels[3 * (static_cast<std::size_t>(y) * this->Width + x)]; }
+  float* At(int x, int y)
+  {
+    return &this->Pixels[3 * (static_cast<std::size_t>(y) * this->Width + x)];
+  }
   const float* At(int x, int y) const
   {
     return &this->Pixels[3 * (static_cast<std::size_t>(y) * this->Width + x)];

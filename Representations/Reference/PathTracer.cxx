@@ -116,7 +116,8 @@ struct MacroGrid
         {
           float m = 0.0f;
           for (int i = ranges[0][c].first; i <= ranges[0][c].second; ++i)
-            m = std::max(m, f[i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k)]);
+            m = std::max(
+              m, f[i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k)]);
           ax[c + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)] = m;
         }
     std::vector<float> axy(static_cast<std::size_t>(cx) * cy * n[2], 0.0f);
@@ -126,7 +127,8 @@ struct MacroGrid
         {
           float m = 0.0f;
           for (int j = ranges[1][c].first; j <= ranges[1][c].second; ++j)
-            m = std::max(m, ax[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)]);
+            m = std::max(
+              m, ax[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)]);
           axy[i + static_cast<std::size_t>(cx) * (c + static_cast<std::size_t>(cy) * k)] = m;
         }
     this->Majorant.assign(static_cast<std::size_t>(cx) * cy * cz, 0.0);
@@ -136,8 +138,10 @@ struct MacroGrid
         {
           float m = 0.0f;
           for (int k = ranges[2][c].first; k <= ranges[2][c].second; ++k)
-            m = std::max(m, axy[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * k)]);
-          this->Majorant[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * c)] =
+            m = std::max(
+              m, axy[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * k)]);
+          this
+            ->Majorant[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * c)] =
             extinctionPerDensity * static_cast<double>(m);
         }
   }
@@ -175,7 +179,8 @@ struct SunTable
     const int j = std::min(this->NMu - 2, static_cast<int>(y));
     const double fx = x - i, fy = y - j;
     const std::size_t k = static_cast<std::size_t>(j) * this->NR + i;
-    auto bilinear = [&](const std::vector<double>& v) {
+    auto bilinear = [&](const std::vector<double>& v)
+    {
       const double a = v[k] + fx * (v[k + 1] - v[k]);
       const double b = v[k + this->NR] + fx * (v[k + this->NR + 1] - v[k + this->NR]);
       return a + fy * (b - a);
@@ -190,8 +195,8 @@ struct SunTable
 struct Ray
 {
   Vector3 Origin;
-  Vector3 Direction;    // unit
-  Vector3 EarthOrigin;  // origin in the earth-centred frame
+  Vector3 Direction;   // unit
+  Vector3 EarthOrigin; // origin in the earth-centred frame
   bool CrossesCloud = false;
   double CloudNear = 0.0, CloudFar = 0.0;
 };
@@ -237,8 +242,8 @@ public:
     if (this->HasCloud)
     {
       this->Macro.Build(this->Grid, context.GetScene().Medium.ExtinctionPerDensity);
-      this->MinCellSize = std::min(
-        { this->Macro.CellSize[0], this->Macro.CellSize[1], this->Macro.CellSize[2] });
+      this->MinCellSize =
+        std::min({ this->Macro.CellSize[0], this->Macro.CellSize[1], this->Macro.CellSize[2] });
     }
     this->CloudAlbedo = context.GetCloudAlbedo();
     if (this->Air)
@@ -261,11 +266,13 @@ public:
         for (int a = 0; a < 3; ++a)
         {
           const double c = -origin[a];
-          const double nearest = std::min(this->Grid.GetUpper()[a], std::max(this->Grid.GetLower()[a], c));
+          const double nearest =
+            std::min(this->Grid.GetUpper()[a], std::max(this->Grid.GetLower()[a], c));
           r2 += (nearest - c) * (nearest - c);
         }
         this->CloudBoxMinRadius = std::sqrt(r2);
-        this->AirMajorantInCloudBox = this->AirMajorantAt(this->CloudBoxMinRadius - this->EarthRadius);
+        this->AirMajorantInCloudBox =
+          this->AirMajorantAt(this->CloudBoxMinRadius - this->EarthRadius);
       }
     }
     else
@@ -333,8 +340,8 @@ private:
   FlightEnd FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, PathState& state, double& t,
     Scatterer& scatterer) const;
   /// Cloud transmittance from p toward the sun by ratio tracking (unbiased).
-  double CloudTransmittance(const Vector3& p, const Vector3& direction, PathRandom& rng,
-    PathState& state) const;
+  double CloudTransmittance(
+    const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state) const;
   /// Adds the sun's single-scattered contribution at p (next-event estimation).
   void SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
     PathState& state) const;
@@ -351,7 +358,7 @@ private:
   double EarthRadius = 0.0, ScaleHeightR = 1.0, ScaleHeightM = 1.0, MieG = 0.0;
   std::vector<double> BetaR; // Rayleigh scattering = extinction at sea level, 1/m
   double BetaRMax = 0.0;
-  double BetaMs = 0.0, BetaMt = 0.0; // Mie scattering / extinction at sea level, 1/m
+  double BetaMs = 0.0, BetaMt = 0.0;  // Mie scattering / extinction at sea level, 1/m
   double AirMajorantInCloudBox = 0.0; // at the box's lowest altitude, 1/m
   double CloudBoxMinRadius = 0.0;     // distance from the earth centre to the box, m
   SunTable SunLengths;
@@ -387,7 +394,8 @@ void Integrator::BuildSunTable()
   muLo = std::max(-1.0, muLo - muPad);
   muHi = std::min(1.0, muHi + muPad);
   // Any unit vector perpendicular to the sun direction.
-  const Vector3 helper = std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
+  const Vector3 helper =
+    std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
   Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
     sun[0] * helper[1] - sun[1] * helper[0] } };
   const double perpLength = std::sqrt(Dot(perp, perp));
@@ -395,10 +403,11 @@ void Integrator::BuildSunTable()
   {
     c /= perpLength;
   }
-  auto exact = [&](double r, double mu, double& lR, double& lM) {
+  auto exact = [&](double r, double mu, double& lR, double& lM)
+  {
     const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]), r * (mu * sun[1] + sinTheta * perp[1]),
-      r * (mu * sun[2] + sinTheta * perp[2]) } };
+    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]),
+      r * (mu * sun[1] + sinTheta * perp[1]), r * (mu * sun[2] + sinTheta * perp[2]) } };
     const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
     lR = lengths.rayleighLength;
     lM = lengths.mieLength;
@@ -714,8 +723,8 @@ double Integrator::CloudTransmittance(
   }
 }
 
-void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer,
-  PathRandom& rng, PathState& state) const
+void Integrator::SunNextEvent(
+  const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng, PathState& state) const
 {
   // Radiance toward -d from the sun's irradiance E(lambda) arriving along -s:
   //   L = f * E * T_cloud * T_atm(lambda),
@@ -779,8 +788,7 @@ void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scat
   const double k = f * cloud;
   for (int i = 0; i < this->Wavelengths; ++i)
   {
-    state.Radiance[i] +=
-      state.Weight[i] * k * this->SunIrradiance[i] * state.SunTransmittance[i];
+    state.Radiance[i] += state.Weight[i] * k * this->SunIrradiance[i] * state.SunTransmittance[i];
   }
 }
 
@@ -905,22 +913,24 @@ void Integrator::TracePath(
         break;
       }
       case Scatterer::Rayleigh:
-        direction = DirectionFromCosine(ray.Direction, SampleRayleigh(rng.Uniform()), rng.Uniform());
+        direction =
+          DirectionFromCosine(ray.Direction, SampleRayleigh(rng.Uniform()), rng.Uniform());
         break;
       case Scatterer::Mie:
-        direction =
-          DirectionFromCosine(ray.Direction, SampleCornetteShanks(this->MieG, uniform), rng.Uniform());
+        direction = DirectionFromCosine(
+          ray.Direction, SampleCornetteShanks(this->MieG, uniform), rng.Uniform());
         break;
       case Scatterer::Cloud:
       default:
-        direction =
-          DirectionFromCosine(ray.Direction, this->Context.GetCloudPhase().Sample(uniform), rng.Uniform());
+        direction = DirectionFromCosine(
+          ray.Direction, this->Context.GetCloudPhase().Sample(uniform), rng.Uniform());
         break;
     }
     // Russian roulette on the largest spectral weight.
     if (rouletteOrder >= 0 && order >= rouletteOrder)
     {
-      const double survive = std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
+      const double survive =
+        std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
       if (!(survive > 0.0) || rng.Uniform() >= survive)
       {
         break;
@@ -994,8 +1004,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   std::vector<PixelStatistics> statistics(pixels);
 
-  int threads = settings.Threads > 0 ? settings.Threads
-                                     : static_cast<int>(std::thread::hardware_concurrency());
+  int threads =
+    settings.Threads > 0 ? settings.Threads : static_cast<int>(std::thread::hardware_concurrency());
   threads = std::max(1, threads);
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
@@ -1020,7 +1030,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     std::atomic<std::size_t> next{ 0 };
     std::exception_ptr failure;
     std::mutex failureMutex;
-    auto worker = [&]() {
+    auto worker = [&]()
+    {
       PathState state;
       std::uint64_t localPaths = 0, localTruncated = 0;
       try
@@ -1095,8 +1106,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     }
     if (progress)
     {
-      progress(std::min(1.0,
-        static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+      progress(std::min(
+        1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
     }
     if (target >= maxSamples)
     {
@@ -1121,8 +1132,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   result.Paths = paths.load();
   result.TruncatedPaths = truncated.load();
   result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
-  result.Seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (progress)
   {
     progress(1.0);

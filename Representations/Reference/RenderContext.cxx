@@ -75,8 +75,8 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid)
       "must be in [-1, 1]");
     Require(std::isfinite(medium.Phase[i].Weight) && medium.Phase[i].Weight >= 0.0,
       field + ".weight", "must be finite and >= 0");
-    this->CloudPhase.AddComponent(
-      medium.Phase[i].Weight, KindFromName(medium.Phase[i].Type, field + ".type"), medium.Phase[i].G);
+    this->CloudPhase.AddComponent(medium.Phase[i].Weight,
+      KindFromName(medium.Phase[i].Type, field + ".type"), medium.Phase[i].G);
   }
   double totalWeight = 0.0;
   for (const auto& component : medium.Phase)
@@ -106,8 +106,8 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid)
   this->SunDirection = { { std::cos(elevation) * std::sin(azimuth),
     std::cos(elevation) * std::cos(azimuth), std::sin(elevation) } };
   const double temperature = sun.Temperature;
-  this->SunIrradiance =
-    this->Spectrum->Sample([temperature](double lambda) { return PlanckSpectralRadiance(lambda, temperature); });
+  this->SunIrradiance = this->Spectrum->Sample(
+    [temperature](double lambda) { return PlanckSpectralRadiance(lambda, temperature); });
   const double luminance = this->Spectrum->ToXyz(this->SunIrradiance)[1];
   for (double& e : this->SunIrradiance)
   {
@@ -136,20 +136,20 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid)
   }
 
   const BackgroundDescription& background = scene.Background;
-  Require(background.Type == "black" || background.Type == "constant" ||
-      background.Type == "atmosphere",
+  Require(
+    background.Type == "black" || background.Type == "constant" || background.Type == "atmosphere",
     "background.type", "must be black, constant or atmosphere");
   Require(background.Type != "atmosphere" || scene.Atmosphere.Enabled, "background.type",
     "'atmosphere' needs atmosphere.enabled");
-  Require(std::isfinite(background.Radiance) && background.Radiance >= 0.0,
-    "background.radiance", "must be finite and >= 0");
+  Require(std::isfinite(background.Radiance) && background.Radiance >= 0.0, "background.radiance",
+    "must be finite and >= 0");
   // A flat spectrum of 1 has Y = 1 (SpectralColor.h).
-  this->BackgroundRadiance.assign(this->Wavelengths.size(),
-    background.Type == "constant" ? background.Radiance : 0.0);
+  this->BackgroundRadiance.assign(
+    this->Wavelengths.size(), background.Type == "constant" ? background.Radiance : 0.0);
 
   Require(std::isfinite(scene.Ground.Height), "ground.height", "must be finite");
-  Require(scene.Ground.Albedo >= 0.0 && scene.Ground.Albedo <= 1.0, "ground.albedo",
-    "must be in [0, 1]");
+  Require(
+    scene.Ground.Albedo >= 0.0 && scene.Ground.Albedo <= 1.0, "ground.albedo", "must be in [0, 1]");
 }
 
 std::array<double, 3> RenderContext::ToLinearSrgb(const std::vector<double>& spectralRadiance) const
@@ -219,7 +219,8 @@ void RenderContext::AtmosphereTransmittanceBetween(
   }
 }
 
-double RenderContext::DistanceToTopOfAtmosphere(const Vector3& origin, const Vector3& direction) const
+double RenderContext::DistanceToTopOfAtmosphere(
+  const Vector3& origin, const Vector3& direction) const
 {
   if (!this->Air)
   {
@@ -237,7 +238,8 @@ double RenderContext::DistanceToTopOfAtmosphere(const Vector3& origin, const Vec
   return std::max(0.0, -b + std::sqrt(disc));
 }
 
-double RenderContext::IntersectGround(const Vector3& origin, const Vector3& direction, double tMin) const
+double RenderContext::IntersectGround(
+  const Vector3& origin, const Vector3& direction, double tMin) const
 {
   if (!this->Scene.Ground.Enabled || direction[2] >= 0.0)
   {

@@ -19,20 +19,21 @@ namespace nimbus
 
 struct CameraDescription
 {
-  std::array<double, 3> Position{ { 0.0, -6000.0, 1500.0 } };   // m
-  std::array<double, 3> FocalPoint{ { 0.0, 0.0, 1600.0 } };     // m
+  std::array<double, 3> Position{ { 0.0, -6000.0, 1500.0 } }; // m
+  std::array<double, 3> FocalPoint{ { 0.0, 0.0, 1600.0 } };   // m
   std::array<double, 3> ViewUp{ { 0.0, 0.0, 1.0 } };
-  double ViewAngle = 35.0;                                      // vertical, degrees
-  int Width = 256;                                              // pixels
-  int Height = 256;                                             // pixels
+  double ViewAngle = 35.0; // vertical, degrees
+  int Width = 256;         // pixels
+  int Height = 256;        // pixels
 };
 
 /// One term of a phase function (004 Eq. 4 mixtures have several).
 struct PhaseComponentDescription
 {
-  std::string Type = "cornette_shanks"; // "isotropic", "rayleigh", "henyey_greenstein", "cornette_shanks"
-  double G = 0.85;                      // asymmetry (ignored by isotropic and rayleigh)
-  double Weight = 1.0;                  // mixture weight (normalised over the components)
+  std::string Type =
+    "cornette_shanks"; // "isotropic", "rayleigh", "henyey_greenstein", "cornette_shanks"
+  double G = 0.85;     // asymmetry (ignored by isotropic and rayleigh)
+  double Weight = 1.0; // mixture weight (normalised over the components)
 };
 
 /// Where the density comes from. Either a VTK image file or a Nimbus source.
@@ -50,7 +51,7 @@ struct DensitySourceDescription
 struct MediumDescription
 {
   DensitySourceDescription Density;
-  double ExtinctionPerDensity = 0.02;  // sigma_t per unit density, 1/m
+  double ExtinctionPerDensity = 0.02;   // sigma_t per unit density, 1/m
   double SingleScatteringAlbedo = 0.99; // sigma_s / sigma_t
   /// k_multi of 000 Eq. 1: a constant added to the 4pi-normalised cloud phase
   /// function that stands in for multiple scattering (dimensionless, >= 0; 0 =
@@ -72,22 +73,22 @@ struct SunDescription
 struct AtmosphereDescription
 {
   bool Enabled = true;
-  double SceneAltitude = 0.0;           // m above sea level of the scene's z = 0
-  double EarthRadius = 6360000.0;       // m
-  double TopRadius = 6420000.0;         // m
+  double SceneAltitude = 0.0;             // m above sea level of the scene's z = 0
+  double EarthRadius = 6360000.0;         // m
+  double TopRadius = 6420000.0;           // m
   double RayleighScattering550 = 13.5e-6; // 1/m at sea level and 550 nm
-  double RayleighScaleHeight = 8000.0;  // m
-  double MieScattering = 2.0e-5;        // 1/m at sea level
-  double MieScaleHeight = 1200.0;       // m
-  double MieAlbedo = 0.9;               // sigma_s / sigma_t of aerosols
-  double MieG = 0.76;                   // Cornette-Shanks asymmetry of aerosols
+  double RayleighScaleHeight = 8000.0;    // m
+  double MieScattering = 2.0e-5;          // 1/m at sea level
+  double MieScaleHeight = 1200.0;         // m
+  double MieAlbedo = 0.9;                 // sigma_s / sigma_t of aerosols
+  double MieG = 0.76;                     // Cornette-Shanks asymmetry of aerosols
 };
 
 struct GroundDescription
 {
   bool Enabled = true;
-  double Height = 0.0;                                  // z of the ground plane, m
-  double Albedo = 0.2;                                  // Lambertian, grey (all wavelengths)
+  double Height = 0.0; // z of the ground plane, m
+  double Albedo = 0.2; // Lambertian, grey (all wavelengths)
 };
 
 struct BackgroundDescription

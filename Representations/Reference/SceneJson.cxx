@@ -80,7 +80,8 @@ std::string Describe(const Json& v)
   {
     return "null";
   }
-  return std::string(v.is_boolean() ? "the boolean " : (v.is_array() ? "the array " : "the object ")) +
+  return std::string(
+           v.is_boolean() ? "the boolean " : (v.is_array() ? "the array " : "the object ")) +
     text;
 }
 
@@ -243,7 +244,8 @@ std::vector<double> ReadNumbers(
   }
   if (v.size() != count)
   {
-    Fail(path, "expected " + noun + ", got " + std::to_string(v.size()) + " element" +
+    Fail(path,
+      "expected " + noun + ", got " + std::to_string(v.size()) + " element" +
         (v.size() == 1 ? "" : "s"));
   }
   std::vector<double> values;
@@ -416,8 +418,9 @@ std::vector<double> ReadParameter(const Json& v, const std::string& path, const 
   {
     if (v.size() != spec.Count)
     {
-      Fail(path, "expected " + std::to_string(spec.Count) + " value" +
-          (spec.Count == 1 ? "" : "s") + ", got " + std::to_string(v.size()));
+      Fail(path,
+        "expected " + std::to_string(spec.Count) + " value" + (spec.Count == 1 ? "" : "s") +
+          ", got " + std::to_string(v.size()));
     }
     for (std::size_t i = 0; i < v.size(); ++i)
     {
@@ -430,8 +433,8 @@ std::vector<double> ReadParameter(const Json& v, const std::string& path, const 
   }
   else
   {
-    Fail(path, "expected an array of " + std::to_string(spec.Count) + " numbers, got " +
-        Describe(v));
+    Fail(
+      path, "expected an array of " + std::to_string(spec.Count) + " numbers, got " + Describe(v));
   }
 
   const std::string name = spec.Name;
@@ -442,20 +445,22 @@ std::vector<double> ReadParameter(const Json& v, const std::string& path, const 
     {
       if (!(values[2 * a] < values[2 * a + 1]))
       {
-        Fail(path, std::string("expected min < max on every axis, axis ") + axes[a] + " has (" +
+        Fail(path,
+          std::string("expected min < max on every axis, axis ") + axes[a] + " has (" +
             FormatNumber(values[2 * a]) + ", " + FormatNumber(values[2 * a + 1]) + ")");
       }
     }
   }
   else if (name == "BaseBallRadiusRange" && !(values[0] <= values[1]))
   {
-    Fail(path, "expected min <= max, got (" + FormatNumber(values[0]) + ", " +
-        FormatNumber(values[1]) + ")");
+    Fail(path,
+      "expected min <= max, got (" + FormatNumber(values[0]) + ", " + FormatNumber(values[1]) +
+        ")");
   }
   else if (name == "Dimensions" && values[0] * values[1] * values[2] > 1073741824.0)
   {
-    Fail(path, "too many grid points (" + FormatNumber(values[0] * values[1] * values[2]) +
-        " > 2^30)");
+    Fail(path,
+      "too many grid points (" + FormatNumber(values[0] * values[1] * values[2]) + " > 2^30)");
   }
   return values;
 }
@@ -466,15 +471,14 @@ std::vector<std::pair<std::string, std::vector<double>>> ReadMetaballParameters(
   const std::vector<std::string> names = MetaballParameterNames();
   if (!v.is_object())
   {
-    Fail(path, "expected an object of vtkNimbusMetaballCloudSource properties, got " +
-        Describe(v));
+    Fail(path, "expected an object of vtkNimbusMetaballCloudSource properties, got " + Describe(v));
   }
   for (const auto& item : v.items())
   {
     if (std::find(names.begin(), names.end(), item.key()) == names.end())
     {
-      Fail(path + "." + item.key(),
-        "unknown metaball_cloud parameter (known: " + Join(names) + ")");
+      Fail(
+        path + "." + item.key(), "unknown metaball_cloud parameter (known: " + Join(names) + ")");
     }
   }
   // Stored in the source's property order: the canonical form does not depend on
@@ -537,7 +541,8 @@ CameraDescription ReadCamera(const Json& v, const std::string& path)
   return c;
 }
 
-DensitySourceDescription ReadDensity(const Json& v, const std::string& path, const std::string& base)
+DensitySourceDescription ReadDensity(
+  const Json& v, const std::string& path, const std::string& base)
 {
   const ObjectReader r(v, path, { "type", "path", "array", "parameters" });
   DensitySourceDescription d;
@@ -569,8 +574,8 @@ DensitySourceDescription ReadDensity(const Json& v, const std::string& path, con
     }
     if (d.ArrayName != "density")
     {
-      Fail(r.Key("array"), "a metaball_cloud's array is always \"density\", got \"" +
-          d.ArrayName + "\"");
+      Fail(r.Key("array"),
+        "a metaball_cloud's array is always \"density\", got \"" + d.ArrayName + "\"");
     }
     if (r.Has("parameters"))
     {
@@ -599,9 +604,9 @@ PhaseComponentDescription ReadPhaseComponent(const Json& v, const std::string& p
 
 MediumDescription ReadMedium(const Json& v, const std::string& path, const std::string& base)
 {
-  const ObjectReader r(
-    v, path, { "density", "extinction_per_density", "single_scattering_albedo", "phase",
-               "multiple_scattering_constant" });
+  const ObjectReader r(v, path,
+    { "density", "extinction_per_density", "single_scattering_albedo", "phase",
+      "multiple_scattering_constant" });
   MediumDescription m;
   m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
   r.RequiredNumber("extinction_per_density", m.ExtinctionPerDensity, AtLeast(0.0));
@@ -629,8 +634,8 @@ MediumDescription ReadMedium(const Json& v, const std::string& path, const std::
     }
     else
     {
-      Fail(phasePath, "expected a phase component (object) or an array of them, got " +
-          Describe(phase));
+      Fail(phasePath,
+        "expected a phase component (object) or an array of them, got " + Describe(phase));
     }
     double total = 0.0;
     for (const auto& c : m.Phase)
@@ -702,13 +707,15 @@ AtmosphereDescription ReadAtmosphere(const Json& v, const std::string& path)
   r.Number("mie_g", a.MieG, Open(-1.0, 1.0));
   if (!(a.TopRadius > a.EarthRadius))
   {
-    Fail(r.Key("top_radius"), "must be greater than earth_radius (" +
-        FormatNumber(a.EarthRadius) + "), got " + FormatNumber(a.TopRadius));
+    Fail(r.Key("top_radius"),
+      "must be greater than earth_radius (" + FormatNumber(a.EarthRadius) + "), got " +
+        FormatNumber(a.TopRadius));
   }
   if (!(a.SceneAltitude < a.TopRadius - a.EarthRadius))
   {
-    Fail(r.Key("scene_altitude"), "must be below the top of the atmosphere (" +
-        FormatNumber(a.TopRadius - a.EarthRadius) + " m), got " + FormatNumber(a.SceneAltitude));
+    Fail(r.Key("scene_altitude"),
+      "must be below the top of the atmosphere (" + FormatNumber(a.TopRadius - a.EarthRadius) +
+        " m), got " + FormatNumber(a.SceneAltitude));
   }
   return a;
 }
@@ -845,7 +852,8 @@ Json ParameterJson(const std::string& name, const std::vector<double>& values)
       count = spec.Count;
     }
   }
-  auto component = [kind](double x) -> Json {
+  auto component = [kind](double x) -> Json
+  {
     if (kind == ParameterKind::Bool && (x == 0.0 || x == 1.0))
     {
       return Json(x != 0.0);
@@ -894,9 +902,8 @@ Json ToJson(const SceneDescription& s)
   // Canonical order: the source's property order, then any others as stored.
   std::vector<std::pair<std::string, std::vector<double>>> parameters = m.Density.Parameters;
   const std::vector<std::string> names = MetaballParameterNames();
-  auto rank = [&names](const std::string& name) {
-    return std::find(names.begin(), names.end(), name) - names.begin();
-  };
+  auto rank = [&names](const std::string& name)
+  { return std::find(names.begin(), names.end(), name) - names.begin(); };
   std::stable_sort(parameters.begin(), parameters.end(),
     [&rank](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
   for (const auto& p : parameters)
@@ -964,8 +971,8 @@ void WritePretty(const Json& v, int indent, std::string& out)
     }
     out += std::string(static_cast<std::size_t>(indent), ' ') + "}";
   }
-  else if (v.is_array() && std::any_of(v.begin(), v.end(),
-                             [](const Json& x) { return x.is_structured(); }))
+  else if (v.is_array() &&
+    std::any_of(v.begin(), v.end(), [](const Json& x) { return x.is_structured(); }))
   {
     out += "[\n";
     for (std::size_t i = 0; i < v.size(); ++i)
@@ -1015,19 +1022,22 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
   // The version first: a newer file may have keys this reader does not know.
   if (!root.contains("nimbus_scene"))
   {
-    Fail(path, "missing required key \"nimbus_scene\" (the format version; this build reads "
-               "version " + std::to_string(SceneDescription::kFormatVersion) + ")");
+    Fail(path,
+      "missing required key \"nimbus_scene\" (the format version; this build reads "
+      "version " +
+        std::to_string(SceneDescription::kFormatVersion) + ")");
   }
   const Json& version = root.at("nimbus_scene");
   if (!(version.is_number_integer() || version.is_number_unsigned()))
   {
-    Fail(path + ".nimbus_scene", "expected the format version, an integer (this build reads " +
+    Fail(path + ".nimbus_scene",
+      "expected the format version, an integer (this build reads " +
         std::to_string(SceneDescription::kFormatVersion) + "), got " + Describe(version));
   }
   if (version.dump() != std::to_string(SceneDescription::kFormatVersion))
   {
-    Fail(path + ".nimbus_scene", "unsupported format version " + version.dump() +
-        "; this build of Nimbus reads version " +
+    Fail(path + ".nimbus_scene",
+      "unsupported format version " + version.dump() + "; this build of Nimbus reads version " +
         std::to_string(SceneDescription::kFormatVersion));
   }
 
@@ -1062,8 +1072,9 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
 
   if (s.Background.Type == "atmosphere" && !s.Atmosphere.Enabled)
   {
-    Fail(r.Key("background.type"), "\"atmosphere\" needs atmosphere.enabled = true (use "
-                                   "\"black\" or \"constant\" without an atmosphere)");
+    Fail(r.Key("background.type"),
+      "\"atmosphere\" needs atmosphere.enabled = true (use "
+      "\"black\" or \"constant\" without an atmosphere)");
   }
   return s;
 }

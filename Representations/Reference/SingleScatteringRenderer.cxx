@@ -151,8 +151,8 @@ public:
     CheckStepScale(stepScale);
     this->HasGrid = !this->Grid.IsEmpty() && this->Ctx.CloudMajorant() > 0.0;
     const double spacing = this->Grid.IsEmpty() ? 100.0 : this->Grid.GetMinimumSpacing();
-    this->Step = stepScale * spacing;   // m
-    this->AirFirstStep = spacing;       // g0, m (times s)
+    this->Step = stepScale * spacing; // m
+    this->AirFirstStep = spacing;     // g0, m (times s)
     this->Albedo = this->Ctx.GetCloudAlbedo();
     this->MultipleScattering = this->Ctx.GetScene().Medium.MultipleScatteringConstant;
     this->E = this->Ctx.GetSunIrradiance();
@@ -208,9 +208,10 @@ public:
     {
       // At most kMaxKnotRise of altitude between knots: ln(L + L0) is log-linear in
       // h only while L >> L0 (the Mie offset is tiny), so long climbs are split.
-      this->Spacing = std::min(integrator.KnotSpacing, kMaxKnotRise / std::max(1e-9, std::abs(d[2])));
-      this->Intervals = std::max<long long>(1,
-        static_cast<long long>(std::ceil(std::min(tEnd / this->Spacing, 1e12))));
+      this->Spacing =
+        std::min(integrator.KnotSpacing, kMaxKnotRise / std::max(1e-9, std::abs(d[2])));
+      this->Intervals = std::max<long long>(
+        1, static_cast<long long>(std::ceil(std::min(tEnd / this->Spacing, 1e12))));
     }
 
     /// T_atm(x(t), λ) into T (size N).
@@ -250,8 +251,7 @@ public:
       {
         // ln L linear in t, corrected for the altitude's departure from linear
         // (the earth's curvature: d²h/dt² ≈ (1 - v_z²)/R), with ∂ln L/∂h = -1/H.
-        const double w =
-          b.T > a.T ? std::min(1.0, std::max(0.0, (t - a.T) / (b.T - a.T))) : 0.0;
+        const double w = b.T > a.T ? std::min(1.0, std::max(0.0, (t - a.T) / (b.T - a.T))) : 0.0;
         const double dh = this->I.Air->Altitude(this->I.Ctx.EarthCentred(x)) -
           (a.Altitude + w * (b.Altitude - a.Altitude));
         lr = std::max(
@@ -365,7 +365,8 @@ public:
       b[a] = cell / kBlockCells;
     }
     if (!this->EmptyBlock[(static_cast<std::size_t>(b[2]) * this->Blocks[1] + b[1]) *
-            this->Blocks[0] + b[0]])
+            this->Blocks[0] +
+          b[0]])
     {
       return k;
     }
@@ -462,8 +463,8 @@ public:
     {
       if (box)
       {
-        alive = this->AirSegment(o, d, 0.0, t0, /*gradeFromStart=*/false, rayleighPhase,
-          miePhase, *knots, w);
+        alive = this->AirSegment(
+          o, d, 0.0, t0, /*gradeFromStart=*/false, rayleighPhase, miePhase, *knots, w);
         if (alive)
         {
           alive = this->CloudSegmentSpectral(
@@ -580,7 +581,8 @@ private:
               for (int a = lo[0]; a <= hi[0]; ++a)
               {
                 this->EmptyBlock[(static_cast<std::size_t>(c) * this->Blocks[1] + b) *
-                    this->Blocks[0] + a] = 0;
+                    this->Blocks[0] +
+                  a] = 0;
               }
             }
           }
@@ -743,9 +745,8 @@ private:
     const double g0 = this->AirFirstStep, alpha = kAirGrowth, s = this->StepScale;
     const double uTotal = std::log1p(alpha * length / g0) / alpha;
     const long long steps = std::max<long long>(1, static_cast<long long>(std::ceil(uTotal / s)));
-    auto distance = [&](long long k) {
-      return k >= steps ? length : std::min(length, g0 / alpha * std::expm1(alpha * k * s));
-    };
+    auto distance = [&](long long k)
+    { return k >= steps ? length : std::min(length, g0 / alpha * std::expm1(alpha * k * s)); };
     for (long long k = 0; k < steps; ++k)
     {
       double ta, tb;
@@ -826,8 +827,7 @@ void CheckRay(const Vector3& origin, const Vector3& direction)
 } // namespace
 
 std::vector<double> SingleScatteringRadiance(const RenderContext& context,
-  const std::array<double, 3>& origin, const std::array<double, 3>& unitDirection,
-  double stepScale)
+  const std::array<double, 3>& origin, const std::array<double, 3>& unitDirection, double stepScale)
 {
   CheckRay(origin, unitDirection);
   const Integrator integrator(context, stepScale);
@@ -837,8 +837,8 @@ std::vector<double> SingleScatteringRadiance(const RenderContext& context,
   return radiance;
 }
 
-FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepScale,
-  int threads, const std::function<void(double)>& progress)
+FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepScale, int threads,
+  const std::function<void(double)>& progress)
 {
   const Integrator integrator(context, stepScale);
   const Camera& camera = context.GetCamera();
@@ -851,7 +851,8 @@ FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepS
   std::mutex failureMutex;
   std::atomic<bool> failed{ false };
 
-  auto work = [&](bool reportProgress) {
+  auto work = [&](bool reportProgress)
+  {
     try
     {
       Integrator::Workspace workspace;
@@ -924,7 +925,8 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
   double reported = 0.0;
   int expectedPasses = std::min(2, maxPasses);
   auto weight = [](int passes) { return (std::pow(4.0, passes) - 1.0) / 3.0; };
-  auto report = [&](int pass, double fraction) {
+  auto report = [&](int pass, double fraction)
+  {
     if (!progress)
     {
       return;
@@ -965,9 +967,8 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
     }
     if (pass > 0 && result.EstimatedRelativeError > 0.0 && settings.RelativeTolerance > 0.0)
     {
-      const double halvings =
-        std::ceil(std::log(result.EstimatedRelativeError / settings.RelativeTolerance) /
-          std::log(4.0));
+      const double halvings = std::ceil(
+        std::log(result.EstimatedRelativeError / settings.RelativeTolerance) / std::log(4.0));
       expectedPasses = std::min(maxPasses, pass + 1 + static_cast<int>(std::max(1.0, halvings)));
     }
     else
@@ -977,8 +978,7 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
     stepScale *= 0.5;
   }
   result.Image = std::move(previous);
-  result.Seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (progress)
   {
     progress(1.0);

@@ -16,8 +16,8 @@ std::array<double, 3> AtmosphereTable::Lookup(int row, double z) const
   {
     return value;
   }
-  const double x = std::clamp((z - this->ZMin) / (this->ZMax - this->ZMin), 0.0, 1.0) *
-    (this->Samples - 1);
+  const double x =
+    std::clamp((z - this->ZMin) / (this->ZMax - this->ZMin), 0.0, 1.0) * (this->Samples - 1);
   const int i0 = std::min(static_cast<int>(x), this->Samples - 2);
   const double f = x - i0;
   for (int c = 0; c < 3; ++c)

@@ -4,10 +4,11 @@
 // in RGB with the same physics as the spectral reference (RenderContext).
 //
 // Rows (each `Samples` heights, z from ZMin to ZMax in scene metres, linear):
-//   0 SunIrradiance      E_sun(z)         = rgb( E(l) T_sun,atm(l, z) )                     000 Eq. 7
-//   1 RayleighSource     beta_R rho_R E   = rgb( beta_R(l) rho_R(h) E(l) T(l, z) )   [1/m] 000 Eq. 5
-//   2 MieSource          beta_M rho_M E   = beta_M,s rho_M(h) E_sun(z)               [1/m] 000 Eq. 5
-//   3 Extinction         k_atm rho_atm    = beta_R,eff rho_R(h) + beta_M,ext rho_M(h) [1/m] 000 Eq. 6
+//   0 SunIrradiance      E_sun(z)         = rgb( E(l) T_sun,atm(l, z) )                     000 Eq.
+//   7 1 RayleighSource     beta_R rho_R E   = rgb( beta_R(l) rho_R(h) E(l) T(l, z) )   [1/m] 000
+//   Eq. 5 2 MieSource          beta_M rho_M E   = beta_M,s rho_M(h) E_sun(z)               [1/m]
+//   000 Eq. 5 3 Extinction         k_atm rho_atm    = beta_R,eff rho_R(h) + beta_M,ext rho_M(h)
+//   [1/m] 000 Eq. 6
 // with h = SceneAltitude + z. The sun transmittance is that of the spherical
 // atmosphere at the point (0, 0, z) (the horizontal offset of a scene of tens of
 // km changes the local sun elevation by < 0.5 deg; ignored).
@@ -31,7 +32,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable
 {
   static constexpr int kRows = 4;
   int Samples = 0;
-  double ZMin = 0.0, ZMax = 0.0;  // scene z of the first and last sample [m]
+  double ZMin = 0.0, ZMax = 0.0; // scene z of the first and last sample [m]
   /// Row-major float RGBA texels: Data[(row * Samples + i) * 4 + c]; alpha = 1.
   std::vector<float> Data;
   /// Sun irradiance above the atmosphere in linear sRGB (used without atmosphere).

@@ -117,8 +117,8 @@ std::vector<Vec3> SlicePolygon(const std::vector<Vec3>& corners, const Vec3& n, 
         continue;
       }
       const double t = da == db ? 0.0 : da / (da - db);
-      points.push_back({ { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]),
-        a[2] + t * (b[2] - a[2]) } });
+      points.push_back(
+        { { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) } });
     }
   }
   return points;

@@ -41,7 +41,8 @@ struct NIMBUSREPRESENTATIONS_EXPORT SliceAxis
 /// when zero or non-finite) and ratio a = theta_s / theta_e (clamped to [0.01, 100];
 /// the paper uses 1..2). Degenerate cases: V parallel or anti-parallel to L give
 /// n = -L exactly.
-NIMBUSREPRESENTATIONS_EXPORT SliceAxis ComputeSliceAxis(const Vec3& view, const Vec3& toSun, double a);
+NIMBUSREPRESENTATIONS_EXPORT SliceAxis ComputeSliceAxis(
+  const Vec3& view, const Vec3& toSun, double a);
 
 /// Range [dMin, dMax] of dot(x, n) over the 8 corners of an axis-aligned or
 /// transformed box (corners given explicitly).

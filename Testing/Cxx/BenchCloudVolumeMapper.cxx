@@ -91,7 +91,8 @@ struct Bench
       this->Window->Render();
       this->Window->WaitForCompletion();
       times.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+          .count());
     }
     std::sort(times.begin(), times.end());
     return times[times.size() / 2];
@@ -102,7 +103,8 @@ struct Bench
 // connections after a few dozen).
 Bench* TheBench = nullptr;
 
-double TimeSvs(vtkImageData* image, int slices, const std::function<void(vtkNimbusCloudVolumeMapper*)>& configure)
+double TimeSvs(vtkImageData* image, int slices,
+  const std::function<void(vtkNimbusCloudVolumeMapper*)>& configure)
 {
   Bench& bench = *TheBench;
   vtkNew<vtkNimbusCloudVolumeMapper> mapper;
@@ -162,7 +164,8 @@ int main(int argc, char* argv[])
   Bench bench;
   TheBench = &bench;
   const auto none = [](vtkNimbusCloudVolumeMapper*) {};
-  const auto cloudOnly = [](vtkNimbusCloudVolumeMapper* m) {
+  const auto cloudOnly = [](vtkNimbusCloudVolumeMapper* m)
+  {
     m->SetAtmosphere(false);
     m->SetGround(false);
   };
@@ -182,20 +185,23 @@ int main(int argc, char* argv[])
                 "| sky background only | %.2f | %.1f |\n",
       empty, skyOnly, skyOnly / empty);
     vtkSmartPointer<vtkImageData> c = Cloud(128, 128, 128);
-    std::printf("\n| cloud 128^3 | mapper's own atmosphere, ms | over the sky, ms | sky adds |\n|---|---|---|---|\n");
+    std::printf("\n| cloud 128^3 | mapper's own atmosphere, ms | over the sky, ms | sky adds "
+                "|\n|---|---|---|---|\n");
     for (int slices : { 64, 256 })
     {
       const double own = TimeSvs(c, slices, none);
       bench.Renderer->AddViewProp(sky);
       const double over = TimeSvs(c, slices, none);
       bench.Renderer->RemoveViewProp(sky);
-      std::printf("| %d slices | %.1f | %.1f | %+.1f %% |\n", slices, own, over, 100.0 * (over - own) / own);
+      std::printf(
+        "| %d slices | %.1f | %.1f | %+.1f %% |\n", slices, own, over, 100.0 * (over - own) / own);
     }
     return EXIT_SUCCESS;
   }
 
   vtkSmartPointer<vtkImageData> c128 = Cloud(128, 128, 128);
-  std::printf("\n| volume | slices | full scene | cloud only (no air, no ground) | unlit floor | cloud only / floor | full / floor |\n|---|---|---|---|---|---|---|\n");
+  std::printf("\n| volume | slices | full scene | cloud only (no air, no ground) | unlit floor | "
+              "cloud only / floor | full / floor |\n|---|---|---|---|---|---|---|\n");
   for (int slices : { 64, 128, 256, 512 })
   {
     const double full = TimeSvs(c128, slices, none);
@@ -210,28 +216,34 @@ int main(int argc, char* argv[])
     const double full = TimeSvs(c, 256, none);
     const double cloud = TimeSvs(c, 256, cloudOnly);
     const double floor = TimeSvs(c, 256, unlit);
-    std::printf("| %dx%dx%d | 256 | %.1f | %.1f | %.1f | %.2f | %.2f |\n", dims[0], dims[1], dims[2],
-      full, cloud, floor, cloud / floor, full / floor);
+    std::printf("| %dx%dx%d | 256 | %.1f | %.1f | %.1f | %.2f | %.2f |\n", dims[0], dims[1],
+      dims[2], full, cloud, floor, cloud / floor, full / floor);
   }
 
-  std::printf("\nComponents (128^3, 256 slices): each switched off alone\n\n| configuration | ms | saving vs full |\n|---|---|---|\n");
+  std::printf("\nComponents (128^3, 256 slices): each switched off alone\n\n| configuration | ms | "
+              "saving vs full |\n|---|---|---|\n");
   const double full = TimeSvs(c128, 256, none);
   std::printf("| full (atmosphere, ground, shafts) | %.1f | |\n", full);
-  const std::vector<std::pair<std::string, std::function<void(vtkNimbusCloudVolumeMapper*)>>> parts = {
-    { "no shafts", [](vtkNimbusCloudVolumeMapper* m) { m->SetShafts(false); } },
-    { "no ground", [](vtkNimbusCloudVolumeMapper* m) { m->SetGround(false); } },
-    { "no atmosphere", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphere(false); } },
-    { "no atmosphere, no ground", cloudOnly },
-    { "atmosphere steps 16 (default 64)", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphereSteps(16); } },
-    { "shadow surface 256 (default 512)", [](vtkNimbusCloudVolumeMapper* m) { m->SetShadowSurfaceSize(256); } },
-  };
+  const std::vector<std::pair<std::string, std::function<void(vtkNimbusCloudVolumeMapper*)>>>
+    parts = {
+      { "no shafts", [](vtkNimbusCloudVolumeMapper* m) { m->SetShafts(false); } },
+      { "no ground", [](vtkNimbusCloudVolumeMapper* m) { m->SetGround(false); } },
+      { "no atmosphere", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphere(false); } },
+      { "no atmosphere, no ground", cloudOnly },
+      { "atmosphere steps 16 (default 64)",
+        [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphereSteps(16); } },
+      { "shadow surface 256 (default 512)",
+        [](vtkNimbusCloudVolumeMapper* m) { m->SetShadowSurfaceSize(256); } },
+    };
   for (const auto& part : parts)
   {
     const double t = TimeSvs(c128, 256, part.second);
     std::printf("| %s | %.1f | %.0f %% |\n", part.first.c_str(), t, 100.0 * (full - t) / full);
   }
 
-  std::printf("\nVTK's vtkGPUVolumeRayCastMapper, volumetric scattering, sample distance 0.5 voxel (128^3)\n\n| GlobalIlluminationReach | ms | / SVS 256 slices full |\n|---|---|---|\n");
+  std::printf(
+    "\nVTK's vtkGPUVolumeRayCastMapper, volumetric scattering, sample distance 0.5 voxel "
+    "(128^3)\n\n| GlobalIlluminationReach | ms | / SVS 256 slices full |\n|---|---|---|\n");
   for (double reach : { 0.0, 0.5, 1.0 })
   {
     const double t = TimeVtkGpu(c128, reach);

@@ -92,20 +92,10 @@ int main(int argc, char* argv[])
   const int n = argc > 1 ? std::atoi(argv[1]) : 256;
   const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
   const std::string dir = argc > 3 ? argv[3] : "/tmp";
-  std::printf("OpenVDB write/read of a %d^3 image, median of %d runs, %u hardware threads\n",
-    n,
-    repeats,
-    std::thread::hardware_concurrency());
-  std::printf("%-7s %-6s %10s %10s %10s %10s %10s %10s %10s\n",
-    "field",
-    "blosc",
-    "active",
-    "write s",
-    "write MB/s",
-    "read pts",
-    "read s",
-    "read MB/s",
-    "file MB");
+  std::printf("OpenVDB write/read of a %d^3 image, median of %d runs, %u hardware threads\n", n,
+    repeats, std::thread::hardware_concurrency());
+  std::printf("%-7s %-6s %10s %10s %10s %10s %10s %10s %10s\n", "field", "blosc", "active",
+    "write s", "write MB/s", "read pts", "read s", "read MB/s", "file MB");
   for (const std::string kind : { "dense", "sparse", "vec3" })
   {
     auto image = MakeImage(n, kind);
@@ -166,16 +156,9 @@ int main(int argc, char* argv[])
       }
       const double w = Median(writes), rd = Median(reads);
       const double readPayload = double(readPoints) * original->GetNumberOfComponents() * 4.0 / 1e6;
-      std::printf("%-7s %-6s %10lld %10.3f %10.1f %10lld %10.3f %10.1f %10.2f\n",
-        kind.c_str(),
-        blosc ? "on" : "off",
-        static_cast<long long>(active),
-        w,
-        payload / w,
-        static_cast<long long>(readPoints),
-        rd,
-        readPayload / rd,
-        FileSize(path) / 1e6);
+      std::printf("%-7s %-6s %10lld %10.3f %10.1f %10lld %10.3f %10.1f %10.2f\n", kind.c_str(),
+        blosc ? "on" : "off", static_cast<long long>(active), w, payload / w,
+        static_cast<long long>(readPoints), rd, readPayload / rd, FileSize(path) / 1e6);
       std::remove(path.c_str());
     }
   }

@@ -52,15 +52,16 @@ nimbus::DensityGrid CloudBlob(int n)
             ((x - l.x) * (x - l.x) + (y - l.y) * (y - l.y) + (z - l.z) * (z - l.z)) / (l.r * l.r);
           field += std::exp(-2.0 * d2);
         }
-        const double detail = 0.12 * std::sin(9.0 * x + 1.0) * std::sin(8.0 * y) * std::sin(10.0 * z + 2.0);
+        const double detail =
+          0.12 * std::sin(9.0 * x + 1.0) * std::sin(8.0 * y) * std::sin(10.0 * z + 2.0);
         values[(static_cast<std::size_t>(k) * n + j) * n + i] =
           static_cast<float>(std::max(0.0, std::min(1.0, 1.8 * (field - 0.45) + detail)));
       }
     }
   }
   const double half = 0.5 * kCloudSize;
-  return nimbus::DensityGrid({ { n, n, n } }, { { -half, -half, 2500.0 - half } }, { { h, h, h } },
-    std::move(values));
+  return nimbus::DensityGrid(
+    { { n, n, n } }, { { -half, -half, 2500.0 - half } }, { { h, h, h } }, std::move(values));
 }
 
 nimbus::SceneDescription CloudScene(int pixels, bool atmosphere)
@@ -120,7 +121,8 @@ int main(int argc, char** argv)
     std::fflush(stdout);
   }
 
-  std::printf("\nStep refinement, %d^3, 128x128, atmosphere (seconds per pass)\n", quick ? 64 : 128);
+  std::printf(
+    "\nStep refinement, %d^3, 128x128, atmosphere (seconds per pass)\n", quick ? 64 : 128);
   {
     const nimbus::RenderContext sky(CloudScene(128, true), grid);
     for (double s : { 1.0, 0.5, 0.25, 0.125 })
@@ -131,7 +133,8 @@ int main(int argc, char** argv)
   }
 
   std::printf("\nConverged image (RenderSingleScattering, StepScale 0.5, tolerance 1e-3), "
-              "%d^3, 256x256\n", quick ? 64 : 128);
+              "%d^3, 256x256\n",
+    quick ? 64 : 128);
   for (bool atmosphere : { false, true })
   {
     const nimbus::RenderContext context(CloudScene(256, atmosphere), grid);

@@ -36,9 +36,9 @@ int main(int argc, char* argv[])
   {
     int wavelengths, orders, r, mus, zenith, azimuth;
   };
-  const Case cases[] = { { 16, 1, 16, 32, 16, 8 }, { 8, 4, 16, 32, 16, 8 }, { 16, 4, 16, 32, 16, 8 },
-    { 32, 4, 16, 32, 16, 8 }, { 16, 2, 16, 32, 16, 8 }, { 16, 6, 16, 32, 16, 8 },
-    { 16, 4, 32, 64, 16, 8 }, { 16, 4, 16, 32, 32, 16 } };
+  const Case cases[] = { { 16, 1, 16, 32, 16, 8 }, { 8, 4, 16, 32, 16, 8 },
+    { 16, 4, 16, 32, 16, 8 }, { 32, 4, 16, 32, 16, 8 }, { 16, 2, 16, 32, 16, 8 },
+    { 16, 6, 16, 32, 16, 8 }, { 16, 4, 32, 64, 16, 8 }, { 16, 4, 16, 32, 32, 16 } };
   for (const Case& c : cases)
   {
     nimbus::SkyParameters p;
@@ -50,15 +50,18 @@ int main(int argc, char* argv[])
     p.ScatteringAzimuthDirections = c.azimuth;
     p.Threads = threads;
     std::size_t tBytes = 0, mBytes = 0;
-    const double s = Median(repeats, [&] {
-      nimbus::SkyModel model(p);
-      tBytes = model.GetTransmittanceTable().size() * sizeof(float);
-      mBytes = model.GetMultipleScatteringTable().size() * sizeof(float);
-    });
+    const double s = Median(repeats,
+      [&]
+      {
+        nimbus::SkyModel model(p);
+        tBytes = model.GetTransmittanceTable().size() * sizeof(float);
+        mBytes = model.GetMultipleScatteringTable().size() * sizeof(float);
+      });
     std::printf("%d,%d,%d,%d,%dx%d,%.3f,%zu,%zu\n", c.wavelengths, c.orders, c.r, c.mus, c.zenith,
       c.azimuth, s, tBytes, mBytes);
   }
-  std::printf("# sky-view and aerial-perspective tables (per sun elevation / altitude), 16 wavelengths\n");
+  std::printf(
+    "# sky-view and aerial-perspective tables (per sun elevation / altitude), 16 wavelengths\n");
   std::printf("table,size,seconds,bytes\n");
   for (int wl : { 8, 16, 32 })
   {
@@ -70,17 +73,21 @@ int main(int argc, char* argv[])
     for (const auto& z : sizes)
     {
       std::size_t bytes = 0;
-      const double s = Median(repeats, [&] {
-        nimbus::SkyViewLut lut(model, 10.0, 0.0, z[0], z[1], z[2]);
-        bytes = lut.GetTable().size() * sizeof(float);
-      });
+      const double s = Median(repeats,
+        [&]
+        {
+          nimbus::SkyViewLut lut(model, 10.0, 0.0, z[0], z[1], z[2]);
+          bytes = lut.GetTable().size() * sizeof(float);
+        });
       std::printf("skyview(wl=%d),%dx%d,%.4f,%zu\n", wl, z[0], z[1] + z[2], s, bytes);
     }
     std::size_t bytes = 0;
-    const double s = Median(repeats, [&] {
-      nimbus::AerialPerspectiveLut lut(model, 10.0, 500.0);
-      bytes = lut.GetTable().size() * sizeof(float);
-    });
+    const double s = Median(repeats,
+      [&]
+      {
+        nimbus::AerialPerspectiveLut lut(model, 10.0, 500.0);
+        bytes = lut.GetTable().size() * sizeof(float);
+      });
     std::printf("aerial(wl=%d),32x64x32,%.4f,%zu\n", wl, s, bytes);
   }
   return 0;

@@ -34,7 +34,8 @@ int main(int argc, char* argv[])
       return 2;
     }
   }
-  const bool same = nimbus::testing::CompareImageFiles(argv[1], argv[2], argv[3], limits, std::cout);
+  const bool same =
+    nimbus::testing::CompareImageFiles(argv[1], argv[2], argv[3], limits, std::cout);
   std::cout << (same ? "images match" : "IMAGES DIFFER") << std::endl;
   return same ? 0 : 1;
 }

@@ -86,7 +86,8 @@ bool CompareImageFiles(const std::string& testPngPath, const std::string& baseli
   const double rmse = std::sqrt(sumSquares / (3.0 * static_cast<double>(pixels)));
 
   vtkNew<vtkTesting> testing;
-  for (const std::string& argument : { std::string("-V"), baselinePng, std::string("-T"), outputDir })
+  for (const std::string& argument :
+    { std::string("-V"), baselinePng, std::string("-T"), outputDir })
   {
     testing->AddArgument(argument.c_str());
   }
@@ -94,9 +95,8 @@ bool CompareImageFiles(const std::string& testPngPath, const std::string& baseli
     testing->RegressionTest(testPng, limits.VTKThreshold, log) == vtkTesting::PASSED;
   const bool rmsePassed = rmse <= limits.MaxRMSE;
   log << "\nimage comparison of " << testPng << " with " << baselinePng << ": RMSE " << rmse
-      << " (limit " << limits.MaxRMSE << "), max |difference| " << maxDifference
-      << ", vtkTesting " << (vtkPassed ? "passed" : "FAILED") << " at threshold "
-      << limits.VTKThreshold << "\n";
+      << " (limit " << limits.MaxRMSE << "), max |difference| " << maxDifference << ", vtkTesting "
+      << (vtkPassed ? "passed" : "FAILED") << " at threshold " << limits.VTKThreshold << "\n";
   return vtkPassed && rmsePassed;
 }
 

@@ -204,8 +204,8 @@ TEST(Atmosphere, ZenithSun)
     EXPECT_NEAR(atm.TransmittanceToTop(At(0.0), { 0.0, 0.0, 5.0 }, lambda), std::exp(-tau), 1e-12);
   }
   // Sea-level vertical transmittance at 550 nm: tau = 0.1079 + 0.0267.
-  std::printf("zenith transmittance 440/550/680 nm: %.4f %.4f %.4f\n",
-    atm.Transmittance(l, 440.0), atm.Transmittance(l, 550.0), atm.Transmittance(l, 680.0));
+  std::printf("zenith transmittance 440/550/680 nm: %.4f %.4f %.4f\n", atm.Transmittance(l, 440.0),
+    atm.Transmittance(l, 550.0), atm.Transmittance(l, 680.0));
 }
 
 TEST(Atmosphere, TopOfAtmosphereStart)
@@ -304,7 +304,8 @@ TEST(Atmosphere, SegmentSymmetricAndAdditive)
   const double ab = atm.OpticalLength(a, b, 1200.0);
   EXPECT_NEAR(ab, atm.OpticalLength(b, a, 1200.0), 1e-10 * ab);
   const V mid = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
-  EXPECT_NEAR(ab, atm.OpticalLength(a, mid, 1200.0) + atm.OpticalLength(mid, b, 1200.0), 1e-10 * ab);
+  EXPECT_NEAR(
+    ab, atm.OpticalLength(a, mid, 1200.0) + atm.OpticalLength(mid, b, 1200.0), 1e-10 * ab);
   const double T = atm.TransmittanceBetween(a, b, 550.0);
   EXPECT_GT(T, 0.0);
   EXPECT_LT(T, 1.0);

@@ -469,11 +469,13 @@ TEST(CloudAutomatonDeterminism, StepToStopsWhenAskedAndRefusesToGoBack)
 {
   CloudAutomaton ca(Busy(1));
   int calls = 0;
-  EXPECT_FALSE(ca.StepTo(10, [&](double fraction) {
-    EXPECT_GE(fraction, 0.0);
-    EXPECT_LT(fraction, 1.0);
-    return ++calls < 4;
-  }));
+  EXPECT_FALSE(ca.StepTo(10,
+    [&](double fraction)
+    {
+      EXPECT_GE(fraction, 0.0);
+      EXPECT_LT(fraction, 1.0);
+      return ++calls < 4;
+    }));
   EXPECT_EQ(ca.GetStep(), 3);
   EXPECT_THROW(ca.StepTo(2), std::invalid_argument);
 }
@@ -631,7 +633,8 @@ TEST(CloudAutomatonExtremes, FlatGridsAndLongRuns)
 
 TEST(CloudAutomatonExtremes, InvalidParametersGiveClearErrors)
 {
-  auto expectError = [](const CloudAutomatonParameters& p, const std::string& word) {
+  auto expectError = [](const CloudAutomatonParameters& p, const std::string& word)
+  {
     try
     {
       CloudAutomaton ca(p);

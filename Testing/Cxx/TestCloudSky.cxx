@@ -56,7 +56,8 @@ Frame Grab(vtkRenderWindow* window)
   capture->ReadFrontBufferOff();
   capture->SetInputBufferTypeToRGB();
   capture->Update();
-  auto* values = vtkUnsignedCharArray::SafeDownCast(capture->GetOutput()->GetPointData()->GetScalars());
+  auto* values =
+    vtkUnsignedCharArray::SafeDownCast(capture->GetOutput()->GetPointData()->GetScalars());
   Frame frame;
   frame.Rgb.assign(values->GetPointer(0), values->GetPointer(0) + 3 * kWidth * kHeight);
   return frame;
@@ -137,15 +138,17 @@ int RunChecks()
     vtkVolume* volume = scene.AddCloud(0.0, 2000.0);
     const Frame empty = Grab(scene.Window);
     const int emptyDiff = MaxDifference(skyOnly, empty, [](int, int) { return true; });
-    ok &= Check(emptyDiff <= 1, "zero-density cloud leaves the sky unchanged: max diff " +
-        std::to_string(emptyDiff) + " of 255");
+    ok &= Check(emptyDiff <= 1,
+      "zero-density cloud leaves the sky unchanged: max diff " + std::to_string(emptyDiff) +
+        " of 255");
     ok &= Check(scene.Mapper->GetLastRenderUsedSceneSky(), "the mapper follows the scene sky");
     // A real cloud: the sky away from it (left quarter, above the horizon) is
     // unchanged; the sun is behind-left of the camera, so the cloud's shadow
     // and shafts fall away from the camera, to the right and down.
     scene.Mapper->SetExtinctionPerDensity(0.02);
     const Frame cloudy = Grab(scene.Window);
-    const int awayDiff = MaxDifference(skyOnly, cloudy, [](int x, int y) { return x < 60 && y > 140; });
+    const int awayDiff =
+      MaxDifference(skyOnly, cloudy, [](int x, int y) { return x < 60 && y > 140; });
     const int cloudDiff = MaxDifference(skyOnly, cloudy, [](int, int) { return true; });
     ok &= Check(awayDiff <= 1 && cloudDiff > 60,
       "the sky away from the cloud is unchanged (max diff " + std::to_string(awayDiff) +
@@ -153,7 +156,8 @@ int RunChecks()
     // The sun is shared: lower it on the sky and the cloud reddens.
     // Colour of the light the cloud adds to its sky: R/B of the summed positive
     // differences from the sky-only image (the sunlit parts of the cloud).
-    auto cloudRedness = [&](vtkVolume* volume) {
+    auto cloudRedness = [&](vtkVolume* volume)
+    {
       volume->VisibilityOff();
       const Frame sky = Grab(scene.Window);
       volume->VisibilityOn();
@@ -181,28 +185,31 @@ int RunChecks()
     {
       scene.Sky->GetSky()->SetSunElevation(elevation);
       Grab(scene.Window);
-      vtkDataArray* radiance = scene.Mapper->GetRadianceImage()->GetPointData()->GetArray("radiance");
+      vtkDataArray* radiance =
+        scene.Mapper->GetRadianceImage()->GetPointData()->GetArray("radiance");
       bool finite = radiance && radiance->GetNumberOfTuples() == kWidth * kHeight;
       for (vtkIdType i = 0; finite && i < radiance->GetNumberOfValues(); ++i)
       {
         const double v = radiance->GetVariantValue(i).ToDouble();
         finite = std::isfinite(v) && v >= 0.0;
       }
-      ok &= Check(finite, "sun at " + std::to_string(elevation) + " deg: finite, non-negative radiance");
+      ok &= Check(
+        finite, "sun at " + std::to_string(elevation) + " deg: finite, non-negative radiance");
     }
     scene.Mapper->CaptureRadianceOff();
     scene.Mapper->UseSceneSkyOff();
     scene.Mapper->SetSunElevation(60.0);
     Grab(scene.Window);
-    ok &= Check(!scene.Mapper->GetLastRenderUsedSceneSky() &&
-        scene.Mapper->GetLastSunElevation() == 60.0,
+    ok &= Check(
+      !scene.Mapper->GetLastRenderUsedSceneSky() && scene.Mapper->GetLastSunElevation() == 60.0,
       "with UseSceneSky off the mapper keeps its own sun");
   }
   {
     // Aerial perspective: one cloud 4 km and 28 km away, the camera's view angle
     // scaled so that it covers the same part of the image. Contrast = mean
     // channel difference from the sky-only image over the frame.
-    auto contrast = [](double distance) {
+    auto contrast = [](double distance)
+    {
       Scene scene;
       vtkCamera* camera = scene.Renderer->GetActiveCamera();
       camera->SetPosition(0.0, -distance, 1800.0);

@@ -12,6 +12,7 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
+#include "vtkCellData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
@@ -25,7 +26,6 @@
 #include "vtkSphereSource.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkUnsignedShortArray.h"
-#include "vtkCellData.h"
 #include "vtkVolume.h"
 #include "vtkWindowToImageFilter.h"
 
@@ -105,8 +105,10 @@ struct Scene
       writer->SetFileName(pngPath.c_str());
       writer->Write();
     }
-    auto* bytes = vtkUnsignedCharArray::SafeDownCast(capture->GetOutput()->GetPointData()->GetScalars());
-    return std::vector<unsigned char>(bytes->GetPointer(0), bytes->GetPointer(0) + bytes->GetNumberOfValues());
+    auto* bytes =
+      vtkUnsignedCharArray::SafeDownCast(capture->GetOutput()->GetPointData()->GetScalars());
+    return std::vector<unsigned char>(
+      bytes->GetPointer(0), bytes->GetPointer(0) + bytes->GetNumberOfValues());
   }
 };
 
@@ -285,7 +287,8 @@ bool SunAlongAndAgainstView(const Context&)
     // Camera on the sun's line through the cloud centre, elevation 20 deg.
     const double e = 20.0 * M_PI / 180.0, d = 7000.0;
     const std::vector<double> focal = { 0, 0, 1600 };
-    const std::vector<double> position = { 0, -sign * d * std::cos(e), 1600 - sign * d * std::sin(e) };
+    const std::vector<double> position = { 0, -sign * d * std::cos(e),
+      1600 - sign * d * std::sin(e) };
     s.LookFrom(position, focal, 35);
     s.Mapper->SetSunAzimuth(0);
     s.Mapper->SetSunElevation(sign > 0 ? 20 : -20);
@@ -298,10 +301,12 @@ bool SunAlongAndAgainstView(const Context&)
     s.Mapper->SetSunElevation(s.Mapper->GetSunElevation() + 0.5);
     const auto near = s.Render();
     const double rmse = Rmse(exact, near);
-    ok &= Check(Mean(exact) > 1.0, std::string(sign > 0 ? "facing" : "back to") +
-        " the sun: the cloud is visible (mean " + std::to_string(Mean(exact)) + ")");
-    ok &= Check(rmse < 3.0, "sun exactly on the view axis vs 0.5 deg off: RMSE " +
-        std::to_string(rmse) + " < 3 (of 255)");
+    ok &= Check(Mean(exact) > 1.0,
+      std::string(sign > 0 ? "facing" : "back to") + " the sun: the cloud is visible (mean " +
+        std::to_string(Mean(exact)) + ")");
+    ok &= Check(rmse < 3.0,
+      "sun exactly on the view axis vs 0.5 deg off: RMSE " + std::to_string(rmse) +
+        " < 3 (of 255)");
   }
   return ok;
 }
@@ -324,10 +329,11 @@ bool SunAtAndBelowHorizon(const Context&)
   {
     groundMax = std::max(groundMax, static_cast<double>(below[i]));
   }
-  bool ok = Check(groundMax <= 1.0, "sun 5 deg below the horizon: the ground is black (max " +
-      std::to_string(groundMax) + ")");
-  ok &= Check(Mean(below) < 0.1 * Mean(above), "sun 5 deg below: twilight sky, mean " +
-      std::to_string(Mean(below)) + " < 10 % of the image at 10 deg (" + std::to_string(Mean(above)) + ")");
+  bool ok = Check(groundMax <= 1.0,
+    "sun 5 deg below the horizon: the ground is black (max " + std::to_string(groundMax) + ")");
+  ok &= Check(Mean(below) < 0.1 * Mean(above),
+    "sun 5 deg below: twilight sky, mean " + std::to_string(Mean(below)) +
+      " < 10 % of the image at 10 deg (" + std::to_string(Mean(above)) + ")");
   ok &= Check(Mean(horizon) <= Mean(above), "sun at the horizon no brighter than at 10 deg");
   ok &= Check(Mean(above) > 5.0, "sun at 10 deg lights the scene");
   return ok;
@@ -377,7 +383,8 @@ bool HugeOpticalThickness(const Context&)
   s.Mapper->SetExtinctionPerDensity(0.02 * 1e3 / 50.0);
   const auto thinner = s.Render();
   const double rmse = Rmse(thick, thinner);
-  return Check(Mean(thick) > 5.0, "tau 1e4: image not black (mean " + std::to_string(Mean(thick)) + ")") &&
+  return Check(Mean(thick) > 5.0,
+           "tau 1e4: image not black (mean " + std::to_string(Mean(thick)) + ")") &&
     Check(rmse < 6.0, "tau 1e4 vs 1e3 (both opaque): RMSE " + std::to_string(rmse) + " < 6");
 }
 
@@ -392,8 +399,8 @@ bool CameraInsideVolume(const Context&)
   const auto inside = s.Render();
   s.Mapper->SetExtinctionPerDensity(0.0);
   const auto clear = s.Render();
-  return Check(Mean(inside) > 1.0 && Mean(inside) < 254.0, "inside the cloud: a grey fog, mean " +
-      std::to_string(Mean(inside))) &&
+  return Check(Mean(inside) > 1.0 && Mean(inside) < 254.0,
+           "inside the cloud: a grey fog, mean " + std::to_string(Mean(inside))) &&
     Check(Rmse(inside, clear) > 5.0, "the cloud around the camera changes the image");
 }
 
@@ -408,12 +415,13 @@ bool LightingChangeKeepsVolume(const Context&)
   const int atmospheres = s.Mapper->GetNumberOfAtmosphereBuilds();
   const int phases = s.Mapper->GetNumberOfIntervalPhaseBuilds();
   s.Render(); // nothing changed
-  bool ok = Check(uploads == 1, "lighting changes do not re-upload the volume (uploads " +
-      std::to_string(uploads) + ")");
-  ok &= Check(atmospheres == 2, "sun change rebuilt the atmosphere table once (builds " +
-      std::to_string(atmospheres) + ")");
+  bool ok = Check(uploads == 1,
+    "lighting changes do not re-upload the volume (uploads " + std::to_string(uploads) + ")");
+  ok &= Check(atmospheres == 2,
+    "sun change rebuilt the atmosphere table once (builds " + std::to_string(atmospheres) + ")");
   ok &= Check(s.Mapper->GetNumberOfAtmosphereBuilds() == atmospheres &&
-      s.Mapper->GetNumberOfIntervalPhaseBuilds() == phases, "an unchanged frame rebuilds nothing");
+      s.Mapper->GetNumberOfIntervalPhaseBuilds() == phases,
+    "an unchanged frame rebuilds nothing");
   s.Mapper->SetAtmosphere(false);
   s.Mapper->SetGround(false);
   s.Render();
@@ -464,7 +472,8 @@ bool DataLayouts(const Context&)
   quantised->SetNumberOfTuples(source->GetNumberOfTuples());
   for (vtkIdType i = 0; i < source->GetNumberOfTuples(); ++i)
   {
-    quantised->SetValue(i, static_cast<unsigned short>(std::lround(1000.0 * source->GetComponent(i, 0))));
+    quantised->SetValue(
+      i, static_cast<unsigned short>(std::lround(1000.0 * source->GetComponent(i, 0))));
   }
   shorts->GetPointData()->SetScalars(quantised);
   Scene typed(shorts);
@@ -479,7 +488,8 @@ bool DataLayouts(const Context&)
   cloud->GetOrigin(origin);
   cells->SetDimensions(dims[0] + 1, dims[1] + 1, dims[2] + 1);
   cells->SetSpacing(spacing);
-  cells->SetOrigin(origin[0] - 0.5 * spacing[0], origin[1] - 0.5 * spacing[1], origin[2] - 0.5 * spacing[2]);
+  cells->SetOrigin(
+    origin[0] - 0.5 * spacing[0], origin[1] - 0.5 * spacing[1], origin[2] - 0.5 * spacing[2]);
   vtkNew<vtkFloatArray> cellValues;
   cellValues->DeepCopy(source);
   cellValues->SetName("density");
@@ -489,8 +499,10 @@ bool DataLayouts(const Context&)
   // The cell box is half a voxel larger on every side, where the point data's
   // box clips the cloud; the cloud's rim has density ~0 there.
   // Measured 0.026 (quantisation to 1/1000) and 0.054 (the rim).
-  return Check(typedRmse < 0.1, "unsigned short x1000 vs float: RMSE " + std::to_string(typedRmse) + " < 0.1") &&
-    Check(cellRmse < 0.1, "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < 0.1");
+  return Check(typedRmse < 0.1,
+           "unsigned short x1000 vs float: RMSE " + std::to_string(typedRmse) + " < 0.1") &&
+    Check(cellRmse < 0.1,
+      "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < 0.1");
 }
 
 // Two viewports side by side each show what a window of their size shows, and a
@@ -524,8 +536,9 @@ bool ViewportsAndParallelProjection(const Context&)
     right.insert(right.end(), row + kWidth * 3, row + 2 * kWidth * 3);
   }
   const double leftRmse = Rmse(left, alone), rightRmse = Rmse(right, alone);
-  bool ok = Check(leftRmse == 0.0 && rightRmse == 0.0, "each of two viewports equals a single window: RMSE " +
-      std::to_string(leftRmse) + ", " + std::to_string(rightRmse));
+  bool ok = Check(leftRmse == 0.0 && rightRmse == 0.0,
+    "each of two viewports equals a single window: RMSE " + std::to_string(leftRmse) + ", " +
+      std::to_string(rightRmse));
 
   Scene parallel(cloud);
   vtkCamera* camera = parallel.Renderer->GetActiveCamera();
@@ -549,8 +562,9 @@ bool Downsampling(const Context&)
   return Check(dims[0] == 16 && dims[1] == 16 && dims[2] == 16,
            "48x48x32 with a 16-texel limit -> " + std::to_string(dims[0]) + "x" +
              std::to_string(dims[1]) + "x" + std::to_string(dims[2])) &&
-    Check(Rmse(small, reference) < 20.0, "downsampled render resembles the full one (RMSE " +
-        std::to_string(Rmse(small, reference)) + ")");
+    Check(Rmse(small, reference) < 20.0,
+      "downsampled render resembles the full one (RMSE " + std::to_string(Rmse(small, reference)) +
+        ")");
 }
 }
 
@@ -563,11 +577,10 @@ int main(int argc, char* argv[])
     { "SunAlongAndAgainstView", SunAlongAndAgainstView },
     { "SunAtAndBelowHorizon", SunAtAndBelowHorizon },
     { "SliceRatioOneAndTwo", SliceRatioOneAndTwo }, { "OneVoxelAndEmpty", OneVoxelAndEmpty },
-    { "HugeOpticalThickness", HugeOpticalThickness },
-    { "CameraInsideVolume", CameraInsideVolume },
-    { "LightingChangeKeepsVolume", LightingChangeKeepsVolume },
-    { "Downsampling", Downsampling }, { "ReallocatedTargets", ReallocatedTargets },
-    { "DataLayouts", DataLayouts }, { "ViewportsAndParallelProjection", ViewportsAndParallelProjection } };
+    { "HugeOpticalThickness", HugeOpticalThickness }, { "CameraInsideVolume", CameraInsideVolume },
+    { "LightingChangeKeepsVolume", LightingChangeKeepsVolume }, { "Downsampling", Downsampling },
+    { "ReallocatedTargets", ReallocatedTargets }, { "DataLayouts", DataLayouts },
+    { "ViewportsAndParallelProjection", ViewportsAndParallelProjection } };
   if (argc != 4 || !cases.count(argv[1]))
   {
     std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";

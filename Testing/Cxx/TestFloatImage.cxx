@@ -43,7 +43,7 @@ TEST(FloatImage, ToneMapClipsAndEncodes)
   image.Pixels = { -1.0f, 0.0f, 0.5f, 1.0f, 2.0f, 1e30f, 0.0f, 0.0f, 0.0f };
   const auto bytes = nimbus::ToneMap(image, 1.0);
   ASSERT_EQ(bytes.size(), 9u);
-  EXPECT_EQ(bytes[0], 0);   // negative -> 0
+  EXPECT_EQ(bytes[0], 0); // negative -> 0
   EXPECT_EQ(bytes[1], 0);
   EXPECT_EQ(bytes[2], 188); // sRGB(0.5) = 0.7354 -> 188
   EXPECT_EQ(bytes[3], 255);

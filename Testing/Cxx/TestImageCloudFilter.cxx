@@ -28,10 +28,12 @@ public:
   explicit ErrorCatcher(vtkObject* object)
   {
     this->Callback->SetClientData(this);
-    this->Callback->SetCallback([](vtkObject*, unsigned long, void* self, void* text) {
-      static_cast<ErrorCatcher*>(self)->Errors.emplace_back(
-        text ? static_cast<const char*>(text) : "");
-    });
+    this->Callback->SetCallback(
+      [](vtkObject*, unsigned long, void* self, void* text)
+      {
+        static_cast<ErrorCatcher*>(self)->Errors.emplace_back(
+          text ? static_cast<const char*>(text) : "");
+      });
     object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
   }
   std::vector<std::string> Errors;

@@ -14,10 +14,10 @@
 #include "vtkImageData.h"
 #include "vtkLight.h"
 #include "vtkNew.h"
+#include "vtkPNGWriter.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
-#include "vtkPNGWriter.h"
 #include "vtkWindowToImageFilter.h"
 
 #include "ImageComparison.h"

@@ -6,8 +6,8 @@
 
 #include "vtkCallbackCommand.h"
 #include "vtkCommand.h"
-#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkImageData.h"
 #include "vtkMassProperties.h"
 #include "vtkNew.h"
@@ -20,8 +20,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <iostream>
 #include <cstring>
+#include <iostream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -389,26 +389,27 @@ const double Inf = std::numeric_limits<double>::infinity();
 
 INSTANTIATE_TEST_SUITE_P(Cases, MetaballCloudSourceBadParameters,
   ::testing::Values(
-    BadParameterCase{ "zero dimension", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetDimensions(0, 10, 10); }, "Dimensions" },
-    BadParameterCase{ "negative dimension", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetDimensions(10, -3, 10); }, "Dimensions" },
-    BadParameterCase{ "zero balls", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetNumberOfBaseBalls(0); }, "No balls" },
-    BadParameterCase{ "NaN bounds", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetBounds(0, NaN, 0, 1, 0, 1); }, "Bounds" },
-    BadParameterCase{ "empty bounds", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetBounds(0, 1, 5, 5, 0, 1); }, "Bounds" },
-    BadParameterCase{ "NaN iso-value", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetIsoValue(NaN); }, "NaN" },
-    BadParameterCase{ "infinite density", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetBallDensity(Inf); }, "NaN or infinite" },
-    BadParameterCase{ "non-positive radius", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetBaseBallRadiusRange(0.0, 100.0); }, "BaseBallRadiusRange" },
-    BadParameterCase{ "NaN user ball", [](vtkNimbusMetaballCloudSource* s)
-      { s->AddBall(0, 0, NaN, 100, 1); }, "AddBall" },
-    BadParameterCase{ "negative levels", [](vtkNimbusMetaballCloudSource* s)
-      { s->SetNumberOfLevels(-1); }, "NumberOfLevels" }),
+    BadParameterCase{ "zero dimension",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetDimensions(0, 10, 10); }, "Dimensions" },
+    BadParameterCase{ "negative dimension",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetDimensions(10, -3, 10); }, "Dimensions" },
+    BadParameterCase{ "zero balls",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetNumberOfBaseBalls(0); }, "No balls" },
+    BadParameterCase{ "NaN bounds",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetBounds(0, NaN, 0, 1, 0, 1); }, "Bounds" },
+    BadParameterCase{ "empty bounds",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetBounds(0, 1, 5, 5, 0, 1); }, "Bounds" },
+    BadParameterCase{
+      "NaN iso-value", [](vtkNimbusMetaballCloudSource* s) { s->SetIsoValue(NaN); }, "NaN" },
+    BadParameterCase{ "infinite density",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetBallDensity(Inf); }, "NaN or infinite" },
+    BadParameterCase{ "non-positive radius",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetBaseBallRadiusRange(0.0, 100.0); },
+      "BaseBallRadiusRange" },
+    BadParameterCase{ "NaN user ball",
+      [](vtkNimbusMetaballCloudSource* s) { s->AddBall(0, 0, NaN, 100, 1); }, "AddBall" },
+    BadParameterCase{ "negative levels",
+      [](vtkNimbusMetaballCloudSource* s) { s->SetNumberOfLevels(-1); }, "NumberOfLevels" }),
   [](const ::testing::TestParamInfo<BadParameterCase>& info)
   {
     std::string name = info.param.Name;

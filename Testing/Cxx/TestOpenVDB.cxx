@@ -95,10 +95,8 @@ std::string TempPath(const std::string& name)
 
 // An image with `n` points per axis over `extent`, a float array "density" = f(i,j,k) and
 // a 3-component float array "velocity".
-vtkSmartPointer<vtkImageData> MakeImage(const int extent[6],
-  const double origin[3],
-  const double spacing[3],
-  bool sparse)
+vtkSmartPointer<vtkImageData> MakeImage(
+  const int extent[6], const double origin[3], const double spacing[3], bool sparse)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetExtent(const_cast<int*>(extent));
@@ -125,9 +123,8 @@ vtkSmartPointer<vtkImageData> MakeImage(const int extent[6],
           d = 0.0f;
         }
         density->SetValue(id, d);
-        const float v[3] = {
-          1.0f + 0.1f * i, -2.0f + 0.01f * j * k, 0.5f * std::cos(float(i + k))
-        };
+        const float v[3] = { 1.0f + 0.1f * i, -2.0f + 0.01f * j * k,
+          0.5f * std::cos(float(i + k)) };
         velocity->SetTypedTuple(id, v);
       }
     }
@@ -137,9 +134,7 @@ vtkSmartPointer<vtkImageData> MakeImage(const int extent[6],
   return image;
 }
 
-bool Write(vtkImageData* image,
-  const std::string& path,
-  double tolerance = 0.0,
+bool Write(vtkImageData* image, const std::string& path, double tolerance = 0.0,
   MessageCatcher** catcherOut = nullptr)
 {
   vtkNew<vtkNimbusOpenVDBWriter> writer;
@@ -179,11 +174,8 @@ void WriteGrids(const std::string& path, const openvdb::GridPtrVec& grids, bool 
   file.close();
 }
 
-openvdb::FloatGrid::Ptr FloatBlock(const std::string& name,
-  openvdb::Coord lo,
-  openvdb::Coord hi,
-  double voxelSize,
-  float value)
+openvdb::FloatGrid::Ptr FloatBlock(
+  const std::string& name, openvdb::Coord lo, openvdb::Coord hi, double voxelSize, float value)
 {
   openvdb::initialize();
   auto grid = openvdb::FloatGrid::create(0.0f);
@@ -197,10 +189,8 @@ openvdb::FloatGrid::Ptr FloatBlock(const std::string& name,
   return grid;
 }
 
-std::string ReadErrors(const std::string& path,
-  vtkIdType limit = 0,
-  int* ok = nullptr,
-  std::string* warnings = nullptr)
+std::string ReadErrors(
+  const std::string& path, vtkIdType limit = 0, int* ok = nullptr, std::string* warnings = nullptr)
 {
   vtkNew<vtkNimbusOpenVDBReader> reader;
   reader->SetFileName(path.c_str());

@@ -327,11 +327,13 @@ TEST(PathTracer, BeerLambertHeterogeneous)
         for (int k = 0; k < steps; ++k)
         {
           const double t = t0 + (k + 0.5) * dt;
-          depth += context.CloudExtinction({ { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] } }) * dt;
+          depth +=
+            context.CloudExtinction({ { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] } }) * dt;
         }
       }
       for (int c = 0; c < 3; ++c)
-        cmp.Add(c, r.Image.At(i, j)[c], r.StandardError.At(i, j)[c], lb[c] * std::exp(-depth), 4.0, 1e-6);
+        cmp.Add(
+          c, r.Image.At(i, j)[c], r.StandardError.At(i, j)[c], lb[c] * std::exp(-depth), 4.0, 1e-6);
     }
   std::printf("Beer-Lambert heterogeneous: bias %.2e +- %.2e relative, z spread %.3f\n",
     cmp.RelativeBias(), cmp.RelativeBiasError(), cmp.ZSpread());
@@ -463,7 +465,8 @@ TEST(PathTracer, SingleScatteringSlabClosedForm)
 // (camera above looking down); the order flips for g < 0. Full multiple scattering.
 TEST(PathTracer, ForwardScatteringBrighterForPositiveG)
 {
-  auto centre = [](bool fromAbove, double g) {
+  auto centre = [](bool fromAbove, double g)
+  {
     SceneDescription scene = SunSlabScene(1, fromAbove, g, 80.0);
     scene.Camera.Position = fromAbove ? V{ { 0.0, 0.0, 600.0 } } : V{ { 0.0, 0.0, -500.0 } };
     scene.Camera.FocalPoint = { { 0.0, 0.0, 50.0 } };
@@ -516,7 +519,8 @@ TEST(PathTracer, Deterministic)
   settings.Seed = 43;
   const PathTracingResult d = nimbus::RenderPathTraced(context, settings);
   ASSERT_TRUE(AllFiniteNonNegative(a));
-  auto same = [](const nimbus::FloatImage& x, const nimbus::FloatImage& y) {
+  auto same = [](const nimbus::FloatImage& x, const nimbus::FloatImage& y)
+  {
     return x.Pixels.size() == y.Pixels.size() &&
       std::memcmp(x.Pixels.data(), y.Pixels.data(), x.Pixels.size() * sizeof(float)) == 0;
   };
@@ -546,7 +550,8 @@ TEST(PathTracer, StabilityCases)
     SceneDescription scene;
     DensityGrid grid;
   };
-  auto base = []() {
+  auto base = []()
+  {
     SceneDescription scene = EmptyScene(4, 4);
     scene.Atmosphere.Enabled = true;
     scene.Ground.Enabled = true;
@@ -558,8 +563,10 @@ TEST(PathTracer, StabilityCases)
     scene.Medium.ExtinctionPerDensity = 0.02;
     return scene;
   };
-  auto box = [](float density) {
-    return DensityGrid::Constant({ { -500.0, -500.0, 500.0 } }, { { 500.0, 500.0, 1500.0 } }, density);
+  auto box = [](float density)
+  {
+    return DensityGrid::Constant(
+      { { -500.0, -500.0, 500.0 } }, { { 500.0, 500.0, 1500.0 } }, density);
   };
   std::vector<Case> cases;
   cases.push_back({ "density 0 everywhere", base(), box(0.0f) });
@@ -585,8 +592,9 @@ TEST(PathTracer, StabilityCases)
   {
     SceneDescription s = base();
     s.Sun.Elevation = elevation;
-    cases.push_back({ elevation == 90.0 ? "sun at zenith" : elevation == 0.0 ? "sun on horizon"
-                                                                              : "sun 5 deg below",
+    cases.push_back({ elevation == 90.0 ? "sun at zenith"
+        : elevation == 0.0              ? "sun on horizon"
+                                        : "sun 5 deg below",
       s, PuffGrid(9, { { -500.0, -500.0, 500.0 } }, 1000.0, 5) });
   }
   {
@@ -600,8 +608,9 @@ TEST(PathTracer, StabilityCases)
     SceneDescription s = base();
     s.Camera.FocalPoint = { { 0.0, 0.0, 1000.0 } };
     s.Camera.ViewAngle = 5.0;
-    cases.push_back({ "one-voxel grid",
-      s, DensityGrid({ { 1, 1, 1 } }, { { 0.0, 0.0, 1000.0 } }, { { 200.0, 200.0, 200.0 } }, { 2.0f }) });
+    cases.push_back({ "one-voxel grid", s,
+      DensityGrid(
+        { { 1, 1, 1 } }, { { 0.0, 0.0, 1000.0 } }, { { 200.0, 200.0, 200.0 } }, { 2.0f }) });
   }
   {
     SceneDescription s = base();

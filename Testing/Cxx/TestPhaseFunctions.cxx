@@ -5,13 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <limits>
 #include <memory>
-#include <array>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -109,7 +109,7 @@ double GammaQ(double a, double x)
   return std::exp(-x + a * std::log(x) - gln) * h;
 }
 
-constexpr int kBins = 32;                 // chi-square degrees of freedom = 31
+constexpr int kBins = 32;                     // chi-square degrees of freedom = 31
 constexpr double kChiSquareCritical = 61.098; // chi^2_{31} at p = 0.001
 constexpr int kSamples = 200000;
 
@@ -167,8 +167,8 @@ ChiSquareResult ChiSquare(const Pdf& p, double g, const std::function<double()>&
   {
     const double mu = sample();
     EXPECT_TRUE(mu >= -1.0 && mu <= 1.0) << mu;
-    const int j = static_cast<int>(std::upper_bound(edges.begin() + 1, edges.end() - 1, mu) -
-      (edges.begin() + 1));
+    const int j = static_cast<int>(
+      std::upper_bound(edges.begin() + 1, edges.end() - 1, mu) - (edges.begin() + 1));
     observed[j] += 1.0;
     sum += mu;
     sum2 += mu * mu;
@@ -264,7 +264,8 @@ TEST(PhaseFunctions, SamplersMatchPdf)
       [g](std::mt19937_64& r) { return nimbus::SampleHenyeyGreenstein(g, Uniform01(r)); },
       nimbus::HenyeyGreensteinMeanCosine(g) });
     cases.push_back({ "CS", g, [g](double mu) { return nimbus::CornetteShanks(mu, g); },
-      [g](std::mt19937_64& r) { return nimbus::SampleCornetteShanks(g, [&r] { return Uniform01(r); }); },
+      [g](std::mt19937_64& r)
+      { return nimbus::SampleCornetteShanks(g, [&r] { return Uniform01(r); }); },
       nimbus::CornetteShanksMeanCosine(g) });
   }
   cases.push_back({ "Rayleigh", 0.0, [](double mu) { return nimbus::Rayleigh(mu); },
@@ -299,10 +300,12 @@ TEST(PhaseFunctions, CornetteShanksRejectionCost)
     const int n = 100000;
     for (int i = 0; i < n; ++i)
     {
-      nimbus::SampleCornetteShanks(g, [&] {
-        ++draws;
-        return Uniform01(rng);
-      });
+      nimbus::SampleCornetteShanks(g,
+        [&]
+        {
+          ++draws;
+          return Uniform01(rng);
+        });
     }
     const double perSample = static_cast<double>(draws) / n;
     EXPECT_NEAR(perSample, 6.0 / (2.0 + g * g), 0.02) << g; // documented expectation
@@ -331,7 +334,8 @@ TEST(PhaseFunctions, FiniteAtExtremes)
     }
     EXPECT_DOUBLE_EQ(nimbus::SampleHenyeyGreenstein(g, 0.0), -1.0);
     // Near u = 1, 1 - mu ~ (1 - u) / (2 pi p(1)): tiny for g > 0, ~1e-9 for g -> -1.
-    const double slack = 2.0 * (1.0 - uMax) / (2.0 * kPi * nimbus::HenyeyGreenstein(1.0, g)) + 1e-15;
+    const double slack =
+      2.0 * (1.0 - uMax) / (2.0 * kPi * nimbus::HenyeyGreenstein(1.0, g)) + 1e-15;
     EXPECT_NEAR(nimbus::SampleHenyeyGreenstein(g, uMax), 1.0, slack) << g;
     // CS proposals with u = 0 and u -> 1 (acceptance uniform 0, so accepted).
     EXPECT_DOUBLE_EQ(nimbus::SampleCornetteShanks(g, [] { return 0.0; }), -1.0);
@@ -356,8 +360,8 @@ TEST(PhaseFunctions, InvalidArguments)
   EXPECT_THROW(nimbus::HenyeyGreenstein(0.0, nan), std::invalid_argument);
   EXPECT_THROW(nimbus::CornetteShanks(0.0, nan), std::invalid_argument);
   EXPECT_THROW(nimbus::SampleHenyeyGreenstein(nan, 0.5), std::invalid_argument);
-  EXPECT_THROW(nimbus::SampleHenyeyGreensteinDirection({ 0, 0, 0 }, 0.5, 0.5, 0.5),
-    std::invalid_argument);
+  EXPECT_THROW(
+    nimbus::SampleHenyeyGreensteinDirection({ 0, 0, 0 }, 0.5, 0.5, 0.5), std::invalid_argument);
   nimbus::PhaseFunctionMixture m;
   EXPECT_THROW(m.AddComponent(-1.0, PhaseFunctionKind::Rayleigh), std::invalid_argument);
   EXPECT_THROW(m.AddComponent(1.0, PhaseFunctionKind::CornetteShanks, nan), std::invalid_argument);
@@ -388,8 +392,8 @@ TEST(PhaseFunctions, MixtureWeightsNormalised)
 TEST(PhaseFunctions, DirectionHasRequestedCosine)
 {
   std::mt19937_64 rng(3);
-  const std::array<std::array<double, 3>, 4> incidents = { { { 0, 0, 1 }, { 0, 0, -1 },
-    { 1, 2, 3 }, { -0.3, 0.1, -5 } } };
+  const std::array<std::array<double, 3>, 4> incidents = { { { 0, 0, 1 }, { 0, 0, -1 }, { 1, 2, 3 },
+    { -0.3, 0.1, -5 } } };
   for (const auto& w : incidents)
   {
     const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);

@@ -29,9 +29,10 @@ nimbus::DensityGrid LumpyCloud()
       {
         const double x = origin[0] + i * spacing[0], y = origin[1] + j * spacing[1],
                      z = origin[2] + k * spacing[2];
-        const double a = std::exp(-((x + 250) * (x + 250) + y * y + (z - 1600) * (z - 1600)) / 2.0e5);
-        const double b = std::exp(-((x - 300) * (x - 300) + (y - 200) * (y - 200) +
-                                     (z - 1700) * (z - 1700)) / 1.2e5);
+        const double a =
+          std::exp(-((x + 250) * (x + 250) + y * y + (z - 1600) * (z - 1600)) / 2.0e5);
+        const double b = std::exp(
+          -((x - 300) * (x - 300) + (y - 200) * (y - 200) + (z - 1700) * (z - 1700)) / 1.2e5);
         values.push_back(static_cast<float>(a + 0.8 * b));
       }
   return nimbus::DensityGrid(dims, origin, spacing, std::move(values));
@@ -64,7 +65,8 @@ void ExpectAgreement(bool atmosphere)
   const nimbus::RenderContext context(SmallScene(atmosphere), LumpyCloud());
   nimbus::SingleScatteringSettings deterministic;
   deterministic.RelativeTolerance = 1e-4;
-  const nimbus::SingleScatteringResult single = nimbus::RenderSingleScattering(context, deterministic);
+  const nimbus::SingleScatteringResult single =
+    nimbus::RenderSingleScattering(context, deterministic);
 
   nimbus::PathTracingSettings monteCarlo;
   monteCarlo.MaxScatteringOrder = 1;

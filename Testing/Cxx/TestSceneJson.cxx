@@ -181,8 +181,8 @@ Json Without(const std::string& pointer)
 
 fs::path MakeTemporaryDirectory(const std::string& name)
 {
-  const fs::path dir = fs::temp_directory_path() /
-    (name + "-" + std::to_string(std::random_device{}()));
+  const fs::path dir =
+    fs::temp_directory_path() / (name + "-" + std::to_string(std::random_device{}()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -215,7 +215,8 @@ TEST(SceneJson, ProjectScenesParse)
     {
       if (p.first == "Dimensions")
       {
-        EXPECT_LE(p.second[0] * p.second[1] * p.second[2], 1.0e6) << "grid too large to render fast";
+        EXPECT_LE(p.second[0] * p.second[1] * p.second[2], 1.0e6)
+          << "grid too large to render fast";
       }
     }
     ExpectSameScene(nimbus::ParseScene(nimbus::SceneToJson(scene), ""), scene);
@@ -293,7 +294,8 @@ TEST(SceneJson, CanonicalForm)
   EXPECT_NE(text.find("\"width\": 256"), std::string::npos);
   EXPECT_EQ(text.back(), '\n');
   // Parameters are stored in the source's property order, whatever the text's order.
-  Json j = With("/medium/density/parameters", Json::parse(R"({"Seed": 4, "Dimensions": [8, 8, 8]})"));
+  Json j =
+    With("/medium/density/parameters", Json::parse(R"({"Seed": 4, "Dimensions": [8, 8, 8]})"));
   const SceneDescription s = Parse(j);
   ASSERT_EQ(s.Medium.Density.Parameters.size(), 2u);
   EXPECT_EQ(s.Medium.Density.Parameters[0].first, "Dimensions");
@@ -339,7 +341,9 @@ TEST(SceneJson, HashSensitiveToEveryField)
     { "Density.Path", [](SceneDescription& s) { s.Medium.Density.Path += "x"; } },
     { "Density.ArrayName", [](SceneDescription& s) { s.Medium.Density.ArrayName += "x"; } },
     { "Density.Parameters",
-      [](SceneDescription& s) { s.Medium.Density.Parameters.push_back({ "Seed", { 2 } }); } },
+      [](SceneDescription& s) {
+        s.Medium.Density.Parameters.push_back({ "Seed", { 2 } });
+      } },
     { "ExtinctionPerDensity", [](SceneDescription& s) { s.Medium.ExtinctionPerDensity *= 1.01; } },
     { "SingleScatteringAlbedo",
       [](SceneDescription& s) { s.Medium.SingleScatteringAlbedo -= 0.001; } },
@@ -407,7 +411,8 @@ TEST(SceneJson, Errors)
   ExpectErrorText(R"({"nimbus_scene": 1, "sun": {"elevation": 1, "elevation": 2}})",
     "scene.sun.elevation: duplicate key");
   ExpectError(With("/name", 3), "scene.name: expected a string, got 3");
-  ExpectError(With("/spectral_samples", 2), "scene.spectral_samples: expected an integer in [3, 256], got 2");
+  ExpectError(
+    With("/spectral_samples", 2), "scene.spectral_samples: expected an integer in [3, 256], got 2");
   ExpectError(With("/spectral_samples", 16.5), "scene.spectral_samples: expected an integer");
   // Huge numbers (JSON cannot hold NaN or Inf; 1e999 overflows).
   {
@@ -426,13 +431,15 @@ TEST(SceneJson, Errors)
   ExpectError(Without("/sun/azimuth"), "scene.sun: missing required key \"azimuth\"");
   ExpectError(Without("/camera/position"), "scene.camera: missing required key \"position\"");
   ExpectError(Without("/medium/density"), "scene.medium: missing required key \"density\"");
-  ExpectError(Without("/medium/density/type"), "scene.medium.density: missing required key \"type\"");
+  ExpectError(
+    Without("/medium/density/type"), "scene.medium.density: missing required key \"type\"");
   ExpectError(Without("/medium/extinction_per_density"),
     "scene.medium: missing required key \"extinction_per_density\"");
 
   // Camera.
   ExpectError(With("/camera/posiiton", Json::array({ 0, 0, 0 })),
-    "scene.camera.posiiton: unknown key (known: position, focal_point, view_up, view_angle, width, height)");
+    "scene.camera.posiiton: unknown key (known: position, focal_point, view_up, view_angle, width, "
+    "height)");
   ExpectError(With("/camera", 5), "scene.camera: expected an object, got 5");
   ExpectError(With("/camera/position", Json::array({ 0, 0 })),
     "scene.camera.position: expected an array of 3 numbers, got 2 elements");
@@ -442,10 +449,14 @@ TEST(SceneJson, Errors)
     "scene.camera.focal_point: must differ from camera.position");
   ExpectError(With("/camera/view_up", Json::array({ 0, 6000, 100 })), "scene.camera.view_up:");
   ExpectError(With("/camera/view_up", Json::array({ 0, 0, 0 })), "scene.camera.view_up:");
-  ExpectError(With("/camera/view_angle", 180), "scene.camera.view_angle: expected a number in (0, 180), got 180");
-  ExpectError(With("/camera/width", 0), "scene.camera.width: expected an integer in [1, 16384], got 0");
-  ExpectError(With("/camera/height", -5), "scene.camera.height: expected an integer in [1, 16384], got -5");
-  ExpectError(With("/camera/width", true), "scene.camera.width: expected an integer in [1, 16384], got the boolean true");
+  ExpectError(With("/camera/view_angle", 180),
+    "scene.camera.view_angle: expected a number in (0, 180), got 180");
+  ExpectError(
+    With("/camera/width", 0), "scene.camera.width: expected an integer in [1, 16384], got 0");
+  ExpectError(
+    With("/camera/height", -5), "scene.camera.height: expected an integer in [1, 16384], got -5");
+  ExpectError(With("/camera/width", true),
+    "scene.camera.width: expected an integer in [1, 16384], got the boolean true");
 
   // Medium.
   ExpectError(With("/medium/extinction_per_density", -1),
@@ -456,8 +467,10 @@ TEST(SceneJson, Errors)
     "scene.medium.single_scattering_albedo: expected a number in [0, 1], got 1.01");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "cornette_shanks", "g": 1.5}])")),
     "scene.medium.phase[0].g: expected a number in [-1, 1], got 1.5");
-  ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic"}, {"type": "mie", "g": 0.5}])")),
-    "scene.medium.phase[1].type: unknown value \"mie\" (known: isotropic, rayleigh, henyey_greenstein, cornette_shanks)");
+  ExpectError(
+    With("/medium/phase", Json::parse(R"([{"type": "isotropic"}, {"type": "mie", "g": 0.5}])")),
+    "scene.medium.phase[1].type: unknown value \"mie\" (known: isotropic, rayleigh, "
+    "henyey_greenstein, cornette_shanks)");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "henyey_greenstein"}])")),
     "scene.medium.phase[0]: missing required key \"g\"");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic", "weight": -1}])")),
@@ -474,15 +487,18 @@ TEST(SceneJson, Errors)
     "scene.medium.density: missing required key \"path\"");
   ExpectError(With("/medium/density", Json::parse(R"({"type": "file", "path": ""})")),
     "scene.medium.density.path: expected a non-empty string");
-  ExpectError(With("/medium/density", Json::parse(R"({"type": "file", "path": "a.vti", "parameters": {"Seed": 1}})")),
+  ExpectError(With("/medium/density",
+                Json::parse(R"({"type": "file", "path": "a.vti", "parameters": {"Seed": 1}})")),
     "scene.medium.density.parameters: only used by type \"metaball_cloud\"");
-  ExpectError(With("/medium/density/path", "a.vti"), "scene.medium.density.path: only used by type \"file\"");
+  ExpectError(
+    With("/medium/density/path", "a.vti"), "scene.medium.density.path: only used by type \"file\"");
   ExpectError(With("/medium/density/array", "lwc"), "scene.medium.density.array:");
 
   // Metaball parameters: names, counts, values.
   const std::string parameters = "/medium/density/parameters";
   ExpectError(With(parameters + "/Dimension", Json::array({ 8, 8, 8 })),
-    "scene.medium.density.parameters.Dimension: unknown metaball_cloud parameter (known: Dimensions, Bounds, Seed,");
+    "scene.medium.density.parameters.Dimension: unknown metaball_cloud parameter (known: "
+    "Dimensions, Bounds, Seed,");
   ExpectError(With(parameters + "/Dimensions", Json::array({ 8, 8 })),
     "scene.medium.density.parameters.Dimensions: expected 3 values, got 2");
   ExpectError(With(parameters + "/Dimensions", 8),
@@ -503,7 +519,8 @@ TEST(SceneJson, Errors)
     "scene.medium.density.parameters.BaseBallRadiusRange[0]: expected a number > 0, got 0");
   ExpectError(With(parameters + "/Seed", Json::array({ 1, 2 })),
     "scene.medium.density.parameters.Seed: expected 1 value, got 2");
-  ExpectError(With(parameters + "/Seed", 1e10), "scene.medium.density.parameters.Seed: expected an integer");
+  ExpectError(
+    With(parameters + "/Seed", 1e10), "scene.medium.density.parameters.Seed: expected an integer");
   ExpectError(With(parameters + "/NumberOfBaseBalls", 0),
     "scene.medium.density.parameters.NumberOfBaseBalls: expected an integer in [1, 100000], got 0");
   ExpectError(With(parameters + "/TowerHeight", -1),
@@ -514,13 +531,18 @@ TEST(SceneJson, Errors)
     "scene.medium.density.parameters.FlatBase: expected true or false");
   ExpectError(With(parameters + "/IsoValue", true),
     "scene.medium.density.parameters.IsoValue: expected a finite number, got the boolean true");
-  ExpectError(With(parameters, Json::array()), "scene.medium.density.parameters: expected an object");
+  ExpectError(
+    With(parameters, Json::array()), "scene.medium.density.parameters: expected an object");
 
   // Sun.
-  ExpectError(With("/sun/elevation", 91), "scene.sun.elevation: expected a number in [-90, 90], got 91");
-  ExpectError(With("/sun/azimuth", 1000), "scene.sun.azimuth: expected a number in [-360, 360], got 1000");
-  ExpectError(With("/sun/illuminance", -1), "scene.sun.illuminance: expected a number >= 0, got -1");
-  ExpectError(With("/sun/temperature", 500), "scene.sun.temperature: expected a number in [1000, 100000], got 500");
+  ExpectError(
+    With("/sun/elevation", 91), "scene.sun.elevation: expected a number in [-90, 90], got 91");
+  ExpectError(
+    With("/sun/azimuth", 1000), "scene.sun.azimuth: expected a number in [-360, 360], got 1000");
+  ExpectError(
+    With("/sun/illuminance", -1), "scene.sun.illuminance: expected a number >= 0, got -1");
+  ExpectError(With("/sun/temperature", 500),
+    "scene.sun.temperature: expected a number in [1000, 100000], got 500");
   ExpectError(With("/sun/direction", Json::array({ 0, 1, 1 })),
     "scene.sun.direction: give either direction or azimuth and elevation, not both");
   {
@@ -534,23 +556,37 @@ TEST(SceneJson, Errors)
   }
 
   // Atmosphere, ground, background.
-  ExpectError(With("/atmosphere/enabled", 1), "scene.atmosphere.enabled: expected true or false, got 1");
-  ExpectError(With("/atmosphere/top_radius", 6000000), "scene.atmosphere.top_radius: must be greater than earth_radius");
-  ExpectError(With("/atmosphere/earth_radius", 0), "scene.atmosphere.earth_radius: expected a number > 0, got 0");
-  ExpectError(With("/atmosphere/scene_altitude", -1), "scene.atmosphere.scene_altitude: expected a number >= 0, got -1");
-  ExpectError(With("/atmosphere/scene_altitude", 70000), "scene.atmosphere.scene_altitude: must be below the top");
-  ExpectError(With("/atmosphere/mie_scattering", -1e-5), "scene.atmosphere.mie_scattering: expected a number >= 0");
-  ExpectError(With("/atmosphere/mie_scale_height", 0), "scene.atmosphere.mie_scale_height: expected a number > 0");
-  ExpectError(With("/atmosphere/rayleigh_scale_height", -8000), "scene.atmosphere.rayleigh_scale_height: expected a number > 0");
-  ExpectError(With("/atmosphere/mie_albedo", 0), "scene.atmosphere.mie_albedo: expected a number in (0, 1], got 0");
-  ExpectError(With("/atmosphere/mie_g", 1), "scene.atmosphere.mie_g: expected a number in (-1, 1), got 1");
+  ExpectError(
+    With("/atmosphere/enabled", 1), "scene.atmosphere.enabled: expected true or false, got 1");
+  ExpectError(With("/atmosphere/top_radius", 6000000),
+    "scene.atmosphere.top_radius: must be greater than earth_radius");
+  ExpectError(With("/atmosphere/earth_radius", 0),
+    "scene.atmosphere.earth_radius: expected a number > 0, got 0");
+  ExpectError(With("/atmosphere/scene_altitude", -1),
+    "scene.atmosphere.scene_altitude: expected a number >= 0, got -1");
+  ExpectError(With("/atmosphere/scene_altitude", 70000),
+    "scene.atmosphere.scene_altitude: must be below the top");
+  ExpectError(With("/atmosphere/mie_scattering", -1e-5),
+    "scene.atmosphere.mie_scattering: expected a number >= 0");
+  ExpectError(With("/atmosphere/mie_scale_height", 0),
+    "scene.atmosphere.mie_scale_height: expected a number > 0");
+  ExpectError(With("/atmosphere/rayleigh_scale_height", -8000),
+    "scene.atmosphere.rayleigh_scale_height: expected a number > 0");
+  ExpectError(With("/atmosphere/mie_albedo", 0),
+    "scene.atmosphere.mie_albedo: expected a number in (0, 1], got 0");
+  ExpectError(
+    With("/atmosphere/mie_g", 1), "scene.atmosphere.mie_g: expected a number in (-1, 1), got 1");
   ExpectError(With("/atmosphere/ozone", 1), "scene.atmosphere.ozone: unknown key");
-  ExpectError(With("/ground/albedo", 1.5), "scene.ground.albedo: expected a number in [0, 1], got 1.5");
-  ExpectError(With("/ground/height", nullptr), "scene.ground.height: expected a finite number, got null");
+  ExpectError(
+    With("/ground/albedo", 1.5), "scene.ground.albedo: expected a number in [0, 1], got 1.5");
+  ExpectError(
+    With("/ground/height", nullptr), "scene.ground.height: expected a finite number, got null");
   ExpectError(With("/background/type", "sky"),
     "scene.background.type: unknown value \"sky\" (known: black, constant, atmosphere)");
-  ExpectError(With("/background/radiance", -0.5), "scene.background.radiance: expected a number >= 0, got -0.5");
-  ExpectError(With("/atmosphere/enabled", false), "scene.background.type: \"atmosphere\" needs atmosphere.enabled");
+  ExpectError(With("/background/radiance", -0.5),
+    "scene.background.radiance: expected a number >= 0, got -0.5");
+  ExpectError(With("/atmosphere/enabled", false),
+    "scene.background.type: \"atmosphere\" needs atmosphere.enabled");
 }
 
 TEST(SceneJson, PhaseAsSingleObject)
@@ -561,7 +597,8 @@ TEST(SceneJson, PhaseAsSingleObject)
   EXPECT_EQ(s.Medium.Phase[0].Type, "henyey_greenstein");
   EXPECT_EQ(s.Medium.Phase[0].G, 0.6);
   EXPECT_EQ(s.Medium.Phase[0].Weight, 1.0);
-  const SceneDescription iso = Parse(With("/medium/phase", Json::parse(R"({"type": "isotropic"})")));
+  const SceneDescription iso =
+    Parse(With("/medium/phase", Json::parse(R"({"type": "isotropic"})")));
   EXPECT_EQ(iso.Medium.Phase[0].Type, "isotropic");
 }
 
@@ -573,13 +610,12 @@ TEST(SceneJson, SunDirection)
     double Azimuth, Elevation;
   };
   const std::vector<Case> cases = {
-    { { { 0, 1, 0 } }, 0, 0 },    // north, on the horizon
-    { { { 1, 0, 0 } }, 90, 0 },   // east
-    { { { 0, -1, 1 } }, 180, 45 }, // south, 45 degrees up
-    { { { -2, 0, 0 } }, 270, 0 }, // west, not unit length
-    { { { 0, 0, 5 } }, 0, 90 },   // zenith: azimuth 0 by convention
-    { { { 1, 1, 0 } }, 45, 0 },
-    { { { 0, 1, -1 } }, 0, -45 }, // below the horizon
+    { { { 0, 1, 0 } }, 0, 0 },                                // north, on the horizon
+    { { { 1, 0, 0 } }, 90, 0 },                               // east
+    { { { 0, -1, 1 } }, 180, 45 },                            // south, 45 degrees up
+    { { { -2, 0, 0 } }, 270, 0 },                             // west, not unit length
+    { { { 0, 0, 5 } }, 0, 90 },                               // zenith: azimuth 0 by convention
+    { { { 1, 1, 0 } }, 45, 0 }, { { { 0, 1, -1 } }, 0, -45 }, // below the horizon
   };
   for (const Case& c : cases)
   {
@@ -662,7 +698,8 @@ TEST(SceneJson, RelativePaths)
   }
   catch (const std::invalid_argument& error)
   {
-    EXPECT_EQ(std::string(error.what()), (dir / "bad.json").string() +
+    EXPECT_EQ(std::string(error.what()),
+      (dir / "bad.json").string() +
         ": scene.sun.elevation: expected a number in [-90, 90], got 100");
   }
   fs::remove_all(dir);

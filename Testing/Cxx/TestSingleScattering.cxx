@@ -125,7 +125,8 @@ DensityGrid Blob(int n, double h, const Vector3& centre)
         const double x = (i * h - half) / half, y = (j * h - half) / half,
                      z = (k * h - half) / half;
         const double r2 = x * x + y * y + 1.5 * z * z;
-        const double ripple = 0.15 * std::sin(7.0 * x) * std::sin(5.0 * y + 1.0) * std::cos(6.0 * z);
+        const double ripple =
+          0.15 * std::sin(7.0 * x) * std::sin(5.0 * y + 1.0) * std::cos(6.0 * z);
         values[(static_cast<std::size_t>(k) * n + j) * n + i] =
           static_cast<float>(std::max(0.0, std::min(1.0, 1.6 * (0.7 - r2) + ripple)));
       }
@@ -170,7 +171,8 @@ TEST(SingleScattering, SlabClosedFormSecondOrder)
   const SceneDescription scene = PlainScene(60.0, 90.0);
   const RenderContext context(scene, Slab());
   const Vector3 s = context.GetSunDirection();
-  const double sigma = scene.Medium.ExtinctionPerDensity, albedo = scene.Medium.SingleScatteringAlbedo;
+  const double sigma = scene.Medium.ExtinctionPerDensity,
+               albedo = scene.Medium.SingleScatteringAlbedo;
   const std::vector<double>& E = context.GetSunIrradiance();
 
   struct Case
@@ -198,8 +200,8 @@ TEST(SingleScattering, SlabClosedFormSecondOrder)
       {
         error = std::max(error, std::abs(L[i] / (E[i] * expected) - 1.0));
       }
-      std::printf("    step %6.3f m  relative error %.3e  ratio %.3f\n",
-        stepScale * kSlabThickness, error, previousError > 0.0 ? previousError / error : 0.0);
+      std::printf("    step %6.3f m  relative error %.3e  ratio %.3f\n", stepScale * kSlabThickness,
+        error, previousError > 0.0 ? previousError / error : 0.0);
       if (previousError > 0.0)
       {
         EXPECT_GT(previousError / error, 3.5) << c.name << " step scale " << stepScale;
@@ -321,7 +323,8 @@ TEST(SingleScattering, ForwardScatteringIsBrighter)
 {
   const double g = 0.7;
   const Vector3 origin{ { 0.0, -5000.0, 0.0 } }, v{ { 0.0, 1.0, 0.0 } };
-  auto render = [&](double azimuth) {
+  auto render = [&](double azimuth)
+  {
     SceneDescription scene = PlainScene(0.0, azimuth, g);
     scene.Medium.ExtinctionPerDensity = 1e-5; // optical thickness 1e-3: thin
     scene.Medium.SingleScatteringAlbedo = 1.0;
@@ -329,7 +332,7 @@ TEST(SingleScattering, ForwardScatteringIsBrighter)
       scene, DensityGrid::Constant({ { -50.0, -50.0, -50.0 } }, { { 50.0, 50.0, 50.0 } }, 1.0f));
     return nimbus::SingleScatteringRadiance(context, origin, v, 0.25)[3];
   };
-  const double forward = render(0.0);   // sun toward +y: behind the cloud
+  const double forward = render(0.0);    // sun toward +y: behind the cloud
   const double backward = render(180.0); // sun toward -y: behind the camera
   const double expected = nimbus::HenyeyGreenstein(1.0, g) / nimbus::HenyeyGreenstein(-1.0, g);
   std::printf("  forward/backward %.4f, p(1)/p(-1) %.4f\n", forward / backward, expected);
@@ -345,8 +348,8 @@ TEST(SingleScattering, GroundShadowUnderCloud)
   scene.Ground.Enabled = true;
   scene.Ground.Albedo = 0.3;
   scene.Medium.ExtinctionPerDensity = 0.02;
-  const RenderContext context(
-    scene, DensityGrid::Constant({ { -500.0, -500.0, 1000.0 } }, { { 500.0, 500.0, 1500.0 } }, 1.0f));
+  const RenderContext context(scene,
+    DensityGrid::Constant({ { -500.0, -500.0, 1000.0 } }, { { 500.0, 500.0, 1500.0 } }, 1.0f));
   const Vector3 down{ { 0.0, 0.0, -1.0 } };
   const std::vector<double> lit =
     nimbus::SingleScatteringRadiance(context, { { 1250.0, 0.0, 100.0 } }, down, 0.5);
@@ -369,7 +372,8 @@ TEST(SingleScattering, GroundShadowUnderCloud)
   const RenderContext imageContext(scene, context.GetGrid());
   const nimbus::FloatImage image = nimbus::RenderSingleScatteringPass(imageContext, 0.5, 2);
   // Find the pixels whose rays hit the ground nearest to the lit and shadow points.
-  auto pixelNear = [&](double x) {
+  auto pixelNear = [&](double x)
+  {
     int best = 0;
     double bestDistance = 1e300;
     for (int i = 0; i < image.Width; ++i)
@@ -407,7 +411,8 @@ TEST(SingleScattering, ThreadCountIndependent)
   const nimbus::FloatImage one = nimbus::RenderSingleScatteringPass(context, 0.5, 1);
   const nimbus::FloatImage four = nimbus::RenderSingleScatteringPass(context, 0.5, 4);
   ASSERT_EQ(one.Pixels.size(), four.Pixels.size());
-  EXPECT_EQ(0, std::memcmp(one.Pixels.data(), four.Pixels.data(), one.Pixels.size() * sizeof(float)));
+  EXPECT_EQ(
+    0, std::memcmp(one.Pixels.data(), four.Pixels.data(), one.Pixels.size() * sizeof(float)));
   EXPECT_TRUE(AllFinite(one));
   double sum = 0.0;
   for (float value : one.Pixels)
@@ -427,7 +432,8 @@ TEST(SingleScattering, StabilityCases)
     DensityGrid grid;
   };
   std::vector<Case> cases;
-  auto base = [](double elevation) {
+  auto base = [](double elevation)
+  {
     SceneDescription scene; // default: atmosphere, ground, sky background
     scene.Sun.Elevation = elevation;
     scene.Camera.Width = 8;
@@ -462,7 +468,8 @@ TEST(SingleScattering, StabilityCases)
     cases.push_back({ "camera inside the cloud", scene, blob });
   }
   cases.push_back({ "one-voxel grid", base(45.0),
-    DensityGrid({ { 1, 1, 1 } }, { { 0.0, 0.0, 1600.0 } }, { { 500.0, 500.0, 500.0 } }, { 1.0f }) });
+    DensityGrid(
+      { { 1, 1, 1 } }, { { 0.0, 0.0, 1600.0 } }, { { 500.0, 500.0, 500.0 } }, { 1.0f }) });
   {
     SceneDescription scene = base(45.0);
     scene.Atmosphere.Enabled = false;
@@ -470,7 +477,8 @@ TEST(SingleScattering, StabilityCases)
     scene.Background.Radiance = 0.5;
     scene.Medium.ExtinctionPerDensity = 1e4 / 500.0;
     cases.push_back({ "no atmosphere, one voxel, thick", scene,
-      DensityGrid({ { 1, 1, 1 } }, { { 0.0, 0.0, 1600.0 } }, { { 500.0, 500.0, 500.0 } }, { 1.0f }) });
+      DensityGrid(
+        { { 1, 1, 1 } }, { { 0.0, 0.0, 1600.0 } }, { { 500.0, 500.0, 500.0 } }, { 1.0f }) });
   }
   {
     SceneDescription scene = base(-5.0);
@@ -541,7 +549,8 @@ TEST(SingleScattering, SunAtmosphereKnots)
         }
       }
     }
-    std::printf("  sun %5.1f deg: knot spacing %7.0f m, max |ΔT| %.2e\n", elevation, spacing, caseWorst);
+    std::printf(
+      "  sun %5.1f deg: knot spacing %7.0f m, max |ΔT| %.2e\n", elevation, spacing, caseWorst);
     worst = std::max(worst, caseWorst);
   }
   EXPECT_LT(worst, 1e-4);
@@ -573,7 +582,8 @@ TEST(SingleScattering, SkyAgainstBruteForce)
       std::vector<double> L(nl, 0.0), tau(nl, 0.0), beta, Tsun;
       for (int k = 0; k < n; ++k)
       {
-        const double ta = tEnd * std::pow(double(k) / n, 3), tb = tEnd * std::pow(double(k + 1) / n, 3);
+        const double ta = tEnd * std::pow(double(k) / n, 3),
+                     tb = tEnd * std::pow(double(k + 1) / n, 3);
         const double tm = 0.5 * (ta + tb), dt = tb - ta;
         const Vector3 x{ { o[0] + tm * v[0], o[1] + tm * v[1], o[2] + tm * v[2] } };
         double mieS, mieE;
@@ -624,15 +634,20 @@ TEST(SingleScattering, EmptySpaceSkippingIsExact)
       value = std::max(value, 1e-30f);
     }
     ASSERT_GT(zeros, values.size() / 3);
-    const DensityGrid dense(sparse.GetDimensions(), sparse.GetOrigin(), sparse.GetSpacing(), values);
-    const nimbus::FloatImage a = nimbus::RenderSingleScatteringPass(RenderContext(scene, sparse), 0.5, 2);
-    const nimbus::FloatImage b = nimbus::RenderSingleScatteringPass(RenderContext(scene, dense), 0.5, 2);
+    const DensityGrid dense(
+      sparse.GetDimensions(), sparse.GetOrigin(), sparse.GetSpacing(), values);
+    const nimbus::FloatImage a =
+      nimbus::RenderSingleScatteringPass(RenderContext(scene, sparse), 0.5, 2);
+    const nimbus::FloatImage b =
+      nimbus::RenderSingleScatteringPass(RenderContext(scene, dense), 0.5, 2);
     double worst = 0.0;
     for (std::size_t k = 0; k < a.Pixels.size(); ++k)
     {
-      worst = std::max(worst, std::abs(double(a.Pixels[k]) - b.Pixels[k]) / std::max(1e-6f, b.Pixels[k]));
+      worst =
+        std::max(worst, std::abs(double(a.Pixels[k]) - b.Pixels[k]) / std::max(1e-6f, b.Pixels[k]));
     }
-    std::printf("  %s: max relative difference %.2e\n", atmosphere ? "atmosphere" : "no atmosphere", worst);
+    std::printf(
+      "  %s: max relative difference %.2e\n", atmosphere ? "atmosphere" : "no atmosphere", worst);
     EXPECT_LT(worst, 1e-6);
   }
 }
@@ -642,7 +657,8 @@ TEST(SingleScattering, InvalidArguments)
   const RenderContext context(PlainScene(45.0, 0.0), Slab());
   EXPECT_THROW(nimbus::RenderSingleScatteringPass(context, 0.0, 1), std::invalid_argument);
   EXPECT_THROW(nimbus::RenderSingleScatteringPass(context, std::nan(""), 1), std::invalid_argument);
-  EXPECT_THROW(nimbus::SingleScatteringRadiance(context, { { 0.0, 0.0, 0.0 } }, { { 0.0, 0.0, 2.0 } }, 0.5),
+  EXPECT_THROW(
+    nimbus::SingleScatteringRadiance(context, { { 0.0, 0.0, 0.0 } }, { { 0.0, 0.0, 2.0 } }, 0.5),
     std::invalid_argument);
   nimbus::SingleScatteringSettings settings;
   settings.StepScale = -1.0;

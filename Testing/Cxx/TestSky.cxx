@@ -60,12 +60,13 @@ const SkyModel& FullModel()
 
 const SkyModel& SingleModel()
 {
-  static const SkyModel model{ [] {
-    SkyParameters p;
-    p.ScatteringOrders = 1;
-    p.GroundAlbedo = 0.0;
-    return p;
-  }() };
+  static const SkyModel model{ []
+    {
+      SkyParameters p;
+      p.ScatteringOrders = 1;
+      p.GroundAlbedo = 0.0;
+      return p;
+    }() };
   return model;
 }
 
@@ -120,8 +121,10 @@ TEST(Sky, TransmittanceTableInterpolation)
       const auto lut = model.LookupOpticalLengths(r, mu);
       for (double lambda : { 440.0, 550.0, 680.0 })
       {
-        const double tauExact = air.RayleighScattering(lambda) * exact[0] + air.MieExtinction(lambda) * exact[1];
-        const double tauLut = air.RayleighScattering(lambda) * lut[0] + air.MieExtinction(lambda) * lut[1];
+        const double tauExact =
+          air.RayleighScattering(lambda) * exact[0] + air.MieExtinction(lambda) * exact[1];
+        const double tauLut =
+          air.RayleighScattering(lambda) * lut[0] + air.MieExtinction(lambda) * lut[1];
         worstT = std::max(worstT, std::abs(std::exp(-tauLut) - std::exp(-tauExact)));
         if (tauExact > 1e-3)
         {
@@ -160,7 +163,8 @@ TEST(Sky, SingleScatteringAgainstReference)
     {
       for (double az = 0.0; az < 360.0; az += 20.0)
       {
-        const double viewElevation = std::max(e, 0.5); // the reference ray must not graze the sphere
+        const double viewElevation =
+          std::max(e, 0.5); // the reference ray must not graze the sphere
         Sample sample;
         sample.w = Direction(viewElevation, az + 7.0);
         sample.ref = context->ToLinearSrgb(
@@ -208,7 +212,8 @@ TEST(Sky, MultipleScatteringOrders)
   for (double elevation : { 45.0, 5.0, -4.0 })
   {
     const std::vector<double> orders = full.OrderMeanRadiance(std::sin(elevation * kDegree));
-    std::printf("  sun %5.1f deg: mean radiance Y of orders 1..%zu at the ground:", elevation, orders.size());
+    std::printf(
+      "  sun %5.1f deg: mean radiance Y of orders 1..%zu at the ground:", elevation, orders.size());
     for (double o : orders)
     {
       std::printf(" %.3e", o);
@@ -271,7 +276,8 @@ TEST(Sky, ZenithLuminanceAgainstPreetham)
   }
   EXPECT_TRUE(monotone);
   // Shape: both normalised at 40 degrees.
-  const std::size_t at40 = static_cast<std::size_t>(std::find(elevations.begin(), elevations.end(), 40.0) - elevations.begin());
+  const std::size_t at40 = static_cast<std::size_t>(
+    std::find(elevations.begin(), elevations.end(), 40.0) - elevations.begin());
   double worst = 0.0;
   for (std::size_t i = 0; i < elevations.size(); ++i)
   {
@@ -282,7 +288,8 @@ TEST(Sky, ZenithLuminanceAgainstPreetham)
     }
     if (static_cast<int>(elevations[i]) % 10 == 0 || elevations[i] < 10.0)
     {
-      std::printf("  sun %4.0f deg: zenith Y ours %.4e, Preetham T=2.5 %.3f kcd/m2, normalised ratio %.3f\n",
+      std::printf(
+        "  sun %4.0f deg: zenith Y ours %.4e, Preetham T=2.5 %.3f kcd/m2, normalised ratio %.3f\n",
         elevations[i], ours[i], preetham[i], ratio);
     }
   }
@@ -302,7 +309,8 @@ TEST(Sky, PublishedBehaviour)
   // Blue zenith at noon: B/R of the zenith.
   {
     const Rgb z = model.Radiance(0.0, { { 0, 0, 1 } }, Direction(60.0, 0.0));
-    std::printf("  sun 60 deg: zenith rgb %.3e %.3e %.3e, B/R %.2f\n", z[0], z[1], z[2], z[2] / z[0]);
+    std::printf(
+      "  sun 60 deg: zenith rgb %.3e %.3e %.3e, B/R %.2f\n", z[0], z[1], z[2], z[2] / z[0]);
     EXPECT_GT(z[2] / z[0], 1.5); // measured 2.0
   }
   // Sunset: near the sun on the horizon red/orange (R > G > B, R/B large), while the
@@ -312,7 +320,8 @@ TEST(Sky, PublishedBehaviour)
     const Rgb nearSun = model.Radiance(0.0, Direction(2.0, 10.0), s);
     const Rgb zenith = model.Radiance(0.0, { { 0, 0, 1 } }, s);
     std::printf("  sun 1 deg: near the sun rgb %.3e %.3e %.3e (R/B %.1f), zenith B/R %.2f\n",
-      nearSun[0], nearSun[1], nearSun[2], nearSun[0] / std::max(nearSun[2], 1e-30), zenith[2] / zenith[0]);
+      nearSun[0], nearSun[1], nearSun[2], nearSun[0] / std::max(nearSun[2], 1e-30),
+      zenith[2] / zenith[0]);
     EXPECT_GT(nearSun[0], nearSun[1]);
     EXPECT_GT(nearSun[1], nearSun[2]);
     EXPECT_GT(nearSun[0], 3.0 * std::max(nearSun[2], 0.0)); // orange-red: measured R/B > 10
@@ -324,7 +333,8 @@ TEST(Sky, PublishedBehaviour)
     const Vector3 s = Direction(45.0, 0.0);
     const Rgb horizon = model.Radiance(0.0, Direction(2.0, 90.0), s);
     const Rgb up = model.Radiance(0.0, Direction(30.0, 90.0), s);
-    std::printf("  sun 45 deg, azimuth 90 from the sun: Y(2 deg)/Y(30 deg) = %.2f, B/R %.2f vs %.2f\n",
+    std::printf(
+      "  sun 45 deg, azimuth 90 from the sun: Y(2 deg)/Y(30 deg) = %.2f, B/R %.2f vs %.2f\n",
       Y(horizon) / Y(up), horizon[2] / horizon[0], up[2] / up[0]);
     EXPECT_GT(Y(horizon), 1.2 * Y(up));
     EXPECT_LT(horizon[2] / horizon[0], up[2] / up[0]);
@@ -342,8 +352,9 @@ TEST(Sky, Extremes)
     {
       const Vector3 s = Direction(elevation, 30.0);
       const SkyViewLut lut(model, elevation, altitude, 16, 8, 8);
-      for (const Vector3& w : { Vector3{ { 0, 0, 1 } }, Vector3{ { 0, 0, -1 } }, Direction(0.0, 10.0),
-             Direction(1e-7, 200.0), Direction(-1e-7, 200.0), Direction(-89.0, 5.0) })
+      for (const Vector3& w :
+        { Vector3{ { 0, 0, 1 } }, Vector3{ { 0, 0, -1 } }, Direction(0.0, 10.0),
+          Direction(1e-7, 200.0), Direction(-1e-7, 200.0), Direction(-89.0, 5.0) })
       {
         const Rgb direct = model.Radiance(altitude, w, s);
         const Rgb table = lut.Radiance(w, 30.0);
@@ -394,7 +405,9 @@ TEST(Sky, Continuity)
           yMax = std::max(yMax, Y(model.Radiance(altitude, Direction(e, az), s)));
         }
       }
-      const double horizon = 90.0 - std::acos(model.HorizonMu(model.GetParameters().Atmosphere.earthRadius + altitude)) / kDegree;
+      const double horizon = 90.0 -
+        std::acos(model.HorizonMu(model.GetParameters().Atmosphere.earthRadius + altitude)) /
+          kDegree;
       double worst = 0.0, worstDe = 0.0, worstAz = 0.0;
       for (double de : { -1.0, -0.1, -0.01, 0.01, 0.1, 1.0 })
       {
@@ -415,7 +428,8 @@ TEST(Sky, Continuity)
       for (double az : { 0.0, 90.0, 180.0 })
       {
         const Vector3 w = Direction(89.99, az);
-        worst = std::max(worst, RelativeError(lut.Radiance(w, 0.0), model.Radiance(altitude, w, s), 1e-3 * yMax));
+        worst = std::max(
+          worst, RelativeError(lut.Radiance(w, 0.0), model.Radiance(altitude, w, s), 1e-3 * yMax));
       }
       std::printf("  altitude %6.0f m, sun %5.1f deg: LUT vs march at the horizon/borders max %.2e "
                   "(at %+.2f deg from the horizon, azimuth %.1f from the sun)\n",
@@ -433,18 +447,21 @@ TEST(Sky, Continuity)
     std::vector<double> y;
     for (double elevation = -10.0; elevation <= 6.0; elevation += 0.25)
     {
-      y.push_back(Y(model.Radiance(0.0, Direction(viewElevation, 120.0), Direction(elevation, 0.0))));
+      y.push_back(
+        Y(model.Radiance(0.0, Direction(viewElevation, 120.0), Direction(elevation, 0.0))));
     }
     double worstJump = 0.0;
     for (std::size_t i = 2; i + 2 < y.size(); ++i)
     {
       const double d = std::abs(std::log(y[i + 1] / y[i]));
-      const double around = 0.25 * (std::abs(std::log(y[i] / y[i - 1])) + std::abs(std::log(y[i - 1] / y[i - 2])) +
-        std::abs(std::log(y[i + 2] / y[i + 1])) + std::abs(std::log(y[i + 1] / y[i])));
+      const double around = 0.25 *
+        (std::abs(std::log(y[i] / y[i - 1])) + std::abs(std::log(y[i - 1] / y[i - 2])) +
+          std::abs(std::log(y[i + 2] / y[i + 1])) + std::abs(std::log(y[i + 1] / y[i])));
       worstJump = std::max(worstJump, d / around);
       EXPECT_TRUE(std::isfinite(d));
     }
-    std::printf("  view elevation %5.1f: worst step / local mean step of ln Y over sun -10..6 deg: %.2f\n",
+    std::printf(
+      "  view elevation %5.1f: worst step / local mean step of ln Y over sun -10..6 deg: %.2f\n",
       viewElevation, worstJump);
     EXPECT_LT(worstJump, 3.0);
   }
@@ -481,7 +498,8 @@ TEST(Sky, AerialPerspectiveTable)
       }
     }
     std::printf("  sun %4.1f deg: aerial-perspective table vs march: max |dT| %.2e, max inscatter "
-                "error %.2e (relative, floor 1e-3)\n", elevation, worstT, worstL);
+                "error %.2e (relative, floor 1e-3)\n",
+      elevation, worstT, worstL);
     // Bounds: measured 1.3e-3 and 1.6e-2 (sun 45 and 3 deg), rounded up.
     EXPECT_LT(worstT, 2e-3);
     EXPECT_LT(worstL, 2e-2);

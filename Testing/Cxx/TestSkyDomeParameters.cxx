@@ -49,8 +49,8 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
   dome->Update();
   vtkFieldData* fields = dome->GetOutput()->GetFieldData();
   const char* names[] = { "SunElevation", "SunAzimuth", "AerosolDensity", "GroundAlbedo",
-    "Exposure", "WhiteBalance", "SunDisc", "ObserverAltitude", "MetresPerUnit",
-    "MaxAerialDistance", "ScatteringOrders" };
+    "Exposure", "WhiteBalance", "SunDisc", "ObserverAltitude", "MetresPerUnit", "MaxAerialDistance",
+    "ScatteringOrders" };
   for (const char* name : names)
   {
     vtkDataArray* array = fields->GetArray(name);

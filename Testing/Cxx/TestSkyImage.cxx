@@ -1,6 +1,7 @@
 // Image tests of the sky pass (vtkNimbusSkyPass): noon, sunset and twilight skies
-// and a scene with aerial perspective (ground, distant boxes and hills), compared with Data/Baseline/TestSkyImage_<mode>.png
-// (ImageComparison.h criteria). Usage: TestSkyImage <mode> <baseline.png> <outputdir>.
+// and a scene with aerial perspective (ground, distant boxes and hills), compared with
+// Data/Baseline/TestSkyImage_<mode>.png (ImageComparison.h criteria). Usage: TestSkyImage <mode>
+// <baseline.png> <outputdir>.
 #include "ImageComparison.h"
 
 #include "vtkNimbusSky.h"
@@ -57,11 +58,13 @@ int main(int argc, char* argv[])
   camera->SetViewUp(0.0, 0.0, 1.0);
   if (mode == "noon" || mode == "sunset" || mode == "twilight")
   {
-    sky->SetPreset(mode == "noon" ? vtkNimbusSky::Noon
-                                  : (mode == "sunset" ? vtkNimbusSky::Sunset : vtkNimbusSky::Twilight));
+    sky->SetPreset(mode == "noon"
+        ? vtkNimbusSky::Noon
+        : (mode == "sunset" ? vtkNimbusSky::Sunset : vtkNimbusSky::Twilight));
     sky->SetExposure(mode == "noon" ? 12.0 : (mode == "sunset" ? 25.0 : 400.0));
     // Looking toward the sun's azimuth, a little above the horizon, wide angle.
-    const double a = vtkMath::RadiansFromDegrees(sky->GetSunAzimuth() + (mode == "noon" ? 180.0 : 0.0));
+    const double a =
+      vtkMath::RadiansFromDegrees(sky->GetSunAzimuth() + (mode == "noon" ? 180.0 : 0.0));
     camera->SetPosition(0.0, 0.0, 2.0);
     camera->SetFocalPoint(std::sin(a), std::cos(a), 2.0 + (mode == "noon" ? 0.45 : 0.25));
     camera->SetViewAngle(80.0);

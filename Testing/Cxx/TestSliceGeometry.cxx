@@ -13,7 +13,8 @@ namespace
 {
 double Angle(const Vec3& a, const Vec3& b)
 {
-  return std::acos(std::clamp(nimbus::Dot(nimbus::Normalized(a), nimbus::Normalized(b)), -1.0, 1.0));
+  return std::acos(
+    std::clamp(nimbus::Dot(nimbus::Normalized(a), nimbus::Normalized(b)), -1.0, 1.0));
 }
 Vec3 Neg(const Vec3& v)
 {
@@ -76,7 +77,8 @@ TEST(SliceGeometry, PlanesAndShadowFrame)
   std::vector<Vec3> corners;
   for (int c = 0; c < 8; ++c)
   {
-    corners.push_back({ { (c & 1) ? 100.0 : -100.0, (c & 2) ? 50.0 : -50.0, (c & 4) ? 30.0 : 10.0 } });
+    corners.push_back(
+      { { (c & 1) ? 100.0 : -100.0, (c & 2) ? 50.0 : -50.0, (c & 4) ? 30.0 : 10.0 } });
   }
   const Vec3 n = nimbus::Normalized({ { 0, 0, 1 } });
   const auto range = nimbus::ProjectedRange(corners, n);
@@ -97,8 +99,10 @@ TEST(SliceGeometry, PlanesAndShadowFrame)
   EXPECT_NEAR(nimbus::Dot(frame.W, l), 0.0, 1e-12);
   for (const Vec3& corner : corners)
   {
-    const Vec3 q = { { corner[0] - frame.Origin[0], corner[1] - frame.Origin[1], corner[2] - frame.Origin[2] } };
-    const double s = nimbus::Dot(q, frame.U) / frame.Width, t = nimbus::Dot(q, frame.W) / frame.Height;
+    const Vec3 q = { { corner[0] - frame.Origin[0], corner[1] - frame.Origin[1],
+      corner[2] - frame.Origin[2] } };
+    const double s = nimbus::Dot(q, frame.U) / frame.Width,
+                 t = nimbus::Dot(q, frame.W) / frame.Height;
     EXPECT_GT(s, 0.0);
     EXPECT_LT(s, 1.0);
     EXPECT_GT(t, 0.0);
@@ -185,14 +189,17 @@ TEST(SliceGeometry, SlicePolygonCutsTheBox)
   }
   // The plane through the centre with normal (1,1,1) cuts a regular hexagon.
   const Vec3 diagonal = nimbus::Normalized({ { 1, 1, 1 } });
-  const auto hexagon = nimbus::SlicePolygon(cube, diagonal, nimbus::Dot(diagonal, { { 0.5, 0.5, 0.5 } }));
+  const auto hexagon =
+    nimbus::SlicePolygon(cube, diagonal, nimbus::Dot(diagonal, { { 0.5, 0.5, 0.5 } }));
   ASSERT_EQ(hexagon.size(), 6u);
   for (const Vec3& p : hexagon)
   {
     EXPECT_NEAR(p[0] + p[1] + p[2], 1.5, 1e-12);
-    EXPECT_NEAR(std::sqrt((p[0] - 0.5) * (p[0] - 0.5) + (p[1] - 0.5) * (p[1] - 0.5) + (p[2] - 0.5) * (p[2] - 0.5)),
+    EXPECT_NEAR(std::sqrt((p[0] - 0.5) * (p[0] - 0.5) + (p[1] - 0.5) * (p[1] - 0.5) +
+                  (p[2] - 0.5) * (p[2] - 0.5)),
       std::sqrt(0.5), 1e-12);
   }
   EXPECT_TRUE(nimbus::SlicePolygon(cube, { { 0, 0, 1 } }, 2.0).empty());
-  EXPECT_THROW(nimbus::SlicePolygon({ { { 0, 0, 0 } } }, { { 0, 0, 1 } }, 0.0), std::invalid_argument);
+  EXPECT_THROW(
+    nimbus::SlicePolygon({ { { 0, 0, 0 } } }, { { 0, 0, 1 } }, 0.0), std::invalid_argument);
 }

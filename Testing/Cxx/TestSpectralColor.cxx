@@ -101,8 +101,8 @@ TEST(SpectralColor, EqualEnergyWhite)
   const nimbus::SpectralSamples s;
   const std::array<double, 3> xyz = s.ToXyz(std::vector<double>(s.GetNumberOfSamples(), 1.0));
   const std::array<double, 2> xy = nimbus::XyzToChromaticity(xyz);
-  std::printf("illuminant E: XYZ = %.5f %.5f %.5f, xy = %.5f %.5f\n", xyz[0], xyz[1], xyz[2],
-    xy[0], xy[1]);
+  std::printf(
+    "illuminant E: XYZ = %.5f %.5f %.5f, xy = %.5f %.5f\n", xyz[0], xyz[1], xyz[2], xy[0], xy[1]);
   // Tabulated CIE 1931 gives X = Y = Z for E; the analytic fit is within 0.5 %
   // (measured X/Y = 1.0011, Z/Y = 0.9979 over 380-780 nm).
   EXPECT_NEAR(xy[0], 1.0 / 3.0, 2e-3);
@@ -111,13 +111,14 @@ TEST(SpectralColor, EqualEnergyWhite)
   EXPECT_NEAR(xyz[2], 1.0, 5e-3);
   // E is not the sRGB white (D65), so its linear sRGB is M (1,1,1) =
   // (1.2048, 0.9484, 0.9087), not exactly equal components.
-  const std::array<double, 3> rgb = s.ToLinearSrgb(std::vector<double>(s.GetNumberOfSamples(), 1.0));
+  const std::array<double, 3> rgb =
+    s.ToLinearSrgb(std::vector<double>(s.GetNumberOfSamples(), 1.0));
   std::printf("illuminant E: linear sRGB = %.4f %.4f %.4f\n", rgb[0], rgb[1], rgb[2]);
   EXPECT_NEAR(rgb[0], 1.2048, 0.01);
   EXPECT_NEAR(rgb[1], 0.9484, 0.01);
   EXPECT_NEAR(rgb[2], 0.9087, 0.01);
-  EXPECT_LT(*std::max_element(rgb.begin(), rgb.end()) / *std::min_element(rgb.begin(), rgb.end()),
-    1.35);
+  EXPECT_LT(
+    *std::max_element(rgb.begin(), rgb.end()) / *std::min_element(rgb.begin(), rgb.end()), 1.35);
 }
 
 TEST(SpectralColor, SrgbMatrixAndTransfer)
@@ -168,9 +169,10 @@ TEST(SpectralColor, SampleCountErrorTable)
 {
   using nimbus::SpectralReconstruction;
   const nimbus::SpectralSamples reference(401, SpectralReconstruction::NaturalCubicSpline);
-  const std::array<std::pair<const char*, Spectrum>, 3> spectra = { {
-    { "sun 5778 K", Sun }, { "sky B*l^-4", RayleighSky }, { "sunset", Sunset } } };
-  std::printf("  N  %-12s  linear: max|dRGB| max|dXYZ|  dE*ab    | spline: max|dRGB| max|dXYZ|  dE*ab\n",
+  const std::array<std::pair<const char*, Spectrum>, 3> spectra = { { { "sun 5778 K", Sun },
+    { "sky B*l^-4", RayleighSky }, { "sunset", Sunset } } };
+  std::printf(
+    "  N  %-12s  linear: max|dRGB| max|dXYZ|  dE*ab    | spline: max|dRGB| max|dXYZ|  dE*ab\n",
     "spectrum");
   ColourError defaultWorst{ 0.0, 0.0, 0.0 };
   for (int n : { 3, 4, 8, 16, 32, 64 })
@@ -181,8 +183,8 @@ TEST(SpectralColor, SampleCountErrorTable)
     {
       const ColourError a = Compare(linear, reference, s.second);
       const ColourError b = Compare(spline, reference, s.second);
-      std::printf("%3d  %-12s  %.2e  %.2e  %.2e | %.2e  %.2e  %.2e\n", n, s.first, a.rgb,
-        a.xyz, a.deltaE, b.rgb, b.xyz, b.deltaE);
+      std::printf("%3d  %-12s  %.2e  %.2e  %.2e | %.2e  %.2e  %.2e\n", n, s.first, a.rgb, a.xyz,
+        a.deltaE, b.rgb, b.xyz, b.deltaE);
       if (n == nimbus::SpectralSamples::kDefaultSampleCount)
       {
         defaultWorst.rgb = std::max(defaultWorst.rgb, b.rgb);
