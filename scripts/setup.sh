@@ -26,7 +26,7 @@ packages=(
   libgl-dev python3-dev python3-mpi4py python3-numpy
   # build tools and tests
   cmake ninja-build g++ make libgtest-dev nlohmann-json3-dev python3-matplotlib
-  libbenchmark-dev
+  libbenchmark-dev clang-format git
   # OpenVDB reader/writer (IO/) and the tests' independent .vdb producer
   libopenvdb-dev python3-openvdb
   # headless OpenGL: Xvfb + Mesa llvmpipe
