@@ -7,6 +7,7 @@ The VTK classes of the Nimbus modules are re-exported here; VTK itself comes fro
 ``vtkmodules`` (ParaView's VTK on Debian, through python3-paraview).
 """
 from .NimbusFilters import *  # noqa: F401,F403
+from .NimbusReference import *  # noqa: F401,F403
 from .NimbusRepresentations import *  # noqa: F401,F403
 try:  # vtkNimbusOpenVDBReader/Writer: built only when OpenVDB was found
     from .NimbusIOOpenVDB import *  # noqa: F401,F403

@@ -1,4 +1,4 @@
-// The versioned JSON scene file (Representations/Reference/SceneJson.h,
+// The versioned JSON scene file (Reference/Core/SceneJson.h,
 // docs/scene-format.md): the project's scenes parse, round trip, hashing,
 // error messages (each starts with the key path), sun.direction, relative paths.
 #include "SceneJson.h"

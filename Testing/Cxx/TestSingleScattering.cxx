@@ -1,5 +1,5 @@
 // Closed-form validation of the single-scattering reference renderer
-// (Representations/Reference/SingleScatteringRenderer.h).
+// (Reference/Core/SingleScatteringRenderer.h).
 //
 // Homogeneous media come from DensityGrid::Constant (2 points per axis, so the grid
 // "minimum spacing" is the smallest box edge and the cloud step is

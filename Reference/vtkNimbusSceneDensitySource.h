@@ -11,14 +11,14 @@
 #ifndef vtkNimbusSceneDensitySource_h
 #define vtkNimbusSceneDensitySource_h
 
-#include "NimbusRepresentationsModule.h" // for export macro
+#include "NimbusReferenceModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
 #include "vtkSmartPointer.h" // for the inner algorithm
 
 #include <string> // for std::string
 
-class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSceneDensitySource : public vtkImageAlgorithm
+class NIMBUSREFERENCE_EXPORT vtkNimbusSceneDensitySource : public vtkImageAlgorithm
 {
 public:
   static vtkNimbusSceneDensitySource* New();

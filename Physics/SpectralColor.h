@@ -13,7 +13,7 @@
 #ifndef nimbus_SpectralColor_h
 #define nimbus_SpectralColor_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusPhysicsExport.h" // for export macro
 
 #include <array>
 #include <cstddef>
@@ -24,25 +24,23 @@ namespace nimbus
 
 /// CIE 1931 2-degree colour-matching functions (Wyman-Sloan-Shirley multi-lobe
 /// fit, JCGT 2013 Eq. 4); lambda in nm; dimensionless (ybar peak ~1 at 555 nm).
-NIMBUSREPRESENTATIONS_EXPORT double CieXBar1931(double lambdaNm);
-NIMBUSREPRESENTATIONS_EXPORT double CieYBar1931(double lambdaNm);
-NIMBUSREPRESENTATIONS_EXPORT double CieZBar1931(double lambdaNm);
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> CieXyzBar1931(double lambdaNm);
+NIMBUSPHYSICS_EXPORT double CieXBar1931(double lambdaNm);
+NIMBUSPHYSICS_EXPORT double CieYBar1931(double lambdaNm);
+NIMBUSPHYSICS_EXPORT double CieZBar1931(double lambdaNm);
+NIMBUSPHYSICS_EXPORT std::array<double, 3> CieXyzBar1931(double lambdaNm);
 
 /// CIE XYZ -> linear sRGB (D65 white, ITU-R BT.709 primaries), matrix of
 /// IEC 61966-2-1.  No clamping: out-of-gamut colours give components < 0 or > 1.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> XyzToLinearSrgb(
-  const std::array<double, 3>& xyz);
+NIMBUSPHYSICS_EXPORT std::array<double, 3> XyzToLinearSrgb(const std::array<double, 3>& xyz);
 /// sRGB transfer function (IEC 61966-2-1) linear -> encoded, input clamped to
 /// [0, 1]: 12.92 c for c <= 0.0031308, else 1.055 c^(1/2.4) - 0.055.
-NIMBUSREPRESENTATIONS_EXPORT double SrgbEncode(double linear);
+NIMBUSPHYSICS_EXPORT double SrgbEncode(double linear);
 /// Chromaticity (x, y) = (X, Y) / (X + Y + Z); (0, 0) for X + Y + Z = 0.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 2> XyzToChromaticity(
-  const std::array<double, 3>& xyz);
+NIMBUSPHYSICS_EXPORT std::array<double, 2> XyzToChromaticity(const std::array<double, 3>& xyz);
 
 /// Planck's law: blackbody spectral radiance B(lambda, T) in W m^-2 sr^-1 nm^-1.
 /// Use T = 5778 K for the sun.
-NIMBUSREPRESENTATIONS_EXPORT double PlanckSpectralRadiance(double lambdaNm, double temperatureK);
+NIMBUSPHYSICS_EXPORT double PlanckSpectralRadiance(double lambdaNm, double temperatureK);
 
 /// How a spectrum known at the sample wavelengths is reconstructed between them
 /// before it is integrated against the CMFs.
@@ -68,7 +66,7 @@ enum class SpectralReconstruction
 /// and max |delta linear sRGB| = 5.0e-5 (at Y = 1); N = 8 gives dE 0.76 and
 /// piecewise linear gives dE 1.7 at N = 16 and still 0.1 at N = 64
 /// (TestSpectralColor, README.md).
-class NIMBUSREPRESENTATIONS_EXPORT SpectralSamples
+class NIMBUSPHYSICS_EXPORT SpectralSamples
 {
 public:
   static constexpr int kDefaultSampleCount = 16;

@@ -19,8 +19,8 @@
  * aerial-perspective table are seen from it. For the sky alone, without a pass,
  * see vtkNimbusSkyBackground.
  *
- * GLSL: SkyShaders/vtkNimbusSkyPassFS.glsl, the GPU twin of
- * nimbus::SkyViewLut::Radiance / AerialPerspectiveLut::Lookup (Optics/Sky.cxx).
+ * GLSL: Shaders/vtkNimbusSkyPassFS.glsl, the GPU twin of
+ * nimbus::SkyViewLut::Radiance / AerialPerspectiveLut::Lookup (Physics/Sky.cxx).
  *
  * @code
  * vtkNew<vtkNimbusSkyPass> pass;  pass->SetSky(sky);

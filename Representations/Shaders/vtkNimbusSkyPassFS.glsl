@@ -1,7 +1,7 @@
 //VTK::System::Dec
 // Sky background and aerial perspective (vtkNimbusSkyPass; CPU twin:
 // nimbus::SkyViewLut::Radiance and nimbus::AerialPerspectiveLut::Lookup in
-// Optics/Sky.cxx — same row/column/slice maps, same phase functions).
+// Physics/Sky.cxx — same row/column/slice maps, same phase functions).
 //
 // Surfaces: colour_out = colour_in * T + DisplayScale * L_inscatter (aerial perspective).
 in vec2 texCoord;

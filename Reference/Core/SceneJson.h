@@ -12,7 +12,7 @@
 #ifndef NimbusSceneJson_h
 #define NimbusSceneJson_h
 
-#include "NimbusRepresentationsModule.h" // for export macro
+#include "NimbusReferenceModule.h" // for export macro
 #include "SceneDescription.h"
 
 #include <string>
@@ -26,23 +26,23 @@ namespace nimbus
 /// the source's property order (vtkNimbusMetaballCloudSource.h), whatever
 /// their order in the text. Throws std::invalid_argument (message starts with
 /// the key path, "scene" being the root).
-NIMBUSREPRESENTATIONS_EXPORT SceneDescription ParseScene(
+NIMBUSREFERENCE_EXPORT SceneDescription ParseScene(
   const std::string& jsonText, const std::string& baseDirectory);
 
 /// Reads the file and parses it with the file's directory as base. Throws
 /// std::runtime_error when the file cannot be read and std::invalid_argument
 /// when it is not a valid scene; both messages start with the file's path.
-NIMBUSREPRESENTATIONS_EXPORT SceneDescription LoadScene(const std::string& path);
+NIMBUSREFERENCE_EXPORT SceneDescription LoadScene(const std::string& path);
 
 /// The canonical JSON of a scene: every field, in the documented order, 2-space
 /// indent, shortest round-trip number formatting, trailing newline. Does not
 /// validate (write only scenes that ParseScene accepts if they must read back).
-NIMBUSREPRESENTATIONS_EXPORT std::string SceneToJson(const SceneDescription& scene);
+NIMBUSREFERENCE_EXPORT std::string SceneToJson(const SceneDescription& scene);
 
 /// 16 lowercase hex digits: FNV-1a 64 of SceneToJson(scene). Covers the
 /// description only: for a "file" density it hashes the (resolved, absolute)
 /// path, not the file's contents, size or modification time.
-NIMBUSREPRESENTATIONS_EXPORT std::string SceneHash(const SceneDescription& scene);
+NIMBUSREFERENCE_EXPORT std::string SceneHash(const SceneDescription& scene);
 
 } // namespace nimbus
 

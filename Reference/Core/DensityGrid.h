@@ -5,7 +5,7 @@
 #ifndef NimbusDensityGrid_h
 #define NimbusDensityGrid_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 
 #include <array>
 #include <cstddef>
@@ -14,7 +14,7 @@
 namespace nimbus
 {
 
-class NIMBUSREPRESENTATIONS_EXPORT DensityGrid
+class NIMBUSREFERENCE_EXPORT DensityGrid
 {
 public:
   using Vector3 = std::array<double, 3>;

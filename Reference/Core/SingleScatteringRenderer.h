@@ -47,7 +47,7 @@
 #ifndef NimbusSingleScatteringRenderer_h
 #define NimbusSingleScatteringRenderer_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 
 #include "FloatImage.h"
 #include "RenderContext.h"
@@ -59,7 +59,7 @@
 namespace nimbus
 {
 
-struct NIMBUSREPRESENTATIONS_EXPORT SingleScatteringSettings
+struct NIMBUSREFERENCE_EXPORT SingleScatteringSettings
 {
   double StepScale = 0.5;          // cloud step = StepScale × grid min spacing (m), first pass
   double RelativeTolerance = 1e-3; // stop when the estimated relative RMS error is below this
@@ -67,7 +67,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT SingleScatteringSettings
   int Threads = 0;                 // 0 = hardware concurrency
 };
 
-struct NIMBUSREPRESENTATIONS_EXPORT SingleScatteringResult
+struct NIMBUSREFERENCE_EXPORT SingleScatteringResult
 {
   FloatImage Image;              // finest pass, linear sRGB
   double EstimatedRelativeError; // Richardson estimate of Image's relative RMS error
@@ -82,7 +82,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT SingleScatteringResult
 /// pixel is computed independently by the same code). progress(fraction in
 /// [0, 1]) is called from the calling thread. Throws std::invalid_argument for
 /// stepScale <= 0 or non-finite.
-NIMBUSREPRESENTATIONS_EXPORT FloatImage RenderSingleScatteringPass(const RenderContext& context,
+NIMBUSREFERENCE_EXPORT FloatImage RenderSingleScatteringPass(const RenderContext& context,
   double stepScale, int threads, const std::function<void(double)>& progress = {});
 
 /// Renders passes at StepScale, StepScale/2, StepScale/4, ... until the Richardson
@@ -93,17 +93,16 @@ NIMBUSREPRESENTATIONS_EXPORT FloatImage RenderSingleScatteringPass(const RenderC
 /// RMS over all pixels and the three linear sRGB channels (0 if both images are 0).
 /// Returns the finest image (not the extrapolated one, which need not be >= 0).
 /// progress is monotonic and reaches 1 at the end.
-NIMBUSREPRESENTATIONS_EXPORT SingleScatteringResult RenderSingleScattering(
-  const RenderContext& context, const SingleScatteringSettings& settings,
-  const std::function<void(double)>& progress = {});
+NIMBUSREFERENCE_EXPORT SingleScatteringResult RenderSingleScattering(const RenderContext& context,
+  const SingleScatteringSettings& settings, const std::function<void(double)>& progress = {});
 
 /// Spectral radiance (one value per context wavelength sample) arriving at origin
 /// from unitDirection, i.e. along the ray origin + t·unitDirection, t >= 0 (the
 /// camera ray convention). Throws std::invalid_argument for stepScale <= 0 or a
 /// non-finite origin / direction.
-NIMBUSREPRESENTATIONS_EXPORT std::vector<double> SingleScatteringRadiance(
-  const RenderContext& context, const std::array<double, 3>& origin,
-  const std::array<double, 3>& unitDirection, double stepScale);
+NIMBUSREFERENCE_EXPORT std::vector<double> SingleScatteringRadiance(const RenderContext& context,
+  const std::array<double, 3>& origin, const std::array<double, 3>& unitDirection,
+  double stepScale);
 
 namespace detail
 {
@@ -111,11 +110,11 @@ namespace detail
 /// origin + t·unitDirection (0 <= t <= tEnd) as the renderer evaluates it along a
 /// ray ending at tEnd: exact optical lengths (Atmosphere::OpticalLengthsToTop) at
 /// knots along the ray, log-linear interpolation between them.
-NIMBUSREPRESENTATIONS_EXPORT std::vector<double> InterpolatedSunAtmosphereTransmittance(
+NIMBUSREFERENCE_EXPORT std::vector<double> InterpolatedSunAtmosphereTransmittance(
   const RenderContext& context, const std::array<double, 3>& origin,
   const std::array<double, 3>& unitDirection, double tEnd, double t);
 /// The knot spacing (m) used for this context's sun direction.
-NIMBUSREPRESENTATIONS_EXPORT double SunAtmosphereKnotSpacing(const RenderContext& context);
+NIMBUSREFERENCE_EXPORT double SunAtmosphereKnotSpacing(const RenderContext& context);
 }
 
 } // namespace nimbus

@@ -24,13 +24,13 @@
 #ifndef vtkNimbusReferenceRenderer_h
 #define vtkNimbusReferenceRenderer_h
 
-#include "NimbusRepresentationsModule.h" // for export macro
+#include "NimbusReferenceModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
 
-class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusReferenceRenderer : public vtkImageAlgorithm
+class NIMBUSREFERENCE_EXPORT vtkNimbusReferenceRenderer : public vtkImageAlgorithm
 {
 public:
   static vtkNimbusReferenceRenderer* New();

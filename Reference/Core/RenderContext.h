@@ -10,7 +10,7 @@
 #ifndef NimbusRenderContext_h
 #define NimbusRenderContext_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 
 #include "Atmosphere.h"
 #include "Camera.h"
@@ -26,7 +26,7 @@
 namespace nimbus
 {
 
-class NIMBUSREPRESENTATIONS_EXPORT RenderContext
+class NIMBUSREFERENCE_EXPORT RenderContext
 {
 public:
   using Vector3 = std::array<double, 3>;

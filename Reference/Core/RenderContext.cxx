@@ -88,7 +88,7 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid)
 
   Require(scene.SpectralSamples >= 3 && scene.SpectralSamples <= 256, "spectral_samples",
     "must be in [3, 256]");
-  // Spline reconstruction overshoots below 8 samples (Optics/README.md): linear there.
+  // Spline reconstruction overshoots below 8 samples (Physics/README.md): linear there.
   this->Spectrum = std::make_unique<SpectralSamples>(scene.SpectralSamples,
     scene.SpectralSamples >= 8 ? SpectralReconstruction::NaturalCubicSpline
                                : SpectralReconstruction::PiecewiseLinear);

@@ -3,7 +3,7 @@
 #ifndef NimbusFloatImage_h
 #define NimbusFloatImage_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 
 #include <array>
 #include <string>
@@ -12,7 +12,7 @@
 namespace nimbus
 {
 
-struct NIMBUSREPRESENTATIONS_EXPORT FloatImage
+struct NIMBUSREFERENCE_EXPORT FloatImage
 {
   int Width = 0;
   int Height = 0;
@@ -41,8 +41,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT FloatImage
 
 /// Display encoding for looking at a linear image: multiply by exposure, clip to
 /// [0, 1], apply the sRGB transfer function; 8-bit RGB, row 0 at the bottom.
-NIMBUSREPRESENTATIONS_EXPORT std::vector<unsigned char> ToneMap(
-  const FloatImage& image, double exposure);
+NIMBUSREFERENCE_EXPORT std::vector<unsigned char> ToneMap(const FloatImage& image, double exposure);
 
 } // namespace nimbus
 

@@ -3,7 +3,7 @@
 #ifndef NimbusCamera_h
 #define NimbusCamera_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 #include "SceneDescription.h"
 
 #include <array>
@@ -11,7 +11,7 @@
 namespace nimbus
 {
 
-class NIMBUSREPRESENTATIONS_EXPORT Camera
+class NIMBUSREFERENCE_EXPORT Camera
 {
 public:
   using Vector3 = std::array<double, 3>;

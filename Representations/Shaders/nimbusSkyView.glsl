@@ -1,6 +1,6 @@
 // The sky-view table lookup shared by the sky pass and the sky background
 // (vtkNimbusSkyPass, vtkNimbusSkyBackground): GPU twin of nimbus::SkyViewLut::Radiance
-// (Optics/Sky.cxx — same row/column maps, same phase functions) plus the
+// (Physics/Sky.cxx — same row/column maps, same phase functions) plus the
 // limb-darkened sun disc and the sRGB transfer functions. Uniforms are set by
 // nimbus::SkyViewTextures (SkyViewGL.cxx).
 //

@@ -56,7 +56,7 @@
 #ifndef nimbus_Sky_h
 #define nimbus_Sky_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusPhysicsExport.h" // for export macro
 
 #include "Atmosphere.h"
 #include "SpectralColor.h"
@@ -68,7 +68,7 @@
 namespace nimbus
 {
 
-struct NIMBUSREPRESENTATIONS_EXPORT SkyParameters
+struct NIMBUSPHYSICS_EXPORT SkyParameters
 {
   AtmosphereParameters Atmosphere;
   double GroundAlbedo = 0.3;      // grey Lambertian albedo of the earth's surface, [0, 1]
@@ -89,21 +89,21 @@ struct NIMBUSREPRESENTATIONS_EXPORT SkyParameters
 
 /// Spectral radiance parts along one ray (size = number of wavelengths); the
 /// radiance is p_R(nu) Rayleigh + p_M(nu) Mie + Isotropic.
-struct NIMBUSREPRESENTATIONS_EXPORT SkySpectra
+struct NIMBUSPHYSICS_EXPORT SkySpectra
 {
   std::vector<double> Rayleigh, Mie, Isotropic;
   std::vector<double> Transmittance; // T(x, end of the ray) (to the ground point if it hits it)
 };
 
 /// Linear-sRGB radiance parts (same meaning as SkySpectra, after the spectrum -> sRGB map).
-struct NIMBUSREPRESENTATIONS_EXPORT SkyRgbParts
+struct NIMBUSPHYSICS_EXPORT SkyRgbParts
 {
   std::array<double, 3> Rayleigh{ { 0, 0, 0 } }, Mie{ { 0, 0, 0 } }, Isotropic{ { 0, 0, 0 } };
 };
 
 /// The atmosphere-dependent tables: transmittance and multiple scattering. They do
 /// not depend on the sun or the observer; build once per atmosphere.
-class NIMBUSREPRESENTATIONS_EXPORT SkyModel
+class NIMBUSPHYSICS_EXPORT SkyModel
 {
 public:
   using Vector3 = std::array<double, 3>;
@@ -238,11 +238,11 @@ private:
 
 /// Sun direction in the local frame (x east, y north, z up) from elevation and
 /// azimuth (degrees; azimuth from north toward east, as in SceneDescription).
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> SunDirectionFromAngles(
+NIMBUSPHYSICS_EXPORT std::array<double, 3> SunDirectionFromAngles(
   double elevationDeg, double azimuthDeg);
 
 /// Maps of the sky-view rows: view zenith angle <-> row coordinate, split at the horizon.
-struct NIMBUSREPRESENTATIONS_EXPORT SkyViewMapping
+struct NIMBUSPHYSICS_EXPORT SkyViewMapping
 {
   int Width = 64;             // azimuth nodes over [0, pi]
   int AboveRows = 64;         // rows from the horizon (row 0) up to the zenith
@@ -259,7 +259,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT SkyViewMapping
 /// Sky radiance parts for one sun elevation and one observer altitude, by view
 /// direction relative to the sun (002 §2's look-up table). Rebuild when the sun's
 /// elevation, the altitude or the atmosphere change; the sun's azimuth only rotates it.
-class NIMBUSREPRESENTATIONS_EXPORT SkyViewLut
+class NIMBUSPHYSICS_EXPORT SkyViewLut
 {
 public:
   using Vector3 = std::array<double, 3>;
@@ -295,7 +295,7 @@ private:
 /// distance d along every direction (Hillaire 2020's aerial-perspective volume,
 /// but in world directions, so moving the camera horizontally or turning it does
 /// not rebuild it).
-class NIMBUSREPRESENTATIONS_EXPORT AerialPerspectiveLut
+class NIMBUSPHYSICS_EXPORT AerialPerspectiveLut
 {
 public:
   using Vector3 = std::array<double, 3>;
@@ -331,10 +331,10 @@ private:
 ///   chi = (4/9 - T/120)(pi - 2 thetaS),
 ///   Y_z = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192.
 /// Implemented from the published formula (valid for the sun above the horizon).
-NIMBUSREPRESENTATIONS_EXPORT double PreethamZenithLuminance(double turbidity, double sunZenith);
+NIMBUSPHYSICS_EXPORT double PreethamZenithLuminance(double turbidity, double sunZenith);
 
 /// Relative luminance Y of linear sRGB (row 2 of the sRGB -> XYZ matrix).
-NIMBUSREPRESENTATIONS_EXPORT double LinearSrgbLuminance(const std::array<double, 3>& rgb);
+NIMBUSPHYSICS_EXPORT double LinearSrgbLuminance(const std::array<double, 3>& rgb);
 
 } // namespace nimbus
 

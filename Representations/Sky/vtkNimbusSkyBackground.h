@@ -19,7 +19,7 @@
  * The background is seen from the sky's observer (scene z = 0 at
  * ObserverAltitude): the camera's height does not change it.
  *
- * GLSL: SkyShaders/vtkNimbusSkyBackgroundFS.glsl with nimbusSkyView.glsl (the
+ * GLSL: Shaders/vtkNimbusSkyBackgroundFS.glsl with nimbusSkyView.glsl (the
  * twin of nimbus::SkyViewLut::Radiance), shared with vtkNimbusSkyPass.
  */
 #ifndef vtkNimbusSkyBackground_h

@@ -1,5 +1,5 @@
 // nimbus::SkyViewTextures — the sky-view table of a vtkNimbusSky as three GL
-// textures (A_R, A_M, A_I) and the uniforms of SkyShaders/nimbusSkyView.glsl.
+// textures (A_R, A_M, A_I) and the uniforms of Shaders/nimbusSkyView.glsl.
 // Shared by vtkNimbusSkyPass and vtkNimbusSkyBackground so that both draw the
 // same sky. Uploads again only when the sky rebuilt its table.
 #ifndef nimbus_SkyViewTextures_h

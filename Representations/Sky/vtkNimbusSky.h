@@ -5,7 +5,7 @@
  * One object that the sky background / aerial-perspective pass
  * (vtkNimbusSkyPass), the sky dome (vtkNimbusSkyDomeSource) and a cloud mapper
  * share, so that sky, haze and clouds agree. It is thin glue around
- * Optics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
+ * Physics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
  * and rebuilds each only when what it depends on changed (cache keys):
  *  - SkyModel (transmittance + multiple scattering): AerosolDensity, GroundAlbedo;
  *  - sky-view table: the model, SunElevation, ObserverAltitude;

@@ -64,7 +64,7 @@
 #ifndef NimbusPathTracer_h
 #define NimbusPathTracer_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusReferenceModule.h"
 
 #include "FloatImage.h"
 #include "RenderContext.h"
@@ -80,7 +80,7 @@ namespace nimbus
 /// a diffusing path needs ~tau^2 steps; the path is then cut (see above).
 constexpr std::uint64_t kMaxTrackingStepsPerPath = std::uint64_t(1) << 20;
 
-struct NIMBUSREPRESENTATIONS_EXPORT PathTracingSettings
+struct NIMBUSREFERENCE_EXPORT PathTracingSettings
 {
   int MinSamplesPerPixel = 16;
   int MaxSamplesPerPixel = 1024;
@@ -101,7 +101,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT PathTracingSettings
   bool PixelJitter = true;
 };
 
-struct NIMBUSREPRESENTATIONS_EXPORT PathTracingResult
+struct NIMBUSREFERENCE_EXPORT PathTracingResult
 {
   FloatImage Image;         // linear sRGB radiance, the scene's relative units
   FloatImage StandardError; // per pixel and channel, same units
@@ -118,7 +118,7 @@ struct NIMBUSREPRESENTATIONS_EXPORT PathTracingResult
 /// progress(fraction in [0, 1]) is called from the calling thread after each
 /// round. Throws std::invalid_argument for MinSamplesPerPixel < 1 or
 /// MaxSamplesPerPixel < MinSamplesPerPixel or a negative / NaN target.
-NIMBUSREPRESENTATIONS_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
+NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
 
 } // namespace nimbus

@@ -15,7 +15,7 @@
 #ifndef nimbus_Atmosphere_h
 #define nimbus_Atmosphere_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusPhysicsExport.h" // for export macro
 
 #include <array>
 
@@ -24,7 +24,7 @@ namespace nimbus
 
 /// Parameters of the atmosphere.  Defaults: Nishita et al. 1993 / Bruneton &
 /// Neyret 2008 values.
-struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereParameters
+struct NIMBUSPHYSICS_EXPORT AtmosphereParameters
 {
   double earthRadius = 6360000.0;         // R_e [m]
   double topRadius = 6420000.0;           // R_top [m], 60 km thick atmosphere
@@ -38,14 +38,14 @@ struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereParameters
 };
 
 /// Optical lengths (sea-level-equivalent column lengths, metres) along a ray.
-struct NIMBUSREPRESENTATIONS_EXPORT OpticalLengths
+struct NIMBUSPHYSICS_EXPORT OpticalLengths
 {
   double rayleighLength = 0.0; // integral exp(-h/H_R) ds [m]
   double mieLength = 0.0;      // integral exp(-h/H_M) ds [m]
   bool hitsGround = false;     // the ray hits the earth; lengths are up to the hit point
 };
 
-class NIMBUSREPRESENTATIONS_EXPORT Atmosphere
+class NIMBUSPHYSICS_EXPORT Atmosphere
 {
 public:
   using Vector3 = std::array<double, 3>;

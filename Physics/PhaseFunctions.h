@@ -15,7 +15,7 @@
 #ifndef nimbus_PhaseFunctions_h
 #define nimbus_PhaseFunctions_h
 
-#include "NimbusRepresentationsModule.h"
+#include "NimbusPhysicsExport.h" // for export macro
 
 #include <array>
 #include <cstddef>
@@ -31,29 +31,29 @@ constexpr double kMaxAbsAsymmetry = 1.0 - 1e-6;
 
 /// Returns g clamped to [-kMaxAbsAsymmetry, kMaxAbsAsymmetry].
 /// Throws std::invalid_argument if g is NaN.
-NIMBUSREPRESENTATIONS_EXPORT double ClampAsymmetry(double g);
+NIMBUSPHYSICS_EXPORT double ClampAsymmetry(double g);
 
 //------------------------------------------------------------------------------
 // Henyey-Greenstein:  p(mu) = (1 - g^2) / (4 pi (1 + g^2 - 2 g mu)^{3/2})   [1/sr]
 //------------------------------------------------------------------------------
-NIMBUSREPRESENTATIONS_EXPORT double HenyeyGreenstein(double mu, double g);
+NIMBUSPHYSICS_EXPORT double HenyeyGreenstein(double mu, double g);
 /// Analytic inversion of the HG cumulative distribution in mu; u in [0,1).
 /// Exactly u = 0 -> mu = -1, u -> 1 -> mu -> 1.  One uniform per sample.
-NIMBUSREPRESENTATIONS_EXPORT double SampleHenyeyGreenstein(double g, double u);
+NIMBUSPHYSICS_EXPORT double SampleHenyeyGreenstein(double g, double u);
 /// <mu> of HG = g.
-NIMBUSREPRESENTATIONS_EXPORT double HenyeyGreensteinMeanCosine(double g);
+NIMBUSPHYSICS_EXPORT double HenyeyGreensteinMeanCosine(double g);
 
 //------------------------------------------------------------------------------
 // Cornette-Shanks (000 Eq. 3, 004 Eq. 5), divided by 4 pi:
 //   p(mu) = 3 (1 - g^2) / (2 (2 + g^2)) * (1 + mu^2) / (1 + g^2 - 2 g mu)^{3/2} / (4 pi)
 // g = 0 gives the Rayleigh phase function.                                [1/sr]
 //------------------------------------------------------------------------------
-NIMBUSREPRESENTATIONS_EXPORT double CornetteShanks(double mu, double g);
+NIMBUSPHYSICS_EXPORT double CornetteShanks(double mu, double g);
 /// <mu> of CS = 3 g (g^2 + 4) / (5 (g^2 + 2))  (from the HG Legendre moments
 /// <P_n> = g^n; checked by quadrature in TestPhaseFunctions).
-NIMBUSREPRESENTATIONS_EXPORT double CornetteShanksMeanCosine(double g);
+NIMBUSPHYSICS_EXPORT double CornetteShanksMeanCosine(double g);
 /// Acceptance probability for one HG proposal mu: CS/HG / max(CS/HG) = (1 + mu^2)/2.
-NIMBUSREPRESENTATIONS_EXPORT double CornetteShanksAcceptance(double mu);
+NIMBUSPHYSICS_EXPORT double CornetteShanksAcceptance(double mu);
 
 /// Samples CS by rejection from HG with the same g.  `uniform` is any callable
 /// returning a double in [0,1).  Each trial uses 2 uniforms and is accepted with
@@ -76,11 +76,11 @@ double SampleCornetteShanks(double g, UniformGenerator&& uniform)
 //------------------------------------------------------------------------------
 // Rayleigh:  p(mu) = 3 / (16 pi) (1 + mu^2)                                [1/sr]
 //------------------------------------------------------------------------------
-NIMBUSREPRESENTATIONS_EXPORT double Rayleigh(double mu);
+NIMBUSPHYSICS_EXPORT double Rayleigh(double mu);
 /// Analytic inversion of the CDF (mu^3 + 3 mu + 4)/8 = u (Cardano); u in [0,1).
-NIMBUSREPRESENTATIONS_EXPORT double SampleRayleigh(double u);
+NIMBUSPHYSICS_EXPORT double SampleRayleigh(double u);
 /// <mu> of Rayleigh = 0.
-NIMBUSREPRESENTATIONS_EXPORT double RayleighMeanCosine();
+NIMBUSPHYSICS_EXPORT double RayleighMeanCosine();
 
 //------------------------------------------------------------------------------
 // Directions
@@ -88,10 +88,10 @@ NIMBUSREPRESENTATIONS_EXPORT double RayleighMeanCosine();
 /// Unit direction making cos(theta) = mu with `incident` (normalised here), with
 /// azimuth phi = 2 pi u2 about it.  Throws std::invalid_argument for a zero or
 /// non-finite incident vector.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> DirectionFromCosine(
+NIMBUSPHYSICS_EXPORT std::array<double, 3> DirectionFromCosine(
   const std::array<double, 3>& incident, double mu, double u2);
 /// Scattered direction for HG: mu = SampleHenyeyGreenstein(g, u1), phi = 2 pi u2.
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 3> SampleHenyeyGreensteinDirection(
+NIMBUSPHYSICS_EXPORT std::array<double, 3> SampleHenyeyGreensteinDirection(
   const std::array<double, 3>& incident, double g, double u1, double u2);
 
 //------------------------------------------------------------------------------
@@ -106,10 +106,9 @@ enum class PhaseFunctionKind
 };
 
 /// Evaluates one kind, normalised to 1 over the sphere [1/sr].
-NIMBUSREPRESENTATIONS_EXPORT double EvaluatePhaseFunction(
-  PhaseFunctionKind kind, double mu, double g);
+NIMBUSPHYSICS_EXPORT double EvaluatePhaseFunction(PhaseFunctionKind kind, double mu, double g);
 /// <mu> of one kind.
-NIMBUSREPRESENTATIONS_EXPORT double PhaseFunctionMeanCosine(PhaseFunctionKind kind, double g);
+NIMBUSPHYSICS_EXPORT double PhaseFunctionMeanCosine(PhaseFunctionKind kind, double g);
 
 /// Samples mu for one kind; `uniform` returns doubles in [0,1).
 template <class UniformGenerator>
@@ -132,7 +131,7 @@ double SamplePhaseFunction(PhaseFunctionKind kind, double g, UniformGenerator&& 
 /// Mixture of phase functions, 004 Eq. 4.  Weights must be >= 0 and finite and
 /// are normalised internally (only their ratios matter).  Example for clouds,
 /// 004 §3.3: AddComponent(0.05, Rayleigh); AddComponent(0.95, CornetteShanks, g).
-class NIMBUSREPRESENTATIONS_EXPORT PhaseFunctionMixture
+class NIMBUSPHYSICS_EXPORT PhaseFunctionMixture
 {
 public:
   struct Component

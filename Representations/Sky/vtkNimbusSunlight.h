@@ -2,7 +2,7 @@
  * @class   vtkNimbusSunlight
  * @brief   Direction and colour of direct sunlight after the atmosphere.
  *
- * Thin VTK glue around the optics core (Optics/Atmosphere.h, Optics/SpectralColor.h):
+ * Thin VTK glue around Nimbus::Physics (Physics/Atmosphere.h, Physics/SpectralColor.h):
  * the sun is a 5778 K blackbody outside the atmosphere; its light reaching an
  * observer at ObserverAltitude is attenuated by Rayleigh and Mie extinction along
  * the slanted path to the top of a spherical atmosphere, sampled at
