@@ -1,4 +1,5 @@
 #include "Atmosphere.h"
+#include "Math.h"
 
 #include "PhaseFunctions.h"
 
@@ -13,23 +14,12 @@ namespace nimbus
 
 namespace
 {
-using Vector3 = Atmosphere::Vector3;
 
 // Relative tolerance of the adaptive quadrature.  The Kronrod estimate is far
 // more accurate than the |K15 - G7| error bound, so the actual error is orders
 // of magnitude below this (measured < 1e-12 in TestAtmosphere).
 constexpr double kRelativeTolerance = 1e-12;
 constexpr int kMaxIntervals = 4000;
-
-double Dot(const Vector3& a, const Vector3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-bool IsFinite(const Vector3& a)
-{
-  return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
-}
 
 //------------------------------------------------------------------------------
 // Adaptive Gauss-Kronrod 7/15 quadrature (QUADPACK QK15 nodes and weights),

@@ -15,6 +15,7 @@
 #ifndef nimbus_Atmosphere_h
 #define nimbus_Atmosphere_h
 
+#include "Math.h"
 #include "NimbusPhysicsExport.h" // for export macro
 
 #include <array>
@@ -48,7 +49,7 @@ struct NIMBUSPHYSICS_EXPORT OpticalLengths
 class NIMBUSPHYSICS_EXPORT Atmosphere
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
 
   /// Throws std::invalid_argument unless 0 < earthRadius < topRadius, scale heights
   /// > 0, coefficients >= 0, 0 < albedo <= 1 (all finite).

@@ -1,4 +1,5 @@
 #include "PhaseFunctions.h"
+#include "Math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,6 @@ namespace nimbus
 
 namespace
 {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInv4Pi = 1.0 / (4.0 * kPi);
 
 double ClampMu(double mu)

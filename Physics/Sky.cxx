@@ -7,6 +7,7 @@
 // exactly for that constant medium (the reference renderer's "exponential
 // midpoint rule"):  A += T(t_a) J (1 - e^{-sigma dt}) / sigma,  T(t_b) = T(t_a) e^{-sigma dt}.
 #include "Sky.h"
+#include "Math.h"
 
 #include "PhaseFunctions.h"
 
@@ -23,15 +24,6 @@ namespace nimbus
 
 namespace
 {
-using Vector3 = SkyModel::Vector3;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegree = kPi / 180.0;
-
-double Dot(const Vector3& a, const Vector3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 double Clamp(double x, double lo, double hi)
 {
   return std::min(hi, std::max(lo, x));

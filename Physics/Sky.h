@@ -56,6 +56,7 @@
 #ifndef nimbus_Sky_h
 #define nimbus_Sky_h
 
+#include "Math.h"
 #include "NimbusPhysicsExport.h" // for export macro
 
 #include "Atmosphere.h"
@@ -106,7 +107,7 @@ struct NIMBUSPHYSICS_EXPORT SkyRgbParts
 class NIMBUSPHYSICS_EXPORT SkyModel
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
 
   /// Builds the tables. Throws std::invalid_argument for bad parameters (message
   /// names the field).
@@ -262,7 +263,7 @@ struct NIMBUSPHYSICS_EXPORT SkyViewMapping
 class NIMBUSPHYSICS_EXPORT SkyViewLut
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
   /// Default size 128 x (64 + 32): measured against the reference renderer, see TestSky
   /// and docs/sky.md (64 columns double the twilight error at the earth's shadow edge).
   SkyViewLut(const SkyModel& model, double sunElevationDeg, double observerAltitude,
@@ -298,7 +299,7 @@ private:
 class NIMBUSPHYSICS_EXPORT AerialPerspectiveLut
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
   AerialPerspectiveLut(const SkyModel& model, double sunElevationDeg, double cameraAltitude,
     double maxDistance = 100000.0, int width = 32, int aboveRows = 32, int belowRows = 32,
     int slices = 32);

@@ -1,6 +1,7 @@
 // Tests for Atmosphere.h: optical lengths against closed forms and brute-force
 // integrals, horizon / ground / top-of-atmosphere edge cases.
 #include "Atmosphere.h"
+#include "Math.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +14,7 @@
 namespace
 {
 using V = nimbus::Atmosphere::Vector3;
-constexpr double kPi = 3.14159265358979323846;
+using nimbus::kPi;
 constexpr double R = 6360000.0;
 constexpr double Rtop = 6420000.0;
 

@@ -1,5 +1,6 @@
 // Tests for PhaseFunctions.h: normalisation (by quadrature, not by the samplers),
 // sampling vs pdf (chi-square), mean cosines, and finiteness at the extremes.
+#include "Math.h"
 #include "PhaseFunctions.h"
 
 #include <gtest/gtest.h>
@@ -18,8 +19,8 @@
 
 namespace
 {
+using nimbus::kPi;
 using nimbus::PhaseFunctionKind;
-constexpr double kPi = 3.14159265358979323846;
 
 // Uniform in [0,1) from the top 53 bits, independent of <random>'s distributions.
 double Uniform01(std::mt19937_64& rng)

@@ -8,15 +8,6 @@ namespace nimbus
 
 namespace
 {
-using Vector3 = Camera::Vector3;
-Vector3 Cross(const Vector3& a, const Vector3& b)
-{
-  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
-}
-double Norm(const Vector3& a)
-{
-  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-}
 Vector3 Scaled(const Vector3& a, double s)
 {
   return { { a[0] * s, a[1] * s, a[2] * s } };
@@ -30,15 +21,15 @@ Camera::Camera(const CameraDescription& d)
 {
   const Vector3 view{ { d.FocalPoint[0] - d.Position[0], d.FocalPoint[1] - d.Position[1],
     d.FocalPoint[2] - d.Position[2] } };
-  const double viewLength = Norm(view);
+  const double viewLength = Length(view);
   if (!(viewLength > 0.0) || !std::isfinite(viewLength))
   {
     throw std::invalid_argument("camera: position and focal point must differ and be finite");
   }
   this->Forward = Scaled(view, 1.0 / viewLength);
   const Vector3 right = Cross(this->Forward, d.ViewUp);
-  const double rightLength = Norm(right);
-  if (!(rightLength > 1e-9 * Norm(d.ViewUp)) || !std::isfinite(rightLength))
+  const double rightLength = Length(right);
+  if (!(rightLength > 1e-9 * Length(d.ViewUp)) || !std::isfinite(rightLength))
   {
     throw std::invalid_argument("camera: view-up must not be parallel to the view direction");
   }
@@ -65,7 +56,7 @@ Camera::Vector3 Camera::RayDirection(double x, double y) const
   {
     direction[a] = this->Forward[a] + sx * this->Right[a] + sy * this->Up[a];
   }
-  return Scaled(direction, 1.0 / Norm(direction));
+  return Scaled(direction, 1.0 / Length(direction));
 }
 
 } // namespace nimbus

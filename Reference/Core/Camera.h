@@ -3,6 +3,7 @@
 #ifndef NimbusCamera_h
 #define NimbusCamera_h
 
+#include "Math.h"
 #include "NimbusReferenceModule.h"
 #include "SceneDescription.h"
 
@@ -14,7 +15,7 @@ namespace nimbus
 class NIMBUSREFERENCE_EXPORT Camera
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
 
   /// Throws std::invalid_argument for a degenerate camera (position == focal
   /// point, view-up parallel to the view direction, angle outside (0, 180),

@@ -5,6 +5,7 @@
 #ifndef NimbusDensityGrid_h
 #define NimbusDensityGrid_h
 
+#include "Math.h"
 #include "NimbusReferenceModule.h"
 
 #include <array>
@@ -17,7 +18,7 @@ namespace nimbus
 class NIMBUSREFERENCE_EXPORT DensityGrid
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
 
   DensityGrid() = default;
   /// values: dims[0]*dims[1]*dims[2] densities, x fastest. Throws

@@ -1,4 +1,5 @@
 #include "PathTracer.h"
+#include "Math.h"
 
 #include <algorithm>
 #include <atomic>
@@ -17,23 +18,11 @@ namespace nimbus
 
 namespace
 {
-using Vector3 = std::array<double, 3>;
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 /// Voxels per macro cell edge of the cloud majorant grid.
 constexpr int kMacroCellVoxels = 4;
 /// Ratio tracking plays Russian roulette once its transmittance falls below this.
 constexpr double kRatioTrackingRouletteThreshold = 0.1;
-
-double Dot(const Vector3& a, const Vector3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-Vector3 Along(const Vector3& o, const Vector3& d, double t)
-{
-  return { { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] } };
-}
 
 //------------------------------------------------------------------------------
 // Counter-based random numbers: SplitMix64 (Steele, Lea & Flood, "Fast Splittable

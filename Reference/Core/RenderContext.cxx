@@ -1,4 +1,5 @@
 #include "RenderContext.h"
+#include "Math.h"
 
 #include <cmath>
 #include <limits>
@@ -10,8 +11,6 @@ namespace nimbus
 
 namespace
 {
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
-
 void Require(bool condition, const std::string& field, const std::string& what)
 {
   if (!condition)

@@ -10,6 +10,7 @@
 #ifndef NimbusRenderContext_h
 #define NimbusRenderContext_h
 
+#include "Math.h"
 #include "NimbusReferenceModule.h"
 
 #include "Atmosphere.h"
@@ -29,7 +30,7 @@ namespace nimbus
 class NIMBUSREFERENCE_EXPORT RenderContext
 {
 public:
-  using Vector3 = std::array<double, 3>;
+  using Vector3 = nimbus::Vector3;
 
   /// Validates the parts the renderers rely on (throws std::invalid_argument with
   /// the offending field's name).

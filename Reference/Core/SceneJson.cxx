@@ -1,4 +1,5 @@
 #include "SceneJson.h"
+#include "Math.h"
 
 #include <nlohmann/json.hpp>
 
@@ -23,7 +24,6 @@ namespace
 // Insertion-ordered objects: SceneToJson's key order is the documented order.
 using Json = nlohmann::ordered_json;
 
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void Fail(const std::string& path, const std::string& what)
@@ -508,11 +508,6 @@ std::array<double, 3> Subtract(const std::array<double, 3>& a, const std::array<
   return { { a[0] - b[0], a[1] - b[1], a[2] - b[2] } };
 }
 
-double Norm(const std::array<double, 3>& a)
-{
-  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-}
-
 CameraDescription ReadCamera(const Json& v, const std::string& path)
 {
   const ObjectReader r(
@@ -526,7 +521,7 @@ CameraDescription ReadCamera(const Json& v, const std::string& path)
   r.Integer("height", c.Height, 1, 16384);
 
   const std::array<double, 3> view = Subtract(c.FocalPoint, c.Position);
-  const double viewLength = Norm(view);
+  const double viewLength = Length(view);
   if (!(viewLength > 0.0) || !std::isfinite(viewLength))
   {
     Fail(r.Key("focal_point"), "must differ from camera.position");
@@ -534,7 +529,7 @@ CameraDescription ReadCamera(const Json& v, const std::string& path)
   const std::array<double, 3>& up = c.ViewUp;
   const std::array<double, 3> cross{ { view[1] * up[2] - view[2] * up[1],
     view[2] * up[0] - view[0] * up[2], view[0] * up[1] - view[1] * up[0] } };
-  if (!(Norm(cross) > 1e-6 * viewLength * Norm(up)) || !std::isfinite(Norm(cross)))
+  if (!(Length(cross) > 1e-6 * viewLength * Length(up)) || !std::isfinite(Length(cross)))
   {
     Fail(r.Key("view_up"), "must be non-zero and not parallel to the view direction");
   }
@@ -663,7 +658,7 @@ SunDescription ReadSun(const Json& v, const std::string& path)
     }
     const std::array<double, 3> d = ReadVector3(r["direction"], r.Key("direction"));
     const double horizontal = std::hypot(d[0], d[1]);
-    if (!(Norm(d) > 0.0) || !std::isfinite(Norm(d)))
+    if (!(Length(d) > 0.0) || !std::isfinite(Length(d)))
     {
       Fail(r.Key("direction"), "must be a non-zero vector (toward the sun)");
     }

@@ -72,6 +72,7 @@
 // trilinear look-ups (fewer with early termination), so a pass costs
 // O(pixels × (N/s)²) for an N³ grid; halving the step quadruples the cloud cost.
 #include "SingleScatteringRenderer.h"
+#include "Math.h"
 
 #include <algorithm>
 #include <atomic>
@@ -89,9 +90,6 @@ namespace nimbus
 
 namespace
 {
-using Vector3 = std::array<double, 3>;
-
-constexpr double kPi = 3.14159265358979323846;
 // Sun march stops when T_cloud < 1e-7, i.e. optical depth > -ln(1e-7).
 constexpr double kSunCutoffDepth = 16.11809565095832;
 // View march stops when every spectral view transmittance is < 1e-7.
@@ -106,16 +104,6 @@ constexpr double kMaxKnotRise = 8000.0;
 constexpr int kBlockCells = 4;
 // Air shadow knots inside the cloud box: every K-th cloud step (see CloudSegmentSpectral).
 constexpr long long kAirShadowKnotSteps = 8;
-
-inline Vector3 PointAt(const Vector3& o, const Vector3& d, double t)
-{
-  return { { o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2] } };
-}
-
-inline double Dot(const Vector3& a, const Vector3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 /// φ(x) = (1 - e^{-x}) / x for x = σΔ >= 0, given e = e^{-x}; series below 1e-4
 /// (no cancellation; error < x³/24 < 1e-13).
@@ -276,7 +264,7 @@ public:
     {
       KnotValue v;
       v.T = std::min(static_cast<double>(k) * this->Spacing, this->TEnd);
-      const Vector3 p = this->I.Ctx.EarthCentred(PointAt(this->O, this->D, v.T));
+      const Vector3 p = this->I.Ctx.EarthCentred(Along(this->O, this->D, v.T));
       v.Altitude = this->I.Air->Altitude(p);
       const OpticalLengths lengths = this->I.Air->OpticalLengthsToTop(p, this->I.Sun);
       v.Blocked = lengths.hitsGround;
@@ -319,7 +307,7 @@ public:
       const double ta = begin + static_cast<double>(k) * h;
       const double tb = k == last ? tFar : std::min(ta + h, tFar);
       const double tm = 0.5 * (ta + tb);
-      const Vector3 p = PointAt(x, this->Sun, tm);
+      const Vector3 p = Along(x, this->Sun, tm);
       const double sigma = this->Ctx.CloudExtinction(p);
       if (sigma > 0.0)
       {
@@ -498,7 +486,7 @@ public:
     {
       if (end == End::Ground)
       {
-        const Vector3 xg = PointAt(o, d, tEnd);
+        const Vector3 xg = Along(o, d, tEnd);
         const double cosSun = std::max(0.0, this->Sun[2]);
         const double tCloud = cosSun > 0.0 ? this->SunCloudTransmittance(xg) : 0.0;
         if (tCloud > 0.0)
@@ -623,7 +611,7 @@ private:
       const double tb = k == last ? b : std::min(ta + h, b);
       const double dt = tb - ta;
       const double tm = 0.5 * (ta + tb);
-      const Vector3 x = PointAt(o, d, tm);
+      const Vector3 x = Along(o, d, tm);
       const double sigma = this->Ctx.CloudExtinction(x);
       if (sigma <= 0.0)
       {
@@ -696,7 +684,7 @@ private:
       const double ta = a + static_cast<double>(k) * h;
       const double tb = k == last ? b : std::min(ta + h, b);
       const double tm = 0.5 * (ta + tb);
-      const Vector3 x = PointAt(o, d, tm);
+      const Vector3 x = Along(o, d, tm);
       const long long j = k / kAirShadowKnotSteps;
       if (j != knot)
       {
@@ -708,14 +696,14 @@ private:
         else
         {
           tLeft = a + static_cast<double>(j * kAirShadowKnotSteps) * h;
-          shadowLeft = this->SunCloudTransmittance(PointAt(o, d, tLeft));
+          shadowLeft = this->SunCloudTransmittance(Along(o, d, tLeft));
         }
         tRight = std::min(b, a + static_cast<double>((j + 1) * kAirShadowKnotSteps) * h);
         if ((j + 1) * kAirShadowKnotSteps > last)
         {
           tRight = b;
         }
-        shadowRight = this->SunCloudTransmittance(PointAt(o, d, tRight));
+        shadowRight = this->SunCloudTransmittance(Along(o, d, tRight));
         knot = j;
       }
       const double wRight = tRight > tLeft ? (tm - tLeft) / (tRight - tLeft) : 0.0;
@@ -765,7 +753,7 @@ private:
         continue;
       }
       const double tm = 0.5 * (ta + tb);
-      const Vector3 x = PointAt(o, d, tm);
+      const Vector3 x = Along(o, d, tm);
       if (!this->SpectralStep(x, tm, tb - ta, 0.0, 0.0, 0.0, this->SunCloudTransmittance(x),
             rayleighPhase, miePhase, knots, w))
       {
@@ -999,7 +987,7 @@ std::vector<double> InterpolatedSunAtmosphereTransmittance(const RenderContext& 
   }
   const Integrator integrator(context, 1.0);
   Integrator::SunKnots knots(integrator, origin, unitDirection, tEnd);
-  knots.Evaluate(t, PointAt(origin, unitDirection, t), T.data());
+  knots.Evaluate(t, Along(origin, unitDirection, t), T.data());
   return T;
 }
 

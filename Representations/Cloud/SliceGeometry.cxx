@@ -8,41 +8,21 @@
 namespace nimbus
 {
 
-double Dot(const Vec3& a, const Vec3& b)
+SliceAxis ComputeSliceAxis(const Vector3& view, const Vector3& toSun, double a)
 {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-Vec3 Cross(const Vec3& a, const Vec3& b)
-{
-  return { { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] } };
-}
-
-Vec3 Normalized(const Vec3& v)
-{
-  const double length = std::sqrt(Dot(v, v));
-  if (!(length > 0.0) || !std::isfinite(length))
-  {
-    throw std::invalid_argument("direction must be finite and non-zero");
-  }
-  return { { v[0] / length, v[1] / length, v[2] / length } };
-}
-
-SliceAxis ComputeSliceAxis(const Vec3& view, const Vec3& toSun, double a)
-{
-  const Vec3 v = Normalized(view);
-  const Vec3 l = Normalized(toSun);
+  const Vector3 v = Normalized(view);
+  const Vector3 l = Normalized(toSun);
   if (!std::isfinite(a))
   {
     throw std::invalid_argument("slice angle ratio a must be finite");
   }
   a = std::clamp(a, 0.01, 100.0);
-  const Vec3 away = { { -l[0], -l[1], -l[2] } }; // direction sunlight travels
+  const Vector3 away = { { -l[0], -l[1], -l[2] } }; // direction sunlight travels
   SliceAxis axis;
   // Sun behind the camera (dot(V, L) < 0): moving away from the sun moves away
   // from the eye -> front to back along +V. Otherwise back to front along -V.
   axis.BackToFront = Dot(v, l) >= 0.0;
-  const Vec3 e = axis.BackToFront ? Vec3{ { -v[0], -v[1], -v[2] } } : v;
+  const Vector3 e = axis.BackToFront ? Vector3{ { -v[0], -v[1], -v[2] } } : v;
   // Angle between e and -L is in [0, pi/2] by the choice of sign.
   const double c = std::clamp(Dot(e, away), -1.0, 1.0);
   const double total = std::acos(c);
@@ -65,11 +45,11 @@ SliceAxis ComputeSliceAxis(const Vec3& view, const Vec3& toSun, double a)
   return axis;
 }
 
-std::array<double, 2> ProjectedRange(const std::vector<Vec3>& corners, const Vec3& n)
+std::array<double, 2> ProjectedRange(const std::vector<Vector3>& corners, const Vector3& n)
 {
   std::array<double, 2> range{ { std::numeric_limits<double>::infinity(),
     -std::numeric_limits<double>::infinity() } };
-  for (const Vec3& corner : corners)
+  for (const Vector3& corner : corners)
   {
     const double d = Dot(corner, n);
     range[0] = std::min(range[0], d);
@@ -94,9 +74,9 @@ SlicePlanes MakeSlicePlanes(double dMin, double dMax, int count)
   return planes;
 }
 
-std::vector<Vec3> SlicePolygon(const std::vector<Vec3>& corners, const Vec3& n, double d)
+std::vector<Vector3> SlicePolygon(const std::vector<Vector3>& corners, const Vector3& n, double d)
 {
-  std::vector<Vec3> points;
+  std::vector<Vector3> points;
   if (corners.size() != 8)
   {
     throw std::invalid_argument("SlicePolygon needs the 8 corners of a box");
@@ -109,8 +89,8 @@ std::vector<Vec3> SlicePolygon(const std::vector<Vec3>& corners, const Vec3& n, 
       {
         continue;
       }
-      const Vec3& a = corners[c];
-      const Vec3& b = corners[c | bit];
+      const Vector3& a = corners[c];
+      const Vector3& b = corners[c | bit];
       const double da = Dot(a, n) - d, db = Dot(b, n) - d;
       if ((da < 0.0 && db < 0.0) || (da > 0.0 && db > 0.0))
       {
@@ -124,16 +104,18 @@ std::vector<Vec3> SlicePolygon(const std::vector<Vec3>& corners, const Vec3& n, 
   return points;
 }
 
-ShadowFrame ComputeShadowFrame(const std::vector<Vec3>& corners, const Vec3& toSun, double margin)
+ShadowFrame ComputeShadowFrame(
+  const std::vector<Vector3>& corners, const Vector3& toSun, double margin)
 {
-  const Vec3 l = Normalized(toSun);
+  const Vector3 l = Normalized(toSun);
   // Any axis not parallel to L seeds the basis.
-  const Vec3 seed = std::abs(l[2]) < 0.9 ? Vec3{ { 0.0, 0.0, 1.0 } } : Vec3{ { 1.0, 0.0, 0.0 } };
+  const Vector3 seed =
+    std::abs(l[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
   ShadowFrame frame;
   frame.U = Normalized(Cross(seed, l));
   frame.W = Cross(l, frame.U);
   double uMin = std::numeric_limits<double>::infinity(), uMax = -uMin, wMin = uMin, wMax = -uMin;
-  for (const Vec3& corner : corners)
+  for (const Vector3& corner : corners)
   {
     const double u = Dot(corner, frame.U), w = Dot(corner, frame.W);
     uMin = std::min(uMin, u);

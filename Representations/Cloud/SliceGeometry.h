@@ -19,6 +19,7 @@
 #ifndef nimbus_SliceGeometry_h
 #define nimbus_SliceGeometry_h
 
+#include "Math.h"
 #include "NimbusRepresentationsModule.h"
 
 #include <array>
@@ -26,15 +27,13 @@
 
 namespace nimbus
 {
-using Vec3 = std::array<double, 3>;
-
 struct NIMBUSREPRESENTATIONS_EXPORT SliceAxis
 {
-  Vec3 Normal{ { 0.0, 0.0, 1.0 } }; // n, unit, dot(n, -L) > 0
-  bool BackToFront = false;         // traversal order on the screen (000 §4.3)
-  double ThetaView = 0.0;           // angle between n and +-V [rad]
-  double ThetaSun = 0.0;            // angle between n and -L  [rad]
-  double SunCosine = 1.0;           // dot(n, -L) > 0: Delta s = Delta d / SunCosine
+  Vector3 Normal{ { 0.0, 0.0, 1.0 } }; // n, unit, dot(n, -L) > 0
+  bool BackToFront = false;            // traversal order on the screen (000 §4.3)
+  double ThetaView = 0.0;              // angle between n and +-V [rad]
+  double ThetaSun = 0.0;               // angle between n and -L  [rad]
+  double SunCosine = 1.0;              // dot(n, -L) > 0: Delta s = Delta d / SunCosine
 };
 
 /// Slice normal for view V, sun L (need not be unit; throws std::invalid_argument
@@ -42,12 +41,12 @@ struct NIMBUSREPRESENTATIONS_EXPORT SliceAxis
 /// the paper uses 1..2). Degenerate cases: V parallel or anti-parallel to L give
 /// n = -L exactly.
 NIMBUSREPRESENTATIONS_EXPORT SliceAxis ComputeSliceAxis(
-  const Vec3& view, const Vec3& toSun, double a);
+  const Vector3& view, const Vector3& toSun, double a);
 
 /// Range [dMin, dMax] of dot(x, n) over the 8 corners of an axis-aligned or
 /// transformed box (corners given explicitly).
 NIMBUSREPRESENTATIONS_EXPORT std::array<double, 2> ProjectedRange(
-  const std::vector<Vec3>& corners, const Vec3& n);
+  const std::vector<Vector3>& corners, const Vector3& n);
 
 /// Slice plane offsets: `count` planes at the centres of equal slabs covering
 /// [dMin, dMax]; spacing = (dMax - dMin)/count. count >= 1.
@@ -62,28 +61,25 @@ NIMBUSREPRESENTATIONS_EXPORT SlicePlanes MakeSlicePlanes(double dMin, double dMa
 /// corners are given in the order corner c = (c & 1 ? x1 : x0, c & 2 ? y1 : y0,
 /// c & 4 ? z1 : z0) (any affine image of such a box). Empty when the plane misses
 /// the box. Used to scissor each slice's passes to the pixels it can touch.
-NIMBUSREPRESENTATIONS_EXPORT std::vector<Vec3> SlicePolygon(
-  const std::vector<Vec3>& corners, const Vec3& n, double d);
+NIMBUSREPRESENTATIONS_EXPORT std::vector<Vector3> SlicePolygon(
+  const std::vector<Vector3>& corners, const Vector3& n, double d);
 
 /// Orthographic frame of the shadow surface: it faces the sun (normal -L) and
 /// covers the projection of the box corners. A point x maps to texture
 /// coordinates ((dot(x - Origin, U)) / Width, (dot(x - Origin, W)) / Height).
 struct NIMBUSREPRESENTATIONS_EXPORT ShadowFrame
 {
-  Vec3 Origin{ { 0.0, 0.0, 0.0 } };
-  Vec3 U{ { 1.0, 0.0, 0.0 } };
-  Vec3 W{ { 0.0, 1.0, 0.0 } };
+  Vector3 Origin{ { 0.0, 0.0, 0.0 } };
+  Vector3 U{ { 1.0, 0.0, 0.0 } };
+  Vector3 W{ { 0.0, 1.0, 0.0 } };
   double Width = 1.0;
   double Height = 1.0;
 };
 /// `margin` is a fraction of the extent added on every side (texels at the rim
 /// then stay unshadowed, so clamp-to-edge lookups outside are exact).
 NIMBUSREPRESENTATIONS_EXPORT ShadowFrame ComputeShadowFrame(
-  const std::vector<Vec3>& corners, const Vec3& toSun, double margin);
+  const std::vector<Vector3>& corners, const Vector3& toSun, double margin);
 
-NIMBUSREPRESENTATIONS_EXPORT Vec3 Normalized(const Vec3& v);
-NIMBUSREPRESENTATIONS_EXPORT double Dot(const Vec3& a, const Vec3& b);
-NIMBUSREPRESENTATIONS_EXPORT Vec3 Cross(const Vec3& a, const Vec3& b);
 } // namespace nimbus
 
 #endif

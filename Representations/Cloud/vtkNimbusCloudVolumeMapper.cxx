@@ -1,4 +1,5 @@
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "Math.h"
 
 #include "AtmosphereTable.h"
 #include "SceneDescription.h"
@@ -48,7 +49,7 @@ vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
 
 namespace
 {
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
+using nimbus::kDegree;
 
 // Column-major float copy of a VTK (row-major) matrix, for glUniformMatrix4fv.
 std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
@@ -481,16 +482,16 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     return;
   }
   const double elevation = settings.SunElevation * kDegree, azimuth = settings.SunAzimuth * kDegree;
-  const nimbus::Vec3 toSun = { { std::cos(elevation) * std::sin(azimuth),
+  const nimbus::Vector3 toSun = { { std::cos(elevation) * std::sin(azimuth),
     std::cos(elevation) * std::cos(azimuth), std::sin(elevation) } };
   double projection[3];
   camera->GetDirectionOfProjection(projection);
-  const nimbus::Vec3 view = { { projection[0], projection[1], projection[2] } };
+  const nimbus::Vector3 view = { { projection[0], projection[1], projection[2] } };
   const nimbus::SliceAxis axis = nimbus::ComputeSliceAxis(view, toSun, this->SliceAngleRatio);
   in.LastBackToFront = axis.BackToFront;
 
   vtkMatrix4x4* dataToWorld = volume->GetMatrix();
-  std::vector<nimbus::Vec3> corners;
+  std::vector<nimbus::Vector3> corners;
   for (int c = 0; c < 8; ++c)
   {
     const double p[4] = { in.BoxOrigin[0] + ((c & 1) ? in.BoxSize[0] : 0.0),
@@ -826,7 +827,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   // it the density is zero. On screen this holds only when nothing outside the
   // box is drawn (no atmosphere, no ground).
   vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
-  auto screenRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4])
+  auto screenRect = [&](const std::vector<nimbus::Vector3>& points, int rect[4])
   {
     double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
     for (const auto& point : points)
@@ -858,13 +859,13 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     rect[3] = std::max(py1 - py0, 0);
     return true;
   };
-  auto shadowRect = [&](const std::vector<nimbus::Vec3>& points, int rect[4])
+  auto shadowRect = [&](const std::vector<nimbus::Vector3>& points, int rect[4])
   {
     const int size = this->ShadowSurfaceSize;
     double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
     for (const auto& point : points)
     {
-      const nimbus::Vec3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
+      const nimbus::Vector3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
         point[2] - frame.Origin[2] } };
       const double st[2] = { nimbus::Dot(q, frame.U) / frame.Width * size,
         nimbus::Dot(q, frame.W) / frame.Height * size };
@@ -903,7 +904,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   for (size_t i = 0; i < planes.Offsets.size(); ++i)
   {
     const float offset = static_cast<float>(planes.Offsets[i]);
-    const std::vector<nimbus::Vec3> polygon =
+    const std::vector<nimbus::Vector3> polygon =
       nimbus::SlicePolygon(corners, axis.Normal, planes.Offsets[i]);
     if (polygon.empty())
     {

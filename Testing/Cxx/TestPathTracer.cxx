@@ -3,6 +3,7 @@
 // 1/sqrt(N) convergence rate, single scattering from a slab against its closed
 // form, the phase-function sign convention, determinism across seeds and thread
 // counts, calibration of the standard-error estimate, and stability cases.
+#include "Math.h"
 #include "PathTracer.h"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,7 @@ using nimbus::PathTracingSettings;
 using nimbus::RenderContext;
 using nimbus::SceneDescription;
 using V = std::array<double, 3>;
-constexpr double kPi = 3.14159265358979323846;
+using nimbus::kPi;
 
 /// A scene with nothing but the camera: no atmosphere, no ground, black
 /// background, no sun. Tests switch on what they need.

@@ -4,6 +4,7 @@
 // Homogeneous media come from DensityGrid::Constant (2 points per axis, so the grid
 // "minimum spacing" is the smallest box edge and the cloud step is
 // StepScale × that edge). Units: metres, 1/m; radiance relative to the sun.
+#include "Math.h"
 #include "SingleScatteringRenderer.h"
 
 #include "DensityGrid.h"
@@ -23,12 +24,13 @@
 namespace
 {
 using nimbus::DensityGrid;
+using nimbus::Dot;
 using nimbus::RenderContext;
 using nimbus::SceneDescription;
-using Vector3 = std::array<double, 3>;
+using nimbus::Vector3;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegree = kPi / 180.0;
+using nimbus::kDegree;
+using nimbus::kPi;
 
 /// No atmosphere, no ground, black background, HG phase.
 SceneDescription PlainScene(double sunElevation, double sunAzimuth, double g = 0.6)
@@ -62,11 +64,6 @@ Vector3 Direction(double elevationDeg, double azimuthDeg)
 {
   const double e = elevationDeg * kDegree, a = azimuthDeg * kDegree;
   return { { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) } };
-}
-
-double Dot(const Vector3& a, const Vector3& b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
 /// Single scattering of a homogeneous slab z in [0, D] (σ_t, σ_s = albedo σ_t),

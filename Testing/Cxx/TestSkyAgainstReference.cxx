@@ -5,6 +5,7 @@
 //
 // Every bound below is set from the measured value printed by the test (see
 // docs/sky.md for the table); units: radiance relative to the sun (Y = 1).
+#include "Math.h"
 #include "Sky.h"
 
 #include "DensityGrid.h"
@@ -25,11 +26,10 @@ namespace
 using nimbus::SkyModel;
 using nimbus::SkyParameters;
 using nimbus::SkyViewLut;
-using Vector3 = std::array<double, 3>;
+using nimbus::Vector3;
 using Rgb = std::array<double, 3>;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegree = kPi / 180.0;
+using nimbus::kDegree;
 
 Vector3 Direction(double elevationDeg, double azimuthDeg)
 {

@@ -7,16 +7,16 @@
 #include <cmath>
 #include <random>
 
-using nimbus::Vec3;
+using nimbus::Vector3;
 
 namespace
 {
-double Angle(const Vec3& a, const Vec3& b)
+double Angle(const Vector3& a, const Vector3& b)
 {
   return std::acos(
     std::clamp(nimbus::Dot(nimbus::Normalized(a), nimbus::Normalized(b)), -1.0, 1.0));
 }
-Vec3 Neg(const Vec3& v)
+Vector3 Neg(const Vector3& v)
 {
   return { { -v[0], -v[1], -v[2] } };
 }
@@ -28,8 +28,8 @@ TEST(SliceGeometry, AngleRatioAndOrder)
   std::normal_distribution<double> n01;
   for (int i = 0; i < 2000; ++i)
   {
-    const Vec3 v = nimbus::Normalized({ { n01(rng), n01(rng), n01(rng) } });
-    const Vec3 l = nimbus::Normalized({ { n01(rng), n01(rng), n01(rng) } });
+    const Vector3 v = nimbus::Normalized({ { n01(rng), n01(rng), n01(rng) } });
+    const Vector3 l = nimbus::Normalized({ { n01(rng), n01(rng), n01(rng) } });
     for (double a : { 1.0, 1.5, 2.0 })
     {
       const nimbus::SliceAxis axis = nimbus::ComputeSliceAxis(v, l, a);
@@ -37,7 +37,7 @@ TEST(SliceGeometry, AngleRatioAndOrder)
       // Always moving away from the sun, so the shadow accumulates in order.
       ASSERT_GT(nimbus::Dot(axis.Normal, Neg(l)), 0.0);
       ASSERT_EQ(axis.BackToFront, nimbus::Dot(v, l) >= 0.0);
-      const Vec3 e = axis.BackToFront ? Neg(v) : v;
+      const Vector3 e = axis.BackToFront ? Neg(v) : v;
       const double thetaE = Angle(axis.Normal, e), thetaS = Angle(axis.Normal, Neg(l));
       // theta_e : theta_s = 1 : a, and the normal lies between the two.
       ASSERT_NEAR(thetaS, a * thetaE, 1e-9);
@@ -51,8 +51,8 @@ TEST(SliceGeometry, AngleRatioAndOrder)
 
 TEST(SliceGeometry, DegenerateViewAlongAndAgainstSun)
 {
-  const Vec3 l = nimbus::Normalized({ { 0.3, 0.4, 0.5 } });
-  for (const Vec3& v : { l, Neg(l) })
+  const Vector3 l = nimbus::Normalized({ { 0.3, 0.4, 0.5 } });
+  for (const Vector3& v : { l, Neg(l) })
   {
     for (double a : { 1.0, 2.0 })
     {
@@ -74,13 +74,13 @@ TEST(SliceGeometry, DegenerateViewAlongAndAgainstSun)
 
 TEST(SliceGeometry, PlanesAndShadowFrame)
 {
-  std::vector<Vec3> corners;
+  std::vector<Vector3> corners;
   for (int c = 0; c < 8; ++c)
   {
     corners.push_back(
       { { (c & 1) ? 100.0 : -100.0, (c & 2) ? 50.0 : -50.0, (c & 4) ? 30.0 : 10.0 } });
   }
-  const Vec3 n = nimbus::Normalized({ { 0, 0, 1 } });
+  const Vector3 n = nimbus::Normalized({ { 0, 0, 1 } });
   const auto range = nimbus::ProjectedRange(corners, n);
   EXPECT_DOUBLE_EQ(range[0], 10.0);
   EXPECT_DOUBLE_EQ(range[1], 30.0);
@@ -90,16 +90,16 @@ TEST(SliceGeometry, PlanesAndShadowFrame)
   EXPECT_DOUBLE_EQ(planes.Offsets.back(), 27.5);
   EXPECT_THROW(nimbus::MakeSlicePlanes(0, 1, 0), std::invalid_argument);
 
-  const Vec3 l = nimbus::Normalized({ { 0.2, -0.5, 0.8 } });
+  const Vector3 l = nimbus::Normalized({ { 0.2, -0.5, 0.8 } });
   const nimbus::ShadowFrame frame = nimbus::ComputeShadowFrame(corners, l, 0.02);
   EXPECT_NEAR(nimbus::Dot(frame.U, frame.U), 1.0, 1e-12);
   EXPECT_NEAR(nimbus::Dot(frame.W, frame.W), 1.0, 1e-12);
   EXPECT_NEAR(nimbus::Dot(frame.U, frame.W), 0.0, 1e-12);
   EXPECT_NEAR(nimbus::Dot(frame.U, l), 0.0, 1e-12);
   EXPECT_NEAR(nimbus::Dot(frame.W, l), 0.0, 1e-12);
-  for (const Vec3& corner : corners)
+  for (const Vector3& corner : corners)
   {
-    const Vec3 q = { { corner[0] - frame.Origin[0], corner[1] - frame.Origin[1],
+    const Vector3 q = { { corner[0] - frame.Origin[0], corner[1] - frame.Origin[1],
       corner[2] - frame.Origin[2] } };
     const double s = nimbus::Dot(q, frame.U) / frame.Width,
                  t = nimbus::Dot(q, frame.W) / frame.Height;
@@ -176,23 +176,23 @@ TEST(AtmosphereTable, RowsFollowTheAtmosphere)
 
 TEST(SliceGeometry, SlicePolygonCutsTheBox)
 {
-  std::vector<Vec3> cube;
+  std::vector<Vector3> cube;
   for (int c = 0; c < 8; ++c)
   {
     cube.push_back({ { (c & 1) ? 1.0 : 0.0, (c & 2) ? 1.0 : 0.0, (c & 4) ? 1.0 : 0.0 } });
   }
   const auto square = nimbus::SlicePolygon(cube, { { 0, 0, 1 } }, 0.25);
   ASSERT_EQ(square.size(), 4u);
-  for (const Vec3& p : square)
+  for (const Vector3& p : square)
   {
     EXPECT_DOUBLE_EQ(p[2], 0.25);
   }
   // The plane through the centre with normal (1,1,1) cuts a regular hexagon.
-  const Vec3 diagonal = nimbus::Normalized({ { 1, 1, 1 } });
+  const Vector3 diagonal = nimbus::Normalized({ { 1, 1, 1 } });
   const auto hexagon =
     nimbus::SlicePolygon(cube, diagonal, nimbus::Dot(diagonal, { { 0.5, 0.5, 0.5 } }));
   ASSERT_EQ(hexagon.size(), 6u);
-  for (const Vec3& p : hexagon)
+  for (const Vector3& p : hexagon)
   {
     EXPECT_NEAR(p[0] + p[1] + p[2], 1.5, 1e-12);
     EXPECT_NEAR(std::sqrt((p[0] - 0.5) * (p[0] - 0.5) + (p[1] - 0.5) * (p[1] - 0.5) +
