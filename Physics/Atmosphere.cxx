@@ -204,12 +204,13 @@ void CheckPoint(const Vector3& p)
 Atmosphere::Atmosphere(const AtmosphereParameters& p)
   : Parameters(p)
 {
-  const bool ok = std::isfinite(p.earthRadius) && std::isfinite(p.topRadius) &&
-    p.earthRadius > 0.0 && p.topRadius > p.earthRadius && std::isfinite(p.rayleighScaleHeight) &&
-    p.rayleighScaleHeight > 0.0 && std::isfinite(p.mieScaleHeight) && p.mieScaleHeight > 0.0 &&
-    std::isfinite(p.rayleighScattering550) && p.rayleighScattering550 >= 0.0 &&
-    std::isfinite(p.mieScattering) && p.mieScattering >= 0.0 && p.mieSingleScatteringAlbedo > 0.0 &&
-    p.mieSingleScatteringAlbedo <= 1.0 && !std::isnan(p.mieG);
+  const bool ok = std::isfinite(p.EarthRadiusMetres) && std::isfinite(p.TopRadiusMetres) &&
+    p.EarthRadiusMetres > 0.0 && p.TopRadiusMetres > p.EarthRadiusMetres &&
+    std::isfinite(p.RayleighScaleHeightMetres) && p.RayleighScaleHeightMetres > 0.0 &&
+    std::isfinite(p.MieScaleHeightMetres) && p.MieScaleHeightMetres > 0.0 &&
+    std::isfinite(p.RayleighScatteringPerMetre) && p.RayleighScatteringPerMetre >= 0.0 &&
+    std::isfinite(p.MieScatteringPerMetre) && p.MieScatteringPerMetre >= 0.0 && p.MieAlbedo > 0.0 &&
+    p.MieAlbedo <= 1.0 && !std::isnan(p.MieG);
   if (!ok)
   {
     throw std::invalid_argument("nimbus::Atmosphere: invalid AtmosphereParameters");
@@ -218,12 +219,12 @@ Atmosphere::Atmosphere(const AtmosphereParameters& p)
 
 double Atmosphere::Altitude(const Vector3& p) const
 {
-  return std::sqrt(Dot(p, p)) - this->Parameters.earthRadius;
+  return std::sqrt(Dot(p, p)) - this->Parameters.EarthRadiusMetres;
 }
 
 double Atmosphere::Density(double altitude, double scaleHeight) const
 {
-  const double thickness = this->Parameters.topRadius - this->Parameters.earthRadius;
+  const double thickness = this->Parameters.TopRadiusMetres - this->Parameters.EarthRadiusMetres;
   if (altitude > thickness)
   {
     return 0.0;
@@ -234,17 +235,17 @@ double Atmosphere::Density(double altitude, double scaleHeight) const
 double Atmosphere::RayleighScattering(double lambdaNm) const
 {
   const double x = 550.0 / lambdaNm;
-  return this->Parameters.rayleighScattering550 * (x * x) * (x * x);
+  return this->Parameters.RayleighScatteringPerMetre * (x * x) * (x * x);
 }
 
 double Atmosphere::MieScattering(double) const
 {
-  return this->Parameters.mieScattering;
+  return this->Parameters.MieScatteringPerMetre;
 }
 
 double Atmosphere::MieExtinction(double lambdaNm) const
 {
-  return this->MieScattering(lambdaNm) / this->Parameters.mieSingleScatteringAlbedo;
+  return this->MieScattering(lambdaNm) / this->Parameters.MieAlbedo;
 }
 
 double Atmosphere::RayleighPhase(double mu) const
@@ -254,7 +255,7 @@ double Atmosphere::RayleighPhase(double mu) const
 
 double Atmosphere::MiePhase(double mu) const
 {
-  return CornetteShanks(mu, this->Parameters.mieG);
+  return CornetteShanks(mu, this->Parameters.MieG);
 }
 
 //------------------------------------------------------------------------------
@@ -274,19 +275,19 @@ double Atmosphere::OpticalLength(const Vector3& p0, const Vector3& p1, double H)
   }
   const Ray ray = MakeRay(p0, delta);
   double sIn = 0.0, sOut = 0.0;
-  if (!BallInterval(ray, this->Parameters.topRadius, sIn, sOut))
+  if (!BallInterval(ray, this->Parameters.TopRadiusMetres, sIn, sOut))
   {
     return 0.0;
   }
   // Clip the segment [0, length] to the atmosphere ball (density 0 above the top).
   return IntegrateDensity(
-    ray, this->Parameters.earthRadius, H, std::max(0.0, sIn), std::min(length, sOut));
+    ray, this->Parameters.EarthRadiusMetres, H, std::max(0.0, sIn), std::min(length, sOut));
 }
 
 OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& d) const
 {
   CheckPoint(p);
-  const double R = this->Parameters.earthRadius;
+  const double R = this->Parameters.EarthRadiusMetres;
   Ray ray = MakeRay(p, d);
   if (ray.r0 < R)
   {
@@ -301,7 +302,7 @@ OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& 
 
   OpticalLengths result;
   double sIn = 0.0, sOut = 0.0;
-  if (!BallInterval(ray, this->Parameters.topRadius, sIn, sOut) || !(sOut > 0.0))
+  if (!BallInterval(ray, this->Parameters.TopRadiusMetres, sIn, sOut) || !(sOut > 0.0))
   {
     return result; // misses the atmosphere, or above it looking away
   }
@@ -316,26 +317,27 @@ OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& 
   {
     // Nearest root without cancellation: s = c / (-b + sqrt(disc)).
     const double sGround = cGround / (-ray.b + std::sqrt(discGround));
-    result.hitsGround = true;
+    result.HitsGround = true;
     sEnd = std::min(sEnd, sGround);
   }
   sBegin = std::min(sBegin, sEnd);
 
-  result.rayleighLength =
-    IntegrateDensity(ray, R, this->Parameters.rayleighScaleHeight, sBegin, sEnd);
-  result.mieLength = IntegrateDensity(ray, R, this->Parameters.mieScaleHeight, sBegin, sEnd);
+  result.RayleighLengthMetres =
+    IntegrateDensity(ray, R, this->Parameters.RayleighScaleHeightMetres, sBegin, sEnd);
+  result.MieLengthMetres =
+    IntegrateDensity(ray, R, this->Parameters.MieScaleHeightMetres, sBegin, sEnd);
   return result;
 }
 
 double Atmosphere::OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const
 {
-  return this->RayleighScattering(lambdaNm) * lengths.rayleighLength +
-    this->MieExtinction(lambdaNm) * lengths.mieLength;
+  return this->RayleighScattering(lambdaNm) * lengths.RayleighLengthMetres +
+    this->MieExtinction(lambdaNm) * lengths.MieLengthMetres;
 }
 
 double Atmosphere::Transmittance(const OpticalLengths& lengths, double lambdaNm) const
 {
-  if (lengths.hitsGround)
+  if (lengths.HitsGround)
   {
     return 0.0;
   }
@@ -350,8 +352,9 @@ double Atmosphere::TransmittanceToTop(const Vector3& p, const Vector3& d, double
 double Atmosphere::TransmittanceBetween(const Vector3& p0, const Vector3& p1, double lambdaNm) const
 {
   OpticalLengths lengths;
-  lengths.rayleighLength = this->OpticalLength(p0, p1, this->Parameters.rayleighScaleHeight);
-  lengths.mieLength = this->OpticalLength(p0, p1, this->Parameters.mieScaleHeight);
+  lengths.RayleighLengthMetres =
+    this->OpticalLength(p0, p1, this->Parameters.RayleighScaleHeightMetres);
+  lengths.MieLengthMetres = this->OpticalLength(p0, p1, this->Parameters.MieScaleHeightMetres);
   return this->Transmittance(lengths, lambdaNm);
 }
 

@@ -23,27 +23,37 @@
 namespace nimbus
 {
 
-/// Parameters of the atmosphere.  Defaults: Nishita et al. 1993 / Bruneton &
-/// Neyret 2008 values.
+/// The air: what every renderer, the sky and the scene format call the
+/// atmosphere's parameters (names carry their units). Defaults: Nishita et al.
+/// 1993 / Bruneton & Neyret 2008 values.
 struct NIMBUSPHYSICS_EXPORT AtmosphereParameters
 {
-  double earthRadius = 6360000.0;         // R_e [m]
-  double topRadius = 6420000.0;           // R_top [m], 60 km thick atmosphere
-  double rayleighScaleHeight = 8000.0;    // H_R [m]
-  double mieScaleHeight = 1200.0;         // H_M [m]
-  double rayleighScattering550 = 13.5e-6; // beta_R at sea level and 550 nm [1/m]
-                                          // (molecules do not absorb: extinction = scattering)
-  double mieScattering = 2.0e-5;          // beta_M,s at sea level [1/m], wavelength independent
-  double mieSingleScatteringAlbedo = 0.9; // beta_M,s / beta_M,ext
-  double mieG = 0.76;                     // Cornette-Shanks asymmetry of the aerosol phase function
+  double EarthRadiusMetres = 6360000.0;        // R_e
+  double TopRadiusMetres = 6420000.0;          // R_top: a 60 km thick atmosphere
+  double RayleighScaleHeightMetres = 8000.0;   // H_R
+  double MieScaleHeightMetres = 1200.0;        // H_M
+  double RayleighScatteringPerMetre = 13.5e-6; // beta_R at sea level and 550 nm (molecules
+                                               // do not absorb: extinction = scattering)
+  double MieScatteringPerMetre = 2.0e-5;       // beta_M,s at sea level, wavelength independent
+  double MieAlbedo = 0.9;                      // beta_M,s / beta_M,ext of the aerosols
+  double MieG = 0.76; // Cornette-Shanks asymmetry of the aerosol phase function
 };
 
-/// Optical lengths (sea-level-equivalent column lengths, metres) along a ray.
+/// The air over a scene: the atmosphere, whether it is there at all, and where the
+/// scene sits in it. Scene point p (metres) maps to the earth-centred frame as
+/// (p.x, p.y, EarthRadiusMetres + SceneAltitudeMetres + p.z).
+struct NIMBUSPHYSICS_EXPORT SceneAtmosphere : AtmosphereParameters
+{
+  bool Enabled = true;
+  double SceneAltitudeMetres = 0.0; // altitude above sea level of the scene's z = 0
+};
+
+/// Optical lengths (sea-level-equivalent column lengths) along a ray.
 struct NIMBUSPHYSICS_EXPORT OpticalLengths
 {
-  double rayleighLength = 0.0; // integral exp(-h/H_R) ds [m]
-  double mieLength = 0.0;      // integral exp(-h/H_M) ds [m]
-  bool hitsGround = false;     // the ray hits the earth; lengths are up to the hit point
+  double RayleighLengthMetres = 0.0; // integral exp(-h/H_R) ds
+  double MieLengthMetres = 0.0;      // integral exp(-h/H_M) ds
+  bool HitsGround = false;           // the ray hits the earth; lengths are up to the hit point
 };
 
 class NIMBUSPHYSICS_EXPORT Atmosphere
@@ -96,7 +106,7 @@ public:
 
   /// tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M (dimensionless; ignores hitsGround).
   double OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const;
-  /// exp(-tau(lambda)); exactly 0 when lengths.hitsGround.
+  /// exp(-tau(lambda)); exactly 0 when lengths.HitsGround.
   double Transmittance(const OpticalLengths& lengths, double lambdaNm) const;
   /// Transmittance from p toward direction d to the top of the atmosphere (e.g.
   /// sunlight reaching p, with d toward the sun); 0 if the earth blocks the ray.

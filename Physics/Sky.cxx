@@ -10,6 +10,7 @@
 #include "Math.h"
 
 #include "PhaseFunctions.h"
+#include "Sun.h"
 
 #include <algorithm>
 #include <atomic>
@@ -117,12 +118,6 @@ void Locate(double x, int n, int& i0, double& f)
 } // namespace
 
 //------------------------------------------------------------------------------
-std::array<double, 3> SunDirectionFromAngles(double elevationDeg, double azimuthDeg)
-{
-  const double e = elevationDeg * kDegree, a = azimuthDeg * kDegree;
-  return { { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) } };
-}
-
 double PreethamZenithLuminance(double turbidity, double sunZenith)
 {
   const double chi = (4.0 / 9.0 - turbidity / 120.0) * (kPi - 2.0 * sunZenith);
@@ -144,8 +139,8 @@ SkyModel::SkyModel(const SkyParameters& p)
   Require(
     p.ScatteringOrders >= 1 && p.ScatteringOrders <= 50, "ScatteringOrders", "must be in [1, 50]");
   Require(p.Wavelengths >= 3 && p.Wavelengths <= 256, "Wavelengths", "must be in [3, 256]");
-  Require(std::isfinite(p.SunTemperature) && p.SunTemperature >= 1000.0, "SunTemperature",
-    "must be >= 1000 K");
+  Require(std::isfinite(p.SunTemperatureKelvin) && p.SunTemperatureKelvin >= 1000.0,
+    "SunTemperatureKelvin", "must be >= 1000 K");
   Require(p.TransmittanceMuSize >= 2 && p.TransmittanceRSize >= 2, "TransmittanceMuSize/RSize",
     "must be >= 2");
   Require(
@@ -164,14 +159,7 @@ SkyModel::SkyModel(const SkyParameters& p)
   this->Spectrum = std::make_unique<SpectralSamples>(p.Wavelengths,
     p.Wavelengths >= 8 ? SpectralReconstruction::NaturalCubicSpline
                        : SpectralReconstruction::PiecewiseLinear);
-  const double temperature = p.SunTemperature;
-  this->SunIrradiance = this->Spectrum->Sample(
-    [temperature](double lambda) { return PlanckSpectralRadiance(lambda, temperature); });
-  const double y = this->Spectrum->ToXyz(this->SunIrradiance)[1];
-  for (double& e : this->SunIrradiance)
-  {
-    e /= y;
-  }
+  this->SunIrradiance = SunIrradianceSpectrum(*this->Spectrum, p.SunTemperatureKelvin, 1.0);
   for (double lambda : this->Spectrum->GetWavelengths())
   {
     this->BetaRayleigh.push_back(this->Air->RayleighScattering(lambda));
@@ -201,28 +189,28 @@ double SkyModel::MiePhase(double nu) const
 // Geometry (Bruneton 2017 §"Distance to the top/bottom atmosphere boundary").
 double SkyModel::DistanceToTop(double r, double mu) const
 {
-  const double top = this->Parameters.Atmosphere.topRadius;
+  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double disc = r * r * (mu * mu - 1.0) + top * top;
   return std::max(0.0, -r * mu + std::sqrt(std::max(0.0, disc)));
 }
 
 double SkyModel::DistanceToGround(double r, double mu) const
 {
-  const double R = this->Parameters.Atmosphere.earthRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
   const double disc = r * r * (mu * mu - 1.0) + R * R;
   return std::max(0.0, -r * mu - std::sqrt(std::max(0.0, disc)));
 }
 
 bool SkyModel::RayHitsGround(double r, double mu) const
 {
-  const double R = this->Parameters.Atmosphere.earthRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
   r = std::max(r, R);
   return mu < 0.0 && r * r * (mu * mu - 1.0) + R * R >= 0.0;
 }
 
 double SkyModel::HorizonMu(double r) const
 {
-  const double R = this->Parameters.Atmosphere.earthRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
   if (r <= R)
   {
     return 0.0;
@@ -238,8 +226,8 @@ double SkyModel::HorizonMu(double r) const
 void SkyModel::BuildTransmittance()
 {
   const int nmu = this->Parameters.TransmittanceMuSize, nr = this->Parameters.TransmittanceRSize;
-  const double R = this->Parameters.Atmosphere.earthRadius;
-  const double top = this->Parameters.Atmosphere.topRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
+  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
   this->TransmittanceTable.assign(static_cast<std::size_t>(nmu) * nr * 2, 0.0f);
   ParallelFor(nr, this->Parameters.Threads,
@@ -268,20 +256,20 @@ std::array<double, 2> SkyModel::ExactOpticalLengths(double r, double mu) const
   Vector3 d{ { std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu } };
   OpticalLengths lengths = this->Air->OpticalLengthsToTop(p, d);
   // The tangent ray (x_mu = 1) may round into the ground: tilt it up by ulps.
-  for (int k = 0; k < 8 && lengths.hitsGround; ++k)
+  for (int k = 0; k < 8 && lengths.HitsGround; ++k)
   {
     mu += 1e-12 * (1 << (2 * k));
     d = { { std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu } };
     lengths = this->Air->OpticalLengthsToTop(p, d);
   }
-  return { { lengths.rayleighLength, lengths.mieLength } };
+  return { { lengths.RayleighLengthMetres, lengths.MieLengthMetres } };
 }
 
 std::array<double, 2> SkyModel::LookupOpticalLengths(double r, double mu) const
 {
   const int nmu = this->Parameters.TransmittanceMuSize, nr = this->Parameters.TransmittanceRSize;
-  const double R = this->Parameters.Atmosphere.earthRadius;
-  const double top = this->Parameters.Atmosphere.topRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
+  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
   r = Clamp(r, R, top);
   const double rho = std::sqrt(std::max(0.0, r * r - R * R));
@@ -327,8 +315,8 @@ void SkyModel::LookupTable(const std::vector<float>& table, double r, double muS
 {
   const int n = static_cast<int>(this->BetaRayleigh.size());
   const int nmus = this->Parameters.ScatteringMuSSize, nr = this->Parameters.ScatteringRSize;
-  const double R = this->Parameters.Atmosphere.earthRadius;
-  const double top = this->Parameters.Atmosphere.topRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
+  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
   r = Clamp(r, R, top);
   const double rho = std::sqrt(std::max(0.0, r * r - R * R));
@@ -411,7 +399,7 @@ SkySpectra SkyModel::March(
 {
   const int n = static_cast<int>(this->BetaRayleigh.size());
   const AtmosphereParameters& a = this->Parameters.Atmosphere;
-  const double R = a.earthRadius, top = a.topRadius;
+  const double R = a.EarthRadiusMetres, top = a.TopRadiusMetres;
   SkySpectra out;
   out.Rayleigh.assign(n, 0.0);
   out.Mie.assign(n, 0.0);
@@ -554,8 +542,8 @@ SkySpectra SkyModel::March(
       const Vector3 p{ { x[0] + tm * w[0], x[1] + tm * w[1], x[2] + tm * w[2] } };
       const double rp = std::sqrt(Dot(p, p));
       const double h = rp - R;
-      const double rhoR = this->Air->Density(h, a.rayleighScaleHeight);
-      const double rhoM = this->Air->Density(h, a.mieScaleHeight);
+      const double rhoR = this->Air->Density(h, a.RayleighScaleHeightMetres);
+      const double rhoM = this->Air->Density(h, a.MieScaleHeightMetres);
       const double muS = Clamp(Dot(p, s) / rp, -1.0, 1.0);
       if (o.Single)
       {
@@ -650,8 +638,8 @@ void SkyModel::BuildMultipleScattering()
 {
   const int n = static_cast<int>(this->BetaRayleigh.size());
   const int nmus = this->Parameters.ScatteringMuSSize, nr = this->Parameters.ScatteringRSize;
-  const double R = this->Parameters.Atmosphere.earthRadius;
-  const double top = this->Parameters.Atmosphere.topRadius;
+  const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
+  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
   const std::size_t tableSize = static_cast<std::size_t>(nr) * nmus * n;
   this->MultipleTable.assign(tableSize, 0.0f);
@@ -776,7 +764,7 @@ std::array<double, 3> SkyModel::TransmittanceRgb(const std::vector<double>& tran
 std::array<double, 3> SkyModel::Radiance(
   double altitude, const Vector3& w, const Vector3& s, bool includeMultiple, int steps) const
 {
-  const Vector3 x{ { 0.0, 0.0, this->Parameters.Atmosphere.earthRadius + altitude } };
+  const Vector3 x{ { 0.0, 0.0, this->Parameters.Atmosphere.EarthRadiusMetres + altitude } };
   const SkyRgbParts parts = this->ToRgb(this->IntegrateRay(x, w, s, -1.0, steps, includeMultiple));
   const double nu = Dot(w, s);
   const double pR = this->RayleighPhase(nu), pM = this->MiePhase(nu);
@@ -858,7 +846,7 @@ SkyViewMapping MakeMapping(const SkyModel& model, double altitude, int width, in
   m.AboveRows = above;
   m.BelowRows = below;
   m.HorizonZenith =
-    std::acos(model.HorizonMu(model.GetParameters().Atmosphere.earthRadius + altitude));
+    std::acos(model.HorizonMu(model.GetParameters().Atmosphere.EarthRadiusMetres + altitude));
   return m;
 }
 
@@ -900,7 +888,7 @@ SkyViewLut::SkyViewLut(const SkyModel& model, double sunElevationDeg, double obs
   int width, int aboveRows, int belowRows, bool includeMultiple)
   : Model(model)
   , Mapping(MakeMapping(model, observerAltitude, width, aboveRows, belowRows))
-  , SunElevation(sunElevationDeg)
+  , SunElevationDegrees(sunElevationDeg)
   , ObserverAltitude(observerAltitude)
 {
   Require(std::isfinite(sunElevationDeg) && std::abs(sunElevationDeg) <= 90.0, "sun elevation",
@@ -909,8 +897,9 @@ SkyViewLut::SkyViewLut(const SkyModel& model, double sunElevationDeg, double obs
   const int rows = this->Mapping.Rows(), cols = this->Mapping.Width;
   const std::size_t plane = static_cast<std::size_t>(rows) * cols * 3;
   this->Table.assign(plane * 3, 0.0f);
-  const Vector3 s = SunDirectionFromAngles(sunElevationDeg, 0.0);
-  const Vector3 x{ { 0.0, 0.0, model.GetParameters().Atmosphere.earthRadius + observerAltitude } };
+  const Vector3 s = SunDirection(sunElevationDeg, 0.0);
+  const Vector3 x{ { 0.0, 0.0,
+    model.GetParameters().Atmosphere.EarthRadiusMetres + observerAltitude } };
   ParallelFor(rows, model.GetParameters().Threads,
     [&](int row)
     {
@@ -971,7 +960,7 @@ SkyRgbParts SkyViewLut::Parts(const Vector3& w, double sunAzimuthDeg) const
 std::array<double, 3> SkyViewLut::Radiance(const Vector3& w, double sunAzimuthDeg) const
 {
   const SkyRgbParts parts = this->Parts(w, sunAzimuthDeg);
-  const Vector3 s = SunDirectionFromAngles(this->SunElevation, sunAzimuthDeg);
+  const Vector3 s = SunDirection(this->SunElevationDegrees, sunAzimuthDeg);
   const double nu = Dot(w, s);
   const double pR = this->Model.RayleighPhase(nu), pM = this->Model.MiePhase(nu);
   std::array<double, 3> L;
@@ -989,7 +978,7 @@ AerialPerspectiveLut::AerialPerspectiveLut(const SkyModel& model, double sunElev
   , Model(model)
   , Slices(slices)
   , MaxDistance(maxDistance)
-  , SunElevation(sunElevationDeg)
+  , SunElevationDegrees(sunElevationDeg)
 {
   Require(slices >= 2, "aerial-perspective slices", "must be >= 2");
   Require(std::isfinite(maxDistance) && maxDistance > 0.0, "aerial-perspective max distance",
@@ -1003,8 +992,9 @@ AerialPerspectiveLut::AerialPerspectiveLut(const SkyModel& model, double sunElev
     const double u = static_cast<double>(k) / (slices - 1);
     distances.push_back(maxDistance * u * u);
   }
-  const Vector3 s = SunDirectionFromAngles(sunElevationDeg, 0.0);
-  const Vector3 x{ { 0.0, 0.0, model.GetParameters().Atmosphere.earthRadius + cameraAltitude } };
+  const Vector3 s = SunDirection(sunElevationDeg, 0.0);
+  const Vector3 x{ { 0.0, 0.0,
+    model.GetParameters().Atmosphere.EarthRadiusMetres + cameraAltitude } };
   ParallelFor(rows, model.GetParameters().Threads,
     [&](int row)
     {
@@ -1081,7 +1071,7 @@ void AerialPerspectiveLut::Lookup(const Vector3& w, double distance, double sunA
     }
   }
   // The sun's elevation is in the table; the phase functions take the actual nu.
-  const double nu = Dot(w, SunDirectionFromAngles(this->SunElevation, sunAzimuthDeg));
+  const double nu = Dot(w, SunDirection(this->SunElevationDegrees, sunAzimuthDeg));
   const double pR = this->Model.RayleighPhase(nu), pM = this->Model.MiePhase(nu);
   for (int c = 0; c < 3; ++c)
   {

@@ -61,6 +61,7 @@
 
 #include "Atmosphere.h"
 #include "SpectralColor.h"
+#include "Sun.h"
 
 #include <array>
 #include <memory>
@@ -72,10 +73,10 @@ namespace nimbus
 struct NIMBUSPHYSICS_EXPORT SkyParameters
 {
   AtmosphereParameters Atmosphere;
-  double GroundAlbedo = 0.3;      // grey Lambertian albedo of the earth's surface, [0, 1]
-  int ScatteringOrders = 4;       // K >= 1; 1 = single scattering only
-  int Wavelengths = 16;           // spectral samples (SpectralSamples; >= 8 uses the spline)
-  double SunTemperature = 5778.0; // K, blackbody spectrum of the sun
+  double GroundAlbedo = 0.3;            // grey Lambertian albedo of the earth's surface, [0, 1]
+  int ScatteringOrders = 4;             // K >= 1; 1 = single scattering only
+  int Wavelengths = 16;                 // spectral samples (SpectralSamples; >= 8 uses the spline)
+  double SunTemperatureKelvin = 5778.0; // blackbody spectrum of the sun
   // Table sizes (nodes).
   int TransmittanceMuSize = 256;
   int TransmittanceRSize = 64;
@@ -237,11 +238,6 @@ private:
   double BuildSeconds = 0.0;
 };
 
-/// Sun direction in the local frame (x east, y north, z up) from elevation and
-/// azimuth (degrees; azimuth from north toward east, as in SceneDescription).
-NIMBUSPHYSICS_EXPORT std::array<double, 3> SunDirectionFromAngles(
-  double elevationDeg, double azimuthDeg);
-
 /// Maps of the sky-view rows: view zenith angle <-> row coordinate, split at the horizon.
 struct NIMBUSPHYSICS_EXPORT SkyViewMapping
 {
@@ -276,7 +272,7 @@ public:
   SkyRgbParts Parts(const Vector3& w, double sunAzimuthDeg) const;
 
   const SkyViewMapping& GetMapping() const { return this->Mapping; }
-  double GetSunElevation() const { return this->SunElevation; }
+  double GetSunElevationDegrees() const { return this->SunElevationDegrees; }
   double GetObserverAltitude() const { return this->ObserverAltitude; }
   /// [component (Rayleigh, Mie, Isotropic)][row][column][rgb], linear sRGB floats.
   const std::vector<float>& GetTable() const { return this->Table; }
@@ -285,7 +281,7 @@ public:
 private:
   const SkyModel& Model;
   SkyViewMapping Mapping;
-  double SunElevation;
+  double SunElevationDegrees;
   double ObserverAltitude;
   std::vector<float> Table;
   double BuildSeconds = 0.0;
@@ -321,7 +317,7 @@ private:
   const SkyModel& Model;
   int Slices;
   double MaxDistance;
-  double SunElevation;
+  double SunElevationDegrees;
   std::vector<float> Table;
   double BuildSeconds = 0.0;
 };

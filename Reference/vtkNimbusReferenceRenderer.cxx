@@ -259,6 +259,19 @@ int vtkNimbusReferenceRenderer::RequestData(
   return 1;
 }
 
+std::string vtkNimbusReferenceRenderer::GetCanonicalSceneJson()
+{
+  try
+  {
+    return nimbus::SceneToJson(nimbus::LoadScene(this->SceneFileName));
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+    return std::string();
+  }
+}
+
 void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

@@ -49,6 +49,13 @@ public:
   vtkGetCharFromStdStringMacro(SceneFileName);
   ///@}
 
+  /// The scene file read and validated, as canonical JSON of the current format
+  /// version (every field, defaults filled in, a relative density path made
+  /// absolute; docs/scene-format.md): what scripts should read instead of the file,
+  /// so that they see one version whatever version the file has. Empty, with an
+  /// error, when the file cannot be read or is not a valid scene.
+  std::string GetCanonicalSceneJson();
+
   ///@{
   /// Point-data array of the optional input image used as density. Default "density".
   vtkSetStdStringFromCharMacro(DensityArrayName);

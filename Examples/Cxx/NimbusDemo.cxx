@@ -126,8 +126,8 @@ int main(int argc, char* argv[])
   cloudMapper->SetAlbedo(0.99);
   cloudMapper->SetCloudG(0.85);
   cloudMapper->SetMultipleScattering(kMulti);
-  cloudMapper->SetSunElevation(sunElevation);
-  cloudMapper->SetSunAzimuth(sunAzimuth);
+  cloudMapper->SetSunElevationDegrees(sunElevation);
+  cloudMapper->SetSunAzimuthDegrees(sunAzimuth);
   cloudMapper->SetGroundAlbedo(0.25);
   cloudMapper->SetNumberOfSlices(256);
   cloudMapper->SetExposure(exposure);
@@ -143,8 +143,8 @@ int main(int argc, char* argv[])
     // The sky behind everything; the cloud mapper finds it and takes its sun,
     // air, ground albedo and exposure (UseSceneSky), so sky and cloud agree.
     vtkNew<vtkNimbusSkyBackground> sky;
-    sky->GetSky()->SetSunElevation(sunElevation);
-    sky->GetSky()->SetSunAzimuth(sunAzimuth);
+    sky->GetSky()->SetSunElevationDegrees(sunElevation);
+    sky->GetSky()->SetSunAzimuthDegrees(sunAzimuth);
     sky->GetSky()->SetGroundAlbedo(0.25);
     sky->GetSky()->SetExposure(exposure);
     renderer->AddViewProp(sky);

@@ -57,8 +57,8 @@ double MidpointLength(const V& p, const V& d, double s0, double s1, double H, lo
 
 bool Finite(const nimbus::OpticalLengths& l)
 {
-  return std::isfinite(l.rayleighLength) && std::isfinite(l.mieLength) && l.rayleighLength >= 0.0 &&
-    l.mieLength >= 0.0;
+  return std::isfinite(l.RayleighLengthMetres) && std::isfinite(l.MieLengthMetres) &&
+    l.RayleighLengthMetres >= 0.0 && l.MieLengthMetres >= 0.0;
 }
 } // namespace
 
@@ -66,10 +66,10 @@ TEST(Atmosphere, DefaultParameters)
 {
   const nimbus::Atmosphere atm;
   const nimbus::AtmosphereParameters& p = atm.GetParameters();
-  EXPECT_EQ(p.earthRadius, 6360000.0);
-  EXPECT_EQ(p.topRadius, 6420000.0);
-  EXPECT_EQ(p.rayleighScaleHeight, 8000.0);
-  EXPECT_EQ(p.mieScaleHeight, 1200.0);
+  EXPECT_EQ(p.EarthRadiusMetres, 6360000.0);
+  EXPECT_EQ(p.TopRadiusMetres, 6420000.0);
+  EXPECT_EQ(p.RayleighScaleHeightMetres, 8000.0);
+  EXPECT_EQ(p.MieScaleHeightMetres, 1200.0);
   // Nishita / Bruneton beta_R: 5.8e-6, 13.5e-6, 33.1e-6 1/m at 680, 550, 440 nm.
   EXPECT_NEAR(atm.RayleighScattering(680.0), 5.8e-6, 0.01 * 5.8e-6);
   EXPECT_DOUBLE_EQ(atm.RayleighScattering(550.0), 13.5e-6);
@@ -116,8 +116,8 @@ TEST(Atmosphere, SlantPathsMatchBruteForce)
       const V p = At(1000.0);
       const V d = Elevation(elevation);
       const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
-      ASSERT_FALSE(l.hitsGround) << elevation; // horizon dip from 1 km is 1.01 deg
-      const double L = H == 8000.0 ? l.rayleighLength : l.mieLength;
+      ASSERT_FALSE(l.HitsGround) << elevation; // horizon dip from 1 km is 1.01 deg
+      const double L = H == 8000.0 ? l.RayleighLengthMetres : l.MieLengthMetres;
       const double ref = MidpointLength(p, d, 0.0, ExitDistance(p, d, Rtop), H, n);
       const double rel = std::abs(L / ref - 1.0);
       std::printf("H=%5.0f elevation %5.1f deg: L = %.9e m, brute force %.9e m, rel.err %.1e\n", H,
@@ -130,8 +130,8 @@ TEST(Atmosphere, SlantPathsMatchBruteForce)
   for (double H : { 8000.0, 1200.0 })
   {
     const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), { 1.0, 0.0, 0.0 });
-    EXPECT_FALSE(l.hitsGround);
-    const double L = H == 8000.0 ? l.rayleighLength : l.mieLength;
+    EXPECT_FALSE(l.HitsGround);
+    const double L = H == 8000.0 ? l.RayleighLengthMetres : l.MieLengthMetres;
     const V d = { 1.0, 0.0, 0.0 };
     const double ref = MidpointLength(At(0.0), d, 0.0, ExitDistance(At(0.0), d, Rtop), H, n);
     EXPECT_LT(std::abs(L / ref - 1.0), 1e-6) << H;
@@ -152,11 +152,11 @@ TEST(Atmosphere, NearHorizonFiniteAndMonotone)
     {
       const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(h), Elevation(e));
       ASSERT_TRUE(Finite(l)) << e;
-      ASSERT_FALSE(l.hitsGround) << e;
-      EXPECT_LT(l.rayleighLength, previousR) << "h=" << h << " e=" << e;
-      EXPECT_LT(l.mieLength, previousM) << "h=" << h << " e=" << e;
-      previousR = l.rayleighLength;
-      previousM = l.mieLength;
+      ASSERT_FALSE(l.HitsGround) << e;
+      EXPECT_LT(l.RayleighLengthMetres, previousR) << "h=" << h << " e=" << e;
+      EXPECT_LT(l.MieLengthMetres, previousM) << "h=" << h << " e=" << e;
+      previousR = l.RayleighLengthMetres;
+      previousM = l.MieLengthMetres;
     }
   }
 }
@@ -168,7 +168,7 @@ TEST(Atmosphere, BelowHorizonHitsGround)
   for (double e : { -1e-9, -0.1, -0.5, -10.0, -90.0 })
   {
     const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), Elevation(e));
-    EXPECT_TRUE(l.hitsGround) << e;
+    EXPECT_TRUE(l.HitsGround) << e;
     EXPECT_TRUE(Finite(l));
     EXPECT_EQ(atm.Transmittance(l, 550.0), 0.0);
     EXPECT_EQ(atm.TransmittanceToTop(At(0.0), Elevation(e), 550.0), 0.0);
@@ -177,17 +177,18 @@ TEST(Atmosphere, BelowHorizonHitsGround)
   const V p = At(1000.0);
   const V d = Elevation(-5.0);
   const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
-  EXPECT_TRUE(l.hitsGround);
+  EXPECT_TRUE(l.HitsGround);
   const double b = p[2] * d[2];
   const double sHit = -b - std::sqrt(b * b - (p[2] * p[2] - R * R));
   const V ground = { sHit * d[0], 0.0, p[2] + sHit * d[2] };
-  EXPECT_NEAR(l.rayleighLength, atm.OpticalLength(p, ground, 8000.0), 1e-9 * l.rayleighLength);
-  EXPECT_NEAR(l.mieLength, atm.OpticalLength(p, ground, 1200.0), 1e-9 * l.mieLength);
+  EXPECT_NEAR(
+    l.RayleighLengthMetres, atm.OpticalLength(p, ground, 8000.0), 1e-9 * l.RayleighLengthMetres);
+  EXPECT_NEAR(l.MieLengthMetres, atm.OpticalLength(p, ground, 1200.0), 1e-9 * l.MieLengthMetres);
   EXPECT_EQ(atm.Transmittance(l, 680.0), 0.0);
   // Just beyond the horizon dip (1.0141 deg) the ray hits; just above it, it does not.
   const double dip = std::acos(R / (R + 1000.0)) * 180.0 / kPi;
-  EXPECT_TRUE(atm.OpticalLengthsToTop(p, Elevation(-dip - 1e-4)).hitsGround);
-  EXPECT_FALSE(atm.OpticalLengthsToTop(p, Elevation(-dip + 1e-4)).hitsGround);
+  EXPECT_TRUE(atm.OpticalLengthsToTop(p, Elevation(-dip - 1e-4)).HitsGround);
+  EXPECT_FALSE(atm.OpticalLengthsToTop(p, Elevation(-dip + 1e-4)).HitsGround);
 }
 
 TEST(Atmosphere, ZenithSun)
@@ -196,8 +197,8 @@ TEST(Atmosphere, ZenithSun)
   const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(At(0.0), { 0.0, 0.0, 1.0 });
   const double LR = 8000.0 * -std::expm1(-60000.0 / 8000.0);
   const double LM = 1200.0 * -std::expm1(-60000.0 / 1200.0);
-  EXPECT_NEAR(l.rayleighLength, LR, 1e-9 * LR);
-  EXPECT_NEAR(l.mieLength, LM, 1e-9 * LM);
+  EXPECT_NEAR(l.RayleighLengthMetres, LR, 1e-9 * LR);
+  EXPECT_NEAR(l.MieLengthMetres, LM, 1e-9 * LM);
   for (double lambda : { 440.0, 550.0, 680.0 })
   {
     const double tau = atm.RayleighScattering(lambda) * LR + 2.0e-5 / 0.9 * LM;
@@ -214,24 +215,24 @@ TEST(Atmosphere, TopOfAtmosphereStart)
   const nimbus::Atmosphere atm;
   const V top = At(60000.0);
   const nimbus::OpticalLengths up = atm.OpticalLengthsToTop(top, { 0.0, 0.0, 1.0 });
-  EXPECT_EQ(up.rayleighLength, 0.0);
-  EXPECT_EQ(up.mieLength, 0.0);
-  EXPECT_FALSE(up.hitsGround);
+  EXPECT_EQ(up.RayleighLengthMetres, 0.0);
+  EXPECT_EQ(up.MieLengthMetres, 0.0);
+  EXPECT_FALSE(up.HitsGround);
   EXPECT_EQ(atm.Transmittance(up, 550.0), 1.0);
   const nimbus::OpticalLengths flat = atm.OpticalLengthsToTop(top, { 1.0, 0.0, 0.0 });
   EXPECT_TRUE(Finite(flat));
-  EXPECT_EQ(flat.rayleighLength, 0.0); // tangent to the top sphere
+  EXPECT_EQ(flat.RayleighLengthMetres, 0.0); // tangent to the top sphere
   // 5 deg down from the top: passes above the 7.8 deg horizon dip.
   const V d = Elevation(-5.0);
   const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(top, d);
-  EXPECT_FALSE(l.hitsGround);
+  EXPECT_FALSE(l.HitsGround);
   const double ref = MidpointLength(top, d, 0.0, ExitDistance(top, d, Rtop), 8000.0, 2000000);
-  EXPECT_NEAR(l.rayleighLength, ref, 1e-6 * ref);
+  EXPECT_NEAR(l.RayleighLengthMetres, ref, 1e-6 * ref);
   // 30 deg down hits the ground.
   const nimbus::OpticalLengths down = atm.OpticalLengthsToTop(top, Elevation(-30.0));
-  EXPECT_TRUE(down.hitsGround);
+  EXPECT_TRUE(down.HitsGround);
   EXPECT_TRUE(Finite(down));
-  EXPECT_GT(down.rayleighLength, 0.0);
+  EXPECT_GT(down.RayleighLengthMetres, 0.0);
 }
 
 TEST(Atmosphere, ObserverAboveAtmosphere)
@@ -242,30 +243,30 @@ TEST(Atmosphere, ObserverAboveAtmosphere)
   for (const V& d : { V{ 0.0, 0.0, 1.0 }, V{ 1.0, 0.0, 0.0 }, V{ 1.0, 0.0, -0.1 } })
   {
     const nimbus::OpticalLengths l = atm.OpticalLengthsToTop(p, d);
-    EXPECT_EQ(l.rayleighLength, 0.0);
-    EXPECT_EQ(l.mieLength, 0.0);
-    EXPECT_FALSE(l.hitsGround);
+    EXPECT_EQ(l.RayleighLengthMetres, 0.0);
+    EXPECT_EQ(l.MieLengthMetres, 0.0);
+    EXPECT_FALSE(l.HitsGround);
   }
   // Straight down: the full vertical column, then the ground.
   const nimbus::OpticalLengths down = atm.OpticalLengthsToTop(p, { 0.0, 0.0, -1.0 });
-  EXPECT_TRUE(down.hitsGround);
+  EXPECT_TRUE(down.HitsGround);
   const double LR = 8000.0 * -std::expm1(-60000.0 / 8000.0);
-  EXPECT_NEAR(down.rayleighLength, LR, 1e-9 * LR);
+  EXPECT_NEAR(down.RayleighLengthMetres, LR, 1e-9 * LR);
   // Limb ray with tangent altitude 20 km: through the atmosphere and out again.
   const double rt = R + 20000.0;
   const double pr = R + 200000.0;
   const double sinA = rt / pr; // angle between -p and d
   const V d = { sinA, 0.0, -std::sqrt(1.0 - sinA * sinA) };
   const nimbus::OpticalLengths limb = atm.OpticalLengthsToTop(p, d);
-  EXPECT_FALSE(limb.hitsGround);
+  EXPECT_FALSE(limb.HitsGround);
   // Brute force over the chord through the top sphere.
   const double b = p[2] * d[2];
   const double disc = b * b - (pr * pr - Rtop * Rtop);
   const double ref =
     MidpointLength(p, d, -b - std::sqrt(disc), -b + std::sqrt(disc), 8000.0, 2000000);
-  EXPECT_NEAR(limb.rayleighLength, ref, 1e-6 * ref);
+  EXPECT_NEAR(limb.RayleighLengthMetres, ref, 1e-6 * ref);
   std::printf("limb ray (tangent altitude 20 km): L_R = %.6e m, brute force %.6e m\n",
-    limb.rayleighLength, ref);
+    limb.RayleighLengthMetres, ref);
 }
 
 TEST(Atmosphere, PointBelowGroundIsClamped)
@@ -273,14 +274,14 @@ TEST(Atmosphere, PointBelowGroundIsClamped)
   const nimbus::Atmosphere atm;
   const nimbus::OpticalLengths a = atm.OpticalLengthsToTop(At(-100.0), Elevation(20.0));
   const nimbus::OpticalLengths b = atm.OpticalLengthsToTop(At(0.0), Elevation(20.0));
-  EXPECT_NEAR(a.rayleighLength, b.rayleighLength, 1e-9 * b.rayleighLength);
-  EXPECT_NEAR(a.mieLength, b.mieLength, 1e-9 * b.mieLength);
+  EXPECT_NEAR(a.RayleighLengthMetres, b.RayleighLengthMetres, 1e-9 * b.RayleighLengthMetres);
+  EXPECT_NEAR(a.MieLengthMetres, b.MieLengthMetres, 1e-9 * b.MieLengthMetres);
   const nimbus::OpticalLengths c = atm.OpticalLengthsToTop({ 0.0, 0.0, 0.0 }, { 0.0, 1.0, 0.0 });
   EXPECT_TRUE(Finite(c));
-  EXPECT_NEAR(c.rayleighLength, 8000.0 * -std::expm1(-7.5), 1e-6);
+  EXPECT_NEAR(c.RayleighLengthMetres, 8000.0 * -std::expm1(-7.5), 1e-6);
   const nimbus::OpticalLengths e = atm.OpticalLengthsToTop(At(-100.0), Elevation(0.0));
   EXPECT_TRUE(Finite(e));
-  EXPECT_FALSE(e.hitsGround);
+  EXPECT_FALSE(e.HitsGround);
 }
 
 TEST(Atmosphere, InvalidInput)
@@ -293,7 +294,7 @@ TEST(Atmosphere, InvalidInput)
   EXPECT_THROW(atm.OpticalLength(At(0.0), At(10.0), 0.0), std::invalid_argument);
   EXPECT_EQ(atm.OpticalLength(At(10.0), At(10.0), 8000.0), 0.0);
   nimbus::AtmosphereParameters bad;
-  bad.topRadius = bad.earthRadius;
+  bad.TopRadiusMetres = bad.EarthRadiusMetres;
   EXPECT_THROW(nimbus::Atmosphere{ bad }, std::invalid_argument);
 }
 

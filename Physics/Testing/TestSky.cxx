@@ -32,7 +32,7 @@ using nimbus::kPi;
 
 Vector3 Direction(double elevationDeg, double azimuthDeg)
 {
-  return nimbus::SunDirectionFromAngles(elevationDeg, azimuthDeg);
+  return nimbus::SunDirection(elevationDeg, azimuthDeg);
 }
 
 double Y(const Rgb& c)
@@ -85,8 +85,8 @@ double RelativeError(const Rgb& a, const Rgb& ref, double floor = 1e-30)
 TEST(Sky, TransmittanceTableInterpolation)
 {
   const SkyModel& model = FullModel();
-  const double R = model.GetParameters().Atmosphere.earthRadius;
-  const double top = model.GetParameters().Atmosphere.topRadius;
+  const double R = model.GetParameters().Atmosphere.EarthRadiusMetres;
+  const double top = model.GetParameters().Atmosphere.TopRadiusMetres;
   const nimbus::Atmosphere& air = model.GetAtmosphere();
   double worstT = 0.0, worstTau = 0.0;
   for (int j = 0; j <= 40; ++j)
@@ -284,9 +284,9 @@ TEST(Sky, Extremes)
   EXPECT_EQ(Y(space), 0.0);
   // The transmittance toward the sun: 1 at the top looking up, 0 through the earth.
   std::vector<double> t(model.GetSunIrradiance().size());
-  model.SunTransmittance(model.GetParameters().Atmosphere.topRadius, 1.0, t.data());
+  model.SunTransmittance(model.GetParameters().Atmosphere.TopRadiusMetres, 1.0, t.data());
   EXPECT_NEAR(t[0], 1.0, 1e-6);
-  model.SunTransmittance(model.GetParameters().Atmosphere.earthRadius, -0.5, t.data());
+  model.SunTransmittance(model.GetParameters().Atmosphere.EarthRadiusMetres, -0.5, t.data());
   EXPECT_EQ(t[0], 0.0);
   // Bad parameters: one clear error naming the field.
   SkyParameters bad;
@@ -321,7 +321,7 @@ TEST(Sky, Continuity)
         }
       }
       const double horizon = 90.0 -
-        std::acos(model.HorizonMu(model.GetParameters().Atmosphere.earthRadius + altitude)) /
+        std::acos(model.HorizonMu(model.GetParameters().Atmosphere.EarthRadiusMetres + altitude)) /
           kDegree;
       double worst = 0.0, worstDe = 0.0, worstAz = 0.0;
       for (double de : { -1.0, -0.1, -0.01, 0.01, 0.1, 1.0 })
@@ -389,7 +389,7 @@ TEST(Sky, AerialPerspectiveTable)
   for (double elevation : { 45.0, 3.0 })
   {
     const nimbus::AerialPerspectiveLut table(model, elevation, 500.0);
-    const double R = model.GetParameters().Atmosphere.earthRadius;
+    const double R = model.GetParameters().Atmosphere.EarthRadiusMetres;
     const Vector3 camera{ { 0.0, 0.0, R + 500.0 } };
     const Vector3 s = Direction(elevation, 40.0);
     double worstT = 0.0, worstL = 0.0;

@@ -51,14 +51,14 @@ public:
   ///@{
   /// Sun: azimuth [deg from +y toward +x], elevation [deg], illuminance above
   /// the atmosphere (relative), blackbody temperature [K].
-  void SetSunAzimuth(double value);
-  double GetSunAzimuth();
-  void SetSunElevation(double value);
-  double GetSunElevation();
+  void SetSunAzimuthDegrees(double value);
+  double GetSunAzimuthDegrees();
+  void SetSunElevationDegrees(double value);
+  double GetSunElevationDegrees();
   void SetSunIlluminance(double value);
   double GetSunIlluminance();
-  void SetSunTemperature(double value);
-  double GetSunTemperature();
+  void SetSunTemperatureKelvin(double value);
+  double GetSunTemperatureKelvin();
   ///@}
 
   ///@{
@@ -66,14 +66,14 @@ public:
   /// Rayleigh scattering at sea level [1/m], altitude of z = 0 [m].
   void SetAtmosphere(bool value);
   bool GetAtmosphere();
-  void SetHazeDensity(double value);
-  double GetHazeDensity();
-  void SetHazeG(double value);
-  double GetHazeG();
-  void SetRayleighScattering(double value);
-  double GetRayleighScattering();
-  void SetSceneAltitude(double value);
-  double GetSceneAltitude();
+  void SetMieScatteringPerMetre(double value);
+  double GetMieScatteringPerMetre();
+  void SetMieG(double value);
+  double GetMieG();
+  void SetRayleighScatteringPerMetre(double value);
+  double GetRayleighScatteringPerMetre();
+  void SetSceneAltitudeMetres(double value);
+  double GetSceneAltitudeMetres();
   ///@}
 
   ///@{
@@ -114,8 +114,8 @@ public:
 
   ///@{
   /// Metres per world unit; framebuffer = Exposure * radiance; sRGB encoding.
-  void SetLengthUnit(double value);
-  double GetLengthUnit();
+  void SetMetresPerUnit(double value);
+  double GetMetresPerUnit();
   void SetExposure(double value);
   double GetExposure();
   void SetEncodeSrgb(bool value);

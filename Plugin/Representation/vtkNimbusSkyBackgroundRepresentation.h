@@ -10,8 +10,8 @@
  * background shows again.
  *
  * The sky's parameters come from the input's field data: the one-tuple arrays
- * that vtkNimbusSkyDomeSource writes ("SunElevation", "SunAzimuth",
- * "AerosolDensity", "GroundAlbedo", "Exposure", "ObserverAltitude", ..., see
+ * that vtkNimbusSkyDomeSource writes ("SunElevationDegrees", "SunAzimuthDegrees",
+ * "MieScatteringPerMetre", "GroundAlbedo", "Exposure", "SceneAltitudeMetres", ..., see
  * vtkNimbusSkyDomeSource). A parameter without its array takes the vtkNimbusSky
  * default, so any polygonal data can be shown as the default sky. The input's
  * geometry is not drawn and not moved: only its field data is delivered (through

@@ -71,8 +71,14 @@ DISPLAY_EXPOSURE = 6.0
 # --- scenes and references ------------------------------------------------------------------
 
 def load_scene(path):
-    with open(path) as stream:
-        return json.load(stream)
+    """The scene as the C++ reader sees it: validated, every field filled in, in the
+    current format version whatever version the file has (docs/scene-format.md)."""
+    reader = nimbus.vtkNimbusReferenceRenderer()
+    reader.SetSceneFileName(path)
+    text = reader.GetCanonicalSceneJson()
+    if not text:
+        raise RuntimeError(f"{path}: not a valid Nimbus scene (see the error above)")
+    return json.loads(text)
 
 
 def scene_hash(scene_path, reference):
@@ -262,15 +268,9 @@ class VtkGpuRenderer:
         atmosphere = scene.get("atmosphere", {})
         sunlight = nimbus.vtkNimbusSunlight()
         sunlight.WhiteBalanceOff()
-        if "direction" in sun:
-            dx, dy, dz = sun["direction"]
-            norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-            sunlight.SetSunElevation(math.degrees(math.asin(dz / norm)))
-            sunlight.SetSunAzimuth(math.degrees(math.atan2(dx, dy)))
-        else:
-            sunlight.SetSunElevation(sun["elevation"])
-            sunlight.SetSunAzimuth(sun.get("azimuth", 0.0))
-        sunlight.SetObserverAltitude(atmosphere.get("scene_altitude", 0.0) + centre_z)
+        sunlight.SetSunElevationDegrees(sun["elevation_degrees"])  # the canonical scene
+        sunlight.SetSunAzimuthDegrees(sun["azimuth_degrees"])  # has angles, never "direction"
+        sunlight.SetSceneAltitudeMetres(atmosphere["scene_altitude_metres"] + centre_z)
         rgb = [0.0, 0.0, 0.0]
         if atmosphere.get("enabled", True):
             sunlight.GetColor(rgb)
@@ -423,22 +423,16 @@ def configure_svs_mapper(mapper, scene):
     mapper.SetCloudG(float(phase[0].get("g", 0.85)))
     mapper.SetMultipleScattering(medium.get("multiple_scattering_constant", 0.0))
     sun = scene["sun"]
-    if "direction" in sun:
-        dx, dy, dz = sun["direction"]
-        norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-        mapper.SetSunElevation(math.degrees(math.asin(dz / norm)))
-        mapper.SetSunAzimuth(math.degrees(math.atan2(dx, dy)))
-    else:
-        mapper.SetSunElevation(sun["elevation"])
-        mapper.SetSunAzimuth(sun.get("azimuth", 0.0))
-    mapper.SetSunIlluminance(sun.get("illuminance", 1.0))
-    mapper.SetSunTemperature(sun.get("temperature", 5778.0))
+    mapper.SetSunElevationDegrees(sun["elevation_degrees"])  # the canonical scene has
+    mapper.SetSunAzimuthDegrees(sun["azimuth_degrees"])  # angles, never "direction"
+    mapper.SetSunIlluminance(sun["illuminance"])
+    mapper.SetSunTemperatureKelvin(sun["temperature_kelvin"])
     atmosphere = scene.get("atmosphere", {})
     mapper.SetAtmosphere(bool(atmosphere.get("enabled", True)))
-    mapper.SetSceneAltitude(atmosphere.get("scene_altitude", 0.0))
-    mapper.SetRayleighScattering(atmosphere.get("rayleigh_scattering_550", 13.5e-6))
-    mapper.SetHazeDensity(atmosphere.get("mie_scattering", 2.0e-5))
-    mapper.SetHazeG(atmosphere.get("mie_g", 0.76))
+    mapper.SetSceneAltitudeMetres(atmosphere["scene_altitude_metres"])
+    mapper.SetRayleighScatteringPerMetre(atmosphere["rayleigh_scattering_per_metre"])
+    mapper.SetMieScatteringPerMetre(atmosphere["mie_scattering_per_metre"])
+    mapper.SetMieG(atmosphere["mie_g"])
     ground = scene.get("ground", {})
     mapper.SetGround(bool(ground.get("enabled", True)))
     mapper.SetGroundHeight(ground.get("height", 0.0))

@@ -238,10 +238,10 @@ public:
     if (this->Air)
     {
       const AtmosphereParameters& a = this->Air->GetParameters();
-      this->EarthRadius = a.earthRadius;
-      this->ScaleHeightR = a.rayleighScaleHeight;
-      this->ScaleHeightM = a.mieScaleHeight;
-      this->MieG = a.mieG;
+      this->EarthRadius = a.EarthRadiusMetres;
+      this->ScaleHeightR = a.RayleighScaleHeightMetres;
+      this->ScaleHeightM = a.MieScaleHeightMetres;
+      this->MieG = a.MieG;
       this->BetaR = context.GetRayleighScatteringSeaLevel();
       this->BetaRMax = *std::max_element(this->BetaR.begin(), this->BetaR.end());
       this->BetaMs = context.GetMieScatteringSeaLevel();
@@ -398,9 +398,9 @@ void Integrator::BuildSunTable()
     const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]),
       r * (mu * sun[1] + sinTheta * perp[1]), r * (mu * sun[2] + sinTheta * perp[2]) } };
     const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
-    lR = lengths.rayleighLength;
-    lM = lengths.mieLength;
-    return !lengths.hitsGround;
+    lR = lengths.RayleighLengthMetres;
+    lM = lengths.MieLengthMetres;
+    return !lengths.HitsGround;
   };
   const double betaMax = std::max(this->BetaRMax, this->BetaMt);
   for (int nR = 17; nR <= 257; nR = 2 * nR - 1)

@@ -5,8 +5,10 @@
 // integrate; everything physical comes from here, so they render the same scene.
 //
 // Units: metres, 1/m, wavelengths in nm; radiometry relative to the sun (see
-// SceneDescription.h). Scene point p maps to the earth-centred frame of
-// Atmosphere.h as (p.x, p.y, EarthRadius + SceneAltitude + p.z).
+// SceneDescription.h). The sun, the air and the colour conversion are those of
+// Physics/SunAndAir.h, which the GPU mapper's atmosphere table uses too; scene point
+// p maps to the earth-centred frame of Atmosphere.h as
+// (p.x, p.y, EarthRadiusMetres + SceneAltitudeMetres + p.z).
 #ifndef NimbusRenderContext_h
 #define NimbusRenderContext_h
 
@@ -19,6 +21,7 @@
 #include "PhaseFunctions.h"
 #include "SceneDescription.h"
 #include "SpectralColor.h"
+#include "SunAndAir.h"
 
 #include <array>
 #include <memory>
@@ -40,18 +43,24 @@ public:
   const Camera& GetCamera() const { return this->ViewCamera; }
   const DensityGrid& GetGrid() const { return this->Grid; }
 
+  /// The sun, the air and the spectrum of the scene (shared with the GPU path).
+  const SunAndAir& GetSunAndAir() const { return *this->Light; }
+
   // --- spectrum
-  const SpectralSamples& GetSpectrum() const { return *this->Spectrum; }
-  int GetNumberOfWavelengths() const { return static_cast<int>(this->Wavelengths.size()); }
-  const std::vector<double>& GetWavelengths() const { return this->Wavelengths; }
+  const SpectralSamples& GetSpectrum() const { return this->Light->GetSpectrum(); }
+  int GetNumberOfWavelengths() const { return static_cast<int>(this->GetWavelengths().size()); }
+  const std::vector<double>& GetWavelengths() const { return this->Light->GetWavelengths(); }
   /// Spectral radiance at the wavelength samples -> linear sRGB.
-  std::array<double, 3> ToLinearSrgb(const std::vector<double>& spectralRadiance) const;
+  std::array<double, 3> ToLinearSrgb(const std::vector<double>& spectralRadiance) const
+  {
+    return this->Light->ToLinearSrgb(spectralRadiance);
+  }
 
   // --- sun
   /// Unit vector toward the sun.
-  const Vector3& GetSunDirection() const { return this->SunDirection; }
+  const Vector3& GetSunDirection() const { return this->Light->GetSunDirection(); }
   /// Irradiance at the top of the atmosphere per wavelength sample (luminance Y = Illuminance).
-  const std::vector<double>& GetSunIrradiance() const { return this->SunIrradiance; }
+  const std::vector<double>& GetSunIrradiance() const { return this->Light->GetSunIrradiance(); }
 
   // --- cloud (wavelength independent)
   /// sigma_t = ExtinctionPerDensity * density(p), 1/m.
@@ -64,30 +73,34 @@ public:
   double GetCloudAlbedo() const { return this->Scene.Medium.SingleScatteringAlbedo; }
   const PhaseFunctionMixture& GetCloudPhase() const { return this->CloudPhase; }
 
-  // --- atmosphere (absent when disabled)
-  bool HasAtmosphere() const { return this->Air != nullptr; }
-  const Atmosphere* GetAtmosphere() const { return this->Air.get(); }
-  Vector3 EarthCentred(const Vector3& p) const;
-  /// Sea-level coefficients (1/m): Rayleigh scattering (= extinction) per
-  /// wavelength sample, and the grey Mie scattering and extinction. Multiply by
-  /// Atmosphere::Density(h, H) for altitude h. Empty / 0 without atmosphere.
-  const std::vector<double>& GetRayleighScatteringSeaLevel() const { return this->BetaRayleigh; }
-  double GetMieScatteringSeaLevel() const { return this->BetaMieScattering; }
-  double GetMieExtinctionSeaLevel() const { return this->BetaMieExtinction; }
-  /// Per wavelength sample at scene point p (1/m): Rayleigh scattering (=
-  /// extinction), Mie scattering, Mie extinction. Zero without atmosphere.
+  // --- atmosphere (absent when disabled): SunAndAir.h
+  bool HasAtmosphere() const { return this->Light->HasAtmosphere(); }
+  const Atmosphere* GetAtmosphere() const { return this->Light->GetAtmosphere(); }
+  Vector3 EarthCentred(const Vector3& p) const { return this->Light->EarthCentred(p); }
+  const std::vector<double>& GetRayleighScatteringSeaLevel() const
+  {
+    return this->Light->GetRayleighScatteringSeaLevel();
+  }
+  double GetMieScatteringSeaLevel() const { return this->Light->GetMieScatteringSeaLevel(); }
+  double GetMieExtinctionSeaLevel() const { return this->Light->GetMieExtinctionSeaLevel(); }
   void AtmosphereCoefficients(const Vector3& p, std::vector<double>& rayleighScattering,
-    double& mieScattering, double& mieExtinction) const;
-  /// Transmittance of the atmosphere from p toward the sun, per wavelength sample
-  /// (0 where the earth blocks the sun; 1 without atmosphere). The cloud is not
-  /// included: renderers march it themselves.
-  void SunAtmosphereTransmittance(const Vector3& p, std::vector<double>& transmittance) const;
-  /// Transmittance of the atmosphere along the segment p0 -> p1, per wavelength sample.
+    double& mieScattering, double& mieExtinction) const
+  {
+    this->Light->AtmosphereCoefficients(p, rayleighScattering, mieScattering, mieExtinction);
+  }
+  void SunAtmosphereTransmittance(const Vector3& p, std::vector<double>& transmittance) const
+  {
+    this->Light->SunAtmosphereTransmittance(p, transmittance);
+  }
   void AtmosphereTransmittanceBetween(
-    const Vector3& p0, const Vector3& p1, std::vector<double>& transmittance) const;
-  /// Distance along origin + t*direction (unit) to the top of the atmosphere, or
-  /// infinity without atmosphere.
-  double DistanceToTopOfAtmosphere(const Vector3& origin, const Vector3& direction) const;
+    const Vector3& p0, const Vector3& p1, std::vector<double>& transmittance) const
+  {
+    this->Light->AtmosphereTransmittanceBetween(p0, p1, transmittance);
+  }
+  double DistanceToTopOfAtmosphere(const Vector3& origin, const Vector3& direction) const
+  {
+    return this->Light->DistanceToTopOfAtmosphere(origin, direction);
+  }
 
   // --- ground plane z = height (absent when disabled) and background
   bool HasGround() const { return this->Scene.Ground.Enabled; }
@@ -105,16 +118,9 @@ private:
   SceneDescription Scene;
   Camera ViewCamera;
   DensityGrid Grid;
-  std::unique_ptr<SpectralSamples> Spectrum;
-  std::vector<double> Wavelengths;
-  Vector3 SunDirection;
-  std::vector<double> SunIrradiance;
+  std::unique_ptr<SunAndAir> Light;
   double ExtinctionPerDensity;
   PhaseFunctionMixture CloudPhase;
-  std::unique_ptr<Atmosphere> Air;
-  std::vector<double> BetaRayleigh;
-  double BetaMieScattering = 0.0;
-  double BetaMieExtinction = 0.0;
   std::vector<double> BackgroundRadiance;
 };
 

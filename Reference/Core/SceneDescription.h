@@ -9,6 +9,9 @@
 #ifndef NimbusSceneDescription_h
 #define NimbusSceneDescription_h
 
+#include "Atmosphere.h"
+#include "Sun.h"
+
 #include <array>
 #include <string>
 #include <utility>
@@ -62,28 +65,6 @@ struct MediumDescription
   std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
 };
 
-struct SunDescription
-{
-  double Azimuth = 135.0;      // degrees from north (+y) toward east (+x)
-  double Elevation = 45.0;     // degrees above the horizon
-  double Illuminance = 1.0;    // luminance Y of the irradiance at the top of the atmosphere
-  double Temperature = 5778.0; // K, blackbody spectrum
-};
-
-struct AtmosphereDescription
-{
-  bool Enabled = true;
-  double SceneAltitude = 0.0;             // m above sea level of the scene's z = 0
-  double EarthRadius = 6360000.0;         // m
-  double TopRadius = 6420000.0;           // m
-  double RayleighScattering550 = 13.5e-6; // 1/m at sea level and 550 nm
-  double RayleighScaleHeight = 8000.0;    // m
-  double MieScattering = 2.0e-5;          // 1/m at sea level
-  double MieScaleHeight = 1200.0;         // m
-  double MieAlbedo = 0.9;                 // sigma_s / sigma_t of aerosols
-  double MieG = 0.76;                     // Cornette-Shanks asymmetry of aerosols
-};
-
 struct GroundDescription
 {
   bool Enabled = true;
@@ -103,13 +84,13 @@ struct BackgroundDescription
 
 struct SceneDescription
 {
-  static constexpr int kFormatVersion = 1;
+  static constexpr int kFormatVersion = 2;
   std::string Name;
   std::string Description;
   CameraDescription Camera;
   MediumDescription Medium;
-  SunDescription Sun;
-  AtmosphereDescription Atmosphere;
+  SunParameters Sun;          // the sun (Physics/Sun.h)
+  SceneAtmosphere Atmosphere; // the air and the scene's place in it (Physics/Atmosphere.h)
   GroundDescription Ground;
   BackgroundDescription Background;
   /// Wavelengths the renderers sample (SpectralSamples; 16 = measured ΔE 0.02).

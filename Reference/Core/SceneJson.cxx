@@ -645,16 +645,17 @@ MediumDescription ReadMedium(const Json& v, const std::string& path, const std::
   return m;
 }
 
-SunDescription ReadSun(const Json& v, const std::string& path)
+SunParameters ReadSun(const Json& v, const std::string& path)
 {
-  const ObjectReader r(
-    v, path, { "azimuth", "elevation", "direction", "illuminance", "temperature" });
-  SunDescription s;
+  const ObjectReader r(v, path,
+    { "azimuth_degrees", "elevation_degrees", "direction", "illuminance", "temperature_kelvin" });
+  SunParameters s;
   if (r.Has("direction"))
   {
-    if (r.Has("azimuth") || r.Has("elevation"))
+    if (r.Has("azimuth_degrees") || r.Has("elevation_degrees"))
     {
-      Fail(r.Key("direction"), "give either direction or azimuth and elevation, not both");
+      Fail(r.Key("direction"),
+        "give either direction or azimuth_degrees and elevation_degrees, not both");
     }
     const std::array<double, 3> d = ReadVector3(r["direction"], r.Key("direction"));
     const double horizontal = std::hypot(d[0], d[1]);
@@ -662,7 +663,7 @@ SunDescription ReadSun(const Json& v, const std::string& path)
     {
       Fail(r.Key("direction"), "must be a non-zero vector (toward the sun)");
     }
-    s.Elevation = std::atan2(d[2], horizontal) / kDegree;
+    s.ElevationDegrees = std::atan2(d[2], horizontal) / kDegree;
     double azimuth = horizontal > 0.0 ? std::atan2(d[0], d[1]) / kDegree : 0.0;
     if (azimuth < 0.0)
     {
@@ -672,45 +673,47 @@ SunDescription ReadSun(const Json& v, const std::string& path)
     {
       azimuth -= 360.0;
     }
-    s.Azimuth = azimuth + 0.0; // no -0
+    s.AzimuthDegrees = azimuth + 0.0; // no -0
   }
   else
   {
-    r.RequiredNumber("elevation", s.Elevation, Closed(-90.0, 90.0));
-    r.RequiredNumber("azimuth", s.Azimuth, Closed(-360.0, 360.0));
+    r.RequiredNumber("elevation_degrees", s.ElevationDegrees, Closed(-90.0, 90.0));
+    r.RequiredNumber("azimuth_degrees", s.AzimuthDegrees, Closed(-360.0, 360.0));
   }
   r.Number("illuminance", s.Illuminance, AtLeast(0.0));
-  r.Number("temperature", s.Temperature, Closed(1000.0, 100000.0));
+  r.Number("temperature_kelvin", s.TemperatureKelvin, Closed(1000.0, 100000.0));
   return s;
 }
 
-AtmosphereDescription ReadAtmosphere(const Json& v, const std::string& path)
+SceneAtmosphere ReadAtmosphere(const Json& v, const std::string& path)
 {
   const ObjectReader r(v, path,
-    { "enabled", "scene_altitude", "earth_radius", "top_radius", "rayleigh_scattering_550",
-      "rayleigh_scale_height", "mie_scattering", "mie_scale_height", "mie_albedo", "mie_g" });
-  AtmosphereDescription a;
+    { "enabled", "scene_altitude_metres", "earth_radius_metres", "top_radius_metres",
+      "rayleigh_scattering_per_metre", "rayleigh_scale_height_metres", "mie_scattering_per_metre",
+      "mie_scale_height_metres", "mie_albedo", "mie_g" });
+  SceneAtmosphere a;
   r.Bool("enabled", a.Enabled);
-  r.Number("scene_altitude", a.SceneAltitude, AtLeast(0.0));
-  r.Number("earth_radius", a.EarthRadius, Above(0.0));
-  r.Number("top_radius", a.TopRadius, Above(0.0));
-  r.Number("rayleigh_scattering_550", a.RayleighScattering550, AtLeast(0.0));
-  r.Number("rayleigh_scale_height", a.RayleighScaleHeight, Above(0.0));
-  r.Number("mie_scattering", a.MieScattering, AtLeast(0.0));
-  r.Number("mie_scale_height", a.MieScaleHeight, Above(0.0));
+  r.Number("scene_altitude_metres", a.SceneAltitudeMetres, AtLeast(0.0));
+  r.Number("earth_radius_metres", a.EarthRadiusMetres, Above(0.0));
+  r.Number("top_radius_metres", a.TopRadiusMetres, Above(0.0));
+  r.Number("rayleigh_scattering_per_metre", a.RayleighScatteringPerMetre, AtLeast(0.0));
+  r.Number("rayleigh_scale_height_metres", a.RayleighScaleHeightMetres, Above(0.0));
+  r.Number("mie_scattering_per_metre", a.MieScatteringPerMetre, AtLeast(0.0));
+  r.Number("mie_scale_height_metres", a.MieScaleHeightMetres, Above(0.0));
   r.Number("mie_albedo", a.MieAlbedo, Range{ 0.0, 1.0, true, false });
   r.Number("mie_g", a.MieG, Open(-1.0, 1.0));
-  if (!(a.TopRadius > a.EarthRadius))
+  if (!(a.TopRadiusMetres > a.EarthRadiusMetres))
   {
-    Fail(r.Key("top_radius"),
-      "must be greater than earth_radius (" + FormatNumber(a.EarthRadius) + "), got " +
-        FormatNumber(a.TopRadius));
+    Fail(r.Key("top_radius_metres"),
+      "must be greater than earth_radius_metres (" + FormatNumber(a.EarthRadiusMetres) + "), got " +
+        FormatNumber(a.TopRadiusMetres));
   }
-  if (!(a.SceneAltitude < a.TopRadius - a.EarthRadius))
+  if (!(a.SceneAltitudeMetres < a.TopRadiusMetres - a.EarthRadiusMetres))
   {
-    Fail(r.Key("scene_altitude"),
-      "must be below the top of the atmosphere (" + FormatNumber(a.TopRadius - a.EarthRadius) +
-        " m), got " + FormatNumber(a.SceneAltitude));
+    Fail(r.Key("scene_altitude_metres"),
+      "must be below the top of the atmosphere (" +
+        FormatNumber(a.TopRadiusMetres - a.EarthRadiusMetres) + " m), got " +
+        FormatNumber(a.SceneAltitudeMetres));
   }
   return a;
 }
@@ -743,9 +746,9 @@ BackgroundDescription ReadBackground(const Json& v, const std::string& path)
 class ParseTracker
 {
 public:
-  bool operator()(int, nlohmann::detail::parse_event_t event, Json& parsed)
+  bool operator()(int, Json::parse_event_t event, Json& parsed)
   {
-    using Event = nlohmann::detail::parse_event_t;
+    using Event = Json::parse_event_t;
     switch (event)
     {
       case Event::object_start:
@@ -922,20 +925,20 @@ Json ToJson(const SceneDescription& s)
     j["medium"]["phase"].push_back(component);
   }
 
-  j["sun"]["azimuth"] = s.Sun.Azimuth;
-  j["sun"]["elevation"] = s.Sun.Elevation;
+  j["sun"]["azimuth_degrees"] = s.Sun.AzimuthDegrees;
+  j["sun"]["elevation_degrees"] = s.Sun.ElevationDegrees;
   j["sun"]["illuminance"] = s.Sun.Illuminance;
-  j["sun"]["temperature"] = s.Sun.Temperature;
+  j["sun"]["temperature_kelvin"] = s.Sun.TemperatureKelvin;
 
-  const AtmosphereDescription& a = s.Atmosphere;
+  const SceneAtmosphere& a = s.Atmosphere;
   j["atmosphere"]["enabled"] = a.Enabled;
-  j["atmosphere"]["scene_altitude"] = a.SceneAltitude;
-  j["atmosphere"]["earth_radius"] = a.EarthRadius;
-  j["atmosphere"]["top_radius"] = a.TopRadius;
-  j["atmosphere"]["rayleigh_scattering_550"] = a.RayleighScattering550;
-  j["atmosphere"]["rayleigh_scale_height"] = a.RayleighScaleHeight;
-  j["atmosphere"]["mie_scattering"] = a.MieScattering;
-  j["atmosphere"]["mie_scale_height"] = a.MieScaleHeight;
+  j["atmosphere"]["scene_altitude_metres"] = a.SceneAltitudeMetres;
+  j["atmosphere"]["earth_radius_metres"] = a.EarthRadiusMetres;
+  j["atmosphere"]["top_radius_metres"] = a.TopRadiusMetres;
+  j["atmosphere"]["rayleigh_scattering_per_metre"] = a.RayleighScatteringPerMetre;
+  j["atmosphere"]["rayleigh_scale_height_metres"] = a.RayleighScaleHeightMetres;
+  j["atmosphere"]["mie_scattering_per_metre"] = a.MieScatteringPerMetre;
+  j["atmosphere"]["mie_scale_height_metres"] = a.MieScaleHeightMetres;
   j["atmosphere"]["mie_albedo"] = a.MieAlbedo;
   j["atmosphere"]["mie_g"] = a.MieG;
 
@@ -996,46 +999,75 @@ void WritePretty(const Json& v, int indent, std::string& out)
 } // namespace
 
 //------------------------------------------------------------------------------
-SceneDescription ParseScene(const std::string& jsonText, const std::string& baseDirectory)
+namespace
 {
-  Json root;
-  ParseTracker tracker;
-  try
-  {
-    root = Json::parse(jsonText, std::ref(tracker));
-  }
-  catch (const nlohmann::json::exception& error)
-  {
-    Fail(tracker.CurrentPath(), "invalid JSON: " + WithoutJsonPrefix(error.what()));
-  }
+/// Version 1 named the sun's and the air's parameters without their units;
+/// version 2 names them as Physics/Sun.h and Physics/Atmosphere.h do (and as the
+/// mapper, the sky, the Python API and the plugin do). A version-1 file is read by
+/// renaming these keys; nothing else changed.
+struct Version1Rename
+{
+  const char* Section;
+  const char* Version1;
+  const char* Version2;
+};
+constexpr Version1Rename kVersion1Renames[] = {
+  { "sun", "azimuth", "azimuth_degrees" },
+  { "sun", "elevation", "elevation_degrees" },
+  { "sun", "temperature", "temperature_kelvin" },
+  { "atmosphere", "scene_altitude", "scene_altitude_metres" },
+  { "atmosphere", "earth_radius", "earth_radius_metres" },
+  { "atmosphere", "top_radius", "top_radius_metres" },
+  { "atmosphere", "rayleigh_scattering_550", "rayleigh_scattering_per_metre" },
+  { "atmosphere", "rayleigh_scale_height", "rayleigh_scale_height_metres" },
+  { "atmosphere", "mie_scattering", "mie_scattering_per_metre" },
+  { "atmosphere", "mie_scale_height", "mie_scale_height_metres" },
+};
+constexpr int kFirstFormatVersion = 1;
 
-  const std::string path = "scene";
-  if (!root.is_object())
+/// Renames a version-1 document's keys to their version-2 names, in place. A
+/// version-2 name in a version-1 file is an error (it was unknown in version 1).
+void MigrateVersion1(Json& root)
+{
+  for (const Version1Rename& rename : kVersion1Renames)
   {
-    Fail(path, "expected an object, got " + Describe(root));
+    if (!root.contains(rename.Section) || !root[rename.Section].is_object())
+    {
+      continue; // a missing or malformed section fails later, as in version 2
+    }
+    Json& section = root[rename.Section];
+    if (section.contains(rename.Version2))
+    {
+      Fail(std::string("scene.") + rename.Section + "." + rename.Version2,
+        std::string("unknown key in a version-1 file (version 1 calls it \"") + rename.Version1 +
+          "\"; version 2 \"" + rename.Version2 + "\")");
+    }
+    if (section.contains(rename.Version1))
+    {
+      section[rename.Version2] = section[rename.Version1];
+      section.erase(rename.Version1);
+    }
   }
-  // The version first: a newer file may have keys this reader does not know.
-  if (!root.contains("nimbus_scene"))
-  {
-    Fail(path,
-      "missing required key \"nimbus_scene\" (the format version; this build reads "
-      "version " +
-        std::to_string(SceneDescription::kFormatVersion) + ")");
-  }
-  const Json& version = root.at("nimbus_scene");
-  if (!(version.is_number_integer() || version.is_number_unsigned()))
-  {
-    Fail(path + ".nimbus_scene",
-      "expected the format version, an integer (this build reads " +
-        std::to_string(SceneDescription::kFormatVersion) + "), got " + Describe(version));
-  }
-  if (version.dump() != std::to_string(SceneDescription::kFormatVersion))
-  {
-    Fail(path + ".nimbus_scene",
-      "unsupported format version " + version.dump() + "; this build of Nimbus reads version " +
-        std::to_string(SceneDescription::kFormatVersion));
-  }
+}
 
+/// A message about a migrated version-1 file in the file's own words.
+std::string InVersion1Words(std::string message)
+{
+  for (const Version1Rename& rename : kVersion1Renames)
+  {
+    const std::string from = rename.Version2, to = rename.Version1;
+    for (std::size_t at = message.find(from); at != std::string::npos;
+         at = message.find(from, at + to.size()))
+    {
+      message.replace(at, from.size(), to);
+    }
+  }
+  return message;
+}
+
+SceneDescription ReadScene(
+  const Json& root, const std::string& path, const std::string& baseDirectory)
+{
   const ObjectReader r(root, path,
     { "nimbus_scene", "name", "description", "camera", "medium", "sun", "atmosphere", "ground",
       "background", "spectral_samples" });
@@ -1072,6 +1104,63 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
       "\"black\" or \"constant\" without an atmosphere)");
   }
   return s;
+}
+
+} // namespace
+
+SceneDescription ParseScene(const std::string& jsonText, const std::string& baseDirectory)
+{
+  Json root;
+  ParseTracker tracker;
+  try
+  {
+    root = Json::parse(jsonText, std::ref(tracker));
+  }
+  catch (const nlohmann::json::exception& error)
+  {
+    Fail(tracker.CurrentPath(), "invalid JSON: " + WithoutJsonPrefix(error.what()));
+  }
+
+  const std::string path = "scene";
+  if (!root.is_object())
+  {
+    Fail(path, "expected an object, got " + Describe(root));
+  }
+  // The version first: a newer file may have keys this reader does not know.
+  const std::string versions = "versions " + std::to_string(kFirstFormatVersion) + " to " +
+    std::to_string(SceneDescription::kFormatVersion);
+  if (!root.contains("nimbus_scene"))
+  {
+    Fail(path,
+      "missing required key \"nimbus_scene\" (the format version; this build reads " + versions +
+        ")");
+  }
+  const Json& version = root.at("nimbus_scene");
+  if (!(version.is_number_integer() || version.is_number_unsigned()))
+  {
+    Fail(path + ".nimbus_scene",
+      "expected the format version, an integer (this build reads " + versions + "), got " +
+        Describe(version));
+  }
+  const std::string number = version.dump();
+  if (number != "1" && number != std::to_string(SceneDescription::kFormatVersion))
+  {
+    Fail(path + ".nimbus_scene",
+      "unsupported format version " + number + "; this build of Nimbus reads " + versions);
+  }
+  if (number == "1")
+  {
+    MigrateVersion1(root);
+    try
+    {
+      return ReadScene(root, path, baseDirectory);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      throw std::invalid_argument(InVersion1Words(error.what()));
+    }
+  }
+  return ReadScene(root, path, baseDirectory);
 }
 
 SceneDescription LoadScene(const std::string& path)

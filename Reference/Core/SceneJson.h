@@ -1,6 +1,11 @@
 // The versioned JSON scene file (format: docs/scene-format.md).
 //
-//   {"nimbus_scene": 1, "camera": {...}, "medium": {...}, "sun": {...}, ...}
+//   {"nimbus_scene": 2, "camera": {...}, "medium": {...}, "sun": {...}, ...}
+//
+// Version 2 names the sun's and the air's parameters as Physics/Sun.h and
+// Physics/Atmosphere.h do, with their units ("elevation_degrees",
+// "mie_scattering_per_metre"). Version-1 files still load: their keys are renamed
+// on reading (the table in docs/scene-format.md); SceneToJson writes version 2.
 //
 // ParseScene/LoadScene validate everything they read and throw
 // std::invalid_argument with a message that starts with the key path of the

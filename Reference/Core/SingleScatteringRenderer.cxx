@@ -156,16 +156,16 @@ public:
       this->BetaR = this->Ctx.GetRayleighScatteringSeaLevel();
       this->BetaMs = this->Ctx.GetMieScatteringSeaLevel();
       this->BetaMext = this->Ctx.GetMieExtinctionSeaLevel();
-      this->HR = a.rayleighScaleHeight;
-      this->HM = a.mieScaleHeight;
-      this->EarthRadius = a.earthRadius;
-      this->KnotSpacing = KnotSpacingFor(this->Sun[2], a.earthRadius, a.mieScaleHeight);
+      this->HR = a.RayleighScaleHeightMetres;
+      this->HM = a.MieScaleHeightMetres;
+      this->EarthRadius = a.EarthRadiusMetres;
+      this->KnotSpacing = KnotSpacingFor(this->Sun[2], a.EarthRadiusMetres, a.MieScaleHeightMetres);
       // Offsets L0 of the interpolated ln(L + L0): in a plane-parallel atmosphere
       // clipped at the top, L = (H/μ_s)(e^{-h/H} - e^{-h_top/H}), so L + (H/μ_s) e^{-h_top/H}
       // is exactly log-linear in h; also keeps the log finite where L = 0. μ_s clamped to
       // >= 0.1 (only the order of magnitude matters); L0 >= 1e-6 m.
       const double mu = std::max(0.1, this->Sun[2]);
-      const double top = a.topRadius - a.earthRadius;
+      const double top = a.TopRadiusMetres - a.EarthRadiusMetres;
       this->OffsetR = std::max(1e-6, this->HR * std::exp(-top / this->HR) / mu);
       this->OffsetM = std::max(1e-6, this->HM * std::exp(-top / this->HM) / mu);
     }
@@ -227,13 +227,13 @@ public:
       {
         const OpticalLengths exact =
           this->I.Air->OpticalLengthsToTop(this->I.Ctx.EarthCentred(x), this->I.Sun);
-        if (exact.hitsGround)
+        if (exact.HitsGround)
         {
           std::fill(T, T + this->I.N, 0.0);
           return;
         }
-        lr = exact.rayleighLength;
-        lm = exact.mieLength;
+        lr = exact.RayleighLengthMetres;
+        lm = exact.MieLengthMetres;
       }
       else
       {
@@ -267,9 +267,9 @@ public:
       const Vector3 p = this->I.Ctx.EarthCentred(Along(this->O, this->D, v.T));
       v.Altitude = this->I.Air->Altitude(p);
       const OpticalLengths lengths = this->I.Air->OpticalLengthsToTop(p, this->I.Sun);
-      v.Blocked = lengths.hitsGround;
-      v.LogR = std::log(lengths.rayleighLength + this->I.OffsetR);
-      v.LogM = std::log(lengths.mieLength + this->I.OffsetM);
+      v.Blocked = lengths.HitsGround;
+      v.LogR = std::log(lengths.RayleighLengthMetres + this->I.OffsetR);
+      v.LogM = std::log(lengths.MieLengthMetres + this->I.OffsetM);
       return v;
     }
 
@@ -998,7 +998,8 @@ double SunAtmosphereKnotSpacing(const RenderContext& context)
     return 0.0;
   }
   const AtmosphereParameters& a = context.GetAtmosphere()->GetParameters();
-  return Integrator::KnotSpacingFor(context.GetSunDirection()[2], a.earthRadius, a.mieScaleHeight);
+  return Integrator::KnotSpacingFor(
+    context.GetSunDirection()[2], a.EarthRadiusMetres, a.MieScaleHeightMetres);
 }
 } // namespace detail
 

@@ -1,15 +1,15 @@
 // The "atmosphere texture" of 000 §3/§4.1: per height, the atmosphere's density
 // rho_atm(h) and the sun attenuation g_sun_atm(h), here folded with the sun's
 // spectrum and converted to linear sRGB once on the CPU, so the GPU shaders work
-// in RGB with the same physics as the spectral reference (RenderContext).
+// in RGB with the same physics as the spectral reference: both take the sun, the
+// air and the colour conversion from nimbus::SunAndAir (Physics/SunAndAir.h).
 //
 // Rows (each `Samples` heights, z from ZMin to ZMax in scene metres, linear):
-//   0 SunIrradiance      E_sun(z)         = rgb( E(l) T_sun,atm(l, z) )                     000 Eq.
-//   7 1 RayleighSource     beta_R rho_R E   = rgb( beta_R(l) rho_R(h) E(l) T(l, z) )   [1/m] 000
-//   Eq. 5 2 MieSource          beta_M rho_M E   = beta_M,s rho_M(h) E_sun(z)               [1/m]
-//   000 Eq. 5 3 Extinction         k_atm rho_atm    = beta_R,eff rho_R(h) + beta_M,ext rho_M(h)
-//   [1/m] 000 Eq. 6
-// with h = SceneAltitude + z. The sun transmittance is that of the spherical
+//   0 SunIrradiance   E_sun(z)        = rgb(E(l) T_sun,atm(l, z))                      000 Eq. 7
+//   1 RayleighSource  beta_R rho_R E  = rgb(beta_R(l) rho_R(h) E(l) T(l, z))    [1/m]  000 Eq. 5
+//   2 MieSource       beta_M rho_M E  = beta_M,s rho_M(h) E_sun(z)              [1/m]  000 Eq. 5
+//   3 Extinction      k_atm rho_atm   = beta_R,eff rho_R(h) + beta_M,ext rho_M(h) [1/m] 000 Eq. 6
+// with h = SceneAltitudeMetres + z. The sun transmittance is that of the spherical
 // atmosphere at the point (0, 0, z) (the horizontal offset of a scene of tens of
 // km changes the local sun elevation by < 0.5 deg; ignored).
 //
@@ -21,7 +21,7 @@
 #define nimbus_AtmosphereTable_h
 
 #include "NimbusRepresentationsModule.h"
-#include "SceneDescription.h"
+#include "SunAndAir.h"
 
 #include <array>
 #include <vector>
@@ -37,12 +37,12 @@ struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable
   std::vector<float> Data;
   /// Sun irradiance above the atmosphere in linear sRGB (used without atmosphere).
   std::array<double, 3> SunIrradianceTop{ { 0.0, 0.0, 0.0 } };
-  /// Sea-level coefficients for analytic view transmittance [1/m] and scale heights [m].
+  /// Sea-level coefficients for the analytic view transmittance [1/m].
   std::array<double, 3> RayleighExtinctionSeaLevel{ { 0.0, 0.0, 0.0 } };
   double MieExtinctionSeaLevel = 0.0;
   double MieScatteringSeaLevel = 0.0;
-  double RayleighScaleHeight = 8000.0, MieScaleHeight = 1200.0;
-  double SceneAltitude = 0.0, EarthRadius = 6360000.0, TopRadius = 6420000.0;
+  /// The air the table was built for (scale heights, radii, the scene's altitude).
+  SceneAtmosphere Air;
   bool HasAtmosphere = false;
 
   /// Linear interpolation in z of one row (clamped at the ends), like the GPU's
@@ -50,12 +50,11 @@ struct NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable
   std::array<double, 3> Lookup(int row, double z) const;
 };
 
-/// Builds the table for the sun and atmosphere of `scene` (Sun, Atmosphere,
-/// SpectralSamples are used) over z in [zMin, zMax] with `samples` >= 2 heights.
-/// With the atmosphere disabled only SunIrradianceTop is filled (Samples = 0).
-/// Throws std::invalid_argument for invalid parameters (the scene's messages).
+/// Builds the table for the sun and air of `sunAndAir` over z in [zMin, zMax] with
+/// `samples` >= 2 heights. Without an atmosphere only SunIrradianceTop is filled
+/// (Samples = 0). Throws std::invalid_argument for a bad range or sample count.
 NIMBUSREPRESENTATIONS_EXPORT AtmosphereTable BuildAtmosphereTable(
-  const SceneDescription& scene, double zMin, double zMax, int samples);
+  const SunAndAir& sunAndAir, double zMin, double zMax, int samples);
 } // namespace nimbus
 
 #endif

@@ -2,8 +2,8 @@
 #include "Math.h"
 
 #include "AtmosphereTable.h"
-#include "SceneDescription.h"
 #include "SliceGeometry.h"
+#include "SunAndAir.h"
 
 #include "svsCommon.h"
 #include "svsCompositeFS.h"
@@ -88,10 +88,12 @@ void ResetTexture(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, bool
 // those of the Nimbus sky drawn behind it (see UseSceneSky).
 struct FrameSettings
 {
-  double SunAzimuth, SunElevation, SunIlluminance, SunTemperature; // deg, deg, relative, K
-  double HazeDensity, HazeG, RayleighScattering;                   // 1/m, -, 1/m
-  double SceneAltitude, GroundHeight, GroundAlbedo, LengthUnit;    // m, world, -, m/unit
-  double DisplayScale[3];                                          // per channel
+  nimbus::SunParameters Sun;
+  nimbus::SceneAtmosphere Air;
+  double GroundHeight;    // world units
+  double GroundAlbedo;    // dimensionless
+  double MetresPerUnit;   // metres per world unit
+  double DisplayScale[3]; // per channel
   bool EncodeSrgb;
   bool OverSky;
 };
@@ -179,7 +181,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   int PassesLastRender = 0;
   bool LastBackToFront = false;
   bool LastOverSky = false;
-  double LastSunElevation = 0.0;
+  double LastSunElevationDegrees = 0.0;
 
   void Release(vtkWindow* window)
   {
@@ -255,9 +257,9 @@ bool vtkNimbusCloudVolumeMapper::GetLastRenderUsedSceneSky() const
 {
   return this->Internal->LastOverSky;
 }
-double vtkNimbusCloudVolumeMapper::GetLastSunElevation() const
+double vtkNimbusCloudVolumeMapper::GetLastSunElevationDegrees() const
 {
-  return this->Internal->LastSunElevation;
+  return this->Internal->LastSunElevationDegrees;
 }
 bool vtkNimbusCloudVolumeMapper::GetLastBackToFront() const
 {
@@ -439,39 +441,48 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   }
 
   // --- this frame's sun, air, ground and display: ours, or the sky's behind us.
-  FrameSettings settings{ this->SunAzimuth, this->SunElevation, this->SunIlluminance,
-    this->SunTemperature, this->HazeDensity, this->HazeG, this->RayleighScattering,
-    this->SceneAltitude, this->GroundHeight, this->GroundAlbedo, this->LengthUnit,
-    { this->Exposure, this->Exposure, this->Exposure }, this->EncodeSrgb, false };
+  FrameSettings settings;
+  settings.Sun.AzimuthDegrees = this->SunAzimuthDegrees;
+  settings.Sun.ElevationDegrees = this->SunElevationDegrees;
+  settings.Sun.Illuminance = this->SunIlluminance;
+  settings.Sun.TemperatureKelvin = this->SunTemperatureKelvin;
+  settings.Air.RayleighScatteringPerMetre = this->RayleighScatteringPerMetre;
+  settings.Air.MieScatteringPerMetre = this->MieScatteringPerMetre;
+  settings.Air.MieG = this->MieG;
+  settings.Air.SceneAltitudeMetres = this->SceneAltitudeMetres;
+  settings.GroundHeight = this->GroundHeight;
+  settings.GroundAlbedo = this->GroundAlbedo;
+  settings.MetresPerUnit = this->MetresPerUnit;
+  std::fill(settings.DisplayScale, settings.DisplayScale + 3, this->Exposure);
+  settings.EncodeSrgb = this->EncodeSrgb;
+  settings.OverSky = false;
   if (vtkNimbusSky* sky = (this->UseSceneSky && !this->Unlit) ? FindSceneSky(renderer) : nullptr)
   {
-    const nimbus::AtmosphereParameters* air = nullptr;
+    const nimbus::SkyParameters* skyParameters = nullptr;
     try
     {
-      air = &sky->GetSkyModel().GetParameters().Atmosphere;
+      skyParameters = &sky->GetSkyModel().GetParameters();
     }
     catch (const std::exception& error)
     {
       vtkErrorMacro("The scene's sky is invalid: " << error.what());
       return;
     }
-    settings.SunAzimuth = sky->GetSunAzimuth();
-    settings.SunElevation = sky->GetSunElevation();
-    settings.SunIlluminance = 1.0;    // the sky's sun: luminance 1 above the atmosphere
-    settings.SunTemperature = 5778.0; // and a 5778 K blackbody (Sky.h)
-    settings.HazeDensity = air->mieScattering;
-    settings.HazeG = air->mieG;
-    settings.RayleighScattering = air->rayleighScattering550;
-    settings.SceneAltitude = sky->GetObserverAltitude();
-    settings.LengthUnit = sky->GetMetresPerUnit();
-    settings.GroundHeight = -sky->GetObserverAltitude() / sky->GetMetresPerUnit(); // sea level
+    settings.Sun.AzimuthDegrees = sky->GetSunAzimuthDegrees();
+    settings.Sun.ElevationDegrees = sky->GetSunElevationDegrees();
+    settings.Sun.Illuminance = 1.0; // the sky's sun: luminance 1 above the atmosphere
+    settings.Sun.TemperatureKelvin = skyParameters->SunTemperatureKelvin;
+    static_cast<nimbus::AtmosphereParameters&>(settings.Air) = skyParameters->Atmosphere;
+    settings.Air.SceneAltitudeMetres = sky->GetSceneAltitudeMetres();
+    settings.MetresPerUnit = sky->GetMetresPerUnit();
+    settings.GroundHeight = -sky->GetSceneAltitudeMetres() / sky->GetMetresPerUnit(); // sea level
     settings.GroundAlbedo = sky->GetGroundAlbedo();
     sky->GetDisplayScale(settings.DisplayScale);
     settings.EncodeSrgb = true; // the sky background is sRGB-encoded
     settings.OverSky = true;
   }
   in.LastOverSky = settings.OverSky;
-  in.LastSunElevation = settings.SunElevation;
+  in.LastSunElevationDegrees = settings.Sun.ElevationDegrees;
 
   // --- geometry: sun, view, slice axis, box corners in world coordinates.
   vtkCamera* camera = renderer->GetActiveCamera();
@@ -481,9 +492,8 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   {
     return;
   }
-  const double elevation = settings.SunElevation * kDegree, azimuth = settings.SunAzimuth * kDegree;
-  const nimbus::Vector3 toSun = { { std::cos(elevation) * std::sin(azimuth),
-    std::cos(elevation) * std::cos(azimuth), std::sin(elevation) } };
+  const nimbus::Vector3 toSun =
+    nimbus::SunDirection(settings.Sun.ElevationDegrees, settings.Sun.AzimuthDegrees);
   double projection[3];
   camera->GetDirectionOfProjection(projection);
   const nimbus::Vector3 view = { { projection[0], projection[1], projection[2] } };
@@ -505,7 +515,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   const nimbus::SlicePlanes planes =
     nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), this->NumberOfSlices);
   const nimbus::ShadowFrame frame = nimbus::ComputeShadowFrame(corners, toSun, 0.02);
-  const double sunStepMetres = planes.Spacing / axis.SunCosine * settings.LengthUnit;
+  const double sunStepMetres = planes.Spacing / axis.SunCosine * settings.MetresPerUnit;
 
   // world -> box [0,1]^3 -> density texture coordinates.
   vtkNew<vtkMatrix4x4> worldToData;
@@ -616,29 +626,21 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     boxZMin = std::min(boxZMin, corner[2]);
   }
   const double zLow =
-    (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.LengthUnit;
-  nimbus::SceneDescription scene;
-  scene.Sun.Azimuth = settings.SunAzimuth;
-  scene.Sun.Elevation = settings.SunElevation;
-  scene.Sun.Illuminance = settings.SunIlluminance;
-  scene.Sun.Temperature = settings.SunTemperature;
-  scene.Atmosphere.Enabled = atmosphere;
-  scene.Atmosphere.SceneAltitude = settings.SceneAltitude;
-  scene.Atmosphere.RayleighScattering550 = settings.RayleighScattering;
-  scene.Atmosphere.MieScattering = settings.HazeDensity;
-  scene.Atmosphere.MieG = settings.HazeG;
-  scene.Background.Type = "black"; // the framebuffer is the background
-  const double zHigh =
-    scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius - settings.SceneAltitude;
-  const std::vector<double> atmosphereKey = { settings.SunAzimuth, settings.SunElevation,
-    settings.SunIlluminance, settings.SunTemperature, atmosphere ? 1.0 : 0.0,
-    settings.SceneAltitude, settings.RayleighScattering, settings.HazeDensity, settings.HazeG,
-    zLow };
+    (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.MetresPerUnit;
+  settings.Air.Enabled = atmosphere;
+  const nimbus::SceneAtmosphere& air = settings.Air;
+  const double zHigh = air.TopRadiusMetres - air.EarthRadiusMetres - air.SceneAltitudeMetres;
+  const std::vector<double> atmosphereKey = { settings.Sun.AzimuthDegrees,
+    settings.Sun.ElevationDegrees, settings.Sun.Illuminance, settings.Sun.TemperatureKelvin,
+    air.Enabled ? 1.0 : 0.0, air.SceneAltitudeMetres, air.EarthRadiusMetres, air.TopRadiusMetres,
+    air.RayleighScaleHeightMetres, air.MieScaleHeightMetres, air.RayleighScatteringPerMetre,
+    air.MieScatteringPerMetre, air.MieAlbedo, air.MieG, zLow };
   if (atmosphereKey != in.AtmosphereKey)
   {
     try
     {
-      in.Table = nimbus::BuildAtmosphereTable(scene, std::min(zLow, zHigh - 1.0), zHigh, 1024);
+      const nimbus::SunAndAir sunAndAir(settings.Sun, air, 16);
+      in.Table = nimbus::BuildAtmosphereTable(sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024);
     }
     catch (const std::exception& error)
     {
@@ -669,7 +671,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(w2b.data()));
     program->SetUniform3f("toSun", toSun.data());
     program->SetUniform3f("sliceNormal", axis.Normal.data());
-    program->SetUniformf("lengthUnit", static_cast<float>(settings.LengthUnit));
+    program->SetUniformf("lengthUnit", static_cast<float>(settings.MetresPerUnit));
     program->SetUniformi("density", in.Density->GetTextureUnit());
     program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
     program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
@@ -694,11 +696,12 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniform2f("atmosphereZRange", zRange);
     program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
     program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
-    program->SetUniformf("rayleighScaleHeight", static_cast<float>(in.Table.RayleighScaleHeight));
-    program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.MieScaleHeight));
-    program->SetUniformf("sceneAltitude", static_cast<float>(settings.SceneAltitude));
-    program->SetUniformf("earthRadius", static_cast<float>(scene.Atmosphere.EarthRadius));
-    program->SetUniformf("topRadius", static_cast<float>(scene.Atmosphere.TopRadius));
+    program->SetUniformf(
+      "rayleighScaleHeight", static_cast<float>(in.Table.Air.RayleighScaleHeightMetres));
+    program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.Air.MieScaleHeightMetres));
+    program->SetUniformf("sceneAltitude", static_cast<float>(air.SceneAltitudeMetres));
+    program->SetUniformf("earthRadius", static_cast<float>(air.EarthRadiusMetres));
+    program->SetUniformf("topRadius", static_cast<float>(air.TopRadiusMetres));
     program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
     program->SetUniformi("groundOn", ground ? 1 : 0);
     program->SetUniformf("groundZ", static_cast<float>(settings.GroundHeight));
@@ -731,7 +734,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   std::vector<double> intervalKey(ivp.begin(), ivp.end());
   intervalKey.insert(intervalKey.end(),
     { static_cast<double>(width), static_cast<double>(height), toSun[0], toSun[1], toSun[2],
-      axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG, settings.HazeG,
+      axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG, settings.Air.MieG,
       this->MultipleScattering });
   state->vtkglDisable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_FALSE);
@@ -744,7 +747,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
     setCommon(program);
     program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
-    program->SetUniformf("hazeG", static_cast<float>(settings.HazeG));
+    program->SetUniformf("hazeG", static_cast<float>(settings.Air.MieG));
     program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
     in.IntervalPhasePass->Render();
     ++in.PassesLastRender;
@@ -1017,15 +1020,15 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Albedo: " << this->Albedo << "\n";
   os << indent << "CloudG: " << this->CloudG << "\n";
   os << indent << "MultipleScattering (k_multi): " << this->MultipleScattering << "\n";
-  os << indent << "SunAzimuth: " << this->SunAzimuth << " deg\n";
-  os << indent << "SunElevation: " << this->SunElevation << " deg\n";
+  os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
+  os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
   os << indent << "SunIlluminance: " << this->SunIlluminance << "\n";
-  os << indent << "SunTemperature: " << this->SunTemperature << " K\n";
+  os << indent << "SunTemperatureKelvin: " << this->SunTemperatureKelvin << "\n";
   os << indent << "Atmosphere: " << this->Atmosphere << "\n";
-  os << indent << "HazeDensity: " << this->HazeDensity << " 1/m\n";
-  os << indent << "HazeG: " << this->HazeG << "\n";
-  os << indent << "RayleighScattering: " << this->RayleighScattering << " 1/m\n";
-  os << indent << "SceneAltitude: " << this->SceneAltitude << " m\n";
+  os << indent << "MieScatteringPerMetre: " << this->MieScatteringPerMetre << "\n";
+  os << indent << "MieG: " << this->MieG << "\n";
+  os << indent << "RayleighScatteringPerMetre: " << this->RayleighScatteringPerMetre << "\n";
+  os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
   os << indent << "Ground: " << this->Ground << "\n";
   os << indent << "GroundHeight: " << this->GroundHeight << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
@@ -1034,7 +1037,7 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SliceAngleRatio (a): " << this->SliceAngleRatio << "\n";
   os << indent << "ShadowSurfaceSize: " << this->ShadowSurfaceSize << "\n";
   os << indent << "AtmosphereSteps: " << this->AtmosphereSteps << "\n";
-  os << indent << "LengthUnit: " << this->LengthUnit << " m\n";
+  os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "EncodeSrgb: " << this->EncodeSrgb << "\n";
   os << indent << "Unlit: " << this->Unlit << "\n";

@@ -20,7 +20,7 @@
  *  - A ground plane lit by the attenuated sun and shadowed through the shadow
  *    surface, and shafts of light in the atmosphere beyond the cloud box.
  *
- * Frame and units: world z is up; LengthUnit metres per world unit (1 by
+ * Frame and units: world z is up; MetresPerUnit metres per world unit (1 by
  * default); extinction in 1/m per unit density; radiance relative to the sun
  * (SunIlluminance = luminance of its irradiance above the atmosphere), in linear
  * sRGB, times Exposure in the framebuffer (EncodeSrgb applies the display
@@ -75,36 +75,37 @@ public:
   ///@}
 
   ///@{
-  /// Sun: azimuth in degrees from north (+y) toward east (+x), elevation in
-  /// degrees above the horizon (below it the sun is blocked by the earth when the
-  /// atmosphere is on), illuminance above the atmosphere (relative units) and
-  /// blackbody temperature in K.
-  vtkSetMacro(SunAzimuth, double);
-  vtkGetMacro(SunAzimuth, double);
-  vtkSetClampMacro(SunElevation, double, -90.0, 90.0);
-  vtkGetMacro(SunElevation, double);
+  /// The sun (nimbus::SunParameters, Physics/Sun.h): azimuth from north (+y) toward
+  /// east (+x), elevation above the horizon (below it the earth blocks the sun when
+  /// the atmosphere is on), the luminance of its irradiance above the atmosphere
+  /// (relative units) and its blackbody temperature. Names carry the units.
+  vtkSetMacro(SunAzimuthDegrees, double);
+  vtkGetMacro(SunAzimuthDegrees, double);
+  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  vtkGetMacro(SunElevationDegrees, double);
   vtkSetClampMacro(SunIlluminance, double, 0.0, 1e9);
   vtkGetMacro(SunIlluminance, double);
-  vtkSetClampMacro(SunTemperature, double, 1000.0, 40000.0);
-  vtkGetMacro(SunTemperature, double);
+  vtkSetClampMacro(SunTemperatureKelvin, double, 1000.0, 40000.0);
+  vtkGetMacro(SunTemperatureKelvin, double);
   ///@}
 
   ///@{
-  /// Atmosphere (Rayleigh + Mie, exponential densities over a spherical earth,
-  /// the optics core's model). HazeDensity is the Mie scattering coefficient at
-  /// sea level [1/m]; HazeG its Cornette-Shanks asymmetry; SceneAltitude the
-  /// altitude of world z = 0 [m].
+  /// The air (nimbus::AtmosphereParameters, Physics/Atmosphere.h: Rayleigh + Mie,
+  /// exponential densities over a spherical earth): the Rayleigh and Mie (haze)
+  /// scattering coefficients at sea level, the Mie phase function's Cornette-Shanks
+  /// asymmetry g, and the altitude above sea level of world z = 0. The same names
+  /// as vtkNimbusSky and the scene format; the other parameters keep their defaults.
   vtkSetMacro(Atmosphere, bool);
   vtkGetMacro(Atmosphere, bool);
   vtkBooleanMacro(Atmosphere, bool);
-  vtkSetClampMacro(HazeDensity, double, 0.0, 1.0);
-  vtkGetMacro(HazeDensity, double);
-  vtkSetClampMacro(HazeG, double, -0.999, 0.999);
-  vtkGetMacro(HazeG, double);
-  vtkSetClampMacro(RayleighScattering, double, 0.0, 1.0);
-  vtkGetMacro(RayleighScattering, double);
-  vtkSetClampMacro(SceneAltitude, double, 0.0, 50000.0);
-  vtkGetMacro(SceneAltitude, double);
+  vtkSetClampMacro(MieScatteringPerMetre, double, 0.0, 1.0);
+  vtkGetMacro(MieScatteringPerMetre, double);
+  vtkSetClampMacro(MieG, double, -0.999, 0.999);
+  vtkGetMacro(MieG, double);
+  vtkSetClampMacro(RayleighScatteringPerMetre, double, 0.0, 1.0);
+  vtkGetMacro(RayleighScatteringPerMetre, double);
+  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 50000.0);
+  vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
 
   ///@{
@@ -142,8 +143,8 @@ public:
 
   ///@{
   /// Metres per world unit (distances and heights are converted with it).
-  vtkSetClampMacro(LengthUnit, double, 1e-9, 1e9);
-  vtkGetMacro(LengthUnit, double);
+  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  vtkGetMacro(MetresPerUnit, double);
   ///@}
 
   ///@{
@@ -159,10 +160,10 @@ public:
 
   ///@{
   /// Follow the sky of a visible vtkNimbusSkyBackground in the renderer (default
-  /// on): while one is there, its vtkNimbusSky replaces SunAzimuth, SunElevation,
-  /// SunIlluminance (1) and SunTemperature (5778 K), HazeDensity, HazeG,
-  /// RayleighScattering, SceneAltitude (= ObserverAltitude), GroundHeight (sea
-  /// level), GroundAlbedo, LengthUnit (= MetresPerUnit), Exposure and EncodeSrgb
+  /// on): while one is there, its vtkNimbusSky replaces the sun (SunAzimuthDegrees,
+  /// SunElevationDegrees, SunIlluminance 1, SunTemperatureKelvin 5778), the air
+  /// (RayleighScatteringPerMetre, MieScatteringPerMetre, MieG, SceneAltitudeMetres),
+  /// GroundHeight (sea level), GroundAlbedo, MetresPerUnit, Exposure and EncodeSrgb
   /// (the sky's exposure and white balance, sRGB on); the background is the sky
   /// and the cloud is composited over it as I = S - T_cl S_clear + T_cl L_sky
   /// (svsCompositeFS.glsl), which costs a second accumulation target.
@@ -172,7 +173,7 @@ public:
   /// Whether the last render followed a scene sky, and that sky's sun elevation
   /// (degrees; the mapper's own when it did not).
   bool GetLastRenderUsedSceneSky() const;
-  double GetLastSunElevation() const;
+  double GetLastSunElevationDegrees() const;
   ///@}
 
   ///@{
@@ -223,15 +224,15 @@ protected:
   double Albedo = 0.99;
   double CloudG = 0.85;
   double MultipleScattering = 0.0;
-  double SunAzimuth = 135.0;
-  double SunElevation = 45.0;
+  double SunAzimuthDegrees = 135.0;
+  double SunElevationDegrees = 45.0;
   double SunIlluminance = 1.0;
-  double SunTemperature = 5778.0;
+  double SunTemperatureKelvin = 5778.0;
   bool Atmosphere = true;
-  double HazeDensity = 2.0e-5;
-  double HazeG = 0.76;
-  double RayleighScattering = 13.5e-6;
-  double SceneAltitude = 0.0;
+  double MieScatteringPerMetre = 2.0e-5;
+  double MieG = 0.76;
+  double RayleighScatteringPerMetre = 13.5e-6;
+  double SceneAltitudeMetres = 0.0;
   bool Ground = true;
   double GroundHeight = 0.0;
   double GroundAlbedo = 0.2;
@@ -240,7 +241,7 @@ protected:
   double SliceAngleRatio = 1.0;
   int ShadowSurfaceSize = 512;
   int AtmosphereSteps = 64;
-  double LengthUnit = 1.0;
+  double MetresPerUnit = 1.0;
   double Exposure = 1.0;
   bool EncodeSrgb = false;
   bool Unlit = false;

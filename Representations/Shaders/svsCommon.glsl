@@ -1,7 +1,7 @@
 // Shared GLSL of the shadow-view-slice mapper (000). Prepended to each pass's
 // fragment shader by vtkNimbusCloudVolumeMapper. World frame: z is up; lengths in
 // world units, converted to metres with lengthUnit. Radiometry: linear sRGB,
-// relative to the sun (see Reference/Core/SceneDescription.h).
+// relative to the sun (see Physics/Sun.h).
 uniform mat4 inverseViewProjection; // NDC -> world
 uniform int perspective;            // 1: rays start at the eye, 0: on the near plane
 uniform vec3 eyePosition;           // world position of the eye (perspective)

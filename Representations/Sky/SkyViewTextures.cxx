@@ -39,7 +39,7 @@ std::string SkyViewTextures::Substitute(const char* source)
 
 double SkyViewTextures::CameraAltitude(vtkNimbusSky* sky, double z)
 {
-  return std::max(0.0, sky->GetObserverAltitude() + z * sky->GetMetresPerUnit());
+  return std::max(0.0, sky->GetSceneAltitudeMetres() + z * sky->GetMetresPerUnit());
 }
 
 bool SkyViewTextures::Update(
@@ -92,9 +92,9 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
   sky->GetSunDiscRadiance(disc);
   program->SetUniform3f("sunDirection", sun);
   program->SetUniformf(
-    "sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuth())));
+    "sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuthDegrees())));
   program->SetUniformf(
-    "mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.mieG));
+    "mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.MieG));
   program->SetUniform3f("displayScale", scale);
   const float skyTable[4] = { static_cast<float>(m.HorizonZenith), static_cast<float>(m.Width),
     static_cast<float>(m.AboveRows), static_cast<float>(m.BelowRows) };

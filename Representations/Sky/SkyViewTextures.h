@@ -34,7 +34,7 @@ public:
   /// Binds the textures and sets the sky uniforms of nimbusSkyView.glsl.
   void Activate(vtkShaderProgram* program, vtkNimbusSky* sky);
   /// The altitude a camera at scene height z sees the sky from:
-  /// ObserverAltitude + z MetresPerUnit, at least 0.
+  /// SceneAltitudeMetres + z MetresPerUnit, at least 0.
   static double CameraAltitude(vtkNimbusSky* sky, double z);
   void Deactivate();
   void Release(vtkWindow* window);

@@ -13,7 +13,7 @@ vtkStandardNewMacro(vtkNimbusSky);
 struct vtkNimbusSky::Internals
 {
   std::unique_ptr<nimbus::SkyModel> Model;
-  double ModelAerosol = -1.0, ModelAlbedo = -1.0;
+  double ModelMieScattering = -1.0, ModelAlbedo = -1.0;
   int ModelOrders = -1;
   int ModelGeneration = 0;
 
@@ -43,20 +43,20 @@ void vtkNimbusSky::SetPreset(int preset)
   switch (preset)
   {
     case Noon:
-      this->SetSunElevation(60.0);
-      this->SetSunAzimuth(180.0);
+      this->SetSunElevationDegrees(60.0);
+      this->SetSunAzimuthDegrees(180.0);
       break;
     case Afternoon:
-      this->SetSunElevation(30.0);
-      this->SetSunAzimuth(240.0);
+      this->SetSunElevationDegrees(30.0);
+      this->SetSunAzimuthDegrees(240.0);
       break;
     case Sunset:
-      this->SetSunElevation(2.0);
-      this->SetSunAzimuth(270.0);
+      this->SetSunElevationDegrees(2.0);
+      this->SetSunAzimuthDegrees(270.0);
       break;
     case Twilight:
-      this->SetSunElevation(-4.0);
-      this->SetSunAzimuth(270.0);
+      this->SetSunElevationDegrees(-4.0);
+      this->SetSunAzimuthDegrees(270.0);
       break;
     default:
       vtkErrorMacro(
@@ -66,7 +66,7 @@ void vtkNimbusSky::SetPreset(int preset)
 
 void vtkNimbusSky::GetSunDirection(double direction[3])
 {
-  const auto s = nimbus::SunDirectionFromAngles(this->SunElevation, this->SunAzimuth);
+  const auto s = nimbus::SunDirection(this->SunElevationDegrees, this->SunAzimuthDegrees);
   for (int i = 0; i < 3; ++i)
   {
     direction[i] = s[i];
@@ -76,18 +76,18 @@ void vtkNimbusSky::GetSunDirection(double direction[3])
 const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
 {
   Internals& in = *this->Internal;
-  if (!in.Model || in.ModelAerosol != this->AerosolDensity ||
+  if (!in.Model || in.ModelMieScattering != this->MieScatteringPerMetre ||
     in.ModelAlbedo != this->GroundAlbedo || in.ModelOrders != this->ScatteringOrders)
   {
     nimbus::SkyParameters p;
-    p.Atmosphere.mieScattering *= this->AerosolDensity;
+    p.Atmosphere.MieScatteringPerMetre = this->MieScatteringPerMetre;
     p.GroundAlbedo = this->GroundAlbedo;
     p.ScatteringOrders = this->ScatteringOrders;
     in.SkyView.reset();
     in.CameraSkyView.reset();
     in.Aerial.reset();
     in.Model = std::make_unique<nimbus::SkyModel>(p);
-    in.ModelAerosol = this->AerosolDensity;
+    in.ModelMieScattering = this->MieScatteringPerMetre;
     in.ModelAlbedo = this->GroundAlbedo;
     in.ModelOrders = this->ScatteringOrders;
     ++in.ModelGeneration;
@@ -101,13 +101,14 @@ const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLut()
   const nimbus::SkyModel& model = this->GetSkyModel();
   Internals& in = *this->Internal;
   if (!in.SkyView || in.SkyViewGeneration != in.ModelGeneration ||
-    in.SkyViewElevation != this->SunElevation || in.SkyViewAltitude != this->ObserverAltitude)
+    in.SkyViewElevation != this->SunElevationDegrees ||
+    in.SkyViewAltitude != this->SceneAltitudeMetres)
   {
-    in.SkyView =
-      std::make_unique<nimbus::SkyViewLut>(model, this->SunElevation, this->ObserverAltitude);
+    in.SkyView = std::make_unique<nimbus::SkyViewLut>(
+      model, this->SunElevationDegrees, this->SceneAltitudeMetres);
     in.SkyViewGeneration = in.ModelGeneration;
-    in.SkyViewElevation = this->SunElevation;
-    in.SkyViewAltitude = this->ObserverAltitude;
+    in.SkyViewElevation = this->SunElevationDegrees;
+    in.SkyViewAltitude = this->SceneAltitudeMetres;
     ++this->SkyViewBuilds;
   }
   return *in.SkyView;
@@ -119,18 +120,18 @@ const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLutAt(double altitude)
   Internals& in = *this->Internal;
   altitude = std::max(0.0, altitude);
   const double tolerance = std::max(25.0, 0.02 * altitude);
-  if (std::abs(altitude - this->ObserverAltitude) <= tolerance)
+  if (std::abs(altitude - this->SceneAltitudeMetres) <= tolerance)
   {
     return observer;
   }
   if (!in.CameraSkyView || in.CameraSkyViewGeneration != in.ModelGeneration ||
-    in.CameraSkyViewElevation != this->SunElevation ||
+    in.CameraSkyViewElevation != this->SunElevationDegrees ||
     std::abs(in.CameraSkyViewAltitude - altitude) > tolerance)
   {
-    in.CameraSkyView =
-      std::make_unique<nimbus::SkyViewLut>(this->GetSkyModel(), this->SunElevation, altitude);
+    in.CameraSkyView = std::make_unique<nimbus::SkyViewLut>(
+      this->GetSkyModel(), this->SunElevationDegrees, altitude);
     in.CameraSkyViewGeneration = in.ModelGeneration;
-    in.CameraSkyViewElevation = this->SunElevation;
+    in.CameraSkyViewElevation = this->SunElevationDegrees;
     in.CameraSkyViewAltitude = altitude;
     ++this->SkyViewBuilds;
   }
@@ -144,15 +145,16 @@ const nimbus::AerialPerspectiveLut& vtkNimbusSky::GetAerialPerspectiveLut(double
   cameraAltitude = std::max(0.0, cameraAltitude);
   const double tolerance = std::max(10.0, 0.01 * cameraAltitude);
   if (!in.Aerial || in.AerialGeneration != in.ModelGeneration ||
-    in.AerialElevation != this->SunElevation || in.AerialRange != this->MaxAerialDistance ||
+    in.AerialElevation != this->SunElevationDegrees ||
+    in.AerialRange != this->MaxAerialDistanceMetres ||
     std::abs(in.AerialAltitude - cameraAltitude) > tolerance)
   {
     in.Aerial = std::make_unique<nimbus::AerialPerspectiveLut>(
-      model, this->SunElevation, cameraAltitude, this->MaxAerialDistance);
+      model, this->SunElevationDegrees, cameraAltitude, this->MaxAerialDistanceMetres);
     in.AerialGeneration = in.ModelGeneration;
-    in.AerialElevation = this->SunElevation;
+    in.AerialElevation = this->SunElevationDegrees;
     in.AerialAltitude = cameraAltitude;
-    in.AerialRange = this->MaxAerialDistance;
+    in.AerialRange = this->MaxAerialDistanceMetres;
     ++this->AerialBuilds;
   }
   return *in.Aerial;
@@ -169,7 +171,7 @@ void vtkNimbusSky::GetRadiance(const double direction[3], double rgb[3])
     return;
   }
   const auto L = this->GetSkyViewLut().Radiance(
-    { { direction[0] / n, direction[1] / n, direction[2] / n } }, this->SunAzimuth);
+    { { direction[0] / n, direction[1] / n, direction[2] / n } }, this->SunAzimuthDegrees);
   for (int i = 0; i < 3; ++i)
   {
     rgb[i] = L[i];
@@ -201,7 +203,8 @@ void vtkNimbusSky::AerialPerspective(
   const double camera[3], const double point[3], double transmittance[3], double inscatter[3])
 {
   const nimbus::SkyModel& model = this->GetSkyModel();
-  const double base = model.GetParameters().Atmosphere.earthRadius + this->ObserverAltitude;
+  const double base =
+    model.GetParameters().Atmosphere.EarthRadiusMetres + this->SceneAltitudeMetres;
   const double m = this->MetresPerUnit;
   const nimbus::SkyModel::Vector3 p0{ { camera[0] * m, camera[1] * m, base + camera[2] * m } };
   const nimbus::SkyModel::Vector3 p1{ { point[0] * m, point[1] * m, base + point[2] * m } };
@@ -209,7 +212,7 @@ void vtkNimbusSky::AerialPerspective(
   try
   {
     model.AerialPerspective(
-      p0, p1, nimbus::SunDirectionFromAngles(this->SunElevation, this->SunAzimuth), t, l);
+      p0, p1, nimbus::SunDirection(this->SunElevationDegrees, this->SunAzimuthDegrees), t, l);
   }
   catch (const std::exception& e)
   {
@@ -227,9 +230,9 @@ void vtkNimbusSky::AerialPerspective(
 void vtkNimbusSky::GetSunDiscRadiance(double rgb[3])
 {
   const nimbus::SkyModel& model = this->GetSkyModel();
-  const double r = model.GetParameters().Atmosphere.earthRadius + this->ObserverAltitude;
+  const double r = model.GetParameters().Atmosphere.EarthRadiusMetres + this->SceneAltitudeMetres;
   std::vector<double> T(model.GetSunIrradiance().size());
-  model.SunTransmittance(r, std::sin(this->SunElevation * vtkMath::Pi() / 180.0), T.data());
+  model.SunTransmittance(r, std::sin(this->SunElevationDegrees * nimbus::kDegree), T.data());
   std::vector<double> spectrum(T.size());
   for (std::size_t i = 0; i < T.size(); ++i)
   {
@@ -248,14 +251,14 @@ void vtkNimbusSky::GetSunDiscRadiance(double rgb[3])
 void vtkNimbusSky::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "SunElevation: " << this->SunElevation << "\n";
-  os << indent << "SunAzimuth: " << this->SunAzimuth << "\n";
-  os << indent << "AerosolDensity: " << this->AerosolDensity << "\n";
+  os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
+  os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
+  os << indent << "MieScatteringPerMetre: " << this->MieScatteringPerMetre << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
-  os << indent << "ObserverAltitude: " << this->ObserverAltitude << "\n";
+  os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
   os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
-  os << indent << "MaxAerialDistance: " << this->MaxAerialDistance << "\n";
+  os << indent << "MaxAerialDistanceMetres: " << this->MaxAerialDistanceMetres << "\n";
   os << indent << "ScatteringOrders: " << this->ScatteringOrders << "\n";
   os << indent << "WhiteBalance: " << this->WhiteBalance << "\n";
   os << indent << "SunDisc: " << this->SunDisc << "\n";

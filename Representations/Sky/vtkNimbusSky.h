@@ -1,17 +1,17 @@
 /**
  * @class   vtkNimbusSky
- * @brief   Shared sky parameters and their look-up tables (issue 6).
+ * @brief   Shared sky parameters and their look-up tables.
  *
  * One object that the sky background / aerial-perspective pass
  * (vtkNimbusSkyPass), the sky dome (vtkNimbusSkyDomeSource) and a cloud mapper
  * share, so that sky, haze and clouds agree. It is thin glue around
  * Physics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
  * and rebuilds each only when what it depends on changed (cache keys):
- *  - SkyModel (transmittance + multiple scattering): AerosolDensity, GroundAlbedo;
- *  - sky-view table: the model, SunElevation, ObserverAltitude;
- *  - aerial-perspective table: the model, SunElevation, the camera altitude,
- *    MaxAerialDistance.
- * SunAzimuth, Exposure and WhiteBalance never rebuild anything.
+ *  - SkyModel (transmittance + multiple scattering): MieScatteringPerMetre, GroundAlbedo;
+ *  - sky-view table: the model, SunElevationDegrees, SceneAltitudeMetres;
+ *  - aerial-perspective table: the model, SunElevationDegrees, the camera altitude,
+ *    MaxAerialDistanceMetres.
+ * SunAzimuthDegrees, Exposure and WhiteBalance never rebuild anything.
  *
  * Radiance is relative to the sun: the solar irradiance outside the atmosphere
  * has luminance Y = 1 (so a white Lambertian plane facing the sun there has
@@ -20,7 +20,7 @@
  * vtkNimbusSunlight).
  *
  * Scene frame: z up, y north, x east; scene lengths x MetresPerUnit = metres;
- * scene z = 0 is at ObserverAltitude above sea level.
+ * scene z = 0 is at SceneAltitudeMetres above sea level.
  *
  * For a GL mapper: GetTransmittanceTable / GetMultipleScatteringTable give the
  * atmosphere's float tables, GetSkyViewTable / GetAerialPerspectiveTable the
@@ -55,24 +55,25 @@ public:
     Sunset = 2,    ///< sun 2 deg, west
     Twilight = 3   ///< sun -4 deg, west (civil twilight)
   };
-  /// Sets SunElevation and SunAzimuth from a preset (an error for an unknown one).
+  /// Sets SunElevationDegrees and SunAzimuthDegrees from a preset (an error for an unknown one).
   void SetPreset(int preset);
 
   ///@{
   /// Sun elevation above the horizon, degrees, [-90, 90]. Default 45.
-  vtkSetClampMacro(SunElevation, double, -90.0, 90.0);
-  vtkGetMacro(SunElevation, double);
+  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  vtkGetMacro(SunElevationDegrees, double);
   ///@}
   ///@{
   /// Sun azimuth from north (+y) toward east (+x), degrees. Default 135.
-  vtkSetMacro(SunAzimuth, double);
-  vtkGetMacro(SunAzimuth, double);
+  vtkSetMacro(SunAzimuthDegrees, double);
+  vtkGetMacro(SunAzimuthDegrees, double);
   ///@}
   ///@{
-  /// Aerosol (Mie) density relative to the default clear atmosphere
-  /// (beta_M,s = 2e-5 1/m at sea level), [0, 20]; the "turbidity" knob. Default 1.
-  vtkSetClampMacro(AerosolDensity, double, 0.0, 20.0);
-  vtkGetMacro(AerosolDensity, double);
+  /// Aerosol (Mie) scattering coefficient at sea level, 1/m, [0, 4e-4]: how hazy
+  /// the air is. Default 2e-5 (a clear atmosphere; the mapper and the scene format
+  /// use the same name and unit).
+  vtkSetClampMacro(MieScatteringPerMetre, double, 0.0, 4.0e-4);
+  vtkGetMacro(MieScatteringPerMetre, double);
   ///@}
   ///@{
   /// Grey Lambertian albedo of the ground, [0, 1]. Default 0.3.
@@ -87,8 +88,8 @@ public:
   ///@{
   /// Altitude of the scene's z = 0 (and of the dome's observer) above sea level,
   /// metres, [0, 1e6]. Default 0.
-  vtkSetClampMacro(ObserverAltitude, double, 0.0, 1.0e6);
-  vtkGetMacro(ObserverAltitude, double);
+  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 1.0e6);
+  vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
   ///@{
   /// Metres per scene unit, (0, 1e6]. Default 1.
@@ -97,8 +98,8 @@ public:
   ///@}
   ///@{
   /// Range of the aerial-perspective table, metres, [100, 1e6]. Default 1e5.
-  vtkSetClampMacro(MaxAerialDistance, double, 100.0, 1.0e6);
-  vtkGetMacro(MaxAerialDistance, double);
+  vtkSetClampMacro(MaxAerialDistanceMetres, double, 100.0, 1.0e6);
+  vtkGetMacro(MaxAerialDistanceMetres, double);
   ///@}
   ///@{
   /// Scattering orders K (1 = single scattering), [1, 10]. Default 4.
@@ -146,7 +147,7 @@ public:
   /// Sky-view table seen from another altitude (m; a camera's): below the
   /// horizon it holds the air between that altitude and the ground. The
   /// observer's table when the altitude is within max(25 m, 2 %) of
-  /// ObserverAltitude; otherwise a second cached table, rebuilt when the altitude
+  /// SceneAltitudeMetres; otherwise a second cached table, rebuilt when the altitude
   /// moves by more than max(25 m, 2 %) (0.2 s at the default size).
   const nimbus::SkyViewLut& GetSkyViewLutAt(double altitude);
   /// Aerial-perspective table for a camera at the given altitude (m); rebuilt
@@ -162,14 +163,14 @@ protected:
   vtkNimbusSky();
   ~vtkNimbusSky() override;
 
-  double SunElevation = 45.0;
-  double SunAzimuth = 135.0;
-  double AerosolDensity = 1.0;
+  double SunElevationDegrees = 45.0;
+  double SunAzimuthDegrees = 135.0;
+  double MieScatteringPerMetre = 2.0e-5;
   double GroundAlbedo = 0.3;
   double Exposure = 10.0;
-  double ObserverAltitude = 0.0;
+  double SceneAltitudeMetres = 0.0;
   double MetresPerUnit = 1.0;
-  double MaxAerialDistance = 1.0e5;
+  double MaxAerialDistanceMetres = 1.0e5;
   int ScatteringOrders = 4;
   bool WhiteBalance = true;
   bool SunDisc = true;

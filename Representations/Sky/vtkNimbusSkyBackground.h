@@ -17,7 +17,7 @@
  * vtkNimbusCloudVolumeMapper::UseSceneSky).
  *
  * The background is seen from the sky's observer (scene z = 0 at
- * ObserverAltitude): the camera's height does not change it.
+ * SceneAltitudeMetres): the camera's height does not change it.
  *
  * GLSL: Shaders/vtkNimbusSkyBackgroundFS.glsl with nimbusSkyView.glsl (the
  * twin of nimbus::SkyViewLut::Radiance), shared with vtkNimbusSkyPass.

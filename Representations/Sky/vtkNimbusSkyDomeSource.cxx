@@ -39,12 +39,12 @@ vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
       this->Sky->Set##name(v);                                                                     \
     }                                                                                              \
   }
-NIMBUS_FORWARD(SunElevation)
-NIMBUS_FORWARD(SunAzimuth)
-NIMBUS_FORWARD(AerosolDensity)
+NIMBUS_FORWARD(SunElevationDegrees)
+NIMBUS_FORWARD(SunAzimuthDegrees)
+NIMBUS_FORWARD(MieScatteringPerMetre)
 NIMBUS_FORWARD(GroundAlbedo)
 NIMBUS_FORWARD(Exposure)
-NIMBUS_FORWARD(ObserverAltitude)
+NIMBUS_FORWARD(SceneAltitudeMetres)
 NIMBUS_FORWARD(MetresPerUnit)
 #undef NIMBUS_FORWARD
 
@@ -89,16 +89,16 @@ struct SkyParameter
       [](vtkNimbusSky * s, double v) { s->Set##name(static_cast<type>(v)); }                       \
   }
 const SkyParameter SkyParameters[] = {
-  NIMBUS_PARAMETER(SunElevation, double),
-  NIMBUS_PARAMETER(SunAzimuth, double),
-  NIMBUS_PARAMETER(AerosolDensity, double),
+  NIMBUS_PARAMETER(SunElevationDegrees, double),
+  NIMBUS_PARAMETER(SunAzimuthDegrees, double),
+  NIMBUS_PARAMETER(MieScatteringPerMetre, double),
   NIMBUS_PARAMETER(GroundAlbedo, double),
   NIMBUS_PARAMETER(Exposure, double),
   NIMBUS_PARAMETER(WhiteBalance, bool),
   NIMBUS_PARAMETER(SunDisc, bool),
-  NIMBUS_PARAMETER(ObserverAltitude, double),
+  NIMBUS_PARAMETER(SceneAltitudeMetres, double),
   NIMBUS_PARAMETER(MetresPerUnit, double),
-  NIMBUS_PARAMETER(MaxAerialDistance, double),
+  NIMBUS_PARAMETER(MaxAerialDistanceMetres, double),
   NIMBUS_PARAMETER(ScatteringOrders, int),
 };
 #undef NIMBUS_PARAMETER

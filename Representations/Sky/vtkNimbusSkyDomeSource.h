@@ -15,10 +15,10 @@
  * The output's field data carries the sky's parameters, as they were when the
  * colours were computed (after the Preset), one one-tuple vtkDoubleArray each,
  * named as the vtkNimbusSky parameter (units as there):
- *  - "SunElevation" (deg above the horizon), "SunAzimuth" (deg from +y toward +x),
- *  - "AerosolDensity" (relative to the clear atmosphere), "GroundAlbedo",
+ *  - "SunElevationDegrees" (deg above the horizon), "SunAzimuthDegrees" (deg from +y toward +x),
+ *  - "MieScatteringPerMetre" (1/m at sea level), "GroundAlbedo",
  *  - "Exposure", "WhiteBalance" (0/1), "SunDisc" (0/1),
- *  - "ObserverAltitude" (m), "MetresPerUnit", "MaxAerialDistance" (m),
+ *  - "SceneAltitudeMetres" (m), "MetresPerUnit", "MaxAerialDistanceMetres" (m),
  *  - "ScatteringOrders" (1 = single scattering).
  * Consumers (ParaView's "Sky Background" representation) rebuild the same sky
  * from them with ApplySkyParameters(); AddSkyParameters() writes them.
@@ -55,12 +55,12 @@ public:
 
   ///@{
   /// Forwarded to the sky (one place for ParaView's properties).
-  void SetSunElevation(double v);
-  void SetSunAzimuth(double v);
-  void SetAerosolDensity(double v);
+  void SetSunElevationDegrees(double v);
+  void SetSunAzimuthDegrees(double v);
+  void SetMieScatteringPerMetre(double v);
   void SetGroundAlbedo(double v);
   void SetExposure(double v);
-  void SetObserverAltitude(double v);
+  void SetSceneAltitudeMetres(double v);
   void SetMetresPerUnit(double v);
   void SetScatteringOrders(int v);
   void SetWhiteBalance(bool v);

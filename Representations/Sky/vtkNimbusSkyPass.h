@@ -14,7 +14,7 @@
  * Translucent geometry and volumes write no depth and get no aerial perspective;
  * they are composited over the sky by their alpha (the delegate renders on
  * transparent black: the renderer's background is ignored while the pass is on).
- * The camera's altitude is the sky's ObserverAltitude + camera z x MetresPerUnit;
+ * The camera's altitude is the sky's SceneAltitudeMetres + camera z x MetresPerUnit;
  * both the sky-view table (vtkNimbusSky::GetSkyViewLutAt) and the
  * aerial-perspective table are seen from it. For the sky alone, without a pass,
  * see vtkNimbusSkyBackground.

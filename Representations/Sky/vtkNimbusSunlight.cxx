@@ -1,5 +1,7 @@
 #include "vtkNimbusSunlight.h"
 
+#include "Sun.h"
+
 #include "Atmosphere.h"
 #include "SpectralColor.h"
 
@@ -21,11 +23,9 @@ vtkNimbusSunlight::vtkNimbusSunlight() = default;
 
 void vtkNimbusSunlight::GetDirection(double direction[3])
 {
-  const double elevation = vtkMath::RadiansFromDegrees(this->SunElevation);
-  const double azimuth = vtkMath::RadiansFromDegrees(this->SunAzimuth);
-  direction[0] = std::cos(elevation) * std::sin(azimuth); // east
-  direction[1] = std::cos(elevation) * std::cos(azimuth); // north
-  direction[2] = std::sin(elevation);                     // up
+  const nimbus::Vector3 toSun =
+    nimbus::SunDirection(this->SunElevationDegrees, this->SunAzimuthDegrees);
+  std::copy(toSun.begin(), toSun.end(), direction);
 }
 
 void vtkNimbusSunlight::ComputeXyz(double transmitted[3], double outside[3])
@@ -36,7 +36,7 @@ void vtkNimbusSunlight::ComputeXyz(double transmitted[3], double outside[3])
   this->GetDirection(direction);
   // Observer on the z axis of an earth-centred frame; the local frame is the scene frame.
   const nimbus::Atmosphere::Vector3 observer{ { 0.0, 0.0,
-    atmosphere.GetParameters().earthRadius + this->ObserverAltitude } };
+    atmosphere.GetParameters().EarthRadiusMetres + this->SceneAltitudeMetres } };
   const nimbus::OpticalLengths lengths =
     atmosphere.OpticalLengthsToTop(observer, { { direction[0], direction[1], direction[2] } });
 
@@ -107,8 +107,8 @@ void vtkNimbusSunlight::ApplyToLight(vtkLight* light)
 void vtkNimbusSunlight::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "SunElevation: " << this->SunElevation << " deg\n";
-  os << indent << "SunAzimuth: " << this->SunAzimuth << " deg\n";
-  os << indent << "ObserverAltitude: " << this->ObserverAltitude << " m\n";
+  os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
+  os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
+  os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
   os << indent << "WhiteBalance: " << (this->WhiteBalance ? "On" : "Off") << "\n";
 }

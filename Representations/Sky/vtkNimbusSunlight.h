@@ -4,7 +4,7 @@
  *
  * Thin VTK glue around Nimbus::Physics (Physics/Atmosphere.h, Physics/SpectralColor.h):
  * the sun is a 5778 K blackbody outside the atmosphere; its light reaching an
- * observer at ObserverAltitude is attenuated by Rayleigh and Mie extinction along
+ * observer at SceneAltitudeMetres is attenuated by Rayleigh and Mie extinction along
  * the slanted path to the top of a spherical atmosphere, sampled at
  * nimbus::SpectralSamples' default wavelengths and converted via CIE XYZ to
  * linear sRGB. The colour is normalised so that the sun outside the atmosphere
@@ -16,8 +16,8 @@
  * unattenuated sun is orange-tinted, (1.05, 0.88, 0.73), because a 5778 K
  * blackbody is warmer than sRGB's D65 white point.
  *
- * Scene frame: z up, y north, x east. SunElevation is the angle above the
- * horizon (degrees, -90..90); SunAzimuth is measured from north (+y) toward
+ * Scene frame: z up, y north, x east. SunElevationDegrees is the angle above the
+ * horizon (degrees, -90..90); SunAzimuthDegrees is measured from north (+y) toward
  * east (+x), degrees.
  */
 #ifndef vtkNimbusSunlight_h
@@ -37,20 +37,20 @@ public:
 
   ///@{
   /// Sun elevation above the horizon, degrees in [-90, 90]. Default 45.
-  vtkSetClampMacro(SunElevation, double, -90.0, 90.0);
-  vtkGetMacro(SunElevation, double);
+  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  vtkGetMacro(SunElevationDegrees, double);
   ///@}
 
   ///@{
   /// Sun azimuth from north (+y) toward east (+x), degrees. Default 135 (south-east).
-  vtkSetMacro(SunAzimuth, double);
-  vtkGetMacro(SunAzimuth, double);
+  vtkSetMacro(SunAzimuthDegrees, double);
+  vtkGetMacro(SunAzimuthDegrees, double);
   ///@}
 
   ///@{
   /// Altitude of the lit scene above sea level, metres (>= 0). Default 1500.
-  vtkSetClampMacro(ObserverAltitude, double, 0.0, 1.0e5);
-  vtkGetMacro(ObserverAltitude, double);
+  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 1.0e5);
+  vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
 
   ///@{
@@ -77,9 +77,9 @@ protected:
   vtkNimbusSunlight();
   ~vtkNimbusSunlight() override = default;
 
-  double SunElevation = 45.0;
-  double SunAzimuth = 135.0;
-  double ObserverAltitude = 1500.0;
+  double SunElevationDegrees = 45.0;
+  double SunAzimuthDegrees = 135.0;
+  double SceneAltitudeMetres = 1500.0;
   bool WhiteBalance = true;
 
 private:

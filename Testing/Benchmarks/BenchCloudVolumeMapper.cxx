@@ -110,8 +110,8 @@ double TimeSvs(vtkImageData* image, int slices,
   vtkNew<vtkNimbusCloudVolumeMapper> mapper;
   mapper->SetInputData(image);
   mapper->SetNumberOfSlices(slices);
-  mapper->SetSunAzimuth(135);
-  mapper->SetSunElevation(65);
+  mapper->SetSunAzimuthDegrees(135);
+  mapper->SetSunElevationDegrees(65);
   configure(mapper);
   bench.Volume->SetMapper(mapper);
   const double t = bench.Time();
@@ -175,8 +175,8 @@ int main(int argc, char* argv[])
   {
     // Sky at 65 deg (as the mapper's sun here); tables built in the warm-up frame.
     vtkNew<vtkNimbusSkyBackground> sky;
-    sky->GetSky()->SetSunElevation(65);
-    sky->GetSky()->SetSunAzimuth(135);
+    sky->GetSky()->SetSunElevationDegrees(65);
+    sky->GetSky()->SetSunAzimuthDegrees(135);
     const double empty = bench.Time();
     bench.Renderer->AddViewProp(sky);
     const double skyOnly = bench.Time();

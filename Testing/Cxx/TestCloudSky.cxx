@@ -170,11 +170,11 @@ int RunChecks()
       return added[0] / std::max(added[2], 1.0); // at least one level of blue
     };
     const double highRedness = cloudRedness(volume);
-    scene.Sky->GetSky()->SetSunElevation(4.0);
+    scene.Sky->GetSky()->SetSunElevationDegrees(4.0);
     const double lowRedness = cloudRedness(volume);
-    ok &= Check(std::abs(scene.Mapper->GetLastSunElevation() - 4.0) < 1e-12,
+    ok &= Check(std::abs(scene.Mapper->GetLastSunElevationDegrees() - 4.0) < 1e-12,
       "the mapper lit the cloud with the sky's sun (elevation " +
-        std::to_string(scene.Mapper->GetLastSunElevation()) + ")");
+        std::to_string(scene.Mapper->GetLastSunElevationDegrees()) + ")");
     ok &= Check(lowRedness > highRedness * 1.5,
       "a low sun reddens the cloud: R/B of its light " + std::to_string(highRedness) +
         " (sun 30 deg) -> " + std::to_string(lowRedness) + " (4 deg)");
@@ -183,7 +183,7 @@ int RunChecks()
     scene.Mapper->CaptureRadianceOn();
     for (double elevation : { 90.0, -6.0 })
     {
-      scene.Sky->GetSky()->SetSunElevation(elevation);
+      scene.Sky->GetSky()->SetSunElevationDegrees(elevation);
       Grab(scene.Window);
       vtkDataArray* radiance =
         scene.Mapper->GetRadianceImage()->GetPointData()->GetArray("radiance");
@@ -198,10 +198,10 @@ int RunChecks()
     }
     scene.Mapper->CaptureRadianceOff();
     scene.Mapper->UseSceneSkyOff();
-    scene.Mapper->SetSunElevation(60.0);
+    scene.Mapper->SetSunElevationDegrees(60.0);
     Grab(scene.Window);
-    ok &= Check(
-      !scene.Mapper->GetLastRenderUsedSceneSky() && scene.Mapper->GetLastSunElevation() == 60.0,
+    ok &= Check(!scene.Mapper->GetLastRenderUsedSceneSky() &&
+        scene.Mapper->GetLastSunElevationDegrees() == 60.0,
       "with UseSceneSky off the mapper keeps its own sun");
   }
   {
@@ -247,7 +247,7 @@ int main(int argc, char* argv[])
     return EXIT_FAILURE;
   }
   Scene scene;
-  scene.Sky->GetSky()->SetAerosolDensity(2.0);
+  scene.Sky->GetSky()->SetMieScatteringPerMetre(2.0 * 2.0e-5); // twice the default haze
   // Far to near (volumes are composited in the order they were added).
   scene.AddCloud(-9000.0, 28000.0);
   scene.AddCloud(2500.0, 10000.0);

@@ -155,8 +155,8 @@ bool Check(bool condition, const std::string& what)
 bool Noon(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(135);
-  s.Mapper->SetSunElevation(65);
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(65);
   s.Render(c.Png());
   return Check(!s.Mapper->GetLastBackToFront(), "sun behind the camera: front to back") &&
     c.CompareWithBaseline();
@@ -165,8 +165,8 @@ bool Noon(const Context& c)
 bool Sunset(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(250);
-  s.Mapper->SetSunElevation(3);
+  s.Mapper->SetSunAzimuthDegrees(250);
+  s.Mapper->SetSunElevationDegrees(3);
   s.Render(c.Png());
   return c.CompareWithBaseline();
 }
@@ -174,8 +174,8 @@ bool Sunset(const Context& c)
 bool SilverLining(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(0); // north, behind the cloud seen from the south
-  s.Mapper->SetSunElevation(14);
+  s.Mapper->SetSunAzimuthDegrees(0); // north, behind the cloud seen from the south
+  s.Mapper->SetSunElevationDegrees(14);
   s.Render(c.Png());
   return Check(s.Mapper->GetLastBackToFront(), "camera faces the sun: back to front") &&
     c.CompareWithBaseline();
@@ -184,8 +184,8 @@ bool SilverLining(const Context& c)
 bool FacingSun(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(12); // in view, to the right of the cloud
-  s.Mapper->SetSunElevation(9);
+  s.Mapper->SetSunAzimuthDegrees(12); // in view, to the right of the cloud
+  s.Mapper->SetSunElevationDegrees(9);
   s.Render(c.Png());
   return Check(s.Mapper->GetLastBackToFront(), "camera faces the sun: back to front") &&
     c.CompareWithBaseline();
@@ -194,8 +194,8 @@ bool FacingSun(const Context& c)
 bool GroundShadows(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(285);
-  s.Mapper->SetSunElevation(35);
+  s.Mapper->SetSunAzimuthDegrees(285);
+  s.Mapper->SetSunElevationDegrees(35);
   s.Mapper->SetGroundAlbedo(0.4);
   s.LookFrom({ 0, -7000, 5000 }, { 0, -800, 300 }, 50);
   s.Render(c.Png());
@@ -233,9 +233,9 @@ bool ShaftsThroughGap(const Context& c)
       }
   image->GetPointData()->SetScalars(density);
   Scene s(image);
-  s.Mapper->SetSunAzimuth(0);
-  s.Mapper->SetSunElevation(30);
-  s.Mapper->SetHazeDensity(1.0e-4);
+  s.Mapper->SetSunAzimuthDegrees(0);
+  s.Mapper->SetSunElevationDegrees(30);
+  s.Mapper->SetMieScatteringPerMetre(1.0e-4);
   s.LookFrom({ 0, -4500, 200 }, { 0, 0, 1200 }, 70);
   s.Render(c.Png());
   return c.CompareWithBaseline();
@@ -246,9 +246,9 @@ bool HazeOnly(const Context& c)
   vtkSmartPointer<vtkImageData> image = MakeCloud();
   image->GetPointData()->GetScalars()->Fill(0.0);
   Scene s(image);
-  s.Mapper->SetSunAzimuth(200);
-  s.Mapper->SetSunElevation(20);
-  s.Mapper->SetHazeDensity(6e-5);
+  s.Mapper->SetSunAzimuthDegrees(200);
+  s.Mapper->SetSunElevationDegrees(20);
+  s.Mapper->SetMieScatteringPerMetre(6e-5);
   s.Render(c.Png());
   return c.CompareWithBaseline();
 }
@@ -256,8 +256,8 @@ bool HazeOnly(const Context& c)
 bool OpaqueInside(const Context& c)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(135);
-  s.Mapper->SetSunElevation(40);
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(40);
   vtkNew<vtkSphereSource> sphere;
   sphere->SetCenter(300, -200, 1600);
   sphere->SetRadius(500);
@@ -290,15 +290,15 @@ bool SunAlongAndAgainstView(const Context&)
     const std::vector<double> position = { 0, -sign * d * std::cos(e),
       1600 - sign * d * std::sin(e) };
     s.LookFrom(position, focal, 35);
-    s.Mapper->SetSunAzimuth(0);
-    s.Mapper->SetSunElevation(sign > 0 ? 20 : -20);
+    s.Mapper->SetSunAzimuthDegrees(0);
+    s.Mapper->SetSunElevationDegrees(sign > 0 ? 20 : -20);
     if (sign < 0)
     {
-      s.Mapper->SetSunAzimuth(180);
-      s.Mapper->SetSunElevation(-20);
+      s.Mapper->SetSunAzimuthDegrees(180);
+      s.Mapper->SetSunElevationDegrees(-20);
     }
     const auto exact = s.Render();
-    s.Mapper->SetSunElevation(s.Mapper->GetSunElevation() + 0.5);
+    s.Mapper->SetSunElevationDegrees(s.Mapper->GetSunElevationDegrees() + 0.5);
     const auto near = s.Render();
     const double rmse = Rmse(exact, near);
     ok &= Check(Mean(exact) > 1.0,
@@ -314,12 +314,12 @@ bool SunAlongAndAgainstView(const Context&)
 bool SunAtAndBelowHorizon(const Context&)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(90);
-  s.Mapper->SetSunElevation(0.0);
+  s.Mapper->SetSunAzimuthDegrees(90);
+  s.Mapper->SetSunElevationDegrees(0.0);
   const auto horizon = s.Render();
-  s.Mapper->SetSunElevation(-5.0);
+  s.Mapper->SetSunElevationDegrees(-5.0);
   const auto below = s.Render();
-  s.Mapper->SetSunElevation(10.0);
+  s.Mapper->SetSunElevationDegrees(10.0);
   const auto above = s.Render();
   // Below the horizon the earth blocks the sun for the ground and the cloud (the
   // bottom of the image, ground, is black); only the high atmosphere is still lit
@@ -342,8 +342,8 @@ bool SunAtAndBelowHorizon(const Context&)
 bool SliceRatioOneAndTwo(const Context&)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(60);
-  s.Mapper->SetSunElevation(30);
+  s.Mapper->SetSunAzimuthDegrees(60);
+  s.Mapper->SetSunElevationDegrees(30);
   s.Mapper->SetSliceAngleRatio(1.0);
   const auto one = s.Render();
   s.Mapper->SetSliceAngleRatio(2.0);
@@ -376,8 +376,8 @@ bool OneVoxelAndEmpty(const Context&)
 bool HugeOpticalThickness(const Context&)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(135);
-  s.Mapper->SetSunElevation(45);
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(45);
   s.Mapper->SetExtinctionPerDensity(0.02 * 1e4 / 50.0); // tau ~ 1e4 through the core
   const auto thick = s.Render();
   s.Mapper->SetExtinctionPerDensity(0.02 * 1e3 / 50.0);
@@ -391,8 +391,8 @@ bool HugeOpticalThickness(const Context&)
 bool CameraInsideVolume(const Context&)
 {
   Scene s(MakeCloud());
-  s.Mapper->SetSunAzimuth(135);
-  s.Mapper->SetSunElevation(45);
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(45);
   // Optical thickness ~5 through the core: single scattering still lights the inside.
   s.Mapper->SetExtinctionPerDensity(0.002);
   s.LookFrom({ 0, 0, 1500 }, { 0, 1000, 1600 }, 60);
@@ -408,7 +408,7 @@ bool LightingChangeKeepsVolume(const Context&)
 {
   Scene s(MakeCloud());
   s.Render();
-  s.Mapper->SetSunElevation(20);
+  s.Mapper->SetSunElevationDegrees(20);
   s.Mapper->SetCloudG(0.5);
   s.Render();
   const int uploads = s.Mapper->GetNumberOfVolumeUploads();

@@ -74,8 +74,8 @@ int main(int argc, char* argv[])
 
   // Low sun (15 degrees) from the camera's right: warm light, visible shading.
   vtkNew<vtkNimbusSunlight> sun;
-  sun->SetSunElevation(15.0);
-  sun->SetSunAzimuth(60.0);
+  sun->SetSunElevationDegrees(15.0);
+  sun->SetSunAzimuthDegrees(60.0);
   vtkNew<vtkLight> light;
   sun->ApplyToLight(light);
   light->SetAmbientColor(1.0, 1.0, 1.0);

@@ -420,8 +420,8 @@ SceneDescription SunSlabScene(int n, bool fromAbove, double g, double sunElevati
   scene.Camera.FocalPoint = fromAbove ? V{ { 0.0, 0.0, 100.0 } } : V{ { 0.0, 0.0, 0.0 } };
   scene.Camera.ViewAngle = 30.0;
   scene.Sun.Illuminance = 1.0;
-  scene.Sun.Azimuth = 0.0;
-  scene.Sun.Elevation = sunElevation;
+  scene.Sun.AzimuthDegrees = 0.0;
+  scene.Sun.ElevationDegrees = sunElevation;
   scene.Medium.SingleScatteringAlbedo = 0.9;
   scene.Medium.ExtinctionPerDensity = 0.02; // D = 100 m: tau = 2
   scene.Medium.Phase = { { "henyey_greenstein", g, 1.0 } };
@@ -498,7 +498,7 @@ TEST(PathTracer, Deterministic)
   scene.Ground.Enabled = true;
   scene.Background.Type = "atmosphere";
   scene.Sun.Illuminance = 1.0;
-  scene.Sun.Elevation = 30.0;
+  scene.Sun.ElevationDegrees = 30.0;
   scene.Camera.Position = { { 0.0, -2500.0, 800.0 } };
   scene.Camera.FocalPoint = { { 0.0, 0.0, 1000.0 } };
   scene.Camera.ViewAngle = 40.0;
@@ -592,7 +592,7 @@ TEST(PathTracer, StabilityCases)
   for (const double elevation : { 90.0, 0.0, -5.0 })
   {
     SceneDescription s = base();
-    s.Sun.Elevation = elevation;
+    s.Sun.ElevationDegrees = elevation;
     cases.push_back({ elevation == 90.0 ? "sun at zenith"
         : elevation == 0.0              ? "sun on horizon"
                                         : "sun 5 deg below",
@@ -616,7 +616,7 @@ TEST(PathTracer, StabilityCases)
   {
     SceneDescription s = base();
     s.SpectralSamples = 3;
-    s.Atmosphere.SceneAltitude = 2000.0;
+    s.Atmosphere.SceneAltitudeMetres = 2000.0;
     s.Ground.Albedo = 1.0;
     s.Camera.FocalPoint = { { 0.0, 0.0, 0.0 } }; // looking down at the ground
     cases.push_back({ "3 wavelengths, white ground", s, box(1.0f) });

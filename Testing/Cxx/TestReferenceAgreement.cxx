@@ -49,8 +49,8 @@ nimbus::SceneDescription SmallScene(bool atmosphere)
   scene.Medium.ExtinctionPerDensity = 0.004; // optical thickness ~ 4 through the core
   scene.Medium.SingleScatteringAlbedo = 0.95;
   scene.Medium.Phase = { { "cornette_shanks", 0.7, 0.95 }, { "rayleigh", 0.0, 0.05 } };
-  scene.Sun.Elevation = 35.0;
-  scene.Sun.Azimuth = 200.0;
+  scene.Sun.ElevationDegrees = 35.0;
+  scene.Sun.AzimuthDegrees = 200.0;
   scene.Atmosphere.Enabled = atmosphere;
   scene.Ground.Enabled = atmosphere;
   // Black surroundings: the path tracer's one bounce would also scatter a constant

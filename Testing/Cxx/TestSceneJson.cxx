@@ -22,6 +22,9 @@
 #ifndef NIMBUS_SCENES_DIR
 #error "NIMBUS_SCENES_DIR must name Data/Scenes"
 #endif
+#ifndef NIMBUS_TEST_DATA_DIR
+#error "NIMBUS_TEST_DATA_DIR must name Testing/Data"
+#endif
 
 namespace
 {
@@ -53,19 +56,19 @@ void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
     EXPECT_EQ(a.Medium.Phase[i].G, b.Medium.Phase[i].G);
     EXPECT_EQ(a.Medium.Phase[i].Weight, b.Medium.Phase[i].Weight);
   }
-  EXPECT_EQ(a.Sun.Azimuth, b.Sun.Azimuth);
-  EXPECT_EQ(a.Sun.Elevation, b.Sun.Elevation);
+  EXPECT_EQ(a.Sun.AzimuthDegrees, b.Sun.AzimuthDegrees);
+  EXPECT_EQ(a.Sun.ElevationDegrees, b.Sun.ElevationDegrees);
   EXPECT_EQ(a.Sun.Illuminance, b.Sun.Illuminance);
-  EXPECT_EQ(a.Sun.Temperature, b.Sun.Temperature);
+  EXPECT_EQ(a.Sun.TemperatureKelvin, b.Sun.TemperatureKelvin);
   const auto &x = a.Atmosphere, &y = b.Atmosphere;
   EXPECT_EQ(x.Enabled, y.Enabled);
-  EXPECT_EQ(x.SceneAltitude, y.SceneAltitude);
-  EXPECT_EQ(x.EarthRadius, y.EarthRadius);
-  EXPECT_EQ(x.TopRadius, y.TopRadius);
-  EXPECT_EQ(x.RayleighScattering550, y.RayleighScattering550);
-  EXPECT_EQ(x.RayleighScaleHeight, y.RayleighScaleHeight);
-  EXPECT_EQ(x.MieScattering, y.MieScattering);
-  EXPECT_EQ(x.MieScaleHeight, y.MieScaleHeight);
+  EXPECT_EQ(x.SceneAltitudeMetres, y.SceneAltitudeMetres);
+  EXPECT_EQ(x.EarthRadiusMetres, y.EarthRadiusMetres);
+  EXPECT_EQ(x.TopRadiusMetres, y.TopRadiusMetres);
+  EXPECT_EQ(x.RayleighScatteringPerMetre, y.RayleighScatteringPerMetre);
+  EXPECT_EQ(x.RayleighScaleHeightMetres, y.RayleighScaleHeightMetres);
+  EXPECT_EQ(x.MieScatteringPerMetre, y.MieScatteringPerMetre);
+  EXPECT_EQ(x.MieScaleHeightMetres, y.MieScaleHeightMetres);
   EXPECT_EQ(x.MieAlbedo, y.MieAlbedo);
   EXPECT_EQ(x.MieG, y.MieG);
   EXPECT_EQ(a.Ground.Enabled, b.Ground.Enabled);
@@ -80,10 +83,10 @@ void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
 Json MinimalJson()
 {
   return Json::parse(R"({
-    "nimbus_scene": 1,
+    "nimbus_scene": 2,
     "camera": { "position": [0, -6000, 1500], "focal_point": [0, 0, 1600] },
     "medium": { "density": { "type": "metaball_cloud" }, "extinction_per_density": 0.02 },
-    "sun": { "azimuth": 135, "elevation": 45 }
+    "sun": { "azimuth_degrees": 135, "elevation_degrees": 45 }
   })");
 }
 
@@ -113,13 +116,13 @@ SceneDescription NonDefaultScene()
     { "isotropic", 0.85, 0.1 } };
   s.Sun = { 271.5, 12.25, 3.5, 6000.0 };
   s.Atmosphere.Enabled = false;
-  s.Atmosphere.SceneAltitude = 250.0;
-  s.Atmosphere.EarthRadius = 6371000.0;
-  s.Atmosphere.TopRadius = 6471000.0;
-  s.Atmosphere.RayleighScattering550 = 1.1e-5;
-  s.Atmosphere.RayleighScaleHeight = 8500.0;
-  s.Atmosphere.MieScattering = 1.0e-4;
-  s.Atmosphere.MieScaleHeight = 900.0;
+  s.Atmosphere.SceneAltitudeMetres = 250.0;
+  s.Atmosphere.EarthRadiusMetres = 6371000.0;
+  s.Atmosphere.TopRadiusMetres = 6471000.0;
+  s.Atmosphere.RayleighScatteringPerMetre = 1.1e-5;
+  s.Atmosphere.RayleighScaleHeightMetres = 8500.0;
+  s.Atmosphere.MieScatteringPerMetre = 1.0e-4;
+  s.Atmosphere.MieScaleHeightMetres = 900.0;
   s.Atmosphere.MieAlbedo = 0.95;
   s.Atmosphere.MieG = 0.7;
   s.Ground = { false, 12.0, 0.35 };
@@ -232,18 +235,18 @@ TEST(SceneJson, ProjectScenesPhysics)
   const SceneDescription silver = nimbus::LoadScene(dir + "/silver_lining.json");
   const SceneDescription haze = nimbus::LoadScene(dir + "/haze_shafts.json");
   const SceneDescription cb = nimbus::LoadScene(dir + "/cumulonimbus.json");
-  EXPECT_NEAR(noon.Sun.Elevation, 65.0, 5.0);
-  EXPECT_NEAR(sunset.Sun.Elevation, 5.0, 0.5);
+  EXPECT_NEAR(noon.Sun.ElevationDegrees, 65.0, 5.0);
+  EXPECT_NEAR(sunset.Sun.ElevationDegrees, 5.0, 0.5);
   EXPECT_EQ(noon.Medium.Density.Parameters, sunset.Medium.Density.Parameters); // same cloud
   EXPECT_EQ(noon.Camera.Position, sunset.Camera.Position);
   EXPECT_TRUE(noon.Atmosphere.Enabled && noon.Ground.Enabled);
   EXPECT_EQ(noon.Background.Type, "atmosphere");
   // Silver lining: the camera looks toward the sun.
   const double kDegree = 3.14159265358979323846 / 180.0;
-  const double sunToward[3] = { std::cos(silver.Sun.Elevation * kDegree) *
-      std::sin(silver.Sun.Azimuth * kDegree),
-    std::cos(silver.Sun.Elevation * kDegree) * std::cos(silver.Sun.Azimuth * kDegree),
-    std::sin(silver.Sun.Elevation * kDegree) };
+  const double sunToward[3] = { std::cos(silver.Sun.ElevationDegrees * kDegree) *
+      std::sin(silver.Sun.AzimuthDegrees * kDegree),
+    std::cos(silver.Sun.ElevationDegrees * kDegree) * std::cos(silver.Sun.AzimuthDegrees * kDegree),
+    std::sin(silver.Sun.ElevationDegrees * kDegree) };
   double view[3], length = 0.0, dot = 0.0;
   for (int a = 0; a < 3; ++a)
   {
@@ -256,8 +259,8 @@ TEST(SceneJson, ProjectScenesPhysics)
   }
   EXPECT_GT(dot, std::cos(15.0 * kDegree));
   EXPECT_GE(silver.Medium.Phase.at(0).G, 0.8);
-  EXPECT_GE(haze.Atmosphere.MieScattering, 5.0e-5);
-  EXPECT_LT(haze.Atmosphere.MieScaleHeight, 1200.0);
+  EXPECT_GE(haze.Atmosphere.MieScatteringPerMetre, 5.0e-5);
+  EXPECT_LT(haze.Atmosphere.MieScaleHeightMetres, 1200.0);
   EXPECT_GE(cb.Medium.ExtinctionPerDensity, 0.1);
   EXPECT_NE(cb.Description.find("optical thickness"), std::string::npos);
 }
@@ -288,7 +291,7 @@ TEST(SceneJson, CanonicalForm)
 {
   const std::string text = nimbus::SceneToJson(MetaballScene());
   // Fixed key order, integers and booleans where the property is one.
-  EXPECT_LT(text.find("\"nimbus_scene\": 1"), text.find("\"camera\""));
+  EXPECT_LT(text.find("\"nimbus_scene\": 2"), text.find("\"camera\""));
   EXPECT_NE(text.find("\"Seed\": -7"), std::string::npos);
   EXPECT_NE(text.find("\"FlatBase\": false"), std::string::npos);
   EXPECT_NE(text.find("\"width\": 256"), std::string::npos);
@@ -313,14 +316,14 @@ TEST(SceneJson, HashStable)
   EXPECT_EQ(nimbus::SceneHash(s), hash);
   // Pinned: the canonical form (and so every cached reference image's key) changes only
   // on purpose. Update this when a field is added or the format changes deliberately.
-  EXPECT_EQ(hash, "5884e4b0bb036ec3");
+  EXPECT_EQ(hash, "5e1d742df6799b74"); // format version 2
   EXPECT_EQ(nimbus::SceneHash(nimbus::ParseScene(nimbus::SceneToJson(s), "")), hash);
   // Formatting and key order of the text do not matter, only the description.
   Json a = MinimalJson(), b = Json::parse(R"({
-    "sun": {"elevation": 45.0, "azimuth": 135},
+    "sun": {"elevation_degrees": 45.0, "azimuth_degrees": 135},
     "medium": {"extinction_per_density": 2e-2, "density": {"type": "metaball_cloud"}},
     "camera": {"focal_point": [0, 0, 1600], "position": [0.0, -6000, 1.5e3]},
-    "nimbus_scene": 1})");
+    "nimbus_scene": 2})");
   EXPECT_EQ(nimbus::SceneHash(Parse(a)), nimbus::SceneHash(Parse(b)));
 }
 
@@ -351,20 +354,25 @@ TEST(SceneJson, HashSensitiveToEveryField)
     { "Phase.Type", [](SceneDescription& s) { s.Medium.Phase[0].Type = "cornette_shanks"; } },
     { "Phase.G", [](SceneDescription& s) { s.Medium.Phase[1].G += 0.01; } },
     { "Phase.Weight", [](SceneDescription& s) { s.Medium.Phase[2].Weight += 0.01; } },
-    { "Sun.Azimuth", [](SceneDescription& s) { s.Sun.Azimuth += 1; } },
-    { "Sun.Elevation", [](SceneDescription& s) { s.Sun.Elevation += 1; } },
+    { "Sun.AzimuthDegrees", [](SceneDescription& s) { s.Sun.AzimuthDegrees += 1; } },
+    { "Sun.ElevationDegrees", [](SceneDescription& s) { s.Sun.ElevationDegrees += 1; } },
     { "Sun.Illuminance", [](SceneDescription& s) { s.Sun.Illuminance += 1; } },
-    { "Sun.Temperature", [](SceneDescription& s) { s.Sun.Temperature += 1; } },
+    { "Sun.TemperatureKelvin", [](SceneDescription& s) { s.Sun.TemperatureKelvin += 1; } },
     { "Atmosphere.Enabled", [](SceneDescription& s) { s.Atmosphere.Enabled = true; } },
-    { "Atmosphere.SceneAltitude", [](SceneDescription& s) { s.Atmosphere.SceneAltitude += 1; } },
-    { "Atmosphere.EarthRadius", [](SceneDescription& s) { s.Atmosphere.EarthRadius += 1; } },
-    { "Atmosphere.TopRadius", [](SceneDescription& s) { s.Atmosphere.TopRadius += 1; } },
-    { "Atmosphere.RayleighScattering550",
-      [](SceneDescription& s) { s.Atmosphere.RayleighScattering550 *= 1.01; } },
-    { "Atmosphere.RayleighScaleHeight",
-      [](SceneDescription& s) { s.Atmosphere.RayleighScaleHeight += 1; } },
-    { "Atmosphere.MieScattering", [](SceneDescription& s) { s.Atmosphere.MieScattering *= 1.01; } },
-    { "Atmosphere.MieScaleHeight", [](SceneDescription& s) { s.Atmosphere.MieScaleHeight += 1; } },
+    { "Atmosphere.SceneAltitudeMetres",
+      [](SceneDescription& s) { s.Atmosphere.SceneAltitudeMetres += 1; } },
+    { "Atmosphere.EarthRadiusMetres",
+      [](SceneDescription& s) { s.Atmosphere.EarthRadiusMetres += 1; } },
+    { "Atmosphere.TopRadiusMetres",
+      [](SceneDescription& s) { s.Atmosphere.TopRadiusMetres += 1; } },
+    { "Atmosphere.RayleighScatteringPerMetre",
+      [](SceneDescription& s) { s.Atmosphere.RayleighScatteringPerMetre *= 1.01; } },
+    { "Atmosphere.RayleighScaleHeightMetres",
+      [](SceneDescription& s) { s.Atmosphere.RayleighScaleHeightMetres += 1; } },
+    { "Atmosphere.MieScatteringPerMetre",
+      [](SceneDescription& s) { s.Atmosphere.MieScatteringPerMetre *= 1.01; } },
+    { "Atmosphere.MieScaleHeightMetres",
+      [](SceneDescription& s) { s.Atmosphere.MieScaleHeightMetres += 1; } },
     { "Atmosphere.MieAlbedo", [](SceneDescription& s) { s.Atmosphere.MieAlbedo -= 0.01; } },
     { "Atmosphere.MieG", [](SceneDescription& s) { s.Atmosphere.MieG += 0.01; } },
     { "Ground.Enabled", [](SceneDescription& s) { s.Ground.Enabled = true; } },
@@ -399,17 +407,17 @@ TEST(SceneJson, HashSensitiveToEveryField)
 TEST(SceneJson, Errors)
 {
   // Syntax, top level and version.
-  ExpectErrorText("{\"nimbus_scene\": 1,", "scene");
+  ExpectErrorText("{\"nimbus_scene\": 2,", "scene");
   ExpectErrorText("[1, 2]", "scene: expected an object");
   ExpectError(Without("/nimbus_scene"), "scene: missing required key \"nimbus_scene\"");
-  ExpectError(With("/nimbus_scene", 2), "scene.nimbus_scene: unsupported format version 2");
+  ExpectError(With("/nimbus_scene", 3), "scene.nimbus_scene: unsupported format version 3");
   ExpectError(With("/nimbus_scene", 0), "scene.nimbus_scene: unsupported format version 0");
-  ExpectError(With("/nimbus_scene", "1"), "scene.nimbus_scene: expected the format version");
+  ExpectError(With("/nimbus_scene", "2"), "scene.nimbus_scene: expected the format version");
   ExpectError(With("/nimbus_scene", 1.5), "scene.nimbus_scene: expected the format version");
   ExpectError(With("/colour", 1), "scene.colour: unknown key (known: nimbus_scene, name,");
-  ExpectErrorText(R"({"nimbus_scene": 1, "nimbus_scene": 1})", "scene.nimbus_scene: duplicate key");
-  ExpectErrorText(R"({"nimbus_scene": 1, "sun": {"elevation": 1, "elevation": 2}})",
-    "scene.sun.elevation: duplicate key");
+  ExpectErrorText(R"({"nimbus_scene": 2, "nimbus_scene": 2})", "scene.nimbus_scene: duplicate key");
+  ExpectErrorText(R"({"nimbus_scene": 2, "sun": {"elevation_degrees": 1, "elevation_degrees": 2}})",
+    "scene.sun.elevation_degrees: duplicate key");
   ExpectError(With("/name", 3), "scene.name: expected a string, got 3");
   ExpectError(
     With("/spectral_samples", 2), "scene.spectral_samples: expected an integer in [3, 256], got 2");
@@ -417,18 +425,20 @@ TEST(SceneJson, Errors)
   // Huge numbers (JSON cannot hold NaN or Inf; 1e999 overflows).
   {
     std::string text = MinimalJson().dump();
-    const std::string key = "\"elevation\":45";
+    const std::string key = "\"elevation_degrees\":45";
     ASSERT_NE(text.find(key), std::string::npos);
-    text.replace(text.find(key), key.size(), "\"elevation\":1e999");
-    ExpectErrorText(text, "scene.sun.elevation: invalid JSON");
+    text.replace(text.find(key), key.size(), "\"elevation_degrees\":1e999");
+    ExpectErrorText(text, "scene.sun.elevation_degrees: invalid JSON");
   }
 
   // Required sections and keys.
   ExpectError(Without("/camera"), "scene: missing required key \"camera\"");
   ExpectError(Without("/medium"), "scene: missing required key \"medium\"");
   ExpectError(Without("/sun"), "scene: missing required key \"sun\"");
-  ExpectError(Without("/sun/elevation"), "scene.sun: missing required key \"elevation\"");
-  ExpectError(Without("/sun/azimuth"), "scene.sun: missing required key \"azimuth\"");
+  ExpectError(
+    Without("/sun/elevation_degrees"), "scene.sun: missing required key \"elevation_degrees\"");
+  ExpectError(
+    Without("/sun/azimuth_degrees"), "scene.sun: missing required key \"azimuth_degrees\"");
   ExpectError(Without("/camera/position"), "scene.camera: missing required key \"position\"");
   ExpectError(Without("/medium/density"), "scene.medium: missing required key \"density\"");
   ExpectError(
@@ -535,43 +545,44 @@ TEST(SceneJson, Errors)
     With(parameters, Json::array()), "scene.medium.density.parameters: expected an object");
 
   // Sun.
-  ExpectError(
-    With("/sun/elevation", 91), "scene.sun.elevation: expected a number in [-90, 90], got 91");
-  ExpectError(
-    With("/sun/azimuth", 1000), "scene.sun.azimuth: expected a number in [-360, 360], got 1000");
+  ExpectError(With("/sun/elevation_degrees", 91),
+    "scene.sun.elevation_degrees: expected a number in [-90, 90], got 91");
+  ExpectError(With("/sun/azimuth_degrees", 1000),
+    "scene.sun.azimuth_degrees: expected a number in [-360, 360], got 1000");
   ExpectError(
     With("/sun/illuminance", -1), "scene.sun.illuminance: expected a number >= 0, got -1");
-  ExpectError(With("/sun/temperature", 500),
-    "scene.sun.temperature: expected a number in [1000, 100000], got 500");
+  ExpectError(With("/sun/temperature_kelvin", 500),
+    "scene.sun.temperature_kelvin: expected a number in [1000, 100000], got 500");
   ExpectError(With("/sun/direction", Json::array({ 0, 1, 1 })),
-    "scene.sun.direction: give either direction or azimuth and elevation, not both");
+    "scene.sun.direction: give either direction or azimuth_degrees and elevation_degrees, not "
+    "both");
   {
     Json j = MinimalJson();
     j["sun"] = Json::parse(R"({"direction": [0, 0, 0]})");
     ExpectError(j, "scene.sun.direction: must be a non-zero vector");
     j["sun"] = Json::parse(R"({"direction": [0, 1]})");
     ExpectError(j, "scene.sun.direction: expected an array of 3 numbers, got 2 elements");
-    j["sun"] = Json::parse(R"({"direction": [0, 1, 1], "azimuth": 3})");
+    j["sun"] = Json::parse(R"({"direction": [0, 1, 1], "azimuth_degrees": 3})");
     ExpectError(j, "scene.sun.direction: give either");
   }
 
   // Atmosphere, ground, background.
   ExpectError(
     With("/atmosphere/enabled", 1), "scene.atmosphere.enabled: expected true or false, got 1");
-  ExpectError(With("/atmosphere/top_radius", 6000000),
-    "scene.atmosphere.top_radius: must be greater than earth_radius");
-  ExpectError(With("/atmosphere/earth_radius", 0),
-    "scene.atmosphere.earth_radius: expected a number > 0, got 0");
-  ExpectError(With("/atmosphere/scene_altitude", -1),
-    "scene.atmosphere.scene_altitude: expected a number >= 0, got -1");
-  ExpectError(With("/atmosphere/scene_altitude", 70000),
-    "scene.atmosphere.scene_altitude: must be below the top");
-  ExpectError(With("/atmosphere/mie_scattering", -1e-5),
-    "scene.atmosphere.mie_scattering: expected a number >= 0");
-  ExpectError(With("/atmosphere/mie_scale_height", 0),
-    "scene.atmosphere.mie_scale_height: expected a number > 0");
-  ExpectError(With("/atmosphere/rayleigh_scale_height", -8000),
-    "scene.atmosphere.rayleigh_scale_height: expected a number > 0");
+  ExpectError(With("/atmosphere/top_radius_metres", 6000000),
+    "scene.atmosphere.top_radius_metres: must be greater than earth_radius_metres");
+  ExpectError(With("/atmosphere/earth_radius_metres", 0),
+    "scene.atmosphere.earth_radius_metres: expected a number > 0, got 0");
+  ExpectError(With("/atmosphere/scene_altitude_metres", -1),
+    "scene.atmosphere.scene_altitude_metres: expected a number >= 0, got -1");
+  ExpectError(With("/atmosphere/scene_altitude_metres", 70000),
+    "scene.atmosphere.scene_altitude_metres: must be below the top");
+  ExpectError(With("/atmosphere/mie_scattering_per_metre", -1e-5),
+    "scene.atmosphere.mie_scattering_per_metre: expected a number >= 0");
+  ExpectError(With("/atmosphere/mie_scale_height_metres", 0),
+    "scene.atmosphere.mie_scale_height_metres: expected a number > 0");
+  ExpectError(With("/atmosphere/rayleigh_scale_height_metres", -8000),
+    "scene.atmosphere.rayleigh_scale_height_metres: expected a number > 0");
   ExpectError(With("/atmosphere/mie_albedo", 0),
     "scene.atmosphere.mie_albedo: expected a number in (0, 1], got 0");
   ExpectError(
@@ -622,10 +633,10 @@ TEST(SceneJson, SunDirection)
     Json j = MinimalJson();
     j["sun"] = Json{ { "direction", c.Direction }, { "illuminance", 2.0 } };
     const SceneDescription s = Parse(j);
-    EXPECT_NEAR(s.Sun.Azimuth, c.Azimuth, 1e-12) << c.Direction[0] << " " << c.Direction[1];
-    EXPECT_NEAR(s.Sun.Elevation, c.Elevation, 1e-12);
+    EXPECT_NEAR(s.Sun.AzimuthDegrees, c.Azimuth, 1e-12) << c.Direction[0] << " " << c.Direction[1];
+    EXPECT_NEAR(s.Sun.ElevationDegrees, c.Elevation, 1e-12);
     EXPECT_EQ(s.Sun.Illuminance, 2.0);
-    EXPECT_FALSE(std::signbit(s.Sun.Azimuth));
+    EXPECT_FALSE(std::signbit(s.Sun.AzimuthDegrees));
   }
   // Inverse of RenderContext's (cos e sin a, cos e cos a, sin e).
   const double kDegree = 3.14159265358979323846 / 180.0;
@@ -634,7 +645,7 @@ TEST(SceneJson, SunDirection)
   j["sun"] = Json{ { "direction", d } };
   const SceneDescription s = Parse(j);
   const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  const double e = s.Sun.Elevation * kDegree, a = s.Sun.Azimuth * kDegree;
+  const double e = s.Sun.ElevationDegrees * kDegree, a = s.Sun.AzimuthDegrees * kDegree;
   EXPECT_NEAR(std::cos(e) * std::sin(a), d[0] / n, 1e-12);
   EXPECT_NEAR(std::cos(e) * std::cos(a), d[1] / n, 1e-12);
   EXPECT_NEAR(std::sin(e), d[2] / n, 1e-12);
@@ -689,7 +700,7 @@ TEST(SceneJson, RelativePaths)
   }
   {
     std::ofstream out(dir / "bad.json");
-    out << With("/sun/elevation", 100).dump();
+    out << With("/sun/elevation_degrees", 100).dump();
   }
   try
   {
@@ -700,7 +711,87 @@ TEST(SceneJson, RelativePaths)
   {
     EXPECT_EQ(std::string(error.what()),
       (dir / "bad.json").string() +
-        ": scene.sun.elevation: expected a number in [-90, 90], got 100");
+        ": scene.sun.elevation_degrees: expected a number in [-90, 90], got 100");
   }
   fs::remove_all(dir);
+}
+
+//------------------------------------------------------------------------------
+// Version 1 of the format named the sun's and the air's parameters without their
+// units ("elevation", "mie_scattering"); version 2 uses the names of Physics/Sun.h and
+// Physics/Atmosphere.h ("elevation_degrees", "mie_scattering_per_metre"). Version-1
+// files keep loading: they are read by renaming those keys (docs/scene-format.md).
+
+/// Every key version 2 renamed: (section, version-1 name, version-2 name).
+const std::vector<std::array<std::string, 3>> kRenamedKeys = {
+  { "sun", "azimuth", "azimuth_degrees" },
+  { "sun", "elevation", "elevation_degrees" },
+  { "sun", "temperature", "temperature_kelvin" },
+  { "atmosphere", "scene_altitude", "scene_altitude_metres" },
+  { "atmosphere", "earth_radius", "earth_radius_metres" },
+  { "atmosphere", "top_radius", "top_radius_metres" },
+  { "atmosphere", "rayleigh_scattering_550", "rayleigh_scattering_per_metre" },
+  { "atmosphere", "rayleigh_scale_height", "rayleigh_scale_height_metres" },
+  { "atmosphere", "mie_scattering", "mie_scattering_per_metre" },
+  { "atmosphere", "mie_scale_height", "mie_scale_height_metres" },
+};
+
+/// A version-2 document written back in version-1 words.
+Json AsVersion1(Json j)
+{
+  j["nimbus_scene"] = 1;
+  for (const auto& key : kRenamedKeys)
+  {
+    if (j.contains(key[0]) && j[key[0]].contains(key[2]))
+    {
+      j[key[0]][key[1]] = j[key[0]][key[2]];
+      j[key[0]].erase(key[2]);
+    }
+  }
+  return j;
+}
+
+TEST(SceneJson, Version1FilesLoadAsTheSameScene)
+{
+  // The project's haze_shafts scene as it was committed in version 1, against today's file.
+  const SceneDescription old =
+    nimbus::LoadScene(std::string(NIMBUS_TEST_DATA_DIR) + "/haze_shafts_version1.json");
+  const SceneDescription now =
+    nimbus::LoadScene(std::string(NIMBUS_SCENES_DIR) + "/haze_shafts.json");
+  ExpectSameScene(old, now);
+  EXPECT_EQ(nimbus::SceneHash(old), nimbus::SceneHash(now));
+  // Every renamed key, with a value that differs from the default.
+  const SceneDescription everything = NonDefaultScene();
+  const Json written = Json::parse(nimbus::SceneToJson(everything));
+  for (const auto& key : kRenamedKeys)
+  {
+    ASSERT_TRUE(written[key[0]].contains(key[2])) << key[2];
+  }
+  ExpectSameScene(Parse(AsVersion1(written)), Parse(written));
+  // Written back, a version-1 scene is version 2.
+  EXPECT_NE(nimbus::SceneToJson(old).find("\"nimbus_scene\": 2"), std::string::npos);
+}
+
+TEST(SceneJson, Version1ErrorsNameTheVersion1Keys)
+{
+  const Json v1 = AsVersion1(MinimalJson());
+  Json j = v1;
+  j["sun"]["elevation"] = 91;
+  ExpectError(j, "scene.sun.elevation: expected a number in [-90, 90], got 91");
+  j = v1;
+  j["sun"].erase("azimuth");
+  ExpectError(j, "scene.sun: missing required key \"azimuth\"");
+  j = v1;
+  j["atmosphere"] = Json::parse(R"({"top_radius": 6000000})");
+  ExpectError(j, "scene.atmosphere.top_radius: must be greater than earth_radius (");
+  // A version-2 name was unknown in version 1: rejected, with both names.
+  j = v1;
+  j["sun"]["elevation_degrees"] = 10;
+  ExpectError(j,
+    "scene.sun.elevation_degrees: unknown key in a version-1 file (version 1 "
+    "calls it \"elevation\"");
+  // And a version-1 name is unknown in version 2.
+  j = MinimalJson();
+  j["atmosphere"] = Json::parse(R"({"mie_scattering": 1e-5})");
+  ExpectError(j, "scene.atmosphere.mie_scattering: unknown key");
 }

@@ -39,8 +39,8 @@ SceneDescription PlainScene(double sunElevation, double sunAzimuth, double g = 0
   scene.Atmosphere.Enabled = false;
   scene.Ground.Enabled = false;
   scene.Background.Type = "black";
-  scene.Sun.Elevation = sunElevation;
-  scene.Sun.Azimuth = sunAzimuth;
+  scene.Sun.ElevationDegrees = sunElevation;
+  scene.Sun.AzimuthDegrees = sunAzimuth;
   scene.Sun.Illuminance = 1.0;
   scene.Medium.ExtinctionPerDensity = 0.01;
   scene.Medium.SingleScatteringAlbedo = 0.9;
@@ -432,7 +432,7 @@ TEST(SingleScattering, StabilityCases)
   auto base = [](double elevation)
   {
     SceneDescription scene; // default: atmosphere, ground, sky background
-    scene.Sun.Elevation = elevation;
+    scene.Sun.ElevationDegrees = elevation;
     scene.Camera.Width = 8;
     scene.Camera.Height = 8;
     scene.SpectralSamples = 8;
@@ -451,7 +451,7 @@ TEST(SingleScattering, StabilityCases)
   {
     SceneDescription scene = base(10.0);
     scene.Medium.Phase = { nimbus::PhaseComponentDescription{ "henyey_greenstein", g, 1.0 } };
-    scene.Sun.Azimuth = 0.0; // toward the camera's view direction (+y)
+    scene.Sun.AzimuthDegrees = 0.0; // toward the camera's view direction (+y)
     cases.push_back({ g > 0 ? "g = +0.9999" : "g = -0.9999", scene, blob });
   }
   cases.push_back({ "sun at the zenith", base(90.0), blob });
@@ -521,7 +521,7 @@ TEST(SingleScattering, SunAtmosphereKnots)
   for (double elevation : { 60.0, 20.0, 5.0, 1.0, 0.0, -1.0, -5.0 })
   {
     SceneDescription scene;
-    scene.Sun.Elevation = elevation;
+    scene.Sun.ElevationDegrees = elevation;
     scene.SpectralSamples = 8;
     const RenderContext context(scene, Slab());
     const double spacing = nimbus::detail::SunAtmosphereKnotSpacing(context);
@@ -560,8 +560,8 @@ TEST(SingleScattering, SkyAgainstBruteForce)
   for (double elevation : { 40.0, 8.0 })
   {
     SceneDescription scene;
-    scene.Sun.Elevation = elevation;
-    scene.Sun.Azimuth = 100.0;
+    scene.Sun.ElevationDegrees = elevation;
+    scene.Sun.AzimuthDegrees = 100.0;
     scene.SpectralSamples = 8;
     scene.Ground.Enabled = false;
     const RenderContext context(scene,

@@ -33,7 +33,7 @@ using nimbus::kDegree;
 
 Vector3 Direction(double elevationDeg, double azimuthDeg)
 {
-  return nimbus::SunDirectionFromAngles(elevationDeg, azimuthDeg);
+  return nimbus::SunDirection(elevationDeg, azimuthDeg);
 }
 
 double Y(const Rgb& c)
@@ -58,10 +58,10 @@ const SkyModel& SingleModel()
 std::unique_ptr<nimbus::RenderContext> ReferenceContext(double sunElevation, double altitude)
 {
   nimbus::SceneDescription scene;
-  scene.Sun.Elevation = sunElevation;
-  scene.Sun.Azimuth = 0.0;
+  scene.Sun.ElevationDegrees = sunElevation;
+  scene.Sun.AzimuthDegrees = 0.0;
   scene.Ground.Enabled = false;
-  scene.Atmosphere.SceneAltitude = altitude;
+  scene.Atmosphere.SceneAltitudeMetres = altitude;
   scene.SpectralSamples = 16;
   return std::make_unique<nimbus::RenderContext>(scene,
     nimbus::DensityGrid({ { 2, 2, 2 } }, { { 0.0, 0.0, -1.0e6 } }, { { 50.0, 50.0, 50.0 } },

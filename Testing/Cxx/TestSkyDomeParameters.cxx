@@ -17,16 +17,16 @@ namespace
 {
 void ExpectSameSky(vtkNimbusSky* a, vtkNimbusSky* b)
 {
-  EXPECT_EQ(a->GetSunElevation(), b->GetSunElevation());
-  EXPECT_EQ(a->GetSunAzimuth(), b->GetSunAzimuth());
-  EXPECT_EQ(a->GetAerosolDensity(), b->GetAerosolDensity());
+  EXPECT_EQ(a->GetSunElevationDegrees(), b->GetSunElevationDegrees());
+  EXPECT_EQ(a->GetSunAzimuthDegrees(), b->GetSunAzimuthDegrees());
+  EXPECT_EQ(a->GetMieScatteringPerMetre(), b->GetMieScatteringPerMetre());
   EXPECT_EQ(a->GetGroundAlbedo(), b->GetGroundAlbedo());
   EXPECT_EQ(a->GetExposure(), b->GetExposure());
   EXPECT_EQ(a->GetWhiteBalance(), b->GetWhiteBalance());
   EXPECT_EQ(a->GetSunDisc(), b->GetSunDisc());
-  EXPECT_EQ(a->GetObserverAltitude(), b->GetObserverAltitude());
+  EXPECT_EQ(a->GetSceneAltitudeMetres(), b->GetSceneAltitudeMetres());
   EXPECT_EQ(a->GetMetresPerUnit(), b->GetMetresPerUnit());
-  EXPECT_EQ(a->GetMaxAerialDistance(), b->GetMaxAerialDistance());
+  EXPECT_EQ(a->GetMaxAerialDistanceMetres(), b->GetMaxAerialDistanceMetres());
   EXPECT_EQ(a->GetScatteringOrders(), b->GetScatteringOrders());
 }
 }
@@ -37,20 +37,20 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
   dome->SetElevationResolution(4);
   dome->SetAzimuthResolution(8);
   dome->SetPreset(vtkNimbusSky::Sunset);
-  dome->SetSunElevation(70.0); // overridden by the preset
+  dome->SetSunElevationDegrees(70.0); // overridden by the preset
   dome->SetExposure(25.0);
-  dome->SetAerosolDensity(3.0);
+  dome->SetMieScatteringPerMetre(3.0 * 2.0e-5);
   dome->SetGroundAlbedo(0.1);
-  dome->SetObserverAltitude(1500.0);
+  dome->SetSceneAltitudeMetres(1500.0);
   dome->SetMetresPerUnit(1000.0);
   dome->SetScatteringOrders(2);
   dome->SetWhiteBalance(false);
   dome->SetSunDisc(false);
   dome->Update();
   vtkFieldData* fields = dome->GetOutput()->GetFieldData();
-  const char* names[] = { "SunElevation", "SunAzimuth", "AerosolDensity", "GroundAlbedo",
-    "Exposure", "WhiteBalance", "SunDisc", "ObserverAltitude", "MetresPerUnit", "MaxAerialDistance",
-    "ScatteringOrders" };
+  const char* names[] = { "SunElevationDegrees", "SunAzimuthDegrees", "MieScatteringPerMetre",
+    "GroundAlbedo", "Exposure", "WhiteBalance", "SunDisc", "SceneAltitudeMetres", "MetresPerUnit",
+    "MaxAerialDistanceMetres", "ScatteringOrders" };
   for (const char* name : names)
   {
     vtkDataArray* array = fields->GetArray(name);
@@ -60,10 +60,10 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
     EXPECT_TRUE(vtkDoubleArray::SafeDownCast(array)) << name;
   }
   EXPECT_EQ(fields->GetNumberOfArrays(), 11);
-  EXPECT_EQ(fields->GetArray("SunElevation")->GetComponent(0, 0), 2.0);
-  EXPECT_EQ(fields->GetArray("SunAzimuth")->GetComponent(0, 0), 270.0);
+  EXPECT_EQ(fields->GetArray("SunElevationDegrees")->GetComponent(0, 0), 2.0);
+  EXPECT_EQ(fields->GetArray("SunAzimuthDegrees")->GetComponent(0, 0), 270.0);
   EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 25.0);
-  EXPECT_EQ(fields->GetArray("ObserverAltitude")->GetComponent(0, 0), 1500.0);
+  EXPECT_EQ(fields->GetArray("SceneAltitudeMetres")->GetComponent(0, 0), 1500.0);
   EXPECT_EQ(fields->GetArray("ScatteringOrders")->GetComponent(0, 0), 2.0);
   EXPECT_EQ(fields->GetArray("SunDisc")->GetComponent(0, 0), 0.0);
 
@@ -95,12 +95,12 @@ TEST(SkyDomeParameters, MissingArraysMeanDefaults)
 
   vtkNew<vtkFieldData> one;
   vtkNew<vtkDoubleArray> elevation;
-  elevation->SetName("SunElevation");
+  elevation->SetName("SunElevationDegrees");
   elevation->InsertNextValue(12.5);
   one->AddArray(elevation);
   sky->SetExposure(400.0);
   EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(one, sky), 1);
-  EXPECT_EQ(sky->GetSunElevation(), 12.5);
+  EXPECT_EQ(sky->GetSunElevationDegrees(), 12.5);
   EXPECT_EQ(sky->GetExposure(), defaults->GetExposure());
 
   // An empty array counts as missing; a null field data too.

@@ -64,7 +64,7 @@ int main(int argc, char* argv[])
     sky->SetExposure(mode == "noon" ? 12.0 : (mode == "sunset" ? 25.0 : 400.0));
     // Looking toward the sun's azimuth, a little above the horizon, wide angle.
     const double a =
-      vtkMath::RadiansFromDegrees(sky->GetSunAzimuth() + (mode == "noon" ? 180.0 : 0.0));
+      vtkMath::RadiansFromDegrees(sky->GetSunAzimuthDegrees() + (mode == "noon" ? 180.0 : 0.0));
     camera->SetPosition(0.0, 0.0, 2.0);
     camera->SetFocalPoint(std::sin(a), std::cos(a), 2.0 + (mode == "noon" ? 0.45 : 0.25));
     camera->SetViewAngle(80.0);
@@ -73,9 +73,9 @@ int main(int argc, char* argv[])
   else if (mode == "aerial")
   {
     sky->SetPreset(vtkNimbusSky::Afternoon);
-    sky->SetSunAzimuth(150.0);
+    sky->SetSunAzimuthDegrees(150.0);
     sky->SetExposure(12.0);
-    sky->SetAerosolDensity(2.0);
+    sky->SetMieScatteringPerMetre(2.0 * 2.0e-5); // twice the default haze
     vtkNew<vtkPlaneSource> ground;
     ground->SetOrigin(-2.0e5, -2.0e5, 0.0);
     ground->SetPoint1(2.0e5, -2.0e5, 0.0);
@@ -110,8 +110,8 @@ int main(int argc, char* argv[])
     // CaptureDepthTexture blit, measured) and draws nothing; clouds get the sky
     // through the Nimbus cloud mapper instead (issue 4).
     vtkNew<vtkNimbusSunlight> sun;
-    sun->SetSunElevation(sky->GetSunElevation());
-    sun->SetSunAzimuth(sky->GetSunAzimuth());
+    sun->SetSunElevationDegrees(sky->GetSunElevationDegrees());
+    sun->SetSunAzimuthDegrees(sky->GetSunAzimuthDegrees());
     vtkNew<vtkLight> light;
     sun->ApplyToLight(light);
     renderer->AddLight(light);

@@ -112,10 +112,10 @@ TEST(SliceGeometry, PlanesAndShadowFrame)
 
 TEST(AtmosphereTable, WithoutAtmosphereOnlyTheSun)
 {
-  nimbus::SceneDescription scene;
-  scene.Atmosphere.Enabled = false;
-  scene.Background.Type = "black";
-  const nimbus::AtmosphereTable table = nimbus::BuildAtmosphereTable(scene, 0.0, 1000.0, 16);
+  nimbus::SceneAtmosphere air;
+  air.Enabled = false;
+  const nimbus::SunAndAir sunAndAir(nimbus::SunParameters(), air, 16);
+  const nimbus::AtmosphereTable table = nimbus::BuildAtmosphereTable(sunAndAir, 0.0, 1000.0, 16);
   EXPECT_FALSE(table.HasAtmosphere);
   EXPECT_EQ(table.Samples, 0);
   // Luminance of the sun's linear sRGB = the scene's illuminance (1).
@@ -125,11 +125,12 @@ TEST(AtmosphereTable, WithoutAtmosphereOnlyTheSun)
 
 TEST(AtmosphereTable, RowsFollowTheAtmosphere)
 {
-  nimbus::SceneDescription scene;
-  scene.Background.Type = "black";
-  scene.Sun.Elevation = 5.0;
-  const double top = scene.Atmosphere.TopRadius - scene.Atmosphere.EarthRadius;
-  const nimbus::AtmosphereTable table = nimbus::BuildAtmosphereTable(scene, 0.0, top, 1024);
+  nimbus::SunParameters sun;
+  sun.ElevationDegrees = 5.0;
+  const nimbus::SceneAtmosphere air;
+  const nimbus::SunAndAir sunAndAir(sun, air, 16);
+  const double top = air.TopRadiusMetres - air.EarthRadiusMetres;
+  const nimbus::AtmosphereTable table = nimbus::BuildAtmosphereTable(sunAndAir, 0.0, top, 1024);
   ASSERT_TRUE(table.HasAtmosphere);
   // Low sun: reddened at the ground, nearly unattenuated at the top.
   const auto ground = table.Lookup(0, 0.0), high = table.Lookup(0, top);
@@ -156,7 +157,7 @@ TEST(AtmosphereTable, RowsFollowTheAtmosphere)
   for (int i = 0; i < 20; ++i)
   {
     const double z = (i + 0.37) * top / 1023.0 * 3.0;
-    const nimbus::AtmosphereTable exact = nimbus::BuildAtmosphereTable(scene, z, z + 1.0, 2);
+    const nimbus::AtmosphereTable exact = nimbus::BuildAtmosphereTable(sunAndAir, z, z + 1.0, 2);
     for (int row = 0; row < 4; ++row)
     {
       const auto a = table.Lookup(row, z), b = exact.Lookup(row, z);
@@ -171,7 +172,7 @@ TEST(AtmosphereTable, RowsFollowTheAtmosphere)
   }
   std::cout << "worst relative interpolation error of the atmosphere texture: " << worst << "\n";
   EXPECT_LT(worst, 2e-4); // measured 9.6e-5
-  EXPECT_THROW(nimbus::BuildAtmosphereTable(scene, 10.0, 0.0, 16), std::invalid_argument);
+  EXPECT_THROW(nimbus::BuildAtmosphereTable(sunAndAir, 10.0, 0.0, 16), std::invalid_argument);
 }
 
 TEST(SliceGeometry, SlicePolygonCutsTheBox)

@@ -54,7 +54,7 @@ class SunlightTest(unittest.TestCase):
         previous_luminance = 2.0
         previous_blue_over_red = 2.0
         for elevation in (90, 45, 20, 10, 5, 2):
-            sun.SetSunElevation(elevation)
+            sun.SetSunElevationDegrees(elevation)
             rgb = [0.0, 0.0, 0.0]
             sun.GetColor(rgb)
             luminance = sun.GetRelativeLuminance()
@@ -62,7 +62,7 @@ class SunlightTest(unittest.TestCase):
             self.assertLess(rgb[2] / rgb[0], previous_blue_over_red)
             previous_luminance = luminance
             previous_blue_over_red = rgb[2] / rgb[0]
-        sun.SetSunElevation(-10)
+        sun.SetSunElevationDegrees(-10)
         rgb = [1.0, 1.0, 1.0]
         sun.GetColor(rgb)
         self.assertEqual(rgb, [0.0, 0.0, 0.0])

@@ -9,7 +9,7 @@ Checks, through paraview.simple only:
   1. "Cloud" is one of the representation types offered for image data;
   2. the metaball cloud shown as "Cloud" with the XML defaults (noon-like sun,
      atmosphere, ground) matches the baseline image;
-  3. changing SunElevation re-renders and changes the image (a low sun is
+  3. changing SunElevationDegrees re-renders and changes the image (a low sun is
      redder and darker), and does not upload the density volume again;
   4. changing the input (a new metaball seed) uploads the volume exactly once;
   5. a two-step time series (.vti files) uploads once per change of time step,
@@ -91,11 +91,11 @@ def main():
     display.SetRepresentationType("Cloud")
     ColorBy(display, ("POINTS", "density"))
     # A few properties set through the proxy (the others keep the XML defaults).
-    display.SunAzimuth = 135.0
-    display.SunElevation = 60.0
+    display.SunAzimuthDegrees = 135.0
+    display.SunElevationDegrees = 60.0
     display.NumberOfSlices = 192
-    print("defaults: k_multi %g, Exposure %g, CloudG %g, HazeG %g, slices %d" % (
-        display.MultipleScattering, display.Exposure, display.CloudG, display.HazeG,
+    print("defaults: k_multi %g, Exposure %g, CloudG %g, MieG %g, slices %d" % (
+        display.MultipleScattering, display.Exposure, display.CloudG, display.MieG,
         display.NumberOfSlices))
 
     noon = os.path.join(args.output_dir, "TestPluginCloudRepresentation.png")
@@ -110,7 +110,7 @@ def main():
         failures.append("expected 1 volume upload after the first render, got %s" % uploads)
 
     # A lighting change: re-render, new picture, no new upload.
-    display.SunElevation = 8.0
+    display.SunElevationDegrees = 8.0
     Render(view)
     low_sun = os.path.join(args.output_dir, "TestPluginCloudRepresentation-lowsun.png")
     SaveScreenshot(low_sun, view, ImageResolution=SIZE)
@@ -118,7 +118,7 @@ def main():
     change = abs(a - b).mean()
     print("mean |noon - low sun| = %.2f (of 255)" % change)
     if change < 5.0:
-        failures.append("changing SunElevation changed the image by only %.2f" % change)
+        failures.append("changing SunElevationDegrees changed the image by only %.2f" % change)
     # The low sun through the atmosphere is redder relative to blue.
     red_blue_noon = a[:, 0].mean() / max(a[:, 2].mean(), 1e-6)
     red_blue_low = b[:, 0].mean() / max(b[:, 2].mean(), 1e-6)
@@ -157,7 +157,7 @@ def main():
         for time, lighting in ((0.0, None), (0.0, None), (1.0, None), (1.0, 30.0), (0.0, None)):
             view.ViewTime = time
             if lighting is not None:
-                series_display.SunElevation = lighting
+                series_display.SunElevationDegrees = lighting
             Render(view)
             series_mapper = cloud_mapper(view)
             counts.append(series_mapper.GetNumberOfVolumeUploads())

@@ -148,11 +148,11 @@ def main():
     print("field data:", parameters)
     view = CreateRenderView()
     check = Checker(view, args.output_dir)
-    for name in ("SunElevation", "SunAzimuth", "AerosolDensity", "GroundAlbedo", "Exposure",
-                 "ObserverAltitude", "MetresPerUnit", "ScatteringOrders", "WhiteBalance",
+    for name in ("SunElevationDegrees", "SunAzimuthDegrees", "MieScatteringPerMetre", "GroundAlbedo", "Exposure",
+                 "SceneAltitudeMetres", "MetresPerUnit", "ScatteringOrders", "WhiteBalance",
                  "SunDisc"):
         check.expect(name in parameters, "field data lacks %s" % name)
-    check.expect(parameters.get("SunElevation") == 60.0 and parameters.get("SunAzimuth") == 180.0,
+    check.expect(parameters.get("SunElevationDegrees") == 60.0 and parameters.get("SunAzimuthDegrees") == 180.0,
                  "Noon preset not in the field data: %s" % parameters)
 
     view.ViewSize = SIZE
@@ -205,7 +205,7 @@ def main():
     check.expect(toward_sun[0] > toward_sun[2] + 60.0,
                  "the sunset horizon toward the sun is not reddish (R > B): %s" % toward_sun)
     check.expect(change > 20.0, "Sunset changed the image by only %.1f" % change)
-    check.expect(field_parameters(sky).get("SunElevation") == 2.0,
+    check.expect(field_parameters(sky).get("SunElevationDegrees") == 2.0,
                  "the Sunset preset is not in the field data")
 
     # 4b. Exposure (not a sun parameter) reaches the view too.

@@ -29,7 +29,7 @@ def main():
     LoadPlugin(args.plugin, ns=globals())
     dome = NimbusSky(Preset="Sunset", Radius=1000.0, Exposure=25.0,  # noqa: F821 (proxy NimbusSkyDome)
                          ElevationResolution=24, AzimuthResolution=72,
-                         SunElevation=70.0, SunAzimuth=0.0)  # overridden by the preset
+                         SunElevationDegrees=70.0, SunAzimuthDegrees=0.0)  # overridden by the preset
     dome.UpdatePipeline()
     data = servermanager.Fetch(dome)
     rings, columns = 24, 72

@@ -18,7 +18,7 @@ int main()
   cloud->GetOutput()->GetPointData()->GetArray("density")->GetRange(range);
 
   vtkNew<vtkNimbusSunlight> sun;
-  sun->SetSunElevation(60.0);
+  sun->SetSunElevationDegrees(60.0);
   double rgb[3];
   sun->GetColor(rgb);
 
