@@ -5,8 +5,6 @@
 #include "CloudAutomaton.h"
 #include "vtkNimbusCloudAutomatonSource.h"
 
-#include "vtkCallbackCommand.h"
-#include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -16,6 +14,8 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "MessageCatcher.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,36 +24,7 @@
 
 namespace
 {
-class MessageCatcher
-{
-public:
-  explicit MessageCatcher(vtkObject* object)
-  {
-    this->Callback->SetClientData(this);
-    this->Callback->SetCallback(&MessageCatcher::Catch);
-    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
-    object->AddObserver(vtkCommand::WarningEvent, this->Callback);
-    object->AddObserver(vtkCommand::ProgressEvent, this->Callback);
-  }
-  std::vector<std::string> Errors;
-  int ProgressEvents = 0;
-
-private:
-  static void Catch(vtkObject*, unsigned long event, void* clientData, void* callData)
-  {
-    auto* self = static_cast<MessageCatcher*>(clientData);
-    if (event == vtkCommand::ProgressEvent)
-    {
-      ++self->ProgressEvents;
-      return;
-    }
-    if (event == vtkCommand::ErrorEvent)
-    {
-      self->Errors.emplace_back(callData ? static_cast<const char*>(callData) : "");
-    }
-  }
-  vtkNew<vtkCallbackCommand> Callback;
-};
+using nimbus::testing::MessageCatcher;
 
 void Configure(vtkNimbusCloudAutomatonSource* source)
 {

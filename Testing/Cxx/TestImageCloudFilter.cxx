@@ -3,14 +3,14 @@
 // arrays), RGB input uses luminance, the shipped sample image runs, bad input is refused.
 #include "vtkNimbusImageCloudFilter.h"
 
-#include "vtkCallbackCommand.h"
-#include "vtkCommand.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPNGReader.h"
 #include "vtkPointData.h"
 #include "vtkUnsignedCharArray.h"
+
+#include "MessageCatcher.h"
 
 #include <gtest/gtest.h>
 
@@ -22,25 +22,7 @@
 
 namespace
 {
-class ErrorCatcher
-{
-public:
-  explicit ErrorCatcher(vtkObject* object)
-  {
-    this->Callback->SetClientData(this);
-    this->Callback->SetCallback(
-      [](vtkObject*, unsigned long, void* self, void* text)
-      {
-        static_cast<ErrorCatcher*>(self)->Errors.emplace_back(
-          text ? static_cast<const char*>(text) : "");
-      });
-    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
-  }
-  std::vector<std::string> Errors;
-
-private:
-  vtkNew<vtkCallbackCommand> Callback;
-};
+using nimbus::testing::MessageCatcher;
 
 struct Disc
 {
@@ -136,7 +118,7 @@ TEST(ImageCloudFilter, SampleImageAndErrors)
   EXPECT_GT(range[1], 0.1);
   EXPECT_TRUE(std::isfinite(range[1]));
 
-  ErrorCatcher catcher(filter);
+  MessageCatcher catcher(filter);
   vtkNew<vtkImageData> volume;
   volume->SetDimensions(8, 8, 8);
   volume->AllocateScalars(VTK_UNSIGNED_CHAR, 1);

@@ -15,6 +15,8 @@
 #include "vtkPolyData.h"
 #include "vtkTriangleFilter.h"
 
+#include "MessageCatcher.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -29,28 +31,7 @@
 namespace
 {
 // Collects vtkErrorMacro / vtkWarningMacro messages of one object instead of printing them.
-class MessageCatcher
-{
-public:
-  explicit MessageCatcher(vtkObject* object)
-  {
-    this->Callback->SetClientData(this);
-    this->Callback->SetCallback(&MessageCatcher::Catch);
-    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
-    object->AddObserver(vtkCommand::WarningEvent, this->Callback);
-  }
-  std::vector<std::string> Errors;
-  std::vector<std::string> Warnings;
-
-private:
-  static void Catch(vtkObject*, unsigned long event, void* clientData, void* callData)
-  {
-    auto* self = static_cast<MessageCatcher*>(clientData);
-    const std::string text = callData ? static_cast<const char*>(callData) : "";
-    (event == vtkCommand::ErrorEvent ? self->Errors : self->Warnings).push_back(text);
-  }
-  vtkNew<vtkCallbackCommand> Callback;
-};
+using nimbus::testing::MessageCatcher;
 
 // A cheap configuration for tests: 48 x 48 x 32 points.
 void MakeSmall(vtkNimbusMetaballCloudSource* source)

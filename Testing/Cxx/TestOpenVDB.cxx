@@ -22,6 +22,8 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include "MessageCatcher.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -38,39 +40,7 @@ namespace vdb = nimbus::vdb;
 namespace
 {
 // Collects vtkErrorMacro / vtkWarningMacro messages of one object instead of printing them.
-class MessageCatcher
-{
-public:
-  explicit MessageCatcher(vtkObject* object)
-  {
-    this->Callback->SetClientData(this);
-    this->Callback->SetCallback(&MessageCatcher::Catch);
-    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
-    object->AddObserver(vtkCommand::WarningEvent, this->Callback);
-  }
-  std::vector<std::string> Errors;
-  std::vector<std::string> Warnings;
-  std::string AllErrors() const { return Join(this->Errors); }
-  std::string AllWarnings() const { return Join(this->Warnings); }
-
-private:
-  static std::string Join(const std::vector<std::string>& v)
-  {
-    std::string s;
-    for (const auto& x : v)
-    {
-      s += x + "\n";
-    }
-    return s;
-  }
-  static void Catch(vtkObject*, unsigned long event, void* clientData, void* callData)
-  {
-    auto* self = static_cast<MessageCatcher*>(clientData);
-    const std::string text = callData ? static_cast<const char*>(callData) : "";
-    (event == vtkCommand::ErrorEvent ? self->Errors : self->Warnings).push_back(text);
-  }
-  vtkNew<vtkCallbackCommand> Callback;
-};
+using nimbus::testing::MessageCatcher;
 
 bool Contains(const std::string& haystack, const std::string& needle)
 {
