@@ -1,6 +1,6 @@
 /**
  * @class   vtkNimbusSkyPass
- * @brief   Sky background and aerial perspective as a render pass (issue 6).
+ * @brief   Sky background and aerial perspective as a render pass.
  *
  * Renders its delegate (e.g. vtkRenderStepsPass) into a colour + depth
  * framebuffer, then draws one full-screen quad that

@@ -108,7 +108,7 @@ int main(int argc, char* argv[])
     // No cloud volume here: VTK's vtkGPUVolumeRayCastMapper fails to copy the
     // depth of this pass's framebuffer (GL_INVALID_OPERATION in its
     // CaptureDepthTexture blit, measured) and draws nothing; clouds get the sky
-    // through the Nimbus cloud mapper instead (issue 4).
+    // through the Nimbus cloud mapper (vtkNimbusCloudVolumeMapper) instead.
     vtkNew<vtkNimbusSunlight> sun;
     sun->SetSunElevationDegrees(sky->GetSunElevationDegrees());
     sun->SetSunAzimuthDegrees(sky->GetSunAzimuthDegrees());
