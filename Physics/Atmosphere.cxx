@@ -358,4 +358,26 @@ double Atmosphere::TransmittanceBetween(const Vector3& p0, const Vector3& p1, do
   return this->Transmittance(lengths, lambdaNm);
 }
 
+double DistanceToTopOfAtmosphere(double r, double mu, double topRadius)
+{
+  const double b = r * mu;
+  const double c = (r - topRadius) * (r + topRadius);
+  const double disc = b * b - c;
+  if (disc < 0.0)
+  {
+    return 0.0;
+  }
+  return std::max(-b + std::sqrt(disc), 0.0);
+}
+
+double FlatLayerOpticalLength(
+  double altitudeMetres, double cosZenith, double distanceMetres, double scaleHeightMetres)
+{
+  const double x = distanceMetres * cosZenith / scaleHeightMetres;
+  const double factor = std::abs(x) < 1e-2
+    ? distanceMetres * (1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0)
+    : scaleHeightMetres * (1.0 - std::exp(-x)) / cosZenith;
+  return std::exp(-std::max(altitudeMetres, 0.0) / scaleHeightMetres) * factor;
+}
+
 } // namespace nimbus

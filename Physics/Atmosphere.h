@@ -56,6 +56,23 @@ struct NIMBUSPHYSICS_EXPORT OpticalLengths
   bool HitsGround = false;           // the ray hits the earth; lengths are up to the hit point
 };
 
+/// Distance [m] from radius r (from the earth centre, m) along a direction with
+/// zenith cosine mu to the sphere r = topRadius (the top of the atmosphere); 0 when
+/// the ray misses it (only possible from above it). With b = r mu and
+/// c = (r - top)(r + top): -b + sqrt(b^2 - c), at least 0.
+NIMBUSPHYSICS_EXPORT double DistanceToTopOfAtmosphere(double r, double mu, double topRadius);
+
+/// Sea-level-equivalent length [m] of one exponential layer (scale height H) along a
+/// straight ray in a flat atmosphere: integral_0^d exp(-max(h0 + s cosZenith, 0)/H) ds
+/// in closed form, with the density at the start taken at max(h0, 0):
+///   exp(-max(h0, 0)/H) H (1 - exp(-x)) / cosZenith,  x = d cosZenith / H,
+/// and its series d (1 - x/2 + x^2/6 - x^3/24) for |x| < 1e-2 (truncation error
+/// below 1e-10 relative; no cancellation of 1 - exp(-x) in float either). The GPU
+/// mapper's per-pixel view transmittance (000 Eq. 6 in closed form); its error
+/// against the spherical earth (Atmosphere::OpticalLength) is measured in TestAtmosphere.
+NIMBUSPHYSICS_EXPORT double FlatLayerOpticalLength(
+  double altitudeMetres, double cosZenith, double distanceMetres, double scaleHeightMetres);
+
 class NIMBUSPHYSICS_EXPORT Atmosphere
 {
 public:

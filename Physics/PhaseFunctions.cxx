@@ -17,12 +17,19 @@ double ClampMu(double mu)
   return std::min(1.0, std::max(-1.0, mu));
 }
 
-// 1 + g^2 - 2 g mu, written as (1 - g)^2 + 2 g (1 - mu) so that it does not
-// cancel for g -> 1, mu -> 1 (it is >= (1 - |g|)^2 > 0 after clamping).
+// 1 + g^2 - 2 g mu, written as (1 - g)^2 + 2 g (1 - mu) for g >= 0 and as
+// (1 + g)^2 - 2 g (1 + mu) for g < 0: sums of non-negative terms, so it does not
+// cancel at the forward peak (g -> 1, mu -> 1) or the backward one (g -> -1,
+// mu -> -1); it is >= (1 - |g|)^2 > 0 after clamping.
 double HgDenominator(double mu, double g)
 {
-  const double oneMinusG = 1.0 - g;
-  return oneMinusG * oneMinusG + 2.0 * g * (1.0 - mu);
+  if (g >= 0.0)
+  {
+    const double oneMinusG = 1.0 - g;
+    return oneMinusG * oneMinusG + 2.0 * g * (1.0 - mu);
+  }
+  const double onePlusG = 1.0 + g;
+  return onePlusG * onePlusG - 2.0 * g * (1.0 + mu);
 }
 
 // (1 - g^2) / (1 + g^2 - 2 g mu)^{3/2}: the HG lobe normalised to 4 pi.

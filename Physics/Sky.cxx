@@ -189,9 +189,7 @@ double SkyModel::MiePhase(double nu) const
 // Geometry (Bruneton 2017 §"Distance to the top/bottom atmosphere boundary").
 double SkyModel::DistanceToTop(double r, double mu) const
 {
-  const double top = this->Parameters.Atmosphere.TopRadiusMetres;
-  const double disc = r * r * (mu * mu - 1.0) + top * top;
-  return std::max(0.0, -r * mu + std::sqrt(std::max(0.0, disc)));
+  return DistanceToTopOfAtmosphere(r, mu, this->Parameters.Atmosphere.TopRadiusMetres);
 }
 
 double SkyModel::DistanceToGround(double r, double mu) const
@@ -821,6 +819,21 @@ double SkyViewMapping::Row(double zenith) const
   return this->AboveRows + std::cbrt(b) * (this->BelowRows - 1);
 }
 
+void SkyViewMapping::Texel(
+  const Vector3& w, double sunAzimuthDegrees, double& column, double& row) const
+{
+  const double zenith = std::atan2(std::hypot(w[0], w[1]), w[2]);
+  row = this->Row(zenith);
+  double phi = 0.0;
+  if (w[0] * w[0] + w[1] * w[1] > 0.0)
+  {
+    phi = std::atan2(w[0], w[1]) - sunAzimuthDegrees * kDegree;
+    phi = std::remainder(phi, 2.0 * kPi);
+    phi = std::abs(phi);
+  }
+  column = Clamp(phi / kPi, 0.0, 1.0) * (this->Width - 1);
+}
+
 double SkyViewMapping::ZenithOfRow(int row) const
 {
   const double th = this->HorizonZenith;
@@ -851,21 +864,6 @@ SkyViewMapping MakeMapping(const SkyModel& model, double altitude, int width, in
 }
 
 /// Column (continuous, [0, width-1]) and row (continuous) of direction w for the sun azimuth.
-void DirectionToTexel(
-  const SkyViewMapping& m, const Vector3& w, double sunAzimuthDeg, double& col, double& row)
-{
-  const double zenith = std::acos(Clamp(w[2], -1.0, 1.0));
-  row = m.Row(zenith);
-  double phi = 0.0;
-  if (w[0] * w[0] + w[1] * w[1] > 0.0)
-  {
-    phi = std::atan2(w[0], w[1]) - sunAzimuthDeg * kDegree;
-    phi = std::remainder(phi, 2.0 * kPi);
-    phi = std::abs(phi);
-  }
-  col = Clamp(phi / kPi, 0.0, 1.0) * (m.Width - 1);
-}
-
 /// Bilinear texel corners without crossing the horizon between the row halves.
 void Corners(
   const SkyViewMapping& m, double col, double row, int& c0, double& fc, int& r0, double& fr)
@@ -935,7 +933,7 @@ SkyViewLut::SkyViewLut(const SkyModel& model, double sunElevationDeg, double obs
 SkyRgbParts SkyViewLut::Parts(const Vector3& w, double sunAzimuthDeg) const
 {
   double col, row;
-  DirectionToTexel(this->Mapping, w, sunAzimuthDeg, col, row);
+  this->Mapping.Texel(w, sunAzimuthDeg, col, row);
   int c0, r0;
   double fc, fr;
   Corners(this->Mapping, col, row, c0, fc, r0, fr);
@@ -1039,7 +1037,7 @@ void AerialPerspectiveLut::Lookup(const Vector3& w, double distance, double sunA
   std::array<double, 3>& transmittance, std::array<double, 3>& inscatter) const
 {
   double col, row;
-  DirectionToTexel(this->Mapping, w, sunAzimuthDeg, col, row);
+  this->Mapping.Texel(w, sunAzimuthDeg, col, row);
   int c0, r0;
   double fc, fr;
   Corners(this->Mapping, col, row, c0, fc, r0, fr);

@@ -251,6 +251,10 @@ struct NIMBUSPHYSICS_EXPORT SkyViewMapping
   double Row(double zenith) const;
   double ZenithOfRow(int row) const;
   int Rows() const { return this->AboveRows + this->BelowRows; }
+  /// Continuous (column, row) of unit view direction w (local frame) when the sun
+  /// is at azimuth sunAzimuthDegrees: the column is the azimuth from the sun in
+  /// [0, pi] over [0, Width - 1], the row Row(zenith).
+  void Texel(const Vector3& w, double sunAzimuthDegrees, double& column, double& row) const;
 };
 
 /// Sky radiance parts for one sun elevation and one observer altitude, by view

@@ -88,6 +88,12 @@ double SrgbEncode(double linear)
   return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
 }
 
+double SrgbDecode(double encoded)
+{
+  const double c = std::min(1.0, std::max(0.0, encoded)); // also maps NaN -> 0
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
 std::array<double, 2> XyzToChromaticity(const std::array<double, 3>& xyz)
 {
   const double sum = xyz[0] + xyz[1] + xyz[2];

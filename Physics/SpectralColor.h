@@ -35,6 +35,9 @@ NIMBUSPHYSICS_EXPORT std::array<double, 3> XyzToLinearSrgb(const std::array<doub
 /// sRGB transfer function (IEC 61966-2-1) linear -> encoded, input clamped to
 /// [0, 1]: 12.92 c for c <= 0.0031308, else 1.055 c^(1/2.4) - 0.055.
 NIMBUSPHYSICS_EXPORT double SrgbEncode(double linear);
+/// Its inverse, encoded -> linear, input clamped to [0, 1]: c / 12.92 for
+/// c <= 0.04045, else ((c + 0.055) / 1.055)^2.4.
+NIMBUSPHYSICS_EXPORT double SrgbDecode(double encoded);
 /// Chromaticity (x, y) = (X, Y) / (X + Y + Z); (0, 0) for X + Y + Z = 0.
 NIMBUSPHYSICS_EXPORT std::array<double, 2> XyzToChromaticity(const std::array<double, 3>& xyz);
 

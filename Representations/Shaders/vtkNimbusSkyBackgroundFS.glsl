@@ -5,6 +5,7 @@
 in vec2 texCoord;
 //VTK::Output::Dec
 
+//NIMBUS::Library
 //NIMBUS::SkyView
 
 uniform mat4 inverseViewProjection; // VTK matrix (row-major): use as vec4 * M
@@ -16,6 +17,6 @@ void main()
   vec4 near = vec4(texCoord * 2.0 - 1.0, -1.0, 1.0) * inverseViewProjection;
   // Perspective: from the eye; parallel: along the (constant) view direction.
   vec3 w = normalize(far.xyz / far.w - near.xyz / near.w);
-  gl_FragData[0] = vec4(encode(SkyRadiance(w) * displayScale), 1.0);
+  gl_FragData[0] = vec4(SrgbEncode(SkyRadiance(w) * displayScale), 1.0);
   gl_FragDepth = 1.0;
 }

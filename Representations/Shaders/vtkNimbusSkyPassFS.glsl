@@ -7,6 +7,7 @@
 in vec2 texCoord;
 //VTK::Output::Dec
 
+//NIMBUS::Library
 //NIMBUS::SkyView
 
 uniform sampler2D colorTexture;
@@ -40,7 +41,7 @@ void main()
     vec3 L = SkyRadiance(normalize(unproject(1.0) - cameraPosition));
     // Translucent props drawn here (no depth) are composited over the sky
     // (premultiplied colour, coverage in alpha).
-    gl_FragData[0] = vec4(encode(decode(color.rgb) + (1.0 - color.a) * L * displayScale), 1.0);
+    gl_FragData[0] = vec4(SrgbEncode(SrgbDecode(color.rgb) + (1.0 - color.a) * L * displayScale), 1.0);
     return;
   }
   if (aerialPerspective == 0)
@@ -57,7 +58,7 @@ void main()
   }
   vec3 w = d / len;
   float distance = len * metresPerUnit;
-  vec2 uv = tableUv(w, aerialTable);
+  vec2 uv = SkyViewUv(w, aerialTable);
   // Slices at D (k/(S-1))^2, linear in the distance between two slices (as the CPU twin).
   float S = aerialSlices.x, D = aerialSlices.y;
   float u = sqrt(clamp(distance / D, 0.0, 1.0)) * (S - 1.0);
@@ -67,9 +68,9 @@ void main()
   float fk = clamp((min(distance, D) - d0) / (d1 - d0), 0.0, 1.0);
   vec3 uvw = vec3(uv, (k0 + fk + 0.5) / S);
   float nu = dot(w, sunDirection);
-  vec3 inscatter = rayleighPhase(nu) * texture(aerialRayleigh, uvw).rgb +
-    miePhase(nu) * texture(aerialMie, uvw).rgb + texture(aerialIsotropic, uvw).rgb;
+  vec3 inscatter = Rayleigh(nu) * texture(aerialRayleigh, uvw).rgb +
+    CornetteShanks(nu, mieG) * texture(aerialMie, uvw).rgb + texture(aerialIsotropic, uvw).rgb;
   vec3 T = texture(aerialTransmittance, uvw).rgb;
-  vec3 surface = decode(color.rgb);
-  gl_FragData[0] = vec4(encode(surface * T + inscatter * displayScale), color.a);
+  vec3 surface = SrgbDecode(color.rgb);
+  gl_FragData[0] = vec4(SrgbEncode(surface * T + inscatter * displayScale), color.a);
 }

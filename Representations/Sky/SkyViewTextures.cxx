@@ -1,7 +1,7 @@
 #include "SkyViewTextures.h"
 
+#include "ShaderLibrary.h"
 #include "Sky.h"
-#include "nimbusSkyView.h"
 #include "vtkMath.h"
 #include "vtkNimbusSky.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -32,9 +32,7 @@ vtkTextureObject* SkyViewTextures::NewLinearTexture(vtkOpenGLRenderWindow* windo
 
 std::string SkyViewTextures::Substitute(const char* source)
 {
-  std::string result(source);
-  vtkShaderProgram::Substitute(result, "//NIMBUS::SkyView", nimbusSkyView);
-  return result;
+  return nimbus::WithShaderLibrary(source);
 }
 
 double SkyViewTextures::CameraAltitude(vtkNimbusSky* sky, double z)
@@ -91,8 +89,8 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
   sky->GetDisplayScale(scale);
   sky->GetSunDiscRadiance(disc);
   program->SetUniform3f("sunDirection", sun);
-  program->SetUniformf(
-    "sunAzimuth", static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuthDegrees())));
+  program->SetUniformf("sunAzimuthRadians",
+    static_cast<float>(vtkMath::RadiansFromDegrees(sky->GetSunAzimuthDegrees())));
   program->SetUniformf(
     "mieG", static_cast<float>(sky->GetSkyModel().GetParameters().Atmosphere.MieG));
   program->SetUniform3f("displayScale", scale);
@@ -101,7 +99,7 @@ void SkyViewTextures::Activate(vtkShaderProgram* program, vtkNimbusSky* sky)
   program->SetUniform4f("skyTable", skyTable);
   program->SetUniformi("sunDisc", sky->GetSunDisc() ? 1 : 0);
   program->SetUniform3f("sunDiscRadiance", disc);
-  program->SetUniformf("sunRadius", static_cast<float>(vtkNimbusSky::GetSunAngularRadius()));
+  program->SetUniformf("sunAngularRadius", static_cast<float>(vtkNimbusSky::GetSunAngularRadius()));
 }
 
 void SkyViewTextures::Deactivate()

@@ -39,7 +39,8 @@ public:
   void Deactivate();
   void Release(vtkWindow* window);
 
-  /// The GLSL of nimbusSkyView.glsl put where `//NIMBUS::SkyView` is in `source`.
+  /// `source` with the GLSL library and nimbusSkyView.glsl put where its lines
+  /// `//NIMBUS::Library` and `//NIMBUS::SkyView` are (nimbus::WithShaderLibrary).
   static std::string Substitute(const char* source);
   /// A float texture with linear filtering and clamp-to-edge wrapping.
   static vtkTextureObject* NewLinearTexture(vtkOpenGLRenderWindow* window);
