@@ -35,7 +35,7 @@ struct vtkNimbusSkyPass::Internals
   vtkTextureObject* Depth = nullptr;
   nimbus::SkyViewTextures SkyView;
   std::array<vtkTextureObject*, 4> AerialTextures{ { nullptr, nullptr, nullptr, nullptr } };
-  const void* AerialTable = nullptr; // identity of the uploaded table
+  const nimbus::AerialPerspectiveLut* Aerial = nullptr; // the uploaded table
   int AerialBuilds = -1;
   vtkOpenGLQuadHelper* Quad = nullptr;
 
@@ -65,7 +65,7 @@ struct vtkNimbusSkyPass::Internals
     }
     delete this->Quad;
     this->Quad = nullptr;
-    this->AerialTable = nullptr;
+    this->Aerial = nullptr;
     this->AerialBuilds = -1;
   }
 };
@@ -101,35 +101,47 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
     vtkErrorMacro("vtkNimbusSkyPass needs a sky (SetSky)");
     return;
   }
+  vtkRenderer* renderer = s->GetRenderer();
+  auto* window = static_cast<vtkOpenGLRenderWindow*>(renderer->GetRenderWindow());
+  int x, y, width, height;
+  renderer->GetTiledSizeAndOrigin(&width, &height, &x, &y);
+  this->RenderDelegate(s, width, height);
+  const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(
+    this->Sky, renderer->GetActiveCamera()->GetPosition()[2]);
+  if (this->UpdateTables(window, cameraAltitude))
+  {
+    this->DrawSky(renderer, x, y, width, height);
+  }
+  vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyPass::Render");
+}
+
+void vtkNimbusSkyPass::RenderDelegate(const vtkRenderState* s, int width, int height)
+{
   Internals& in = *this->Internal;
   vtkRenderer* r = s->GetRenderer();
-  vtkOpenGLRenderWindow* window = static_cast<vtkOpenGLRenderWindow*>(r->GetRenderWindow());
+  auto* window = static_cast<vtkOpenGLRenderWindow*>(r->GetRenderWindow());
   vtkOpenGLState* state = window->GetState();
-  int x, y, w, h;
-  r->GetTiledSizeAndOrigin(&w, &h, &x, &y);
-
-  // 1. The delegate into colour + depth textures.
   if (!in.Color)
   {
     in.Color = nimbus::SkyViewTextures::NewLinearTexture(window);
-    in.Color->Allocate2D(w, h, 4, VTK_UNSIGNED_CHAR);
+    in.Color->Allocate2D(width, height, 4, VTK_UNSIGNED_CHAR);
     in.Depth = nimbus::SkyViewTextures::NewLinearTexture(window);
     in.Depth->SetMinificationFilter(vtkTextureObject::Nearest);
     in.Depth->SetMagnificationFilter(vtkTextureObject::Nearest);
-    in.Depth->AllocateDepth(w, h, vtkTextureObject::Fixed24);
+    in.Depth->AllocateDepth(width, height, vtkTextureObject::Fixed24);
     in.Framebuffer = vtkOpenGLFramebufferObject::New();
     in.Framebuffer->SetContext(window);
   }
-  in.Color->Resize(w, h);
-  in.Depth->Resize(w, h);
+  in.Color->Resize(width, height);
+  in.Depth->Resize(width, height);
   state->PushFramebufferBindings();
   in.Framebuffer->Bind();
   in.Framebuffer->AddColorAttachment(0, in.Color);
   in.Framebuffer->ActivateDrawBuffers(1);
   in.Framebuffer->AddDepthAttachment(in.Depth);
-  in.Framebuffer->StartNonOrtho(w, h);
-  state->vtkglViewport(0, 0, w, h);
-  state->vtkglScissor(0, 0, w, h);
+  in.Framebuffer->StartNonOrtho(width, height);
+  state->vtkglViewport(0, 0, width, height);
+  state->vtkglScissor(0, 0, width, height);
   vtkRenderState inner(r);
   inner.SetPropArrayAndCount(s->GetPropArray(), s->GetPropArrayCount());
   inner.SetFrameBuffer(in.Framebuffer);
@@ -148,13 +160,12 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   r->SetGradientBackground(gradient);
   this->NumberOfRenderedProps += this->DelegatePass->GetNumberOfRenderedProps();
   state->PopFramebufferBindings();
+}
 
-  // 2. Tables (uploaded again only when the sky rebuilt them).
+bool vtkNimbusSkyPass::UpdateTables(vtkOpenGLRenderWindow* window, double cameraAltitude)
+{
+  Internals& in = *this->Internal;
   vtkNimbusSky* sky = this->Sky;
-  vtkCamera* camera = r->GetActiveCamera();
-  double eye[3];
-  camera->GetPosition(eye);
-  const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(sky, eye[2]);
   const nimbus::AerialPerspectiveLut* aerial = nullptr;
   std::string tableError;
   try
@@ -168,12 +179,14 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   if (!aerial || !in.SkyView.Update(window, sky, cameraAltitude, tableError))
   {
     vtkErrorMacro("sky tables: " << tableError);
-    return;
+    return false;
   }
-  const nimbus::SkyViewMapping& am = aerial->GetMapping();
-  if (in.AerialBuilds != sky->GetAerialBuilds() || in.AerialTable != aerial)
+  if (in.AerialBuilds != sky->GetAerialBuilds() || in.Aerial != aerial)
   {
-    const std::size_t texels = static_cast<std::size_t>(aerial->GetSlices()) * am.Rows() * am.Width;
+    // The table interleaves (Rayleigh, Mie, isotropic, transmittance) rgb per texel:
+    // one 3-D texture each.
+    const nimbus::SkyViewMapping& m = aerial->GetMapping();
+    const std::size_t texels = static_cast<std::size_t>(aerial->GetSlices()) * m.Rows() * m.Width;
     std::vector<float> part(texels * 3);
     for (int k = 0; k < 4; ++k)
     {
@@ -189,13 +202,18 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
         in.AerialTextures[k] = nimbus::SkyViewTextures::NewLinearTexture(window);
       }
       in.AerialTextures[k]->Create3DFromRaw(
-        am.Width, am.Rows(), aerial->GetSlices(), 3, VTK_FLOAT, part.data());
+        m.Width, m.Rows(), aerial->GetSlices(), 3, VTK_FLOAT, part.data());
     }
     in.AerialBuilds = sky->GetAerialBuilds();
-    in.AerialTable = aerial;
   }
+  in.Aerial = aerial;
+  return true;
+}
 
-  // 3. The full-screen quad.
+void vtkNimbusSkyPass::DrawSky(vtkRenderer* renderer, int x, int y, int width, int height)
+{
+  Internals& in = *this->Internal;
+  auto* window = static_cast<vtkOpenGLRenderWindow*>(renderer->GetRenderWindow());
   if (!in.Quad)
   {
     in.Quad = new vtkOpenGLQuadHelper(window,
@@ -216,7 +234,7 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   in.Depth->Activate();
   program->SetUniformi("colorTexture", in.Color->GetTextureUnit());
   program->SetUniformi("depthTexture", in.Depth->GetTextureUnit());
-  in.SkyView.Activate(program, sky);
+  in.SkyView.Activate(program, this->Sky);
   const char* aerialNames[4] = { "aerialRayleigh", "aerialMie", "aerialIsotropic",
     "aerialTransmittance" };
   for (int k = 0; k < 4; ++k)
@@ -224,21 +242,24 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
     in.AerialTextures[k]->Activate();
     program->SetUniformi(aerialNames[k], in.AerialTextures[k]->GetTextureUnit());
   }
+  vtkCamera* camera = renderer->GetActiveCamera();
   vtkNew<vtkMatrix4x4> inverse;
   inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
-    static_cast<double>(w) / std::max(1, h), -1.0, 1.0));
+    static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
   inverse->Invert();
   program->SetUniformMatrix("inverseViewProjection", inverse);
-  program->SetUniform3f("cameraPosition", eye);
-  program->SetUniformf("metresPerUnit", static_cast<float>(sky->GetMetresPerUnit()));
-  const float aerialTable[4] = { static_cast<float>(am.HorizonZenith), static_cast<float>(am.Width),
-    static_cast<float>(am.AboveRows), static_cast<float>(am.BelowRows) };
+  program->SetUniform3f("cameraPosition", camera->GetPosition());
+  program->SetUniformf("metresPerUnit", static_cast<float>(this->Sky->GetMetresPerUnit()));
+  const nimbus::SkyViewMapping& m = in.Aerial->GetMapping();
+  const float aerialTable[4] = { static_cast<float>(m.HorizonZenith), static_cast<float>(m.Width),
+    static_cast<float>(m.AboveRows), static_cast<float>(m.BelowRows) };
   program->SetUniform4f("aerialTable", aerialTable);
-  const float slices[2] = { static_cast<float>(aerial->GetSlices()),
-    static_cast<float>(aerial->GetMaxDistance()) };
+  const float slices[2] = { static_cast<float>(in.Aerial->GetSlices()),
+    static_cast<float>(in.Aerial->GetMaxDistance()) };
   program->SetUniform2f("aerialSlices", slices);
   program->SetUniformi("aerialPerspective", this->AerialPerspective ? 1 : 0);
 
+  vtkOpenGLState* state = window->GetState();
   vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
   vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
   vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(state);
@@ -246,8 +267,8 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthFunc(GL_ALWAYS);
   state->vtkglDepthMask(GL_TRUE);
-  state->vtkglViewport(x, y, w, h);
-  state->vtkglScissor(x, y, w, h);
+  state->vtkglViewport(x, y, width, height);
+  state->vtkglScissor(x, y, width, height);
   in.Quad->Render();
   in.Color->Deactivate();
   in.Depth->Deactivate();
@@ -256,7 +277,6 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
   {
     t->Deactivate();
   }
-  vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyPass::Render");
 }
 
 void vtkNimbusSkyPass::PrintSelf(ostream& os, vtkIndent indent)

@@ -37,6 +37,8 @@
 #include <memory> // for std::unique_ptr
 
 class vtkNimbusSky;
+class vtkOpenGLRenderWindow;
+class vtkRenderer;
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyPass : public vtkImageProcessingPass
 {
@@ -71,6 +73,15 @@ protected:
 private:
   vtkNimbusSkyPass(const vtkNimbusSkyPass&) = delete;
   void operator=(const vtkNimbusSkyPass&) = delete;
+
+  /// The delegate pass into the colour and depth textures (the sky goes behind them).
+  void RenderDelegate(const vtkRenderState* s, int width, int height);
+  /// The sky-view and aerial-perspective tables seen from the camera's altitude (m),
+  /// uploaded again only when the sky rebuilt them; false, with an error, when they
+  /// cannot be built.
+  bool UpdateTables(vtkOpenGLRenderWindow* window, double cameraAltitude);
+  /// The full-screen quad: the sky where nothing was drawn, aerial perspective elsewhere.
+  void DrawSky(vtkRenderer* renderer, int x, int y, int width, int height);
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
