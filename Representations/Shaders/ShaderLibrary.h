@@ -7,21 +7,20 @@
 //   nimbusSkyView.glsl     SkyViewRow, SkyViewTexel, SkyRadiance        (Sky.h, SkyViewLut)
 // A shader asks for them with the lines "//NIMBUS::Library" (phase, colour,
 // atmosphere) and "//NIMBUS::SkyView" (the sky-view lookup, after the library).
+// Plain C++ in the static library NimbusShaderLibrary (Representations/CMakeLists.txt).
 #ifndef nimbus_ShaderLibrary_h
 #define nimbus_ShaderLibrary_h
-
-#include "NimbusRepresentationsModule.h" // for export macro
 
 #include <string>
 
 namespace nimbus
 {
 /// The library's GLSL in dependency order: phase (defines kPi), colour, atmosphere.
-NIMBUSREPRESENTATIONS_EXPORT std::string ShaderLibrarySource();
+std::string ShaderLibrarySource();
 
 /// `source` with "//NIMBUS::Library" replaced by ShaderLibrarySource() and
 /// "//NIMBUS::SkyView" by nimbusSkyView.glsl.
-NIMBUSREPRESENTATIONS_EXPORT std::string WithShaderLibrary(const std::string& source);
+std::string WithShaderLibrary(const std::string& source);
 } // namespace nimbus
 
 #endif

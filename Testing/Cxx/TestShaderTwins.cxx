@@ -6,7 +6,9 @@
 // arithmetic and the GPU's transcendental functions; the bounds below are the errors
 // measured on Mesa llvmpipe (printed by the test), rounded up by about 3x.
 //
-// Run under a display: Testing/with-display.sh build/bin/TestShaderTwins.
+// No VTK and no display: an OpenGL 3.3 core context through EGL (a GPU device when
+// EGL lists one, else Mesa's surfaceless platform), so the same program runs in CI and
+// on a machine with a GPU and no X server. NIMBUS_EGL_DEVICE=<n> picks EGL device n.
 #include "Atmosphere.h"
 #include "Math.h"
 #include "PhaseFunctions.h"
@@ -14,16 +16,11 @@
 #include "Sky.h"
 #include "SpectralColor.h"
 
-#include "vtkNew.h"
-#include "vtkOpenGLFramebufferObject.h"
-#include "vtkOpenGLQuadHelper.h"
-#include "vtkOpenGLRenderWindow.h"
-#include "vtkOpenGLShaderCache.h"
-#include "vtkOpenGLState.h"
-#include "vtkRenderWindow.h"
-#include "vtkShaderProgram.h"
-#include "vtkTextureObject.h"
-#include "vtk_glew.h"
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
 
 #include <gtest/gtest.h>
 
@@ -31,9 +28,10 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
-#include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -60,18 +58,26 @@ enum Function
 // rows (SkyViewLut's default), the horizon zenith in the argument.
 constexpr float kSkyColumns = 128.0f, kSkyRowsAbove = 64.0f, kSkyRowsBelow = 32.0f;
 
-const char* kFragmentShader = R"(//VTK::System::Dec
-in vec2 texCoord;
-//VTK::Output::Dec
+// A triangle that covers the viewport, from gl_VertexID (no vertex buffer).
+const char* kVertexShader = R"(#version 330 core
+void main()
+{
+  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * corner - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* kFragmentShader = R"(#version 330 core
 //NIMBUS::Library
 //NIMBUS::SkyView
 uniform sampler2D arguments;
 uniform int function;
+out vec4 fragmentColor;
 
 void main()
 {
   // This fragment's argument set: texel (i, j) of the argument texture.
-  vec4 a = texelFetch(arguments, ivec2(floor(texCoord * vec2(textureSize(arguments, 0)))), 0);
+  vec4 a = texelFetch(arguments, ivec2(gl_FragCoord.xy), 0);
   vec2 result = vec2(0.0);
   if (function == 0) { result.x = Rayleigh(a.x); }
   else if (function == 1) { result.x = HenyeyGreenstein(a.x, a.y); }
@@ -88,11 +94,11 @@ void main()
     vec3 w = vec3(sin(a.x) * sin(a.y), sin(a.x) * cos(a.y), cos(a.x));
     result = SkyViewTexel(w, a.z, vec4(a.w, 128.0, 64.0, 32.0));
   }
-  gl_FragData[0] = vec4(result, 0.0, 1.0);
+  fragmentColor = vec4(result, 0.0, 1.0);
 }
 )";
 
-/// One OpenGL context for the whole test program, and the evaluation machinery.
+/// An OpenGL context without a window (EGL), and the evaluation machinery.
 class Gpu
 {
 public:
@@ -101,6 +107,9 @@ public:
     static Gpu gpu;
     return gpu;
   }
+
+  bool Ready() const { return this->Program != 0; }
+  const std::string& Problem() const { return this->Error; }
 
   /// Evaluates `function` for each argument set; returns (x, y) per set.
   std::vector<Result> Evaluate(Function function, const std::vector<Arguments>& arguments)
@@ -112,40 +121,40 @@ public:
     {
       std::copy(arguments[i].begin(), arguments[i].end(), input.begin() + 4 * i);
     }
-    this->Window->MakeCurrent();
-    vtkNew<vtkTextureObject> argumentTexture;
-    argumentTexture->SetContext(this->Window);
-    argumentTexture->SetMinificationFilter(vtkTextureObject::Nearest);
-    argumentTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    argumentTexture->Create2DFromRaw(width, height, 4, VTK_FLOAT, input.data());
-    vtkNew<vtkTextureObject> target;
-    target->SetContext(this->Window);
-    target->Allocate2D(width, height, 4, VTK_FLOAT);
-    vtkNew<vtkOpenGLFramebufferObject> framebuffer;
-    framebuffer->SetContext(this->Window);
-    vtkOpenGLState* state = this->Window->GetState();
-    state->PushFramebufferBindings();
-    framebuffer->Bind(GL_FRAMEBUFFER);
-    framebuffer->AddColorAttachment(0, target);
-    framebuffer->ActivateDrawBuffer(0);
-    state->vtkglViewport(0, 0, width, height);
-    state->vtkglDisable(GL_BLEND);
-    state->vtkglDisable(GL_DEPTH_TEST);
-    state->vtkglDisable(GL_SCISSOR_TEST);
-    this->Window->GetShaderCache()->ReadyShaderProgram(this->Quad->Program);
-    argumentTexture->Activate();
-    this->Quad->Program->SetUniformi("arguments", argumentTexture->GetTextureUnit());
-    this->Quad->Program->SetUniformi("function", static_cast<int>(function));
-    this->Quad->Render();
-    std::vector<float> output(static_cast<std::size_t>(width) * height * 4);
-    framebuffer->ActivateReadBuffer(0);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, output.data());
-    argumentTexture->Deactivate();
-    state->PopFramebufferBindings();
-    framebuffer->ReleaseGraphicsResources(this->Window);
-    argumentTexture->ReleaseGraphicsResources(this->Window);
-    target->ReleaseGraphicsResources(this->Window);
+    GLuint textures[2], framebuffer;
+    glGenTextures(2, textures);
+    for (int k = 0; k < 2; ++k)
+    {
+      glBindTexture(GL_TEXTURE_2D, textures[k]);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT,
+        k == 0 ? input.data() : nullptr);
+    }
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, textures[1], 0);
+    std::vector<float> output(static_cast<std::size_t>(width) * height * 4, 0.0f);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE)
+    {
+      glViewport(0, 0, width, height);
+      glUseProgram(this->Program);
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, textures[0]);
+      glUniform1i(glGetUniformLocation(this->Program, "arguments"), 0);
+      glUniform1i(glGetUniformLocation(this->Program, "function"), static_cast<int>(function));
+      glBindVertexArray(this->VertexArray);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, output.data());
+    }
+    else
+    {
+      ADD_FAILURE() << "the float render target is incomplete";
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(2, textures);
     std::vector<Result> results(arguments.size());
     for (std::size_t i = 0; i < arguments.size(); ++i)
     {
@@ -154,30 +163,136 @@ public:
     return results;
   }
 
-  bool Compiled() const { return this->Quad && this->Quad->Program->GetCompiled(); }
-
 private:
   Gpu()
   {
-    this->RenderWindow->SetOffScreenRendering(1);
-    this->RenderWindow->SetSize(8, 8);
-    this->RenderWindow->Render();
-    this->Window = vtkOpenGLRenderWindow::SafeDownCast(this->RenderWindow);
-    this->Window->MakeCurrent();
-    const std::string source = nimbus::WithShaderLibrary(kFragmentShader);
-    this->Quad = std::make_unique<vtkOpenGLQuadHelper>(this->Window, nullptr, source.c_str(), "");
-  }
-  ~Gpu()
-  {
-    if (this->Quad)
+    if (!this->CreateContext())
     {
-      this->Quad->ReleaseGraphicsResources(this->Window);
+      return;
     }
+    std::printf("OpenGL: %s, %s, %s\n", glGetString(GL_VENDOR), glGetString(GL_RENDERER),
+      glGetString(GL_VERSION));
+    this->Program = this->Link(kVertexShader, nimbus::WithShaderLibrary(kFragmentShader));
+    glGenVertexArrays(1, &this->VertexArray);
   }
 
-  vtkNew<vtkRenderWindow> RenderWindow;
-  vtkOpenGLRenderWindow* Window = nullptr;
-  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  /// An EGL display: device `NIMBUS_EGL_DEVICE` (default: the first that initialises),
+  /// else Mesa's surfaceless platform, else the default display.
+  EGLDisplay OpenDisplay()
+  {
+    auto queryDevices =
+      reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto platformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+      eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    EGLint major = 0, minor = 0;
+    if (queryDevices && platformDisplay)
+    {
+      EGLDeviceEXT devices[16];
+      EGLint count = 0;
+      if (queryDevices(16, devices, &count) && count > 0)
+      {
+        const char* wanted = std::getenv("NIMBUS_EGL_DEVICE");
+        for (EGLint d = 0; d < count; ++d)
+        {
+          if (wanted && std::atoi(wanted) != d)
+          {
+            continue;
+          }
+          EGLDisplay display = platformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[d], nullptr);
+          if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor))
+          {
+            return display;
+          }
+        }
+      }
+    }
+    if (platformDisplay)
+    {
+      EGLDisplay display =
+        platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor))
+      {
+        return display;
+      }
+    }
+    EGLDisplay display = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor))
+    {
+      return display;
+    }
+    return EGL_NO_DISPLAY;
+  }
+
+  bool CreateContext()
+  {
+    EGLDisplay display = this->OpenDisplay();
+    if (display == EGL_NO_DISPLAY)
+    {
+      this->Error = "no EGL display";
+      return false;
+    }
+    // No surface is drawn to (the context is made current without one), but
+    // eglChooseConfig asks for window surfaces unless told otherwise.
+    const EGLint configAttributes[] = { EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
+      EGL_PBUFFER_BIT, EGL_NONE };
+    EGLConfig config;
+    EGLint configs = 0;
+    if (!eglBindAPI(EGL_OPENGL_API) ||
+      !eglChooseConfig(display, configAttributes, &config, 1, &configs) || configs < 1)
+    {
+      this->Error = "no EGL configuration with OpenGL";
+      return false;
+    }
+    const EGLint contextAttributes[] = { EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE };
+    EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, contextAttributes);
+    if (context == EGL_NO_CONTEXT ||
+      !eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
+    {
+      this->Error = "no OpenGL 3.3 core context without a surface";
+      return false;
+    }
+    return true;
+  }
+
+  GLuint Compile(GLenum type, const std::string& source)
+  {
+    GLuint shader = glCreateShader(type);
+    const char* text = source.c_str();
+    glShaderSource(shader, 1, &text, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok)
+    {
+      char log[4096];
+      glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+      this->Error += std::string("shader compilation failed: ") + log;
+    }
+    return shader;
+  }
+
+  GLuint Link(const std::string& vertex, const std::string& fragment)
+  {
+    GLuint program = glCreateProgram();
+    glAttachShader(program, this->Compile(GL_VERTEX_SHADER, vertex));
+    glAttachShader(program, this->Compile(GL_FRAGMENT_SHADER, fragment));
+    glLinkProgram(program);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok)
+    {
+      char log[4096];
+      glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+      this->Error += std::string("program link failed: ") + log;
+      return 0;
+    }
+    return program;
+  }
+
+  GLuint Program = 0;
+  GLuint VertexArray = 0;
+  std::string Error;
 };
 
 /// How an error is measured: relative to max(|cpu|, Floor), or absolute.
@@ -247,12 +362,13 @@ const std::vector<float> kAsymmetries = { -0.99f, -0.5f, 0.0f, 0.3f, 0.76f, 0.85
 
 TEST(ShaderTwins, Compiles)
 {
-  ASSERT_TRUE(Gpu::Get().Compiled()) << "the GLSL library did not compile";
+  ASSERT_TRUE(Gpu::Get().Ready()) << Gpu::Get().Problem();
 }
 
 // nimbusPhase.glsl against Physics/PhaseFunctions.h. Relative error.
 TEST(ShaderTwins, PhaseFunctions)
 {
+  ASSERT_TRUE(Gpu::Get().Ready()) << Gpu::Get().Problem();
   std::vector<Arguments> rayleigh, lobes;
   for (float mu : Cosines())
   {
@@ -288,6 +404,7 @@ TEST(ShaderTwins, PhaseFunctions)
 // nimbusColor.glsl against Physics/SpectralColor.h. Absolute error (values in [0, 1]).
 TEST(ShaderTwins, SrgbTransferFunctions)
 {
+  ASSERT_TRUE(Gpu::Get().Ready()) << Gpu::Get().Problem();
   std::vector<Arguments> grid;
   for (float c : Range(-0.1f, 1.1f, 2401))
   {
@@ -316,6 +433,7 @@ TEST(ShaderTwins, SrgbTransferFunctions)
 // nimbusAtmosphere.glsl against Physics/Atmosphere.h.
 TEST(ShaderTwins, AtmosphereGeometryAndLayers)
 {
+  ASSERT_TRUE(Gpu::Get().Ready()) << Gpu::Get().Problem();
   const float earth = 6360000.0f, top = 6420000.0f;
   std::vector<Arguments> distances;
   for (float height : { 0.0f, 10.0f, 1000.0f, 10000.0f, 59000.0f })
@@ -372,6 +490,7 @@ TEST(ShaderTwins, AtmosphereGeometryAndLayers)
 // in texels.
 TEST(ShaderTwins, SkyViewMapping)
 {
+  ASSERT_TRUE(Gpu::Get().Ready()) << Gpu::Get().Problem();
   const std::vector<float> horizons = { static_cast<float>(nimbus::kPi / 2.0), 1.6f, 1.8f };
   auto mapping = [](float horizon)
   {
