@@ -2,6 +2,7 @@
 #include "Math.h"
 
 #include "AtmosphereTable.h"
+#include "CloudDensityTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 
@@ -134,17 +135,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkOpenGLRenderWindow* Window = nullptr;
 
   // Density volume (000: the "volume texture").
-  vtkNew<vtkTextureObject> Density;
-  vtkTimeStamp DensityUploadTime;
-  vtkDataArray* UploadedArray = nullptr;
-  vtkImageData* UploadedImage = nullptr;
-  int UploadedMaximumSize = -1;
-  int TextureDims[3] = { 0, 0, 0 };
-  double BoxToTexScale[3] = { 1, 1, 1 };
-  double BoxToTexOffset[3] = { 0, 0, 0 };
-  double BoxOrigin[3] = { 0, 0, 0 }; // data coordinates of the density box
-  double BoxSize[3] = { 1, 1, 1 };
-  bool HasDensity = false;
+  nimbus::CloudDensityTexture Density;
 
   // Atmosphere texture (000 §3), keyed by the parameters it depends on.
   vtkNew<vtkTextureObject> AtmosphereTexture;
@@ -175,7 +166,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
     CompositePass, RayEndsPass;
 
-  int VolumeUploads = 0;
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
   int PassesLastRender = 0;
@@ -185,10 +175,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
 
   void Release(vtkWindow* window)
   {
-    for (vtkTextureObject* t :
-      { Density.GetPointer(), AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
-        Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
-        SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
+    this->Density.Release(window);
+    for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
+           Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
+           SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
@@ -207,9 +197,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
         pass->reset();
       }
     }
-    UploadedArray = nullptr;
-    UploadedImage = nullptr;
-    HasDensity = false;
     AtmosphereKey.clear();
     IntervalPhaseKey.clear();
     Window = nullptr;
@@ -239,7 +226,7 @@ vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper() = default;
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfVolumeUploads() const
 {
-  return this->Internal->VolumeUploads;
+  return this->Internal->Density.GetNumberOfUploads();
 }
 int vtkNimbusCloudVolumeMapper::GetNumberOfAtmosphereBuilds() const
 {
@@ -271,7 +258,7 @@ vtkImageData* vtkNimbusCloudVolumeMapper::GetRadianceImage()
 }
 void vtkNimbusCloudVolumeMapper::GetTextureDimensions(int dims[3]) const
 {
-  std::copy(this->Internal->TextureDims, this->Internal->TextureDims + 3, dims);
+  this->Internal->Density.GetDimensions(dims);
 }
 
 void vtkNimbusCloudVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
@@ -318,126 +305,18 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   const int maxSize = this->MaximumTextureSize > 0
     ? std::min(this->MaximumTextureSize, vtkTextureObject::GetMaximumTextureSize3D(window))
     : vtkTextureObject::GetMaximumTextureSize3D(window);
-  if (!in.HasDensity || in.UploadedArray != scalars || in.UploadedImage != image ||
-    scalars->GetMTime() > in.DensityUploadTime || image->GetMTime() > in.DensityUploadTime ||
-    in.UploadedMaximumSize != maxSize)
+  std::vector<std::string> warnings;
+  std::string error;
+  const bool uploaded =
+    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, warnings, error);
+  for (const std::string& warning : warnings)
   {
-    int pointDims[3];
-    image->GetDimensions(pointDims);
-    int dims[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      dims[k] = cellFlag ? std::max(pointDims[k] - 1, 1) : pointDims[k];
-    }
-    if (static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] != scalars->GetNumberOfTuples())
-    {
-      vtkErrorMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)") << "' has "
-                              << scalars->GetNumberOfTuples() << " values, but the image needs "
-                              << dims[0] * dims[1] * dims[2]);
-      return;
-    }
-    if (scalars->GetNumberOfComponents() != 1)
-    {
-      vtkWarningMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)")
-                                << "' has " << scalars->GetNumberOfComponents()
-                                << " components; rendering its first as the density.");
-    }
-    // Downsample by an integer factor per axis (box average) above the texture limit.
-    int factor[3], texDims[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      factor[k] = (dims[k] + maxSize - 1) / maxSize;
-      texDims[k] = (dims[k] + factor[k] - 1) / factor[k];
-    }
-    if (factor[0] > 1 || factor[1] > 1 || factor[2] > 1)
-    {
-      vtkWarningMacro("Density " << dims[0] << "x" << dims[1] << "x" << dims[2]
-                                 << " exceeds the texture limit of " << maxSize
-                                 << " per side; downsampled to " << texDims[0] << "x" << texDims[1]
-                                 << "x" << texDims[2] << " by averaging.");
-    }
-    std::vector<float> values(static_cast<size_t>(texDims[0]) * texDims[1] * texDims[2], 0.0f);
-    std::vector<float> counts(values.size(), 0.0f);
-    vtkIdType nonFinite = 0;
-    for (int z = 0; z < dims[2]; ++z)
-    {
-      for (int y = 0; y < dims[1]; ++y)
-      {
-        for (int x = 0; x < dims[0]; ++x)
-        {
-          const vtkIdType id =
-            x + static_cast<vtkIdType>(dims[0]) * (y + static_cast<vtkIdType>(dims[1]) * z);
-          double v = scalars->GetComponent(id, 0);
-          if (!std::isfinite(v))
-          {
-            ++nonFinite;
-            v = 0.0;
-          }
-          const size_t t = (x / factor[0]) +
-            static_cast<size_t>(texDims[0]) *
-              ((y / factor[1]) + static_cast<size_t>(texDims[1]) * (z / factor[2]));
-          values[t] += static_cast<float>(std::max(v, 0.0));
-          counts[t] += 1.0f;
-        }
-      }
-    }
-    for (size_t i = 0; i < values.size(); ++i)
-    {
-      values[i] = counts[i] > 0.0f ? values[i] / counts[i] : 0.0f;
-    }
-    if (nonFinite > 0)
-    {
-      vtkWarningMacro(<< nonFinite << " density values are NaN or infinite; rendered as 0.");
-    }
-    ResetTexture(in.Density, window, true);
-    if (!in.Density->Create3DFromRaw(
-          texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
-    {
-      vtkErrorMacro("Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
-                                            << " density texture.");
-      return;
-    }
-    // Box of the density in data coordinates and the box -> texture-coordinate map.
-    double origin[3], spacing[3];
-    int extent[6];
-    image->GetOrigin(origin);
-    image->GetSpacing(spacing);
-    image->GetExtent(extent);
-    for (int k = 0; k < 3; ++k)
-    {
-      const double first = origin[k] + extent[2 * k] * spacing[k];
-      const int cells = cellFlag ? dims[k] : std::max(dims[k] - 1, 0);
-      in.BoxOrigin[k] = first;
-      in.BoxSize[k] = cells * spacing[k];
-      const double texels = static_cast<double>(texDims[k]) * factor[k]; // in input samples
-      if (cellFlag)
-      {
-        in.BoxToTexScale[k] = dims[k] / texels;
-        in.BoxToTexOffset[k] = 0.0;
-      }
-      else
-      {
-        // Point sample j sits at the centre of input texel j: (j + 0.5) / texels.
-        in.BoxToTexScale[k] = (dims[k] - 1) / texels;
-        in.BoxToTexOffset[k] = 0.5 / texels;
-      }
-      if (in.BoxSize[k] == 0.0)
-      {
-        // A single sample thick: give the box one spacing (or unit) of thickness around it.
-        const double thickness = spacing[k] != 0.0 ? std::abs(spacing[k]) : 1.0;
-        in.BoxOrigin[k] = first - 0.5 * thickness;
-        in.BoxSize[k] = thickness;
-        in.BoxToTexScale[k] = 0.0;
-        in.BoxToTexOffset[k] = 0.5;
-      }
-    }
-    std::copy(texDims, texDims + 3, in.TextureDims);
-    in.UploadedArray = scalars;
-    in.UploadedImage = image;
-    in.UploadedMaximumSize = maxSize;
-    in.DensityUploadTime.Modified();
-    in.HasDensity = true;
-    ++in.VolumeUploads;
+    vtkWarningMacro(<< warning);
+  }
+  if (!uploaded)
+  {
+    vtkErrorMacro(<< error);
+    return;
   }
 
   // --- this frame's sun, air, ground and display: ours, or the sky's behind us.
@@ -501,12 +380,14 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   in.LastBackToFront = axis.BackToFront;
 
   vtkMatrix4x4* dataToWorld = volume->GetMatrix();
+  const double* boxOrigin = in.Density.GetBoxOrigin();
+  const double* boxSize = in.Density.GetBoxSize();
   std::vector<nimbus::Vector3> corners;
   for (int c = 0; c < 8; ++c)
   {
-    const double p[4] = { in.BoxOrigin[0] + ((c & 1) ? in.BoxSize[0] : 0.0),
-      in.BoxOrigin[1] + ((c & 2) ? in.BoxSize[1] : 0.0),
-      in.BoxOrigin[2] + ((c & 4) ? in.BoxSize[2] : 0.0), 1.0 };
+    const double p[4] = { boxOrigin[0] + ((c & 1) ? boxSize[0] : 0.0),
+      boxOrigin[1] + ((c & 2) ? boxSize[1] : 0.0), boxOrigin[2] + ((c & 4) ? boxSize[2] : 0.0),
+      1.0 };
     double w[4];
     dataToWorld->MultiplyPoint(p, w);
     corners.push_back({ { w[0] / w[3], w[1] / w[3], w[2] / w[3] } });
@@ -521,12 +402,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   vtkNew<vtkMatrix4x4> worldToData;
   vtkMatrix4x4::Invert(dataToWorld, worldToData);
   vtkNew<vtkMatrix4x4> dataToTexture;
-  for (int k = 0; k < 3; ++k)
-  {
-    dataToTexture->SetElement(k, k, in.BoxToTexScale[k] / in.BoxSize[k]);
-    dataToTexture->SetElement(
-      k, 3, in.BoxToTexOffset[k] - in.BoxToTexScale[k] * in.BoxOrigin[k] / in.BoxSize[k]);
-  }
+  in.Density.GetDataToTexture(dataToTexture);
   vtkNew<vtkMatrix4x4> worldToTexture;
   vtkMatrix4x4::Multiply4x4(dataToTexture, worldToData, worldToTexture);
   // Texture coordinates are tested against [0,1] for "inside the box": with the
@@ -534,11 +410,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   vtkNew<vtkMatrix4x4> worldToBox;
   {
     vtkNew<vtkMatrix4x4> dataToBox;
-    for (int k = 0; k < 3; ++k)
-    {
-      dataToBox->SetElement(k, k, 1.0 / in.BoxSize[k]);
-      dataToBox->SetElement(k, 3, -in.BoxOrigin[k] / in.BoxSize[k]);
-    }
+    in.Density.GetDataToBox(dataToBox);
     vtkMatrix4x4::Multiply4x4(dataToBox, worldToData, worldToBox);
   }
 
@@ -672,7 +544,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniform3f("toSun", toSun.data());
     program->SetUniform3f("sliceNormal", axis.Normal.data());
     program->SetUniformf("lengthUnit", static_cast<float>(settings.MetresPerUnit));
-    program->SetUniformi("density", in.Density->GetTextureUnit());
+    program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
     program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
     program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
     program->SetUniformi("shadowSurface", in.Shadow->GetTextureUnit());
@@ -710,7 +582,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     program->SetUniformi("overSky", settings.OverSky ? 1 : 0);
   };
 
-  in.Density->Activate();
+  in.Density.GetTexture()->Activate();
   in.SceneDepth->Activate();
   if (atmosphere)
   {
@@ -996,7 +868,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   in.CompositePass->Render();
   ++in.PassesLastRender;
 
-  for (vtkTextureObject* t : { in.Density.GetPointer(), in.SceneDepth.GetPointer(),
+  for (vtkTextureObject* t : { in.Density.GetTexture(), in.SceneDepth.GetPointer(),
          in.RayEnds.GetPointer(), in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(),
          in.Accumulation.GetPointer(), in.SceneColor.GetPointer() })
   {
