@@ -38,6 +38,14 @@
  * Only what the scene needs runs: without atmosphere no atmosphere texture and
  * no atmosphere pass; without ground and atmosphere no passes outside the cloud
  * slices; without shafts no shadow look-ups in the atmosphere.
+ *
+ * A frame (Render) is a sequence of steps, each a method that sets the uniforms of
+ * its own pass (the uniforms all passes share come from SetCommonUniforms): the
+ * density texture (nimbus::CloudDensityTexture: uploads only when the data
+ * changed), the frame's sun and air, its geometry, copies of the scene's colour
+ * and depth, the atmosphere table, the interval/phase pass, the ray-ends pass, the
+ * atmosphere sunward of the slices, the slices (eye pass, then shadow update),
+ * the atmosphere beyond them, the radiance capture and the composite.
  */
 #ifndef vtkNimbusCloudVolumeMapper_h
 #define vtkNimbusCloudVolumeMapper_h
@@ -45,10 +53,11 @@
 #include "NimbusRepresentationsModule.h"
 #include "vtkVolumeMapper.h"
 
-#include <memory>
+#include <memory> // for std::unique_ptr
 
 class vtkImageData;
 class vtkRenderer;
+class vtkShaderProgram;
 class vtkVolume;
 class vtkWindow;
 
@@ -252,6 +261,39 @@ protected:
 private:
   vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;
   void operator=(const vtkNimbusCloudVolumeMapper&) = delete;
+
+  /// What one frame computes once and its passes read (defined in the .cxx).
+  struct FrameState;
+
+  ///@{
+  /// The steps of Render, in order. The bool steps end the frame when false.
+  bool UpdateDensityTexture(vtkRenderer* renderer, FrameState& frame);
+  bool ComputeFrameSettings(vtkRenderer* renderer, FrameState& frame);
+  bool ComputeFrameGeometry(vtkRenderer* renderer, vtkVolume* volume, FrameState& frame);
+  void CopySceneColorAndDepth(FrameState& frame);
+  bool UpdateAtmosphereTable(FrameState& frame);
+  void BeginPasses(const FrameState& frame);
+  void ClearShadowSurface(const FrameState& frame);
+  void RenderIntervalPhase(const FrameState& frame);
+  void RenderRayEnds(const FrameState& frame);
+  void ClearAccumulation(const FrameState& frame);
+  void RenderOutsideRegion(const FrameState& frame, bool beyondCloud);
+  void RenderSlices(const FrameState& frame);
+  void CaptureRadianceImage(const FrameState& frame);
+  void RenderComposite(const FrameState& frame);
+  void EndPasses(const FrameState& frame);
+  ///@}
+
+  ///@{
+  /// Pieces of the steps: the uniforms every pass shares, one slice seen from the
+  /// eye (scissored to `scissor` unless nullptr) and its optical depth added to
+  /// the shadow surface (within the texels `texels`).
+  void SetCommonUniforms(vtkShaderProgram* program, const FrameState& frame);
+  void RenderSliceFromEye(
+    const FrameState& frame, vtkShaderProgram* program, float offset, const int* scissor);
+  void RenderSliceShadow(
+    const FrameState& frame, vtkShaderProgram* program, float offset, const int texels[4]);
+  ///@}
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
