@@ -30,7 +30,6 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPointData.h"
-#include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
@@ -46,6 +45,7 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
+vtkCxxSetObjectMacro(vtkNimbusCloudVolumeMapper, SkyBackground, vtkNimbusSkyBackground);
 
 namespace
 {
@@ -227,23 +227,6 @@ struct SavedPassState
   }
 };
 
-// The sky of the first visible vtkNimbusSkyBackground among the renderer's props.
-vtkNimbusSky* FindSceneSky(vtkRenderer* renderer)
-{
-  vtkPropCollection* props = renderer->GetViewProps();
-  vtkCollectionSimpleIterator it;
-  props->InitTraversal(it);
-  while (vtkProp* prop = props->GetNextProp(it))
-  {
-    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
-    if (background && background->GetVisibility())
-    {
-      return background->GetSky();
-    }
-  }
-  return nullptr;
-}
-
 // The sun, air, ground and display parameters of one frame: the mapper's own, or
 // those of the Nimbus sky drawn behind it (see UseSceneSky).
 struct FrameSettings
@@ -379,7 +362,10 @@ vtkNimbusCloudVolumeMapper::vtkNimbusCloudVolumeMapper()
 {
 }
 
-vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper() = default;
+vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper()
+{
+  this->SetSkyBackground(nullptr);
+}
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfVolumeUploads() const
 {
@@ -428,8 +414,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
 {
   this->Internal->PassesLastRender = 0;
   FrameState frame;
-  if (!this->UpdateDensityTexture(renderer, frame) ||
-    !this->ComputeFrameSettings(renderer, frame) ||
+  if (!this->UpdateDensityTexture(renderer, frame) || !this->ComputeFrameSettings(frame) ||
     !this->ComputeFrameGeometry(renderer, volume, frame))
   {
     return;
@@ -511,8 +496,18 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
 }
 
 //------------------------------------------------------------------------------
+vtkNimbusSky* vtkNimbusCloudVolumeMapper::GetFollowedSky()
+{
+  if (!this->UseSceneSky || this->Unlit || !this->SkyBackground ||
+    !this->SkyBackground->GetVisibility())
+  {
+    return nullptr;
+  }
+  return this->SkyBackground->GetSky();
+}
+
 // This frame's sun, air, ground and display: ours, or the sky's behind us.
-bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(vtkRenderer* renderer, FrameState& frame)
+bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
 {
   FrameSettings& settings = frame.Settings;
   settings.Sun.AzimuthDegrees = this->SunAzimuthDegrees;
@@ -529,7 +524,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(vtkRenderer* renderer, Fra
   std::fill(settings.DisplayScale, settings.DisplayScale + 3, this->Exposure);
   settings.EncodeSrgb = this->EncodeSrgb;
   settings.OverSky = false;
-  if (vtkNimbusSky* sky = (this->UseSceneSky && !this->Unlit) ? FindSceneSky(renderer) : nullptr)
+  if (vtkNimbusSky* sky = this->GetFollowedSky())
   {
     const nimbus::SkyParameters* skyParameters = nullptr;
     try
@@ -1086,4 +1081,5 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CaptureRadiance: " << this->CaptureRadiance << "\n";
   os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
   os << indent << "UseSceneSky: " << this->UseSceneSky << "\n";
+  os << indent << "SkyBackground: " << this->SkyBackground << "\n";
 }
