@@ -140,7 +140,7 @@ int main(int argc, char* argv[])
   renderer->SetBackground(0.0, 0.0, 0.0); // space: the mapper draws the atmosphere
   if (drawSky)
   {
-    // The sky behind everything; the cloud mapper finds it and takes its sun,
+    // The sky behind everything; the cloud mapper, given it, takes its sun,
     // air, ground albedo and exposure (UseSceneSky), so sky and cloud agree.
     vtkNew<vtkNimbusSkyBackground> sky;
     sky->GetSky()->SetSunElevationDegrees(sunElevation);
@@ -148,6 +148,7 @@ int main(int argc, char* argv[])
     sky->GetSky()->SetGroundAlbedo(0.25);
     sky->GetSky()->SetExposure(exposure);
     renderer->AddViewProp(sky);
+    cloudMapper->SetSkyBackground(sky);
   }
 
   vtkCamera* camera = renderer->GetActiveCamera();

@@ -2,9 +2,13 @@
 
 #include "vtkDataObject.h"
 #include "vtkInformation.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkRenderer.h"
 
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
 vtkStandardNewMacro(vtkNimbusCloudRepresentation);
@@ -22,6 +26,29 @@ vtkNimbusCloudRepresentation::~vtkNimbusCloudRepresentation() = default;
 vtkNimbusCloudVolumeMapper* vtkNimbusCloudRepresentation::GetCloudMapper()
 {
   return this->CloudMapper;
+}
+
+int vtkNimbusCloudRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* requestType, vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  if (!this->Superclass::ProcessViewRequest(requestType, inInfo, outInfo))
+  {
+    return 0; // hidden, or nothing to do
+  }
+  if (requestType == vtkPVView::REQUEST_RENDER())
+  {
+    // The sky the view shows now (or none): the representations of a view are
+    // separate, so the coupling goes through the renderer's information.
+    vtkNimbusSkyBackground* sky = nullptr;
+    auto* view = vtkPVRenderView::SafeDownCast(this->GetView());
+    if (view && view->GetRenderer() && view->GetRenderer()->GetInformation())
+    {
+      sky = vtkNimbusSkyBackground::SafeDownCast(view->GetRenderer()->GetInformation()->Get(
+        vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
+    }
+    this->CloudMapper->SetSkyBackground(sky);
+  }
+  return 1;
 }
 
 void vtkNimbusCloudRepresentation::UpdateMapperParameters()

@@ -35,6 +35,13 @@ public:
   /// The mapper this representation renders with (owned by the representation).
   vtkNimbusCloudVolumeMapper* GetCloudMapper();
 
+  /// The superclass's view passes; before each render (REQUEST_RENDER) the mapper
+  /// also gets the sky background the view's renderer shows
+  /// (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND, set by the "Sky Background"
+  /// representation; none when the view has none).
+  int ProcessViewRequest(vtkInformationRequestKey* requestType, vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+
   ///@{
   /// Cloud optics: extinction per unit density [1/m], single-scattering albedo,
   /// Cornette-Shanks g of the cloud, k_multi (000 Eq. 1).
@@ -89,7 +96,7 @@ public:
   ///@}
 
   ///@{
-  /// Follow a Nimbus sky shown in the same view ("Sky Background"): its sun,
+  /// Follow the Nimbus sky shown in the same view ("Sky Background"): its sun,
   /// air, ground albedo and exposure replace the cloud's own (see
   /// vtkNimbusCloudVolumeMapper::SetUseSceneSky). On by default.
   void SetUseSceneSky(bool value);

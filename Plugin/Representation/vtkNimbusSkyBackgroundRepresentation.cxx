@@ -4,6 +4,7 @@
 #include "vtkDataObject.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
@@ -94,7 +95,11 @@ bool vtkNimbusSkyBackgroundRepresentation::AddToView(vtkView* view)
   {
     return false; // the sky is a render view's background only
   }
-  renderView->GetRenderer()->AddViewProp(this->Background);
+  vtkRenderer* renderer = renderView->GetRenderer();
+  renderer->AddViewProp(this->Background);
+  // Named for the view's Cloud representations (vtkNimbusCloudRepresentation).
+  renderer->GetInformation()->Set(
+    vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND(), this->Background);
   return this->Superclass::AddToView(view);
 }
 
@@ -105,7 +110,13 @@ bool vtkNimbusSkyBackgroundRepresentation::RemoveFromView(vtkView* view)
   {
     return false;
   }
-  renderView->GetRenderer()->RemoveViewProp(this->Background);
+  vtkRenderer* renderer = renderView->GetRenderer();
+  renderer->RemoveViewProp(this->Background);
+  vtkInformation* information = renderer->GetInformation();
+  if (information->Get(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()) == this->Background)
+  {
+    information->Remove(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND());
+  }
   return this->Superclass::RemoveFromView(view);
 }
 

@@ -5,9 +5,11 @@
  * The "Sky Background" representation type of polygonal data in ParaView. While
  * it is visible in a render view, the view's renderer (vtkPVRenderView::GetRenderer())
  * holds a vtkNimbusSkyBackground: every pixel where nothing opaque is drawn shows
- * the sky; a vtkNimbusCloudVolumeMapper in the same renderer lights its clouds
- * with that sky's sun. Hidden, or removed from the view, the plain view
- * background shows again.
+ * the sky. The renderer's information names it
+ * (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND), and the view's Cloud
+ * representations hand it to their mappers, which light their clouds with that
+ * sky's sun. Hidden, or removed from the view, the plain view background shows
+ * again.
  *
  * The sky's parameters come from the input's field data: the one-tuple arrays
  * that vtkNimbusSkyDomeSource writes ("SunElevationDegrees", "SunAzimuthDegrees",
@@ -43,7 +45,9 @@ public:
   int ProcessViewRequest(vtkInformationRequestKey* requestType, vtkInformation* inInfo,
     vtkInformation* outInfo) override;
 
-  /// Adds the sky background to / removes it from the render view's renderer.
+  /// Adds the sky background to / removes it from the render view's renderer, and
+  /// names it in / removes it from the renderer's information
+  /// (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND).
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;
 

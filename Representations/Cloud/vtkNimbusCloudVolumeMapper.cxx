@@ -2,6 +2,7 @@
 #include "Math.h"
 
 #include "AtmosphereTable.h"
+#include "CloudDensityTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 
@@ -18,7 +19,6 @@
 #include "vtkNimbusSkyBackground.h"
 
 #include "vtkCamera.h"
-#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -30,7 +30,6 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPointData.h"
-#include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
@@ -46,11 +45,10 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
+vtkCxxSetObjectMacro(vtkNimbusCloudVolumeMapper, SkyBackground, vtkNimbusSkyBackground);
 
 namespace
 {
-using nimbus::kDegree;
-
 // Column-major float copy of a VTK (row-major) matrix, for glUniformMatrix4fv.
 std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
 {
@@ -84,35 +82,25 @@ void ResetTexture(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, bool
   texture->SetMagnificationFilter(filter);
 }
 
-// The sun, air, ground and display parameters of one frame: the mapper's own, or
-// those of the Nimbus sky drawn behind it (see UseSceneSky).
-struct FrameSettings
+// A nearest-filtered 2-D float texture (or depth texture) of w x h texels,
+// reallocated only when its size changed.
+void EnsureTexture2D(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h,
+  int components, bool depth)
 {
-  nimbus::SunParameters Sun;
-  nimbus::SceneAtmosphere Air;
-  double GroundHeight;    // world units
-  double GroundAlbedo;    // dimensionless
-  double MetresPerUnit;   // metres per world unit
-  double DisplayScale[3]; // per channel
-  bool EncodeSrgb;
-  bool OverSky;
-};
-
-// The sky of the first visible vtkNimbusSkyBackground among the renderer's props.
-vtkNimbusSky* FindSceneSky(vtkRenderer* renderer)
-{
-  vtkPropCollection* props = renderer->GetViewProps();
-  vtkCollectionSimpleIterator it;
-  props->InitTraversal(it);
-  while (vtkProp* prop = props->GetNextProp(it))
+  texture->SetContext(window);
+  if (static_cast<int>(texture->GetWidth()) != w || static_cast<int>(texture->GetHeight()) != h ||
+    !texture->GetHandle())
   {
-    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
-    if (background && background->GetVisibility())
+    ResetTexture(texture, window, false);
+    if (depth)
     {
-      return background->GetSky();
+      texture->AllocateDepth(w, h, vtkTextureObject::Float32);
+    }
+    else
+    {
+      texture->Allocate2D(w, h, components, VTK_FLOAT);
     }
   }
-  return nullptr;
 }
 
 // Binds the framebuffer with `target` as its only draw buffer. The attachment is
@@ -127,24 +115,167 @@ void DrawInto(
   framebuffer->AddColorAttachment(0, target);
   framebuffer->ActivateDrawBuffer(0);
 }
+
+// 000 §4.3: back-to-front S_i = C_i + alpha_i S_{i-1}; front-to-back
+// S_i = S_{i-1} + alpha*_i C_i with alpha* the transmittance so far (kept in alpha).
+void UseSliceBlend(vtkOpenGLState* state, bool backToFront)
+{
+  state->vtkglEnable(GL_BLEND);
+  if (backToFront)
+  {
+    state->vtkglBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_SRC_ALPHA);
+  }
+  else
+  {
+    state->vtkglBlendFuncSeparate(GL_DST_ALPHA, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
+  }
 }
+
+// Scissor rectangles: each slice's passes only touch the pixels (and shadow
+// texels) onto which the polygon "slice plane cut by the box" projects; outside
+// it the density is zero.
+
+// Pixels (x, y, width, height) of a width x height viewport covering the
+// polygon's projection, with a pixel of margin; false when a vertex is behind the
+// eye (no finite rectangle).
+bool ScreenRectangle(const std::vector<nimbus::Vector3>& polygon, vtkMatrix4x4* worldToNdc,
+  int width, int height, int rect[4])
+{
+  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+  for (const auto& point : polygon)
+  {
+    const double p[4] = { point[0], point[1], point[2], 1.0 };
+    double q[4];
+    worldToNdc->MultiplyPoint(p, q);
+    if (q[3] <= 1e-9)
+    {
+      return false;
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      lo[k] = std::min(lo[k], q[k] / q[3]);
+      hi[k] = std::max(hi[k], q[k] / q[3]);
+    }
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
+  const int y0 =
+    std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
+  const int x1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
+  const int y1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
+  rect[0] = x0;
+  rect[1] = y0;
+  rect[2] = std::max(x1 - x0, 0);
+  rect[3] = std::max(y1 - y0, 0);
+  return true;
+}
+
+// Texels (x, y, width, height) of the size x size shadow surface covering the
+// polygon's projection along the sun, with a texel of margin.
+void ShadowRectangle(const std::vector<nimbus::Vector3>& polygon, const nimbus::ShadowFrame& frame,
+  int size, int rect[4])
+{
+  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+  for (const auto& point : polygon)
+  {
+    const nimbus::Vector3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
+      point[2] - frame.Origin[2] } };
+    const double st[2] = { nimbus::Dot(q, frame.U) / frame.Width * size,
+      nimbus::Dot(q, frame.W) / frame.Height * size };
+    for (int k = 0; k < 2; ++k)
+    {
+      lo[k] = std::min(lo[k], st[k]);
+      hi[k] = std::max(hi[k], st[k]);
+    }
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(lo[0])) - 1, 0, size);
+  const int y0 = std::clamp(static_cast<int>(std::floor(lo[1])) - 1, 0, size);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(hi[0])) + 1, 0, size);
+  const int y1 = std::clamp(static_cast<int>(std::ceil(hi[1])) + 1, 0, size);
+  rect[0] = x0;
+  rect[1] = y0;
+  rect[2] = std::max(x1 - x0, 0);
+  rect[3] = std::max(y1 - y0, 0);
+}
+
+// The GL state the passes change, restored (in reverse order) when the frame ends.
+struct SavedPassState
+{
+  vtkOpenGLState::ScopedglViewport Viewport;
+  vtkOpenGLState::ScopedglBlendFuncSeparate BlendFunction;
+  vtkOpenGLState::ScopedglEnableDisable Blend;
+  vtkOpenGLState::ScopedglEnableDisable DepthTest;
+  vtkOpenGLState::ScopedglEnableDisable Scissor;
+  vtkOpenGLState::ScopedglScissor ScissorBox;
+  vtkOpenGLState::ScopedglEnableDisable Cull;
+  vtkOpenGLState::ScopedglDepthMask DepthMask;
+  vtkOpenGLState::ScopedglColorMask ColorMask;
+
+  explicit SavedPassState(vtkOpenGLState* state)
+    : Viewport(state)
+    , BlendFunction(state)
+    , Blend(state, GL_BLEND)
+    , DepthTest(state, GL_DEPTH_TEST)
+    , Scissor(state, GL_SCISSOR_TEST)
+    , ScissorBox(state)
+    , Cull(state, GL_CULL_FACE)
+    , DepthMask(state)
+    , ColorMask(state)
+  {
+    state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    state->vtkglDisable(GL_CULL_FACE);
+    state->vtkglDisable(GL_SCISSOR_TEST);
+  }
+};
+
+// The sun, air, ground and display parameters of one frame: the mapper's own, or
+// those of the Nimbus sky drawn behind it (see UseSceneSky).
+struct FrameSettings
+{
+  nimbus::SunParameters Sun;
+  nimbus::SceneAtmosphere Air;
+  double GroundHeight;    // world units
+  double GroundAlbedo;    // dimensionless
+  double MetresPerUnit;   // metres per world unit
+  double DisplayScale[3]; // per channel
+  bool EncodeSrgb;
+  bool OverSky;
+};
+}
+
+struct vtkNimbusCloudVolumeMapper::FrameState
+{
+  vtkOpenGLRenderWindow* Window = nullptr;
+  vtkOpenGLState* State = nullptr;
+  vtkCamera* Camera = nullptr;
+  FrameSettings Settings;
+  bool Atmosphere = false;     // the atmosphere is drawn (Atmosphere, not Unlit)
+  bool Ground = false;         // the ground is drawn (Ground, not Unlit)
+  bool OutsideRegions = false; // passes outside the slices (atmosphere or ground)
+
+  // The renderer's viewport in the framebuffer.
+  int Width = 0, Height = 0, X0 = 0, Y0 = 0;
+
+  // Slice geometry (world coordinates).
+  nimbus::Vector3 ToSun{ { 0.0, 0.0, 1.0 } };
+  nimbus::SliceAxis Axis;
+  std::vector<nimbus::Vector3> Corners; // of the density box
+  nimbus::SlicePlanes Planes;
+  nimbus::ShadowFrame Shadow;
+  double SunStepMetres = 0.0; // sun path length between two slices
+
+  // Matrices of the shared uniforms (column-major) and the one of the scissors.
+  std::array<float, 16> InverseViewProjection{};
+  std::array<float, 16> WorldToTexture{};
+  std::array<float, 16> WorldToBox{};
+  vtkNew<vtkMatrix4x4> WorldToNdc;
+};
 
 struct vtkNimbusCloudVolumeMapper::Internals
 {
   vtkOpenGLRenderWindow* Window = nullptr;
 
   // Density volume (000: the "volume texture").
-  vtkNew<vtkTextureObject> Density;
-  vtkTimeStamp DensityUploadTime;
-  vtkDataArray* UploadedArray = nullptr;
-  vtkImageData* UploadedImage = nullptr;
-  int UploadedMaximumSize = -1;
-  int TextureDims[3] = { 0, 0, 0 };
-  double BoxToTexScale[3] = { 1, 1, 1 };
-  double BoxToTexOffset[3] = { 0, 0, 0 };
-  double BoxOrigin[3] = { 0, 0, 0 }; // data coordinates of the density box
-  double BoxSize[3] = { 1, 1, 1 };
-  bool HasDensity = false;
+  nimbus::CloudDensityTexture Density;
 
   // Atmosphere texture (000 §3), keyed by the parameters it depends on.
   vtkNew<vtkTextureObject> AtmosphereTexture;
@@ -175,7 +306,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
     CompositePass, RayEndsPass;
 
-  int VolumeUploads = 0;
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
   int PassesLastRender = 0;
@@ -185,10 +315,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
 
   void Release(vtkWindow* window)
   {
-    for (vtkTextureObject* t :
-      { Density.GetPointer(), AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
-        Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
-        SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
+    this->Density.Release(window);
+    for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
+           Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
+           SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
@@ -207,9 +337,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
         pass->reset();
       }
     }
-    UploadedArray = nullptr;
-    UploadedImage = nullptr;
-    HasDensity = false;
     AtmosphereKey.clear();
     IntervalPhaseKey.clear();
     Window = nullptr;
@@ -235,11 +362,14 @@ vtkNimbusCloudVolumeMapper::vtkNimbusCloudVolumeMapper()
 {
 }
 
-vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper() = default;
+vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper()
+{
+  this->SetSkyBackground(nullptr);
+}
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfVolumeUploads() const
 {
-  return this->Internal->VolumeUploads;
+  return this->Internal->Density.GetNumberOfUploads();
 }
 int vtkNimbusCloudVolumeMapper::GetNumberOfAtmosphereBuilds() const
 {
@@ -271,7 +401,7 @@ vtkImageData* vtkNimbusCloudVolumeMapper::GetRadianceImage()
 }
 void vtkNimbusCloudVolumeMapper::GetTextureDimensions(int dims[3]) const
 {
-  std::copy(this->Internal->TextureDims, this->Internal->TextureDims + 3, dims);
+  this->Internal->Density.GetDimensions(dims);
 }
 
 void vtkNimbusCloudVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
@@ -282,30 +412,62 @@ void vtkNimbusCloudVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 //------------------------------------------------------------------------------
 void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
 {
+  this->Internal->PassesLastRender = 0;
+  FrameState frame;
+  if (!this->UpdateDensityTexture(renderer, frame) || !this->ComputeFrameSettings(frame) ||
+    !this->ComputeFrameGeometry(renderer, volume, frame))
+  {
+    return;
+  }
+  const SavedPassState savedState(frame.State);
+  this->CopySceneColorAndDepth(frame);
+  if (!this->UpdateAtmosphereTable(frame))
+  {
+    frame.State->PopFramebufferBindings();
+    return;
+  }
+  this->BeginPasses(frame);
+  this->ClearShadowSurface(frame);
+  this->RenderIntervalPhase(frame);
+  this->RenderRayEnds(frame);
+  this->ClearAccumulation(frame);
+  this->RenderOutsideRegion(frame, false);
+  this->RenderSlices(frame);
+  this->RenderOutsideRegion(frame, true);
+  this->CaptureRadianceImage(frame);
+  this->RenderComposite(frame);
+  this->EndPasses(frame);
+}
+
+//------------------------------------------------------------------------------
+// The render window and the density texture: uploaded only when the data (not
+// the lighting) changed.
+bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, FrameState& frame)
+{
   Internals& in = *this->Internal;
-  in.PassesLastRender = 0;
   auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
   if (!window)
   {
     vtkErrorMacro("vtkNimbusCloudVolumeMapper needs an OpenGL render window.");
-    return;
+    return false;
   }
   if (in.Window && in.Window != window)
   {
     in.Release(in.Window);
   }
   in.Window = window;
+  frame.Window = window;
+  frame.State = window->GetState();
   vtkImageData* image = vtkImageData::SafeDownCast(this->GetInput());
   if (!image)
   {
     vtkErrorMacro("No input image: connect a vtkImageData with a density array.");
-    return;
+    return false;
   }
   this->GetInputAlgorithm()->UpdateInformation();
   this->GetInputAlgorithm()->Update();
   image = vtkImageData::SafeDownCast(this->GetInput());
 
-  // --- density texture: uploaded only when the data (not the lighting) changed.
   int cellFlag = 0;
   vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
     image, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
@@ -313,135 +475,41 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   {
     vtkErrorMacro("The input image has no scalar array to render as density (set one with "
                   "SelectScalarArray, or give the image active point scalars).");
-    return;
+    return false;
   }
   const int maxSize = this->MaximumTextureSize > 0
     ? std::min(this->MaximumTextureSize, vtkTextureObject::GetMaximumTextureSize3D(window))
     : vtkTextureObject::GetMaximumTextureSize3D(window);
-  if (!in.HasDensity || in.UploadedArray != scalars || in.UploadedImage != image ||
-    scalars->GetMTime() > in.DensityUploadTime || image->GetMTime() > in.DensityUploadTime ||
-    in.UploadedMaximumSize != maxSize)
+  std::vector<std::string> warnings;
+  std::string error;
+  const bool ok =
+    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, warnings, error);
+  for (const std::string& warning : warnings)
   {
-    int pointDims[3];
-    image->GetDimensions(pointDims);
-    int dims[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      dims[k] = cellFlag ? std::max(pointDims[k] - 1, 1) : pointDims[k];
-    }
-    if (static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] != scalars->GetNumberOfTuples())
-    {
-      vtkErrorMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)") << "' has "
-                              << scalars->GetNumberOfTuples() << " values, but the image needs "
-                              << dims[0] * dims[1] * dims[2]);
-      return;
-    }
-    if (scalars->GetNumberOfComponents() != 1)
-    {
-      vtkWarningMacro("Array '" << (scalars->GetName() ? scalars->GetName() : "(unnamed)")
-                                << "' has " << scalars->GetNumberOfComponents()
-                                << " components; rendering its first as the density.");
-    }
-    // Downsample by an integer factor per axis (box average) above the texture limit.
-    int factor[3], texDims[3];
-    for (int k = 0; k < 3; ++k)
-    {
-      factor[k] = (dims[k] + maxSize - 1) / maxSize;
-      texDims[k] = (dims[k] + factor[k] - 1) / factor[k];
-    }
-    if (factor[0] > 1 || factor[1] > 1 || factor[2] > 1)
-    {
-      vtkWarningMacro("Density " << dims[0] << "x" << dims[1] << "x" << dims[2]
-                                 << " exceeds the texture limit of " << maxSize
-                                 << " per side; downsampled to " << texDims[0] << "x" << texDims[1]
-                                 << "x" << texDims[2] << " by averaging.");
-    }
-    std::vector<float> values(static_cast<size_t>(texDims[0]) * texDims[1] * texDims[2], 0.0f);
-    std::vector<float> counts(values.size(), 0.0f);
-    vtkIdType nonFinite = 0;
-    for (int z = 0; z < dims[2]; ++z)
-    {
-      for (int y = 0; y < dims[1]; ++y)
-      {
-        for (int x = 0; x < dims[0]; ++x)
-        {
-          const vtkIdType id =
-            x + static_cast<vtkIdType>(dims[0]) * (y + static_cast<vtkIdType>(dims[1]) * z);
-          double v = scalars->GetComponent(id, 0);
-          if (!std::isfinite(v))
-          {
-            ++nonFinite;
-            v = 0.0;
-          }
-          const size_t t = (x / factor[0]) +
-            static_cast<size_t>(texDims[0]) *
-              ((y / factor[1]) + static_cast<size_t>(texDims[1]) * (z / factor[2]));
-          values[t] += static_cast<float>(std::max(v, 0.0));
-          counts[t] += 1.0f;
-        }
-      }
-    }
-    for (size_t i = 0; i < values.size(); ++i)
-    {
-      values[i] = counts[i] > 0.0f ? values[i] / counts[i] : 0.0f;
-    }
-    if (nonFinite > 0)
-    {
-      vtkWarningMacro(<< nonFinite << " density values are NaN or infinite; rendered as 0.");
-    }
-    ResetTexture(in.Density, window, true);
-    if (!in.Density->Create3DFromRaw(
-          texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, values.data()))
-    {
-      vtkErrorMacro("Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
-                                            << " density texture.");
-      return;
-    }
-    // Box of the density in data coordinates and the box -> texture-coordinate map.
-    double origin[3], spacing[3];
-    int extent[6];
-    image->GetOrigin(origin);
-    image->GetSpacing(spacing);
-    image->GetExtent(extent);
-    for (int k = 0; k < 3; ++k)
-    {
-      const double first = origin[k] + extent[2 * k] * spacing[k];
-      const int cells = cellFlag ? dims[k] : std::max(dims[k] - 1, 0);
-      in.BoxOrigin[k] = first;
-      in.BoxSize[k] = cells * spacing[k];
-      const double texels = static_cast<double>(texDims[k]) * factor[k]; // in input samples
-      if (cellFlag)
-      {
-        in.BoxToTexScale[k] = dims[k] / texels;
-        in.BoxToTexOffset[k] = 0.0;
-      }
-      else
-      {
-        // Point sample j sits at the centre of input texel j: (j + 0.5) / texels.
-        in.BoxToTexScale[k] = (dims[k] - 1) / texels;
-        in.BoxToTexOffset[k] = 0.5 / texels;
-      }
-      if (in.BoxSize[k] == 0.0)
-      {
-        // A single sample thick: give the box one spacing (or unit) of thickness around it.
-        const double thickness = spacing[k] != 0.0 ? std::abs(spacing[k]) : 1.0;
-        in.BoxOrigin[k] = first - 0.5 * thickness;
-        in.BoxSize[k] = thickness;
-        in.BoxToTexScale[k] = 0.0;
-        in.BoxToTexOffset[k] = 0.5;
-      }
-    }
-    std::copy(texDims, texDims + 3, in.TextureDims);
-    in.UploadedArray = scalars;
-    in.UploadedImage = image;
-    in.UploadedMaximumSize = maxSize;
-    in.DensityUploadTime.Modified();
-    in.HasDensity = true;
-    ++in.VolumeUploads;
+    vtkWarningMacro(<< warning);
   }
+  if (!ok)
+  {
+    vtkErrorMacro(<< error);
+  }
+  return ok;
+}
 
-  // --- this frame's sun, air, ground and display: ours, or the sky's behind us.
-  FrameSettings settings;
+//------------------------------------------------------------------------------
+vtkNimbusSky* vtkNimbusCloudVolumeMapper::GetFollowedSky()
+{
+  if (!this->UseSceneSky || this->Unlit || !this->SkyBackground ||
+    !this->SkyBackground->GetVisibility())
+  {
+    return nullptr;
+  }
+  return this->SkyBackground->GetSky();
+}
+
+// This frame's sun, air, ground and display: ours, or the sky's behind us.
+bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
+{
+  FrameSettings& settings = frame.Settings;
   settings.Sun.AzimuthDegrees = this->SunAzimuthDegrees;
   settings.Sun.ElevationDegrees = this->SunElevationDegrees;
   settings.Sun.Illuminance = this->SunIlluminance;
@@ -456,7 +524,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   std::fill(settings.DisplayScale, settings.DisplayScale + 3, this->Exposure);
   settings.EncodeSrgb = this->EncodeSrgb;
   settings.OverSky = false;
-  if (vtkNimbusSky* sky = (this->UseSceneSky && !this->Unlit) ? FindSceneSky(renderer) : nullptr)
+  if (vtkNimbusSky* sky = this->GetFollowedSky())
   {
     const nimbus::SkyParameters* skyParameters = nullptr;
     try
@@ -466,7 +534,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     catch (const std::exception& error)
     {
       vtkErrorMacro("The scene's sky is invalid: " << error.what());
-      return;
+      return false;
     }
     settings.Sun.AzimuthDegrees = sky->GetSunAzimuthDegrees();
     settings.Sun.ElevationDegrees = sky->GetSunElevationDegrees();
@@ -481,153 +549,134 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     settings.EncodeSrgb = true; // the sky background is sRGB-encoded
     settings.OverSky = true;
   }
-  in.LastOverSky = settings.OverSky;
-  in.LastSunElevationDegrees = settings.Sun.ElevationDegrees;
+  frame.Atmosphere = this->Atmosphere && !this->Unlit;
+  frame.Ground = this->Ground && !this->Unlit;
+  frame.OutsideRegions = frame.Atmosphere || frame.Ground;
+  settings.Air.Enabled = frame.Atmosphere;
+  this->Internal->LastOverSky = settings.OverSky;
+  this->Internal->LastSunElevationDegrees = settings.Sun.ElevationDegrees;
+  return true;
+}
 
-  // --- geometry: sun, view, slice axis, box corners in world coordinates.
+//------------------------------------------------------------------------------
+// Sun, view, slice axis and planes, the box corners and the shadow frame in world
+// coordinates, and the matrices of the shared uniforms. False for an empty viewport.
+bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
+  vtkRenderer* renderer, vtkVolume* volume, FrameState& frame)
+{
+  const nimbus::CloudDensityTexture& density = this->Internal->Density;
   vtkCamera* camera = renderer->GetActiveCamera();
-  int width = 0, height = 0, x0 = 0, y0 = 0;
-  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
-  if (width < 1 || height < 1)
+  frame.Camera = camera;
+  renderer->GetTiledSizeAndOrigin(&frame.Width, &frame.Height, &frame.X0, &frame.Y0);
+  if (frame.Width < 1 || frame.Height < 1)
   {
-    return;
+    return false;
   }
-  const nimbus::Vector3 toSun =
-    nimbus::SunDirection(settings.Sun.ElevationDegrees, settings.Sun.AzimuthDegrees);
+  frame.ToSun =
+    nimbus::SunDirection(frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees);
   double projection[3];
   camera->GetDirectionOfProjection(projection);
   const nimbus::Vector3 view = { { projection[0], projection[1], projection[2] } };
-  const nimbus::SliceAxis axis = nimbus::ComputeSliceAxis(view, toSun, this->SliceAngleRatio);
-  in.LastBackToFront = axis.BackToFront;
+  frame.Axis = nimbus::ComputeSliceAxis(view, frame.ToSun, this->SliceAngleRatio);
+  this->Internal->LastBackToFront = frame.Axis.BackToFront;
 
   vtkMatrix4x4* dataToWorld = volume->GetMatrix();
-  std::vector<nimbus::Vector3> corners;
+  const double* boxOrigin = density.GetBoxOrigin();
+  const double* boxSize = density.GetBoxSize();
   for (int c = 0; c < 8; ++c)
   {
-    const double p[4] = { in.BoxOrigin[0] + ((c & 1) ? in.BoxSize[0] : 0.0),
-      in.BoxOrigin[1] + ((c & 2) ? in.BoxSize[1] : 0.0),
-      in.BoxOrigin[2] + ((c & 4) ? in.BoxSize[2] : 0.0), 1.0 };
+    const double p[4] = { boxOrigin[0] + ((c & 1) ? boxSize[0] : 0.0),
+      boxOrigin[1] + ((c & 2) ? boxSize[1] : 0.0), boxOrigin[2] + ((c & 4) ? boxSize[2] : 0.0),
+      1.0 };
     double w[4];
     dataToWorld->MultiplyPoint(p, w);
-    corners.push_back({ { w[0] / w[3], w[1] / w[3], w[2] / w[3] } });
+    frame.Corners.push_back({ { w[0] / w[3], w[1] / w[3], w[2] / w[3] } });
   }
-  const std::array<double, 2> range = nimbus::ProjectedRange(corners, axis.Normal);
-  const nimbus::SlicePlanes planes =
+  const std::array<double, 2> range = nimbus::ProjectedRange(frame.Corners, frame.Axis.Normal);
+  frame.Planes =
     nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), this->NumberOfSlices);
-  const nimbus::ShadowFrame frame = nimbus::ComputeShadowFrame(corners, toSun, 0.02);
-  const double sunStepMetres = planes.Spacing / axis.SunCosine * settings.MetresPerUnit;
+  frame.Shadow = nimbus::ComputeShadowFrame(frame.Corners, frame.ToSun, 0.02);
+  frame.SunStepMetres = frame.Planes.Spacing / frame.Axis.SunCosine * frame.Settings.MetresPerUnit;
 
-  // world -> box [0,1]^3 -> density texture coordinates.
-  vtkNew<vtkMatrix4x4> worldToData;
+  // world -> data -> density texture coordinates, and -> the box as [0,1]^3:
+  // texture coordinates are tested against [0,1] for "inside the box", and the
+  // half-texel offsets of point data make the box itself [0,1]^3 for that test.
+  vtkNew<vtkMatrix4x4> worldToData, dataToTexture, worldToTexture, dataToBox, worldToBox;
   vtkMatrix4x4::Invert(dataToWorld, worldToData);
-  vtkNew<vtkMatrix4x4> dataToTexture;
-  for (int k = 0; k < 3; ++k)
-  {
-    dataToTexture->SetElement(k, k, in.BoxToTexScale[k] / in.BoxSize[k]);
-    dataToTexture->SetElement(
-      k, 3, in.BoxToTexOffset[k] - in.BoxToTexScale[k] * in.BoxOrigin[k] / in.BoxSize[k]);
-  }
-  vtkNew<vtkMatrix4x4> worldToTexture;
+  density.GetDataToTexture(dataToTexture);
   vtkMatrix4x4::Multiply4x4(dataToTexture, worldToData, worldToTexture);
-  // Texture coordinates are tested against [0,1] for "inside the box": with the
-  // half-texel offsets of point data, map the box itself to [0,1] for that test.
-  vtkNew<vtkMatrix4x4> worldToBox;
-  {
-    vtkNew<vtkMatrix4x4> dataToBox;
-    for (int k = 0; k < 3; ++k)
-    {
-      dataToBox->SetElement(k, k, 1.0 / in.BoxSize[k]);
-      dataToBox->SetElement(k, 3, -in.BoxOrigin[k] / in.BoxSize[k]);
-    }
-    vtkMatrix4x4::Multiply4x4(dataToBox, worldToData, worldToBox);
-  }
+  density.GetDataToBox(dataToBox);
+  vtkMatrix4x4::Multiply4x4(dataToBox, worldToData, worldToBox);
+  frame.WorldToTexture = ColumnMajor(worldToTexture);
+  frame.WorldToBox = ColumnMajor(worldToBox);
 
-  const double aspect = static_cast<double>(width) / height;
+  const double aspect = static_cast<double>(frame.Width) / frame.Height;
+  frame.WorldToNdc->DeepCopy(camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1));
   vtkNew<vtkMatrix4x4> inverseViewProjection;
-  inverseViewProjection->DeepCopy(camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1));
+  inverseViewProjection->DeepCopy(frame.WorldToNdc);
   inverseViewProjection->Invert();
+  frame.InverseViewProjection = ColumnMajor(inverseViewProjection);
+  return true;
+}
 
-  vtkOpenGLState* state = window->GetState();
-  vtkOpenGLState::ScopedglViewport savedViewport(state);
-  vtkOpenGLState::ScopedglBlendFuncSeparate savedBlend(state);
-  vtkOpenGLState::ScopedglEnableDisable savedBlendEnable(state, GL_BLEND);
-  vtkOpenGLState::ScopedglEnableDisable savedDepthTest(state, GL_DEPTH_TEST);
-  vtkOpenGLState::ScopedglEnableDisable savedScissor(state, GL_SCISSOR_TEST);
-  vtkOpenGLState::ScopedglScissor savedScissorBox(state);
-  vtkOpenGLState::ScopedglEnableDisable savedCull(state, GL_CULL_FACE);
-  vtkOpenGLState::ScopedglDepthMask savedDepthMask(state);
-  vtkOpenGLState::ScopedglColorMask savedColorMask(state);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglDisable(GL_CULL_FACE);
-  state->vtkglDisable(GL_SCISSOR_TEST);
-
-  // --- copies of the scene's colour and depth (the background and the opaque depth).
+//------------------------------------------------------------------------------
+// Copies of the scene's colour (the background) and depth (the opaque depth) in
+// our textures. Leaves the scene's framebuffer bindings pushed (popped by the
+// composite). A multisampled framebuffer cannot be copied from
+// (GL_INVALID_OPERATION): then the colour is resolved by a blit and the depth is
+// treated as empty, with a warning.
+void vtkNimbusCloudVolumeMapper::CopySceneColorAndDepth(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  vtkOpenGLState* state = frame.State;
   GLint drawFramebuffer = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
   state->PushFramebufferBindings();
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
-  auto ensure2D = [&](vtkTextureObject* texture, int w, int h, int components, bool depth)
-  {
-    texture->SetContext(window);
-    if (static_cast<int>(texture->GetWidth()) != w || static_cast<int>(texture->GetHeight()) != h ||
-      !texture->GetHandle())
-    {
-      ResetTexture(texture, window, false);
-      if (depth)
-      {
-        texture->AllocateDepth(w, h, vtkTextureObject::Float32);
-      }
-      else
-      {
-        texture->Allocate2D(w, h, components, VTK_FLOAT);
-      }
-    }
-  };
-  // Copy the viewport's colour and depth into our textures. A multisampled
-  // framebuffer cannot be copied from (GL_INVALID_OPERATION): then the colour is
-  // resolved by a blit and the depth is treated as empty, with a warning.
-  ensure2D(in.SceneColor, width, height, 4, false);
-  ensure2D(in.SceneDepth, width, height, 1, true);
+  EnsureTexture2D(in.SceneColor, frame.Window, frame.Width, frame.Height, 4, false);
+  EnsureTexture2D(in.SceneDepth, frame.Window, frame.Width, frame.Height, 1, true);
   GLint samples = 0;
   glGetIntegerv(GL_SAMPLES, &samples);
-  if (samples > 0)
+  if (samples == 0)
   {
-    in.SceneFramebuffer->SetContext(window);
-    in.SceneFramebuffer->Bind(GL_DRAW_FRAMEBUFFER);
-    in.SceneFramebuffer->AddColorAttachment(0, in.SceneColor);
-    in.SceneFramebuffer->AddDepthAttachment(in.SceneDepth);
-    in.SceneFramebuffer->ActivateDrawBuffer(0);
-    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
-    glBlitFramebuffer(
-      x0, y0, x0 + width, y0 + height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    state->vtkglClearDepth(1.0);
-    state->vtkglClear(GL_DEPTH_BUFFER_BIT);
-    in.SceneFramebuffer->RemoveDepthAttachment();
-    in.SceneFramebuffer->RemoveColorAttachments(1);
-    if (!in.WarnedMultisampling)
-    {
-      vtkWarningMacro("The render window is multisampled (MultiSamples = "
-        << samples << "): opaque geometry will not cut the clouds. Set MultiSamples to 0.");
-      in.WarnedMultisampling = true;
-    }
+    in.SceneColor->CopyFromFrameBuffer(frame.X0, frame.Y0, 0, 0, frame.Width, frame.Height);
+    in.SceneDepth->CopyFromFrameBuffer(frame.X0, frame.Y0, 0, 0, frame.Width, frame.Height);
+    return;
   }
-  else
+  in.SceneFramebuffer->SetContext(frame.Window);
+  in.SceneFramebuffer->Bind(GL_DRAW_FRAMEBUFFER);
+  in.SceneFramebuffer->AddColorAttachment(0, in.SceneColor);
+  in.SceneFramebuffer->AddDepthAttachment(in.SceneDepth);
+  in.SceneFramebuffer->ActivateDrawBuffer(0);
+  state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
+  glBlitFramebuffer(frame.X0, frame.Y0, frame.X0 + frame.Width, frame.Y0 + frame.Height, 0, 0,
+    frame.Width, frame.Height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  state->vtkglClearDepth(1.0);
+  state->vtkglClear(GL_DEPTH_BUFFER_BIT);
+  in.SceneFramebuffer->RemoveDepthAttachment();
+  in.SceneFramebuffer->RemoveColorAttachments(1);
+  if (!in.WarnedMultisampling)
   {
-    in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
-    in.SceneDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+    vtkWarningMacro("The render window is multisampled (MultiSamples = "
+      << samples << "): opaque geometry will not cut the clouds. Set MultiSamples to 0.");
+    in.WarnedMultisampling = true;
   }
+}
 
-  // --- atmosphere texture (only with an atmosphere; rebuilt when sun or air change).
-  const bool atmosphere = this->Atmosphere && !this->Unlit;
-  const bool ground = this->Ground && !this->Unlit;
+//------------------------------------------------------------------------------
+// The atmosphere texture (only with an atmosphere), rebuilt when the sun or the
+// air or the lowest height it must cover changed. False when they are invalid.
+bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const FrameSettings& settings = frame.Settings;
   double boxZMin = std::numeric_limits<double>::infinity();
-  for (const auto& corner : corners)
+  for (const auto& corner : frame.Corners)
   {
     boxZMin = std::min(boxZMin, corner[2]);
   }
   const double zLow =
-    (std::min(boxZMin, ground ? settings.GroundHeight : boxZMin)) * settings.MetresPerUnit;
-  settings.Air.Enabled = atmosphere;
+    (std::min(boxZMin, frame.Ground ? settings.GroundHeight : boxZMin)) * settings.MetresPerUnit;
   const nimbus::SceneAtmosphere& air = settings.Air;
   const double zHigh = air.TopRadiusMetres - air.EarthRadiusMetres - air.SceneAltitudeMetres;
   const std::vector<double> atmosphereKey = { settings.Sun.AzimuthDegrees,
@@ -635,381 +684,369 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
     air.Enabled ? 1.0 : 0.0, air.SceneAltitudeMetres, air.EarthRadiusMetres, air.TopRadiusMetres,
     air.RayleighScaleHeightMetres, air.MieScaleHeightMetres, air.RayleighScatteringPerMetre,
     air.MieScatteringPerMetre, air.MieAlbedo, air.MieG, zLow };
-  if (atmosphereKey != in.AtmosphereKey)
+  if (atmosphereKey == in.AtmosphereKey)
   {
-    try
-    {
-      const nimbus::SunAndAir sunAndAir(settings.Sun, air, 16);
-      in.Table = nimbus::BuildAtmosphereTable(sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024);
-    }
-    catch (const std::exception& error)
-    {
-      vtkErrorMacro("Invalid sun or atmosphere: " << error.what());
-      state->PopFramebufferBindings();
-      return;
-    }
-    if (in.Table.HasAtmosphere)
-    {
-      ResetTexture(in.AtmosphereTexture, window, true);
-      in.AtmosphereTexture->Create2DFromRaw(
-        in.Table.Samples, nimbus::AtmosphereTable::kRows, 4, VTK_FLOAT, in.Table.Data.data());
-      ++in.AtmosphereBuilds;
-    }
-    in.AtmosphereKey = atmosphereKey;
+    return true;
   }
-
-  // Uniforms every pass shares.
-  const std::array<float, 16> ivp = ColumnMajor(inverseViewProjection);
-  const std::array<float, 16> w2t = ColumnMajor(worldToTexture);
-  const std::array<float, 16> w2b = ColumnMajor(worldToBox);
-  auto setCommon = [&](vtkShaderProgram* program)
+  try
   {
-    program->SetUniformMatrix4x4("inverseViewProjection", const_cast<float*>(ivp.data()));
-    program->SetUniformi("perspective", camera->GetParallelProjection() ? 0 : 1);
-    program->SetUniform3f("eyePosition", camera->GetPosition());
-    program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(w2t.data()));
-    program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(w2b.data()));
-    program->SetUniform3f("toSun", toSun.data());
-    program->SetUniform3f("sliceNormal", axis.Normal.data());
-    program->SetUniformf("lengthUnit", static_cast<float>(settings.MetresPerUnit));
-    program->SetUniformi("density", in.Density->GetTextureUnit());
-    program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
-    program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
-    program->SetUniformi("shadowSurface", in.Shadow->GetTextureUnit());
-    program->SetUniform3f("shadowOrigin", frame.Origin.data());
-    program->SetUniform3f("shadowU", frame.U.data());
-    program->SetUniform3f("shadowW", frame.W.data());
-    const float extent[2] = { static_cast<float>(frame.Width), static_cast<float>(frame.Height) };
-    program->SetUniform2f("shadowExtent", extent);
-    program->SetUniformi("atmosphereOn", atmosphere ? 1 : 0);
-    if (atmosphere)
-    {
-      program->SetUniformi("atmosphereTable", in.AtmosphereTexture->GetTextureUnit());
-    }
-    else
-    {
-      // Unused, but a sampler2D must not share a unit with the 3-D density texture.
-      program->SetUniformi("atmosphereTable", in.SceneDepth->GetTextureUnit());
-    }
-    const float zRange[2] = { static_cast<float>(in.Table.ZMin),
-      static_cast<float>(in.Table.ZMax) };
-    program->SetUniform2f("atmosphereZRange", zRange);
-    program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
-    program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
-    program->SetUniformf(
-      "rayleighScaleHeight", static_cast<float>(in.Table.Air.RayleighScaleHeightMetres));
-    program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.Air.MieScaleHeightMetres));
-    program->SetUniformf("sceneAltitude", static_cast<float>(air.SceneAltitudeMetres));
-    program->SetUniformf("earthRadius", static_cast<float>(air.EarthRadiusMetres));
-    program->SetUniformf("topRadius", static_cast<float>(air.TopRadiusMetres));
-    program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
-    program->SetUniformi("groundOn", ground ? 1 : 0);
-    program->SetUniformf("groundZ", static_cast<float>(settings.GroundHeight));
-    program->SetUniformf("groundAlbedo", static_cast<float>(settings.GroundAlbedo));
-    program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
-    program->SetUniformi("overSky", settings.OverSky ? 1 : 0);
-  };
+    const nimbus::SunAndAir sunAndAir(settings.Sun, air, 16);
+    in.Table = nimbus::BuildAtmosphereTable(sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro("Invalid sun or atmosphere: " << error.what());
+    return false;
+  }
+  if (in.Table.HasAtmosphere)
+  {
+    ResetTexture(in.AtmosphereTexture, frame.Window, true);
+    in.AtmosphereTexture->Create2DFromRaw(
+      in.Table.Samples, nimbus::AtmosphereTable::kRows, 4, VTK_FLOAT, in.Table.Data.data());
+    ++in.AtmosphereBuilds;
+  }
+  in.AtmosphereKey = atmosphereKey;
+  return true;
+}
 
-  in.Density->Activate();
+//------------------------------------------------------------------------------
+// Uniforms every pass shares (svsCommon.glsl).
+void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
+  vtkShaderProgram* program, const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const nimbus::SceneAtmosphere& air = frame.Settings.Air;
+  program->SetUniformMatrix4x4(
+    "inverseViewProjection", const_cast<float*>(frame.InverseViewProjection.data()));
+  program->SetUniformi("perspective", frame.Camera->GetParallelProjection() ? 0 : 1);
+  program->SetUniform3f("eyePosition", frame.Camera->GetPosition());
+  program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(frame.WorldToTexture.data()));
+  program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(frame.WorldToBox.data()));
+  program->SetUniform3f("toSun", frame.ToSun.data());
+  program->SetUniform3f("sliceNormal", frame.Axis.Normal.data());
+  program->SetUniformf("lengthUnit", static_cast<float>(frame.Settings.MetresPerUnit));
+  program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
+  program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
+  program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
+  program->SetUniformi("shadowSurface", in.Shadow->GetTextureUnit());
+  program->SetUniform3f("shadowOrigin", frame.Shadow.Origin.data());
+  program->SetUniform3f("shadowU", frame.Shadow.U.data());
+  program->SetUniform3f("shadowW", frame.Shadow.W.data());
+  const float extent[2] = { static_cast<float>(frame.Shadow.Width),
+    static_cast<float>(frame.Shadow.Height) };
+  program->SetUniform2f("shadowExtent", extent);
+  program->SetUniformi("atmosphereOn", frame.Atmosphere ? 1 : 0);
+  // Unused without atmosphere, but a sampler2D must not share a unit with the 3-D
+  // density texture.
+  program->SetUniformi("atmosphereTable",
+    frame.Atmosphere ? in.AtmosphereTexture->GetTextureUnit() : in.SceneDepth->GetTextureUnit());
+  const float zRange[2] = { static_cast<float>(in.Table.ZMin), static_cast<float>(in.Table.ZMax) };
+  program->SetUniform2f("atmosphereZRange", zRange);
+  program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
+  program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
+  program->SetUniformf(
+    "rayleighScaleHeight", static_cast<float>(in.Table.Air.RayleighScaleHeightMetres));
+  program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.Air.MieScaleHeightMetres));
+  program->SetUniformf("sceneAltitude", static_cast<float>(air.SceneAltitudeMetres));
+  program->SetUniformf("earthRadius", static_cast<float>(air.EarthRadiusMetres));
+  program->SetUniformf("topRadius", static_cast<float>(air.TopRadiusMetres));
+  program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
+  program->SetUniformi("groundOn", frame.Ground ? 1 : 0);
+  program->SetUniformf("groundZ", static_cast<float>(frame.Settings.GroundHeight));
+  program->SetUniformf("groundAlbedo", static_cast<float>(frame.Settings.GroundAlbedo));
+  program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
+  program->SetUniformi("overSky", frame.Settings.OverSky ? 1 : 0);
+}
+
+//------------------------------------------------------------------------------
+// The textures every pass reads (density, scene depth, atmosphere); the passes
+// neither test nor write depth.
+void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  in.Density.GetTexture()->Activate();
   in.SceneDepth->Activate();
-  if (atmosphere)
+  if (frame.Atmosphere)
   {
     in.AtmosphereTexture->Activate();
   }
+  frame.State->vtkglDisable(GL_DEPTH_TEST);
+  frame.State->vtkglDepthMask(GL_FALSE);
+}
 
-  // --- shadow surface, cleared to optical depth 0.
-  in.Shadow->SetContext(window);
-  if (static_cast<int>(in.Shadow->GetWidth()) != this->ShadowSurfaceSize || !in.Shadow->GetHandle())
-  {
-    ResetTexture(in.Shadow, window, true);
-    in.Shadow->Allocate2D(this->ShadowSurfaceSize, this->ShadowSurfaceSize, 1, VTK_FLOAT);
-  }
-  DrawInto(in.ShadowFramebuffer, in.Shadow, window);
-  state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
-  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT);
-
-  // --- sampling-interval and Mie-phase texture (rebuilt when camera or sun change).
-  const bool unlit = this->Unlit;
-  std::vector<double> intervalKey(ivp.begin(), ivp.end());
-  intervalKey.insert(intervalKey.end(),
-    { static_cast<double>(width), static_cast<double>(height), toSun[0], toSun[1], toSun[2],
-      axis.Normal[0], axis.Normal[1], axis.Normal[2], this->CloudG, settings.Air.MieG,
-      this->MultipleScattering });
-  state->vtkglDisable(GL_DEPTH_TEST);
-  state->vtkglDepthMask(GL_FALSE);
-  if (intervalKey != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
-  {
-    ensure2D(in.IntervalPhase, width, height, 4, false);
-    DrawInto(in.IntervalPhaseFramebuffer, in.IntervalPhase, window);
-    state->vtkglViewport(0, 0, width, height);
-    state->vtkglDisable(GL_BLEND);
-    vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
-    setCommon(program);
-    program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
-    program->SetUniformf("hazeG", static_cast<float>(settings.Air.MieG));
-    program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
-    in.IntervalPhasePass->Render();
-    ++in.PassesLastRender;
-    ++in.IntervalPhaseBuilds;
-    in.IntervalPhaseKey = intervalKey;
-  }
-  in.IntervalPhase->Activate();
-  in.Shadow->Activate();
-
-  // --- where each view ray ends this frame (opaque depth, ground, top of the atmosphere).
-  ensure2D(in.RayEnds, width, height, 4, false);
-  DrawInto(in.RayEndsFramebuffer, in.RayEnds, window);
-  state->vtkglViewport(0, 0, width, height);
-  state->vtkglDisable(GL_BLEND);
-  {
-    vtkShaderProgram* program = in.Ready(in.RayEndsPass, svsRayEndsFS);
-    setCommon(program);
-    in.RayEndsPass->Render();
-    ++in.PassesLastRender;
-  }
-  in.RayEnds->Activate();
-
-  // --- accumulation (S, cloud transmittance), cleared to (0, 0, 0, 1).
-  ensure2D(in.Accumulation, width, height, 4, false);
-  DrawInto(in.AccumulationFramebuffer, in.Accumulation, window);
-  in.AccumulationFramebuffer->RemoveColorAttachment(1);
-  if (settings.OverSky)
-  {
-    // Second target, S_clear: the same blend sums it (its alpha stays 1).
-    ensure2D(in.ClearAccumulation, width, height, 4, false);
-    in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
-    in.AccumulationFramebuffer->ActivateDrawBuffers(2);
-  }
-  state->vtkglViewport(0, 0, width, height);
-  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT);
-
-  // 000 §4.3: back-to-front S_i = C_i + alpha_i S_{i-1}; front-to-back
-  // S_i = S_{i-1} + alpha*_i C_i with alpha* the transmittance so far (kept in alpha).
-  auto useSliceBlend = [&]()
-  {
-    state->vtkglEnable(GL_BLEND);
-    if (axis.BackToFront)
-    {
-      state->vtkglBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_SRC_ALPHA);
-    }
-    else
-    {
-      state->vtkglBlendFuncSeparate(GL_DST_ALPHA, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
-    }
-  };
-
-  const bool outsideRegions = atmosphere || ground;
-  auto drawRegion = [&](double start, double end, bool useShadow)
-  {
-    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-    state->vtkglViewport(0, 0, width, height);
-    useSliceBlend();
-    vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
-    setCommon(program);
-    program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
-    program->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
-    program->SetUniformf("regionStart", static_cast<float>(start));
-    program->SetUniformf("regionEnd", static_cast<float>(end));
-    program->SetUniformi("useShadow", useShadow ? 1 : 0);
-    program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
-    program->SetUniformi("steps", this->AtmosphereSteps);
-    in.MarchPass->Render();
-    ++in.PassesLastRender;
-  };
-  const double firstStart = planes.Offsets.front() - 0.5 * planes.Spacing;
-  const double lastEnd = planes.Offsets.back() + 0.5 * planes.Spacing;
-  if (outsideRegions)
-  {
-    drawRegion(-1e30, firstStart, false); // sunward of the cloud: unshadowed
-  }
-
-  // Scissor rectangles: each slice's passes only touch the pixels (and shadow
-  // texels) onto which the polygon "slice plane cut by the box" projects; outside
-  // it the density is zero. On screen this holds only when nothing outside the
-  // box is drawn (no atmosphere, no ground).
-  vtkMatrix4x4* worldToNdc = camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
-  auto screenRect = [&](const std::vector<nimbus::Vector3>& points, int rect[4])
-  {
-    double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
-    for (const auto& point : points)
-    {
-      const double p[4] = { point[0], point[1], point[2], 1.0 };
-      double q[4];
-      worldToNdc->MultiplyPoint(p, q);
-      if (q[3] <= 1e-9)
-      {
-        return false; // behind the eye: no finite rectangle
-      }
-      for (int k = 0; k < 2; ++k)
-      {
-        lo[k] = std::min(lo[k], q[k] / q[3]);
-        hi[k] = std::max(hi[k], q[k] / q[3]);
-      }
-    }
-    const int px0 =
-      std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
-    const int py0 =
-      std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
-    const int px1 =
-      std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
-    const int py1 =
-      std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
-    rect[0] = px0;
-    rect[1] = py0;
-    rect[2] = std::max(px1 - px0, 0);
-    rect[3] = std::max(py1 - py0, 0);
-    return true;
-  };
-  auto shadowRect = [&](const std::vector<nimbus::Vector3>& points, int rect[4])
-  {
-    const int size = this->ShadowSurfaceSize;
-    double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
-    for (const auto& point : points)
-    {
-      const nimbus::Vector3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
-        point[2] - frame.Origin[2] } };
-      const double st[2] = { nimbus::Dot(q, frame.U) / frame.Width * size,
-        nimbus::Dot(q, frame.W) / frame.Height * size };
-      for (int k = 0; k < 2; ++k)
-      {
-        lo[k] = std::min(lo[k], st[k]);
-        hi[k] = std::max(hi[k], st[k]);
-      }
-    }
-    const int x0s = std::clamp(static_cast<int>(std::floor(lo[0])) - 1, 0, size);
-    const int y0s = std::clamp(static_cast<int>(std::floor(lo[1])) - 1, 0, size);
-    const int x1s = std::clamp(static_cast<int>(std::ceil(hi[0])) + 1, 0, size);
-    const int y1s = std::clamp(static_cast<int>(std::ceil(hi[1])) + 1, 0, size);
-    rect[0] = x0s;
-    rect[1] = y0s;
-    rect[2] = std::max(x1s - x0s, 0);
-    rect[3] = std::max(y1s - y0s, 0);
-  };
-
-  // --- the slices: eye pass with the shadow so far, then the shadow update.
-  vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
-  setCommon(sliceProgram);
-  sliceProgram->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
-  sliceProgram->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
-  sliceProgram->SetUniformf("sliceSpacing", static_cast<float>(planes.Spacing));
-  sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(sunStepMetres));
-  sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
-  sliceProgram->SetUniformi("unlit", unlit ? 1 : 0);
-  vtkShaderProgram* shadowProgram = nullptr;
-  if (!unlit)
-  {
-    shadowProgram = in.Ready(in.ShadowPass, svsShadowFS);
-    setCommon(shadowProgram);
-    shadowProgram->SetUniformf("sunStepMetres", static_cast<float>(sunStepMetres));
-  }
-  for (size_t i = 0; i < planes.Offsets.size(); ++i)
-  {
-    const float offset = static_cast<float>(planes.Offsets[i]);
-    const std::vector<nimbus::Vector3> polygon =
-      nimbus::SlicePolygon(corners, axis.Normal, planes.Offsets[i]);
-    if (polygon.empty())
-    {
-      continue;
-    }
-    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-    state->vtkglViewport(0, 0, width, height);
-    int scissorBox[4];
-    const bool scissor = !outsideRegions && screenRect(polygon, scissorBox);
-    if (scissor)
-    {
-      state->vtkglEnable(GL_SCISSOR_TEST);
-      state->vtkglScissor(scissorBox[0], scissorBox[1], scissorBox[2], scissorBox[3]);
-    }
-    useSliceBlend();
-    window->GetShaderCache()->ReadyShaderProgram(sliceProgram);
-    sliceProgram->SetUniformf("sliceOffset", offset);
-    in.SlicePass->Render();
-    ++in.PassesLastRender;
-    if (scissor)
-    {
-      state->vtkglDisable(GL_SCISSOR_TEST);
-    }
-    if (shadowProgram)
-    {
-      in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
-      state->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
-      int texels[4];
-      shadowRect(polygon, texels);
-      state->vtkglEnable(GL_SCISSOR_TEST);
-      state->vtkglScissor(texels[0], texels[1], texels[2], texels[3]);
-      state->vtkglEnable(GL_BLEND);
-      state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
-      window->GetShaderCache()->ReadyShaderProgram(shadowProgram);
-      shadowProgram->SetUniformf("sliceOffset", offset);
-      in.ShadowPass->Render();
-      state->vtkglDisable(GL_SCISSOR_TEST);
-      ++in.PassesLastRender;
-    }
-  }
-  if (outsideRegions)
-  {
-    drawRegion(lastEnd, 1e30, true); // beyond the cloud: the finished shadow surface
-  }
-
-  if (this->CaptureRadiance)
-  {
-    // Float copy of the sum of the slices (radiance and cloud transmittance).
-    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-    in.AccumulationFramebuffer->ActivateReadBuffer(0);
-    vtkNew<vtkFloatArray> values;
-    values->SetName("radiance");
-    values->SetNumberOfComponents(4);
-    values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
-    in.Radiance->Initialize();
-    in.Radiance->SetDimensions(width, height, 1);
-    in.Radiance->GetPointData()->SetScalars(values);
-  }
-
-  // --- composite over the scene in the renderer's framebuffer (000 Eq. 4).
-  state->PopFramebufferBindings();
-  state->vtkglViewport(x0, y0, width, height);
-  state->vtkglDisable(GL_BLEND);
-  in.Accumulation->Activate();
-  in.SceneColor->Activate();
-  vtkShaderProgram* composite = in.Ready(in.CompositePass, svsCompositeFS);
-  setCommon(composite);
-  composite->SetUniformi("accumulation", in.Accumulation->GetTextureUnit());
-  composite->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
-  composite->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
-  composite->SetUniform3f("displayScale", settings.DisplayScale);
-  composite->SetUniformi("encodeSrgb", settings.EncodeSrgb ? 1 : 0);
-  composite->SetUniformi("skyBackground", settings.OverSky ? 1 : 0);
-  if (settings.OverSky)
-  {
-    in.ClearAccumulation->Activate();
-    composite->SetUniformi("clearAccumulation", in.ClearAccumulation->GetTextureUnit());
-  }
-  else
-  {
-    // Unused; a sampler must still name a 2-D texture unit.
-    composite->SetUniformi("clearAccumulation", in.Accumulation->GetTextureUnit());
-  }
-  in.CompositePass->Render();
-  ++in.PassesLastRender;
-
-  for (vtkTextureObject* t : { in.Density.GetPointer(), in.SceneDepth.GetPointer(),
+void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  for (vtkTextureObject* t : { in.Density.GetTexture(), in.SceneDepth.GetPointer(),
          in.RayEnds.GetPointer(), in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(),
          in.Accumulation.GetPointer(), in.SceneColor.GetPointer() })
   {
     t->Deactivate();
   }
-  if (settings.OverSky)
+  if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Deactivate();
   }
-  if (atmosphere)
+  if (frame.Atmosphere)
   {
     in.AtmosphereTexture->Deactivate();
   }
+}
+
+//------------------------------------------------------------------------------
+// The shadow surface (000 Eq. 10), cleared to optical depth 0.
+void vtkNimbusCloudVolumeMapper::ClearShadowSurface(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  in.Shadow->SetContext(frame.Window);
+  if (static_cast<int>(in.Shadow->GetWidth()) != this->ShadowSurfaceSize || !in.Shadow->GetHandle())
+  {
+    ResetTexture(in.Shadow, frame.Window, true);
+    in.Shadow->Allocate2D(this->ShadowSurfaceSize, this->ShadowSurfaceSize, 1, VTK_FLOAT);
+  }
+  DrawInto(in.ShadowFramebuffer, in.Shadow, frame.Window);
+  frame.State->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+  frame.State->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
+}
+
+//------------------------------------------------------------------------------
+// The sampling-interval and Mie-phase texture (000 §4.4), rebuilt when the camera,
+// the sun or the phase functions changed.
+void vtkNimbusCloudVolumeMapper::RenderIntervalPhase(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const nimbus::Vector3& toSun = frame.ToSun;
+  const nimbus::Vector3& normal = frame.Axis.Normal;
+  const double mieG = frame.Settings.Air.MieG;
+  std::vector<double> key(frame.InverseViewProjection.begin(), frame.InverseViewProjection.end());
+  key.insert(key.end(),
+    { static_cast<double>(frame.Width), static_cast<double>(frame.Height), toSun[0], toSun[1],
+      toSun[2], normal[0], normal[1], normal[2], this->CloudG, mieG, this->MultipleScattering });
+  if (key != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
+  {
+    EnsureTexture2D(in.IntervalPhase, frame.Window, frame.Width, frame.Height, 4, false);
+    DrawInto(in.IntervalPhaseFramebuffer, in.IntervalPhase, frame.Window);
+    frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+    frame.State->vtkglDisable(GL_BLEND);
+    vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
+    this->SetCommonUniforms(program, frame);
+    program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+    program->SetUniformf("hazeG", static_cast<float>(mieG));
+    program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
+    in.IntervalPhasePass->Render();
+    ++in.PassesLastRender;
+    ++in.IntervalPhaseBuilds;
+    in.IntervalPhaseKey = key;
+  }
+  in.IntervalPhase->Activate();
+  in.Shadow->Activate();
+}
+
+//------------------------------------------------------------------------------
+// Where each view ray ends this frame (opaque depth, ground, top of the atmosphere).
+void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  EnsureTexture2D(in.RayEnds, frame.Window, frame.Width, frame.Height, 4, false);
+  DrawInto(in.RayEndsFramebuffer, in.RayEnds, frame.Window);
+  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglDisable(GL_BLEND);
+  vtkShaderProgram* program = in.Ready(in.RayEndsPass, svsRayEndsFS);
+  this->SetCommonUniforms(program, frame);
+  in.RayEndsPass->Render();
+  ++in.PassesLastRender;
+  in.RayEnds->Activate();
+}
+
+//------------------------------------------------------------------------------
+// The accumulation target (S, cloud transmittance), cleared to (0, 0, 0, 1); over a
+// sky a second target, S_clear, summed by the same blend (its alpha stays 1).
+void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  EnsureTexture2D(in.Accumulation, frame.Window, frame.Width, frame.Height, 4, false);
+  DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
+  in.AccumulationFramebuffer->RemoveColorAttachment(1);
+  if (frame.Settings.OverSky)
+  {
+    EnsureTexture2D(in.ClearAccumulation, frame.Window, frame.Width, frame.Height, 4, false);
+    in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
+    in.AccumulationFramebuffer->ActivateDrawBuffers(2);
+  }
+  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
+}
+
+//------------------------------------------------------------------------------
+// The atmosphere and the ground outside the slices (only when either is drawn):
+// sunward of the cloud, unshadowed, or beyond it, through the finished shadow
+// surface (shafts).
+void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bool beyondCloud)
+{
+  if (!frame.OutsideRegions)
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  const double start =
+    beyondCloud ? frame.Planes.Offsets.back() + 0.5 * frame.Planes.Spacing : -1e30;
+  const double end = beyondCloud ? 1e30 : frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing;
+  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  UseSliceBlend(frame.State, frame.Axis.BackToFront);
+  vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
+  this->SetCommonUniforms(program, frame);
+  program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+  program->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
+  program->SetUniformf("regionStart", static_cast<float>(start));
+  program->SetUniformf("regionEnd", static_cast<float>(end));
+  program->SetUniformi("useShadow", beyondCloud ? 1 : 0);
+  program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
+  program->SetUniformi("steps", this->AtmosphereSteps);
+  in.MarchPass->Render();
+  ++in.PassesLastRender;
+}
+
+//------------------------------------------------------------------------------
+// The slices (000 §4.2-4.3), in order of increasing distance from the sun: each
+// seen from the eye with the shadow so far, then added to the shadow surface. The
+// eye pass is scissored to the slice's pixels only when nothing outside the box is
+// drawn (no atmosphere, no ground).
+void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
+  this->SetCommonUniforms(sliceProgram, frame);
+  sliceProgram->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
+  sliceProgram->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
+  sliceProgram->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
+  sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
+  sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
+  sliceProgram->SetUniformi("unlit", this->Unlit ? 1 : 0);
+  vtkShaderProgram* shadowProgram = nullptr;
+  if (!this->Unlit)
+  {
+    shadowProgram = in.Ready(in.ShadowPass, svsShadowFS);
+    this->SetCommonUniforms(shadowProgram, frame);
+    shadowProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
+  }
+  for (const double offset : frame.Planes.Offsets)
+  {
+    const std::vector<nimbus::Vector3> polygon =
+      nimbus::SlicePolygon(frame.Corners, frame.Axis.Normal, offset);
+    if (polygon.empty())
+    {
+      continue;
+    }
+    int scissor[4];
+    const bool scissored = !frame.OutsideRegions &&
+      ScreenRectangle(polygon, frame.WorldToNdc, frame.Width, frame.Height, scissor);
+    this->RenderSliceFromEye(
+      frame, sliceProgram, static_cast<float>(offset), scissored ? scissor : nullptr);
+    if (shadowProgram)
+    {
+      int texels[4];
+      ShadowRectangle(polygon, frame.Shadow, this->ShadowSurfaceSize, texels);
+      this->RenderSliceShadow(frame, shadowProgram, static_cast<float>(offset), texels);
+    }
+  }
+}
+
+void vtkNimbusCloudVolumeMapper::RenderSliceFromEye(
+  const FrameState& frame, vtkShaderProgram* program, float offset, const int* scissor)
+{
+  Internals& in = *this->Internal;
+  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  if (scissor)
+  {
+    frame.State->vtkglEnable(GL_SCISSOR_TEST);
+    frame.State->vtkglScissor(scissor[0], scissor[1], scissor[2], scissor[3]);
+  }
+  UseSliceBlend(frame.State, frame.Axis.BackToFront);
+  frame.Window->GetShaderCache()->ReadyShaderProgram(program);
+  program->SetUniformf("sliceOffset", offset);
+  in.SlicePass->Render();
+  ++in.PassesLastRender;
+  if (scissor)
+  {
+    frame.State->vtkglDisable(GL_SCISSOR_TEST);
+  }
+}
+
+void vtkNimbusCloudVolumeMapper::RenderSliceShadow(
+  const FrameState& frame, vtkShaderProgram* program, float offset, const int texels[4])
+{
+  Internals& in = *this->Internal;
+  in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
+  frame.State->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+  frame.State->vtkglEnable(GL_SCISSOR_TEST);
+  frame.State->vtkglScissor(texels[0], texels[1], texels[2], texels[3]);
+  frame.State->vtkglEnable(GL_BLEND);
+  frame.State->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+  frame.Window->GetShaderCache()->ReadyShaderProgram(program);
+  program->SetUniformf("sliceOffset", offset);
+  in.ShadowPass->Render();
+  frame.State->vtkglDisable(GL_SCISSOR_TEST);
+  ++in.PassesLastRender;
+}
+
+//------------------------------------------------------------------------------
+// With CaptureRadiance: a float copy of the sum of the slices (radiance and cloud
+// transmittance) as the "radiance" array of GetRadianceImage().
+void vtkNimbusCloudVolumeMapper::CaptureRadianceImage(const FrameState& frame)
+{
+  if (!this->CaptureRadiance)
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+  in.AccumulationFramebuffer->ActivateReadBuffer(0);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("radiance");
+  values->SetNumberOfComponents(4);
+  values->SetNumberOfTuples(static_cast<vtkIdType>(frame.Width) * frame.Height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, frame.Width, frame.Height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
+  in.Radiance->Initialize();
+  in.Radiance->SetDimensions(frame.Width, frame.Height, 1);
+  in.Radiance->GetPointData()->SetScalars(values);
+}
+
+//------------------------------------------------------------------------------
+// The cloud composited over the scene in the renderer's framebuffer (000 Eq. 4),
+// over a sky as I = S - T_cl S_clear + T_cl L_sky.
+void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  frame.State->PopFramebufferBindings();
+  frame.State->vtkglViewport(frame.X0, frame.Y0, frame.Width, frame.Height);
+  frame.State->vtkglDisable(GL_BLEND);
+  in.Accumulation->Activate();
+  in.SceneColor->Activate();
+  vtkShaderProgram* program = in.Ready(in.CompositePass, svsCompositeFS);
+  this->SetCommonUniforms(program, frame);
+  program->SetUniformi("accumulation", in.Accumulation->GetTextureUnit());
+  program->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
+  program->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
+  program->SetUniform3f("displayScale", frame.Settings.DisplayScale);
+  program->SetUniformi("encodeSrgb", frame.Settings.EncodeSrgb ? 1 : 0);
+  program->SetUniformi("skyBackground", frame.Settings.OverSky ? 1 : 0);
+  if (frame.Settings.OverSky)
+  {
+    in.ClearAccumulation->Activate();
+    program->SetUniformi("clearAccumulation", in.ClearAccumulation->GetTextureUnit());
+  }
+  else
+  {
+    // Unused; a sampler must still name a 2-D texture unit.
+    program->SetUniformi("clearAccumulation", in.Accumulation->GetTextureUnit());
+  }
+  in.CompositePass->Render();
+  ++in.PassesLastRender;
 }
 
 //------------------------------------------------------------------------------
@@ -1044,4 +1081,5 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CaptureRadiance: " << this->CaptureRadiance << "\n";
   os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
   os << indent << "UseSceneSky: " << this->UseSceneSky << "\n";
+  os << indent << "SkyBackground: " << this->SkyBackground << "\n";
 }

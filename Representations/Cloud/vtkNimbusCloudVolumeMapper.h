@@ -28,16 +28,27 @@
  * (vtkNimbusReferenceRenderer) for the same scene; see docs/svs-mapper.md for the
  * measured errors and costs.
  *
- * Over a Nimbus sky (a visible vtkNimbusSkyBackground in the same renderer, and
- * UseSceneSky on) the mapper takes that sky's sun, atmosphere, ground albedo,
- * observer altitude, length unit and display settings instead of its own, and
- * composites the cloud, its shadow on the ground and its shafts over the sky as
- * a difference from the clear sky, so that where neither the cloud nor its
- * shadow is the sky is left exactly as the sky background drew it.
+ * Over a Nimbus sky (SetSkyBackground: the vtkNimbusSkyBackground drawn behind
+ * this cloud, while it is visible and UseSceneSky is on) the mapper takes that
+ * sky's sun, atmosphere, ground albedo, observer altitude, length unit and
+ * display settings instead of its own, and composites the cloud, its shadow on
+ * the ground and its shafts over the sky as a difference from the clear sky, so
+ * that where neither the cloud nor its shadow is the sky is left exactly as the
+ * sky background drew it. The coupling is explicit: the mapper does not look
+ * for a sky among the renderer's props (in ParaView the Cloud representation
+ * hands it the view's sky, see vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND).
  *
  * Only what the scene needs runs: without atmosphere no atmosphere texture and
  * no atmosphere pass; without ground and atmosphere no passes outside the cloud
  * slices; without shafts no shadow look-ups in the atmosphere.
+ *
+ * A frame (Render) is a sequence of steps, each a method that sets the uniforms of
+ * its own pass (the uniforms all passes share come from SetCommonUniforms): the
+ * density texture (nimbus::CloudDensityTexture: uploads only when the data
+ * changed), the frame's sun and air, its geometry, copies of the scene's colour
+ * and depth, the atmosphere table, the interval/phase pass, the ray-ends pass, the
+ * atmosphere sunward of the slices, the slices (eye pass, then shadow update),
+ * the atmosphere beyond them, the radiance capture and the composite.
  */
 #ifndef vtkNimbusCloudVolumeMapper_h
 #define vtkNimbusCloudVolumeMapper_h
@@ -45,10 +56,13 @@
 #include "NimbusRepresentationsModule.h"
 #include "vtkVolumeMapper.h"
 
-#include <memory>
+#include <memory> // for std::unique_ptr
 
 class vtkImageData;
+class vtkNimbusSky;
+class vtkNimbusSkyBackground;
 class vtkRenderer;
+class vtkShaderProgram;
 class vtkVolume;
 class vtkWindow;
 
@@ -159,9 +173,20 @@ public:
   ///@}
 
   ///@{
-  /// Follow the sky of a visible vtkNimbusSkyBackground in the renderer (default
-  /// on): while one is there, its vtkNimbusSky replaces the sun (SunAzimuthDegrees,
-  /// SunElevationDegrees, SunIlluminance 1, SunTemperatureKelvin 5778), the air
+  /// The sky drawn behind this cloud (nullptr by default; the mapper keeps a
+  /// reference). Set it when the cloud is rendered in front of a
+  /// vtkNimbusSkyBackground, usually the one in the same renderer; the mapper does
+  /// not search the renderer for one. ParaView's Cloud representation sets the
+  /// view's sky (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND) before each render.
+  virtual void SetSkyBackground(vtkNimbusSkyBackground* background);
+  vtkGetObjectMacro(SkyBackground, vtkNimbusSkyBackground);
+  ///@}
+
+  ///@{
+  /// Follow the sky of the SkyBackground (default on): while one is set and
+  /// visible (and the mapper is not Unlit), its vtkNimbusSky replaces the sun
+  /// (SunAzimuthDegrees, SunElevationDegrees, SunIlluminance 1,
+  /// SunTemperatureKelvin the sky's), the air
   /// (RayleighScatteringPerMetre, MieScatteringPerMetre, MieG, SceneAltitudeMetres),
   /// GroundHeight (sea level), GroundAlbedo, MetresPerUnit, Exposure and EncodeSrgb
   /// (the sky's exposure and white balance, sRGB on); the background is the sky
@@ -248,10 +273,46 @@ protected:
   int MaximumTextureSize = 0;
   bool CaptureRadiance = false;
   bool UseSceneSky = true;
+  vtkNimbusSkyBackground* SkyBackground = nullptr;
 
 private:
   vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;
   void operator=(const vtkNimbusCloudVolumeMapper&) = delete;
+
+  /// What one frame computes once and its passes read (defined in the .cxx).
+  struct FrameState;
+
+  ///@{
+  /// The steps of Render, in order. The bool steps end the frame when false.
+  bool UpdateDensityTexture(vtkRenderer* renderer, FrameState& frame);
+  bool ComputeFrameSettings(FrameState& frame);
+  bool ComputeFrameGeometry(vtkRenderer* renderer, vtkVolume* volume, FrameState& frame);
+  void CopySceneColorAndDepth(FrameState& frame);
+  bool UpdateAtmosphereTable(FrameState& frame);
+  void BeginPasses(const FrameState& frame);
+  void ClearShadowSurface(const FrameState& frame);
+  void RenderIntervalPhase(const FrameState& frame);
+  void RenderRayEnds(const FrameState& frame);
+  void ClearAccumulation(const FrameState& frame);
+  void RenderOutsideRegion(const FrameState& frame, bool beyondCloud);
+  void RenderSlices(const FrameState& frame);
+  void CaptureRadianceImage(const FrameState& frame);
+  void RenderComposite(const FrameState& frame);
+  void EndPasses(const FrameState& frame);
+  ///@}
+
+  ///@{
+  /// Pieces of the steps: the sky this frame follows (or nullptr), the uniforms
+  /// every pass shares, one slice seen from the eye (scissored to `scissor`
+  /// unless nullptr) and its optical depth added to the shadow surface (within
+  /// the texels `texels`).
+  vtkNimbusSky* GetFollowedSky();
+  void SetCommonUniforms(vtkShaderProgram* program, const FrameState& frame);
+  void RenderSliceFromEye(
+    const FrameState& frame, vtkShaderProgram* program, float offset, const int* scissor);
+  void RenderSliceShadow(
+    const FrameState& frame, vtkShaderProgram* program, float offset, const int texels[4]);
+  ///@}
 
   struct Internals;
   std::unique_ptr<Internals> Internal;

@@ -2,6 +2,7 @@
 
 #include "SkyViewTextures.h"
 #include "vtkCamera.h"
+#include "vtkInformationObjectBaseKey.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackgroundFS.h"
@@ -19,6 +20,8 @@
 #include <string>
 
 vtkStandardNewMacro(vtkNimbusSkyBackground);
+vtkInformationKeyRestrictedMacro(
+  vtkNimbusSkyBackground, RENDERER_SKY_BACKGROUND, ObjectBase, "vtkNimbusSkyBackground");
 
 struct vtkNimbusSkyBackground::Internals
 {

@@ -11,10 +11,13 @@
  * resets ignore it) and it is not pickable.
  *
  * Framebuffer values are display values: sRGB-encoded Exposure x radiance
- * (white-balanced, see vtkNimbusSky). A vtkNimbusCloudVolumeMapper in the same
- * renderer finds this prop and takes its sun, atmosphere and display settings,
- * so that clouds, their shadows in the air and the sky agree (see
- * vtkNimbusCloudVolumeMapper::UseSceneSky).
+ * (white-balanced, see vtkNimbusSky). A vtkNimbusCloudVolumeMapper given this prop
+ * (vtkNimbusCloudVolumeMapper::SetSkyBackground) takes its sun, atmosphere and
+ * display settings while the prop is visible, so that clouds, their shadows in
+ * the air and the sky agree (see vtkNimbusCloudVolumeMapper::UseSceneSky). Where
+ * the two are set up apart (ParaView's separate representations), the renderer
+ * names its sky in its information (RENDERER_SKY_BACKGROUND) and the cloud's
+ * side hands it to the mapper.
  *
  * The background is seen from the sky's observer (scene z = 0 at
  * SceneAltitudeMetres): the camera's height does not change it.
@@ -30,6 +33,7 @@
 
 #include <memory> // for std::unique_ptr
 
+class vtkInformationObjectBaseKey;
 class vtkNimbusSky;
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyBackground : public vtkProp
@@ -51,6 +55,13 @@ public:
 
   /// Number of sky frames drawn (tests).
   vtkGetMacro(NumberOfDraws, int);
+
+  /// Key of a vtkRenderer's information (vtkRenderer::GetInformation()): the sky
+  /// background shown by that renderer. Set by whoever adds the background to the
+  /// renderer for others to find (ParaView's "Sky Background" representation),
+  /// removed with it; read by whoever sets up a cloud mapper in that renderer
+  /// (vtkNimbusCloudVolumeMapper::SetSkyBackground).
+  static vtkInformationObjectBaseKey* RENDERER_SKY_BACKGROUND();
 
   int RenderOpaqueGeometry(vtkViewport* viewport) override;
   vtkTypeBool HasTranslucentPolygonalGeometry() override { return 0; }

@@ -187,11 +187,12 @@ int main(int argc, char* argv[])
     vtkSmartPointer<vtkImageData> c = Cloud(128, 128, 128);
     std::printf("\n| cloud 128^3 | mapper's own atmosphere, ms | over the sky, ms | sky adds "
                 "|\n|---|---|---|---|\n");
+    const auto overSky = [&sky](vtkNimbusCloudVolumeMapper* m) { m->SetSkyBackground(sky); };
     for (int slices : { 64, 256 })
     {
       const double own = TimeSvs(c, slices, none);
       bench.Renderer->AddViewProp(sky);
-      const double over = TimeSvs(c, slices, none);
+      const double over = TimeSvs(c, slices, overSky);
       bench.Renderer->RemoveViewProp(sky);
       std::printf(
         "| %d slices | %.1f | %.1f | %+.1f %% |\n", slices, own, over, 100.0 * (over - own) / own);

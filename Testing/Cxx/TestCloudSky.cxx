@@ -1,6 +1,7 @@
-// Clouds over the Nimbus sky (issue 6): vtkNimbusCloudVolumeMapper in a renderer
-// with a vtkNimbusSkyBackground follows the sky's sun and air and composites
-// cloud, cloud shadow and shafts over the sky (I = S - T_cl S_clear + T_cl L_sky).
+// Clouds over the Nimbus sky (issue 6): vtkNimbusCloudVolumeMapper given the
+// vtkNimbusSkyBackground of its renderer (SetSkyBackground) follows the sky's sun
+// and air and composites cloud, cloud shadow and shafts over the sky
+// (I = S - T_cl S_clear + T_cl L_sky).
 //
 //   TestCloudSky aerial <baseline.png> <outputdir>   image test: three identical
 //       cumulus 5, 13 and 31 km away in afternoon haze (aerial perspective)
@@ -8,7 +9,8 @@
 //     - a zero-density cloud leaves the sky image unchanged (max 1 of 255),
 //     - a real cloud leaves the sky unchanged away from it and its shadow,
 //     - the mapper takes the sky's sun (and a sky change re-lights the cloud:
-//       a low sun reddens it), and with UseSceneSky off it keeps its own,
+//       a low sun reddens it), and with UseSceneSky off, the background hidden
+//       or no background set it keeps its own,
 //     - the sun at the zenith and below the horizon: finite radiance,
 //     - aerial perspective: the same cloud 28 km away differs less from the sky
 //       behind it than at 4 km.
@@ -97,6 +99,7 @@ struct Scene
     this->Sky->GetSky()->SetPreset(vtkNimbusSky::Afternoon); // sun 30 deg, south-west
     this->Sky->GetSky()->SetExposure(10.0);
     this->Renderer->AddViewProp(this->Sky);
+    this->Mapper->SetSkyBackground(this->Sky);
     this->Cloud->SetDimensions(64, 64, 48);
     this->Mapper->SetInputConnection(this->Cloud->GetOutputPort());
     this->Mapper->SetMultipleScattering(3.0);
@@ -203,6 +206,17 @@ int RunChecks()
     ok &= Check(!scene.Mapper->GetLastRenderUsedSceneSky() &&
         scene.Mapper->GetLastSunElevationDegrees() == 60.0,
       "with UseSceneSky off the mapper keeps its own sun");
+    // The coupling is explicit: a hidden background, or none set, is not followed.
+    scene.Mapper->UseSceneSkyOn();
+    scene.Sky->VisibilityOff();
+    Grab(scene.Window);
+    ok &= Check(!scene.Mapper->GetLastRenderUsedSceneSky(),
+      "with the sky background hidden the mapper keeps its own sun");
+    scene.Sky->VisibilityOn();
+    scene.Mapper->SetSkyBackground(nullptr);
+    Grab(scene.Window);
+    ok &= Check(!scene.Mapper->GetLastRenderUsedSceneSky(),
+      "without SetSkyBackground the mapper ignores the sky in its renderer");
   }
   {
     // Aerial perspective: one cloud 4 km and 28 km away, the camera's view angle
