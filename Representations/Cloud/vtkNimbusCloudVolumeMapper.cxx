@@ -6,6 +6,7 @@
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 
+#include "ShaderLibrary.h"
 #include "svsCommon.h"
 #include "svsCompositeFS.h"
 #include "svsIntervalPhaseFS.h"
@@ -65,7 +66,9 @@ std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
 
 std::string FragmentSource(const char* pass)
 {
-  return std::string("//VTK::System::Dec\n//VTK::Output::Dec\n") + svsCommon + "\n" + pass;
+  return nimbus::WithShaderLibrary(
+    std::string("//VTK::System::Dec\n//VTK::Output::Dec\n//NIMBUS::Library\n") + svsCommon + "\n" +
+    pass);
 }
 
 // Frees a texture's storage and sets clamp-to-edge wrapping and its filter, ready
@@ -719,12 +722,12 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformMatrix4x4(
     "inverseViewProjection", const_cast<float*>(frame.InverseViewProjection.data()));
   program->SetUniformi("perspective", frame.Camera->GetParallelProjection() ? 0 : 1);
-  program->SetUniform3f("eyePosition", frame.Camera->GetPosition());
+  program->SetUniform3f("cameraPosition", frame.Camera->GetPosition());
   program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(frame.WorldToTexture.data()));
   program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(frame.WorldToBox.data()));
-  program->SetUniform3f("toSun", frame.ToSun.data());
+  program->SetUniform3f("sunDirection", frame.ToSun.data());
   program->SetUniform3f("sliceNormal", frame.Axis.Normal.data());
-  program->SetUniformf("lengthUnit", static_cast<float>(frame.Settings.MetresPerUnit));
+  program->SetUniformf("metresPerUnit", static_cast<float>(frame.Settings.MetresPerUnit));
   program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
   program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
   program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
@@ -745,11 +748,12 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniform3f("rayleighExtinction0", in.Table.RayleighExtinctionSeaLevel.data());
   program->SetUniformf("mieExtinction0", static_cast<float>(in.Table.MieExtinctionSeaLevel));
   program->SetUniformf(
-    "rayleighScaleHeight", static_cast<float>(in.Table.Air.RayleighScaleHeightMetres));
-  program->SetUniformf("mieScaleHeight", static_cast<float>(in.Table.Air.MieScaleHeightMetres));
-  program->SetUniformf("sceneAltitude", static_cast<float>(air.SceneAltitudeMetres));
-  program->SetUniformf("earthRadius", static_cast<float>(air.EarthRadiusMetres));
-  program->SetUniformf("topRadius", static_cast<float>(air.TopRadiusMetres));
+    "rayleighScaleHeightMetres", static_cast<float>(in.Table.Air.RayleighScaleHeightMetres));
+  program->SetUniformf(
+    "mieScaleHeightMetres", static_cast<float>(in.Table.Air.MieScaleHeightMetres));
+  program->SetUniformf("sceneAltitudeMetres", static_cast<float>(air.SceneAltitudeMetres));
+  program->SetUniformf("earthRadiusMetres", static_cast<float>(air.EarthRadiusMetres));
+  program->SetUniformf("topRadiusMetres", static_cast<float>(air.TopRadiusMetres));
   program->SetUniform3f("sunIrradianceTop", in.Table.SunIrradianceTop.data());
   program->SetUniformi("groundOn", frame.Ground ? 1 : 0);
   program->SetUniformf("groundZ", static_cast<float>(frame.Settings.GroundHeight));
@@ -832,7 +836,7 @@ void vtkNimbusCloudVolumeMapper::RenderIntervalPhase(const FrameState& frame)
     vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
     this->SetCommonUniforms(program, frame);
     program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
-    program->SetUniformf("hazeG", static_cast<float>(mieG));
+    program->SetUniformf("mieG", static_cast<float>(mieG));
     program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
     in.IntervalPhasePass->Render();
     ++in.PassesLastRender;

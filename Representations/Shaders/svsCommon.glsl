@@ -1,13 +1,15 @@
 // Shared GLSL of the shadow-view-slice mapper (000). Prepended to each pass's
-// fragment shader by vtkNimbusCloudVolumeMapper. World frame: z is up; lengths in
-// world units, converted to metres with lengthUnit. Radiometry: linear sRGB,
-// relative to the sun (see Physics/Sun.h).
+// fragment shader by vtkNimbusCloudVolumeMapper, after the GLSL library
+// (nimbusPhase/Color/Atmosphere.glsl). World frame: z is up; lengths in world units,
+// converted to metres with metresPerUnit. Radiometry: linear sRGB, relative to the
+// sun (see Physics/Sun.h). Uniform names follow the C++ vocabulary (Physics/Sun.h,
+// Atmosphere.h) and the sky shaders (sunDirection, cameraPosition, mieG).
 uniform mat4 inverseViewProjection; // NDC -> world
 uniform int perspective;            // 1: rays start at the eye, 0: on the near plane
-uniform vec3 eyePosition;           // world position of the eye (perspective)
-uniform vec3 toSun;                 // L, unit
+uniform vec3 cameraPosition;        // world position of the eye (perspective)
+uniform vec3 sunDirection;          // L, unit, toward the sun
 uniform vec3 sliceNormal;           // n, unit, dot(n, -L) > 0
-uniform float lengthUnit;           // metres per world unit
+uniform float metresPerUnit;        // metres per world unit
 
 uniform sampler3D density;          // cloud density volume
 uniform mat4 worldToTexture;        // world -> density texture coordinates
@@ -26,11 +28,11 @@ uniform sampler2D atmosphereTable;  // rows: sun, Rayleigh source, Mie source, e
 uniform vec2 atmosphereZRange;      // z of the first and last column [m]
 uniform vec3 rayleighExtinction0;   // sea level [1/m], per channel
 uniform float mieExtinction0;       // sea level [1/m]
-uniform float rayleighScaleHeight;  // [m]
-uniform float mieScaleHeight;       // [m]
-uniform float sceneAltitude;        // [m] above sea level of z = 0
-uniform float earthRadius;          // [m]
-uniform float topRadius;            // [m]
+uniform float rayleighScaleHeightMetres;
+uniform float mieScaleHeightMetres;
+uniform float sceneAltitudeMetres;  // above sea level, of world z = 0
+uniform float earthRadiusMetres;
+uniform float topRadiusMetres;
 uniform vec3 sunIrradianceTop;      // without atmosphere
 
 uniform int groundOn;
@@ -56,7 +58,7 @@ void ViewRay(vec2 uv, out vec3 origin, out vec3 direction)
   // ground or the air between the eye and the cloud.
   if (perspective != 0)
   {
-    origin = eyePosition;
+    origin = cameraPosition;
   }
   direction = normalize(farPoint.xyz / farPoint.w - origin);
 }
@@ -85,8 +87,8 @@ float GroundDistance(vec3 origin, vec3 direction)
 // Altitude above sea level over the spherical earth [m] of world point p.
 float Altitude(vec3 p)
 {
-  vec3 q = vec3(p.xy * lengthUnit, earthRadius + sceneAltitude + p.z * lengthUnit);
-  return length(q) - earthRadius;
+  vec3 q = vec3(p.xy * metresPerUnit, earthRadiusMetres + sceneAltitudeMetres + p.z * metresPerUnit);
+  return length(q) - earthRadiusMetres;
 }
 
 // Distance (world units) to the top of the atmosphere from the ray origin.
@@ -96,21 +98,14 @@ float TopDistance(vec3 origin, vec3 direction)
   {
     return kInfinity;
   }
-  float r0 = earthRadius + sceneAltitude + origin.z * lengthUnit;
-  float b = direction.z * r0;
-  float c = (r0 - topRadius) * (r0 + topRadius);
-  float disc = b * b - c;
-  if (disc < 0.0)
-  {
-    return 0.0;
-  }
-  return max(-b + sqrt(disc), 0.0) / lengthUnit;
+  float r0 = earthRadiusMetres + sceneAltitudeMetres + origin.z * metresPerUnit;
+  return DistanceToTopOfAtmosphere(r0, direction.z, topRadiusMetres) / metresPerUnit;
 }
 
 // Atmosphere table row at altitude h [m] (000: the "atmosphere texture").
 vec3 AtmosphereRow(int row, float altitude)
 {
-  float z = altitude - sceneAltitude;
+  float z = altitude - sceneAltitudeMetres;
   float x = clamp((z - atmosphereZRange.x) / (atmosphereZRange.y - atmosphereZRange.x), 0.0, 1.0);
   ivec2 size = textureSize(atmosphereTable, 0);
   float u = (0.5 + x * float(size.x - 1)) / float(size.x);
@@ -130,16 +125,6 @@ vec3 SunIrradiance(float altitude)
   return atmosphereOn != 0 ? max(AtmosphereRow(0, altitude), vec3(0.0)) : sunIrradianceTop;
 }
 
-// Sea-level-equivalent length of an exponential layer along the straight ray
-// over [0, t] (flat earth; 000 Eq. 6 in closed form) [m].
-float LayerLength(float h0, float dz, float tMetres, float scaleHeight)
-{
-  float x = tMetres * dz / scaleHeight;
-  float factor = abs(x) < 1e-3 ? tMetres * (1.0 - 0.5 * x + x * x / 6.0)
-                               : scaleHeight * (1.0 - exp(-x)) / dz;
-  return exp(-max(h0, 0.0) / scaleHeight) * factor;
-}
-
 // Atmospheric transmittance g_view_atm between the ray origin and distance t (000 Eq. 6).
 vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
 {
@@ -147,10 +132,10 @@ vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
   {
     return vec3(1.0);
   }
-  float h0 = sceneAltitude + origin.z * lengthUnit;
-  float tm = min(t, 1e7) * lengthUnit;
-  float lr = LayerLength(h0, direction.z, tm, rayleighScaleHeight);
-  float lm = LayerLength(h0, direction.z, tm, mieScaleHeight);
+  float h0 = sceneAltitudeMetres + origin.z * metresPerUnit;
+  float tm = min(t, 1e7) * metresPerUnit;
+  float lr = FlatLayerOpticalLength(h0, direction.z, tm, rayleighScaleHeightMetres);
+  float lm = FlatLayerOpticalLength(h0, direction.z, tm, mieScaleHeightMetres);
   return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
 }
 
@@ -179,7 +164,7 @@ float ShadowDepth(vec3 p)
 // Radiance of the Lambertian ground at g, toward the eye, before view attenuation.
 vec3 GroundRadiance(vec3 g, float cloudDepthToSun)
 {
-  float cosSun = max(toSun.z, 0.0);
-  return groundAlbedo / 3.14159265358979 * cosSun * SunIrradiance(Altitude(g)) *
+  float cosSun = max(sunDirection.z, 0.0);
+  return groundAlbedo / kPi * cosSun * SunIrradiance(Altitude(g)) *
     exp(-cloudDepthToSun);
 }

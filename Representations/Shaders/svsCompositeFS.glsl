@@ -26,16 +26,6 @@ uniform vec3 displayScale;
 uniform int encodeSrgb;
 uniform int skyBackground;
 
-vec3 ToLinear(vec3 c)
-{
-  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
-}
-vec3 ToSrgb(vec3 c)
-{
-  c = clamp(c, 0.0, 1.0);
-  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-
 void main()
 {
   vec3 origin, direction;
@@ -43,7 +33,7 @@ void main()
   vec4 sum = texture(accumulation, texCoord);
   vec4 background = texture(sceneColor, texCoord);
   float depth = texture(sceneDepth, texCoord).r;
-  vec3 backgroundLinear = encodeSrgb != 0 ? ToLinear(background.rgb) : background.rgb;
+  vec3 backgroundLinear = encodeSrgb != 0 ? SrgbDecode(background.rgb) : background.rgb;
   vec3 result;
   if (skyBackground != 0 && depth >= 1.0)
   {
@@ -71,6 +61,6 @@ void main()
     vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
     result = displayScale * sum.rgb + behind * backgroundLinear;
   }
-  gl_FragData[0] = vec4(encodeSrgb != 0 ? ToSrgb(result) : result, 1.0);
+  gl_FragData[0] = vec4(encodeSrgb != 0 ? SrgbEncode(result) : result, 1.0);
   gl_FragDepth = depth;
 }

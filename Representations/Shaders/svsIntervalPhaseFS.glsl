@@ -1,29 +1,20 @@
 // Sampling-interval and Mie-scattering textures (000 §4.4) in one RGBA target:
 // r = 1/|v.n| (Delta t(p) = Delta d / |v.n|), g = beta_cl(alpha) + k_multi/(4 pi),
 // b = Rayleigh phase, a = haze (Mie) phase, for the view ray of each pixel.
-// Phase functions are Cornette-Shanks normalised to 1 over the sphere [1/sr]
-// (000 Eq. 3 divided by 4 pi); cos(alpha) = dot(v, L).
+// Phase functions are nimbusPhase.glsl's (Cornette-Shanks normalised to 1 over the
+// sphere [1/sr]: 000 Eq. 3 divided by 4 pi); cos(alpha) = dot(v, L).
 in vec2 texCoord;
 uniform float cloudG;
-uniform float hazeG;
+uniform float mieG;
 uniform float multipleScattering; // k_multi (000 Eq. 1), dimensionless
-
-float CornetteShanks(float mu, float g)
-{
-  float g2 = g * g;
-  float denominator = max(1.0 + g2 - 2.0 * g * mu, 1e-12);
-  return 3.0 * (1.0 - g2) / (2.0 * (2.0 + g2)) * (1.0 + mu * mu) /
-    (denominator * sqrt(denominator)) / (4.0 * 3.14159265358979);
-}
 
 void main()
 {
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
   float vn = abs(dot(direction, sliceNormal));
-  float mu = clamp(dot(direction, toSun), -1.0, 1.0);
+  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
   gl_FragData[0] = vec4(1.0 / max(vn, 1e-6),
-    CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * 3.14159265358979),
-    3.0 / (16.0 * 3.14159265358979) * (1.0 + mu * mu),
-    CornetteShanks(mu, hazeG));
+    CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * kPi), Rayleigh(mu),
+    CornetteShanks(mu, mieG));
 }

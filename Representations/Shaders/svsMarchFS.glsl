@@ -56,7 +56,7 @@ void main()
     {
       float u = (float(k) + 0.5) / float(steps);
       float t = t0 + span * u * u;
-      float dt = span * 2.0 * u / float(steps) * lengthUnit;
+      float dt = span * 2.0 * u / float(steps) * metresPerUnit;
       vec3 p = origin + t * direction;
       float altitude = Altitude(p);
       vec3 clearAir = AirSource(altitude, intervalAndPhase.zw);

@@ -11,7 +11,7 @@ void main()
   // Point of this texel's sun ray on the slice plane dot(x, n) = d_i.
   vec3 base = shadowOrigin + texCoord.x * shadowExtent.x * shadowU +
     texCoord.y * shadowExtent.y * shadowW;
-  float lambda = (sliceOffset - dot(base, sliceNormal)) / dot(-toSun, sliceNormal);
-  vec3 p = base - lambda * toSun;
+  float lambda = (sliceOffset - dot(base, sliceNormal)) / dot(-sunDirection, sliceNormal);
+  vec3 p = base - lambda * sunDirection;
   gl_FragData[0] = vec4(extinctionPerDensity * CloudDensity(p) * sunStepMetres, 0.0, 0.0, 0.0);
 }

@@ -47,7 +47,7 @@ void main()
   if (medium)
   {
     vec3 p = origin + t * direction;
-    float stepMetres = sliceSpacing * intervalAndPhase.x * lengthUnit; // Delta t(p) [m]
+    float stepMetres = sliceSpacing * intervalAndPhase.x * metresPerUnit; // Delta t(p) [m]
     float sigma = extinctionPerDensity * CloudDensity(p);              // k_cl rho_cl [1/m]
     if (sigma <= 0.0 && atmosphereOn == 0 && !ground)
     {
