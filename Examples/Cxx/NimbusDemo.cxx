@@ -8,7 +8,7 @@
 // through the atmosphere, rendered with Nimbus's shadow-view-slice mapper
 // (vtkNimbusCloudVolumeMapper, paper 000): cloud and ground shadows, shafts of
 // light, in front of the Nimbus sky (vtkNimbusSkyBackground: Rayleigh + Mie
-// with multiple scattering, issue 6) whose sun and air the cloud mapper shares.
+// with multiple scattering) whose sun and air the cloud mapper shares.
 // With --no-sky the mapper draws its own single-scattering atmosphere instead.
 // Units: metres; z up.
 #include "vtkNimbusCloudVolumeMapper.h"

@@ -1,6 +1,6 @@
 /**
  * @class   vtkNimbusSkyBackground
- * @brief   The sky as a renderer's background: a prop drawn behind everything (issue 6).
+ * @brief   The sky as a renderer's background: a prop drawn behind everything.
  *
  * Add it to a vtkRenderer (standalone VTK, Python, or a ParaView view through
  * the "Sky Background" representation) and every pixel where nothing opaque is

@@ -5,7 +5,7 @@
 //
 //   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky]
 //
-// With "sky" only the sky table runs (issue 6): what a vtkNimbusSkyBackground
+// With "sky" only the sky table runs: what a vtkNimbusSkyBackground
 // adds to a cloud frame (the background pass plus the mapper's second target).
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it

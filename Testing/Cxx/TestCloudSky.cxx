@@ -1,4 +1,4 @@
-// Clouds over the Nimbus sky (issue 6): vtkNimbusCloudVolumeMapper given the
+// Clouds over the Nimbus sky: vtkNimbusCloudVolumeMapper given the
 // vtkNimbusSkyBackground of its renderer (SetSkyBackground) follows the sky's sun
 // and air and composites cloud, cloud shadow and shafts over the sky
 // (I = S - T_cl S_clear + T_cl L_sky).
