@@ -1,16 +1,14 @@
 #include "PathTracer.h"
 #include "Math.h"
+#include "ParallelFor.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 namespace nimbus
@@ -993,9 +991,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   std::vector<PixelStatistics> statistics(pixels);
 
-  int threads =
-    settings.Threads > 0 ? settings.Threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::max(1, threads);
+  const int threads = ResolveThreadCount(settings.Threads);
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
@@ -1015,23 +1011,18 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       break;
     }
     // One round: every active pixel is brought to `target` samples; pixels are
-    // handed out dynamically, but each is worked on by exactly one thread.
-    std::atomic<std::size_t> next{ 0 };
-    std::exception_ptr failure;
-    std::mutex failureMutex;
-    auto worker = [&]()
-    {
-      PathState state;
-      std::uint64_t localPaths = 0, localTruncated = 0;
-      try
+    // handed out dynamically, but each is worked on by exactly one thread. Chunks of
+    // about 1/256 of a thread's share (down to one pixel when few are left) keep the
+    // threads balanced and the per-chunk scratch rare.
+    const std::size_t grain =
+      std::max<std::size_t>(1, active.size() / (256 * static_cast<std::size_t>(threads)));
+    ParallelFor(active.size(), grain, threads,
+      [&](std::size_t begin, std::size_t end)
       {
-        for (;;)
+        PathState state;
+        std::uint64_t localPaths = 0, localTruncated = 0;
+        for (std::size_t slot = begin; slot < end; ++slot)
         {
-          const std::size_t slot = next.fetch_add(1);
-          if (slot >= active.size())
-          {
-            break;
-          }
           const std::size_t k = active[slot];
           PixelStatistics& stats = statistics[k];
           const int i = static_cast<int>(k % static_cast<std::size_t>(width));
@@ -1065,34 +1056,9 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
             }
           }
         }
-      }
-      catch (...)
-      {
-        std::lock_guard<std::mutex> lock(failureMutex);
-        if (!failure)
-        {
-          failure = std::current_exception();
-        }
-        next.store(active.size());
-      }
-      paths += localPaths;
-      truncated += localTruncated;
-    };
-    const int used = static_cast<int>(std::min<std::size_t>(threads, active.size()));
-    std::vector<std::thread> pool;
-    for (int w = 1; w < used; ++w)
-    {
-      pool.emplace_back(worker);
-    }
-    worker();
-    for (std::thread& thread : pool)
-    {
-      thread.join();
-    }
-    if (failure)
-    {
-      std::rethrow_exception(failure);
-    }
+        paths += localPaths;
+        truncated += localTruncated;
+      });
     if (progress)
     {
       progress(std::min(

@@ -73,17 +73,14 @@
 // O(pixels × (N/s)²) for an N³ grid; halving the step quadruples the cloud cost.
 #include "SingleScatteringRenderer.h"
 #include "Math.h"
+#include "ParallelFor.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
 namespace nimbus
 {
@@ -787,16 +784,6 @@ private:
   double BlockDiagonal = 0.0;
 };
 
-int ResolveThreads(int threads)
-{
-  if (threads > 0)
-  {
-    return threads;
-  }
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw > 0 ? static_cast<int>(hw) : 1;
-}
-
 void CheckRay(const Vector3& origin, const Vector3& direction)
 {
   for (int a = 0; a < 3; ++a)
@@ -833,19 +820,19 @@ FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepS
   const int width = camera.GetWidth(), height = camera.GetHeight();
   FloatImage image(width, height);
 
-  std::atomic<int> nextRow{ 0 };
-  std::atomic<int> rowsDone{ 0 };
-  std::exception_ptr failure;
-  std::mutex failureMutex;
-  std::atomic<bool> failed{ false };
-
-  auto work = [&](bool reportProgress)
+  // Rows are handed out dynamically; progress comes from the calling thread only.
+  std::function<void(std::size_t)> rowsDone;
+  if (progress)
   {
-    try
+    rowsDone = [&](std::size_t done) { progress(static_cast<double>(done) / height); };
+  }
+  ParallelFor(
+    static_cast<std::size_t>(std::max(0, height)), 1, threads,
+    [&](std::size_t begin, std::size_t end)
     {
       Integrator::Workspace workspace;
       std::vector<double> radiance;
-      for (int j = nextRow++; j < height && !failed; j = nextRow++)
+      for (int j = static_cast<int>(begin); j < static_cast<int>(end); ++j)
       {
         for (int i = 0; i < width; ++i)
         {
@@ -858,40 +845,9 @@ FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepS
             pixel[c] = static_cast<float>(rgb[c]);
           }
         }
-        const int done = ++rowsDone;
-        if (reportProgress && progress)
-        {
-          progress(static_cast<double>(done) / height);
-        }
       }
-    }
-    catch (...)
-    {
-      std::lock_guard<std::mutex> lock(failureMutex);
-      if (!failure)
-      {
-        failure = std::current_exception();
-      }
-      failed = true;
-    }
-  };
-
-  const int count = std::min(ResolveThreads(threads), std::max(1, height));
-  std::vector<std::thread> workers;
-  workers.reserve(count - 1);
-  for (int k = 1; k < count; ++k)
-  {
-    workers.emplace_back(work, false);
-  }
-  work(true); // the calling thread works too and reports progress
-  for (std::thread& worker : workers)
-  {
-    worker.join();
-  }
-  if (failure)
-  {
-    std::rethrow_exception(failure);
-  }
+    },
+    rowsDone);
   if (progress)
   {
     progress(1.0);
