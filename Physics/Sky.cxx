@@ -9,16 +9,15 @@
 #include "Sky.h"
 #include "Math.h"
 
+#include "ParallelFor.h"
 #include "PhaseFunctions.h"
 #include "Sun.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 namespace nimbus
 {
@@ -38,30 +37,19 @@ void Require(bool ok, const std::string& field, const std::string& what)
   }
 }
 
-/// Runs f(i) for i in [0, n) on `threads` threads (0 = hardware concurrency).
+/// Runs f(i) for i in [0, n) on `threads` threads (0 = hardware concurrency), one
+/// index per chunk of ParallelFor.
 template <class F>
-void ParallelFor(int n, int threads, const F& f)
+void ForEachIndex(int n, int threads, const F& f)
 {
-  int count = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
-  count = std::max(1, std::min(count, n));
-  std::atomic<int> next{ 0 };
-  auto work = [&]()
-  {
-    for (int i = next++; i < n; i = next++)
+  ParallelFor(static_cast<std::size_t>(std::max(0, n)), 1, threads,
+    [&f](std::size_t begin, std::size_t end)
     {
-      f(i);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < count; ++t)
-  {
-    pool.emplace_back(work);
-  }
-  work();
-  for (auto& thread : pool)
-  {
-    thread.join();
-  }
+      for (std::size_t i = begin; i < end; ++i)
+      {
+        f(static_cast<int>(i));
+      }
+    });
 }
 
 /// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n).
@@ -228,7 +216,7 @@ void SkyModel::BuildTransmittance()
   const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
   this->TransmittanceTable.assign(static_cast<std::size_t>(nmu) * nr * 2, 0.0f);
-  ParallelFor(nr, this->Parameters.Threads,
+  ForEachIndex(nr, this->Parameters.Threads,
     [&](int j)
     {
       const double rho = H * j / (nr - 1.0);
@@ -658,7 +646,7 @@ void SkyModel::BuildMultipleScattering()
   for (int order = 1; order < orders; ++order)
   {
     std::vector<float> mean(tableSize, 0.0f), ground(static_cast<std::size_t>(nmus) * n, 0.0f);
-    ParallelFor(nr * nmus, this->Parameters.Threads,
+    ForEachIndex(nr * nmus, this->Parameters.Threads,
       [&](int node)
       {
         const int j = node / nmus, i = node % nmus;
@@ -898,7 +886,7 @@ SkyViewLut::SkyViewLut(const SkyModel& model, double sunElevationDeg, double obs
   const Vector3 s = SunDirection(sunElevationDeg, 0.0);
   const Vector3 x{ { 0.0, 0.0,
     model.GetParameters().Atmosphere.EarthRadiusMetres + observerAltitude } };
-  ParallelFor(rows, model.GetParameters().Threads,
+  ForEachIndex(rows, model.GetParameters().Threads,
     [&](int row)
     {
       const double zenith = this->Mapping.ZenithOfRow(row);
@@ -993,7 +981,7 @@ AerialPerspectiveLut::AerialPerspectiveLut(const SkyModel& model, double sunElev
   const Vector3 s = SunDirection(sunElevationDeg, 0.0);
   const Vector3 x{ { 0.0, 0.0,
     model.GetParameters().Atmosphere.EarthRadiusMetres + cameraAltitude } };
-  ParallelFor(rows, model.GetParameters().Threads,
+  ForEachIndex(rows, model.GetParameters().Threads,
     [&](int row)
     {
       const double zenith = this->Mapping.ZenithOfRow(row);

@@ -1,13 +1,13 @@
 #include "CloudAutomaton.h"
 
 #include "Metaballs.h" // WyvillFalloff
+#include "ParallelFor.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
 namespace nimbus
@@ -114,39 +114,14 @@ inline Word BernoulliWord(Word key, Word wordIndex, std::uint32_t threshold)
   return mask;
 }
 
-// Runs body(begin, end) over [0, count) split into contiguous slabs, one per thread.
+// Runs body(begin, end) over [0, count) split into contiguous slabs, one per thread
+// (ParallelFor with grain 0).
 template <typename Body>
-void ParallelFor(int count, int threads, const Body& body)
+void ForEachSlab(int count, int threads, const Body& body)
 {
-  threads = std::max(1, std::min(threads, count));
-  if (threads == 1)
-  {
-    body(0, count);
-    return;
-  }
-  std::vector<std::thread> workers;
-  workers.reserve(static_cast<std::size_t>(threads - 1));
-  for (int t = 1; t < threads; ++t)
-  {
-    const int begin = static_cast<int>(static_cast<long long>(count) * t / threads);
-    const int end = static_cast<int>(static_cast<long long>(count) * (t + 1) / threads);
-    workers.emplace_back([&body, begin, end]() { body(begin, end); });
-  }
-  body(0, static_cast<int>(static_cast<long long>(count) / threads));
-  for (auto& worker : workers)
-  {
-    worker.join();
-  }
-}
-
-int ResolveThreads(int requested)
-{
-  if (requested > 0)
-  {
-    return requested;
-  }
-  const unsigned hardware = std::thread::hardware_concurrency();
-  return hardware > 0 ? static_cast<int>(hardware) : 1;
+  ParallelFor(static_cast<std::size_t>(std::max(0, count)), 0, threads,
+    [&body](std::size_t begin, std::size_t end)
+    { body(static_cast<int>(begin), static_cast<int>(end)); });
 }
 
 inline int Wrap(long long i, int n)
@@ -347,7 +322,7 @@ void CloudAutomaton::ValidateAndPrepare()
   this->RowWords = static_cast<int>((nx + Bits - 1) / Bits);
   const int tailBits = static_cast<int>(nx % Bits);
   this->TailMask = tailBits == 0 ? ~Word(0) : ((Word(1) << tailBits) - 1);
-  this->Threads = ResolveThreads(p.NumberOfThreads);
+  this->Threads = ResolveThreadCount(p.NumberOfThreads);
   const std::size_t words = static_cast<std::size_t>(this->RowWords) * ny * nz;
   for (auto* state : { &this->Current, &this->Scratch })
   {
@@ -367,7 +342,7 @@ void CloudAutomaton::InitialState()
   const std::uint32_t actThreshold = ToThreshold(p.InitialActivation);
   auto& s = this->Current;
   s.Step = 0;
-  ParallelFor(nz, this->Threads,
+  ForEachSlab(nz, this->Threads,
     [&](int z0, int z1)
     {
       for (int z = z0; z < z1; ++z)
@@ -445,7 +420,7 @@ void CloudAutomaton::Step()
   }
 
   // 1. growth and 2. extinction/supply: in -> out.
-  ParallelFor(nz, this->Threads,
+  ForEachSlab(nz, this->Threads,
     [&](int z0, int z1)
     {
       for (int z = z0; z < z1; ++z)
@@ -532,7 +507,7 @@ void CloudAutomaton::Step()
   {
     CloudAutomatonState& dst = this->Current;
     const CloudAutomatonState& src = this->Scratch;
-    ParallelFor(nz, this->Threads,
+    ForEachSlab(nz, this->Threads,
       [&](int z0, int z1)
       {
         for (int z = z0; z < z1; ++z)
@@ -707,7 +682,7 @@ void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomato
     throw std::invalid_argument("SmoothCloud: Radius must be in [0, 64] cells.");
   }
   const bool periodic = parameters.Boundary == CloudBoundary::Periodic;
-  const int threads = ResolveThreads(smoothing.NumberOfThreads);
+  const int threads = ResolveThreadCount(smoothing.NumberOfThreads);
 
   // Kernel taps d = -K..K with |d| < R, w(d) = Wyvill falloff (004 §4), sum 1.
   const double R = std::max(1.0, smoothing.Radius);
@@ -726,7 +701,7 @@ void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomato
   density.assign(count, 0.0f);
   std::vector<float> scratch(count);
   // Bits -> 0/1 floats, into `density`.
-  ParallelFor(nz, threads,
+  ForEachSlab(nz, threads,
     [&](int z0, int z1)
     {
       for (int z = z0; z < z1; ++z)
@@ -752,7 +727,7 @@ void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomato
   {
     const int n = parameters.Dimensions[axis];
     const bool wraps = periodic && axis < 2;
-    ParallelFor(nz, threads,
+    ForEachSlab(nz, threads,
       [&](int z0, int z1)
       {
         for (int z = z0; z < z1; ++z)

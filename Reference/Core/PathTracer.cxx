@@ -1,16 +1,15 @@
 #include "PathTracer.h"
+#include "MajorantGrid.h"
 #include "Math.h"
+#include "ParallelFor.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 namespace nimbus
@@ -19,8 +18,6 @@ namespace nimbus
 namespace
 {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-/// Voxels per macro cell edge of the cloud majorant grid.
-constexpr int kMacroCellVoxels = 4;
 /// Ratio tracking plays Russian roulette once its transmittance falls below this.
 constexpr double kRatioTrackingRouletteThreshold = 0.1;
 
@@ -57,83 +54,6 @@ public:
 
 private:
   std::uint64_t State;
-};
-
-//------------------------------------------------------------------------------
-/// Coarse majorant grid of the cloud: sigma_bar per block of kMacroCellVoxels^3
-/// voxels, the maximum over the block's grid points dilated by one point on every
-/// side. Trilinear interpolation never exceeds the corner values, so the value
-/// bounds sigma_t over the block and over one voxel around it (margin for pieces
-/// whose end points round across a block face).
-struct MacroGrid
-{
-  std::array<int, 3> Cells{ { 0, 0, 0 } };
-  Vector3 Lower{ { 0, 0, 0 } };
-  Vector3 CellSize{ { 1, 1, 1 } };
-  std::vector<double> Majorant; // 1/m
-
-  void Build(const DensityGrid& grid, double extinctionPerDensity)
-  {
-    const std::array<int, 3>& n = grid.GetDimensions();
-    std::array<std::vector<std::pair<int, int>>, 3> ranges; // point range per cell
-    for (int a = 0; a < 3; ++a)
-    {
-      this->Lower[a] = grid.GetLower()[a];
-      if (n[a] == 1)
-      {
-        this->Cells[a] = 1;
-        this->CellSize[a] = grid.GetUpper()[a] - grid.GetLower()[a];
-        ranges[a].push_back({ 0, 0 });
-        continue;
-      }
-      const int voxels = n[a] - 1;
-      this->Cells[a] = (voxels + kMacroCellVoxels - 1) / kMacroCellVoxels;
-      this->CellSize[a] = kMacroCellVoxels * grid.GetSpacing()[a];
-      for (int c = 0; c < this->Cells[a]; ++c)
-      {
-        ranges[a].push_back({ std::max(0, c * kMacroCellVoxels - 1),
-          std::min(n[a] - 1, (c + 1) * kMacroCellVoxels + 1) });
-      }
-    }
-    // Separable running maximum: x, then y, then z.
-    const std::vector<float>& f = grid.GetValues();
-    const int cx = this->Cells[0], cy = this->Cells[1], cz = this->Cells[2];
-    std::vector<float> ax(static_cast<std::size_t>(cx) * n[1] * n[2], 0.0f);
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int c = 0; c < cx; ++c)
-        {
-          float m = 0.0f;
-          for (int i = ranges[0][c].first; i <= ranges[0][c].second; ++i)
-            m = std::max(
-              m, f[i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k)]);
-          ax[c + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)] = m;
-        }
-    std::vector<float> axy(static_cast<std::size_t>(cx) * cy * n[2], 0.0f);
-    for (int k = 0; k < n[2]; ++k)
-      for (int c = 0; c < cy; ++c)
-        for (int i = 0; i < cx; ++i)
-        {
-          float m = 0.0f;
-          for (int j = ranges[1][c].first; j <= ranges[1][c].second; ++j)
-            m = std::max(
-              m, ax[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(n[1]) * k)]);
-          axy[i + static_cast<std::size_t>(cx) * (c + static_cast<std::size_t>(cy) * k)] = m;
-        }
-    this->Majorant.assign(static_cast<std::size_t>(cx) * cy * cz, 0.0);
-    for (int c = 0; c < cz; ++c)
-      for (int j = 0; j < cy; ++j)
-        for (int i = 0; i < cx; ++i)
-        {
-          float m = 0.0f;
-          for (int k = ranges[2][c].first; k <= ranges[2][c].second; ++k)
-            m = std::max(
-              m, axy[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * k)]);
-          this
-            ->Majorant[i + static_cast<std::size_t>(cx) * (j + static_cast<std::size_t>(cy) * c)] =
-            extinctionPerDensity * static_cast<double>(m);
-        }
-  }
 };
 
 /// The atmosphere's optical lengths toward the sun, L_R and L_M (Atmosphere.h),
@@ -230,9 +150,21 @@ public:
     this->HasCloud = !this->Grid.IsEmpty() && context.CloudMajorant() > 0.0;
     if (this->HasCloud)
     {
-      this->Macro.Build(this->Grid, context.GetScene().Medium.ExtinctionPerDensity);
-      this->MinCellSize =
-        std::min({ this->Macro.CellSize[0], this->Macro.CellSize[1], this->Macro.CellSize[2] });
+      // Coarse majorant grid of the cloud: sigma_bar per block of 4^3 voxels, the
+      // maximum over the block's grid points dilated by one point on every side, times
+      // the extinction per density. Trilinear interpolation never exceeds the corner
+      // values, so the value bounds sigma_t over the block and over one voxel around it
+      // (margin for pieces whose end points round across a block face).
+      this->Macro = MajorantGrid(this->Grid, 1);
+      const double extinctionPerDensity = context.GetScene().Medium.ExtinctionPerDensity;
+      const std::array<int, 3>& blocks = this->Macro.GetBlocks();
+      this->Majorant.resize(static_cast<std::size_t>(blocks[0]) * blocks[1] * blocks[2]);
+      for (std::size_t i = 0; i < this->Majorant.size(); ++i)
+      {
+        this->Majorant[i] = extinctionPerDensity * this->Macro.GetMaximum(i);
+      }
+      const Vector3& size = this->Macro.GetBlockSize();
+      this->MinCellSize = std::min({ size[0], size[1], size[2] });
     }
     this->CloudAlbedo = context.GetCloudAlbedo();
     if (this->Air)
@@ -341,7 +273,8 @@ private:
   const Atmosphere* Air;
   int Wavelengths = 0;
   bool HasCloud = false;
-  MacroGrid Macro;
+  MajorantGrid Macro;
+  std::vector<double> Majorant; // sigma_bar per block of Macro, 1/m
   double MinCellSize = 1.0;
   double CloudAlbedo = 1.0;
   double EarthRadius = 0.0, ScaleHeightR = 1.0, ScaleHeightM = 1.0, MieG = 0.0;
@@ -474,22 +407,23 @@ double Integrator::Piece(const Ray& ray, double t, double tEnd, bool withAir, do
       std::size_t index = 0, stride = 1;
       for (int a = 0; a < 3; ++a)
       {
-        const double size = this->Macro.CellSize[a];
-        const int c = std::min(this->Macro.Cells[a] - 1,
-          std::max(0, static_cast<int>(std::floor((p[a] - this->Macro.Lower[a]) / size))));
+        const double size = this->Macro.GetBlockSize()[a];
+        const double lower = this->Macro.GetLower()[a];
+        const int c = std::min(this->Macro.GetBlocks()[a] - 1,
+          std::max(0, static_cast<int>(std::floor((p[a] - lower) / size))));
         const double d = ray.Direction[a];
         if (d > 0.0)
         {
-          exit = std::min(exit, (this->Macro.Lower[a] + (c + 1) * size - ray.Origin[a]) / d);
+          exit = std::min(exit, (lower + (c + 1) * size - ray.Origin[a]) / d);
         }
         else if (d < 0.0)
         {
-          exit = std::min(exit, (this->Macro.Lower[a] + c * size - ray.Origin[a]) / d);
+          exit = std::min(exit, (lower + c * size - ray.Origin[a]) / d);
         }
         index += stride * static_cast<std::size_t>(c);
-        stride *= static_cast<std::size_t>(this->Macro.Cells[a]);
+        stride *= static_cast<std::size_t>(this->Macro.GetBlocks()[a]);
       }
-      cloudMajorant = this->Macro.Majorant[index];
+      cloudMajorant = this->Majorant[index];
       tNext = std::min(tNext, exit);
     }
   }
@@ -993,9 +927,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   std::vector<PixelStatistics> statistics(pixels);
 
-  int threads =
-    settings.Threads > 0 ? settings.Threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::max(1, threads);
+  const int threads = ResolveThreadCount(settings.Threads);
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
@@ -1015,23 +947,18 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       break;
     }
     // One round: every active pixel is brought to `target` samples; pixels are
-    // handed out dynamically, but each is worked on by exactly one thread.
-    std::atomic<std::size_t> next{ 0 };
-    std::exception_ptr failure;
-    std::mutex failureMutex;
-    auto worker = [&]()
-    {
-      PathState state;
-      std::uint64_t localPaths = 0, localTruncated = 0;
-      try
+    // handed out dynamically, but each is worked on by exactly one thread. Chunks of
+    // about 1/256 of a thread's share (down to one pixel when few are left) keep the
+    // threads balanced and the per-chunk scratch rare.
+    const std::size_t grain =
+      std::max<std::size_t>(1, active.size() / (256 * static_cast<std::size_t>(threads)));
+    ParallelFor(active.size(), grain, threads,
+      [&](std::size_t begin, std::size_t end)
       {
-        for (;;)
+        PathState state;
+        std::uint64_t localPaths = 0, localTruncated = 0;
+        for (std::size_t slot = begin; slot < end; ++slot)
         {
-          const std::size_t slot = next.fetch_add(1);
-          if (slot >= active.size())
-          {
-            break;
-          }
           const std::size_t k = active[slot];
           PixelStatistics& stats = statistics[k];
           const int i = static_cast<int>(k % static_cast<std::size_t>(width));
@@ -1065,34 +992,9 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
             }
           }
         }
-      }
-      catch (...)
-      {
-        std::lock_guard<std::mutex> lock(failureMutex);
-        if (!failure)
-        {
-          failure = std::current_exception();
-        }
-        next.store(active.size());
-      }
-      paths += localPaths;
-      truncated += localTruncated;
-    };
-    const int used = static_cast<int>(std::min<std::size_t>(threads, active.size()));
-    std::vector<std::thread> pool;
-    for (int w = 1; w < used; ++w)
-    {
-      pool.emplace_back(worker);
-    }
-    worker();
-    for (std::thread& thread : pool)
-    {
-      thread.join();
-    }
-    if (failure)
-    {
-      std::rethrow_exception(failure);
-    }
+        paths += localPaths;
+        truncated += localTruncated;
+      });
     if (progress)
     {
       progress(std::min(

@@ -72,18 +72,16 @@
 // trilinear look-ups (fewer with early termination), so a pass costs
 // O(pixels × (N/s)²) for an N³ grid; halving the step quadruples the cloud cost.
 #include "SingleScatteringRenderer.h"
+#include "MajorantGrid.h"
 #include "Math.h"
+#include "ParallelFor.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
 namespace nimbus
 {
@@ -101,7 +99,7 @@ constexpr double kMaxKnotSpacing = 50000.0;
 // Largest altitude change (m) between two knots.
 constexpr double kMaxKnotRise = 8000.0;
 // Edge (grid cells) of the macro blocks used to skip empty space.
-constexpr int kBlockCells = 4;
+constexpr int kBlockCells = MajorantGrid::BlockVoxels;
 // Air shadow knots inside the cloud box: every K-th cloud step (see CloudSegmentSpectral).
 constexpr long long kAirShadowKnotSteps = 8;
 
@@ -352,9 +350,7 @@ public:
       const int cell = static_cast<int>(std::min<double>(this->Cells[a] - 1, std::max(0.0, c)));
       b[a] = cell / kBlockCells;
     }
-    if (!this->EmptyBlock[(static_cast<std::size_t>(b[2]) * this->Blocks[1] + b[1]) *
-            this->Blocks[0] +
-          b[0]])
+    if (!this->Blocks.IsEmpty(this->Blocks.GetIndex(b[0], b[1], b[2])))
     {
       return k;
     }
@@ -511,11 +507,10 @@ public:
   }
 
 private:
-  /// Flags the macro blocks (kBlockCells³ grid cells) whose grid points are all 0.
+  /// Flags the macro blocks (kBlockCells³ grid cells) whose grid points are all 0
+  /// (MajorantGrid without dilation: maximum 0).
   void BuildEmptyBlocks()
   {
-    this->EmptyBlock.assign(1, 0);
-    this->Blocks = { { 1, 1, 1 } };
     this->Cells = { { 1, 1, 1 } };
     this->CellSize = { { 1.0, 1.0, 1.0 } };
     this->BlockLower = { { 0.0, 0.0, 0.0 } };
@@ -531,52 +526,10 @@ private:
       this->Cells[a] = std::max(1, dims[a] - 1);
       this->CellSize[a] = (upper[a] - lower[a]) / this->Cells[a];
       this->BlockLower[a] = lower[a];
-      this->Blocks[a] = (this->Cells[a] + kBlockCells - 1) / kBlockCells;
       diagonal2 += std::pow(kBlockCells * this->CellSize[a], 2);
     }
     this->BlockDiagonal = std::sqrt(diagonal2);
-    this->EmptyBlock.assign(
-      static_cast<std::size_t>(this->Blocks[0]) * this->Blocks[1] * this->Blocks[2], 1);
-    const std::vector<float>& values = this->Grid.GetValues();
-    const std::size_t nx = dims[0], nxy = nx * dims[1];
-    for (int k = 0; k < dims[2]; ++k)
-    {
-      for (int j = 0; j < dims[1]; ++j)
-      {
-        for (int i = 0; i < dims[0]; ++i)
-        {
-          if (values[i + j * nx + k * nxy] == 0.0f)
-          {
-            continue;
-          }
-          // A point on a block face belongs to both blocks (inclusive ranges).
-          const int p[3] = { i, j, k };
-          int lo[3], hi[3];
-          for (int a = 0; a < 3; ++a)
-          {
-            const int last = this->Blocks[a] - 1;
-            lo[a] = std::min(last, std::max(0, (p[a] - 1) / kBlockCells));
-            hi[a] = std::min(last, p[a] / kBlockCells);
-            if (p[a] > 0 && p[a] % kBlockCells != 0)
-            {
-              lo[a] = hi[a];
-            }
-          }
-          for (int c = lo[2]; c <= hi[2]; ++c)
-          {
-            for (int b = lo[1]; b <= hi[1]; ++b)
-            {
-              for (int a = lo[0]; a <= hi[0]; ++a)
-              {
-                this->EmptyBlock[(static_cast<std::size_t>(c) * this->Blocks[1] + b) *
-                    this->Blocks[0] +
-                  a] = 0;
-              }
-            }
-          }
-        }
-      }
-    }
+    this->Blocks = MajorantGrid(this->Grid, 0);
   }
 
   /// Distance to the earth sphere (radius R_e, earth-centred frame), or infinity.
@@ -781,21 +734,11 @@ private:
   double KnotSpacing = 1000.0;
   double OffsetR = 1e-6, OffsetM = 1e-6; // m
   // Empty-space skipping: macro blocks of kBlockCells³ grid cells.
-  std::vector<unsigned char> EmptyBlock;
-  std::array<int, 3> Blocks{ { 1, 1, 1 } }, Cells{ { 1, 1, 1 } };
+  MajorantGrid Blocks;
+  std::array<int, 3> Cells{ { 1, 1, 1 } };
   Vector3 CellSize{ { 1.0, 1.0, 1.0 } }, BlockLower{ { 0.0, 0.0, 0.0 } };
   double BlockDiagonal = 0.0;
 };
-
-int ResolveThreads(int threads)
-{
-  if (threads > 0)
-  {
-    return threads;
-  }
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw > 0 ? static_cast<int>(hw) : 1;
-}
 
 void CheckRay(const Vector3& origin, const Vector3& direction)
 {
@@ -833,19 +776,19 @@ FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepS
   const int width = camera.GetWidth(), height = camera.GetHeight();
   FloatImage image(width, height);
 
-  std::atomic<int> nextRow{ 0 };
-  std::atomic<int> rowsDone{ 0 };
-  std::exception_ptr failure;
-  std::mutex failureMutex;
-  std::atomic<bool> failed{ false };
-
-  auto work = [&](bool reportProgress)
+  // Rows are handed out dynamically; progress comes from the calling thread only.
+  std::function<void(std::size_t)> rowsDone;
+  if (progress)
   {
-    try
+    rowsDone = [&](std::size_t done) { progress(static_cast<double>(done) / height); };
+  }
+  ParallelFor(
+    static_cast<std::size_t>(std::max(0, height)), 1, threads,
+    [&](std::size_t begin, std::size_t end)
     {
       Integrator::Workspace workspace;
       std::vector<double> radiance;
-      for (int j = nextRow++; j < height && !failed; j = nextRow++)
+      for (int j = static_cast<int>(begin); j < static_cast<int>(end); ++j)
       {
         for (int i = 0; i < width; ++i)
         {
@@ -858,40 +801,9 @@ FloatImage RenderSingleScatteringPass(const RenderContext& context, double stepS
             pixel[c] = static_cast<float>(rgb[c]);
           }
         }
-        const int done = ++rowsDone;
-        if (reportProgress && progress)
-        {
-          progress(static_cast<double>(done) / height);
-        }
       }
-    }
-    catch (...)
-    {
-      std::lock_guard<std::mutex> lock(failureMutex);
-      if (!failure)
-      {
-        failure = std::current_exception();
-      }
-      failed = true;
-    }
-  };
-
-  const int count = std::min(ResolveThreads(threads), std::max(1, height));
-  std::vector<std::thread> workers;
-  workers.reserve(count - 1);
-  for (int k = 1; k < count; ++k)
-  {
-    workers.emplace_back(work, false);
-  }
-  work(true); // the calling thread works too and reports progress
-  for (std::thread& worker : workers)
-  {
-    worker.join();
-  }
-  if (failure)
-  {
-    std::rethrow_exception(failure);
-  }
+    },
+    rowsDone);
   if (progress)
   {
     progress(1.0);
