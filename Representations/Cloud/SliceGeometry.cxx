@@ -138,4 +138,69 @@ ShadowFrame ComputeShadowFrame(
   return frame;
 }
 
+bool ScreenRectangle(const std::vector<Vector3>& polygon, const double worldToNdc[16], int width,
+  int height, int rect[4])
+{
+  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+  for (const auto& point : polygon)
+  {
+    const double p[4] = { point[0], point[1], point[2], 1.0 };
+    double q[4];
+    for (int r = 0; r < 4; ++r)
+    {
+      const double* row = worldToNdc + 4 * r;
+      q[r] = row[0] * p[0] + row[1] * p[1] + row[2] * p[2] + row[3] * p[3];
+    }
+    if (q[3] <= 1e-9)
+    {
+      return false;
+    }
+    for (int k = 0; k < 2; ++k)
+    {
+      lo[k] = std::min(lo[k], q[k] / q[3]);
+      hi[k] = std::max(hi[k], q[k] / q[3]);
+    }
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
+  const int y0 =
+    std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
+  const int x1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
+  const int y1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
+  rect[0] = x0;
+  rect[1] = y0;
+  rect[2] = std::max(x1 - x0, 0);
+  rect[3] = std::max(y1 - y0, 0);
+  return true;
+}
+
+// Texels (x, y, width, height) of the size x size shadow surface covering the
+// polygon's projection along the sun, with a texel of margin.
+void ShadowRectangle(
+  const std::vector<Vector3>& polygon, const ShadowFrame& frame, int size, int rect[4])
+{
+  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
+  for (const auto& point : polygon)
+  {
+    const Vector3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
+      point[2] - frame.Origin[2] } };
+    const double st[2] = { Dot(q, frame.U) / frame.Width * size,
+      Dot(q, frame.W) / frame.Height * size };
+    for (int k = 0; k < 2; ++k)
+    {
+      lo[k] = std::min(lo[k], st[k]);
+      hi[k] = std::max(hi[k], st[k]);
+    }
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(lo[0])) - 1, 0, size);
+  const int y0 = std::clamp(static_cast<int>(std::floor(lo[1])) - 1, 0, size);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(hi[0])) + 1, 0, size);
+  const int y1 = std::clamp(static_cast<int>(std::ceil(hi[1])) + 1, 0, size);
+  rect[0] = x0;
+  rect[1] = y0;
+  rect[2] = std::max(x1 - x0, 0);
+  rect[3] = std::max(y1 - y0, 0);
+}
+
+// The GL state the passes change, restored (in reverse order) when the frame ends.
+
 } // namespace nimbus

@@ -80,6 +80,18 @@ struct NIMBUSREPRESENTATIONS_EXPORT ShadowFrame
 NIMBUSREPRESENTATIONS_EXPORT ShadowFrame ComputeShadowFrame(
   const std::vector<Vector3>& corners, const Vector3& toSun, double margin);
 
+/// Scissor rectangles: a slice's passes only touch the pixels (and shadow texels)
+/// onto which its polygon (SlicePolygon) projects; outside it the density is zero.
+/// Pixels (x, y, width, height) of a width x height viewport covering the
+/// projection of `polygon` by `worldToNdc` (row-major 4 x 4, vtkMatrix4x4's element
+/// order), with a pixel of margin, clamped to the viewport; false when a vertex is
+/// behind the eye (no finite rectangle).
+NIMBUSREPRESENTATIONS_EXPORT bool ScreenRectangle(const std::vector<Vector3>& polygon,
+  const double worldToNdc[16], int width, int height, int rect[4]);
+/// Texels (x, y, width, height) of the size x size shadow surface covering the
+/// projection of `polygon` along the sun onto `frame`, with a texel of margin, clamped.
+NIMBUSREPRESENTATIONS_EXPORT void ShadowRectangle(
+  const std::vector<Vector3>& polygon, const ShadowFrame& frame, int size, int rect[4]);
 } // namespace nimbus
 
 #endif

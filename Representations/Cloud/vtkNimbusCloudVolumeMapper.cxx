@@ -134,73 +134,6 @@ void UseSliceBlend(vtkOpenGLState* state, bool backToFront)
   }
 }
 
-// Scissor rectangles: each slice's passes only touch the pixels (and shadow
-// texels) onto which the polygon "slice plane cut by the box" projects; outside
-// it the density is zero.
-
-// Pixels (x, y, width, height) of a width x height viewport covering the
-// polygon's projection, with a pixel of margin; false when a vertex is behind the
-// eye (no finite rectangle).
-bool ScreenRectangle(const std::vector<nimbus::Vector3>& polygon, vtkMatrix4x4* worldToNdc,
-  int width, int height, int rect[4])
-{
-  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
-  for (const auto& point : polygon)
-  {
-    const double p[4] = { point[0], point[1], point[2], 1.0 };
-    double q[4];
-    worldToNdc->MultiplyPoint(p, q);
-    if (q[3] <= 1e-9)
-    {
-      return false;
-    }
-    for (int k = 0; k < 2; ++k)
-    {
-      lo[k] = std::min(lo[k], q[k] / q[3]);
-      hi[k] = std::max(hi[k], q[k] / q[3]);
-    }
-  }
-  const int x0 = std::clamp(static_cast<int>(std::floor((lo[0] + 1) * 0.5 * width)) - 1, 0, width);
-  const int y0 =
-    std::clamp(static_cast<int>(std::floor((lo[1] + 1) * 0.5 * height)) - 1, 0, height);
-  const int x1 = std::clamp(static_cast<int>(std::ceil((hi[0] + 1) * 0.5 * width)) + 1, 0, width);
-  const int y1 = std::clamp(static_cast<int>(std::ceil((hi[1] + 1) * 0.5 * height)) + 1, 0, height);
-  rect[0] = x0;
-  rect[1] = y0;
-  rect[2] = std::max(x1 - x0, 0);
-  rect[3] = std::max(y1 - y0, 0);
-  return true;
-}
-
-// Texels (x, y, width, height) of the size x size shadow surface covering the
-// polygon's projection along the sun, with a texel of margin.
-void ShadowRectangle(const std::vector<nimbus::Vector3>& polygon, const nimbus::ShadowFrame& frame,
-  int size, int rect[4])
-{
-  double lo[2] = { 1e30, 1e30 }, hi[2] = { -1e30, -1e30 };
-  for (const auto& point : polygon)
-  {
-    const nimbus::Vector3 q = { { point[0] - frame.Origin[0], point[1] - frame.Origin[1],
-      point[2] - frame.Origin[2] } };
-    const double st[2] = { nimbus::Dot(q, frame.U) / frame.Width * size,
-      nimbus::Dot(q, frame.W) / frame.Height * size };
-    for (int k = 0; k < 2; ++k)
-    {
-      lo[k] = std::min(lo[k], st[k]);
-      hi[k] = std::max(hi[k], st[k]);
-    }
-  }
-  const int x0 = std::clamp(static_cast<int>(std::floor(lo[0])) - 1, 0, size);
-  const int y0 = std::clamp(static_cast<int>(std::floor(lo[1])) - 1, 0, size);
-  const int x1 = std::clamp(static_cast<int>(std::ceil(hi[0])) + 1, 0, size);
-  const int y1 = std::clamp(static_cast<int>(std::ceil(hi[1])) + 1, 0, size);
-  rect[0] = x0;
-  rect[1] = y0;
-  rect[2] = std::max(x1 - x0, 0);
-  rect[3] = std::max(y1 - y0, 0);
-}
-
-// The GL state the passes change, restored (in reverse order) when the frame ends.
 struct SavedPassState
 {
   vtkOpenGLState::ScopedglViewport Viewport;
@@ -946,13 +879,14 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
     }
     int scissor[4];
     const bool scissored = !frame.OutsideRegions &&
-      ScreenRectangle(polygon, frame.WorldToNdc, frame.Width, frame.Height, scissor);
+      nimbus::ScreenRectangle(
+        polygon, frame.WorldToNdc->GetData(), frame.Width, frame.Height, scissor);
     this->RenderSliceFromEye(
       frame, sliceProgram, static_cast<float>(offset), scissored ? scissor : nullptr);
     if (shadowProgram)
     {
       int texels[4];
-      ShadowRectangle(polygon, frame.Shadow, this->ShadowSurfaceSize, texels);
+      nimbus::ShadowRectangle(polygon, frame.Shadow, this->ShadowSurfaceSize, texels);
       this->RenderSliceShadow(frame, shadowProgram, static_cast<float>(offset), texels);
     }
   }

@@ -204,3 +204,43 @@ TEST(SliceGeometry, SlicePolygonCutsTheBox)
   EXPECT_THROW(
     nimbus::SlicePolygon({ { { 0, 0, 0 } } }, { { 0, 0, 1 } }, 0.0), std::invalid_argument);
 }
+
+// The scissor rectangles cover the projected polygon with one pixel (texel) of
+// margin, stay inside the target, and refuse a polygon behind the eye.
+TEST(SliceGeometry, ScissorRectanglesCoverTheSlice)
+{
+  const std::vector<Vector3> square = { { { -0.5, -0.5, 0.0 } }, { { 0.5, -0.5, 0.0 } },
+    { { 0.5, 0.5, 0.0 } }, { { -0.5, 0.5, 0.0 } } };
+  // An orthographic "camera": NDC = world / 2 (x, y), w = 1.
+  const double half[16] = { 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  int rect[4];
+  ASSERT_TRUE(nimbus::ScreenRectangle(square, half, 100, 80, rect));
+  // NDC x in [-0.25, 0.25] -> pixels [37.5, 62.5] -> [36, 64) with the margin.
+  EXPECT_EQ(rect[0], 36);
+  EXPECT_EQ(rect[2], 64 - 36);
+  EXPECT_EQ(rect[1], 29); // NDC y in [-0.25, 0.25] over 80 rows: [30, 50] -> [29, 51)
+  EXPECT_EQ(rect[3], 51 - 29);
+  // A polygon larger than the view is clamped to it.
+  const double big[16] = { 10, 0, 0, 0, 0, 10, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  ASSERT_TRUE(nimbus::ScreenRectangle(square, big, 100, 80, rect));
+  EXPECT_EQ(rect[0], 0);
+  EXPECT_EQ(rect[1], 0);
+  EXPECT_EQ(rect[2], 100);
+  EXPECT_EQ(rect[3], 80);
+  // w <= 0: a vertex behind the eye.
+  const double behind[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -1, 0 };
+  EXPECT_FALSE(nimbus::ScreenRectangle(square, behind, 100, 80, rect));
+
+  // The shadow surface seen straight down onto the unit square at the origin.
+  nimbus::ShadowFrame frame;
+  frame.Origin = { { -1.0, -1.0, 0.0 } };
+  frame.Width = frame.Height = 2.0;
+  nimbus::ShadowRectangle(square, frame, 64, rect);
+  EXPECT_EQ(rect[0], 15); // s in [0.25, 0.75] of 64 texels: [16, 48] -> [15, 49)
+  EXPECT_EQ(rect[2], 49 - 15);
+  EXPECT_EQ(rect[1], 15);
+  EXPECT_EQ(rect[3], 49 - 15);
+  nimbus::ShadowRectangle(square, frame, 2, rect); // clamped to the surface
+  EXPECT_EQ(rect[0], 0);
+  EXPECT_EQ(rect[2], 2);
+}
