@@ -1,5 +1,6 @@
 #include "SceneJson.h"
 #include "Math.h"
+#include "SceneMigration.h"
 
 #include <nlohmann/json.hpp>
 
@@ -1001,70 +1002,6 @@ void WritePretty(const Json& v, int indent, std::string& out)
 //------------------------------------------------------------------------------
 namespace
 {
-/// Version 1 named the sun's and the air's parameters without their units;
-/// version 2 names them as Physics/Sun.h and Physics/Atmosphere.h do (and as the
-/// mapper, the sky, the Python API and the plugin do). A version-1 file is read by
-/// renaming these keys; nothing else changed.
-struct Version1Rename
-{
-  const char* Section;
-  const char* Version1;
-  const char* Version2;
-};
-constexpr Version1Rename kVersion1Renames[] = {
-  { "sun", "azimuth", "azimuth_degrees" },
-  { "sun", "elevation", "elevation_degrees" },
-  { "sun", "temperature", "temperature_kelvin" },
-  { "atmosphere", "scene_altitude", "scene_altitude_metres" },
-  { "atmosphere", "earth_radius", "earth_radius_metres" },
-  { "atmosphere", "top_radius", "top_radius_metres" },
-  { "atmosphere", "rayleigh_scattering_550", "rayleigh_scattering_per_metre" },
-  { "atmosphere", "rayleigh_scale_height", "rayleigh_scale_height_metres" },
-  { "atmosphere", "mie_scattering", "mie_scattering_per_metre" },
-  { "atmosphere", "mie_scale_height", "mie_scale_height_metres" },
-};
-constexpr int kFirstFormatVersion = 1;
-
-/// Renames a version-1 document's keys to their version-2 names, in place. A
-/// version-2 name in a version-1 file is an error (it was unknown in version 1).
-void MigrateVersion1(Json& root)
-{
-  for (const Version1Rename& rename : kVersion1Renames)
-  {
-    if (!root.contains(rename.Section) || !root[rename.Section].is_object())
-    {
-      continue; // a missing or malformed section fails later, as in version 2
-    }
-    Json& section = root[rename.Section];
-    if (section.contains(rename.Version2))
-    {
-      Fail(std::string("scene.") + rename.Section + "." + rename.Version2,
-        std::string("unknown key in a version-1 file (version 1 calls it \"") + rename.Version1 +
-          "\"; version 2 \"" + rename.Version2 + "\")");
-    }
-    if (section.contains(rename.Version1))
-    {
-      section[rename.Version2] = section[rename.Version1];
-      section.erase(rename.Version1);
-    }
-  }
-}
-
-/// A message about a migrated version-1 file in the file's own words.
-std::string InVersion1Words(std::string message)
-{
-  for (const Version1Rename& rename : kVersion1Renames)
-  {
-    const std::string from = rename.Version2, to = rename.Version1;
-    for (std::size_t at = message.find(from); at != std::string::npos;
-         at = message.find(from, at + to.size()))
-    {
-      message.replace(at, from.size(), to);
-    }
-  }
-  return message;
-}
-
 SceneDescription ReadScene(
   const Json& root, const std::string& path, const std::string& baseDirectory)
 {
@@ -1127,7 +1064,7 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
     Fail(path, "expected an object, got " + Describe(root));
   }
   // The version first: a newer file may have keys this reader does not know.
-  const std::string versions = "versions " + std::to_string(kFirstFormatVersion) + " to " +
+  const std::string versions = "versions " + std::to_string(kFirstSceneFormatVersion) + " to " +
     std::to_string(SceneDescription::kFormatVersion);
   if (!root.contains("nimbus_scene"))
   {
@@ -1150,14 +1087,14 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
   }
   if (number == "1")
   {
-    MigrateVersion1(root);
+    MigrateSceneVersion1(root);
     try
     {
       return ReadScene(root, path, baseDirectory);
     }
     catch (const std::invalid_argument& error)
     {
-      throw std::invalid_argument(InVersion1Words(error.what()));
+      throw std::invalid_argument(InSceneVersion1Words(error.what()));
     }
   }
   return ReadScene(root, path, baseDirectory);
