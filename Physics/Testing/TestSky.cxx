@@ -9,6 +9,7 @@
 // docs/sky.md for the table); units: radiance relative to the sun (Y = 1).
 #include "Math.h"
 #include "Sky.h"
+#include "SkyTesting.h"
 
 #include <gtest/gtest.h>
 
@@ -25,7 +26,9 @@ using nimbus::SkyModel;
 using nimbus::SkyParameters;
 using nimbus::SkyViewLut;
 using nimbus::Vector3;
-using Rgb = std::array<double, 3>;
+using nimbus::testing::RelativeError;
+using nimbus::testing::Rgb;
+using nimbus::testing::Y;
 
 using nimbus::kDegree;
 using nimbus::kPi;
@@ -35,56 +38,18 @@ Vector3 Direction(double elevationDeg, double azimuthDeg)
   return nimbus::SunDirection(elevationDeg, azimuthDeg);
 }
 
-double Y(const Rgb& c)
-{
-  return nimbus::LinearSrgbLuminance(c);
-}
-
 bool Finite(const Rgb& c)
 {
   return std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]);
 }
 
-/// One full model (multiple scattering, albedo 0.3) and one single-scattering model
-/// (albedo 0, K = 1), shared by the tests (built once).
-const SkyModel& FullModel()
-{
-  static const SkyModel model{ SkyParameters() };
-  return model;
-}
-
-const SkyModel& SingleModel()
-{
-  static const SkyModel model{ []
-    {
-      SkyParameters p;
-      p.ScatteringOrders = 1;
-      p.GroundAlbedo = 0.0;
-      return p;
-    }() };
-  return model;
-}
-
-/// |a - b| per channel relative to the reference luminance (so that a dim channel
-/// at twilight does not count as a large error), maximum over channels; the
-/// luminance is floored at `floor` (absolute).
-double RelativeError(const Rgb& a, const Rgb& ref, double floor = 1e-30)
-{
-  const double y = std::max(Y(ref), floor);
-  double e = 0.0;
-  for (int c = 0; c < 3; ++c)
-  {
-    e = std::max(e, std::abs(a[c] - ref[c]) / y);
-  }
-  return e;
-}
 } // namespace
 
 // The transmittance table (256 x 64 optical lengths) against Atmosphere's exact
 // optical lengths, over r in [R, R_top] and every mu above the horizon.
 TEST(Sky, TransmittanceTableInterpolation)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   const double R = model.GetParameters().Atmosphere.EarthRadiusMetres;
   const double top = model.GetParameters().Atmosphere.TopRadiusMetres;
   const nimbus::Atmosphere& air = model.GetAtmosphere();
@@ -123,7 +88,7 @@ TEST(Sky, TransmittanceTableInterpolation)
 // scattering alone, most at twilight and at the horizon.
 TEST(Sky, MultipleScatteringOrders)
 {
-  const SkyModel& full = FullModel();
+  const SkyModel& full = nimbus::testing::FullSkyModel();
   for (double elevation : { 45.0, 5.0, -4.0 })
   {
     const std::vector<double> orders = full.OrderMeanRadiance(std::sin(elevation * kDegree));
@@ -135,7 +100,7 @@ TEST(Sky, MultipleScatteringOrders)
     }
     std::printf("\n");
   }
-  const SkyModel& single = SingleModel();
+  const SkyModel& single = nimbus::testing::SingleScatteringSkyModel();
   for (double elevation : { 60.0, 10.0, 0.0, -4.0, -8.0 })
   {
     const Vector3 s = Direction(elevation, 0.0);
@@ -172,7 +137,7 @@ TEST(Sky, MultipleScatteringOrders)
 // Zenith luminance against sun elevation: monotone, and its shape against Preetham.
 TEST(Sky, ZenithLuminanceAgainstPreetham)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   double previous = -1.0;
   bool monotone = true;
   std::vector<double> elevations, ours, preetham;
@@ -220,7 +185,7 @@ TEST(Sky, ZenithLuminanceAgainstPreetham)
 // sRGB primaries).
 TEST(Sky, PublishedBehaviour)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   // Blue zenith at noon: B/R of the zenith.
   {
     const Rgb z = model.Radiance(0.0, { { 0, 0, 1 } }, Direction(60.0, 0.0));
@@ -259,7 +224,7 @@ TEST(Sky, PublishedBehaviour)
 // Stability: finite, non-negative (luminance) radiance at the extremes.
 TEST(Sky, Extremes)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   const double alts[] = { 0.0, 10000.0, 59999.0, 100000.0, 1.0e6 };
   for (double altitude : alts)
   {
@@ -305,7 +270,7 @@ TEST(Sky, Extremes)
 // and down to -10 degrees.
 TEST(Sky, Continuity)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   for (double altitude : { 0.0, 2000.0, 30000.0 })
   {
     for (double elevation : { 30.0, 3.0, -3.0, -10.0 })
@@ -385,7 +350,7 @@ TEST(Sky, Continuity)
 // Aerial perspective: the table against the direct march.
 TEST(Sky, AerialPerspectiveTable)
 {
-  const SkyModel& model = FullModel();
+  const SkyModel& model = nimbus::testing::FullSkyModel();
   for (double elevation : { 45.0, 3.0 })
   {
     const nimbus::AerialPerspectiveLut table(model, elevation, 500.0);

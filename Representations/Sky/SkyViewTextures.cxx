@@ -4,7 +4,10 @@
 #include "Sky.h"
 #include "vtkMath.h"
 #include "vtkNimbusSky.h"
+#include "vtkOpenGLQuadHelper.h"
+#include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 
@@ -33,6 +36,23 @@ vtkTextureObject* SkyViewTextures::NewLinearTexture(vtkOpenGLRenderWindow* windo
 std::string SkyViewTextures::Substitute(const char* source)
 {
   return nimbus::WithShaderLibrary(source);
+}
+
+vtkShaderProgram* SkyViewTextures::ReadyQuad(vtkOpenGLRenderWindow* window,
+  std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* fragmentSource)
+{
+  if (!quad)
+  {
+    quad = std::make_unique<vtkOpenGLQuadHelper>(window,
+      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(),
+      Substitute(fragmentSource).c_str(), "");
+  }
+  else
+  {
+    window->GetShaderCache()->ReadyShaderProgram(quad->Program);
+  }
+  vtkShaderProgram* program = quad->Program;
+  return program && program->GetCompiled() ? program : nullptr;
 }
 
 double SkyViewTextures::CameraAltitude(vtkNimbusSky* sky, double z)

@@ -6,9 +6,11 @@
 #define nimbus_SkyViewTextures_h
 
 #include <array>
+#include <memory>
 #include <string>
 
 class vtkNimbusSky;
+class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
 class vtkShaderProgram;
 class vtkTextureObject;
@@ -42,6 +44,10 @@ public:
   /// `source` with the GLSL library and nimbusSkyView.glsl put where its lines
   /// `//NIMBUS::Library` and `//NIMBUS::SkyView` are (nimbus::WithShaderLibrary).
   static std::string Substitute(const char* source);
+  /// The full-screen quad drawing `fragmentSource` (the GLSL library substituted):
+  /// created on first use, its program made current; null when it did not compile.
+  static vtkShaderProgram* ReadyQuad(vtkOpenGLRenderWindow* window,
+    std::unique_ptr<vtkOpenGLQuadHelper>& quad, const char* fragmentSource);
   /// A float texture with linear filtering and clamp-to-edge wrapping.
   static vtkTextureObject* NewLinearTexture(vtkOpenGLRenderWindow* window);
 

@@ -9,9 +9,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLQuadHelper.h"
-#include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
-#include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
@@ -113,18 +111,9 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
     vtkErrorMacro("Sky tables: " << error);
     return 0;
   }
-  if (!in.Quad)
-  {
-    in.Quad = std::make_unique<vtkOpenGLQuadHelper>(window,
-      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(),
-      nimbus::SkyViewTextures::Substitute(vtkNimbusSkyBackgroundFS).c_str(), "");
-  }
-  else
-  {
-    window->GetShaderCache()->ReadyShaderProgram(in.Quad->Program);
-  }
-  vtkShaderProgram* program = in.Quad->Program;
-  if (!program || !program->GetCompiled())
+  vtkShaderProgram* program =
+    nimbus::SkyViewTextures::ReadyQuad(window, in.Quad, vtkNimbusSkyBackgroundFS);
+  if (!program)
   {
     vtkErrorMacro("The sky background shader did not compile.");
     return 0;

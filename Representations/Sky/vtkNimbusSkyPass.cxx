@@ -13,9 +13,7 @@
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
-#include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
-#include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkRenderState.h"
 #include "vtkRenderer.h"
@@ -23,6 +21,7 @@
 #include "vtkTextureObject.h"
 
 #include <array>
+#include <memory>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusSkyPass);
@@ -37,7 +36,7 @@ struct vtkNimbusSkyPass::Internals
   std::array<vtkTextureObject*, 4> AerialTextures{ { nullptr, nullptr, nullptr, nullptr } };
   const nimbus::AerialPerspectiveLut* Aerial = nullptr; // the uploaded table
   int AerialBuilds = -1;
-  vtkOpenGLQuadHelper* Quad = nullptr;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
 
   void Release(vtkWindow* w)
   {
@@ -63,8 +62,11 @@ struct vtkNimbusSkyPass::Internals
       this->Framebuffer->Delete();
       this->Framebuffer = nullptr;
     }
-    delete this->Quad;
-    this->Quad = nullptr;
+    if (this->Quad)
+    {
+      this->Quad->ReleaseGraphicsResources(w);
+      this->Quad.reset();
+    }
     this->Aerial = nullptr;
     this->AerialBuilds = -1;
   }
@@ -214,18 +216,9 @@ void vtkNimbusSkyPass::DrawSky(vtkRenderer* renderer, int x, int y, int width, i
 {
   Internals& in = *this->Internal;
   auto* window = static_cast<vtkOpenGLRenderWindow*>(renderer->GetRenderWindow());
-  if (!in.Quad)
-  {
-    in.Quad = new vtkOpenGLQuadHelper(window,
-      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(),
-      nimbus::SkyViewTextures::Substitute(vtkNimbusSkyPassFS).c_str(), "");
-  }
-  else
-  {
-    window->GetShaderCache()->ReadyShaderProgram(in.Quad->Program);
-  }
-  vtkShaderProgram* program = in.Quad->Program;
-  if (!program || !program->GetCompiled())
+  vtkShaderProgram* program =
+    nimbus::SkyViewTextures::ReadyQuad(window, in.Quad, vtkNimbusSkyPassFS);
+  if (!program)
   {
     vtkErrorMacro("vtkNimbusSkyPass: the sky shader did not compile");
     return;

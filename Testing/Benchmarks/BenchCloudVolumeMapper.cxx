@@ -10,8 +10,8 @@
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
 // under Testing/with-display.sh (needs an OpenGL context).
+#include "TestCumulus.h"
 #include "vtkNimbusCloudVolumeMapper.h"
-#include "vtkNimbusMetaballCloudSource.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -41,21 +41,6 @@ namespace
 int Frames = 5;
 int Width = 320;
 int Height = 240;
-
-vtkSmartPointer<vtkImageData> Cloud(int nx, int ny, int nz)
-{
-  vtkNew<vtkNimbusMetaballCloudSource> source;
-  source->SetDimensions(nx, ny, nz);
-  source->SetBounds(-1500, 1500, -1500, 1500, 800, 2800);
-  source->SetFootprintRadius(700);
-  source->SetBaseBallRadiusRange(350, 600);
-  source->SetTowerHeight(600);
-  source->SetBaseHeight(1000);
-  source->Update();
-  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
-  image->ShallowCopy(source->GetOutput());
-  return image;
-}
 
 struct Bench
 {
@@ -184,7 +169,7 @@ int main(int argc, char* argv[])
     std::printf("\n| frame | ms | / empty |\n|---|---|---|\n| empty | %.2f | 1 |\n"
                 "| sky background only | %.2f | %.1f |\n",
       empty, skyOnly, skyOnly / empty);
-    vtkSmartPointer<vtkImageData> c = Cloud(128, 128, 128);
+    vtkSmartPointer<vtkImageData> c = nimbus::testing::TestCumulus(128, 128, 128);
     std::printf("\n| cloud 128^3 | mapper's own atmosphere, ms | over the sky, ms | sky adds "
                 "|\n|---|---|---|---|\n");
     const auto overSky = [&sky](vtkNimbusCloudVolumeMapper* m) { m->SetSkyBackground(sky); };
@@ -200,7 +185,7 @@ int main(int argc, char* argv[])
     return EXIT_SUCCESS;
   }
 
-  vtkSmartPointer<vtkImageData> c128 = Cloud(128, 128, 128);
+  vtkSmartPointer<vtkImageData> c128 = nimbus::testing::TestCumulus(128, 128, 128);
   std::printf("\n| volume | slices | full scene | cloud only (no air, no ground) | unlit floor | "
               "cloud only / floor | full / floor |\n|---|---|---|---|---|---|---|\n");
   for (int slices : { 64, 128, 256, 512 })
@@ -213,7 +198,7 @@ int main(int argc, char* argv[])
   }
   for (const auto& dims : std::vector<std::array<int, 3>>{ { 64, 64, 64 }, { 256, 256, 64 } })
   {
-    vtkSmartPointer<vtkImageData> c = Cloud(dims[0], dims[1], dims[2]);
+    vtkSmartPointer<vtkImageData> c = nimbus::testing::TestCumulus(dims[0], dims[1], dims[2]);
     const double full = TimeSvs(c, 256, none);
     const double cloud = TimeSvs(c, 256, cloudOnly);
     const double floor = TimeSvs(c, 256, unlit);

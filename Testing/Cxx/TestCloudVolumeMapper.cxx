@@ -9,6 +9,7 @@
 #include "vtkNimbusMetaballCloudSource.h"
 
 #include "ImageComparison.h"
+#include "TestCumulus.h"
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
@@ -45,18 +46,7 @@ constexpr int kHeight = 150;
 
 vtkSmartPointer<vtkImageData> MakeCloud(int seed = 1)
 {
-  vtkNew<vtkNimbusMetaballCloudSource> source;
-  source->SetDimensions(48, 48, 32);
-  source->SetBounds(-1500, 1500, -1500, 1500, 800, 2800);
-  source->SetSeed(seed);
-  source->SetFootprintRadius(700);
-  source->SetBaseBallRadiusRange(350, 600);
-  source->SetTowerHeight(600);
-  source->SetBaseHeight(1000);
-  source->Update();
-  vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
-  image->DeepCopy(source->GetOutput());
-  return image;
+  return nimbus::testing::TestCumulus(48, 48, 32, seed);
 }
 
 /// A scene: the mapper, one renderer, a window; Render() returns RGB bytes.

@@ -7,6 +7,7 @@
 // docs/sky.md for the table); units: radiance relative to the sun (Y = 1).
 #include "Math.h"
 #include "Sky.h"
+#include "SkyTesting.h"
 
 #include "DensityGrid.h"
 #include "RenderContext.h"
@@ -27,31 +28,15 @@ using nimbus::SkyModel;
 using nimbus::SkyParameters;
 using nimbus::SkyViewLut;
 using nimbus::Vector3;
-using Rgb = std::array<double, 3>;
+using nimbus::testing::RelativeError;
+using nimbus::testing::Rgb;
+using nimbus::testing::Y;
 
 using nimbus::kDegree;
 
 Vector3 Direction(double elevationDeg, double azimuthDeg)
 {
   return nimbus::SunDirection(elevationDeg, azimuthDeg);
-}
-
-double Y(const Rgb& c)
-{
-  return nimbus::LinearSrgbLuminance(c);
-}
-
-/// A single-scattering model (albedo 0, K = 1).
-const SkyModel& SingleModel()
-{
-  static const SkyModel model{ []
-    {
-      SkyParameters p;
-      p.ScatteringOrders = 1;
-      p.GroundAlbedo = 0.0;
-      return p;
-    }() };
-  return model;
 }
 
 /// Reference context: empty grid, atmosphere, no ground plane (the earth sphere is black).
@@ -68,19 +53,6 @@ std::unique_ptr<nimbus::RenderContext> ReferenceContext(double sunElevation, dou
       std::vector<float>(8, 0.0f)));
 }
 
-/// |a - b| per channel relative to the reference luminance (so that a dim channel
-/// at twilight does not count as a large error), maximum over channels; the
-/// luminance is floored at `floor` (absolute).
-double RelativeError(const Rgb& a, const Rgb& ref, double floor = 1e-30)
-{
-  const double y = std::max(Y(ref), floor);
-  double e = 0.0;
-  for (int c = 0; c < 3; ++c)
-  {
-    e = std::max(e, std::abs(a[c] - ref[c]) / y);
-  }
-  return e;
-}
 } // namespace
 
 // Single scattering, LUT path (sky-view table of a K = 1 model) against the reference
@@ -92,7 +64,7 @@ double RelativeError(const Rgb& a, const Rgb& ref, double floor = 1e-30)
 // of directions is printed).
 TEST(Sky, SingleScatteringAgainstReference)
 {
-  const SkyModel& model = SingleModel();
+  const SkyModel& model = nimbus::testing::SingleScatteringSkyModel();
   for (double elevation : { 90.0, 45.0, 10.0, 2.0, -4.0 })
   {
     const auto context = ReferenceContext(elevation, 0.0);
