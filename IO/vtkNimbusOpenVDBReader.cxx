@@ -1,5 +1,6 @@
 #include "vtkNimbusOpenVDBReader.h"
 
+#include "MemoryBudget.h"
 #include "VdbGrids.h"
 
 #include "vtkCommand.h"
@@ -15,7 +16,12 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <new>
 #include <set>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -109,7 +115,8 @@ void vtkNimbusOpenVDBReader::Internals::Refresh(const std::string& path)
 vtkStandardNewMacro(vtkNimbusOpenVDBReader);
 
 vtkNimbusOpenVDBReader::vtkNimbusOpenVDBReader()
-  : Internal(new Internals)
+  : MemoryBudgetMiB(nimbus::DefaultMemoryBudgetMiB())
+  , Internal(new Internals)
 {
   this->SetNumberOfInputPorts(0);
   this->SetNumberOfOutputPorts(1);
@@ -296,6 +303,11 @@ int vtkNimbusOpenVDBReader::RequestInformation(
     vtkErrorMacro(<< e.what());
     return 0;
   }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< "cannot read the grids of " << this->FileName << ": " << e.what());
+    return 0;
+  }
   const vdb::TransformInfo& t = plan.Reference->Transform;
   int extent[6];
   for (int c = 0; c < 3; ++c)
@@ -315,6 +327,35 @@ int vtkNimbusOpenVDBReader::RequestInformation(
   return 1;
 }
 
+namespace
+{
+/// Bytes of one value of a grid as OpenVDB holds it in memory.
+uint64_t ValueBytes(vdb::ValueKind kind)
+{
+  switch (kind)
+  {
+    case vdb::ValueKind::Float:
+      return 4;
+    case vdb::ValueKind::Double:
+      return 8;
+    case vdb::ValueKind::Vec3Float:
+      return 12;
+    case vdb::ValueKind::Vec3Double:
+      return 24;
+    default:
+      return 0;
+  }
+}
+
+bool LooksLikeDensity(const vdb::GridInfo& g)
+{
+  std::string lower = g.Name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return g.GridClass == "fog volume" || lower.find("density") != std::string::npos;
+}
+}
+
 int vtkNimbusOpenVDBReader::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
@@ -330,41 +371,94 @@ int vtkNimbusOpenVDBReader::RequestData(
     vtkErrorMacro("FileName is not set: give the .vdb file to read");
     return 0;
   }
-  Internals::Plan plan;
+  // No exception leaves the pipeline: OpenVDB, the standard library and VTK's allocations
+  // all end here in an error and an empty output.
   try
   {
-    this->Internal->Refresh(this->FileName);
-    plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
+    if (this->ReadImage(output))
+    {
+      return 1;
+    }
   }
   catch (const vdb::Error& e)
   {
     vtkErrorMacro(<< e.what());
-    return 0;
   }
+  catch (const std::bad_alloc& e)
+  {
+    vtkErrorMacro(<< "out of memory reading " << this->FileName << " (" << e.what()
+                  << "); lower MemoryBudgetMiB or MaximumNumberOfVoxels, or select fewer grids");
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< "cannot read " << this->FileName << ": " << e.what());
+  }
+  output->Initialize();
+  return 0;
+}
 
-  // Refuse absurd images before allocating anything.
+int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
+{
+  this->Internal->Refresh(this->FileName);
+  const Internals::Plan plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
+
+  // Refuse absurd reads before allocating anything: the voxel limit counts every selected
+  // grid's values (points x grids), the memory budget every byte of the read.
   const uint64_t voxels = plan.Box.VoxelCount();
-  int components = 0;
+  uint64_t components = 0;
+  uint64_t workBytes = 0; // the largest grid's file bytes and tree, while it is read
   for (const auto* g : plan.Read)
   {
-    components += g->Components;
+    components += static_cast<uint64_t>(g->Components);
+    const uint64_t active = g->ActiveVoxelCount > 0 ? uint64_t(g->ActiveVoxelCount) : 0;
+    uint64_t tree = 0;
+    if (!nimbus::CheckedProduct({ active, ValueBytes(g->Kind) }, tree))
+    {
+      tree = UINT64_MAX / 2;
+    }
+    workBytes = std::max(workBytes, std::min(UINT64_MAX / 4, tree + uint64_t(g->FileBytes)));
   }
-  if (voxels > static_cast<uint64_t>(this->MaximumNumberOfVoxels))
+  std::ostringstream dims;
+  dims << (plan.Box.Max[0] - plan.Box.Min[0] + 1) << " x "
+       << (plan.Box.Max[1] - plan.Box.Min[1] + 1) << " x "
+       << (plan.Box.Max[2] - plan.Box.Min[2] + 1);
+  uint64_t values = 0;
+  const bool valuesFit =
+    nimbus::CheckedProduct({ voxels, static_cast<uint64_t>(plan.Read.size()) }, values);
+  if (!valuesFit || values > static_cast<uint64_t>(this->MaximumNumberOfVoxels))
   {
-    std::ostringstream dims;
-    dims << (plan.Box.Max[0] - plan.Box.Min[0] + 1) << " x "
-         << (plan.Box.Max[1] - plan.Box.Min[1] + 1) << " x "
-         << (plan.Box.Max[2] - plan.Box.Min[2] + 1);
+    std::ostringstream values_text;
+    if (valuesFit)
+    {
+      values_text << values;
+    }
+    else
+    {
+      values_text << "more than 2^64";
+    }
     vtkErrorMacro(<< "refusing to read " << this->FileName << ": the image would have "
-                  << dims.str() << " = " << voxels << " points (" << components
-                  << " float components, "
-                  << (static_cast<double>(voxels) * components * 4.0 / (1024.0 * 1024.0))
-                  << " MiB), more than MaximumNumberOfVoxels = " << this->MaximumNumberOfVoxels
-                  << "; raise MaximumNumberOfVoxels, select fewer grids or set BoundsGrid");
+                  << dims.str() << " = " << voxels << " points x " << plan.Read.size()
+                  << " grid(s) = " << values_text.str() << " voxels ("
+                  << nimbus::FormatBytes(double(voxels) * double(components) * 4.0)
+                  << "), more than MaximumNumberOfVoxels = " << this->MaximumNumberOfVoxels
+                  << " (all grids of the file together); raise MaximumNumberOfVoxels, select "
+                     "fewer grids or set BoundsGrid");
+    return 0;
+  }
+  const double budgetMiB =
+    this->MemoryBudgetMiB > 0.0 ? this->MemoryBudgetMiB : nimbus::DefaultMemoryBudgetMiB();
+  const double outputBytes = double(voxels) * double(components) * 4.0;
+  const std::string over = nimbus::OverBudgetMessage("reading " + std::string(this->FileName) +
+      " (" + dims.str() + " points, " + std::to_string(components) +
+      " float components in all, plus the largest grid while it is read)",
+    outputBytes + double(workBytes), budgetMiB * 1024.0 * 1024.0);
+  if (!over.empty())
+  {
+    vtkErrorMacro(<< over << "; raise MemoryBudgetMiB, select fewer grids or set BoundsGrid");
     return 0;
   }
 
-  // Say what happened to transforms, empty grids and unsupported grids.
+  // Say what happened to transforms, names, empty grids and unsupported grids.
   const vdb::TransformInfo& t = plan.Reference->Transform;
   if (!t.Note.empty())
   {
@@ -372,17 +466,41 @@ int vtkNimbusOpenVDBReader::RequestData(
                     << t.Note);
   }
   std::string unsupported;
+  std::map<std::string, std::vector<std::string>> repeated;
   for (const auto& g : this->Internal->Grids)
   {
     if (!g.Supported())
     {
       unsupported += (unsupported.empty() ? "" : ", ") + Quote(g.Name) + " (" + g.ValueType + ")";
     }
+    repeated[g.StoredName].push_back(Quote(g.Name));
   }
   if (!unsupported.empty())
   {
     vtkWarningMacro(<< "skipped grids of unsupported value type in " << this->FileName << ": "
                     << unsupported << "; only float, double, Vec3s and Vec3d grids are read");
+  }
+  for (const auto& r : repeated)
+  {
+    if (r.second.size() > 1 || (r.first.empty() && !r.second.empty()))
+    {
+      std::string list;
+      for (const auto& n : r.second)
+      {
+        list += (list.empty() ? "" : ", ") + n;
+      }
+      if (r.first.empty())
+      {
+        vtkWarningMacro(<< this->FileName << " has " << r.second.size()
+                        << " unnamed grid(s): listed as " << list);
+      }
+      else
+      {
+        vtkWarningMacro(<< this->FileName << " has " << r.second.size() << " grids named "
+                        << Quote(r.first) << ": all are listed, as " << list
+                        << " (OpenVDB's names for repeated grids, in file order)");
+      }
+    }
   }
   for (const auto* g : plan.Read)
   {
@@ -414,32 +532,19 @@ int vtkNimbusOpenVDBReader::RequestData(
     auto array = vtkSmartPointer<vtkFloatArray>::New();
     array->SetName(g->Name.c_str());
     array->SetNumberOfComponents(g->Components);
-    if (!array->Allocate(static_cast<vtkIdType>(voxels) * g->Components))
-    {
-      vtkErrorMacro(<< "cannot allocate " << voxels << " x " << g->Components << " floats for grid "
-                    << Quote(g->Name));
-      output->Initialize();
-      return 0;
-    }
+    // Within the budget (checked above), so VTK's allocation (which aborts on failure in
+    // this VTK) is not asked for more than the budget allows.
     array->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
+    array->Fill(0.0);
     names.push_back(g->Name);
     targets.push_back(array->GetPointer(0));
     arrays.push_back(array);
   }
   std::vector<std::string> resampled;
   vdb::TransformInfo exact = t;
-  try
-  {
-    vdb::ReadDense(
-      this->FileName, names, t, plan.Box, targets, &resampled,
-      [this](double f) { this->UpdateProgress(f); }, &exact);
-  }
-  catch (const vdb::Error& e)
-  {
-    vtkErrorMacro(<< e.what());
-    output->Initialize();
-    return 0;
-  }
+  vdb::ReadDense(
+    this->FileName, names, t, plan.Box, targets, &resampled,
+    [this](double f) { this->UpdateProgress(f); }, &exact);
   // The transform read with the voxels (bit-exact; see ReadDense).
   output->SetOrigin(exact.Origin.data());
   output->SetSpacing(exact.Spacing.data());
@@ -452,6 +557,25 @@ int vtkNimbusOpenVDBReader::RequestData(
                     << Quote(plan.Reference->Name)
                     << ": resampled trilinearly at the image points (values are interpolated; "
                        "read it alone, or set BoundsGrid to it, for its own voxels)");
+  }
+  // Values that are no density: said, with counts (they are read as they are).
+  for (size_t i = 0; i < arrays.size(); ++i)
+  {
+    nimbus::ValueCensus census = nimbus::TakeCensus(
+      arrays[i]->GetPointer(0), static_cast<std::size_t>(arrays[i]->GetNumberOfValues()));
+    const bool densityLike = arrays[i]->GetNumberOfComponents() == 1 && LooksLikeDensity(*plan.Read[i]);
+    if (!densityLike)
+    {
+      census.Negative = 0;
+    }
+    if (!census.AllFiniteNonNegative())
+    {
+      vtkWarningMacro(<< "grid " << Quote(plan.Read[i]->Name) << " of " << this->FileName
+                      << " has " << nimbus::DescribeCensus(census) << " (of "
+                      << arrays[i]->GetNumberOfValues() << ")"
+                      << (census.Negative ? "; negative values are no density" : "")
+                      << ": they are read as they are; clean them before rendering");
+    }
   }
   for (size_t i = 0; i < arrays.size(); ++i)
   {
@@ -477,6 +601,7 @@ void vtkNimbusOpenVDBReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "BoundsGrid: " << (this->BoundsGrid ? this->BoundsGrid : "(union)") << "\n";
   os << indent << "MaximumNumberOfVoxels: " << this->MaximumNumberOfVoxels << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
   os << indent << "Grids:";
   for (int i = 0; i < this->Internal->Selection->GetNumberOfArrays(); ++i)
   {

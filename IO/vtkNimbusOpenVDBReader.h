@@ -19,9 +19,18 @@
  * — each case raises a warning that says what was done (docs/openvdb.md).
  *
  * Grids of other types (bool, int32, int64, string, points, ...) are listed in a warning
- * and skipped. Images with more than MaximumNumberOfVoxels points are refused before any
- * memory is allocated. Grid names and extents are known after UpdateInformation() without
+ * and skipped. Grid names and extents are known after UpdateInformation() without
  * reading voxels (from the file's bounding-box metadata).
+ *
+ * Bad input ends in an error and an empty output, never in a crash or garbage: the file's
+ * layout is checked before OpenVDB reads it (a truncated file is reported with the byte
+ * where it ends and the byte a grid needs), each grid is read from its own bytes only,
+ * the image is refused before any allocation when it has more than MaximumNumberOfVoxels
+ * values (points x selected grids, all grids of the file together) or needs more memory
+ * than MemoryBudgetMiB, and no exception leaves RequestData. NaN and infinite values (and
+ * negative values in fog volumes and grids named like density) are read as they are and
+ * counted in a warning. Grids that share a name are all listed, the repeats with OpenVDB's
+ * own suffix: "density", "density[1]" (warned). See docs/openvdb.md.
  */
 #ifndef vtkNimbusOpenVDBReader_h
 #define vtkNimbusOpenVDBReader_h
@@ -32,6 +41,7 @@
 #include <memory> // for std::unique_ptr
 
 class vtkDataArraySelection;
+class vtkImageData;
 class vtkStringArray;
 
 class NIMBUSIOOPENVDB_EXPORT vtkNimbusOpenVDBReader : public vtkImageAlgorithm
@@ -72,10 +82,21 @@ public:
   ///@}
 
   ///@{
-  /// Largest number of image points read; a larger image is refused with an error before
-  /// allocating (memory is 4 bytes x components x points per grid). Default 512^3.
+  /// Largest number of voxels read from one file: image points x selected grids (all
+  /// grids together, so eight grids of 512^3 count 8 x 512^3). A larger read is refused
+  /// with an error before allocating. Default 512^3.
   vtkSetClampMacro(MaximumNumberOfVoxels, vtkIdType, 1, VTK_ID_MAX);
   vtkGetMacro(MaximumNumberOfVoxels, vtkIdType);
+  ///@}
+
+  ///@{
+  /// Memory budget of one read in MiB: the output arrays (4 bytes x components x points,
+  /// all grids) plus the largest grid's file bytes and tree, estimated before anything is
+  /// allocated; a read over it is refused with an error. Default (and any value <= 0):
+  /// nimbus::DefaultMemoryBudgetMiB(), half the physical memory, at most 3/4 of the
+  /// address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
   ///@}
 
 protected:
@@ -84,10 +105,13 @@ protected:
 
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  /// The read itself; may throw (RequestData catches everything).
+  int ReadImage(vtkImageData* output);
 
   char* FileName = nullptr;
   char* BoundsGrid = nullptr;
   vtkIdType MaximumNumberOfVoxels = vtkIdType(512) * 512 * 512;
+  double MemoryBudgetMiB;
 
 private:
   vtkNimbusOpenVDBReader(const vtkNimbusOpenVDBReader&) = delete;

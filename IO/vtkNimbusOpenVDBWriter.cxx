@@ -2,6 +2,7 @@
 
 #include "VdbGrids.h"
 
+#include "vtkAbstractArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
@@ -13,6 +14,8 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 
+#include <cerrno>
+#include <cmath>
 #include <memory>
 #include <set>
 #include <string>
@@ -120,34 +123,81 @@ void vtkNimbusOpenVDBWriter::WriteData()
     }
   }
 
+  if (!std::isfinite(this->Background))
+  {
+    vtkErrorMacro(<< "Background must be a finite number (it is " << this->Background
+                  << "): it is the value of every inactive voxel; nothing written to "
+                  << this->FileName);
+    this->SetErrorCode(vtkErrorCode::UnknownError);
+    return;
+  }
+
+  // Grid names: every point array keeps its name; a cell array keeps its name unless a
+  // point array (or an earlier cell array's new name) has it, then it becomes
+  // "<name>_cells", or "<name>_cells_2", "_cells_3"... the first that no array has.
+  std::set<std::string> reserved;
+  for (vtkDataSetAttributes* data :
+    { static_cast<vtkDataSetAttributes*>(input->GetPointData()),
+      static_cast<vtkDataSetAttributes*>(input->GetCellData()) })
+  {
+    for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+    {
+      vtkAbstractArray* array = data->GetAbstractArray(i);
+      if (array && array->GetName())
+      {
+        reserved.insert(array->GetName());
+      }
+    }
+  }
   std::vector<vdb::FieldToWrite> fields;
   std::vector<std::unique_ptr<std::vector<float>>> storage;
   std::set<std::string> names;
-  std::string skipped;
+  std::string skipped, renamed;
+  int unnamed = 0;
   auto collect = [&](vtkDataSetAttributes* data, const vdb::IndexBox& box,
                    const vdb::TransformInfo& transform, bool cells)
   {
+    const char* kind = cells ? "cell" : "point";
     const vtkIdType expected = static_cast<vtkIdType>(box.VoxelCount());
     for (int i = 0; i < data->GetNumberOfArrays(); ++i)
     {
-      vtkDataArray* array = data->GetArray(i);
-      if (!array || !array->GetName() ||
-        std::string(array->GetName()) == vtkDataSetAttributes::GhostArrayName())
+      vtkAbstractArray* abstract = data->GetAbstractArray(i);
+      if (!abstract)
       {
         continue;
       }
-      const int nc = array->GetNumberOfComponents();
-      if ((nc != 1 && nc != 3) || array->GetNumberOfTuples() != expected)
+      if (abstract->GetName() &&
+        std::string(abstract->GetName()) == vtkDataSetAttributes::GhostArrayName())
       {
-        skipped += std::string(skipped.empty() ? "" : ", ") + "'" + array->GetName() + "' (" +
-          std::to_string(nc) + " components)";
+        continue;
+      }
+      const int nc = abstract->GetNumberOfComponents();
+      if (!abstract->GetName() || !*abstract->GetName())
+      {
+        ++unnamed;
+        skipped += std::string(skipped.empty() ? "" : ", ") + "an unnamed " + kind + " array (" +
+          std::to_string(nc) + " components; a grid needs a name)";
+        continue;
+      }
+      vtkDataArray* array = vtkDataArray::SafeDownCast(abstract);
+      if (!array || (nc != 1 && nc != 3) || array->GetNumberOfTuples() != expected)
+      {
+        skipped += std::string(skipped.empty() ? "" : ", ") + "'" + abstract->GetName() + "' (" +
+          (array ? std::to_string(nc) + " components" : std::string("not numeric")) + ")";
         continue;
       }
       vdb::FieldToWrite field;
       field.Name = array->GetName();
       if (cells && names.count(field.Name))
       {
-        field.Name += "_cells";
+        std::string name = field.Name + "_cells";
+        for (int n = 2; reserved.count(name) || names.count(name); ++n)
+        {
+          name = field.Name + "_cells_" + std::to_string(n);
+        }
+        renamed += std::string(renamed.empty() ? "" : ", ") + "cell array '" + field.Name +
+          "' -> grid '" + name + "'";
+        field.Name = name;
       }
       names.insert(field.Name);
       field.Components = nc;
@@ -165,27 +215,63 @@ void vtkNimbusOpenVDBWriter::WriteData()
   {
     collect(input->GetCellData(), cellBox, cellTransform, true);
   }
-  if (!skipped.empty())
+  if (!renamed.empty())
   {
-    vtkWarningMacro(<< "arrays not written (only 1- and 3-component arrays become grids): "
+    vtkWarningMacro(<< "grid names of " << this->FileName
+                    << " (a point array has the same name): " << renamed);
+  }
+  if (!fields.empty() && !skipped.empty())
+  {
+    vtkWarningMacro(<< "arrays not written (only named 1- and 3-component numeric arrays "
+                       "become grids): "
                     << skipped);
   }
   if (fields.empty())
   {
     vtkErrorMacro(<< "nothing to write to " << this->FileName
-                  << ": the image has no 1- or 3-component numeric point or cell arrays");
+                  << ": the image has no named 1- or 3-component numeric point or cell array"
+                  << (skipped.empty() ? std::string(" (it has no arrays)")
+                                      : " (it has: " + skipped + ")"));
     this->SetErrorCode(vtkErrorCode::UnknownError);
     return;
   }
+  (void)unnamed;
+  std::vector<std::string> notes;
+  int errorNumber = 0;
   try
   {
-    this->NumberOfActiveVoxels = static_cast<vtkIdType>(vdb::WriteFields(
-      this->FileName, fields, this->Compress, [this](double f) { this->UpdateProgress(f); }));
+    this->NumberOfActiveVoxels = static_cast<vtkIdType>(
+      vdb::WriteFields(this->FileName, fields, this->Compress,
+        [this](double f) { this->UpdateProgress(f); }, &notes, &errorNumber));
   }
   catch (const vdb::Error& e)
   {
     vtkErrorMacro(<< e.what());
-    this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
+    if (errorNumber == ENOSPC || errorNumber == EFBIG || errorNumber == EDQUOT)
+    {
+      this->SetErrorCode(vtkErrorCode::OutOfDiskSpaceError);
+    }
+    else if (errorNumber != 0)
+    {
+      this->SetErrorCode(static_cast<unsigned long>(errorNumber)); // as vtkXMLWriter does
+    }
+    else
+    {
+      this->SetErrorCode(vtkErrorCode::UnknownError);
+    }
+    this->NumberOfActiveVoxels = 0;
+    return;
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro(<< "cannot write " << this->FileName << ": " << e.what());
+    this->SetErrorCode(vtkErrorCode::UnknownError);
+    this->NumberOfActiveVoxels = 0;
+    return;
+  }
+  for (const auto& note : notes)
+  {
+    vtkWarningMacro(<< note);
   }
 }
 

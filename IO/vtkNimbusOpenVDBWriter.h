@@ -2,21 +2,32 @@
  * @class   vtkNimbusOpenVDBWriter
  * @brief   Writes the point (and cell) arrays of a vtkImageData as OpenVDB (.vdb) grids.
  *
- * The reverse of vtkNimbusOpenVDBReader. Each 1-component numeric array becomes a
+ * The reverse of vtkNimbusOpenVDBReader. Each named 1-component numeric array becomes a
  * FloatGrid and each 3-component array a Vec3SGrid named after the array (non-float arrays
- * are converted to float; other component counts and non-numeric arrays are skipped with a
- * warning). Image point (i, j, k) of the extent is VDB voxel (i, j, k); the grid transform
- * maps it to the image's world position (origin, spacing and direction matrix). Cell arrays
- * (when WriteCellData is on) are grids whose voxel (i, j, k) is cell (i, j, k), so their
- * transform is shifted by half a voxel; a cell array whose name is also a point array's is
- * written as "<name>_cells".
+ * are converted to float; other component counts, non-numeric and unnamed arrays are
+ * skipped with a warning). Image point (i, j, k) of the extent is VDB voxel (i, j, k); the
+ * grid transform maps it to the image's world position (origin, spacing and direction
+ * matrix). Cell arrays (when WriteCellData is on) are grids whose voxel (i, j, k) is cell
+ * (i, j, k), so their transform is shifted by half a voxel; a cell array whose name is also
+ * a written point array's becomes "<name>_cells", or "<name>_cells_2", "_cells_3"... the
+ * first name no array of the image has (warned).
  *
  * Voxels whose value differs from Background by at most Tolerance (per component) are
  * inactive and not stored: Tolerance 0 keeps every voxel that is not exactly the
  * background. Scalar grids whose values are all >= 0 with Background 0 are tagged as fog
- * volumes (OpenVDB's class for density). The file is written under a temporary name and
- * renamed when complete, so a failed write never leaves a partial file or damages an
- * existing one. Errors set the error code and Write() returns 0.
+ * volumes (OpenVDB's class for density). Arrays with NaN or infinite values, and a
+ * non-finite Background, are refused with an error (nothing is written).
+ *
+ * Safe replacement: the file is serialised in memory, written to "<target>.tmp-<pid>"
+ * beside the target with every write checked, fsync'ed, given the old file's permission
+ * bits and renamed over the target; any failure (full disk, file-size limit, ...) leaves an
+ * existing file byte for byte and the error names the cause. A read-only target (no write
+ * permission bit, or not writable by this user) is refused, as vtkXMLWriter refuses it,
+ * also for root. Through a symbolic link the link's target file is replaced (the link
+ * stays). A target with other hard links is replaced under this name only (the other names
+ * keep the old content; warned). Errors set the error code (OutOfDiskSpaceError for a full
+ * disk or a file-size limit, else the system's errno as vtkXMLWriter does, else
+ * UnknownError) and Write() returns 0.
  */
 #ifndef vtkNimbusOpenVDBWriter_h
 #define vtkNimbusOpenVDBWriter_h

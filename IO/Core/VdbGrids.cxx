@@ -1,7 +1,12 @@
 // VdbGrids: every OpenVDB call of Nimbus's .vdb reader and writer (see VdbGrids.h).
 #include "VdbGrids.h"
 
+#include "VdbArchive.h"
+
+#include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
+#include <openvdb/io/GridDescriptor.h>
+#include <openvdb/io/io.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
@@ -363,6 +368,184 @@ typename GridT::Ptr BuildGrid(const FieldToWrite& field)
   return grid;
 }
 
+
+/// A stream buffer over bytes [base, base + size) of a file held in memory: reads and seeks
+/// outside that range fail (with the stream's exceptions on: throw), so OpenVDB cannot read
+/// past a grid's end, or past the end of a truncated file, without noticing.
+class SpanBuf : public std::streambuf
+{
+public:
+  SpanBuf(std::vector<char>& bytes, int64_t base)
+    : Base(base)
+  {
+    this->setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
+  }
+
+protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override
+  {
+    if (!(which & std::ios_base::in))
+    {
+      return pos_type(off_type(-1));
+    }
+    const off_type size = this->egptr() - this->eback();
+    off_type at = 0;
+    if (dir == std::ios_base::beg)
+    {
+      at = off - this->Base;
+    }
+    else if (dir == std::ios_base::cur)
+    {
+      at = (this->gptr() - this->eback()) + off;
+    }
+    else
+    {
+      at = size + off;
+    }
+    if (at < 0 || at > size)
+    {
+      return pos_type(off_type(-1));
+    }
+    this->setg(this->eback(), this->eback() + at, this->egptr());
+    return pos_type(at + this->Base);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override
+  {
+    return this->seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+
+private:
+  int64_t Base;
+};
+
+/// OpenVDB's own grid reading (Archive::readGrid), fed one grid at a time from memory
+/// through a SpanBuf, after ScanFile has checked the layout. OpenVDB's File reads from an
+/// ifstream whose failed reads it does not check, which is how a truncated file gave
+/// uninitialised values and a corrupt count unbounded allocations.
+class ArchiveReader : public openvdb::io::Archive
+{
+public:
+  ArchiveReader(const std::string& path, const FileLayout& layout)
+    : Path(path)
+    , Layout(layout)
+  {
+    std::vector<char> header;
+    Load(0, layout.HeaderEnd, header);
+    SpanBuf buf(header, 0);
+    std::istream is(&buf);
+    is.exceptions(std::ios::failbit | std::ios::badbit);
+    this->readHeader(is);
+  }
+
+  openvdb::io::Archive::Ptr copy() const override { return openvdb::io::Archive::Ptr(); }
+  void write(const openvdb::GridCPtrVec&, const openvdb::MetaMap&) const override
+  {
+    throw Error("ArchiveReader cannot write");
+  }
+
+  /// Grid `i` of the layout: metadata and transform only, or the whole grid.
+  openvdb::GridBase::Ptr Read(size_t i, bool metadataOnly, int depth = 0)
+  {
+    const GridLayout& g = this->Layout.Grids[i];
+    std::vector<char> bytes;
+    this->Load(g.DescriptorPos, (metadataOnly ? g.BlockPos : g.EndPos) - g.DescriptorPos, bytes);
+    SpanBuf buf(bytes, g.DescriptorPos);
+    std::istream is(&buf);
+    is.exceptions(std::ios::failbit | std::ios::badbit);
+    auto meta = std::make_shared<openvdb::io::StreamMetadata>();
+    meta->setSeekable(true);
+    openvdb::io::setStreamMetadataPtr(is, meta, /*transfer=*/false);
+    this->setFormatVersion(is);
+    this->setLibraryVersion(is);
+    this->setDataCompression(is);
+    openvdb::io::GridDescriptor gd;
+    openvdb::GridBase::Ptr grid = gd.read(is);
+    if (!grid)
+    {
+      throw Error("cannot create grid " + Quote(this->Layout.DistinctNames[i]) + " of type " +
+        Quote(g.TypeName));
+    }
+    is.seekg(gd.getGridPos(), std::ios_base::beg);
+    if (metadataOnly && this->fileVersion() >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING)
+    {
+      Archive::readGridCompression(is);
+      grid->readMeta(is);
+      grid->readTransform(is);
+      return grid;
+    }
+    Archive::readGrid(grid, gd, is);
+    if (gd.isInstance())
+    {
+      size_t parent = this->Layout.Grids.size();
+      for (size_t p = 0; p < this->Layout.Grids.size(); ++p)
+      {
+        if (this->Layout.Grids[p].UniqueName == gd.instanceParentName() && p != i)
+        {
+          parent = p;
+        }
+      }
+      if (parent == this->Layout.Grids.size() || depth > 0)
+      {
+        throw Error("grid " + Quote(this->Layout.DistinctNames[i]) +
+          " is an instance of a grid that is missing or itself an instance");
+      }
+      grid->setTree(this->Read(parent, false, depth + 1)->baseTreePtr());
+    }
+    return grid;
+  }
+
+private:
+  /// Bytes [pos, pos + n) of the file (ScanFile checked they exist; a file that shrank
+  /// since is an error).
+  void Load(int64_t pos, int64_t n, std::vector<char>& bytes) const
+  {
+    std::ifstream in(this->Path, std::ios::binary);
+    bytes.resize(static_cast<size_t>(n));
+    in.seekg(pos);
+    in.read(bytes.data(), n);
+    if (!in || in.gcount() != n)
+    {
+      throw Error("cannot read bytes " + std::to_string(pos) + " to " + std::to_string(pos + n) +
+        " of " + Quote(this->Path) + " (did the file change while it was read?)");
+    }
+  }
+
+  std::string Path;
+  const FileLayout& Layout;
+};
+
+/// OpenVDB's seekable archive writing (with grid offsets, as File writes) into any stream.
+class ArchiveWriter : public openvdb::io::Archive
+{
+public:
+  openvdb::io::Archive::Ptr copy() const override { return openvdb::io::Archive::Ptr(); }
+  void write(const openvdb::GridCPtrVec&, const openvdb::MetaMap&) const override
+  {
+    throw Error("ArchiveWriter writes with WriteTo");
+  }
+  void WriteTo(std::ostream& os, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta)
+  {
+    this->Archive::write(os, grids, /*seekable=*/true, meta);
+  }
+};
+
+/// The message for an exception OpenVDB (or the stream) threw while reading `grid`.
+std::string ReadFailure(const std::string& path, const std::string& grid, const std::exception& e)
+{
+  if (dynamic_cast<const std::ios_base::failure*>(&e))
+  {
+    return "cannot read grid " + Quote(grid) + " of OpenVDB file " + Quote(path) +
+      ": its data is corrupt (OpenVDB read past the grid's end; truncated or corrupt?)";
+  }
+  if (dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e))
+  {
+    return "cannot read grid " + Quote(grid) + " of OpenVDB file " + Quote(path) +
+      ": out of memory (" + e.what() + "); the file may be corrupt";
+  }
+  return "cannot read grid " + Quote(grid) + " of OpenVDB file " + Quote(path) +
+    " (truncated or corrupt?): " + e.what();
+}
+
 } // namespace
 
 uint64_t IndexBox::VoxelCount() const
@@ -542,17 +725,28 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
 {
   Initialize();
   CheckReadable(path);
+  const FileLayout layout = ScanFile(path);
   std::vector<GridInfo> result;
+  std::string current;
   try
   {
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/false);
-    const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
-    for (const auto& grid : *grids)
+    ArchiveReader archive(path, layout);
+    for (size_t i = 0; i < layout.Grids.size(); ++i)
     {
       GridInfo info;
-      info.Name = grid->getName();
-      info.TypeName = grid->type();
+      info.Name = layout.DistinctNames[i];
+      info.StoredName = layout.Grids[i].StoredName;
+      info.Index = static_cast<int>(i);
+      info.TypeName = layout.Grids[i].TypeName;
+      info.FileBytes = layout.Grids[i].EndPos - layout.Grids[i].DescriptorPos;
+      current = info.Name;
+      if (!openvdb::GridBase::isRegistered(layout.Grids[i].TypeName))
+      {
+        info.ValueType = "unknown type " + Quote(layout.Grids[i].TypeName);
+        result.push_back(std::move(info));
+        continue;
+      }
+      const openvdb::GridBase::Ptr grid = archive.Read(i, /*metadataOnly=*/true);
       info.ValueType = grid->valueType();
       info.Kind = KindOf(*grid);
       info.Components = ComponentsOf(info.Kind);
@@ -579,7 +773,7 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
       else if (info.Supported())
       {
         // No statistics metadata: read this grid's tree to find its active box.
-        const auto full = file.readGrid(grid->getName());
+        const auto full = archive.Read(i, /*metadataOnly=*/false);
         info.ActiveBox = FromCoordBox(full->evalActiveVoxelBoundingBox());
         info.ActiveVoxelCount = static_cast<int64_t>(full->activeVoxelCount());
         info.TreeRead = true;
@@ -595,11 +789,17 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
             0.5 * double(info.ActiveBox.Min[2] + info.ActiveBox.Max[2]));
       if (info.Supported())
       {
-        info.Transform = AnalyseTransform(grid->transform(), centre);
+        try
+        {
+          info.Transform = AnalyseTransform(grid->transform(), centre);
+        }
+        catch (const Error& e)
+        {
+          throw Error("grid " + Quote(info.Name) + " of " + Quote(path) + ": " + e.what());
+        }
       }
       result.push_back(std::move(info));
     }
-    file.close();
   }
   catch (const Error&)
   {
@@ -607,8 +807,7 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
   }
   catch (const std::exception& e)
   {
-    throw Error(
-      "cannot read OpenVDB file " + Quote(path) + " (truncated or corrupt?): " + e.what());
+    throw Error(ReadFailure(path, current, e));
   }
   return result;
 }
@@ -666,20 +865,26 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
   {
     throw Error("ReadDense: empty index box");
   }
+  const FileLayout layout = ScanFile(path);
+  std::string current;
   try
   {
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/false);
+    ArchiveReader archive(path, layout);
     for (size_t g = 0; g < names.size(); ++g)
     {
-      if (!file.hasGrid(names[g]))
+      current = names[g];
+      const auto found = std::find(layout.DistinctNames.begin(), layout.DistinctNames.end(), names[g]);
+      if (found == layout.DistinctNames.end())
       {
         throw Error("no grid named " + Quote(names[g]) + " in " + Quote(path));
       }
-      const auto base = file.readGrid(names[g]);
+      const auto base = archive.Read(size_t(found - layout.DistinctNames.begin()), false);
+      const ValueKind kind = KindOf(*base);
+      // Every value is set even if a copy stopped half-way: never uninitialised memory.
+      std::fill(target[g], target[g] + box.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
       bool wasResampled = false;
       TransformInfo own;
-      switch (KindOf(*base))
+      switch (kind)
       {
         case ValueKind::Float:
           Extract<openvdb::FloatGrid, float>(base, reference, box, target[g], wasResampled, own);
@@ -713,7 +918,6 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
         progress(double(g + 1) / double(names.size()));
       }
     }
-    file.close();
   }
   catch (const Error&)
   {
@@ -721,15 +925,18 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
   }
   catch (const std::exception& e)
   {
-    throw Error("cannot read the voxels of OpenVDB file " + Quote(path) +
-      " (truncated or corrupt?): " + e.what());
+    throw Error(ReadFailure(path, current, e));
   }
 }
 
 uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
-  bool compress, const Progress& progress)
+  bool compress, const Progress& progress, std::vector<std::string>* notes, int* errorNumber)
 {
   Initialize();
+  if (errorNumber)
+  {
+    *errorNumber = 0;
+  }
   if (path.empty())
   {
     throw Error("no file name given");
@@ -750,6 +957,38 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
     if (!(field.Tolerance >= 0.0f))
     {
       throw Error("tolerance must be >= 0 (got " + std::to_string(field.Tolerance) + ")");
+    }
+    if (!std::isfinite(field.Background))
+    {
+      throw Error("the background must be a finite number (got " +
+        std::to_string(field.Background) + "): it is the value of every inactive voxel");
+    }
+    // NaN compares unequal to everything, so OpenVDB's tolerance test would make NaN voxels
+    // inactive, i.e. silently background; infinities are no density either. Refused.
+    const uint64_t count = field.Box.VoxelCount() * uint64_t(field.Components);
+    uint64_t nan = 0, inf = 0, first = count;
+    for (uint64_t i = 0; i < count; ++i)
+    {
+      const float v = field.Values[i];
+      if (std::isnan(v))
+      {
+        ++nan;
+        first = std::min(first, i);
+      }
+      else if (std::isinf(v))
+      {
+        ++inf;
+        first = std::min(first, i);
+      }
+    }
+    if (nan || inf)
+    {
+      throw Error("array " + Quote(field.Name) + " has " +
+        (nan ? std::to_string(nan) + " NaN" : std::string()) + (nan && inf ? " and " : "") +
+        (inf ? std::to_string(inf) + " infinite" : std::string()) +
+        " values (the first at value index " + std::to_string(first) +
+        "): a .vdb grid cannot hold them faithfully (NaN would become inactive background), so "
+        "nothing was written; replace them first (e.g. with a Calculator or Threshold filter)");
     }
     CheckTransformForWrite(field.Transform, field.Name);
     openvdb::GridBase::Ptr grid;
@@ -775,33 +1014,42 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
     grids.push_back(grid);
     if (progress)
     {
-      progress(0.8 * double(f + 1) / double(fields.size()));
+      progress(0.7 * double(f + 1) / double(fields.size()));
     }
   }
 
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  // Serialise in memory (OpenVDB's File writes through an ofstream whose failures it does
+  // not check), then write the bytes with every system call checked.
+  std::string bytes;
   try
   {
-    openvdb::io::File file(tmp);
-    file.setCompression(compress ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
-                                 : openvdb::io::COMPRESS_ACTIVE_MASK);
+    ArchiveWriter archive;
+    archive.setCompression(compress
+        ? (openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK)
+        : openvdb::io::COMPRESS_ACTIVE_MASK);
     openvdb::MetaMap meta;
     meta.insertMeta("creator", openvdb::StringMetadata("Nimbus vtkNimbusOpenVDBWriter"));
-    file.write(grids, meta);
-    file.close();
+    std::ostringstream os(std::ios::out | std::ios::binary);
+    archive.WriteTo(os, grids, meta);
+    if (!os)
+    {
+      throw Error("cannot write " + Quote(path) + ": serialising the grids failed");
+    }
+    bytes = os.str();
+  }
+  catch (const Error&)
+  {
+    throw;
   }
   catch (const std::exception& e)
   {
-    std::remove(tmp.c_str());
-    throw Error("cannot write " + Quote(path) + " (temporary " + Quote(tmp) + "): " + e.what());
+    throw Error("cannot write " + Quote(path) + ": " + e.what());
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  if (progress)
   {
-    const std::string reason = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw Error(
-      "cannot rename the written temporary " + Quote(tmp) + " to " + Quote(path) + ": " + reason);
+    progress(0.8);
   }
+  WriteFileAtomically(path, bytes, notes, errorNumber);
   if (progress)
   {
     progress(1.0);

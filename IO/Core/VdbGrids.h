@@ -89,7 +89,12 @@ enum class ValueKind
 /// A grid as described by the file's metadata (no voxels read).
 struct GridInfo
 {
+  /// The grid's name, made distinct: a name that repeats in the file gets OpenVDB's own
+  /// suffix ("density", "density[1]"), an unnamed grid is "unnamed" (FileLayout).
   std::string Name;
+  std::string StoredName; // the name as stored (may repeat or be empty)
+  int Index = -1;         // position in the file (0 = first grid)
+  int64_t FileBytes = 0;  // the grid's bytes in the file (descriptor to end)
   std::string TypeName;  // OpenVDB's type name, e.g. "Tree_float_5_4_3"
   std::string ValueType; // "float", "double", "vec3s", "bool", ...
   ValueKind Kind = ValueKind::Unsupported;
@@ -106,8 +111,10 @@ struct GridInfo
 };
 
 /// Reads every grid's descriptor, metadata and transform (no voxel data unless a grid
-/// lacks bounding-box statistics). Throws Error for a missing/unreadable file, a file
-/// that is not a VDB, or a truncated header.
+/// lacks bounding-box statistics), after ScanFile (VdbArchive.h) has checked the file's
+/// layout. Throws Error for a missing/unreadable file, a file that is not a VDB, a
+/// truncated or corrupt file. Grids of types OpenVDB does not know are listed as
+/// unsupported (ValueType "unknown type '<type name>'").
 std::vector<GridInfo> ReadFileInfo(const std::string& path);
 
 /// A dense float array over an index box, x fastest (VTK's point order).
@@ -121,8 +128,10 @@ struct DenseField
 /// Progress callback: fraction in [0, 1].
 using Progress = std::function<void(double)>;
 
-/// Reads the named grids into dense arrays over `box` of the reference grid's index
-/// space. `target` points at caller-allocated storage of box.VoxelCount()*components
+/// Reads the named grids (GridInfo::Name, the distinct names) into dense arrays over `box`
+/// of the reference grid's index space. Each grid's bytes are checked (ScanFile) and read
+/// from memory through a stream that fails, instead of returning garbage, on any read
+/// outside the grid's own bytes; every target value is set (filled with 0 first). `target` points at caller-allocated storage of box.VoxelCount()*components
 /// floats per grid (the VTK array's buffer), in the order of `names`. Grids whose
 /// transform differs from `reference` are resampled trilinearly at the reference's
 /// voxel positions (`resampled` receives their names). `exact` receives the transform of
@@ -153,13 +162,16 @@ struct FieldToWrite
   bool FogVolume = false; // grid class GRID_FOG_VOLUME (density-like, >= 0)
 };
 
-/// Writes the fields as FloatGrid / Vec3SGrid to `path`. The file is written to
-/// `path + ".tmp-<pid>"` first and renamed over `path` only after a complete write, so a
-/// failure never leaves a partial or corrupted file. `compress` selects Blosc (else
+/// Writes the fields as FloatGrid / Vec3SGrid to `path`. The file is serialised in memory,
+/// then written by WriteFileAtomically (VdbArchive.h): temporary file beside the target,
+/// every write checked, fsync, rename; a failure leaves an existing file byte for byte and
+/// the message names the cause. Non-finite values (NaN, +-Inf) and a non-finite background
+/// are refused (OpenVDB's tolerance test would silently make NaN voxels inactive). `compress` selects Blosc (else
 /// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the
 /// number of active voxels written.
 uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
-  bool compress = true, const Progress& progress = nullptr);
+  bool compress = true, const Progress& progress = nullptr,
+  std::vector<std::string>* notes = nullptr, int* errorNumber = nullptr);
 
 /// OpenVDB's version string, e.g. "10.0.1".
 std::string LibraryVersion();
