@@ -21,8 +21,8 @@
 #include <map>
 #include <new>
 #include <set>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -563,17 +563,17 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   {
     nimbus::ValueCensus census = nimbus::TakeCensus(
       arrays[i]->GetPointer(0), static_cast<std::size_t>(arrays[i]->GetNumberOfValues()));
-    const bool densityLike = arrays[i]->GetNumberOfComponents() == 1 && LooksLikeDensity(*plan.Read[i]);
+    const bool densityLike =
+      arrays[i]->GetNumberOfComponents() == 1 && LooksLikeDensity(*plan.Read[i]);
     if (!densityLike)
     {
       census.Negative = 0;
     }
     if (!census.AllFiniteNonNegative())
     {
-      vtkWarningMacro(<< "grid " << Quote(plan.Read[i]->Name) << " of " << this->FileName
-                      << " has " << nimbus::DescribeCensus(census) << " (of "
-                      << arrays[i]->GetNumberOfValues() << ")"
-                      << (census.Negative ? "; negative values are no density" : "")
+      vtkWarningMacro(<< "grid " << Quote(plan.Read[i]->Name) << " of " << this->FileName << " has "
+                      << nimbus::DescribeCensus(census) << " (of " << arrays[i]->GetNumberOfValues()
+                      << ")" << (census.Negative ? "; negative values are no density" : "")
                       << ": they are read as they are; clean them before rendering");
     }
   }

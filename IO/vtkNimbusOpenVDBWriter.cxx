@@ -136,9 +136,8 @@ void vtkNimbusOpenVDBWriter::WriteData()
   // point array (or an earlier cell array's new name) has it, then it becomes
   // "<name>_cells", or "<name>_cells_2", "_cells_3"... the first that no array has.
   std::set<std::string> reserved;
-  for (vtkDataSetAttributes* data :
-    { static_cast<vtkDataSetAttributes*>(input->GetPointData()),
-      static_cast<vtkDataSetAttributes*>(input->GetCellData()) })
+  for (vtkDataSetAttributes* data : { static_cast<vtkDataSetAttributes*>(input->GetPointData()),
+         static_cast<vtkDataSetAttributes*>(input->GetCellData()) })
   {
     for (int i = 0; i < data->GetNumberOfArrays(); ++i)
     {
@@ -240,9 +239,9 @@ void vtkNimbusOpenVDBWriter::WriteData()
   int errorNumber = 0;
   try
   {
-    this->NumberOfActiveVoxels = static_cast<vtkIdType>(
-      vdb::WriteFields(this->FileName, fields, this->Compress,
-        [this](double f) { this->UpdateProgress(f); }, &notes, &errorNumber));
+    this->NumberOfActiveVoxels = static_cast<vtkIdType>(vdb::WriteFields(
+      this->FileName, fields, this->Compress, [this](double f) { this->UpdateProgress(f); }, &notes,
+      &errorNumber));
   }
   catch (const vdb::Error& e)
   {

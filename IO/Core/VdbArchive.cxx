@@ -94,8 +94,8 @@ public:
 
   std::string Truncated(uint64_t needed, const std::string& what) const
   {
-    return Quote(this->Path) + ": the file ends at byte " + std::to_string(this->Size) +
-      " but " + what + " needs bytes up to " + std::to_string(needed) +
+    return Quote(this->Path) + ": the file ends at byte " + std::to_string(this->Size) + " but " +
+      what + " needs bytes up to " + std::to_string(needed) +
       ": the file is truncated (an interrupted download or copy?)";
   }
 
@@ -114,8 +114,8 @@ public:
     if (this->Pos + n > sectionEnd && sectionEnd < this->Size)
     {
       throw Error(Quote(this->Path) + " is corrupt: a text of " + std::to_string(n) +
-        " bytes at byte " + std::to_string(this->Pos - 4) + " in " + what + " runs past its end (byte " +
-        std::to_string(sectionEnd) + ")");
+        " bytes at byte " + std::to_string(this->Pos - 4) + " in " + what +
+        " runs past its end (byte " + std::to_string(sectionEnd) + ")");
     }
     std::string s(n, '\0');
     if (n > 0)
@@ -206,6 +206,46 @@ std::string ErrnoText(int e)
 
 } // namespace
 
+SpanBuf::SpanBuf(std::vector<char>& bytes, int64_t base)
+  : Base(base)
+{
+  this->setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
+}
+
+SpanBuf::pos_type SpanBuf::seekoff(
+  off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which)
+{
+  if (!(which & std::ios_base::in))
+  {
+    return pos_type(off_type(-1));
+  }
+  const off_type size = this->egptr() - this->eback();
+  off_type at = 0;
+  if (dir == std::ios_base::beg)
+  {
+    at = off - this->Base;
+  }
+  else if (dir == std::ios_base::cur)
+  {
+    at = (this->gptr() - this->eback()) + off;
+  }
+  else
+  {
+    at = size + off;
+  }
+  if (at < 0 || at > size)
+  {
+    return pos_type(off_type(-1));
+  }
+  this->setg(this->eback(), this->eback() + at, this->egptr());
+  return pos_type(at + this->Base);
+}
+
+SpanBuf::pos_type SpanBuf::seekpos(pos_type pos, std::ios_base::openmode which)
+{
+  return this->seekoff(off_type(pos), std::ios_base::beg, which);
+}
+
 FileLayout ScanFile(const std::string& path)
 {
   openvdb::initialize();
@@ -273,8 +313,8 @@ FileLayout ScanFile(const std::string& path)
       throw Error(r.Truncated(r.Pos + uint64_t(count) * 36,
         "its header (which lists " + std::to_string(count) + " grids)"));
     }
-    throw Error(Quote(path) + " is corrupt: its header gives a grid count of " +
-      std::to_string(count));
+    throw Error(
+      Quote(path) + " is corrupt: its header gives a grid count of " + std::to_string(count));
   }
   for (int32_t i = 0; i < count; ++i)
   {
@@ -300,13 +340,11 @@ FileLayout ScanFile(const std::string& path)
     g.BlockPos = r.Value<int64_t>(what);
     g.EndPos = r.Value<int64_t>(what);
     const std::string grid = "its grid " + Quote(Printable(g.StoredName));
-    if (g.GridPos != static_cast<int64_t>(r.Pos) || g.BlockPos < g.GridPos ||
-      g.EndPos < g.BlockPos)
+    if (g.GridPos != static_cast<int64_t>(r.Pos) || g.BlockPos < g.GridPos || g.EndPos < g.BlockPos)
     {
       throw Error(Quote(path) + " is corrupt: " + grid + " has inconsistent byte offsets (grid " +
         std::to_string(g.GridPos) + ", voxels " + std::to_string(g.BlockPos) + ", end " +
-        std::to_string(g.EndPos) + "; its description ends at byte " + std::to_string(r.Pos) +
-        ")");
+        std::to_string(g.EndPos) + "; its description ends at byte " + std::to_string(r.Pos) + ")");
     }
     if (static_cast<uint64_t>(g.EndPos) > layout.FileSize)
     {
@@ -378,8 +416,9 @@ void WriteFileAtomically(const std::string& path, const std::string& bytes,
       if (!::realpath(path.c_str(), resolved))
       {
         const int e = errno;
-        fail("cannot write " + Quote(path) + ": it is a symbolic link whose target cannot be "
-                                             "resolved (" +
+        fail("cannot write " + Quote(path) +
+            ": it is a symbolic link whose target cannot be "
+            "resolved (" +
             ErrnoText(e) + ")",
           e);
       }
@@ -434,8 +473,8 @@ void WriteFileAtomically(const std::string& path, const std::string& bytes,
     }
     if (n == 0)
     {
-      abandon("writing byte " + std::to_string(written) + " of " + std::to_string(bytes.size()),
-        ENOSPC);
+      abandon(
+        "writing byte " + std::to_string(written) + " of " + std::to_string(bytes.size()), ENOSPC);
     }
     written += static_cast<size_t>(n);
   }

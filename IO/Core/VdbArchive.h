@@ -17,6 +17,7 @@
 #define NimbusVdbArchive_h
 
 #include <cstdint>
+#include <streambuf>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,25 @@ struct FileLayout
   /// Distinct names, one per grid, in file order: the stored name; a repeated name gets
   /// OpenVDB's own "name[1]", "name[2]"...; an unnamed grid is "unnamed" (then "unnamed[1]"...).
   std::vector<std::string> DistinctNames;
+};
+
+/// A stream buffer over bytes [base, base + size) of a file held in memory: reads and seeks
+/// outside that range fail (with the stream's exceptions on: throw), so OpenVDB cannot read
+/// past a grid's end, or past the end of a truncated file, without noticing. Remaining()
+/// tells the chunk-size checks of VdbCompressionGuard.cxx how many bytes are left.
+class SpanBuf : public std::streambuf
+{
+public:
+  SpanBuf(std::vector<char>& bytes, int64_t base);
+  int64_t Remaining() const { return this->egptr() - this->gptr(); }
+
+protected:
+  pos_type seekoff(
+    off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override;
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override;
+
+private:
+  int64_t Base;
 };
 
 /// Checks the layout of `path` (see above). Throws Error with a message that says what is

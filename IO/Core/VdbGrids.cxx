@@ -368,56 +368,6 @@ typename GridT::Ptr BuildGrid(const FieldToWrite& field)
   return grid;
 }
 
-
-/// A stream buffer over bytes [base, base + size) of a file held in memory: reads and seeks
-/// outside that range fail (with the stream's exceptions on: throw), so OpenVDB cannot read
-/// past a grid's end, or past the end of a truncated file, without noticing.
-class SpanBuf : public std::streambuf
-{
-public:
-  SpanBuf(std::vector<char>& bytes, int64_t base)
-    : Base(base)
-  {
-    this->setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
-  }
-
-protected:
-  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override
-  {
-    if (!(which & std::ios_base::in))
-    {
-      return pos_type(off_type(-1));
-    }
-    const off_type size = this->egptr() - this->eback();
-    off_type at = 0;
-    if (dir == std::ios_base::beg)
-    {
-      at = off - this->Base;
-    }
-    else if (dir == std::ios_base::cur)
-    {
-      at = (this->gptr() - this->eback()) + off;
-    }
-    else
-    {
-      at = size + off;
-    }
-    if (at < 0 || at > size)
-    {
-      return pos_type(off_type(-1));
-    }
-    this->setg(this->eback(), this->eback() + at, this->egptr());
-    return pos_type(at + this->Base);
-  }
-  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override
-  {
-    return this->seekoff(off_type(pos), std::ios_base::beg, which);
-  }
-
-private:
-  int64_t Base;
-};
-
 /// OpenVDB's own grid reading (Archive::readGrid), fed one grid at a time from memory
 /// through a SpanBuf, after ScanFile has checked the layout. OpenVDB's File reads from an
 /// ifstream whose failed reads it does not check, which is how a truncated file gave
@@ -873,7 +823,8 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
     for (size_t g = 0; g < names.size(); ++g)
     {
       current = names[g];
-      const auto found = std::find(layout.DistinctNames.begin(), layout.DistinctNames.end(), names[g]);
+      const auto found =
+        std::find(layout.DistinctNames.begin(), layout.DistinctNames.end(), names[g]);
       if (found == layout.DistinctNames.end())
       {
         throw Error("no grid named " + Quote(names[g]) + " in " + Quote(path));

@@ -95,8 +95,8 @@ struct GridInfo
   std::string StoredName; // the name as stored (may repeat or be empty)
   int Index = -1;         // position in the file (0 = first grid)
   int64_t FileBytes = 0;  // the grid's bytes in the file (descriptor to end)
-  std::string TypeName;  // OpenVDB's type name, e.g. "Tree_float_5_4_3"
-  std::string ValueType; // "float", "double", "vec3s", "bool", ...
+  std::string TypeName;   // OpenVDB's type name, e.g. "Tree_float_5_4_3"
+  std::string ValueType;  // "float", "double", "vec3s", "bool", ...
   ValueKind Kind = ValueKind::Unsupported;
   int Components = 0;    // 1 or 3 when supported
   std::string GridClass; // "fog volume", "level set", "staggered", "unknown"
@@ -131,13 +131,13 @@ using Progress = std::function<void(double)>;
 /// Reads the named grids (GridInfo::Name, the distinct names) into dense arrays over `box`
 /// of the reference grid's index space. Each grid's bytes are checked (ScanFile) and read
 /// from memory through a stream that fails, instead of returning garbage, on any read
-/// outside the grid's own bytes; every target value is set (filled with 0 first). `target` points at caller-allocated storage of box.VoxelCount()*components
-/// floats per grid (the VTK array's buffer), in the order of `names`. Grids whose
-/// transform differs from `reference` are resampled trilinearly at the reference's
-/// voxel positions (`resampled` receives their names). `exact` receives the transform of
-/// the first grid copied without resampling, as read with its voxels: OpenVDB's
-/// metadata-only read (ReadFileInfo) can differ from it in the last bit of the voxel size.
-/// Throws Error on read failure.
+/// outside the grid's own bytes; every target value is set (filled with 0 first). `target` points
+/// at caller-allocated storage of box.VoxelCount()*components floats per grid (the VTK array's
+/// buffer), in the order of `names`. Grids whose transform differs from `reference` are resampled
+/// trilinearly at the reference's voxel positions (`resampled` receives their names). `exact`
+/// receives the transform of the first grid copied without resampling, as read with its voxels:
+/// OpenVDB's metadata-only read (ReadFileInfo) can differ from it in the last bit of the voxel
+/// size. Throws Error on read failure.
 void ReadDense(const std::string& path, const std::vector<std::string>& names,
   const TransformInfo& reference, const IndexBox& box, const std::vector<float*>& target,
   std::vector<std::string>* resampled = nullptr, const Progress& progress = nullptr,
@@ -166,9 +166,9 @@ struct FieldToWrite
 /// then written by WriteFileAtomically (VdbArchive.h): temporary file beside the target,
 /// every write checked, fsync, rename; a failure leaves an existing file byte for byte and
 /// the message names the cause. Non-finite values (NaN, +-Inf) and a non-finite background
-/// are refused (OpenVDB's tolerance test would silently make NaN voxels inactive). `compress` selects Blosc (else
-/// no compression beyond OpenVDB's active-mask encoding). Throws Error on failure. Returns the
-/// number of active voxels written.
+/// are refused (OpenVDB's tolerance test would silently make NaN voxels inactive). `compress`
+/// selects Blosc (else no compression beyond OpenVDB's active-mask encoding). Throws Error on
+/// failure. Returns the number of active voxels written.
 uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
   bool compress = true, const Progress& progress = nullptr,
   std::vector<std::string>* notes = nullptr, int* errorNumber = nullptr);

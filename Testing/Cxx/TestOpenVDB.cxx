@@ -11,6 +11,8 @@
 #include "vtkCommand.h"
 #include "vtkDataArraySelection.h"
 #include "vtkDoubleArray.h"
+#include "vtkErrorCode.h"
+#include "vtkExecutive.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -20,19 +22,28 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
 
+#include <openvdb/io/Compression.h>
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include "MessageCatcher.h"
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
+#include <set>
+#include <sstream>
 #include <string>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <vector>
 
@@ -835,4 +846,406 @@ TEST(BadInput, FailedWriteLeavesExistingFileIntact)
   int ok = 0;
   const std::string errors = ReadErrors(path, 0, &ok);
   EXPECT_EQ(ok, 1) << errors;
+}
+
+// --- Safe replacement of existing files (writer) -----------------------------------------------
+
+namespace
+{
+std::vector<char> Bytes(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+vtkSmartPointer<vtkImageData> SmallImage(float scale)
+{
+  const int extent[6] = { 0, 15, 0, 15, 0, 15 };
+  const double origin[3] = { 0, 0, 0 };
+  const double spacing[3] = { 1, 1, 1 };
+  auto image = MakeImage(extent, origin, spacing, false);
+  auto* density = vtkFloatArray::SafeDownCast(image->GetPointData()->GetArray("density"));
+  for (vtkIdType i = 0; i < density->GetNumberOfValues(); ++i)
+  {
+    density->SetValue(i, density->GetValue(i) * scale);
+  }
+  return image;
+}
+
+/// Writes `image` to `path`; returns Write()'s result, the errors, warnings and error code.
+int WriteCatching(vtkImageData* image, const std::string& path, std::string* errors,
+  std::string* warnings = nullptr, unsigned long* code = nullptr, double background = 0.0)
+{
+  vtkNew<vtkNimbusOpenVDBWriter> writer;
+  writer->SetInputData(image);
+  writer->SetFileName(path.c_str());
+  writer->SetBackground(background);
+  MessageCatcher catcher(writer);
+  const int ok = writer->Write();
+  *errors = catcher.AllErrors();
+  if (warnings)
+  {
+    *warnings = catcher.AllWarnings();
+  }
+  if (code)
+  {
+    *code = writer->GetErrorCode();
+  }
+  return ok;
+}
+
+bool NoTemporaryLeft(const std::string& path)
+{
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  struct stat st;
+  return ::lstat(tmp.c_str(), &st) != 0;
+}
+} // namespace
+
+TEST(SafeWrite, FileSizeLimitKeepsTheOldFileByteForByte)
+{
+  // A full disk, simulated by RLIMIT_FSIZE in a child process (SIGXFSZ ignored, so write(2)
+  // fails with EFBIG "File too large", as it fails with ENOSPC on a full disk).
+  const std::string path = TempPath("fsize.vdb");
+  std::string errors;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), path, &errors), 1) << errors;
+  const std::vector<char> before = Bytes(path);
+  ASSERT_GT(before.size(), 20000u);
+  const std::string report = TempPath("fsize-child.txt");
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0)
+  {
+    std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit limit;
+    limit.rlim_cur = limit.rlim_max = 8192; // bytes: far less than the new file needs
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::string childErrors;
+    unsigned long code = 0;
+    const int ok = WriteCatching(SmallImage(2.0f), path, &childErrors, nullptr, &code);
+    std::ofstream(report) << ok << "\n" << code << "\n" << childErrors;
+    std::_Exit(0);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  std::ifstream in(report);
+  int ok = -1;
+  unsigned long code = 0;
+  in >> ok >> code;
+  const std::string childErrors(
+    (std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(ok, 0);
+  EXPECT_EQ(code, static_cast<unsigned long>(vtkErrorCode::OutOfDiskSpaceError));
+  EXPECT_TRUE(Contains(childErrors, "File too large") &&
+    Contains(childErrors, "the existing file was left as it was"))
+    << childErrors;
+  EXPECT_TRUE(Bytes(path) == before) << "the old file changed";
+  EXPECT_TRUE(NoTemporaryLeft(path));
+  int read = 0;
+  const std::string readErrors = ReadErrors(path, 0, &read);
+  EXPECT_EQ(read, 1) << readErrors;
+}
+
+TEST(SafeWrite, ReadOnlyTargetRefused)
+{
+  const std::string path = TempPath("readonly.vdb");
+  std::string errors;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), path, &errors), 1) << errors;
+  const std::vector<char> before = Bytes(path);
+  ASSERT_EQ(::chmod(path.c_str(), 0444), 0);
+  unsigned long code = 0;
+  EXPECT_EQ(WriteCatching(SmallImage(2.0f), path, &errors, nullptr, &code), 0);
+  EXPECT_TRUE(Contains(errors, "Permission denied") && Contains(errors, "read-only")) << errors;
+  EXPECT_EQ(code, static_cast<unsigned long>(EACCES)); // as vtkXMLWriter: the system's errno
+  EXPECT_TRUE(Bytes(path) == before);
+  struct stat st;
+  ASSERT_EQ(::stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0444u);
+  EXPECT_TRUE(NoTemporaryLeft(path));
+}
+
+TEST(SafeWrite, PermissionsKeptAndSymlinkWritesThroughToItsTarget)
+{
+  const std::string target = TempPath("link-target.vdb");
+  const std::string link = TempPath("link.vdb");
+  std::string errors;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), target, &errors), 1) << errors;
+  ASSERT_EQ(::chmod(target.c_str(), 0640), 0);
+  ::unlink(link.c_str());
+  ASSERT_EQ(::symlink(target.c_str(), link.c_str()), 0);
+  ASSERT_EQ(WriteCatching(SmallImage(2.0f), link, &errors), 1) << errors;
+  struct stat st;
+  ASSERT_EQ(::lstat(link.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode)) << "the link was replaced by a file";
+  ASSERT_EQ(::stat(target.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u) << "permission bits not kept";
+  // The target holds the new data (density doubled).
+  vtkNew<vtkNimbusOpenVDBReader> reader;
+  reader->SetFileName(target.c_str());
+  reader->Update();
+  vtkDataArray* density = reader->GetOutput()->GetPointData()->GetArray("density");
+  ASSERT_NE(density, nullptr);
+  auto reference = SmallImage(2.0f);
+  ExpectSameArray(reference->GetPointData()->GetArray("density"), density);
+  EXPECT_TRUE(NoTemporaryLeft(target));
+}
+
+TEST(SafeWrite, HardLinkKeepsOldContentAndIsWarned)
+{
+  const std::string path = TempPath("hard-a.vdb");
+  const std::string other = TempPath("hard-b.vdb");
+  std::string errors, warnings;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), path, &errors), 1) << errors;
+  ::unlink(other.c_str());
+  ASSERT_EQ(::link(path.c_str(), other.c_str()), 0);
+  const std::vector<char> before = Bytes(other);
+  ASSERT_EQ(WriteCatching(SmallImage(2.0f), path, &errors, &warnings), 1) << errors;
+  EXPECT_TRUE(Contains(warnings, "had 2 hard links") && Contains(warnings, "keep the old content"))
+    << warnings;
+  EXPECT_TRUE(Bytes(other) == before);
+  EXPECT_FALSE(Bytes(path) == before);
+}
+
+TEST(SafeWrite, NaNAndInfiniteValuesAndBackgroundRefused)
+{
+  const std::string path = TempPath("nan.vdb");
+  std::string errors;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), path, &errors), 1) << errors;
+  const std::vector<char> before = Bytes(path);
+  auto image = SmallImage(2.0f);
+  auto* density = vtkFloatArray::SafeDownCast(image->GetPointData()->GetArray("density"));
+  density->SetValue(7, std::nanf(""));
+  density->SetValue(9, std::nanf(""));
+  density->SetValue(11, INFINITY);
+  EXPECT_EQ(WriteCatching(image, path, &errors), 0);
+  EXPECT_TRUE(Contains(errors, "'density' has 2 NaN and 1 infinite values") &&
+    Contains(errors, "value index 7") && Contains(errors, "nothing was written"))
+    << errors;
+  EXPECT_TRUE(Bytes(path) == before);
+  for (double background : { std::nan(""), HUGE_VAL })
+  {
+    EXPECT_EQ(WriteCatching(SmallImage(2.0f), path, &errors, nullptr, nullptr, background), 0);
+    EXPECT_TRUE(Contains(errors, "Background must be a finite number")) << errors;
+    EXPECT_TRUE(Bytes(path) == before);
+  }
+}
+
+TEST(SafeWrite, CellArrayNamesAreUniqueAndPredictable)
+{
+  vtkNew<vtkImageData> image;
+  image->SetExtent(0, 3, 0, 3, 0, 3);
+  auto add = [&](vtkDataSetAttributes* data, const char* name, vtkIdType n, float value)
+  {
+    vtkNew<vtkFloatArray> array;
+    array->SetName(name);
+    array->SetNumberOfTuples(n);
+    array->Fill(value);
+    data->AddArray(array);
+  };
+  add(image->GetPointData(), "density", image->GetNumberOfPoints(), 1.0f);
+  add(image->GetCellData(), "density", image->GetNumberOfCells(), 2.0f);
+  add(image->GetCellData(), "density_cells", image->GetNumberOfCells(), 3.0f);
+  const std::string path = TempPath("names.vdb");
+  std::string errors, warnings;
+  ASSERT_EQ(WriteCatching(image, path, &errors, &warnings), 1) << errors;
+  EXPECT_TRUE(Contains(warnings, "cell array 'density' -> grid 'density_cells_2'")) << warnings;
+  const auto info = vdb::ReadFileInfo(path);
+  std::set<std::string> names;
+  for (const auto& g : info)
+  {
+    names.insert(g.StoredName);
+  }
+  EXPECT_EQ(names, (std::set<std::string>{ "density", "density_cells", "density_cells_2" }));
+  // Each grid holds its own array's values.
+  vtkNew<vtkNimbusOpenVDBReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->UpdateInformation();
+  reader->SetGridArrayStatus("density", 0);
+  reader->Update();
+  vtkDataArray* a = reader->GetOutput()->GetPointData()->GetArray("density_cells");
+  vtkDataArray* b = reader->GetOutput()->GetPointData()->GetArray("density_cells_2");
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->GetTuple1(0), 3.0);
+  EXPECT_EQ(b->GetTuple1(0), 2.0);
+}
+
+TEST(SafeWrite, UnnamedArrayIsNamedInTheMessage)
+{
+  vtkNew<vtkImageData> image;
+  image->SetExtent(0, 2, 0, 2, 0, 2);
+  vtkNew<vtkFloatArray> array;
+  array->SetNumberOfTuples(image->GetNumberOfPoints());
+  array->Fill(1.0f);
+  image->GetPointData()->AddArray(array);
+  std::string errors;
+  EXPECT_EQ(WriteCatching(image, TempPath("unnamed.vdb"), &errors), 0);
+  EXPECT_TRUE(Contains(errors, "an unnamed point array (1 components; a grid needs a name)"))
+    << errors;
+  EXPECT_FALSE(Contains(errors, "no arrays")) << errors;
+}
+
+// --- Reader: validation, budgets, censuses, names ------------------------------------------------
+
+TEST(ReadChecks, TruncatedHeaderSaysTruncatedNotNoGrids)
+{
+  const std::string path = TempPath("header.vdb");
+  std::string errors;
+  ASSERT_EQ(WriteCatching(SmallImage(1.0f), path, &errors), 1) << errors;
+  for (long cut : { 20L, 60L, 100L, 200L })
+  {
+    const std::string cutPath = TempPath("header-cut.vdb");
+    Truncate(path, cutPath, cut);
+    int ok = 1;
+    errors = ReadErrors(cutPath, 0, &ok);
+    EXPECT_EQ(ok, 0);
+    EXPECT_TRUE(Contains(errors, "the file ends at byte " + std::to_string(cut)) &&
+      Contains(errors, "the file is truncated (an interrupted download or copy?)") &&
+      !Contains(errors, "has no grids"))
+      << cut << ": " << errors;
+  }
+  // Cut inside the voxels of the last grid: the message names the grid and the bytes.
+  const std::string last = TempPath("last-cut.vdb");
+  const long size = FileSize(path);
+  Truncate(path, last, size - 3);
+  int ok = 1;
+  errors = ReadErrors(last, 0, &ok);
+  EXPECT_EQ(ok, 0);
+  EXPECT_TRUE(Contains(errors,
+    "the file ends at byte " + std::to_string(size - 3) +
+      " but its grid 'velocity' needs bytes up to " + std::to_string(size)))
+    << errors;
+}
+
+TEST(ReadChecks, DuplicateGridNamesAreAllRead)
+{
+  const std::string path = TempPath("duplicates.vdb");
+  WriteGrids(path,
+    { FloatBlock("density", openvdb::Coord(0), openvdb::Coord(3), 1.0, 1.0f),
+      FloatBlock("density", openvdb::Coord(0), openvdb::Coord(3), 1.0, 5.0f) });
+  vtkNew<vtkNimbusOpenVDBReader> reader;
+  reader->SetFileName(path.c_str());
+  MessageCatcher catcher(reader);
+  reader->Update();
+  EXPECT_TRUE(catcher.Errors.empty()) << catcher.AllErrors();
+  ASSERT_EQ(reader->GetGridNames()->GetNumberOfValues(), 2);
+  EXPECT_EQ(reader->GetGridNames()->GetValue(0), "density");
+  EXPECT_EQ(reader->GetGridNames()->GetValue(1), "density[1]");
+  vtkDataArray* first = reader->GetOutput()->GetPointData()->GetArray("density");
+  vtkDataArray* second = reader->GetOutput()->GetPointData()->GetArray("density[1]");
+  ASSERT_TRUE(first && second);
+  EXPECT_FLOAT_EQ(first->GetTuple1(0), 1.0f);
+  EXPECT_FLOAT_EQ(second->GetTuple1(0), 5.0f);
+  EXPECT_TRUE(Contains(catcher.AllWarnings(), "has 2 grids named 'density'") &&
+    Contains(catcher.AllWarnings(), "'density', 'density[1]'"))
+    << catcher.AllWarnings();
+}
+
+TEST(ReadChecks, VoxelLimitAndMemoryBudgetCountAllGrids)
+{
+  // Nine sparse grids, each two voxels 255 apart: 9 x 256^3 voxels from a small file.
+  openvdb::GridPtrVec grids;
+  for (int g = 0; g < 9; ++g)
+  {
+    auto grid = openvdb::FloatGrid::create(0.0f);
+    grid->setName("g" + std::to_string(g));
+    grid->tree().setValue(openvdb::Coord(0), 1.0f);
+    grid->tree().setValue(openvdb::Coord(255), 1.0f);
+    grids.push_back(grid);
+  }
+  const std::string path = TempPath("many-sparse.vdb");
+  WriteGrids(path, grids);
+  EXPECT_LT(FileSize(path), 200000);
+  int ok = 1;
+  std::string errors = ReadErrors(path, 0, &ok);
+  EXPECT_EQ(ok, 0);
+  EXPECT_TRUE(
+    Contains(errors, "256 x 256 x 256 = 16777216 points x 9 grid(s) = 150994944 voxels") &&
+    Contains(errors, "all grids of the file together"))
+    << errors;
+  // Under the voxel limit but over a small memory budget: 9 x 64 MiB = 576 MiB > 100 MiB.
+  vtkNew<vtkNimbusOpenVDBReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->SetMaximumNumberOfVoxels(VTK_ID_MAX);
+  reader->SetMemoryBudgetMiB(100);
+  MessageCatcher catcher(reader);
+  reader->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, vtkNew<vtkCallbackCommand>());
+  EXPECT_EQ(reader->GetExecutive()->Update(), 0);
+  EXPECT_TRUE(Contains(catcher.AllErrors(), "memory budget") &&
+    Contains(catcher.AllErrors(), "raise MemoryBudgetMiB"))
+    << catcher.AllErrors();
+  EXPECT_EQ(reader->GetOutput()->GetNumberOfPoints(), 0);
+}
+
+TEST(ReadChecks, HugeSparseGridAtTheLargestVoxelLimitDoesNotAbort)
+{
+  // Two voxels at -1e6 and +1e6: (2e6+1)^3 points. With MaximumNumberOfVoxels at its
+  // maximum, the memory budget refuses it (this VTK aborts on a failed allocation).
+  openvdb::initialize();
+  auto grid = openvdb::FloatGrid::create(0.0f);
+  grid->setName("spread");
+  grid->tree().setValue(openvdb::Coord(-1000000), 1.0f);
+  grid->tree().setValue(openvdb::Coord(1000000), 1.0f);
+  const std::string path = TempPath("spread.vdb");
+  WriteGrids(path, { grid });
+  int ok = 1;
+  const std::string errors = ReadErrors(path, VTK_ID_MAX, &ok);
+  EXPECT_EQ(ok, 0);
+  EXPECT_TRUE(Contains(errors, "memory budget")) << errors;
+}
+
+TEST(ReadChecks, NonFiniteAndNegativeValuesAreCountedInAWarning)
+{
+  openvdb::initialize();
+  auto density = FloatBlock("density", openvdb::Coord(0), openvdb::Coord(3), 1.0, 1.0f);
+  density->tree().setValue(openvdb::Coord(1, 1, 1), std::nanf(""));
+  density->tree().setValue(openvdb::Coord(2, 1, 1), std::nanf(""));
+  density->tree().setValue(openvdb::Coord(3, 1, 1), INFINITY);
+  density->tree().setValue(openvdb::Coord(0, 2, 1), -0.5f);
+  auto level = FloatBlock("distance", openvdb::Coord(0), openvdb::Coord(3), 1.0, -1.0f);
+  const std::string path = TempPath("nonfinite.vdb");
+  WriteGrids(path, { density, level });
+  int ok = 0;
+  std::string warnings;
+  const std::string errors = ReadErrors(path, 0, &ok, &warnings);
+  EXPECT_EQ(ok, 1) << errors;
+  EXPECT_TRUE(Contains(warnings, "grid 'density'") && Contains(warnings, "2 NaN") &&
+    Contains(warnings, "1 infinite") && Contains(warnings, "1 negative") &&
+    Contains(warnings, "(of 64)"))
+    << warnings;
+  // Negative values of a grid that is not density-like are not warned about.
+  EXPECT_FALSE(Contains(warnings, "grid 'distance'")) << warnings;
+}
+
+TEST(ReadChecks, StreamFilesWithoutOffsetsAreRefusedClearly)
+{
+  openvdb::initialize();
+  const std::string path = TempPath("stream.vdb");
+  {
+    std::ofstream out(path, std::ios::binary);
+    openvdb::io::Stream(out).write(openvdb::GridPtrVec{
+      FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f) });
+  }
+  int ok = 1;
+  const std::string errors = ReadErrors(path, 0, &ok);
+  EXPECT_EQ(ok, 0);
+  EXPECT_TRUE(Contains(errors, "without grid offsets")) << errors;
+}
+
+TEST(Guard, NegativeChunkSizeDoesNotOverflowTheBuffer)
+{
+  // OpenVDB 10.0.1's bloscFromStream reads -size bytes into the buffer before checking the
+  // size; the replacement in IO/Core/VdbCompressionGuard.cxx checks first.
+  openvdb::initialize();
+  std::string bytes(8 + 64, 'x');
+  const int64_t size = -64;
+  std::memcpy(&bytes[0], &size, 8);
+  std::istringstream in(bytes);
+  char buffer[32];
+  std::memset(buffer, 0, sizeof(buffer));
+  EXPECT_THROW(openvdb::io::bloscFromStream(in, buffer, 16), openvdb::RuntimeError);
+  EXPECT_EQ(buffer[16], 0) << "wrote past the 16-byte buffer";
+  std::istringstream in2(bytes);
+  EXPECT_THROW(openvdb::io::unzipFromStream(in2, buffer, 16), openvdb::RuntimeError);
+  EXPECT_EQ(buffer[16], 0) << "wrote past the 16-byte buffer";
 }

@@ -1,0 +1,140 @@
+// Chunk-size checks that OpenVDB 10.0.1 lacks, as replacement definitions of its
+// openvdb::io::bloscFromStream and openvdb::io::unzipFromStream.
+//
+// OpenVDB reads a leaf's values as a 64-bit chunk size followed by the chunk. A negative
+// size means "uncompressed, -size bytes", and OpenVDB 10.0.1 reads those bytes into the
+// leaf's buffer BEFORE comparing the size with the buffer's: one corrupt byte there makes
+// it write past the buffer (a heap overflow, found by Testing/Cxx/TestOpenVDBFuzz.cxx:
+// "double free or corruption" a little later). A Blosc chunk's own header is trusted as
+// well. These definitions do the same reads with the checks first. libopenvdb calls both
+// functions through its PLT (it is not linked with -Bsymbolic), and this library comes
+// before libopenvdb in the dynamic linker's search order of every program that links it,
+// so these definitions are the ones called, from this library, from OpenVDB's own code
+// and from the tests (Testing/Cxx/TestOpenVDB.cxx, Guard.* tests, checks that they are).
+// Only for the OpenVDB version they were written against (10.0.x); any other version keeps
+// its own functions.
+#include "VdbArchive.h"
+
+#include <openvdb/Exceptions.h>
+#include <openvdb/io/Compression.h>
+#include <openvdb/version.h>
+
+#include <blosc.h>
+#include <zlib.h>
+
+#include <cstdint>
+#include <istream>
+#include <limits>
+#include <memory>
+
+#if OPENVDB_LIBRARY_MAJOR_VERSION_NUMBER == 10 && OPENVDB_LIBRARY_MINOR_VERSION_NUMBER == 0
+
+namespace
+{
+/// Bytes left in the stream when it reads a grid held in memory (SpanBuf); -1 otherwise.
+int64_t Remaining(std::istream& is)
+{
+  const auto* span = dynamic_cast<const nimbus::vdb::SpanBuf*>(is.rdbuf());
+  return span ? span->Remaining() : -1;
+}
+
+/// The chunk size read from the stream, checked: a negative (uncompressed) size must be
+/// exactly the buffer's size; any size must fit in the bytes left (when known).
+uint64_t CheckedChunk(std::istream& is, int64_t size, size_t numBytes, bool& compressed)
+{
+  compressed = size > 0;
+  const uint64_t bytes = size > 0
+    ? uint64_t(size)
+    : (size == std::numeric_limits<int64_t>::min() ? std::numeric_limits<uint64_t>::max()
+                                                   : uint64_t(-size));
+  if (!compressed && bytes != numBytes)
+  {
+    OPENVDB_THROW(openvdb::RuntimeError,
+      "corrupt voxel data: an uncompressed chunk of " << bytes << " bytes where " << numBytes
+                                                      << " are expected");
+  }
+  const int64_t left = Remaining(is);
+  if (left >= 0 && bytes > uint64_t(left))
+  {
+    OPENVDB_THROW(openvdb::RuntimeError,
+      "corrupt voxel data: a chunk of " << bytes << " bytes where only " << left
+                                        << " are left in the grid");
+  }
+  return bytes;
+}
+}
+
+namespace openvdb
+{
+OPENVDB_USE_VERSION_NAMESPACE
+namespace OPENVDB_VERSION_NAME
+{
+namespace io
+{
+
+void bloscFromStream(std::istream& is, char* data, size_t numBytes)
+{
+  Int64 size = 0;
+  is.read(reinterpret_cast<char*>(&size), 8);
+  bool compressed = false;
+  const uint64_t bytes = CheckedChunk(is, size, numBytes, compressed);
+  if (!data)
+  {
+    is.seekg(static_cast<std::streamoff>(bytes), std::ios_base::cur);
+    return;
+  }
+  if (!compressed)
+  {
+    is.read(data, static_cast<std::streamsize>(bytes));
+    return;
+  }
+  std::unique_ptr<char[]> chunk(new char[bytes]);
+  is.read(chunk.get(), static_cast<std::streamsize>(bytes));
+  size_t expanded = 0;
+  if (blosc_cbuffer_validate(chunk.get(), bytes, &expanded) != 0 || expanded != numBytes)
+  {
+    OPENVDB_THROW(RuntimeError,
+      "corrupt voxel data: a Blosc chunk that does not expand to " << numBytes << " bytes");
+  }
+  const int got = blosc_decompress_ctx(chunk.get(), data, numBytes, /*numthreads=*/1);
+  if (got < 0 || size_t(got) != numBytes)
+  {
+    OPENVDB_THROW(
+      RuntimeError, "Expected to decompress " << numBytes << " bytes, got " << got << " bytes");
+  }
+}
+
+void unzipFromStream(std::istream& is, char* data, size_t numBytes)
+{
+  Int64 size = 0;
+  is.read(reinterpret_cast<char*>(&size), 8);
+  bool compressed = false;
+  const uint64_t bytes = CheckedChunk(is, size, numBytes, compressed);
+  if (!data)
+  {
+    is.seekg(static_cast<std::streamoff>(bytes), std::ios_base::cur);
+    return;
+  }
+  if (!compressed)
+  {
+    is.read(data, static_cast<std::streamsize>(bytes));
+    return;
+  }
+  std::unique_ptr<Bytef[]> chunk(new Bytef[bytes]);
+  is.read(reinterpret_cast<char*>(chunk.get()), static_cast<std::streamsize>(bytes));
+  uLongf unzipped = static_cast<uLongf>(numBytes);
+  const int status =
+    uncompress(reinterpret_cast<Bytef*>(data), &unzipped, chunk.get(), static_cast<uLong>(bytes));
+  if (status != Z_OK || unzipped != numBytes)
+  {
+    OPENVDB_THROW(RuntimeError,
+      "Expected to decompress " << numBytes << " bytes, got " << unzipped << " bytes (zlib "
+                                << status << ")");
+  }
+}
+
+} // namespace io
+} // namespace OPENVDB_VERSION_NAME
+} // namespace openvdb
+
+#endif
