@@ -26,6 +26,15 @@
  * Units: Bounds in metres; Wind in m/s (x, y) at the bottom of the grid, Shear in
  * (m/s) per metre of height; StepDuration in seconds; probabilities per cell per step.
  * The field data holds "AutomatonStep" (the fractional step shown).
+ *
+ * Bad input ends in an error message and an empty output, never in an exception or an
+ * allocation VTK cannot make: NaN probabilities or smoothing radius, StepDuration outside
+ * (0, 1e9] s, Bounds not finite, not min < max or beyond +-1e8 m, a wind or shear that moves
+ * a layer more than 1e6 cells per step, input arrays with values outside [0, 1] (counted in
+ * the message), a grid, cache and checkpoints that would need more than MemoryBudgetMiB, or a
+ * requested time that would need more than about 1e11 cell updates from the nearest cached
+ * state (the message gives the estimate). Stepping reports progress and stops soon after
+ * AbortExecute is set (the output is then empty; the states computed so far stay cached).
  */
 #ifndef vtkNimbusCloudAutomatonSource_h
 #define vtkNimbusCloudAutomatonSource_h
@@ -138,6 +147,15 @@ public:
   vtkGetMacro(MaximumNumberOfCheckpoints, int);
   ///@}
 
+  ///@{
+  /// Memory the source may use (grid states, checkpoints, cached densities, output), MiB
+  /// (> 0, finite). Settings that would need more are refused with a message. Default
+  /// nimbus::DefaultMemoryBudgetMiB(): half the physical memory, at most three quarters of
+  /// the process's address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  ///@}
+
   /// Automaton steps run since the cache was last reset (for tests and timings).
   vtkGetMacro(NumberOfStepsComputed, vtkIdType);
 
@@ -149,6 +167,11 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// RequestData's work; may throw (RequestData catches and clears the cache).
+  int Generate(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
+  /// False (after vtkErrorMacro) when a parameter is unusable.
+  bool CheckParameters();
 
   int Dimensions[3];
   double Bounds[6];
@@ -169,6 +192,7 @@ protected:
   int CheckpointInterval;
   int MaximumNumberOfCheckpoints;
   vtkIdType NumberOfStepsComputed;
+  double MemoryBudgetMiB;
 
 private:
   vtkNimbusCloudAutomatonSource(const vtkNimbusCloudAutomatonSource&) = delete;

@@ -22,6 +22,16 @@
  * (dimensionless; a renderer's extinction is ExtinctionCoefficient * density, 1/m).
  * Output port 1: the 2-D map at z = BaseHeight with "optical_depth" (the image's target
  * tau) and "column_optical_depth" (the achieved tau of the density).
+ *
+ * Bad input ends in an error message and empty outputs, never in an exception or an
+ * allocation VTK cannot make: NaN or infinite parameters, values outside the documented
+ * ranges (PixelSize and VerticalSpacing in [1e-3, 1e6] m, ExtinctionCoefficient in
+ * (0, 1e3] 1/m, NominalDensity in (0, 1e6], |BaseHeight| and BaseTransitionThickness at
+ * most 1e8 m), a cloud thicker than 4096 layers, an image whose grid would exceed 2e9
+ * points or MemoryBudgetMiB, or work beyond about 2e11 grid-point updates (the messages
+ * say which). NaN, infinite and (with IntensityRange[0] >= 0) negative intensities are
+ * counted in a warning: NaN reads as clear sky, the others are clamped to the range's ends.
+ * The build reports progress and stops soon after AbortExecute is set (outputs then empty).
  */
 #ifndef vtkNimbusImageCloudFilter_h
 #define vtkNimbusImageCloudFilter_h
@@ -112,6 +122,14 @@ public:
   vtkGetMacro(Seed, int);
   ///@}
 
+  ///@{
+  /// Memory the filter may use for one update, MiB (> 0, finite). Images whose cloud would
+  /// need more are refused with a message. Default nimbus::DefaultMemoryBudgetMiB(): half
+  /// the physical memory, at most three quarters of the process's address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  ///@}
+
   /// Port 1's data: target and achieved optical depth maps.
   vtkImageData* GetOpticalDepthMap();
 
@@ -124,6 +142,9 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// RequestData's work; may throw (RequestData catches).
+  int Generate(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
   double IntensityRange[2];
   int MappingType;
@@ -143,6 +164,7 @@ protected:
   double TopRoughness;
   int Iterations;
   int Seed;
+  double MemoryBudgetMiB;
 
 private:
   vtkNimbusImageCloudFilter(const vtkNimbusImageCloudFilter&) = delete;
