@@ -50,6 +50,22 @@ struct vtkNimbusCloudAutomatonSource::vtkInternals
 
 namespace
 {
+// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
+// RequestData refuses them with a message instead of their being clamped silently.
+template <typename Object>
+void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
+{
+  if (std::isfinite(value))
+  {
+    value = std::clamp(value, low, high);
+  }
+  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
+  {
+    member = value;
+    object->Modified();
+  }
+}
+
 constexpr int MaximumCachedDensities = 4;
 // Valid ranges (see the class documentation).
 constexpr double MaximumLength = 1.0e8;       // m
@@ -126,6 +142,36 @@ vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
 }
 
 vtkNimbusCloudAutomatonSource::~vtkNimbusCloudAutomatonSource() = default;
+
+void vtkNimbusCloudAutomatonSource::SetExtinctionProbability(double value)
+{
+  SetClampedFiniteValue(this, this->ExtinctionProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetHumidityProbability(double value)
+{
+  SetClampedFiniteValue(this, this->HumidityProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetActivationProbability(double value)
+{
+  SetClampedFiniteValue(this, this->ActivationProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetInitialHumidity(double value)
+{
+  SetClampedFiniteValue(this, this->InitialHumidity, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetInitialActivation(double value)
+{
+  SetClampedFiniteValue(this, this->InitialActivation, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetSmoothingRadius(double value)
+{
+  SetClampedFiniteValue(this, this->SmoothingRadius, value, 0.0, 16.0);
+}
 
 int vtkNimbusCloudAutomatonSource::FillInputPortInformation(int, vtkInformation* info)
 {

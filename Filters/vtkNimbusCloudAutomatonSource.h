@@ -73,20 +73,35 @@ public:
   ///@{
   /// Per-step probabilities used where the input has no array: cloud extinction p_ext,
   /// vapour supply p_hum, activation supply p_act (002 §3). Defaults 0.05, 0.002, 0.0002.
-  vtkSetClampMacro(ExtinctionProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetExtinctionProbability(double value);
+  double GetExtinctionProbabilityMinValue() { return 0.0; }
+  double GetExtinctionProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(ExtinctionProbability, double);
-  vtkSetClampMacro(HumidityProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetHumidityProbability(double value);
+  double GetHumidityProbabilityMinValue() { return 0.0; }
+  double GetHumidityProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(HumidityProbability, double);
-  vtkSetClampMacro(ActivationProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetActivationProbability(double value);
+  double GetActivationProbabilityMinValue() { return 0.0; }
+  double GetActivationProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(ActivationProbability, double);
   ///@}
 
   ///@{
   /// Probabilities of hum and act in each cell at time 0 (cld starts empty).
   /// Defaults 0.3 and 0.001.
-  vtkSetClampMacro(InitialHumidity, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetInitialHumidity(double value);
+  double GetInitialHumidityMinValue() { return 0.0; }
+  double GetInitialHumidityMaxValue() { return 1.0; }
   vtkGetMacro(InitialHumidity, double);
-  vtkSetClampMacro(InitialActivation, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetInitialActivation(double value);
+  double GetInitialActivationMinValue() { return 0.0; }
+  double GetInitialActivationMaxValue() { return 1.0; }
   vtkGetMacro(InitialActivation, double);
   ///@}
 
@@ -119,7 +134,10 @@ public:
 
   ///@{
   /// Radius (cells) of the smoothing kernel; <= 1 gives the raw 0/1 cld field. Default 2.5.
-  vtkSetClampMacro(SmoothingRadius, double, 0.0, 16.0);
+  /// Clamped to [0.0, 16.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetSmoothingRadius(double value);
+  double GetSmoothingRadiusMinValue() { return 0.0; }
+  double GetSmoothingRadiusMaxValue() { return 16.0; }
   vtkGetMacro(SmoothingRadius, double);
   ///@}
 

@@ -26,6 +26,25 @@
 
 vtkStandardNewMacro(vtkNimbusImageCloudFilter);
 
+namespace
+{
+// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
+// RequestData refuses them with a message instead of their being clamped silently.
+template <typename Object>
+void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
+{
+  if (std::isfinite(value))
+  {
+    value = std::clamp(value, low, high);
+  }
+  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
+  {
+    member = value;
+    object->Modified();
+  }
+}
+}
+
 vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
 {
   this->SetNumberOfInputPorts(1);
@@ -57,6 +76,31 @@ vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
 }
 
 vtkNimbusImageCloudFilter::~vtkNimbusImageCloudFilter() = default;
+
+void vtkNimbusImageCloudFilter::SetGamma(double value)
+{
+  SetClampedFiniteValue(this, this->Gamma, value, 0.01, 100.0);
+}
+
+void vtkNimbusImageCloudFilter::SetMaximumOpticalDepth(double value)
+{
+  SetClampedFiniteValue(this, this->MaximumOpticalDepth, value, 0.0, 1000.0);
+}
+
+void vtkNimbusImageCloudFilter::SetAsymmetryParameter(double value)
+{
+  SetClampedFiniteValue(this, this->AsymmetryParameter, value, 0.0, 0.99);
+}
+
+void vtkNimbusImageCloudFilter::SetBallRadiusFactor(double value)
+{
+  SetClampedFiniteValue(this, this->BallRadiusFactor, value, 0.1, 20.0);
+}
+
+void vtkNimbusImageCloudFilter::SetTopRoughness(double value)
+{
+  SetClampedFiniteValue(this, this->TopRoughness, value, 0.0, 1.0);
+}
 
 vtkImageData* vtkNimbusImageCloudFilter::GetOpticalDepthMap()
 {
@@ -318,7 +362,7 @@ int vtkNimbusImageCloudFilter::Generate(
                   << ") must be greater than ClearIntensity (" << this->ClearIntensity << ").");
     return 1;
   }
-  // The clamped setters let NaN through: name it here, not deep in the core.
+  // The clamping setters keep NaN and infinities: name them here, not deep in the core.
   const struct
   {
     const char* Name;
@@ -328,9 +372,10 @@ int vtkNimbusImageCloudFilter::Generate(
     { "BallRadiusFactor", this->BallRadiusFactor }, { "TopRoughness", this->TopRoughness } };
   for (const auto& parameter : clamped)
   {
-    if (std::isnan(parameter.Value))
+    if (!std::isfinite(parameter.Value))
     {
-      vtkErrorMacro(<< parameter.Name << " is NaN; it must be a number.");
+      vtkErrorMacro(<< parameter.Name << " is " << parameter.Value
+                    << "; it must be a finite number (finite values are clamped to its range).");
       return 1;
     }
   }

@@ -72,11 +72,20 @@ public:
   vtkGetMacro(ClearIntensity, double);
   vtkSetMacro(WhiteIntensity, double);
   vtkGetMacro(WhiteIntensity, double);
-  vtkSetClampMacro(Gamma, double, 0.01, 100.0);
+  /// Clamped to [0.01, 100.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetGamma(double value);
+  double GetGammaMinValue() { return 0.01; }
+  double GetGammaMaxValue() { return 100.0; }
   vtkGetMacro(Gamma, double);
-  vtkSetClampMacro(MaximumOpticalDepth, double, 0.0, 1000.0);
+  /// Clamped to [0.0, 1000.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetMaximumOpticalDepth(double value);
+  double GetMaximumOpticalDepthMinValue() { return 0.0; }
+  double GetMaximumOpticalDepthMaxValue() { return 1000.0; }
   vtkGetMacro(MaximumOpticalDepth, double);
-  vtkSetClampMacro(AsymmetryParameter, double, 0.0, 0.99);
+  /// Clamped to [0.0, 0.99]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetAsymmetryParameter(double value);
+  double GetAsymmetryParameterMinValue() { return 0.0; }
+  double GetAsymmetryParameterMaxValue() { return 0.99; }
   vtkGetMacro(AsymmetryParameter, double);
   ///@}
 
@@ -112,9 +121,15 @@ public:
   /// Seed of the jitter. Defaults 2, 3, 0.6, 10, 1.
   vtkSetClampMacro(BallSpacing, int, 1, 64);
   vtkGetMacro(BallSpacing, int);
-  vtkSetClampMacro(BallRadiusFactor, double, 0.1, 20.0);
+  /// Clamped to [0.1, 20.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetBallRadiusFactor(double value);
+  double GetBallRadiusFactorMinValue() { return 0.1; }
+  double GetBallRadiusFactorMaxValue() { return 20.0; }
   vtkGetMacro(BallRadiusFactor, double);
-  vtkSetClampMacro(TopRoughness, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetTopRoughness(double value);
+  double GetTopRoughnessMinValue() { return 0.0; }
+  double GetTopRoughnessMaxValue() { return 1.0; }
   vtkGetMacro(TopRoughness, double);
   vtkSetClampMacro(Iterations, int, 0, 100);
   vtkGetMacro(Iterations, int);
