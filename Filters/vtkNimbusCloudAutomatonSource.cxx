@@ -68,11 +68,12 @@ void SetClampedFiniteValue(Object* object, double& member, double value, double 
 
 constexpr int MaximumCachedDensities = 4;
 // Valid ranges (see the class documentation).
-constexpr double MaximumLength = 1.0e8;       // m
-constexpr double MaximumStepDuration = 1.0e9; // s (about 32 years)
-constexpr double MaximumCellsPerStep = 1.0e6; // wind shift of one layer, cells per step
-constexpr double MaximumWork = 1.0e11;        // cell updates of one request (minutes)
-constexpr double StepOverhead = 65536.0;      // fixed cost of a step, in cell updates
+constexpr double MaximumLength = 1.0e8;        // m
+constexpr double MinimumStepDuration = 1.0e-6; // s (ParaView's time steps stay distinct)
+constexpr double MaximumStepDuration = 1.0e9;  // s (about 32 years)
+constexpr double MaximumCellsPerStep = 1.0e6;  // wind shift of one layer, cells per step
+constexpr double MaximumWork = 1.0e11;         // cell updates of one request (minutes)
+constexpr double StepOverhead = 65536.0;       // fixed cost of a step, in cell updates
 constexpr double MiB = 1048576.0;
 
 std::string Number(double value)
@@ -85,7 +86,7 @@ std::string Number(double value)
 
 bool ValidStepDuration(double seconds)
 {
-  return seconds > 0.0 && seconds <= MaximumStepDuration;
+  return seconds >= MinimumStepDuration && seconds <= MaximumStepDuration;
 }
 
 bool AllFinite(const double* values, int count)
@@ -272,8 +273,8 @@ bool vtkNimbusCloudAutomatonSource::CheckParameters()
   }
   if (!ValidStepDuration(this->StepDuration))
   {
-    vtkErrorMacro(<< "StepDuration must be a finite number of seconds > 0 and at most "
-                  << MaximumStepDuration << ", got " << this->StepDuration << ".");
+    vtkErrorMacro(<< "StepDuration must be between " << MinimumStepDuration << " and "
+                  << MaximumStepDuration << " seconds, got " << this->StepDuration << ".");
     return false;
   }
   const struct

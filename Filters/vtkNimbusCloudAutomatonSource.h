@@ -28,13 +28,14 @@
  * The field data holds "AutomatonStep" (the fractional step shown).
  *
  * Bad input ends in an error message and an empty output, never in an exception or an
- * allocation VTK cannot make: NaN probabilities or smoothing radius, StepDuration outside
- * (0, 1e9] s, Bounds not finite, not min < max or beyond +-1e8 m, a wind or shear that moves
- * a layer more than 1e6 cells per step, input arrays with values outside [0, 1] (counted in
- * the message), a grid, cache and checkpoints that would need more than MemoryBudgetMiB, or a
- * requested time that would need more than about 1e11 cell updates from the nearest cached
- * state (the message gives the estimate). Stepping reports progress and stops soon after
- * AbortExecute is set (the output is then empty; the states computed so far stay cached).
+ * allocation VTK cannot make: NaN or infinite probabilities or smoothing radius (finite
+ * values are clamped to their ranges), StepDuration outside [1e-6, 1e9] s, Bounds not finite, not
+ * min < max or beyond +-1e8 m, a wind or shear that moves a layer more than 1e6 cells per step,
+ * input arrays with values outside [0, 1] (counted in the message), a grid, cache and checkpoints
+ * that would need more than MemoryBudgetMiB, or a requested time that would need more than about
+ * 1e11 cell updates from the nearest cached state (the message gives the estimate). Stepping
+ * reports progress and stops soon after AbortExecute is set (the output is then empty; the states
+ * computed so far stay cached).
  */
 #ifndef vtkNimbusCloudAutomatonSource_h
 #define vtkNimbusCloudAutomatonSource_h
@@ -124,8 +125,8 @@ public:
   ///@}
 
   ///@{
-  /// Seconds per automaton step (> 0) and number of steps advertised as TIME_STEPS
-  /// (>= 0). Defaults 1 and 100.
+  /// Seconds per automaton step (in [1e-6, 1e9]) and number of steps advertised as
+  /// TIME_STEPS (clamped to [0, 1e6]). Defaults 1 and 100.
   vtkSetMacro(StepDuration, double);
   vtkGetMacro(StepDuration, double);
   vtkSetClampMacro(NumberOfTimeSteps, int, 0, 1000000);

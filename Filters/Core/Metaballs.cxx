@@ -15,8 +15,10 @@ double WyvillFalloff(double distanceSquared, double radiusSquared)
     return 0.0;
   }
   const double q = distanceSquared / radiusSquared; // (r/R)^2
-  // 1 - 22/9 q + 17/9 q^2 - 4/9 q^3, in Horner form
-  return 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * (4.0 / 9.0)));
+  // 1 - 22/9 q + 17/9 q^2 - 4/9 q^3, in Horner form. f(1) = 0 exactly only in real
+  // arithmetic: just inside the radius rounding can give about -1e-17, so clamp at 0 (no
+  // negative density anywhere, as documented).
+  return std::max(0.0, 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * (4.0 / 9.0))));
 }
 
 namespace
