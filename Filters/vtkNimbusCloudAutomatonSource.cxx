@@ -140,6 +140,8 @@ vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
   this->MaximumNumberOfCheckpoints = 16;
   this->NumberOfStepsComputed = 0;
   this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusCloudAutomatonSource::~vtkNimbusCloudAutomatonSource() = default;

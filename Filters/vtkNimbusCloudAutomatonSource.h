@@ -173,6 +173,9 @@ public:
   /// the process's address-space limit.
   vtkSetMacro(MemoryBudgetMiB, double);
   vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
   ///@}
 
   /// Automaton steps run since the cache was last reset (for tests and timings).
@@ -212,6 +215,7 @@ protected:
   int MaximumNumberOfCheckpoints;
   vtkIdType NumberOfStepsComputed;
   double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusCloudAutomatonSource(const vtkNimbusCloudAutomatonSource&) = delete;

@@ -73,6 +73,8 @@ vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
   this->Iterations = p.Iterations;
   this->Seed = 1;
   this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusImageCloudFilter::~vtkNimbusImageCloudFilter() = default;

@@ -143,6 +143,9 @@ public:
   /// the physical memory, at most three quarters of the process's address-space limit.
   vtkSetMacro(MemoryBudgetMiB, double);
   vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
   ///@}
 
   /// Port 1's data: target and achieved optical depth maps.
@@ -180,6 +183,7 @@ protected:
   int Iterations;
   int Seed;
   double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusImageCloudFilter(const vtkNimbusImageCloudFilter&) = delete;

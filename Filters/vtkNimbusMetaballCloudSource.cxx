@@ -125,6 +125,8 @@ vtkNimbusMetaballCloudSource::vtkNimbusMetaballCloudSource()
   this->BaseHeight = 1000.0;
   this->BaseTransitionThickness = 100.0;
   this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusMetaballCloudSource::~vtkNimbusMetaballCloudSource() = default;

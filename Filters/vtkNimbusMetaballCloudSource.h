@@ -143,6 +143,9 @@ public:
   /// the process's address-space limit.
   vtkSetMacro(MemoryBudgetMiB, double);
   vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
   ///@}
 
   /// The metaballs of the last update (port 1's data).
@@ -180,6 +183,7 @@ protected:
   double BaseHeight;
   double BaseTransitionThickness;
   double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusMetaballCloudSource(const vtkNimbusMetaballCloudSource&) = delete;
