@@ -110,7 +110,21 @@ ChildResult RunIsolated(const std::function<int(std::string&)>& body)
     setrlimit(RLIMIT_AS, &limit);
     alarm(AlarmSeconds);
     std::string note;
-    const int outcome = body(note);
+    int outcome = Crashed;
+    // An exception leaving the source would end ParaView: count it as a crash, and never let
+    // it reach gtest in this child.
+    try
+    {
+      outcome = body(note);
+    }
+    catch (const std::exception& error)
+    {
+      note = std::string("uncaught exception: ") + error.what();
+    }
+    catch (...)
+    {
+      note = "uncaught exception";
+    }
     note = note.substr(0, 2000);
     const ssize_t written = write(fds[1], note.data(), note.size());
     (void)written;
@@ -129,7 +143,7 @@ ChildResult RunIsolated(const std::function<int(std::string&)>& body)
   int status = 0;
   waitpid(pid, &status, 0);
   result.Seconds = Seconds(start);
-  if (WIFEXITED(status) && WEXITSTATUS(status) <= Silent + 1)
+  if (WIFEXITED(status) && WEXITSTATUS(status) <= Crashed)
   {
     result.Outcome = WEXITSTATUS(status);
   }
