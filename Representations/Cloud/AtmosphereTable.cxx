@@ -89,7 +89,8 @@ AtmosphereTable BuildAtmosphereTable(
     // colour (a sun reddened near the horizon, a 1000 K sun), and would make the
     // sums of the passes negative. Clipped at 0 per channel (gamut clipping of the
     // light, as SunIrradiance() in svsCommon.glsl clips row 0 already).
-    auto put = [&](int row, int c, double value) {
+    auto put = [&](int row, int c, double value)
+    {
       table.Data[(static_cast<std::size_t>(row) * samples + i) * 4 + c] =
         static_cast<float>(std::max(value, 0.0));
     };

@@ -88,14 +88,15 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   }
   std::ostringstream message;
   uint64_t needed = 0;
-  const bool representable = CheckedProduct({ static_cast<uint64_t>(dims[0]),
-                                              static_cast<uint64_t>(dims[1]),
-                                              static_cast<uint64_t>(dims[2]) },
-    needed);
+  const bool representable =
+    CheckedProduct({ static_cast<uint64_t>(dims[0]), static_cast<uint64_t>(dims[1]),
+                     static_cast<uint64_t>(dims[2]) },
+      needed);
   if (!representable || needed != static_cast<uint64_t>(scalars->GetNumberOfTuples()))
   {
     message << "Array '" << NameOf(scalars) << "' has " << scalars->GetNumberOfTuples()
-            << " values, but the image (" << dims[0] << "x" << dims[1] << "x" << dims[2] << ") needs ";
+            << " values, but the image (" << dims[0] << "x" << dims[1] << "x" << dims[2]
+            << ") needs ";
     if (representable)
     {
       message << needed;
@@ -127,8 +128,8 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   std::string overBudget =
     OverBudgetMessage("the density texture", kBytesPerTexel * plan.OutputSize(), budgetBytes);
   const std::string firstOverBudget = overBudget;
-  int limit = std::max({ plan.OutputDimensions[0], plan.OutputDimensions[1],
-    plan.OutputDimensions[2], 1 });
+  int limit =
+    std::max({ plan.OutputDimensions[0], plan.OutputDimensions[1], plan.OutputDimensions[2], 1 });
   while (!overBudget.empty() && limit > 1)
   {
     const double shrink = std::cbrt(budgetBytes / (kBytesPerTexel * plan.OutputSize()));
@@ -162,8 +163,8 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
     message.str("");
   }
   const ResampledDensity density = Resample(scalars, plan);
-  const bool newValues = this->ReportedArray != scalars ||
-    scalars->GetMTime() > this->ReportTime || image->GetMTime() > this->ReportTime;
+  const bool newValues = this->ReportedArray != scalars || scalars->GetMTime() > this->ReportTime ||
+    image->GetMTime() > this->ReportTime;
   if (newValues && (!density.Census.AllFiniteNonNegative() || density.TooLargeCount > 0))
   {
     message << "Density array '" << NameOf(scalars) << "': ";

@@ -33,7 +33,7 @@ namespace nimbus
 /// The largest density a texel holds; larger samples are clamped to it (and
 /// counted), so that a block's float sum stays finite (below 3.4e38 for blocks of
 /// up to 3e8 samples) and k_cl rho does too (k_cl <= 1e6).
-constexpr double kMaximumDensity = 1e30;
+constexpr double kMaximumDensity = 0x1p100; // 1.27e30, exact in float and double
 
 /// Sizes of one resampling: samples per axis, samples per texel per axis (the
 /// block), texels per axis.
@@ -99,7 +99,7 @@ inline double TextureDensity(double v, ValueCensus& census, std::size_t& tooLarg
     ++tooLarge;
     return kMaximumDensity;
   }
-  return v;
+  return v > 0.0 ? v : 0.0; // -0 -> +0
 }
 
 /// Resampling of plan.InputSize() samples, `sample(i)` giving sample i (x fastest)

@@ -16,7 +16,7 @@
 /// Defines `void cls::Set<name>(double)`: refuses non-finite values (error, value
 /// kept), clamps finite ones to [Get<name>MinValue(), Get<name>MaxValue()] (declared
 /// in the class, as vtkSetClampMacro does).
-#define nimbusDefineFiniteSetter(cls, name)                                         \
+#define nimbusDefineFiniteSetter(cls, name)                                                        \
   void cls::Set##name(double value)                                                                \
   {                                                                                                \
     if (!std::isfinite(value))                                                                     \
@@ -25,7 +25,8 @@
                                     << this->name << ".");                                         \
       return;                                                                                      \
     }                                                                                              \
-    const double clamped = std::clamp(value, this->Get##name##MinValue(), this->Get##name##MaxValue());  \
+    const double clamped =                                                                         \
+      std::clamp(value, this->Get##name##MinValue(), this->Get##name##MaxValue());                 \
     if (this->name != clamped)                                                                     \
     {                                                                                              \
       this->name = clamped;                                                                        \

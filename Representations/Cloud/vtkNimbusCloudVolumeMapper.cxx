@@ -538,8 +538,8 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
     : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
   std::vector<std::string> warnings;
   std::string error;
-  const bool ok = in.Density.Update(
-    window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error);
+  const bool ok =
+    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error);
   for (const std::string& warning : warnings)
   {
     vtkWarningMacro(<< warning);
@@ -718,8 +718,8 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   vtkMatrix4x4* viewMatrix = camera->GetViewTransformMatrix();
   const double forward[3] = { -viewMatrix->GetElement(2, 0), -viewMatrix->GetElement(2, 1),
     -viewMatrix->GetElement(2, 2) };
-  const double length = std::sqrt(
-    forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
+  const double length =
+    std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
   for (int k = 0; k < 3; ++k)
   {
     frame.ViewForward[k] = length > 0.0 ? forward[k] / length : projection[k];
@@ -871,8 +871,8 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   const nimbus::SceneAtmosphere& air = frame.Settings.Air;
   program->SetUniformMatrix4x4(
     "inverseViewProjection", const_cast<float*>(frame.InverseViewProjection.data()));
-  program->SetUniformMatrix4x4("inverseViewProjectionFromEye",
-    const_cast<float*>(frame.InverseViewProjectionFromEye.data()));
+  program->SetUniformMatrix4x4(
+    "inverseViewProjectionFromEye", const_cast<float*>(frame.InverseViewProjectionFromEye.data()));
   program->SetUniform3f("viewForward", frame.ViewForward.data());
   program->SetUniform2f("clippingRange", frame.ClippingRange.data());
   program->SetUniformi("perspective", frame.Camera->GetParallelProjection() ? 0 : 1);

@@ -32,6 +32,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -39,6 +40,11 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#ifdef __linux__
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
 
 namespace
 {
@@ -87,9 +93,9 @@ struct Frame
       s << "nothing drawn (no radiance), framebuffer mean " << MeanPixel();
       return s.str();
     }
-    s << "radiance: " << NaN << " NaN, " << Infinite << " inf, " << Negative
-      << " negative; range [" << MinRadiance << ", " << MaxRadiance << "], mean " << MeanRadiance
-      << "; framebuffer mean " << MeanPixel();
+    s << "radiance: " << NaN << " NaN, " << Infinite << " inf, " << Negative << " negative; range ["
+      << MinRadiance << ", " << MaxRadiance << "], mean " << MeanRadiance << "; framebuffer mean "
+      << MeanPixel();
     return s.str();
   }
 };
@@ -220,8 +226,16 @@ bool Contains(const std::string& text, const std::string& part)
   return text.find(part) != std::string::npos;
 }
 
-std::string FirstLine(const std::string& text)
+// The first message's text (VTK's messages start with a line "ERROR: In file, line
+// n" and then "vtkClass (0x...): text").
+std::string FirstLine(std::string text)
 {
+  if (text.compare(0, 6, "ERROR:") == 0 || text.compare(0, 8, "Warning:") == 0)
+  {
+    text = text.substr(text.find('\n') + 1);
+    const std::size_t colon = text.find("): ");
+    text = colon != std::string::npos ? text.substr(colon + 3) : text;
+  }
   const std::string line = text.substr(0, text.find('\n'));
   return line.size() > 160 ? line.substr(0, 160) + "..." : line;
 }
@@ -235,7 +249,8 @@ struct Result
 // --- the cases ----------------------------------------------------------------------------
 // A refused value: the setter says so (an error naming the property), the property
 // keeps its value, and the frame is the finite image of the kept value.
-Result Refused(const std::string& property, const std::function<void(vtkNimbusCloudVolumeMapper*)>& set,
+Result Refused(const std::string& property,
+  const std::function<void(vtkNimbusCloudVolumeMapper*)>& set,
   const std::function<double(vtkNimbusCloudVolumeMapper*)>& get)
 {
   Scene s(MakeCloud());
@@ -265,8 +280,8 @@ Result FiniteImage(const std::function<void(Scene&)>& setUp, bool requireLight =
 
 Result SunElevation(double elevation)
 {
-  return FiniteImage([elevation](Scene& s) { s.Mapper->SetSunElevationDegrees(elevation); },
-    elevation > -1.0);
+  return FiniteImage(
+    [elevation](Scene& s) { s.Mapper->SetSunElevationDegrees(elevation); }, elevation > -1.0);
 }
 
 // The same scene with a clipping range of 1 ... 1e8 renders as with 10 ... 1e6.
@@ -284,7 +299,9 @@ Result WideClippingRange()
 Result CameraFarAbove()
 {
   return FiniteImage(
-    [](Scene& s) { s.LookFrom({ 0, 0, 1.0e6 }, { 0, 0, 0 }, { 0, 1, 0 }, 1e4, 2e6); });
+    [](Scene& s) {
+      s.LookFrom({ 0, 0, 1.0e6 }, { 0, 0, 0 }, { 0, 1, 0 }, 1e4, 2e6);
+    });
 }
 
 Result CameraInside()
@@ -301,7 +318,8 @@ Result CameraInside()
 // looking toward the sun (sign 1, view parallel to it) or away from it (-1).
 Result ViewAlongSun(double sign)
 {
-  return FiniteImage([sign](Scene& s)
+  return FiniteImage(
+    [sign](Scene& s)
     {
       const double e = 20.0 * M_PI / 180.0, d = 7000.0;
       s.LookFrom({ 0, -sign * d * std::cos(e), 1600 - sign * d * std::sin(e) }, { 0, 0, 1600 });
@@ -354,12 +372,12 @@ Result BadDensities()
   values->Modified();
   s.Render();
   const std::size_t afterChange = s.Messages.Warnings.size();
-  const bool counted =
-    Contains(warning, "2 NaN") && Contains(warning, "1 infinite") && Contains(warning, "3 negative");
+  const bool counted = Contains(warning, "2 NaN") && Contains(warning, "1 infinite") &&
+    Contains(warning, "3 negative");
   return { first.FiniteNonNegative() && counted && afterTwo == 1 && afterChange == 2,
-    "warnings after two renders: " + std::to_string(afterTwo) + ", after a change: " +
-      std::to_string(afterChange) + "; " + (warning.empty() ? "no warning" : FirstLine(warning)) +
-      "; " + first.Describe() };
+    "warnings after two renders: " + std::to_string(afterTwo) +
+      ", after a change: " + std::to_string(afterChange) + "; " +
+      (warning.empty() ? "no warning" : FirstLine(warning)) + "; " + first.Describe() };
 }
 
 Result OneVoxel()
@@ -460,6 +478,90 @@ Result NonFiniteCamera()
       (frame.HasRadiance ? "; drawn" : "; nothing drawn") };
 }
 
+// The texture memory budget: a volume over it is downsampled (a warning); one that
+// cannot fit even one texel is not drawn (an error).
+Result TextureBudget()
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetTextureMemoryBudgetMiB(0.01); // 10 KiB: 24x24x16 x 8 B = 72 KiB
+  const Frame small = s.Render();
+  int dims[3];
+  s.Mapper->GetTextureDimensions(dims);
+  const std::string warning = s.Messages.AllWarnings();
+  const bool fits = 8.0 * dims[0] * dims[1] * dims[2] <= 0.01 * 1024 * 1024;
+  s.Mapper->SetTextureMemoryBudgetMiB(1e-7);
+  s.Messages.Errors.clear();
+  const Frame none = s.Render();
+  const std::string error = s.Messages.AllErrors();
+  return { small.FiniteNonNegative() && fits && Contains(warning, "budget") && !none.Escaped &&
+      !none.HasRadiance && Contains(error, "budget"),
+    "0.01 MiB: texture " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+      std::to_string(dims[2]) + ", " + (warning.empty() ? "no warning" : FirstLine(warning)) +
+      "; 1e-7 MiB: " + (error.empty() ? "no error" : FirstLine(error)) +
+      (none.HasRadiance ? ", drawn" : ", nothing drawn") };
+}
+
+// Spacing 1e300: a box of 1e301 world units, whose sizes overflow float in the
+// shaders. Either VTK culls it (its bounds are beyond any frustum) or the mapper
+// draws a finite image or says why; no exception leaves Render.
+Result HugeSpacing()
+{
+  vtkSmartPointer<vtkImageData> image = MakeCloud();
+  image->SetSpacing(1e300, 1e300, 1e300);
+  Scene s(image);
+  const Frame frame = s.Render();
+  const std::string messages = s.AllMessages();
+  return { !frame.Escaped && (!frame.HasRadiance || frame.FiniteNonNegative()),
+    frame.Describe() + "; " + (messages.empty() ? "no message" : FirstLine(messages)) };
+}
+
+// std::bad_alloc inside the frame: the converted copy of a 64 MiB double density
+// cannot be allocated under an address-space limit (Linux: RLIMIT_AS just above
+// what the process uses). Caught at Render's boundary: an error, nothing drawn
+// over the scene, and the next frame, without the limit, draws again.
+Result OutOfMemoryInFrame()
+{
+#ifdef __linux__
+  Scene s(MakeCloud());
+  s.Mapper->SetTextureMemoryBudgetMiB(1e6); // the budget would refuse it first
+  s.Render();                               // shaders, targets, tables: allocated now
+  vtkNew<vtkImageData> big;
+  big->SetDimensions(256, 256, 128);
+  big->SetOrigin(-1500, -1500, 800);
+  big->SetSpacing(3000.0 / 255, 3000.0 / 255, 2000.0 / 127);
+  vtkNew<vtkDoubleArray> values;
+  values->SetName("density");
+  values->SetNumberOfTuples(256 * 256 * 128);
+  values->Fill(0.5);
+  big->GetPointData()->SetScalars(values);
+  s.Mapper->SetInputData(big);
+  long pages = 0;
+  std::ifstream("/proc/self/statm") >> pages;
+  const rlim_t used = static_cast<rlim_t>(pages) * static_cast<rlim_t>(sysconf(_SC_PAGESIZE));
+  rlimit saved{};
+  getrlimit(RLIMIT_AS, &saved);
+  rlimit tight = saved;
+  tight.rlim_cur = used + (8u << 20); // 8 MiB to spare; the copy needs 32 MiB
+  if (tight.rlim_cur > saved.rlim_cur || setrlimit(RLIMIT_AS, &tight) != 0)
+  {
+    return { true, "skipped (the address-space limit is already lower)" };
+  }
+  const Frame frame = s.Render();
+  setrlimit(RLIMIT_AS, &saved);
+  const std::string errors = s.Messages.AllErrors();
+  const Frame after = s.Render();
+  return { !frame.Escaped && !frame.HasRadiance && Contains(errors, "out of memory") &&
+      after.FiniteNonNegative(),
+    (frame.Escaped       ? "EXCEPTION escaped Render: " + frame.Exception
+        : errors.empty() ? std::string("no error")
+                         : FirstLine(errors)) +
+      (frame.HasRadiance ? "; drawn" : "; nothing drawn") +
+      "; without the limit: " + after.Describe() };
+#else
+  return { true, "skipped (needs Linux's RLIMIT_AS)" };
+#endif
+}
+
 // A size no texture can take: a message, no crash (the array does not match such an
 // image; the mapper must say so without computing the product in int).
 Result AbsurdDimensions()
@@ -485,103 +587,139 @@ int main(int argc, char* argv[])
   using M = vtkNimbusCloudVolumeMapper;
   const std::vector<std::pair<std::string, std::function<Result()>>> cases = {
     { "SunElevationNaN",
-      [] {
-        return Refused("SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(kNaN); },
+      []
+      {
+        return Refused(
+          "SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(kNaN); },
           [](M* m) { return m->GetSunElevationDegrees(); });
       } },
     { "SunElevation+Inf",
-      [] {
-        return Refused("SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(kInf); },
+      []
+      {
+        return Refused(
+          "SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(kInf); },
           [](M* m) { return m->GetSunElevationDegrees(); });
       } },
     { "SunElevation-Inf",
-      [] {
-        return Refused("SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(-kInf); },
+      []
+      {
+        return Refused(
+          "SunElevationDegrees", [](M* m) { m->SetSunElevationDegrees(-kInf); },
           [](M* m) { return m->GetSunElevationDegrees(); });
       } },
     { "SunAzimuthNaN",
-      [] {
-        return Refused("SunAzimuthDegrees", [](M* m) { m->SetSunAzimuthDegrees(kNaN); },
+      []
+      {
+        return Refused(
+          "SunAzimuthDegrees", [](M* m) { m->SetSunAzimuthDegrees(kNaN); },
           [](M* m) { return m->GetSunAzimuthDegrees(); });
       } },
     { "SunAzimuth+Inf",
-      [] {
-        return Refused("SunAzimuthDegrees", [](M* m) { m->SetSunAzimuthDegrees(kInf); },
+      []
+      {
+        return Refused(
+          "SunAzimuthDegrees", [](M* m) { m->SetSunAzimuthDegrees(kInf); },
           [](M* m) { return m->GetSunAzimuthDegrees(); });
       } },
     { "SunIlluminanceNaN",
-      [] {
-        return Refused("SunIlluminance", [](M* m) { m->SetSunIlluminance(kNaN); },
+      []
+      {
+        return Refused(
+          "SunIlluminance", [](M* m) { m->SetSunIlluminance(kNaN); },
           [](M* m) { return m->GetSunIlluminance(); });
       } },
     { "SunTemperatureNaN",
-      [] {
-        return Refused("SunTemperatureKelvin", [](M* m) { m->SetSunTemperatureKelvin(kNaN); },
+      []
+      {
+        return Refused(
+          "SunTemperatureKelvin", [](M* m) { m->SetSunTemperatureKelvin(kNaN); },
           [](M* m) { return m->GetSunTemperatureKelvin(); });
       } },
     { "MieScatteringNaN",
-      [] {
-        return Refused("MieScatteringPerMetre", [](M* m) { m->SetMieScatteringPerMetre(kNaN); },
+      []
+      {
+        return Refused(
+          "MieScatteringPerMetre", [](M* m) { m->SetMieScatteringPerMetre(kNaN); },
           [](M* m) { return m->GetMieScatteringPerMetre(); });
       } },
     { "RayleighScatteringInf",
-      [] {
-        return Refused("RayleighScatteringPerMetre",
-          [](M* m) { m->SetRayleighScatteringPerMetre(kInf); },
+      []
+      {
+        return Refused(
+          "RayleighScatteringPerMetre", [](M* m) { m->SetRayleighScatteringPerMetre(kInf); },
           [](M* m) { return m->GetRayleighScatteringPerMetre(); });
       } },
     { "MieGNaN",
-      [] {
-        return Refused("MieG", [](M* m) { m->SetMieG(kNaN); }, [](M* m) { return m->GetMieG(); });
+      []
+      {
+        return Refused(
+          "MieG", [](M* m) { m->SetMieG(kNaN); }, [](M* m) { return m->GetMieG(); });
       } },
     { "CloudGNaN",
-      [] {
+      []
+      {
         return Refused(
           "CloudG", [](M* m) { m->SetCloudG(kNaN); }, [](M* m) { return m->GetCloudG(); });
       } },
     { "AlbedoNaN",
-      [] {
+      []
+      {
         return Refused(
           "Albedo", [](M* m) { m->SetAlbedo(kNaN); }, [](M* m) { return m->GetAlbedo(); });
       } },
     { "ExtinctionNaN",
-      [] {
-        return Refused("ExtinctionPerDensity", [](M* m) { m->SetExtinctionPerDensity(kNaN); },
+      []
+      {
+        return Refused(
+          "ExtinctionPerDensity", [](M* m) { m->SetExtinctionPerDensity(kNaN); },
           [](M* m) { return m->GetExtinctionPerDensity(); });
       } },
     { "MultipleScatteringNaN",
-      [] {
-        return Refused("MultipleScattering", [](M* m) { m->SetMultipleScattering(kNaN); },
+      []
+      {
+        return Refused(
+          "MultipleScattering", [](M* m) { m->SetMultipleScattering(kNaN); },
           [](M* m) { return m->GetMultipleScattering(); });
       } },
     { "SceneAltitudeNaN",
-      [] {
-        return Refused("SceneAltitudeMetres", [](M* m) { m->SetSceneAltitudeMetres(kNaN); },
+      []
+      {
+        return Refused(
+          "SceneAltitudeMetres", [](M* m) { m->SetSceneAltitudeMetres(kNaN); },
           [](M* m) { return m->GetSceneAltitudeMetres(); });
       } },
     { "MetresPerUnitNaN",
-      [] {
-        return Refused("MetresPerUnit", [](M* m) { m->SetMetresPerUnit(kNaN); },
+      []
+      {
+        return Refused(
+          "MetresPerUnit", [](M* m) { m->SetMetresPerUnit(kNaN); },
           [](M* m) { return m->GetMetresPerUnit(); });
       } },
     { "ExposureNaN",
-      [] {
+      []
+      {
         return Refused(
           "Exposure", [](M* m) { m->SetExposure(kNaN); }, [](M* m) { return m->GetExposure(); });
       } },
     { "GroundHeightNaN",
-      [] {
-        return Refused("GroundHeight", [](M* m) { m->SetGroundHeight(kNaN); },
+      []
+      {
+        return Refused(
+          "GroundHeight", [](M* m) { m->SetGroundHeight(kNaN); },
           [](M* m) { return m->GetGroundHeight(); });
       } },
     { "GroundAlbedoNaN",
-      [] {
-        return Refused("GroundAlbedo", [](M* m) { m->SetGroundAlbedo(kNaN); },
+      []
+      {
+        return Refused(
+          "GroundAlbedo", [](M* m) { m->SetGroundAlbedo(kNaN); },
           [](M* m) { return m->GetGroundAlbedo(); });
       } },
     { "SliceAngleRatioNaN",
-      [] {
-        return Refused("SliceAngleRatio", [](M* m) { m->SetSliceAngleRatio(kNaN); },
+      []
+      {
+        return Refused(
+          "SliceAngleRatio", [](M* m) { m->SetSliceAngleRatio(kNaN); },
           [](M* m) { return m->GetSliceAngleRatio(); });
       } },
     { "SunElevation+90", [] { return SunElevation(90.0); } },
@@ -589,7 +727,8 @@ int main(int argc, char* argv[])
     { "SunElevation0", [] { return SunElevation(0.0); } },
     { "SunElevation-0.5", [] { return SunElevation(-0.5); } },
     { "SunElevation-5", [] { return SunElevation(-5.0); } },
-    { "SunAzimuth1e6", [] { return FiniteImage([](Scene& s) { s.Mapper->SetSunAzimuthDegrees(1e6); }); } },
+    { "SunAzimuth1e6",
+      [] { return FiniteImage([](Scene& s) { s.Mapper->SetSunAzimuthDegrees(1e6); }); } },
     { "CameraFarAbove", CameraFarAbove },
     { "ClippingRange1To1e8", WideClippingRange },
     { "CameraInsideVolume", CameraInside },
@@ -601,33 +740,84 @@ int main(int argc, char* argv[])
     { "NaNInfNegativeDensities", BadDensities },
     { "OneVoxel", OneVoxel },
     { "RotatedDirectionMatrix", RotatedDirection },
-    { "RayleighMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetRayleighScatteringPerMetre(1.0); }, false); } },
-    { "MieMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetMieScatteringPerMetre(1.0); }, false); } },
-    { "MieG+-0.999", [] { return FiniteImage([](Scene& s) { s.Mapper->SetMieG(0.999); s.Mapper->SetCloudG(-0.999); }); } },
-    { "SceneAltitudeMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetSceneAltitudeMetres(1e300); }, false); } },
-    { "MetresPerUnitMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetMetresPerUnit(1e300); }, false); } },
-    { "MetresPerUnitMin", [] { return FiniteImage([](Scene& s) { s.Mapper->SetMetresPerUnit(1e-300); }, false); } },
-    { "ExposureAndIlluminanceMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetExposure(1e300); s.Mapper->SetSunIlluminance(1e300); }); } },
-    { "SunTemperature1000K", [] { return FiniteImage([](Scene& s) { s.Mapper->SetSunTemperatureKelvin(1000); s.Mapper->SetSunElevationDegrees(2); }); } },
-    { "ExtinctionMax", [] { return FiniteImage([](Scene& s) { s.Mapper->SetExtinctionPerDensity(1e300); s.Mapper->SetMultipleScattering(1e300); }); } },
-    { "GroundHeightHuge", [] { return FiniteImage([](Scene& s) { s.Mapper->SetGroundHeight(-1e300); }, false); } },
+    { "RayleighMax",
+      [] {
+        return FiniteImage([](Scene& s) { s.Mapper->SetRayleighScatteringPerMetre(1.0); }, false);
+      } },
+    { "MieMax",
+      []
+      { return FiniteImage([](Scene& s) { s.Mapper->SetMieScatteringPerMetre(1.0); }, false); } },
+    { "MieG+-0.999",
+      []
+      {
+        return FiniteImage(
+          [](Scene& s)
+          {
+            s.Mapper->SetMieG(0.999);
+            s.Mapper->SetCloudG(-0.999);
+          });
+      } },
+    { "SceneAltitudeMax",
+      []
+      { return FiniteImage([](Scene& s) { s.Mapper->SetSceneAltitudeMetres(1e300); }, false); } },
+    { "MetresPerUnitMax",
+      [] { return FiniteImage([](Scene& s) { s.Mapper->SetMetresPerUnit(1e300); }, false); } },
+    { "MetresPerUnitMin",
+      [] { return FiniteImage([](Scene& s) { s.Mapper->SetMetresPerUnit(1e-300); }, false); } },
+    { "ExposureAndIlluminanceMax",
+      []
+      {
+        return FiniteImage(
+          [](Scene& s)
+          {
+            s.Mapper->SetExposure(1e300);
+            s.Mapper->SetSunIlluminance(1e300);
+          });
+      } },
+    { "SunTemperature1000K",
+      []
+      {
+        return FiniteImage(
+          [](Scene& s)
+          {
+            s.Mapper->SetSunTemperatureKelvin(1000);
+            s.Mapper->SetSunElevationDegrees(2);
+          });
+      } },
+    { "ExtinctionMax",
+      []
+      {
+        return FiniteImage(
+          [](Scene& s)
+          {
+            s.Mapper->SetExtinctionPerDensity(1e300);
+            s.Mapper->SetMultipleScattering(1e300);
+          });
+      } },
+    { "GroundHeightHuge",
+      [] { return FiniteImage([](Scene& s) { s.Mapper->SetGroundHeight(-1e300); }, false); } },
     { "NonFiniteVolumePosition", NonFiniteVolumePosition },
     { "NonFiniteCamera", NonFiniteCamera },
     { "AbsurdDimensions", AbsurdDimensions },
+    { "TextureBudget", TextureBudget },
+    { "HugeSpacing", HugeSpacing },
+    { "OutOfMemoryInFrame", OutOfMemoryInFrame },
   };
   std::vector<std::string> selected(argv + 1, argv + argc);
   int failures = 0, run = 0;
   const auto start = std::chrono::steady_clock::now();
   for (const auto& entry : cases)
   {
-    if (!selected.empty() && std::find(selected.begin(), selected.end(), entry.first) == selected.end())
+    if (!selected.empty() &&
+      std::find(selected.begin(), selected.end(), entry.first) == selected.end())
     {
       continue;
     }
     const Result result = entry.second();
     ++run;
     failures += result.Ok ? 0 : 1;
-    std::cout << (result.Ok ? "ok:   " : "FAIL: ") << entry.first << ": " << result.What << std::endl;
+    std::cout << (result.Ok ? "ok:   " : "FAIL: ") << entry.first << ": " << result.What
+              << std::endl;
   }
   const double seconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
