@@ -8,6 +8,10 @@
 //
 // Prints one line per case: ok/FAIL, the case, what happened.
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackground.h"
+#include "vtkNimbusSkyDomeSource.h"
+#include "vtkNimbusSunlight.h"
 
 #include "MessageCatcher.h"
 #include "TestCumulus.h"
@@ -562,6 +566,52 @@ Result OutOfMemoryInFrame()
 #endif
 }
 
+// The sky classes refuse the same non-finite numbers; a cloud over a sky at its
+// extremes (sun at the nadir, 1000 km up, exposure 1e6) renders a finite image.
+Result SkyExtremes()
+{
+  vtkNew<vtkNimbusSkyBackground> background;
+  vtkNimbusSky* sky = background->GetSky();
+  nimbus::testing::MessageCatcher skyMessages(sky);
+  sky->SetSunElevationDegrees(kNaN);
+  sky->SetSunAzimuthDegrees(kInf);
+  sky->SetMetresPerUnit(-kInf);
+  sky->SetExposure(kNaN);
+  const bool kept = sky->GetSunElevationDegrees() == 45.0 && sky->GetSunAzimuthDegrees() == 135.0 &&
+    sky->GetMetresPerUnit() == 1.0 && sky->GetExposure() == 10.0;
+  const std::size_t skyErrors = skyMessages.Errors.size();
+
+  vtkNew<vtkNimbusSunlight> sunlight;
+  nimbus::testing::MessageCatcher sunMessages(sunlight);
+  sunlight->SetSunElevationDegrees(kNaN);
+  sunlight->SetSceneAltitudeMetres(kInf);
+  vtkNew<vtkNimbusSkyDomeSource> dome;
+  nimbus::testing::MessageCatcher domeMessages(dome);
+  dome->SetCenter(kNaN, 0.0, 0.0);
+  dome->SetRadius(kInf);
+  const bool otherKept = std::isfinite(sunlight->GetSunElevationDegrees()) &&
+    std::isfinite(sunlight->GetSceneAltitudeMetres()) && std::isfinite(dome->GetCenter()[0]) &&
+    std::isfinite(dome->GetRadius());
+  const std::size_t otherErrors = sunMessages.Errors.size() + domeMessages.Errors.size();
+
+  sky->SetSunElevationDegrees(-90.0);
+  sky->SetExposure(1e6);
+  Scene s(MakeCloud());
+  s.Renderer->AddViewProp(background);
+  s.Mapper->SetSkyBackground(background);
+  s.LookFrom({ 0, 0, 1.0e6 }, { 0, 0, 0 }, { 0, 1, 0 }, 1e4, 2e6);
+  const Frame nadir = s.Render();
+  sky->SetSunElevationDegrees(0.0);
+  const Frame horizon = s.Render();
+  return { kept && skyErrors == 4 && otherKept && otherErrors == 4 && nadir.FiniteNonNegative() &&
+      horizon.FiniteNonNegative() && s.Mapper->GetLastRenderUsedSceneSky(),
+    std::string("sky: ") + std::to_string(skyErrors) + " of 4 refused" +
+      (kept ? ", kept" : ", CHANGED") + "; sunlight and dome: " + std::to_string(otherErrors) +
+      " of 4 refused; over the sky, sun at "
+      "the nadir: " +
+      nadir.Describe() + "; at the horizon: " + horizon.Describe() };
+}
+
 // A size no texture can take: a message, no crash (the array does not match such an
 // image; the mapper must say so without computing the product in int).
 Result AbsurdDimensions()
@@ -802,6 +852,7 @@ int main(int argc, char* argv[])
     { "TextureBudget", TextureBudget },
     { "HugeSpacing", HugeSpacing },
     { "OutOfMemoryInFrame", OutOfMemoryInFrame },
+    { "SkyExtremes", SkyExtremes },
   };
   std::vector<std::string> selected(argv + 1, argv + argc);
   int failures = 0, run = 0;
