@@ -520,8 +520,8 @@ Result HugeSpacing()
 }
 
 // std::bad_alloc inside the frame: the converted copy of a 64 MiB double density
-// cannot be allocated under an address-space limit (Linux: RLIMIT_AS just above
-// what the process uses). Caught at Render's boundary: an error, nothing drawn
+// cannot be allocated under an address-space limit (Linux: RLIMIT_AS at what the
+// process maps already). Caught at Render's boundary: an error, nothing drawn
 // over the scene, and the next frame, without the limit, draws again.
 Result OutOfMemoryInFrame()
 {
@@ -545,7 +545,7 @@ Result OutOfMemoryInFrame()
   rlimit saved{};
   getrlimit(RLIMIT_AS, &saved);
   rlimit tight = saved;
-  tight.rlim_cur = used + (8u << 20); // 8 MiB to spare; the copy needs 32 MiB
+  tight.rlim_cur = used; // no new mapping: the copy (32 MiB) needs one
   if (tight.rlim_cur > saved.rlim_cur || setrlimit(RLIMIT_AS, &tight) != 0)
   {
     return { true, "skipped (the address-space limit is already lower)" };
@@ -554,7 +554,7 @@ Result OutOfMemoryInFrame()
   setrlimit(RLIMIT_AS, &saved);
   const std::string errors = s.Messages.AllErrors();
   const Frame after = s.Render();
-  return { !frame.Escaped && !frame.HasRadiance && Contains(errors, "out of memory") &&
+  return { !frame.Escaped && !frame.HasRadiance && Contains(errors, "not drawn: out of memory") &&
       after.FiniteNonNegative(),
     (frame.Escaped       ? "EXCEPTION escaped Render: " + frame.Exception
         : errors.empty() ? std::string("no error")
