@@ -1,6 +1,7 @@
 #include "vtkNimbusCloudAutomatonSource.h"
 
 #include "CloudAutomaton.h"
+#include "MemoryBudget.h"
 
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -18,7 +19,10 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <new>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusCloudAutomatonSource);
@@ -46,7 +50,44 @@ struct vtkNimbusCloudAutomatonSource::vtkInternals
 
 namespace
 {
+// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
+// RequestData refuses them with a message instead of their being clamped silently.
+template <typename Object>
+void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
+{
+  if (std::isfinite(value))
+  {
+    value = std::clamp(value, low, high);
+  }
+  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
+  {
+    member = value;
+    object->Modified();
+  }
+}
+
 constexpr int MaximumCachedDensities = 4;
+// Valid ranges (see the class documentation).
+constexpr double MaximumLength = 1.0e8;        // m
+constexpr double MinimumStepDuration = 1.0e-6; // s (ParaView's time steps stay distinct)
+constexpr double MaximumStepDuration = 1.0e9;  // s (about 32 years)
+constexpr double MaximumCellsPerStep = 1.0e6;  // wind shift of one layer, cells per step
+constexpr double MaximumWork = 1.0e11;         // cell updates of one request (minutes)
+constexpr double StepOverhead = 65536.0;       // fixed cost of a step, in cell updates
+constexpr double MiB = 1048576.0;
+
+std::string Number(double value)
+{
+  std::ostringstream text;
+  text.precision(3);
+  text << value;
+  return text.str();
+}
+
+bool ValidStepDuration(double seconds)
+{
+  return seconds >= MinimumStepDuration && seconds <= MaximumStepDuration;
+}
 
 bool AllFinite(const double* values, int count)
 {
@@ -98,9 +139,42 @@ vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
   this->CheckpointInterval = 10;
   this->MaximumNumberOfCheckpoints = 16;
   this->NumberOfStepsComputed = 0;
+  this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusCloudAutomatonSource::~vtkNimbusCloudAutomatonSource() = default;
+
+void vtkNimbusCloudAutomatonSource::SetExtinctionProbability(double value)
+{
+  SetClampedFiniteValue(this, this->ExtinctionProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetHumidityProbability(double value)
+{
+  SetClampedFiniteValue(this, this->HumidityProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetActivationProbability(double value)
+{
+  SetClampedFiniteValue(this, this->ActivationProbability, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetInitialHumidity(double value)
+{
+  SetClampedFiniteValue(this, this->InitialHumidity, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetInitialActivation(double value)
+{
+  SetClampedFiniteValue(this, this->InitialActivation, value, 0.0, 1.0);
+}
+
+void vtkNimbusCloudAutomatonSource::SetSmoothingRadius(double value)
+{
+  SetClampedFiniteValue(this, this->SmoothingRadius, value, 0.0, 16.0);
+}
 
 int vtkNimbusCloudAutomatonSource::FillInputPortInformation(int, vtkInformation* info)
 {
@@ -134,7 +208,7 @@ int vtkNimbusCloudAutomatonSource::RequestInformation(
 
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (this->StepDuration > 0.0 && std::isfinite(this->StepDuration))
+  if (ValidStepDuration(this->StepDuration))
   {
     std::vector<double> times(static_cast<std::size_t>(this->NumberOfTimeSteps) + 1);
     for (std::size_t k = 0; k < times.size(); ++k)
@@ -163,29 +237,25 @@ int vtkNimbusCloudAutomatonSource::RequestUpdateExtent(
   return 1;
 }
 
-int vtkNimbusCloudAutomatonSource::RequestData(
-  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+bool vtkNimbusCloudAutomatonSource::CheckParameters()
 {
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
-  output->Initialize();
-  vtkImageData* input = inputVector[0]->GetNumberOfInformationObjects() > 0
-    ? vtkImageData::GetData(inputVector[0], 0)
-    : nullptr;
-  auto& internals = *this->Internals;
-
-  // --- parameters ---------------------------------------------------------------------------
+  if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
+  {
+    vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
+                  << this->MemoryBudgetMiB << ".");
+    return false;
+  }
   const int* d = this->Dimensions;
   if (d[0] < 1 || d[1] < 1 || d[2] < 1)
   {
     vtkErrorMacro(<< "Dimensions must be >= 1 along every axis, got (" << d[0] << ", " << d[1]
                   << ", " << d[2] << ").");
-    return 1;
+    return false;
   }
   if (!AllFinite(this->Bounds, 6))
   {
     vtkErrorMacro(<< "Bounds must be finite numbers.");
-    return 1;
+    return false;
   }
   for (int a = 0; a < 3; ++a)
   {
@@ -193,18 +263,145 @@ int vtkNimbusCloudAutomatonSource::RequestData(
     {
       vtkErrorMacro(<< "Bounds must satisfy min < max on every axis; axis " << a << " has ("
                     << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
-      return 1;
+      return false;
+    }
+    if (std::abs(this->Bounds[2 * a]) > MaximumLength ||
+      std::abs(this->Bounds[2 * a + 1]) > MaximumLength)
+    {
+      vtkErrorMacro(<< "Bounds must lie within +-" << MaximumLength << " m; axis " << a << " has ("
+                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
+      return false;
     }
   }
-  if (!(this->StepDuration > 0.0) || !std::isfinite(this->StepDuration))
+  if (!ValidStepDuration(this->StepDuration))
   {
-    vtkErrorMacro(<< "StepDuration must be a finite number of seconds > 0, got "
-                  << this->StepDuration << ".");
-    return 1;
+    vtkErrorMacro(<< "StepDuration must be between " << MinimumStepDuration << " and "
+                  << MaximumStepDuration << " seconds, got " << this->StepDuration << ".");
+    return false;
+  }
+  const struct
+  {
+    const char* Name;
+    double Value;
+  } probabilities[] = { { "ExtinctionProbability", this->ExtinctionProbability },
+    { "HumidityProbability", this->HumidityProbability },
+    { "ActivationProbability", this->ActivationProbability },
+    { "InitialHumidity", this->InitialHumidity },
+    { "InitialActivation", this->InitialActivation } };
+  for (const auto& probability : probabilities)
+  {
+    if (!(probability.Value >= 0.0 && probability.Value <= 1.0))
+    {
+      vtkErrorMacro(<< probability.Name << " must be a probability in [0, 1], got "
+                    << probability.Value << ".");
+      return false;
+    }
+  }
+  if (!(this->SmoothingRadius >= 0.0 && this->SmoothingRadius <= 16.0))
+  {
+    vtkErrorMacro(<< "SmoothingRadius must be in [0, 16] cells, got " << this->SmoothingRadius
+                  << ".");
+    return false;
   }
   if (!AllFinite(this->Wind, 2) || !AllFinite(this->Shear, 2))
   {
     vtkErrorMacro(<< "Wind and Shear must be finite.");
+    return false;
+  }
+  // m/s -> cells per step; the top layer moves fastest.
+  const double dz = AxisSpacing(d[2], this->Bounds[4], this->Bounds[5]);
+  for (int a = 0; a < 2; ++a)
+  {
+    const double spacing = AxisSpacing(d[a], this->Bounds[2 * a], this->Bounds[2 * a + 1]);
+    const double bottom = std::abs(this->Wind[a]) * this->StepDuration / spacing;
+    const double top =
+      bottom + std::abs(this->Shear[a]) * dz * (d[2] - 1) * this->StepDuration / spacing;
+    if (!(top <= MaximumCellsPerStep))
+    {
+      vtkErrorMacro(<< "Wind " << this->Wind[a] << " m/s and Shear " << this->Shear[a]
+                    << " (m/s)/m along " << (a == 0 ? "x" : "y") << " move the clouds "
+                    << Number(top) << " cells per step (StepDuration " << this->StepDuration
+                    << " s, cells of " << spacing << " m), more than the limit of "
+                    << Number(MaximumCellsPerStep) << ".");
+      return false;
+    }
+  }
+  return true;
+}
+
+int vtkNimbusCloudAutomatonSource::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  output->Initialize();
+  if (!this->CheckParameters())
+  {
+    this->Internals->Clear();
+    return 1;
+  }
+  try
+  {
+    return this->Generate(inputVector, outputVector);
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro(<< "Out of memory while running the cloud automaton; lower Dimensions or "
+                     "MaximumNumberOfCheckpoints, or MemoryBudgetMiB.");
+  }
+  catch (const std::length_error& error)
+  {
+    vtkErrorMacro(<< "The cloud automaton is too large (" << error.what()
+                  << "); lower Dimensions.");
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< "Cannot run the cloud automaton: " << error.what());
+  }
+  this->Internals->Clear();
+  output->Initialize();
+  return 1;
+}
+
+int vtkNimbusCloudAutomatonSource::Generate(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  vtkImageData* input = inputVector[0]->GetNumberOfInformationObjects() > 0
+    ? vtkImageData::GetData(inputVector[0], 0)
+    : nullptr;
+  auto& internals = *this->Internals;
+  const int* d = this->Dimensions;
+  // --- memory: states, checkpoints, cached densities, output and input maps ----------------
+  std::uint64_t cells = 0;
+  if (!nimbus::CheckedProduct({ static_cast<std::uint64_t>(d[0]), static_cast<std::uint64_t>(d[1]),
+                                static_cast<std::uint64_t>(d[2]) },
+        cells))
+  {
+    vtkErrorMacro(<< "Dimensions (" << d[0] << ", " << d[1] << ", " << d[2]
+                  << ") have more cells than 64 bits can count.");
+    return 1;
+  }
+  const double cellCount = static_cast<double>(cells);
+  // One state: three bit fields, rows padded to 64-bit words.
+  const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * d[2];
+  const double checkpoints = std::min(static_cast<double>(this->MaximumNumberOfCheckpoints),
+    std::floor(static_cast<double>(this->NumberOfTimeSteps) / this->CheckpointInterval));
+  // Floats per cell: the cached densities (up to 2 more while a request runs), the
+  // smoothing's two buffers and the output array; 8 bytes per cell per input map.
+  const double bytes = stateBytes * (2.0 + checkpoints) +
+    4.0 * cellCount * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0);
+  std::ostringstream what;
+  what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
+       << checkpoints << " checkpoints)";
+  const std::string overBudget =
+    nimbus::OverBudgetMessage(what.str(), bytes, this->MemoryBudgetMiB * MiB);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< overBudget
+                  << " (MemoryBudgetMiB); lower Dimensions or MaximumNumberOfCheckpoints, or "
+                     "raise MemoryBudgetMiB.");
+    internals.Clear();
     return 1;
   }
 
@@ -263,10 +460,41 @@ int vtkNimbusCloudAutomatonSource::RequestData(
                         << array->GetNumberOfComponents() << ".");
           return 1;
         }
+        const vtkIdType expected = static_cast<vtkIdType>(inDims[0]) * inDims[1] * inDims[2];
+        if (array->GetNumberOfTuples() != expected)
+        {
+          vtkErrorMacro(<< "Input array \"" << names[f] << "\" has " << array->GetNumberOfTuples()
+                        << " values for " << expected << " points.");
+          return 1;
+        }
         std::vector<float> values(static_cast<std::size_t>(array->GetNumberOfTuples()));
+        std::size_t aboveOne = 0;
+        vtkIdType firstBad = -1;
         for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
         {
           values[i] = static_cast<float>(array->GetComponent(i, 0));
+          aboveOne += values[i] > 1.0f && std::isfinite(values[i]) ? 1 : 0;
+          if (firstBad < 0 && !(values[i] >= 0.0f && values[i] <= 1.0f))
+          {
+            firstBad = i;
+          }
+        }
+        // Bad values where they enter, counted (the core names the first one).
+        const nimbus::ValueCensus census = nimbus::TakeCensus(values.data(), values.size());
+        if (!census.AllFiniteNonNegative() || aboveOne > 0)
+        {
+          std::string problems = nimbus::DescribeCensus(census);
+          if (aboveOne > 0)
+          {
+            problems +=
+              (problems.empty() ? "" : " and ") + std::to_string(aboveOne) + " values above 1";
+          }
+          const char* core[3] = { "Extinction", "HumiditySupply", "ActivationSupply" };
+          vtkErrorMacro(<< "Input array \"" << names[f] << "\" (" << core[f] << ") has " << problems
+                        << ", the first " << values[firstBad] << " at index " << firstBad
+                        << "; probabilities must be in [0, 1] (an 8-bit image needs scaling "
+                           "by 1/255 first).");
+          return 1;
         }
         *fields[f] = volume ? nimbus::ProbabilityField::Volume(std::move(values))
                             : nimbus::ProbabilityField::Plane(std::move(values));
@@ -348,6 +576,22 @@ int vtkNimbusCloudAutomatonSource::RequestData(
     }
     const std::int64_t start = automaton.GetStep();
     const double total = static_cast<double>(lastNeeded - start + 1);
+    // Work of this request, from the state it starts at.
+    const int radiusCells = static_cast<int>(std::ceil(std::max(1.0, this->SmoothingRadius)));
+    const double work = static_cast<double>(lastNeeded - start) * (cellCount + StepOverhead) +
+      2.0 * cellCount * (1.0 + 3.0 * (2.0 * radiusCells - 1.0));
+    if (!(work <= MaximumWork))
+    {
+      vtkErrorMacro(<< "Time " << time << " s is automaton step " << lastNeeded << "; from the "
+                    << "nearest cached state (step " << start << ") that needs about "
+                    << Number(work) << " cell updates (" << d[0] << " x " << d[1] << " x " << d[2]
+                    << " cells), more than the limit of " << Number(MaximumWork)
+                    << " (minutes of work); lower NumberOfTimeSteps or Dimensions, or raise "
+                       "StepDuration.");
+      return 1;
+    }
+    // About 200 progress reports per request, an abort check every step.
+    const std::int64_t reportEvery = std::max<std::int64_t>(1, (lastNeeded - start) / 200);
     for (;;)
     {
       const std::int64_t s = automaton.GetStep();
@@ -383,7 +627,10 @@ int vtkNimbusCloudAutomatonSource::RequestData(
       {
         break;
       }
-      this->UpdateProgress(static_cast<double>(s - start + 1) / total);
+      if ((s - start) % reportEvery == 0)
+      {
+        this->UpdateProgress(static_cast<double>(s - start + 1) / total);
+      }
       if (this->CheckAbort())
       {
         return 1;
@@ -434,6 +681,16 @@ int vtkNimbusCloudAutomatonSource::RequestData(
   stepArray->InsertNextValue(static_cast<double>(step) + fraction);
   output->GetFieldData()->AddArray(stepArray);
   output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
+  // The smoothed field is a weighted mean of 0/1 cells: in [0, 1] unless something broke.
+  const nimbus::ValueCensus census =
+    nimbus::TakeCensus(out, static_cast<std::size_t>(density->GetNumberOfTuples()));
+  if (!census.AllFiniteNonNegative())
+  {
+    vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(census)
+                  << "; the output is withheld.");
+    output->Initialize();
+    return 1;
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -466,4 +723,5 @@ void vtkNimbusCloudAutomatonSource::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CheckpointInterval: " << this->CheckpointInterval << "\n";
   os << indent << "MaximumNumberOfCheckpoints: " << this->MaximumNumberOfCheckpoints << "\n";
   os << indent << "NumberOfStepsComputed: " << this->NumberOfStepsComputed << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }

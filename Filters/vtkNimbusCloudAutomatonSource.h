@@ -26,6 +26,16 @@
  * Units: Bounds in metres; Wind in m/s (x, y) at the bottom of the grid, Shear in
  * (m/s) per metre of height; StepDuration in seconds; probabilities per cell per step.
  * The field data holds "AutomatonStep" (the fractional step shown).
+ *
+ * Bad input ends in an error message and an empty output, never in an exception or an
+ * allocation VTK cannot make: NaN or infinite probabilities or smoothing radius (finite
+ * values are clamped to their ranges), StepDuration outside [1e-6, 1e9] s, Bounds not finite, not
+ * min < max or beyond +-1e8 m, a wind or shear that moves a layer more than 1e6 cells per step,
+ * input arrays with values outside [0, 1] (counted in the message), a grid, cache and checkpoints
+ * that would need more than MemoryBudgetMiB, or a requested time that would need more than about
+ * 1e11 cell updates from the nearest cached state (the message gives the estimate). Stepping
+ * reports progress and stops soon after AbortExecute is set (the output is then empty; the states
+ * computed so far stay cached).
  */
 #ifndef vtkNimbusCloudAutomatonSource_h
 #define vtkNimbusCloudAutomatonSource_h
@@ -64,20 +74,35 @@ public:
   ///@{
   /// Per-step probabilities used where the input has no array: cloud extinction p_ext,
   /// vapour supply p_hum, activation supply p_act (002 §3). Defaults 0.05, 0.002, 0.0002.
-  vtkSetClampMacro(ExtinctionProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetExtinctionProbability(double value);
+  double GetExtinctionProbabilityMinValue() { return 0.0; }
+  double GetExtinctionProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(ExtinctionProbability, double);
-  vtkSetClampMacro(HumidityProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetHumidityProbability(double value);
+  double GetHumidityProbabilityMinValue() { return 0.0; }
+  double GetHumidityProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(HumidityProbability, double);
-  vtkSetClampMacro(ActivationProbability, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetActivationProbability(double value);
+  double GetActivationProbabilityMinValue() { return 0.0; }
+  double GetActivationProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(ActivationProbability, double);
   ///@}
 
   ///@{
   /// Probabilities of hum and act in each cell at time 0 (cld starts empty).
   /// Defaults 0.3 and 0.001.
-  vtkSetClampMacro(InitialHumidity, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetInitialHumidity(double value);
+  double GetInitialHumidityMinValue() { return 0.0; }
+  double GetInitialHumidityMaxValue() { return 1.0; }
   vtkGetMacro(InitialHumidity, double);
-  vtkSetClampMacro(InitialActivation, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetInitialActivation(double value);
+  double GetInitialActivationMinValue() { return 0.0; }
+  double GetInitialActivationMaxValue() { return 1.0; }
   vtkGetMacro(InitialActivation, double);
   ///@}
 
@@ -100,8 +125,8 @@ public:
   ///@}
 
   ///@{
-  /// Seconds per automaton step (> 0) and number of steps advertised as TIME_STEPS
-  /// (>= 0). Defaults 1 and 100.
+  /// Seconds per automaton step (in [1e-6, 1e9]) and number of steps advertised as
+  /// TIME_STEPS (clamped to [0, 1e6]). Defaults 1 and 100.
   vtkSetMacro(StepDuration, double);
   vtkGetMacro(StepDuration, double);
   vtkSetClampMacro(NumberOfTimeSteps, int, 0, 1000000);
@@ -110,7 +135,10 @@ public:
 
   ///@{
   /// Radius (cells) of the smoothing kernel; <= 1 gives the raw 0/1 cld field. Default 2.5.
-  vtkSetClampMacro(SmoothingRadius, double, 0.0, 16.0);
+  /// Clamped to [0.0, 16.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetSmoothingRadius(double value);
+  double GetSmoothingRadiusMinValue() { return 0.0; }
+  double GetSmoothingRadiusMaxValue() { return 16.0; }
   vtkGetMacro(SmoothingRadius, double);
   ///@}
 
@@ -138,6 +166,18 @@ public:
   vtkGetMacro(MaximumNumberOfCheckpoints, int);
   ///@}
 
+  ///@{
+  /// Memory the source may use (grid states, checkpoints, cached densities, output), MiB
+  /// (> 0, finite). Settings that would need more are refused with a message. Default
+  /// nimbus::DefaultMemoryBudgetMiB(): half the physical memory, at most three quarters of
+  /// the process's address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
+  ///@}
+
   /// Automaton steps run since the cache was last reset (for tests and timings).
   vtkGetMacro(NumberOfStepsComputed, vtkIdType);
 
@@ -149,6 +189,11 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// RequestData's work; may throw (RequestData catches and clears the cache).
+  int Generate(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
+  /// False (after vtkErrorMacro) when a parameter is unusable.
+  bool CheckParameters();
 
   int Dimensions[3];
   double Bounds[6];
@@ -169,6 +214,8 @@ protected:
   int CheckpointInterval;
   int MaximumNumberOfCheckpoints;
   vtkIdType NumberOfStepsComputed;
+  double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusCloudAutomatonSource(const vtkNimbusCloudAutomatonSource&) = delete;

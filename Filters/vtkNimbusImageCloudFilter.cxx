@@ -1,7 +1,9 @@
 #include "vtkNimbusImageCloudFilter.h"
 
 #include "ImageClouds.h"
+#include "MemoryBudget.h"
 
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
@@ -16,11 +18,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusImageCloudFilter);
+
+namespace
+{
+// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
+// RequestData refuses them with a message instead of their being clamped silently.
+template <typename Object>
+void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
+{
+  if (std::isfinite(value))
+  {
+    value = std::clamp(value, low, high);
+  }
+  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
+  {
+    member = value;
+    object->Modified();
+  }
+}
+}
 
 vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
 {
@@ -49,9 +72,37 @@ vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
   this->TopRoughness = p.TopRoughness;
   this->Iterations = p.Iterations;
   this->Seed = 1;
+  this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusImageCloudFilter::~vtkNimbusImageCloudFilter() = default;
+
+void vtkNimbusImageCloudFilter::SetGamma(double value)
+{
+  SetClampedFiniteValue(this, this->Gamma, value, 0.01, 100.0);
+}
+
+void vtkNimbusImageCloudFilter::SetMaximumOpticalDepth(double value)
+{
+  SetClampedFiniteValue(this, this->MaximumOpticalDepth, value, 0.0, 1000.0);
+}
+
+void vtkNimbusImageCloudFilter::SetAsymmetryParameter(double value)
+{
+  SetClampedFiniteValue(this, this->AsymmetryParameter, value, 0.0, 0.99);
+}
+
+void vtkNimbusImageCloudFilter::SetBallRadiusFactor(double value)
+{
+  SetClampedFiniteValue(this, this->BallRadiusFactor, value, 0.1, 20.0);
+}
+
+void vtkNimbusImageCloudFilter::SetTopRoughness(double value)
+{
+  SetClampedFiniteValue(this, this->TopRoughness, value, 0.0, 1.0);
+}
 
 vtkImageData* vtkNimbusImageCloudFilter::GetOpticalDepthMap()
 {
@@ -91,6 +142,40 @@ nimbus::ImageCloudParameters MakeParameters(const vtkNimbusImageCloudFilter* sel
   // RequestInformation knows it.
   p.GridOpticalDepth = f->GetMaximumOpticalDepth();
   return p;
+}
+
+constexpr double MaximumWork = 2.0e11; // grid-point updates (minutes)
+constexpr double MiB = 1048576.0;
+
+std::string Number(double value)
+{
+  std::ostringstream text;
+  text.precision(3);
+  text << value;
+  return text.str();
+}
+
+// "\"gray\" (1 component), an unnamed array (3 components)" -- what the input offers.
+std::string DescribeArrays(vtkDataSetAttributes* attributes)
+{
+  std::ostringstream text;
+  for (int i = 0; i < attributes->GetNumberOfArrays(); ++i)
+  {
+    vtkAbstractArray* array = attributes->GetAbstractArray(i);
+    text << (i > 0 ? ", " : "");
+    if (array->GetName() && *array->GetName())
+    {
+      text << "\"" << array->GetName() << "\"";
+    }
+    else
+    {
+      text << "an unnamed array";
+    }
+    text << " (" << array->GetNumberOfComponents() << " component"
+         << (array->GetNumberOfComponents() == 1 ? "" : "s")
+         << (vtkDataArray::SafeDownCast(array) ? "" : ", not numeric") << ")";
+  }
+  return text.str();
 }
 
 void SetGeometry(
@@ -150,14 +235,53 @@ int vtkNimbusImageCloudFilter::RequestUpdateExtent(
 int vtkNimbusImageCloudFilter::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkImageData* input = vtkImageData::GetData(inputVector[0], 0);
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   vtkImageData* map = vtkImageData::GetData(outputVector, 1);
   output->Initialize();
   map->Initialize();
+  try
+  {
+    return this->Generate(inputVector, outputVector);
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro(<< "Out of memory while building the image cloud; shrink the image, raise "
+                     "VerticalSpacing, or lower MemoryBudgetMiB.");
+  }
+  catch (const std::length_error& error)
+  {
+    vtkErrorMacro(<< "The image cloud is too large (" << error.what() << "); shrink the image.");
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< error.what());
+  }
+  output->Initialize();
+  map->Initialize();
+  return 1;
+}
+
+int vtkNimbusImageCloudFilter::Generate(
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkImageData* input = vtkImageData::GetData(inputVector[0], 0);
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  vtkImageData* map = vtkImageData::GetData(outputVector, 1);
+  auto aborted = [output, map]()
+  {
+    output->Initialize();
+    map->Initialize();
+    return 1;
+  };
   if (!input)
   {
     vtkErrorMacro(<< "No input image.");
+    return 1;
+  }
+  if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
+  {
+    vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
+                  << this->MemoryBudgetMiB << ".");
     return 1;
   }
   int dims[3];
@@ -173,34 +297,126 @@ int vtkNimbusImageCloudFilter::RequestData(
   const char* arrayName = arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
     : nullptr;
-  if (!intensity && (!arrayName || !*arrayName))
+  const bool named = arrayName && *arrayName;
+  vtkPointData* pointData = input->GetPointData();
+  if (!intensity && !named)
   {
     // No array chosen (an empty name, as ParaView may send before its domain is filled):
-    // the active scalars, else the first point array.
-    intensity = input->GetPointData()->GetScalars();
-    if (!intensity && input->GetPointData()->GetNumberOfArrays() > 0)
+    // the active scalars, else the first numeric point array (named or not).
+    intensity = pointData->GetScalars();
+    for (int i = 0; !intensity && i < pointData->GetNumberOfArrays(); ++i)
     {
-      intensity = input->GetPointData()->GetArray(0);
+      intensity = pointData->GetArray(i);
     }
   }
   if (!intensity)
   {
-    vtkErrorMacro(<< "The input image has no point array "
-                  << (arrayName && *arrayName ? std::string("\"") + arrayName + "\"" : "")
-                  << " to read intensities from (choose one with SetInputArrayToProcess).");
+    if (pointData->GetNumberOfArrays() == 0)
+    {
+      vtkErrorMacro(<< "The input image has no point arrays to read intensities from"
+                    << (input->GetCellData()->GetNumberOfArrays() > 0
+                           ? " (it has cell arrays; convert them with Cell Data to Point Data)."
+                           : "."));
+    }
+    else if (named)
+    {
+      vtkErrorMacro(<< "The input image has no numeric point array \"" << arrayName
+                    << "\"; its point arrays are " << DescribeArrays(pointData)
+                    << " (choose one with SetInputArrayToProcess).");
+    }
+    else
+    {
+      vtkErrorMacro(<< "The input image has no numeric point array to read intensities from; "
+                       "its point arrays are "
+                    << DescribeArrays(pointData) << ".");
+    }
+    return 1;
+  }
+  const vtkIdType pixels = static_cast<vtkIdType>(dims[0]) * dims[1];
+  const std::string intensityName = intensity->GetName() && *intensity->GetName()
+    ? std::string("\"") + intensity->GetName() + "\""
+    : std::string("(unnamed)");
+  if (intensity->GetNumberOfTuples() != pixels)
+  {
+    vtkErrorMacro(<< "The intensity array " << intensityName << " has "
+                  << intensity->GetNumberOfTuples() << " values for " << dims[0] << " x " << dims[1]
+                  << " = " << pixels << " pixels.");
     return 1;
   }
   if (!(this->IntensityRange[1] > this->IntensityRange[0]) ||
-    !std::isfinite(this->IntensityRange[0]) || !std::isfinite(this->IntensityRange[1]))
+    !std::isfinite(this->IntensityRange[1] - this->IntensityRange[0]))
   {
     vtkErrorMacro(<< "IntensityRange must be finite with min < max, got ("
                   << this->IntensityRange[0] << ", " << this->IntensityRange[1] << ").");
     return 1;
   }
-  if (!(this->WhiteIntensity > this->ClearIntensity))
+  if (!std::isfinite(this->ClearIntensity) || !std::isfinite(this->WhiteIntensity))
+  {
+    vtkErrorMacro(<< "ClearIntensity and WhiteIntensity must be finite (normalised intensities, "
+                     "usually in [0, 1]); got "
+                  << this->ClearIntensity << " and " << this->WhiteIntensity << ".");
+    return 1;
+  }
+  if (!(this->WhiteIntensity > this->ClearIntensity) ||
+    !std::isfinite(this->WhiteIntensity - this->ClearIntensity))
   {
     vtkErrorMacro(<< "WhiteIntensity (" << this->WhiteIntensity
                   << ") must be greater than ClearIntensity (" << this->ClearIntensity << ").");
+    return 1;
+  }
+  // The clamping setters keep NaN and infinities: name them here, not deep in the core.
+  const struct
+  {
+    const char* Name;
+    double Value;
+  } clamped[] = { { "Gamma", this->Gamma }, { "MaximumOpticalDepth", this->MaximumOpticalDepth },
+    { "AsymmetryParameter", this->AsymmetryParameter },
+    { "BallRadiusFactor", this->BallRadiusFactor }, { "TopRoughness", this->TopRoughness } };
+  for (const auto& parameter : clamped)
+  {
+    if (!std::isfinite(parameter.Value))
+    {
+      vtkErrorMacro(<< parameter.Name << " is " << parameter.Value
+                    << "; it must be a finite number (finite values are clamped to its range).");
+      return 1;
+    }
+  }
+
+  // Size, memory and work, from the parameters alone, before anything is allocated.
+  const nimbus::ImageCloudParameters parameters = MakeParameters(this);
+  const nimbus::GridGeometry grid =
+    nimbus::ImageCloudGrid(dims[0], dims[1], this->MaximumOpticalDepth, parameters);
+  const double points = static_cast<double>(grid.NumberOfPoints());
+  const double balls =
+    nimbus::MaximumImageCloudBalls(dims[0], dims[1], this->MaximumOpticalDepth, parameters);
+  // Floats: the density and its output copy; doubles per pixel: tau, the achieved column
+  // optical depths (twice while resampling); floats per pixel: the two maps; the balls.
+  const double bytes = 8.0 * points + 28.0 * static_cast<double>(pixels) + 48.0 * balls;
+  std::ostringstream what;
+  what << "the image cloud (" << grid.Dimensions[0] << " x " << grid.Dimensions[1] << " x "
+       << grid.Dimensions[2] << " points)";
+  const std::string overBudget =
+    nimbus::OverBudgetMessage(what.str(), bytes, this->MemoryBudgetMiB * MiB);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< overBudget
+                  << " (MemoryBudgetMiB); shrink the image, raise VerticalSpacing, or raise "
+                     "MemoryBudgetMiB.");
+    return 1;
+  }
+  const double radius =
+    this->BallRadiusFactor * this->BallSpacing * this->PixelSize * (1.0 + this->TopRoughness);
+  const double work =
+    (this->Iterations + 1.0) * (3.0 * points + balls * nimbus::MetaballBoxPoints(radius, grid));
+  if (!(work <= MaximumWork))
+  {
+    vtkErrorMacro(<< "The image cloud would need about " << Number(work) << " grid-point updates ("
+                  << grid.Dimensions[0] << " x " << grid.Dimensions[1] << " x "
+                  << grid.Dimensions[2] << " points, up to " << Number(balls) << " balls, "
+                  << this->Iterations + 1 << " samplings), more than the limit of "
+                  << Number(MaximumWork)
+                  << " (minutes of work); shrink the image, lower Iterations or "
+                     "BallRadiusFactor, or raise BallSpacing.");
     return 1;
   }
 
@@ -213,10 +429,11 @@ int vtkNimbusImageCloudFilter::RequestData(
   mapping.Gamma = this->Gamma;
   mapping.MaximumOpticalDepth = this->MaximumOpticalDepth;
   mapping.AsymmetryParameter = this->AsymmetryParameter;
+  nimbus::IntensityToOpticalDepth(0.0, mapping); // throws now for a bad mapping
   const int components = intensity->GetNumberOfComponents();
-  const vtkIdType pixels = static_cast<vtkIdType>(dims[0]) * dims[1];
   std::vector<double> tau(static_cast<std::size_t>(pixels));
   const double scale = 1.0 / (this->IntensityRange[1] - this->IntensityRange[0]);
+  nimbus::ValueCensus census;
   for (vtkIdType i = 0; i < pixels; ++i)
   {
     double value = intensity->GetComponent(i, 0);
@@ -225,36 +442,69 @@ int vtkNimbusImageCloudFilter::RequestData(
       value = 0.2126 * value + 0.7152 * intensity->GetComponent(i, 1) +
         0.0722 * intensity->GetComponent(i, 2); // Rec. 709 luminance
     }
+    census.NaN += std::isnan(value) ? 1 : 0;
+    census.Infinite += std::isinf(value) ? 1 : 0;
+    census.Negative += std::isfinite(value) && value < 0.0 ? 1 : 0;
     tau[i] = nimbus::IntensityToOpticalDepth((value - this->IntensityRange[0]) * scale, mapping);
+    if ((i & 0xFFFFF) == 0xFFFFF)
+    {
+      this->UpdateProgress(0.1 * static_cast<double>(i) / static_cast<double>(pixels));
+      if (this->CheckAbort())
+      {
+        return aborted();
+      }
+    }
+  }
+  if (this->IntensityRange[0] < 0.0)
+  {
+    census.Negative = 0; // negative intensities are part of the chosen range
+  }
+  if (!census.AllFiniteNonNegative())
+  {
+    vtkWarningMacro(<< "The intensity array " << intensityName << " has "
+                    << nimbus::DescribeCensus(census)
+                    << ": NaN pixels are read as clear sky, infinite and negative ones as the "
+                       "ends of IntensityRange.");
   }
 
   this->UpdateProgress(0.1);
-  nimbus::ImageCloud cloud;
-  try
+  if (this->CheckAbort())
   {
-    cloud = nimbus::BuildImageCloud(tau, dims[0], dims[1], MakeParameters(this));
+    return aborted();
   }
-  catch (const std::exception& error)
+  const nimbus::ImageCloud cloud = nimbus::BuildImageCloud(tau, dims[0], dims[1], parameters,
+    [this](double fraction)
+    {
+      this->UpdateProgress(0.1 + 0.8 * std::clamp(fraction, 0.0, 1.0));
+      return !this->CheckAbort();
+    });
+  if (!cloud.Complete)
   {
-    vtkErrorMacro(<< error.what());
-    return 1;
+    return aborted();
   }
   this->UpdateProgress(0.9);
+  const nimbus::ValueCensus densityCensus =
+    nimbus::TakeCensus(cloud.Density.data(), cloud.Density.size());
+  if (!densityCensus.AllFiniteNonNegative())
+  {
+    vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(densityCensus)
+                  << "; the output is withheld.");
+    return aborted();
+  }
 
-  const nimbus::GridGeometry& grid = cloud.Grid;
-  output->SetExtent(
-    0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0, grid.Dimensions[2] - 1);
-  output->SetOrigin(grid.Origin.data());
-  output->SetSpacing(grid.Spacing.data());
+  output->SetExtent(0, cloud.Grid.Dimensions[0] - 1, 0, cloud.Grid.Dimensions[1] - 1, 0,
+    cloud.Grid.Dimensions[2] - 1);
+  output->SetOrigin(cloud.Grid.Origin.data());
+  output->SetSpacing(cloud.Grid.Spacing.data());
   vtkNew<vtkFloatArray> density;
   density->SetName("density");
   density->SetNumberOfTuples(static_cast<vtkIdType>(cloud.Density.size()));
   std::copy(cloud.Density.begin(), cloud.Density.end(), density->GetPointer(0));
   output->GetPointData()->SetScalars(density);
 
-  map->SetExtent(0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0, 0);
-  map->SetOrigin(grid.Origin[0], grid.Origin[1], this->BaseHeight);
-  map->SetSpacing(grid.Spacing.data());
+  map->SetExtent(0, cloud.Grid.Dimensions[0] - 1, 0, cloud.Grid.Dimensions[1] - 1, 0, 0);
+  map->SetOrigin(cloud.Grid.Origin[0], cloud.Grid.Origin[1], this->BaseHeight);
+  map->SetSpacing(cloud.Grid.Spacing.data());
   vtkNew<vtkFloatArray> target, achieved;
   target->SetName("optical_depth");
   achieved->SetName("column_optical_depth");
@@ -294,4 +544,5 @@ void vtkNimbusImageCloudFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TopRoughness: " << this->TopRoughness << "\n";
   os << indent << "Iterations: " << this->Iterations << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }

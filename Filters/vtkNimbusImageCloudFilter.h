@@ -22,6 +22,16 @@
  * (dimensionless; a renderer's extinction is ExtinctionCoefficient * density, 1/m).
  * Output port 1: the 2-D map at z = BaseHeight with "optical_depth" (the image's target
  * tau) and "column_optical_depth" (the achieved tau of the density).
+ *
+ * Bad input ends in an error message and empty outputs, never in an exception or an
+ * allocation VTK cannot make: NaN or infinite parameters, values outside the documented
+ * ranges (PixelSize and VerticalSpacing in [1e-3, 1e6] m, ExtinctionCoefficient in
+ * (0, 1e3] 1/m, NominalDensity in (0, 1e6], |BaseHeight| and BaseTransitionThickness at
+ * most 1e8 m), a cloud thicker than 4096 layers, an image whose grid would exceed 2e9
+ * points or MemoryBudgetMiB, or work beyond about 2e11 grid-point updates (the messages
+ * say which). NaN, infinite and (with IntensityRange[0] >= 0) negative intensities are
+ * counted in a warning: NaN reads as clear sky, the others are clamped to the range's ends.
+ * The build reports progress and stops soon after AbortExecute is set (outputs then empty).
  */
 #ifndef vtkNimbusImageCloudFilter_h
 #define vtkNimbusImageCloudFilter_h
@@ -62,11 +72,20 @@ public:
   vtkGetMacro(ClearIntensity, double);
   vtkSetMacro(WhiteIntensity, double);
   vtkGetMacro(WhiteIntensity, double);
-  vtkSetClampMacro(Gamma, double, 0.01, 100.0);
+  /// Clamped to [0.01, 100.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetGamma(double value);
+  double GetGammaMinValue() { return 0.01; }
+  double GetGammaMaxValue() { return 100.0; }
   vtkGetMacro(Gamma, double);
-  vtkSetClampMacro(MaximumOpticalDepth, double, 0.0, 1000.0);
+  /// Clamped to [0.0, 1000.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetMaximumOpticalDepth(double value);
+  double GetMaximumOpticalDepthMinValue() { return 0.0; }
+  double GetMaximumOpticalDepthMaxValue() { return 1000.0; }
   vtkGetMacro(MaximumOpticalDepth, double);
-  vtkSetClampMacro(AsymmetryParameter, double, 0.0, 0.99);
+  /// Clamped to [0.0, 0.99]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetAsymmetryParameter(double value);
+  double GetAsymmetryParameterMinValue() { return 0.0; }
+  double GetAsymmetryParameterMaxValue() { return 0.99; }
   vtkGetMacro(AsymmetryParameter, double);
   ///@}
 
@@ -102,14 +121,31 @@ public:
   /// Seed of the jitter. Defaults 2, 3, 0.6, 10, 1.
   vtkSetClampMacro(BallSpacing, int, 1, 64);
   vtkGetMacro(BallSpacing, int);
-  vtkSetClampMacro(BallRadiusFactor, double, 0.1, 20.0);
+  /// Clamped to [0.1, 20.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetBallRadiusFactor(double value);
+  double GetBallRadiusFactorMinValue() { return 0.1; }
+  double GetBallRadiusFactorMaxValue() { return 20.0; }
   vtkGetMacro(BallRadiusFactor, double);
-  vtkSetClampMacro(TopRoughness, double, 0.0, 1.0);
+  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  virtual void SetTopRoughness(double value);
+  double GetTopRoughnessMinValue() { return 0.0; }
+  double GetTopRoughnessMaxValue() { return 1.0; }
   vtkGetMacro(TopRoughness, double);
   vtkSetClampMacro(Iterations, int, 0, 100);
   vtkGetMacro(Iterations, int);
   vtkSetMacro(Seed, int);
   vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /// Memory the filter may use for one update, MiB (> 0, finite). Images whose cloud would
+  /// need more are refused with a message. Default nimbus::DefaultMemoryBudgetMiB(): half
+  /// the physical memory, at most three quarters of the process's address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
   ///@}
 
   /// Port 1's data: target and achieved optical depth maps.
@@ -124,6 +160,9 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  /// RequestData's work; may throw (RequestData catches).
+  int Generate(vtkInformationVector** inputVector, vtkInformationVector* outputVector);
 
   double IntensityRange[2];
   int MappingType;
@@ -143,6 +182,8 @@ protected:
   double TopRoughness;
   int Iterations;
   int Seed;
+  double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusImageCloudFilter(const vtkNimbusImageCloudFilter&) = delete;

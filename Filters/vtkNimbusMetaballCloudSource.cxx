@@ -1,5 +1,6 @@
 #include "vtkNimbusMetaballCloudSource.h"
 
+#include "MemoryBudget.h"
 #include "Metaballs.h"
 #include "Random.h"
 
@@ -22,6 +23,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <new>
+#include <sstream>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusMetaballCloudSource);
@@ -66,6 +71,32 @@ bool AllFinite(const double* values, int count)
   }
   return true;
 }
+
+// Valid ranges (see the class documentation).
+constexpr double MaximumLength = 1.0e8;      // m: coordinates, radii, heights
+constexpr double MaximumBallDensity = 1.0e6; // dimensionless; 1e7 balls x 1e6 << FLT_MAX
+constexpr int MaximumNumberOfLevels = 100;
+constexpr double MaximumBallCountFactor = 1.0e3;
+constexpr double MaximumNumberOfBalls = 1.0e7;
+// About a few minutes of work at ~1e9 simple updates per second.
+constexpr double MaximumWork = 2.0e11;
+constexpr double MiB = 1048576.0;
+
+// Estimated triangles of an isosurface on the grid: a cloud's surface crosses about
+// 6 points^(2/3) grid cells (a cube's faces), with about 2 triangles each, times 4 for a
+// rough, grown surface. Only for the memory and work estimates.
+double EstimatedTriangles(double points)
+{
+  return 48.0 * std::pow(points, 2.0 / 3.0);
+}
+
+std::string Number(double value)
+{
+  std::ostringstream text;
+  text.precision(3);
+  text << value;
+  return text.str();
+}
 }
 
 vtkNimbusMetaballCloudSource::vtkNimbusMetaballCloudSource()
@@ -93,6 +124,9 @@ vtkNimbusMetaballCloudSource::vtkNimbusMetaballCloudSource()
   this->FlatBase = true;
   this->BaseHeight = 1000.0;
   this->BaseTransitionThickness = 100.0;
+  this->MemoryBudgetMiB = nimbus::DefaultMemoryBudgetMiB();
+  this->MemoryBudgetRangeMiB[0] = 1.0;
+  this->MemoryBudgetRangeMiB[1] = this->MemoryBudgetMiB;
 }
 
 vtkNimbusMetaballCloudSource::~vtkNimbusMetaballCloudSource() = default;
@@ -140,6 +174,12 @@ int vtkNimbusMetaballCloudSource::FillOutputPortInformation(int port, vtkInforma
 
 bool vtkNimbusMetaballCloudSource::CheckParameters()
 {
+  if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
+  {
+    vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
+                  << this->MemoryBudgetMiB << ".");
+    return false;
+  }
   const int* d = this->Dimensions;
   if (d[0] < 1 || d[1] < 1 || d[2] < 1)
   {
@@ -160,6 +200,13 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
                     << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
       return false;
     }
+    if (std::abs(this->Bounds[2 * a]) > MaximumLength ||
+      std::abs(this->Bounds[2 * a + 1]) > MaximumLength)
+    {
+      vtkErrorMacro(<< "Bounds must lie within +-" << MaximumLength << " m; axis " << a << " has ("
+                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
+      return false;
+    }
   }
   const double scalars[] = { this->FootprintRadius, this->TowerHeight, this->BallCountFactor,
     this->RadiusScalePerLevel, this->BallDensity, this->IsoValue, this->BaseHeight,
@@ -175,6 +222,14 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
     vtkErrorMacro(<< "NumberOfLevels and BallsPerLevel must be >= 0.");
     return false;
   }
+  if (this->NumberOfLevels > MaximumNumberOfLevels)
+  {
+    vtkErrorMacro(<< "NumberOfLevels is " << this->NumberOfLevels << "; at most "
+                  << MaximumNumberOfLevels
+                  << " growth levels are allowed (each level shrinks the balls by "
+                     "RadiusScalePerLevel; a handful of levels reaches the grid spacing).");
+    return false;
+  }
   const auto& userBalls = this->Internals->UserBalls;
   if (userBalls.empty())
   {
@@ -185,11 +240,12 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
       return false;
     }
     if (!(this->BaseBallRadiusRange[0] > 0.0) ||
-      this->BaseBallRadiusRange[1] < this->BaseBallRadiusRange[0])
+      this->BaseBallRadiusRange[1] < this->BaseBallRadiusRange[0] ||
+      this->BaseBallRadiusRange[1] > MaximumLength)
     {
-      vtkErrorMacro(<< "BaseBallRadiusRange must satisfy 0 < min <= max, got ("
-                    << this->BaseBallRadiusRange[0] << ", " << this->BaseBallRadiusRange[1]
-                    << ").");
+      vtkErrorMacro(<< "BaseBallRadiusRange must satisfy 0 < min <= max <= " << MaximumLength
+                    << " m, got (" << this->BaseBallRadiusRange[0] << ", "
+                    << this->BaseBallRadiusRange[1] << ").");
       return false;
     }
   }
@@ -197,12 +253,16 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
   {
     const double values[] = { ball.Center[0], ball.Center[1], ball.Center[2], ball.Radius,
       ball.Density };
-    if (!AllFinite(values, 5) || !(ball.Radius > 0.0) || ball.Density < 0.0)
+    if (!AllFinite(values, 5) || !(ball.Radius > 0.0) || ball.Density < 0.0 ||
+      ball.Radius > MaximumLength || ball.Density > MaximumBallDensity ||
+      std::abs(ball.Center[0]) > MaximumLength || std::abs(ball.Center[1]) > MaximumLength ||
+      std::abs(ball.Center[2]) > MaximumLength)
     {
-      vtkErrorMacro(<< "AddBall: every ball needs a finite centre, a radius > 0 and a density "
-                       ">= 0; got centre ("
-                    << ball.Center[0] << ", " << ball.Center[1] << ", " << ball.Center[2]
-                    << "), radius " << ball.Radius << ", density " << ball.Density << ".");
+      vtkErrorMacro(<< "AddBall: every ball needs a finite centre within +-" << MaximumLength
+                    << " m, a radius in (0, " << MaximumLength << "] m and a density in [0, "
+                    << MaximumBallDensity << "]; got centre (" << ball.Center[0] << ", "
+                    << ball.Center[1] << ", " << ball.Center[2] << "), radius " << ball.Radius
+                    << ", density " << ball.Density << ".");
       return false;
     }
   }
@@ -213,9 +273,114 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
                      "must be >= 0.");
     return false;
   }
+  if (this->BallDensity > MaximumBallDensity)
+  {
+    vtkErrorMacro(<< "BallDensity is " << this->BallDensity << "; at most " << MaximumBallDensity
+                  << " (the density is dimensionless, 1 for a typical cloud; larger values "
+                     "would overflow the float output where balls overlap).");
+    return false;
+  }
+  if (this->FootprintRadius > MaximumLength || this->TowerHeight > MaximumLength ||
+    this->BaseTransitionThickness > MaximumLength || std::abs(this->BaseHeight) > MaximumLength)
+  {
+    vtkErrorMacro(<< "FootprintRadius, TowerHeight, BaseTransitionThickness and |BaseHeight| "
+                     "must be at most "
+                  << MaximumLength << " m.");
+    return false;
+  }
   if (!(this->RadiusScalePerLevel > 0.0) || !(this->BallCountFactor > 0.0))
   {
     vtkErrorMacro(<< "RadiusScalePerLevel and BallCountFactor must be > 0.");
+    return false;
+  }
+  if (this->RadiusScalePerLevel > 1.0 || this->BallCountFactor > MaximumBallCountFactor)
+  {
+    vtkErrorMacro(<< "RadiusScalePerLevel must be in (0, 1] (growth balls are smaller than "
+                     "the basic shape's) and BallCountFactor in (0, "
+                  << MaximumBallCountFactor << "]; got " << this->RadiusScalePerLevel << " and "
+                  << this->BallCountFactor << ".");
+    return false;
+  }
+
+  // --- memory and work, estimated before anything is allocated --------------------------------
+  std::uint64_t points = 0;
+  if (!nimbus::CheckedProduct({ static_cast<std::uint64_t>(d[0]), static_cast<std::uint64_t>(d[1]),
+                                static_cast<std::uint64_t>(d[2]) },
+        points))
+  {
+    vtkErrorMacro(<< "Dimensions (" << d[0] << ", " << d[1] << ", " << d[2]
+                  << ") have more grid points than 64 bits can count.");
+    return false;
+  }
+  const nimbus::GridGeometry grid = MakeGrid(this->Dimensions, this->Bounds);
+  const double pointCount = static_cast<double>(points);
+  const int levels = this->NumberOfLevels;
+  double radiusMax = this->BaseBallRadiusRange[1];
+  double balls = userBalls.empty() ? this->NumberOfBaseBalls : userBalls.size();
+  if (!userBalls.empty())
+  {
+    radiusMax = 0.0;
+    for (const auto& ball : userBalls)
+    {
+      radiusMax = std::max(radiusMax, ball.Radius);
+    }
+  }
+  // Sampling passes: one per growth level and the final one; each visits every ball's box.
+  double sampleWork = balls * nimbus::MetaballBoxPoints(radiusMax, grid); // balls so far
+  double work = pointCount + sampleWork;
+  const double triangles = levels > 0 ? EstimatedTriangles(pointCount) : 0.0;
+  double levelCount = this->BallsPerLevel;
+  double radius = radiusMax;
+  for (int level = 1; level <= levels; ++level)
+  {
+    // Growth: flying edges over the grid and the gradient of every ball at every triangle.
+    work += pointCount + triangles * (balls + 1.0);
+    radius *= this->RadiusScalePerLevel;
+    balls += levelCount;
+    sampleWork += levelCount * nimbus::MetaballBoxPoints(radius, grid);
+    work += pointCount + sampleWork;
+    levelCount *= this->BallCountFactor;
+    if (!(balls <= MaximumNumberOfBalls))
+    {
+      break;
+    }
+  }
+  if (!(balls <= MaximumNumberOfBalls))
+  {
+    vtkErrorMacro(<< "The growth would place " << Number(balls) << " metaballs or more ("
+                  << this->BallsPerLevel << " at the first level, times " << this->BallCountFactor
+                  << " per level, " << levels << " levels), more than the limit of "
+                  << Number(MaximumNumberOfBalls)
+                  << "; lower NumberOfLevels, BallsPerLevel or BallCountFactor.");
+    return false;
+  }
+  // Bytes: the density (float) and its output copy, flying edges' edge cases (1 byte per
+  // point) and row metadata (6 ids per x row), the isosurface (about 100 bytes per
+  // triangle with its points and our copies), the balls (48 bytes) and their output
+  // polydata (about 60 bytes).
+  const double rows = static_cast<double>(d[1]) * d[2];
+  const double bytes =
+    pointCount * 9.0 + (levels > 0 ? rows * 48.0 + triangles * 100.0 : 0.0) + balls * 108.0;
+  std::ostringstream what;
+  what << "the metaball cloud (" << d[0] << " x " << d[1] << " x " << d[2] << " points, "
+       << Number(balls) << " balls)";
+  const std::string overBudget =
+    nimbus::OverBudgetMessage(what.str(), bytes, this->MemoryBudgetMiB * MiB);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< overBudget
+                  << " (MemoryBudgetMiB); lower Dimensions, NumberOfLevels or BallsPerLevel, or "
+                     "raise MemoryBudgetMiB.");
+    return false;
+  }
+  if (!(work <= MaximumWork))
+  {
+    vtkErrorMacro(<< "The metaball cloud would need about " << Number(work)
+                  << " grid-point and ball updates (" << d[0] << " x " << d[1] << " x " << d[2]
+                  << " points, " << levels << " growth levels, " << Number(balls)
+                  << " balls), more than the limit of " << Number(MaximumWork)
+                  << " (minutes of work); lower Dimensions, NumberOfLevels, BallsPerLevel or "
+                     "the ball radii.");
     return false;
   }
   return true;
@@ -258,6 +423,46 @@ int vtkNimbusMetaballCloudSource::RequestData(
   {
     return 1; // empty outputs; the error has been reported
   }
+  // The budget above is an estimate: whatever still goes wrong ends here, not in ParaView.
+  try
+  {
+    return this->Generate(image, metaballs);
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro(<< "Out of memory while generating the metaball cloud; lower Dimensions, "
+                     "NumberOfLevels or BallsPerLevel, or MemoryBudgetMiB.");
+  }
+  catch (const std::length_error& error)
+  {
+    vtkErrorMacro(<< "The metaball cloud is too large (" << error.what()
+                  << "); lower Dimensions, NumberOfLevels or BallsPerLevel.");
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< "Cannot generate the metaball cloud: " << error.what());
+  }
+  image->Initialize();
+  metaballs->Initialize();
+  return 1;
+}
+
+int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* metaballs)
+{
+  // Progress: growth levels and the final sampling share [0, 1]; each reports inside too.
+  const int totalSteps = this->NumberOfLevels + 1;
+  double stepStart = 0.0;
+  auto progress = [this, &stepStart, totalSteps](double fraction)
+  {
+    this->UpdateProgress((stepStart + std::clamp(fraction, 0.0, 1.0)) / totalSteps);
+    return !this->CheckAbort();
+  };
+  auto aborted = [image, metaballs]()
+  {
+    image->Initialize();
+    metaballs->Initialize();
+    return 1;
+  };
 
   const nimbus::GridGeometry grid = MakeGrid(this->Dimensions, this->Bounds);
   nimbus::Random random(static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed)));
@@ -288,7 +493,6 @@ int vtkNimbusMetaballCloudSource::RequestData(
   vtkNew<vtkFloatArray> fieldArray;
   fieldArray->SetName("density");
   field->GetPointData()->SetScalars(fieldArray);
-  const int totalSteps = this->NumberOfLevels + 1;
   double radiusScale = 1.0;
   double ballCount = this->BallsPerLevel;
   // Growth radii scale from the basic shape's radius range.
@@ -305,12 +509,19 @@ int vtkNimbusMetaballCloudSource::RequestData(
   }
   for (int level = 1; level <= this->NumberOfLevels; ++level)
   {
-    this->UpdateProgress(static_cast<double>(level - 1) / totalSteps);
+    stepStart = level - 1;
+    this->UpdateProgress(stepStart / totalSteps);
     if (this->CheckAbort())
     {
-      break;
+      return aborted();
     }
-    nimbus::SampleMetaballs(balls, grid, density);
+    // Sampling, flying edges and the growth share the level's part of the progress.
+    auto part = [&progress](double from, double to)
+    { return [&progress, from, to](double f) { return progress(from + (to - from) * f); }; };
+    if (!nimbus::SampleMetaballs(balls, grid, density, part(0.0, 0.5)))
+    {
+      return aborted();
+    }
     fieldArray->SetArray(density.data(), static_cast<vtkIdType>(density.size()), 1);
     fieldArray->Modified();
 
@@ -321,6 +532,10 @@ int vtkNimbusMetaballCloudSource::RequestData(
     contour->ComputeGradientsOff();
     contour->ComputeScalarsOff();
     contour->Update();
+    if (!progress(0.7))
+    {
+      return aborted();
+    }
     vtkPolyData* surface = contour->GetOutput();
 
     std::vector<double> points(3 * static_cast<std::size_t>(surface->GetNumberOfPoints()));
@@ -349,8 +564,19 @@ int vtkNimbusMetaballCloudSource::RequestData(
     growth.RadiusMax = radiusMax * radiusScale;
     growth.Density = this->BallDensity;
     growth.Level = level;
+    bool stopped = false;
+    auto growthProgress = part(0.7, 1.0);
     const std::vector<nimbus::Metaball> grown =
-      nimbus::GrowOnSurface(balls, points, triangles, growth, random);
+      nimbus::GrowOnSurface(balls, points, triangles, growth, random,
+        [&growthProgress, &stopped](double f)
+        {
+          stopped = !growthProgress(f);
+          return !stopped;
+        });
+    if (stopped)
+    {
+      return aborted();
+    }
     if (grown.empty())
     {
       vtkWarningMacro(<< "Growth level " << level << ": the isosurface at IsoValue "
@@ -362,8 +588,12 @@ int vtkNimbusMetaballCloudSource::RequestData(
   fieldArray->SetArray(nullptr, 0, 1);
 
   // Final density on the output grid.
-  this->UpdateProgress(static_cast<double>(this->NumberOfLevels) / totalSteps);
-  nimbus::SampleMetaballs(balls, grid, density);
+  stepStart = this->NumberOfLevels;
+  this->UpdateProgress(stepStart / totalSteps);
+  if (!nimbus::SampleMetaballs(balls, grid, density, progress))
+  {
+    return aborted();
+  }
   if (this->FlatBase)
   {
     nimbus::ApplyCloudBase(grid, this->BaseHeight, this->BaseTransitionThickness, density);
@@ -379,6 +609,14 @@ int vtkNimbusMetaballCloudSource::RequestData(
   densityArray->SetNumberOfTuples(static_cast<vtkIdType>(density.size()));
   std::copy(density.begin(), density.end(), densityArray->GetPointer(0));
   image->GetPointData()->SetScalars(densityArray);
+  // Checked ranges keep every sum finite; check anyway (cheap next to the sampling).
+  const nimbus::ValueCensus census = nimbus::TakeCensus(density.data(), density.size());
+  if (!census.AllFiniteNonNegative())
+  {
+    vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(census)
+                  << "; the output is withheld. Lower BallDensity or the number of balls.");
+    return aborted();
+  }
 
   // Port 1: the metaballs themselves.
   vtkNew<vtkPoints> centres;
@@ -435,4 +673,5 @@ void vtkNimbusMetaballCloudSource::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BaseHeight: " << this->BaseHeight << "\n";
   os << indent << "BaseTransitionThickness: " << this->BaseTransitionThickness << "\n";
   os << indent << "NumberOfUserBalls: " << this->GetNumberOfUserBalls() << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }

@@ -19,8 +19,19 @@
  * Units: Bounds, radii, heights in metres. The result depends only on the
  * parameters and Seed (same seed -> identical bytes).
  * Invalid parameters (non-positive dimensions, empty or non-finite bounds, no
- * balls, non-positive radii, NaN anywhere) produce an error message and empty
- * outputs.
+ * balls, non-positive radii, NaN or infinity anywhere, values outside the ranges given
+ * below) produce an error message and empty outputs; so do outputs that would need more
+ * memory than MemoryBudgetMiB, or more work than about 2e11 grid-point and ball updates
+ * (the message gives the estimate). Nothing is allocated before it has been checked
+ * against the budget, and no exception leaves RequestData. Long runs report progress
+ * and stop soon after AbortExecute is set (outputs then empty).
+ *
+ * Valid ranges (lengths in metres): Bounds within +-1e8 with min < max on every axis;
+ * radii in (0, 1e8]; FootprintRadius, TowerHeight, BaseTransitionThickness in [0, 1e8];
+ * BaseHeight within +-1e8; BallDensity and AddBall densities in [0, 1e6] (so that sums
+ * of overlapping balls stay finite in float); IsoValue finite; NumberOfLevels in
+ * [0, 100]; RadiusScalePerLevel in (0, 1]; BallCountFactor in (0, 1e3]; at most 1e7
+ * balls in all.
  */
 #ifndef vtkNimbusMetaballCloudSource_h
 #define vtkNimbusMetaballCloudSource_h
@@ -30,6 +41,7 @@
 
 #include <memory> // for std::unique_ptr
 
+class vtkImageData;
 class vtkPolyData;
 
 class NIMBUSFILTERS_EXPORT vtkNimbusMetaballCloudSource : public vtkImageAlgorithm
@@ -124,6 +136,18 @@ public:
   int GetNumberOfUserBalls() const;
   ///@}
 
+  ///@{
+  /// Memory the source may use for one update, MiB (> 0, finite). Outputs that would need
+  /// more are refused with a message instead of being allocated. Default
+  /// nimbus::DefaultMemoryBudgetMiB(): half the physical memory, at most three quarters of
+  /// the process's address-space limit.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  /// (1, nimbus::DefaultMemoryBudgetMiB()) MiB: ParaView's range for MemoryBudgetMiB, whose
+  /// default there is the upper end (the machine's default, not a number in the XML).
+  vtkGetVector2Macro(MemoryBudgetRangeMiB, double);
+  ///@}
+
   /// The metaballs of the last update (port 1's data).
   vtkPolyData* GetMetaballs();
 
@@ -135,8 +159,12 @@ protected:
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
-  /// Returns false (after vtkErrorMacro) when a parameter is unusable.
+  /// Returns false (after vtkErrorMacro) when a parameter is unusable, or the output
+  /// would need more memory than MemoryBudgetMiB or more work than the limit.
   bool CheckParameters();
+
+  /// RequestData's work; may throw (RequestData catches).
+  int Generate(vtkImageData* image, vtkPolyData* metaballs);
 
   int Dimensions[3];
   double Bounds[6];
@@ -154,6 +182,8 @@ protected:
   bool FlatBase;
   double BaseHeight;
   double BaseTransitionThickness;
+  double MemoryBudgetMiB;
+  double MemoryBudgetRangeMiB[2];
 
 private:
   vtkNimbusMetaballCloudSource(const vtkNimbusMetaballCloudSource&) = delete;

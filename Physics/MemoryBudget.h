@@ -36,7 +36,8 @@ NIMBUSPHYSICS_EXPORT uint64_t DefaultMemoryBudgetBytes();
 NIMBUSPHYSICS_EXPORT double DefaultMemoryBudgetMiB();
 
 /// The product of the factors; false (and `product` untouched) on overflow of 64 bits.
-NIMBUSPHYSICS_EXPORT bool CheckedProduct(std::initializer_list<uint64_t> factors, uint64_t& product);
+NIMBUSPHYSICS_EXPORT bool CheckedProduct(
+  std::initializer_list<uint64_t> factors, uint64_t& product);
 
 /// Bytes in words: "512 B", "3.2 MiB", "17.5 GiB".
 NIMBUSPHYSICS_EXPORT std::string FormatBytes(double bytes);

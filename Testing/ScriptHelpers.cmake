@@ -1,5 +1,5 @@
 # Helpers shared by the cmake -P test scripts (RunStandaloneTest.cmake, RunVTKOnlyBuild.cmake,
-# RunPhysicsStandalone.cmake).
+# RunPhysicsStandalone.cmake, RunSanitizers.cmake).
 
 # nimbus_require_variables(<script name> <var>...): stop with a message unless each -D<var> was given.
 function (nimbus_require_variables script)

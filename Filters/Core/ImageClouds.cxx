@@ -81,6 +81,10 @@ std::vector<double> ColumnOpticalDepth(
 namespace
 {
 constexpr double HorizontalJitter = 1.0 / 3.0; // of a block, each way
+constexpr int MaximumBallsPerColumn = 30;
+constexpr double MaximumDensityFactor = 1.0e6; // ball density <= this * NominalDensity
+constexpr double MaximumLayers = 4096.0;
+constexpr double MaximumGridPoints = 2.0e9;
 
 void Require(bool condition, const char* message)
 {
@@ -117,23 +121,27 @@ GridGeometry ImageCloudGrid(
   int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& p)
 {
   Require(nx >= 1 && ny >= 1, "BuildImageCloud: the image must have at least 1 x 1 pixels.");
-  Require(p.PixelSize > 0.0 && std::isfinite(p.PixelSize), "PixelSize must be finite and > 0.");
-  Require(p.VerticalSpacing > 0.0 && std::isfinite(p.VerticalSpacing),
-    "VerticalSpacing must be finite and > 0.");
-  Require(p.ExtinctionCoefficient > 0.0 && std::isfinite(p.ExtinctionCoefficient),
-    "ExtinctionCoefficient must be finite and > 0.");
-  Require(p.NominalDensity > 0.0 && std::isfinite(p.NominalDensity),
-    "NominalDensity must be finite and > 0.");
-  Require(std::isfinite(p.BaseHeight), "BaseHeight must be finite.");
-  Require(p.BaseTransitionThickness >= 0.0 && std::isfinite(p.BaseTransitionThickness),
-    "BaseTransitionThickness must be finite and >= 0.");
+  Require(p.PixelSize >= 1.0e-3 && p.PixelSize <= 1.0e6,
+    "PixelSize must be between 1e-3 and 1e6 m (a millimetre to 1000 km per pixel).");
+  Require(p.VerticalSpacing >= 1.0e-3 && p.VerticalSpacing <= 1.0e6,
+    "VerticalSpacing must be between 1e-3 and 1e6 m.");
+  Require(p.ExtinctionCoefficient > 0.0 && p.ExtinctionCoefficient <= 1.0e3,
+    "ExtinctionCoefficient must be > 0 and at most 1e3 1/m (clouds: about 0.01 to 0.1 1/m).");
+  Require(p.NominalDensity > 0.0 && p.NominalDensity <= 1.0e6,
+    "NominalDensity must be > 0 and at most 1e6.");
+  Require(std::abs(p.BaseHeight) <= 1.0e8, "BaseHeight must be finite, within +-1e8 m.");
+  Require(p.BaseTransitionThickness >= 0.0 && p.BaseTransitionThickness <= 1.0e8,
+    "BaseTransitionThickness must be between 0 and 1e8 m.");
+  Require(static_cast<double>(std::max(nx, ny)) * p.PixelSize <= 2.0e8,
+    "The image is wider than 2e8 m (pixels times PixelSize); lower PixelSize.");
   Require(p.BallSpacing >= 1, "BallSpacing must be >= 1 pixel.");
-  Require(p.BallRadiusFactor > 0.0 && std::isfinite(p.BallRadiusFactor),
-    "BallRadiusFactor must be finite and > 0.");
+  Require(p.BallSpacing <= 1 << 20, "BallSpacing must be at most 2^20 pixels.");
+  Require(p.BallRadiusFactor > 0.0 && p.BallRadiusFactor <= 1.0e3,
+    "BallRadiusFactor must be > 0 and at most 1e3.");
   Require(p.TopRoughness >= 0.0 && p.TopRoughness <= 1.0, "TopRoughness must be in [0, 1].");
   Require(p.MinimumOpticalDepth >= 0.0 && std::isfinite(p.MinimumOpticalDepth),
     "MinimumOpticalDepth must be finite and >= 0.");
-  Require(p.Iterations >= 0, "Iterations must be >= 0.");
+  Require(p.Iterations >= 0 && p.Iterations <= 10000, "Iterations must be in [0, 10000].");
   Require(p.GridOpticalDepth >= 0.0 && std::isfinite(p.GridOpticalDepth),
     "GridOpticalDepth must be finite and >= 0.");
   Require(maximumOpticalDepth >= 0.0 && std::isfinite(maximumOpticalDepth),
@@ -152,21 +160,48 @@ GridGeometry ImageCloudGrid(
   const double top =
     p.BaseHeight + std::max(maxThickness, radius) + radius * (1.0 + p.TopRoughness);
   const double layers = std::ceil((top - grid.Origin[2]) / p.VerticalSpacing) + 1.0;
-  if (layers > 4096.0 || static_cast<double>(nx) * ny * layers > 2.0e9)
+  if (!(layers <= MaximumLayers))
   {
     std::ostringstream message;
-    message << "BuildImageCloud: the cloud would need " << layers << " layers (thickness "
-            << maxThickness << " m at spacing " << p.VerticalSpacing
+    message << "BuildImageCloud: the cloud would need " << layers << " layers, more than "
+            << MaximumLayers << " (thickness " << maxThickness << " m and balls of radius "
+            << radius << " m at a vertical spacing of " << p.VerticalSpacing
             << " m); raise VerticalSpacing, ExtinctionCoefficient or NominalDensity, or lower "
-               "the maximum optical depth.";
+               "the maximum optical depth or BallRadiusFactor.";
+    throw std::invalid_argument(message.str());
+  }
+  const double points = static_cast<double>(nx) * ny * layers;
+  if (!(points <= MaximumGridPoints))
+  {
+    std::ostringstream message;
+    message << "BuildImageCloud: the grid would have " << nx << " x " << ny << " x " << layers
+            << " = " << points << " points, more than " << MaximumGridPoints << "; the image ("
+            << nx << " x " << ny
+            << " pixels) is too large: shrink it first (e.g. ParaView's Resample To Image), or "
+               "raise VerticalSpacing if the layers are many.";
     throw std::invalid_argument(message.str());
   }
   grid.Dimensions[2] = static_cast<int>(layers);
   return grid;
 }
 
-ImageCloud BuildImageCloud(
-  const std::vector<double>& opticalDepth, int nx, int ny, const ImageCloudParameters& p)
+double MaximumImageCloudBalls(
+  int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& p)
+{
+  const GridGeometry grid = ImageCloudGrid(nx, ny, maximumOpticalDepth, p); // validates
+  (void)grid;
+  const double s = p.BallSpacing;
+  const double sites = std::ceil(nx / s) * std::ceil(ny / s);
+  const double radius = p.BallRadiusFactor * p.BallSpacing * p.PixelSize;
+  const double thickness = std::max(maximumOpticalDepth, p.GridOpticalDepth) /
+    (p.ExtinctionCoefficient * p.NominalDensity);
+  const double perColumn = std::min(static_cast<double>(MaximumBallsPerColumn),
+    2.0 + std::ceil(std::max(0.0, thickness - 0.5 * radius) / (0.5 * radius)));
+  return sites * perColumn;
+}
+
+ImageCloud BuildImageCloud(const std::vector<double>& opticalDepth, int nx, int ny,
+  const ImageCloudParameters& p, const ProgressCallback& progress)
 {
   Require(opticalDepth.size() == static_cast<std::size_t>(nx < 0 ? 0 : nx) * (ny < 0 ? 0 : ny),
     "BuildImageCloud: the optical-depth map must have nx * ny values.");
@@ -211,8 +246,8 @@ ImageCloud BuildImageCloud(
       const double thickness = site.Target / (sigma * rho);
       const double zFirst = p.BaseHeight + 0.5 * std::min(radius, thickness);
       const double zLast = std::max(zFirst, p.BaseHeight + thickness - 0.5 * radius);
-      const int count =
-        std::min(30, 1 + static_cast<int>(std::ceil((zLast - zFirst) / (0.5 * radius))));
+      const int count = static_cast<int>(std::min(static_cast<double>(MaximumBallsPerColumn),
+        1.0 + std::ceil((zLast - zFirst) / (0.5 * radius))));
       const double cx = grid.Origin[0] + (0.5 * (site.X0 + site.X1) - 0.5) * p.PixelSize;
       const double cy = grid.Origin[1] + (0.5 * (site.Y0 + site.Y1) - 0.5) * p.PixelSize;
       site.FirstBall = balls.size();
@@ -241,13 +276,35 @@ ImageCloud BuildImageCloud(
   }
 
   // Fit: rescale each column's balls by target / achieved optical depth over its block.
+  // Progress: each of the Iterations + 1 samplings is an equal part.
+  const int passes = (sites.empty() ? 0 : p.Iterations) + 1;
+  int pass = 0;
   auto sample = [&]()
   {
-    SampleMetaballs(balls, grid, cloud.Density);
+    ProgressCallback within;
+    if (progress)
+    {
+      within = [&](double f) { return progress((pass + f) / passes); };
+    }
+    if (!SampleMetaballs(balls, grid, cloud.Density, within))
+    {
+      return false;
+    }
     ApplyCloudBase(grid, p.BaseHeight, p.BaseTransitionThickness, cloud.Density);
     cloud.ColumnOpticalDepth = ColumnOpticalDepth(grid, cloud.Density, sigma);
+    ++pass;
+    return !progress || progress(static_cast<double>(pass) / passes);
   };
-  sample();
+  const auto stopped = [&cloud]()
+  {
+    cloud.Complete = false;
+    return cloud;
+  };
+  if (!sample())
+  {
+    return stopped();
+  }
+  const double maximumDensity = MaximumDensityFactor * rho;
   for (int iteration = 0; iteration < p.Iterations && !sites.empty(); ++iteration)
   {
     for (const Site& site : sites)
@@ -256,10 +313,15 @@ ImageCloud BuildImageCloud(
       const double factor = achieved > 0.0 ? std::clamp(site.Target / achieved, 0.1, 10.0) : 10.0;
       for (std::size_t b = site.FirstBall; b < site.EndBall; ++b)
       {
-        balls[b].Density *= factor;
+        // A column whose balls reach no grid point (or only below the base) never
+        // achieves anything; without the cap its density would grow 10x per iteration.
+        balls[b].Density = std::min(balls[b].Density * factor, maximumDensity);
       }
     }
-    sample();
+    if (!sample())
+    {
+      return stopped();
+    }
   }
   return cloud;
 }

@@ -68,6 +68,8 @@ struct ImageCloudParameters
 
 struct ImageCloud
 {
+  bool Complete = true; // false: stopped by the progress callback
+
   GridGeometry Grid;                      // x, y: one point per pixel, z from below the base up
   std::vector<float> Density;             // dimensionless, x fastest
   std::vector<Metaball> Balls;            // the fitted metaballs
@@ -75,8 +77,12 @@ struct ImageCloud
 };
 
 /// The grid BuildImageCloud uses for an nx x ny map whose largest optical depth is
-/// maximumOpticalDepth. Throws std::invalid_argument for unusable parameters or a grid of
-/// more than 4096 layers.
+/// maximumOpticalDepth. Throws std::invalid_argument, with a message naming the parameter
+/// or the real cause, for unusable parameters (NaN, infinite, out of range: PixelSize and
+/// VerticalSpacing in [1e-3, 1e6] m, |BaseHeight| and BaseTransitionThickness at most
+/// 1e8 m, ExtinctionCoefficient in (0, 1e3] 1/m, NominalDensity in (0, 1e6]), for a
+/// grid of more than 4096 layers (a cloud too thick for the vertical spacing) and for a
+/// grid of more than 2e9 points (an image too large).
 NIMBUSFILTERS_EXPORT GridGeometry ImageCloudGrid(
   int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& parameters);
 
@@ -87,9 +93,17 @@ NIMBUSFILTERS_EXPORT GridGeometry ImageCloudGrid(
 /// varied by TopRoughness (the bumpy top); the flat base is ApplyCloudBase. Then the balls of
 /// each column are rescaled Iterations times by target / achieved column optical depth at
 /// the column (multiplicative fixed point, like Richardson-Lucy), so the rendered thickness
-/// matches the image. Throws std::invalid_argument for unusable parameters.
-NIMBUSFILTERS_EXPORT ImageCloud BuildImageCloud(
-  const std::vector<double>& opticalDepth, int nx, int ny, const ImageCloudParameters& parameters);
+/// matches the image; no ball's density grows beyond 1e6 NominalDensity. Throws
+/// std::invalid_argument for unusable parameters. `progress` (optional) is called after
+/// each sampling of the field and within it; when it returns false the build stops and
+/// the result has Complete = false.
+NIMBUSFILTERS_EXPORT ImageCloud BuildImageCloud(const std::vector<double>& opticalDepth, int nx,
+  int ny, const ImageCloudParameters& parameters, const ProgressCallback& progress = nullptr);
+
+/// Upper bound of the number of metaballs BuildImageCloud places on an nx x ny map whose
+/// largest optical depth is maximumOpticalDepth (for memory and work estimates).
+NIMBUSFILTERS_EXPORT double MaximumImageCloudBalls(
+  int nx, int ny, double maximumOpticalDepth, const ImageCloudParameters& parameters);
 
 /// sigma * sum_k density(x, y, z_k) * dz for every column (x, y) of the grid.
 NIMBUSFILTERS_EXPORT std::vector<double> ColumnOpticalDepth(

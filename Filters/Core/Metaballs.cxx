@@ -15,8 +15,10 @@ double WyvillFalloff(double distanceSquared, double radiusSquared)
     return 0.0;
   }
   const double q = distanceSquared / radiusSquared; // (r/R)^2
-  // 1 - 22/9 q + 17/9 q^2 - 4/9 q^3, in Horner form
-  return 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * (4.0 / 9.0)));
+  // 1 - 22/9 q + 17/9 q^2 - 4/9 q^3, in Horner form. f(1) = 0 exactly only in real
+  // arithmetic: just inside the radius rounding can give about -1e-17, so clamp at 0 (no
+  // negative density anywhere, as documented).
+  return std::max(0.0, 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * (4.0 / 9.0))));
 }
 
 namespace
@@ -63,22 +65,55 @@ std::array<double, 3> MetaballDensityGradient(
   return gradient;
 }
 
-void SampleMetaballs(
-  const std::vector<Metaball>& balls, const GridGeometry& grid, std::vector<float>& density)
+namespace
+{
+// Grid-point updates (or ball evaluations) between two progress calls.
+constexpr double ProgressInterval = 4194304.0;
+
+// Index range [lo, hi] of the grid points along one axis within `radius` of `centre`,
+// clipped to [0, n - 1] in floating point (no out-of-range conversion); empty (lo > hi)
+// when the ball misses the grid or anything is NaN.
+void AxisRange(double centre, double radius, double origin, double spacing, int n, int& lo, int& hi)
+{
+  const double first = std::ceil((centre - radius - origin) / spacing);
+  const double last = std::floor((centre + radius - origin) / spacing);
+  if (!(first <= last) || !(last >= 0.0) || !(first <= n - 1.0))
+  {
+    lo = 0;
+    hi = -1;
+    return;
+  }
+  lo = static_cast<int>(std::max(0.0, first));
+  hi = static_cast<int>(std::min(n - 1.0, last));
+}
+}
+
+double MetaballBoxPoints(double radius, const GridGeometry& grid)
+{
+  double points = 1.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    const double across = 2.0 * radius / grid.Spacing[a] + 1.0;
+    points *= std::min(static_cast<double>(grid.Dimensions[a]), std::isnan(across) ? 1.0 : across);
+  }
+  return points;
+}
+
+bool SampleMetaballs(const std::vector<Metaball>& balls, const GridGeometry& grid,
+  std::vector<float>& density, const ProgressCallback& progress)
 {
   const auto& dims = grid.Dimensions;
   density.assign(grid.NumberOfPoints(), 0.0f);
-  for (const Metaball& ball : balls)
+  double sinceReport = 0.0;
+  for (std::size_t b = 0; b < balls.size(); ++b)
   {
+    const Metaball& ball = balls[b];
     // Index range of the ball's bounding box, clipped to the grid.
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a)
     {
-      const double spacing = grid.Spacing[a];
-      const double first = (ball.Center[a] - ball.Radius - grid.Origin[a]) / spacing;
-      const double last = (ball.Center[a] + ball.Radius - grid.Origin[a]) / spacing;
-      lo[a] = static_cast<int>(std::max(0.0, std::ceil(first)));
-      hi[a] = static_cast<int>(std::min(static_cast<double>(dims[a] - 1), std::floor(last)));
+      AxisRange(
+        ball.Center[a], ball.Radius, grid.Origin[a], grid.Spacing[a], dims[a], lo[a], hi[a]);
     }
     const double r2 = ball.Radius * ball.Radius;
     for (int k = lo[2]; k <= hi[2]; ++k)
@@ -99,8 +134,22 @@ void SampleMetaballs(
           row[i] += static_cast<float>(ball.Density * WyvillFalloff(dx * dx + dyz2, r2));
         }
       }
+      if (progress && hi[0] >= lo[0] && hi[1] >= lo[1])
+      {
+        sinceReport += static_cast<double>(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1);
+        if (sinceReport >= ProgressInterval)
+        {
+          sinceReport = 0.0;
+          const double withinBall = static_cast<double>(k - lo[2] + 1) / (hi[2] - lo[2] + 1);
+          if (!progress((static_cast<double>(b) + withinBall) / static_cast<double>(balls.size())))
+          {
+            return false;
+          }
+        }
+      }
     }
   }
+  return true;
 }
 
 void ApplyCloudBase(const GridGeometry& grid, double baseHeight, double transitionThickness,
@@ -162,7 +211,7 @@ std::vector<Metaball> MakeBasicShape(const BasicShapeParameters& parameters, Ran
 
 std::vector<Metaball> GrowOnSurface(const std::vector<Metaball>& balls,
   const std::vector<double>& points, const std::vector<std::int64_t>& triangles,
-  const GrowthParameters& parameters, Random& random)
+  const GrowthParameters& parameters, Random& random, const ProgressCallback& progress)
 {
   const std::size_t numberOfTriangles = triangles.size() / 3;
   // Cumulative area of the triangles allowed to grow (outward normal not downward).
@@ -171,8 +220,21 @@ std::vector<Metaball> GrowOnSurface(const std::vector<Metaball>& balls,
   cumulativeArea.reserve(numberOfTriangles);
   eligible.reserve(numberOfTriangles);
   double totalArea = 0.0;
+  double sinceReport = 0.0;
   for (std::size_t t = 0; t < numberOfTriangles; ++t)
   {
+    if (progress)
+    {
+      sinceReport += static_cast<double>(balls.size()) + 1.0;
+      if (sinceReport >= ProgressInterval)
+      {
+        sinceReport = 0.0;
+        if (!progress(static_cast<double>(t) / static_cast<double>(numberOfTriangles)))
+        {
+          return {};
+        }
+      }
+    }
     const double* a = &points[3 * triangles[3 * t]];
     const double* b = &points[3 * triangles[3 * t + 1]];
     const double* c = &points[3 * triangles[3 * t + 2]];

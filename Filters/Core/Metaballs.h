@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace nimbus
@@ -57,11 +58,25 @@ struct GridGeometry
   }
 };
 
+/// Called now and then by long loops with the fraction of the work done (0..1); returning
+/// false stops the loop early (the caller then discards the partial result).
+using ProgressCallback = std::function<bool(double)>;
+
 /// Samples the metaball field on the grid: density[idx] = sum over balls. Each
 /// ball only visits the grid points inside its bounding box, so the cost is
-/// sum_i (2 R_i / spacing)^3, not (points x balls).
-NIMBUSFILTERS_EXPORT void SampleMetaballs(
-  const std::vector<Metaball>& balls, const GridGeometry& grid, std::vector<float>& density);
+/// sum_i (2 R_i / spacing)^3, not (points x balls). A ball's box is clipped to the grid in
+/// floating point before any conversion to an index, so any finite or infinite centre,
+/// radius and spacing is safe (a ball that reaches no grid point adds nothing).
+/// `progress` (optional) is called about every 4 million grid-point updates; when it
+/// returns false sampling stops and the function returns false (density incomplete).
+NIMBUSFILTERS_EXPORT bool SampleMetaballs(const std::vector<Metaball>& balls,
+  const GridGeometry& grid, std::vector<float>& density,
+  const ProgressCallback& progress = nullptr);
+
+/// Number of grid points a ball of this radius visits in SampleMetaballs at most (its
+/// bounding box clipped to the grid), as a double so that nothing overflows. For work
+/// estimates.
+NIMBUSFILTERS_EXPORT double MetaballBoxPoints(double radius, const GridGeometry& grid);
 
 /// Flat cloud base: multiplies the density by a smoothstep that is 0 at and below
 /// baseHeight (z, m) and 1 from baseHeight + transitionThickness up. Below the
@@ -107,10 +122,13 @@ struct GrowthParameters
 /// with probability proportional to area among those not facing down, places a
 /// ball at a uniformly random point of each, radius uniform in [RadiusMin, RadiusMax].
 /// Outward normals come from the analytic field gradient, not the triangle winding.
-/// Returns the new balls (none if no triangle qualifies).
+/// Returns the new balls (none if no triangle qualifies). The cost is about
+/// triangles x balls (the gradient at each triangle). `progress` (optional) is called about
+/// every 4 million ball evaluations; when it returns false the function stops and
+/// returns no balls.
 NIMBUSFILTERS_EXPORT std::vector<Metaball> GrowOnSurface(const std::vector<Metaball>& balls,
   const std::vector<double>& points, const std::vector<std::int64_t>& triangles,
-  const GrowthParameters& parameters, Random& random);
+  const GrowthParameters& parameters, Random& random, const ProgressCallback& progress = nullptr);
 
 } // namespace nimbus
 

@@ -28,7 +28,8 @@ TEST(MemoryBudget, CheckedProductDetectsOverflow)
 TEST(MemoryBudget, MessagesNameSizeAndBudget)
 {
   EXPECT_EQ(nimbus::OverBudgetMessage("x", 1024.0, 1024.0), "");
-  const std::string message = nimbus::OverBudgetMessage("the grid", 3.0 * 1073741824.0, 1073741824.0);
+  const std::string message =
+    nimbus::OverBudgetMessage("the grid", 3.0 * 1073741824.0, 1073741824.0);
   EXPECT_EQ(message, "the grid would need 3.0 GiB, more than the memory budget of 1.0 GiB");
   EXPECT_FALSE(nimbus::OverBudgetMessage("x", std::nan(""), 1e30).empty());
   EXPECT_FALSE(nimbus::OverBudgetMessage("x", HUGE_VAL, 1e30).empty());

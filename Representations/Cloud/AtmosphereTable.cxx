@@ -36,7 +36,12 @@ AtmosphereTable BuildAtmosphereTable(
   }
   AtmosphereTable table;
   const std::vector<double>& sun = sunAndAir.GetSunIrradiance();
-  table.SunIrradianceTop = sunAndAir.ToLinearSrgb(sun);
+  const std::array<double, 3> sunTop = sunAndAir.ToLinearSrgb(sun);
+  for (int c = 0; c < 3; ++c)
+  {
+    // Out of gamut (a cool sun) gives a negative channel: clipped, see put() below.
+    table.SunIrradianceTop[c] = std::max(sunTop[c], 0.0);
+  }
   table.Air = sunAndAir.GetSceneAtmosphere();
   if (!sunAndAir.HasAtmosphere())
   {
@@ -80,8 +85,14 @@ AtmosphereTable BuildAtmosphereTable(
     }
     const std::array<double, 3> sunRgb = sunAndAir.ToLinearSrgb(irradiance);
     const std::array<double, 3> rayleighRgb = sunAndAir.ToLinearSrgb(rayleigh);
-    auto put = [&](int row, int c, double value) {
-      table.Data[(static_cast<std::size_t>(row) * samples + i) * 4 + c] = static_cast<float>(value);
+    // Radiance is >= 0: a negative linear-sRGB channel is only an out-of-gamut
+    // colour (a sun reddened near the horizon, a 1000 K sun), and would make the
+    // sums of the passes negative. Clipped at 0 per channel (gamut clipping of the
+    // light, as SunIrradiance() in svsCommon.glsl clips row 0 already).
+    auto put = [&](int row, int c, double value)
+    {
+      table.Data[(static_cast<std::size_t>(row) * samples + i) * 4 + c] =
+        static_cast<float>(std::max(value, 0.0));
     };
     for (int c = 0; c < 3; ++c)
     {

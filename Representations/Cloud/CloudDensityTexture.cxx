@@ -1,4 +1,5 @@
 #include "CloudDensityTexture.h"
+#include "MemoryBudget.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkArrayDispatch.h"
@@ -8,6 +9,7 @@
 #include "vtkMatrix4x4.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkTextureObject.h"
+#include "vtk_glew.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,18 +64,18 @@ ResampledDensity CloudDensityTexture::Resample(
 }
 
 bool CloudDensityTexture::NeedsUpload(
-  vtkImageData* image, vtkDataArray* scalars, int maximumSize) const
+  vtkImageData* image, vtkDataArray* scalars, int maximumSize, double budgetBytes) const
 {
   return !this->HasDensity || this->UploadedArray != scalars || this->UploadedImage != image ||
     scalars->GetMTime() > this->UploadTime || image->GetMTime() > this->UploadTime ||
-    this->UploadedMaximumSize != maximumSize;
+    this->UploadedMaximumSize != maximumSize || this->UploadedBudgetBytes != budgetBytes;
 }
 
 bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
-  vtkDataArray* scalars, bool cellData, int maximumSize, std::vector<std::string>& warnings,
-  std::string& error)
+  vtkDataArray* scalars, bool cellData, int maximumSize, double budgetBytes,
+  std::vector<std::string>& warnings, std::string& error)
 {
-  if (!this->NeedsUpload(image, scalars, maximumSize))
+  if (!this->NeedsUpload(image, scalars, maximumSize, budgetBytes))
   {
     return true;
   }
@@ -82,14 +84,33 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   std::array<int, 3> dims;
   for (int k = 0; k < 3; ++k)
   {
-    dims[k] = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    dims[k] = cellData ? std::max(pointDims[k] - 1, 1) : std::max(pointDims[k], 0);
   }
   std::ostringstream message;
-  if (static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2] != scalars->GetNumberOfTuples())
+  uint64_t needed = 0;
+  const bool representable =
+    CheckedProduct({ static_cast<uint64_t>(dims[0]), static_cast<uint64_t>(dims[1]),
+                     static_cast<uint64_t>(dims[2]) },
+      needed);
+  if (!representable || needed != static_cast<uint64_t>(scalars->GetNumberOfTuples()))
   {
     message << "Array '" << NameOf(scalars) << "' has " << scalars->GetNumberOfTuples()
-            << " values, but the image needs " << dims[0] * dims[1] * dims[2];
+            << " values, but the image (" << dims[0] << "x" << dims[1] << "x" << dims[2]
+            << ") needs ";
+    if (representable)
+    {
+      message << needed;
+    }
+    else
+    {
+      message << "more than 2^64";
+    }
     error = message.str();
+    return false;
+  }
+  if (needed == 0)
+  {
+    error = "The image has no samples (an empty extent).";
     return false;
   }
   if (scalars->GetNumberOfComponents() != 1)
@@ -99,23 +120,70 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
     warnings.push_back(message.str());
     message.str("");
   }
-  const DensityResamplePlan plan = PlanDensityResample(dims, maximumSize);
+  // The GL limit per side, then the memory budget: the texture and the converted
+  // copy on the CPU, 8 bytes per texel.
+  constexpr double kBytesPerTexel = 2.0 * sizeof(float);
+  DensityResamplePlan plan = PlanDensityResample(dims, maximumSize);
+  const DensityResamplePlan glPlan = plan;
+  std::string overBudget =
+    OverBudgetMessage("the density texture", kBytesPerTexel * plan.OutputSize(), budgetBytes);
+  const std::string firstOverBudget = overBudget;
+  int limit =
+    std::max({ plan.OutputDimensions[0], plan.OutputDimensions[1], plan.OutputDimensions[2], 1 });
+  while (!overBudget.empty() && limit > 1)
+  {
+    const double shrink = std::cbrt(budgetBytes / (kBytesPerTexel * plan.OutputSize()));
+    limit = std::min(limit - 1, static_cast<int>(limit * (std::isfinite(shrink) ? shrink : 0.0)));
+    limit = std::max(limit, 1);
+    plan = PlanDensityResample(dims, limit);
+    overBudget =
+      OverBudgetMessage("the density texture", kBytesPerTexel * plan.OutputSize(), budgetBytes);
+  }
+  if (!overBudget.empty())
+  {
+    error = "Cannot render the density: " + overBudget + ".";
+    return false;
+  }
   const std::array<int, 3>& texDims = plan.OutputDimensions;
-  if (plan.Downsamples())
+  if (glPlan.Downsamples())
   {
     message << "Density " << dims[0] << "x" << dims[1] << "x" << dims[2]
             << " exceeds the texture limit of " << maximumSize << " per side; downsampled to "
-            << texDims[0] << "x" << texDims[1] << "x" << texDims[2] << " by averaging.";
+            << glPlan.OutputDimensions[0] << "x" << glPlan.OutputDimensions[1] << "x"
+            << glPlan.OutputDimensions[2] << " by averaging.";
+    warnings.push_back(message.str());
+    message.str("");
+  }
+  if (!firstOverBudget.empty())
+  {
+    message << "Density " << dims[0] << "x" << dims[1] << "x" << dims[2] << ": " << firstOverBudget
+            << "; downsampled to " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
+            << " by averaging (raise TextureMemoryBudgetMiB to keep more detail).";
     warnings.push_back(message.str());
     message.str("");
   }
   const ResampledDensity density = Resample(scalars, plan);
-  if (density.NonFiniteCount > 0)
+  const bool newValues = this->ReportedArray != scalars || scalars->GetMTime() > this->ReportTime ||
+    image->GetMTime() > this->ReportTime;
+  if (newValues && (!density.Census.AllFiniteNonNegative() || density.TooLargeCount > 0))
   {
-    message << density.NonFiniteCount << " density values are NaN or infinite; rendered as 0.";
+    message << "Density array '" << NameOf(scalars) << "': ";
+    if (!density.Census.AllFiniteNonNegative())
+    {
+      message << DescribeCensus(density.Census) << " (NaN and infinite rendered as 0, negative "
+              << "clamped to 0)";
+    }
+    if (density.TooLargeCount > 0)
+    {
+      message << (density.Census.AllFiniteNonNegative() ? "" : "; ") << density.TooLargeCount
+              << " values above " << kMaximumDensity << " (clamped to it)";
+    }
+    message << ".";
     warnings.push_back(message.str());
     message.str("");
   }
+  this->ReportedArray = scalars;
+  this->ReportTime.Modified();
   this->Texture->SetContext(window);
   this->Texture->ReleaseGraphicsResources(window);
   this->Texture->SetWrapS(vtkTextureObject::ClampToEdge);
@@ -124,11 +192,19 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   this->Texture->SetMinificationFilter(vtkTextureObject::Linear);
   this->Texture->SetMagnificationFilter(vtkTextureObject::Linear);
   // GL copies the texels during the call; they are only read.
-  if (!this->Texture->Create3DFromRaw(
-        texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, const_cast<float*>(density.Data())))
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
   {
+    // errors of earlier GL calls are not this upload's
+  }
+  const bool created = this->Texture->Create3DFromRaw(
+    texDims[0], texDims[1], texDims[2], 1, VTK_FLOAT, const_cast<float*>(density.Data()));
+  if (!created || glGetError() == GL_OUT_OF_MEMORY)
+  {
+    this->Texture->ReleaseGraphicsResources(window);
+    this->HasDensity = false;
     message << "Could not upload the " << texDims[0] << "x" << texDims[1] << "x" << texDims[2]
-            << " density texture.";
+            << " density texture (" << FormatBytes(4.0 * plan.OutputSize())
+            << "; GL out of memory?). Lower MaximumTextureSize or TextureMemoryBudgetMiB.";
     error = message.str();
     return false;
   }
@@ -137,6 +213,7 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   this->UploadedArray = scalars;
   this->UploadedImage = image;
   this->UploadedMaximumSize = maximumSize;
+  this->UploadedBudgetBytes = budgetBytes;
   this->UploadTime.Modified();
   this->HasDensity = true;
   ++this->Uploads;

@@ -37,12 +37,17 @@ public:
   CloudDensityTexture& operator=(const CloudDensityTexture&) = delete;
 
   /// Makes the texture hold `scalars` of `image` (cell data when `cellData`), at
-  /// most `maximumSize` texels per side, uploading only when it does not already.
-  /// What the user should hear of (several components, downsampling, NaN) is
+  /// most `maximumSize` texels per side and `budgetBytes` bytes (the texture and
+  /// its converted copy on the CPU, 8 bytes per texel: a larger volume is
+  /// downsampled further), uploading only when it does not already.
+  /// What the user should hear of (several components, downsampling, NaN,
+  /// infinite, negative or too large values: once per version of the array) is
   /// appended to `warnings`. False, with the reason in `error`, when the array does
-  /// not match the image or the upload failed.
+  /// not match the image, not even one texel fits the budget or the upload failed
+  /// (GL_OUT_OF_MEMORY).
   bool Update(vtkOpenGLRenderWindow* window, vtkImageData* image, vtkDataArray* scalars,
-    bool cellData, int maximumSize, std::vector<std::string>& warnings, std::string& error);
+    bool cellData, int maximumSize, double budgetBytes, std::vector<std::string>& warnings,
+    std::string& error);
 
   /// The density (the first component of the array) at the texels of `plan`,
   /// read with typed access (vtkArrayDispatch) from any numeric array; a
@@ -69,7 +74,8 @@ public:
   void Release(vtkWindow* window);
 
 private:
-  bool NeedsUpload(vtkImageData* image, vtkDataArray* scalars, int maximumSize) const;
+  bool NeedsUpload(
+    vtkImageData* image, vtkDataArray* scalars, int maximumSize, double budgetBytes) const;
   void SetBox(vtkImageData* image, bool cellData, const DensityResamplePlan& plan);
 
   vtkNew<vtkTextureObject> Texture;
@@ -77,6 +83,12 @@ private:
   vtkDataArray* UploadedArray = nullptr; // identity only, never dereferenced
   vtkImageData* UploadedImage = nullptr;
   int UploadedMaximumSize = -1;
+  double UploadedBudgetBytes = -1.0;
+  // The array whose values were last reported (NaN, infinite, negative): reported
+  // again only for another array or a newer version of it, not for a re-upload
+  // of the same values (a new size limit).
+  vtkDataArray* ReportedArray = nullptr; // identity only, never dereferenced
+  vtkTimeStamp ReportTime;
   bool HasDensity = false;
   int Uploads = 0;
   int Dimensions[3] = { 0, 0, 0 };

@@ -37,7 +37,7 @@ bool IsTextureReadyDensity(const float* values, std::size_t count)
 {
   for (std::size_t i = 0; i < count; ++i)
   {
-    if (!std::isfinite(values[i]) || std::signbit(values[i]))
+    if (!std::isfinite(values[i]) || std::signbit(values[i]) || values[i] > kMaximumDensity)
     {
       return false;
     }

@@ -5,8 +5,10 @@
 //    axis that fits, f_k = ceil(n_k / limit); each texel is the mean of its
 //    f_x x f_y x f_z block of samples, the blocks at the upper edges partial
 //    (ceil(n_k / f_k) texels per axis).
-//  - NaN and infinite samples are taken as 0 and counted; negative samples are
-//    clamped to 0 before averaging.
+//  - NaN and infinite samples are taken as 0, negative samples are clamped to 0
+//    and samples above kMaximumDensity (1e30) to kMaximumDensity, all before
+//    averaging and all counted (ResampledDensity::Census, TooLargeCount): the sum
+//    of a block then stays finite in float, and so does k_cl rho in the shaders.
 //  - A volume that fits and already is such floats (contiguous, one component,
 //    finite, no sign bit) is used where it is: ResampledDensity::Data() points into
 //    it and nothing is allocated. Anything else is converted once.
@@ -16,6 +18,7 @@
 #ifndef nimbus_DensityResample_h
 #define nimbus_DensityResample_h
 
+#include "MemoryBudget.h" // for ValueCensus
 #include "NimbusRepresentationsModule.h"
 
 #include <algorithm>
@@ -27,6 +30,11 @@
 
 namespace nimbus
 {
+/// The largest density a texel holds; larger samples are clamped to it (and
+/// counted), so that a block's float sum stays finite (below 3.4e38 for blocks of
+/// up to 3e8 samples) and k_cl rho does too (k_cl <= 1e6).
+constexpr double kMaximumDensity = 0x1p100; // 1.27e30, exact in float and double
+
 /// Sizes of one resampling: samples per axis, samples per texel per axis (the
 /// block), texels per axis.
 struct NIMBUSREPRESENTATIONS_EXPORT DensityResamplePlan
@@ -54,13 +62,45 @@ struct ResampledDensity
 
   const float* Borrowed = nullptr;
   std::vector<float> Storage;
-  /// Samples that were NaN or infinite (taken as 0).
+  /// Samples that were NaN or infinite (taken as 0): Census.NaN + Census.Infinite.
   std::size_t NonFiniteCount = 0;
+  /// NaN, infinite (taken as 0) and negative (clamped to 0) samples.
+  ValueCensus Census;
+  /// Finite samples above kMaximumDensity (clamped to it).
+  std::size_t TooLargeCount = 0;
 };
 
-/// Whether `count` floats can be the texture as they are: all finite and without
-/// sign bit (a -0 is converted to +0 like every other negative value).
+/// Whether `count` floats can be the texture as they are: all finite, without
+/// sign bit (a -0 is converted to +0 like every other negative value) and at most
+/// kMaximumDensity.
 NIMBUSREPRESENTATIONS_EXPORT bool IsTextureReadyDensity(const float* values, std::size_t count);
+
+/// One sample as the texture takes it: NaN and infinity -> 0, negative -> 0, above
+/// kMaximumDensity -> kMaximumDensity; each counted.
+inline double TextureDensity(double v, ValueCensus& census, std::size_t& tooLarge)
+{
+  if (std::isnan(v))
+  {
+    ++census.NaN;
+    return 0.0;
+  }
+  if (std::isinf(v))
+  {
+    ++census.Infinite;
+    return 0.0;
+  }
+  if (v < 0.0)
+  {
+    ++census.Negative;
+    return 0.0;
+  }
+  if (v > kMaximumDensity)
+  {
+    ++tooLarge;
+    return kMaximumDensity;
+  }
+  return v > 0.0 ? v : 0.0; // -0 -> +0
+}
 
 /// Resampling of plan.InputSize() samples, `sample(i)` giving sample i (x fastest)
 /// as a double; always converts into Storage.
@@ -70,21 +110,16 @@ ResampledDensity ResampleDensityWith(const SampleFunction& sample, const Density
   ResampledDensity result;
   result.Storage.assign(plan.OutputSize(), 0.0f);
   float* texels = result.Storage.data();
-  std::size_t nonFinite = 0;
+  ValueCensus& census = result.Census;
+  std::size_t& tooLarge = result.TooLargeCount;
   if (!plan.Downsamples())
   {
     const std::size_t count = plan.InputSize();
     for (std::size_t i = 0; i < count; ++i)
     {
-      double v = sample(i);
-      if (!std::isfinite(v))
-      {
-        ++nonFinite;
-        v = 0.0;
-      }
-      texels[i] = v > 0.0 ? static_cast<float>(v) : 0.0f;
+      texels[i] = static_cast<float>(TextureDensity(sample(i), census, tooLarge));
     }
-    result.NonFiniteCount = nonFinite;
+    result.NonFiniteCount = census.NaN + census.Infinite;
     return result;
   }
   // Block sums in float, the samples in memory order, then divided by the block's
@@ -102,13 +137,7 @@ ResampledDensity ResampleDensityWith(const SampleFunction& sample, const Density
           (static_cast<std::size_t>(y / f[1]) + static_cast<std::size_t>(m[1]) * (z / f[2]));
       for (int x = 0; x < n[0]; ++x)
       {
-        double v = sample(i++);
-        if (!std::isfinite(v))
-        {
-          ++nonFinite;
-          v = 0.0;
-        }
-        row[x / f[0]] += static_cast<float>(std::max(v, 0.0));
+        row[x / f[0]] += static_cast<float>(TextureDensity(sample(i++), census, tooLarge));
       }
     }
   }
@@ -126,7 +155,7 @@ ResampledDensity ResampleDensityWith(const SampleFunction& sample, const Density
       }
     }
   }
-  result.NonFiniteCount = nonFinite;
+  result.NonFiniteCount = census.NaN + census.Infinite;
   return result;
 }
 

@@ -3,6 +3,8 @@
 
 #include "AtmosphereTable.h"
 #include "CloudDensityTexture.h"
+#include "FiniteSetters.h"
+#include "MemoryBudget.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 
@@ -23,6 +25,7 @@
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
+#include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLFramebufferObject.h"
@@ -41,6 +44,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,8 +53,34 @@
 vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
 vtkCxxSetObjectMacro(vtkNimbusCloudVolumeMapper, SkyBackground, vtkNimbusSkyBackground);
 
+// The physical numbers refuse NaN and infinity (an error; the value is kept) and
+// clamp finite values to their ranges (FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, ExtinctionPerDensity);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Albedo);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, CloudG);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScattering);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunAzimuthDegrees);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunElevationDegrees);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunIlluminance);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunTemperatureKelvin);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieScatteringPerMetre);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieG);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, RayleighScatteringPerMetre);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SceneAltitudeMetres);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, GroundHeight);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, GroundAlbedo);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SliceAngleRatio);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MetresPerUnit);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Exposure);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, TextureMemoryBudgetMiB);
+
 namespace
 {
+bool AllFinite(const double* values, int count)
+{
+  return std::all_of(values, values + count, [](double v) { return std::isfinite(v); });
+}
+
 // Column-major float copy of a VTK (row-major) matrix, for glUniformMatrix4fv.
 std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
 {
@@ -201,6 +232,13 @@ struct vtkNimbusCloudVolumeMapper::FrameState
 
   // Matrices of the shared uniforms (column-major) and the one of the scissors.
   std::array<float, 16> InverseViewProjection{};
+  // NDC -> world relative to the eye (perspective rays: no far-plane point, whose
+  // w underflows in float for a far/near ratio of 1e8), the view's forward axis
+  // and the clipping range (depth -> distance in closed form).
+  std::array<float, 16> InverseViewProjectionFromEye{};
+  std::array<double, 3> ViewForward{ { 0.0, 0.0, -1.0 } };
+  std::array<float, 2> ClippingRange{ { 1.0f, 2.0f } };
+  mutable bool FramebuffersPushed = false; // the scene's bindings, popped by the composite
   std::array<float, 16> WorldToTexture{};
   std::array<float, 16> WorldToBox{};
   vtkNew<vtkMatrix4x4> WorldToNdc;
@@ -248,6 +286,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
   bool LastBackToFront = false;
   bool LastOverSky = false;
   double LastSunElevationDegrees = 0.0;
+  // The error of the last frame that failed: the same error is not repeated every
+  // frame, only after a frame that worked or another error.
+  std::string LastFrameError;
 
   void Release(vtkWindow* window)
   {
@@ -348,19 +389,91 @@ void vtkNimbusCloudVolumeMapper::ReleaseGraphicsResources(vtkWindow* window)
 //------------------------------------------------------------------------------
 void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
 {
-  this->Internal->PassesLastRender = 0;
+  // No exception leaves Render (a VTK render loop, ParaView's, does not catch):
+  // whatever a step throws ends the frame with an error, and nothing is drawn
+  // over the scene (the composite, the only pass that writes there, is the last).
+  Internals& in = *this->Internal;
+  in.PassesLastRender = 0;
   FrameState frame;
+  std::string failure;
+  try
+  {
+    if (this->RenderFrame(renderer, volume, frame))
+    {
+      in.LastFrameError.clear();
+    }
+    return;
+  }
+  catch (const std::bad_alloc&)
+  {
+    failure = "out of memory";
+  }
+  catch (const std::length_error& error)
+  {
+    failure = std::string("a size too large (") + error.what() + ")";
+  }
+  catch (const std::exception& error)
+  {
+    failure = error.what();
+  }
+  catch (...)
+  {
+    failure = "an unknown exception";
+  }
+  this->AbandonFrame(frame);
+  this->ReportFrameError("The cloud is not drawn: " + failure + ".");
+}
+
+void vtkNimbusCloudVolumeMapper::ReportFrameError(const std::string& message)
+{
+  Internals& in = *this->Internal;
+  if (message != in.LastFrameError)
+  {
+    vtkErrorMacro(<< message);
+    in.LastFrameError = message;
+  }
+}
+
+// After an exception: the scene's framebuffer bindings back, our textures released
+// from their units (the GL state the passes set is restored by SavedPassState).
+void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
+{
+  if (frame.FramebuffersPushed && frame.State)
+  {
+    frame.State->PopFramebufferBindings();
+    frame.FramebuffersPushed = false;
+  }
+  if (frame.Window)
+  {
+    Internals& in = *this->Internal;
+    for (vtkTextureObject* t : { in.Density.GetTexture(), in.SceneDepth.GetPointer(),
+           in.RayEnds.GetPointer(), in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(),
+           in.Accumulation.GetPointer(), in.SceneColor.GetPointer(),
+           in.ClearAccumulation.GetPointer(), in.AtmosphereTexture.GetPointer() })
+    {
+      if (t->GetContext())
+      {
+        t->Deactivate();
+      }
+    }
+  }
+}
+
+bool vtkNimbusCloudVolumeMapper::RenderFrame(
+  vtkRenderer* renderer, vtkVolume* volume, FrameState& frame)
+{
   if (!this->UpdateDensityTexture(renderer, frame) || !this->ComputeFrameSettings(frame) ||
     !this->ComputeFrameGeometry(renderer, volume, frame))
   {
-    return;
+    return false;
   }
   const SavedPassState savedState(frame.State);
   this->CopySceneColorAndDepth(frame);
   if (!this->UpdateAtmosphereTable(frame))
   {
     frame.State->PopFramebufferBindings();
-    return;
+    frame.FramebuffersPushed = false;
+    return false;
   }
   this->BeginPasses(frame);
   this->ClearShadowSurface(frame);
@@ -373,6 +486,7 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   this->CaptureRadianceImage(frame);
   this->RenderComposite(frame);
   this->EndPasses(frame);
+  return true;
 }
 
 //------------------------------------------------------------------------------
@@ -384,7 +498,7 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
   auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
   if (!window)
   {
-    vtkErrorMacro("vtkNimbusCloudVolumeMapper needs an OpenGL render window.");
+    this->ReportFrameError("vtkNimbusCloudVolumeMapper needs an OpenGL render window.");
     return false;
   }
   if (in.Window && in.Window != window)
@@ -397,7 +511,7 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
   vtkImageData* image = vtkImageData::SafeDownCast(this->GetInput());
   if (!image)
   {
-    vtkErrorMacro("No input image: connect a vtkImageData with a density array.");
+    this->ReportFrameError("No input image: connect a vtkImageData with a density array.");
     return false;
   }
   this->GetInputAlgorithm()->UpdateInformation();
@@ -409,24 +523,30 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
     image, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
   if (!scalars)
   {
-    vtkErrorMacro("The input image has no scalar array to render as density (set one with "
-                  "SelectScalarArray, or give the image active point scalars).");
+    this->ReportFrameError("The input image has no scalar array to render as density (set one "
+                           "with SelectScalarArray, or give the image active point scalars).");
     return false;
   }
-  const int maxSize = this->MaximumTextureSize > 0
-    ? std::min(this->MaximumTextureSize, vtkTextureObject::GetMaximumTextureSize3D(window))
-    : vtkTextureObject::GetMaximumTextureSize3D(window);
+  // GL_MAX_3D_TEXTURE_SIZE (256 if the driver does not say), lowered by
+  // MaximumTextureSize; the texture memory budget may lower it further.
+  int glLimit = vtkTextureObject::GetMaximumTextureSize3D(window);
+  glLimit = glLimit > 0 ? glLimit : 256;
+  const int maxSize =
+    this->MaximumTextureSize > 0 ? std::min(this->MaximumTextureSize, glLimit) : glLimit;
+  const double budgetBytes = this->TextureMemoryBudgetMiB > 0.0
+    ? this->TextureMemoryBudgetMiB * 1024.0 * 1024.0
+    : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
   std::vector<std::string> warnings;
   std::string error;
   const bool ok =
-    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, warnings, error);
+    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error);
   for (const std::string& warning : warnings)
   {
     vtkWarningMacro(<< warning);
   }
   if (!ok)
   {
-    vtkErrorMacro(<< error);
+    this->ReportFrameError(error);
   }
   return ok;
 }
@@ -469,7 +589,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
     }
     catch (const std::exception& error)
     {
-      vtkErrorMacro("The scene's sky is invalid: " << error.what());
+      this->ReportFrameError(std::string("The scene's sky is invalid: ") + error.what());
       return false;
     }
     settings.Sun.AzimuthDegrees = sky->GetSunAzimuthDegrees();
@@ -512,11 +632,30 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
     nimbus::SunDirection(frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees);
   double projection[3];
   camera->GetDirectionOfProjection(projection);
+  const double* eye = camera->GetPosition();
+  const double* clipping = camera->GetClippingRange();
+  if (!AllFinite(eye, 3) || !AllFinite(projection, 3) || !AllFinite(clipping, 2) ||
+    !(clipping[0] > 0.0 && clipping[1] > clipping[0]))
+  {
+    std::ostringstream message;
+    message << "The camera is not usable (position " << eye[0] << ", " << eye[1] << ", " << eye[2]
+            << ", clipping range " << clipping[0] << " ... " << clipping[1]
+            << "): the cloud is not drawn.";
+    this->ReportFrameError(message.str());
+    return false;
+  }
   const nimbus::Vector3 view = { { projection[0], projection[1], projection[2] } };
   frame.Axis = nimbus::ComputeSliceAxis(view, frame.ToSun, this->SliceAngleRatio);
   this->Internal->LastBackToFront = frame.Axis.BackToFront;
 
-  vtkMatrix4x4* dataToWorld = volume->GetMatrix();
+  // Data -> world: the volume's matrix times the image's direction matrix about its
+  // origin (VTK 9.2: point = origin + D (index * spacing); the density box is in
+  // the unrotated frame origin + index * spacing).
+  vtkNew<vtkMatrix4x4> dataToWorld;
+  if (!this->ComputeDataToWorld(volume, dataToWorld))
+  {
+    return false;
+  }
   const double* boxOrigin = density.GetBoxOrigin();
   const double* boxSize = density.GetBoxSize();
   for (int c = 0; c < 8; ++c)
@@ -539,6 +678,11 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   // half-texel offsets of point data make the box itself [0,1]^3 for that test.
   vtkNew<vtkMatrix4x4> worldToData, dataToTexture, worldToTexture, dataToBox, worldToBox;
   vtkMatrix4x4::Invert(dataToWorld, worldToData);
+  if (!AllFinite(worldToData->GetData(), 16))
+  {
+    this->ReportFrameError("The volume's matrix is singular: the cloud is not drawn.");
+    return false;
+  }
   density.GetDataToTexture(dataToTexture);
   vtkMatrix4x4::Multiply4x4(dataToTexture, worldToData, worldToTexture);
   density.GetDataToBox(dataToBox);
@@ -551,7 +695,79 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   vtkNew<vtkMatrix4x4> inverseViewProjection;
   inverseViewProjection->DeepCopy(frame.WorldToNdc);
   inverseViewProjection->Invert();
+  // The same with the eye at the origin (world -> NDC of x + eye, inverted): its
+  // rays need no far-plane point.
+  vtkNew<vtkMatrix4x4> fromEye, eyeToNdc;
+  fromEye->Identity();
+  for (int k = 0; k < 3; ++k)
+  {
+    fromEye->SetElement(k, 3, eye[k]);
+  }
+  vtkMatrix4x4::Multiply4x4(frame.WorldToNdc, fromEye, eyeToNdc);
+  eyeToNdc->Invert();
+  if (!AllFinite(frame.WorldToNdc->GetData(), 16) ||
+    !AllFinite(inverseViewProjection->GetData(), 16) || !AllFinite(eyeToNdc->GetData(), 16))
+  {
+    this->ReportFrameError("The camera's projection is singular or not finite: the cloud is not "
+                           "drawn.");
+    return false;
+  }
   frame.InverseViewProjection = ColumnMajor(inverseViewProjection);
+  frame.InverseViewProjectionFromEye = ColumnMajor(eyeToNdc);
+  // The eye's forward axis: minus the third row of the view matrix.
+  vtkMatrix4x4* viewMatrix = camera->GetViewTransformMatrix();
+  const double forward[3] = { -viewMatrix->GetElement(2, 0), -viewMatrix->GetElement(2, 1),
+    -viewMatrix->GetElement(2, 2) };
+  const double length =
+    std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
+  for (int k = 0; k < 3; ++k)
+  {
+    frame.ViewForward[k] = length > 0.0 ? forward[k] / length : projection[k];
+  }
+  frame.ClippingRange = { { static_cast<float>(clipping[0]), static_cast<float>(clipping[1]) } };
+  return true;
+}
+
+//------------------------------------------------------------------------------
+// The volume's matrix times the input image's direction matrix about its origin.
+bool vtkNimbusCloudVolumeMapper::ComputeDataToWorld(vtkVolume* volume, vtkMatrix4x4* dataToWorld)
+{
+  vtkNew<vtkMatrix4x4> imageFrame; // identity without a direction matrix
+  auto* image = vtkImageData::SafeDownCast(this->GetInput());
+  vtkMatrix3x3* direction = image ? image->GetDirectionMatrix() : nullptr;
+  if (direction && !direction->IsIdentity())
+  {
+    const double determinant = direction->Determinant();
+    if (!AllFinite(direction->GetData(), 9) || !std::isfinite(determinant) ||
+      std::abs(determinant) < 1e-12)
+    {
+      std::ostringstream message;
+      message << "The input image's direction matrix is singular or not finite (determinant "
+              << determinant << "): the cloud is not drawn.";
+      this->ReportFrameError(message.str());
+      return false;
+    }
+    double origin[3];
+    image->GetOrigin(origin);
+    for (int r = 0; r < 3; ++r)
+    {
+      double shift = origin[r];
+      for (int c = 0; c < 3; ++c)
+      {
+        imageFrame->SetElement(r, c, direction->GetElement(r, c));
+        shift -= direction->GetElement(r, c) * origin[c];
+      }
+      imageFrame->SetElement(r, 3, shift);
+    }
+  }
+  vtkMatrix4x4* volumeMatrix = volume->GetMatrix();
+  if (!AllFinite(volumeMatrix->GetData(), 16))
+  {
+    this->ReportFrameError("The volume's matrix (position, orientation, scale or user matrix) "
+                           "is not finite: the cloud is not drawn.");
+    return false;
+  }
+  vtkMatrix4x4::Multiply4x4(volumeMatrix, imageFrame, dataToWorld);
   return true;
 }
 
@@ -568,6 +784,7 @@ void vtkNimbusCloudVolumeMapper::CopySceneColorAndDepth(FrameState& frame)
   GLint drawFramebuffer = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFramebuffer);
   state->PushFramebufferBindings();
+  frame.FramebuffersPushed = true;
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, drawFramebuffer);
   EnsureTexture2D(in.SceneColor, frame.Window, frame.Width, frame.Height, 4, false);
   EnsureTexture2D(in.SceneDepth, frame.Window, frame.Width, frame.Height, 1, true);
@@ -631,7 +848,7 @@ bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
   }
   catch (const std::exception& error)
   {
-    vtkErrorMacro("Invalid sun or atmosphere: " << error.what());
+    this->ReportFrameError(std::string("Invalid sun or atmosphere: ") + error.what());
     return false;
   }
   if (in.Table.HasAtmosphere)
@@ -654,6 +871,10 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   const nimbus::SceneAtmosphere& air = frame.Settings.Air;
   program->SetUniformMatrix4x4(
     "inverseViewProjection", const_cast<float*>(frame.InverseViewProjection.data()));
+  program->SetUniformMatrix4x4(
+    "inverseViewProjectionFromEye", const_cast<float*>(frame.InverseViewProjectionFromEye.data()));
+  program->SetUniform3f("viewForward", frame.ViewForward.data());
+  program->SetUniform2f("clippingRange", frame.ClippingRange.data());
   program->SetUniformi("perspective", frame.Camera->GetParallelProjection() ? 0 : 1);
   program->SetUniform3f("cameraPosition", frame.Camera->GetPosition());
   program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(frame.WorldToTexture.data()));
@@ -961,6 +1182,7 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
 {
   Internals& in = *this->Internal;
   frame.State->PopFramebufferBindings();
+  frame.FramebuffersPushed = false;
   frame.State->vtkglViewport(frame.X0, frame.Y0, frame.Width, frame.Height);
   frame.State->vtkglDisable(GL_BLEND);
   in.Accumulation->Activate();
@@ -1018,6 +1240,8 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Unlit: " << this->Unlit << "\n";
   os << indent << "CaptureRadiance: " << this->CaptureRadiance << "\n";
   os << indent << "MaximumTextureSize: " << this->MaximumTextureSize << "\n";
+  os << indent << "TextureMemoryBudgetMiB: " << this->TextureMemoryBudgetMiB
+     << (this->TextureMemoryBudgetMiB > 0.0 ? "" : " (default)") << "\n";
   os << indent << "UseSceneSky: " << this->UseSceneSky << "\n";
   os << indent << "SkyBackground: " << this->SkyBackground << "\n";
 }

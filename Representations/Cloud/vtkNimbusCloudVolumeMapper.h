@@ -38,6 +38,16 @@
  * for a sky among the renderer's props (in ParaView the Cloud representation
  * hands it the view's sky, see vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND).
  *
+ * Bad input ends in a message, not in a crash or a silent black frame: the
+ * numeric setters refuse NaN and infinity (an error; the value is kept) and clamp
+ * finite values to their ranges; no exception leaves Render (an error, and
+ * nothing is drawn over the scene that frame); an unusable camera or volume
+ * matrix, a singular direction matrix or a density that does not fit the texture
+ * limits or TextureMemoryBudgetMiB is reported (once, not every frame); NaN,
+ * infinite and negative densities are rendered as 0 with a warning per version
+ * of the array. The input image's direction matrix (VTK 9.2) is honoured: the
+ * density sits at origin + D (index * spacing), then the vtkVolume's matrix.
+ *
  * Only what the scene needs runs: without atmosphere no atmosphere texture and
  * no atmosphere pass; without ground and atmosphere no passes outside the cloud
  * slices; without shafts no shadow look-ups in the atmosphere.
@@ -57,8 +67,10 @@
 #include "vtkVolumeMapper.h"
 
 #include <memory> // for std::unique_ptr
+#include <string> // for std::string
 
 class vtkImageData;
+class vtkMatrix4x4;
 class vtkNimbusSky;
 class vtkNimbusSkyBackground;
 class vtkRenderer;
@@ -78,13 +90,21 @@ public:
   /// Albedo: sigma_s / sigma_t; CloudG: Cornette-Shanks asymmetry (000 Eq. 3);
   /// MultipleScattering: k_multi of 000 Eq. 1 (dimensionless; added to the
   /// 4pi-normalised phase function, i.e. k_multi/4pi per steradian here).
-  vtkSetClampMacro(ExtinctionPerDensity, double, 0.0, 1e6);
+  virtual void SetExtinctionPerDensity(double value);
+  virtual double GetExtinctionPerDensityMinValue() { return 0.0; }
+  virtual double GetExtinctionPerDensityMaxValue() { return 1e6; }
   vtkGetMacro(ExtinctionPerDensity, double);
-  vtkSetClampMacro(Albedo, double, 0.0, 1.0);
+  virtual void SetAlbedo(double value);
+  virtual double GetAlbedoMinValue() { return 0.0; }
+  virtual double GetAlbedoMaxValue() { return 1.0; }
   vtkGetMacro(Albedo, double);
-  vtkSetClampMacro(CloudG, double, -0.999, 0.999);
+  virtual void SetCloudG(double value);
+  virtual double GetCloudGMinValue() { return -0.999; }
+  virtual double GetCloudGMaxValue() { return 0.999; }
   vtkGetMacro(CloudG, double);
-  vtkSetClampMacro(MultipleScattering, double, 0.0, 100.0);
+  virtual void SetMultipleScattering(double value);
+  virtual double GetMultipleScatteringMinValue() { return 0.0; }
+  virtual double GetMultipleScatteringMaxValue() { return 100.0; }
   vtkGetMacro(MultipleScattering, double);
   ///@}
 
@@ -93,13 +113,21 @@ public:
   /// east (+x), elevation above the horizon (below it the earth blocks the sun when
   /// the atmosphere is on), the luminance of its irradiance above the atmosphere
   /// (relative units) and its blackbody temperature. Names carry the units.
-  vtkSetMacro(SunAzimuthDegrees, double);
+  virtual void SetSunAzimuthDegrees(double value);
+  virtual double GetSunAzimuthDegreesMinValue() { return -1e9; }
+  virtual double GetSunAzimuthDegreesMaxValue() { return 1e9; }
   vtkGetMacro(SunAzimuthDegrees, double);
-  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  virtual void SetSunElevationDegrees(double value);
+  virtual double GetSunElevationDegreesMinValue() { return -90.0; }
+  virtual double GetSunElevationDegreesMaxValue() { return 90.0; }
   vtkGetMacro(SunElevationDegrees, double);
-  vtkSetClampMacro(SunIlluminance, double, 0.0, 1e9);
+  virtual void SetSunIlluminance(double value);
+  virtual double GetSunIlluminanceMinValue() { return 0.0; }
+  virtual double GetSunIlluminanceMaxValue() { return 1e9; }
   vtkGetMacro(SunIlluminance, double);
-  vtkSetClampMacro(SunTemperatureKelvin, double, 1000.0, 40000.0);
+  virtual void SetSunTemperatureKelvin(double value);
+  virtual double GetSunTemperatureKelvinMinValue() { return 1000.0; }
+  virtual double GetSunTemperatureKelvinMaxValue() { return 40000.0; }
   vtkGetMacro(SunTemperatureKelvin, double);
   ///@}
 
@@ -112,13 +140,21 @@ public:
   vtkSetMacro(Atmosphere, bool);
   vtkGetMacro(Atmosphere, bool);
   vtkBooleanMacro(Atmosphere, bool);
-  vtkSetClampMacro(MieScatteringPerMetre, double, 0.0, 1.0);
+  virtual void SetMieScatteringPerMetre(double value);
+  virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
+  virtual double GetMieScatteringPerMetreMaxValue() { return 1.0; }
   vtkGetMacro(MieScatteringPerMetre, double);
-  vtkSetClampMacro(MieG, double, -0.999, 0.999);
+  virtual void SetMieG(double value);
+  virtual double GetMieGMinValue() { return -0.999; }
+  virtual double GetMieGMaxValue() { return 0.999; }
   vtkGetMacro(MieG, double);
-  vtkSetClampMacro(RayleighScatteringPerMetre, double, 0.0, 1.0);
+  virtual void SetRayleighScatteringPerMetre(double value);
+  virtual double GetRayleighScatteringPerMetreMinValue() { return 0.0; }
+  virtual double GetRayleighScatteringPerMetreMaxValue() { return 1.0; }
   vtkGetMacro(RayleighScatteringPerMetre, double);
-  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 50000.0);
+  virtual void SetSceneAltitudeMetres(double value);
+  virtual double GetSceneAltitudeMetresMinValue() { return 0.0; }
+  virtual double GetSceneAltitudeMetresMaxValue() { return 50000.0; }
   vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
 
@@ -127,9 +163,13 @@ public:
   vtkSetMacro(Ground, bool);
   vtkGetMacro(Ground, bool);
   vtkBooleanMacro(Ground, bool);
-  vtkSetMacro(GroundHeight, double);
+  virtual void SetGroundHeight(double value);
+  virtual double GetGroundHeightMinValue() { return -1e30; }
+  virtual double GetGroundHeightMaxValue() { return 1e30; }
   vtkGetMacro(GroundHeight, double);
-  vtkSetClampMacro(GroundAlbedo, double, 0.0, 1.0);
+  virtual void SetGroundAlbedo(double value);
+  virtual double GetGroundAlbedoMinValue() { return 0.0; }
+  virtual double GetGroundAlbedoMaxValue() { return 1.0; }
   vtkGetMacro(GroundAlbedo, double);
   ///@}
 
@@ -147,7 +187,9 @@ public:
   /// samples per pixel of the atmosphere outside the cloud slices.
   vtkSetClampMacro(NumberOfSlices, int, 1, 8192);
   vtkGetMacro(NumberOfSlices, int);
-  vtkSetClampMacro(SliceAngleRatio, double, 0.01, 100.0);
+  virtual void SetSliceAngleRatio(double value);
+  virtual double GetSliceAngleRatioMinValue() { return 0.01; }
+  virtual double GetSliceAngleRatioMaxValue() { return 100.0; }
   vtkGetMacro(SliceAngleRatio, double);
   vtkSetClampMacro(ShadowSurfaceSize, int, 1, 16384);
   vtkGetMacro(ShadowSurfaceSize, int);
@@ -157,7 +199,9 @@ public:
 
   ///@{
   /// Metres per world unit (distances and heights are converted with it).
-  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  virtual void SetMetresPerUnit(double value);
+  virtual double GetMetresPerUnitMinValue() { return 1e-9; }
+  virtual double GetMetresPerUnitMaxValue() { return 1e9; }
   vtkGetMacro(MetresPerUnit, double);
   ///@}
 
@@ -165,7 +209,9 @@ public:
   /// Framebuffer value = Exposure * radiance (+ attenuated background); with
   /// EncodeSrgb the result (and the background read from the framebuffer) is
   /// treated as display-encoded sRGB.
-  vtkSetClampMacro(Exposure, double, 0.0, 1e9);
+  virtual void SetExposure(double value);
+  virtual double GetExposureMinValue() { return 0.0; }
+  virtual double GetExposureMaxValue() { return 1e9; }
   vtkGetMacro(Exposure, double);
   vtkSetMacro(EncodeSrgb, bool);
   vtkGetMacro(EncodeSrgb, bool);
@@ -213,6 +259,18 @@ public:
   /// are downsampled with a warning. Lower it to save GPU memory.
   vtkSetClampMacro(MaximumTextureSize, int, 0, 1 << 16);
   vtkGetMacro(MaximumTextureSize, int);
+  ///@}
+
+  ///@{
+  /// Memory the density texture may take, MiB (0, the default: half of the
+  /// physical memory, nimbus::DefaultMemoryBudgetBytes). Counted as 8 bytes per
+  /// texel (the texture and its converted copy). A volume over the budget is
+  /// downsampled further, with a warning; one that cannot fit even at one texel
+  /// is not drawn (an error).
+  virtual void SetTextureMemoryBudgetMiB(double value);
+  virtual double GetTextureMemoryBudgetMiBMinValue() { return 0.0; }
+  virtual double GetTextureMemoryBudgetMiBMaxValue() { return 1e12; }
+  vtkGetMacro(TextureMemoryBudgetMiB, double);
   ///@}
 
   ///@{
@@ -271,6 +329,7 @@ protected:
   bool EncodeSrgb = false;
   bool Unlit = false;
   int MaximumTextureSize = 0;
+  double TextureMemoryBudgetMiB = 0.0;
   bool CaptureRadiance = false;
   bool UseSceneSky = true;
   vtkNimbusSkyBackground* SkyBackground = nullptr;
@@ -283,10 +342,20 @@ private:
   struct FrameState;
 
   ///@{
+  /// Render's boundary: the frame (false when a step ended it), an error reported
+  /// once until a frame succeeds or another error comes, and the clean-up after an
+  /// exception.
+  bool RenderFrame(vtkRenderer* renderer, vtkVolume* volume, FrameState& frame);
+  void ReportFrameError(const std::string& message);
+  void AbandonFrame(FrameState& frame);
+  ///@}
+
+  ///@{
   /// The steps of Render, in order. The bool steps end the frame when false.
   bool UpdateDensityTexture(vtkRenderer* renderer, FrameState& frame);
   bool ComputeFrameSettings(FrameState& frame);
   bool ComputeFrameGeometry(vtkRenderer* renderer, vtkVolume* volume, FrameState& frame);
+  bool ComputeDataToWorld(vtkVolume* volume, vtkMatrix4x4* dataToWorld);
   void CopySceneColorAndDepth(FrameState& frame);
   bool UpdateAtmosphereTable(FrameState& frame);
   void BeginPasses(const FrameState& frame);

@@ -5,8 +5,11 @@
 // sun (see Physics/Sun.h). Uniform names follow the C++ vocabulary (Physics/Sun.h,
 // Atmosphere.h) and the sky shaders (sunDirection, cameraPosition, mieG).
 uniform mat4 inverseViewProjection; // NDC -> world
+uniform mat4 inverseViewProjectionFromEye; // NDC -> world relative to the eye
 uniform int perspective;            // 1: rays start at the eye, 0: on the near plane
 uniform vec3 cameraPosition;        // world position of the eye (perspective)
+uniform vec3 viewForward;           // unit, the eye's -z axis in world (perspective)
+uniform vec2 clippingRange;         // near, far (world units along viewForward)
 uniform vec3 sunDirection;          // L, unit, toward the sun
 uniform vec3 sliceNormal;           // n, unit, dot(n, -L) > 0
 uniform float metresPerUnit;        // metres per world unit
@@ -50,26 +53,40 @@ const float kInfinity = 1e30;
 void ViewRay(vec2 uv, out vec3 origin, out vec3 direction)
 {
   vec2 ndc = 2.0 * uv - 1.0;
+  // Perspective rays start at the eye, not on the near plane: the camera's
+  // clipping range (ParaView fits it to the props' bounds) must not cut the
+  // ground or the air between the eye and the cloud. Their direction is that of
+  // the near-plane point relative to the eye: a far-plane point has w = 1/far,
+  // which float rounds to 0 for far/near = 1e8 (NaN rays, a black frame).
+  if (perspective != 0)
+  {
+    vec4 nearFromEye = inverseViewProjectionFromEye * vec4(ndc, -1.0, 1.0);
+    origin = cameraPosition;
+    direction = normalize(nearFromEye.xyz / nearFromEye.w);
+    return;
+  }
   vec4 nearPoint = inverseViewProjection * vec4(ndc, -1.0, 1.0);
   vec4 farPoint = inverseViewProjection * vec4(ndc, 1.0, 1.0);
   origin = nearPoint.xyz / nearPoint.w;
-  // Perspective rays start at the eye, not on the near plane: the camera's
-  // clipping range (ParaView fits it to the props' bounds) must not cut the
-  // ground or the air between the eye and the cloud.
-  if (perspective != 0)
-  {
-    origin = cameraPosition;
-  }
   direction = normalize(farPoint.xyz / farPoint.w - origin);
 }
 
 // Distance along the ray to the opaque geometry (infinity where none was drawn).
+// Perspective: the eye depth in closed form, z = n / ((1 - n/f)(1 - d) + n/f) for
+// depth d (OpenGL's projection), whose denominator stays >= n/f > 0 in float
+// (unprojecting d through the inverse matrix divides by a w that cancels to 0).
 float OpaqueDistance(vec2 uv, vec3 origin, vec3 direction)
 {
   float depth = texture(sceneDepth, uv).r;
   if (depth >= 1.0)
   {
     return kInfinity;
+  }
+  if (perspective != 0)
+  {
+    float ratio = clippingRange.x / clippingRange.y;
+    float eyeDepth = clippingRange.x / ((1.0 - ratio) * (1.0 - depth) + ratio);
+    return eyeDepth / max(dot(direction, viewForward), 1e-6);
   }
   vec4 p = inverseViewProjection * vec4(2.0 * uv - 1.0, 2.0 * depth - 1.0, 1.0);
   return max(dot(p.xyz / p.w - origin, direction), 0.0);
@@ -134,8 +151,27 @@ vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
   }
   float h0 = sceneAltitudeMetres + origin.z * metresPerUnit;
   float tm = min(t, 1e7) * metresPerUnit;
-  float lr = FlatLayerOpticalLength(h0, direction.z, tm, rayleighScaleHeightMetres);
-  float lm = FlatLayerOpticalLength(h0, direction.z, tm, mieScaleHeightMetres);
+  // Above the top of the atmosphere there is no air: the path starts where the ray
+  // enters it. Otherwise, for an eye far above (1000 km), exp(-h0/H) underflows
+  // to 0 while the layer factor overflows to infinity: 0 x inf = NaN.
+  float topAltitude = topRadiusMetres - earthRadiusMetres;
+  if (h0 > topAltitude)
+  {
+    if (direction.z >= 0.0)
+    {
+      return vec3(1.0);
+    }
+    tm -= (h0 - topAltitude) / -direction.z;
+    h0 = topAltitude;
+    if (tm <= 0.0)
+    {
+      return vec3(1.0);
+    }
+  }
+  // Capped: a ray far below sea level (no ground) has an infinite optical length,
+  // which times a zero coefficient would be NaN; 1e30 gives transmittance 0 alike.
+  float lr = min(FlatLayerOpticalLength(h0, direction.z, tm, rayleighScaleHeightMetres), 1e30);
+  float lm = min(FlatLayerOpticalLength(h0, direction.z, tm, mieScaleHeightMetres), 1e30);
   return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
 }
 

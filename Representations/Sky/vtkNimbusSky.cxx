@@ -2,6 +2,7 @@
 
 #include "Sky.h"
 
+#include "FiniteSetters.h"
 #include "vtkMath.h"
 #include "vtkObjectFactory.h"
 
@@ -9,6 +10,17 @@
 #include <stdexcept>
 
 vtkStandardNewMacro(vtkNimbusSky);
+
+// Non-finite values are refused (an error; the value is kept), finite ones clamped
+// (FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusSky, SunElevationDegrees);
+nimbusDefineFiniteSetter(vtkNimbusSky, SunAzimuthDegrees);
+nimbusDefineFiniteSetter(vtkNimbusSky, MieScatteringPerMetre);
+nimbusDefineFiniteSetter(vtkNimbusSky, GroundAlbedo);
+nimbusDefineFiniteSetter(vtkNimbusSky, Exposure);
+nimbusDefineFiniteSetter(vtkNimbusSky, SceneAltitudeMetres);
+nimbusDefineFiniteSetter(vtkNimbusSky, MetresPerUnit);
+nimbusDefineFiniteSetter(vtkNimbusSky, MaxAerialDistanceMetres);
 
 struct vtkNimbusSky::Internals
 {

@@ -60,45 +60,61 @@ public:
 
   ///@{
   /// Sun elevation above the horizon, degrees, [-90, 90]. Default 45.
-  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  virtual void SetSunElevationDegrees(double value);
+  virtual double GetSunElevationDegreesMinValue() { return -90.0; }
+  virtual double GetSunElevationDegreesMaxValue() { return 90.0; }
   vtkGetMacro(SunElevationDegrees, double);
   ///@}
   ///@{
   /// Sun azimuth from north (+y) toward east (+x), degrees. Default 135.
-  vtkSetMacro(SunAzimuthDegrees, double);
+  virtual void SetSunAzimuthDegrees(double value);
+  virtual double GetSunAzimuthDegreesMinValue() { return -1e9; }
+  virtual double GetSunAzimuthDegreesMaxValue() { return 1e9; }
   vtkGetMacro(SunAzimuthDegrees, double);
   ///@}
   ///@{
   /// Aerosol (Mie) scattering coefficient at sea level, 1/m, [0, 4e-4]: how hazy
   /// the air is. Default 2e-5 (a clear atmosphere; the mapper and the scene format
   /// use the same name and unit).
-  vtkSetClampMacro(MieScatteringPerMetre, double, 0.0, 4.0e-4);
+  virtual void SetMieScatteringPerMetre(double value);
+  virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
+  virtual double GetMieScatteringPerMetreMaxValue() { return 4.0e-4; }
   vtkGetMacro(MieScatteringPerMetre, double);
   ///@}
   ///@{
   /// Grey Lambertian albedo of the ground, [0, 1]. Default 0.3.
-  vtkSetClampMacro(GroundAlbedo, double, 0.0, 1.0);
+  virtual void SetGroundAlbedo(double value);
+  virtual double GetGroundAlbedoMinValue() { return 0.0; }
+  virtual double GetGroundAlbedoMaxValue() { return 1.0; }
   vtkGetMacro(GroundAlbedo, double);
   ///@}
   ///@{
   /// Display scale of the radiance, [0, 1e6]. Default 10.
-  vtkSetClampMacro(Exposure, double, 0.0, 1.0e6);
+  virtual void SetExposure(double value);
+  virtual double GetExposureMinValue() { return 0.0; }
+  virtual double GetExposureMaxValue() { return 1.0e6; }
   vtkGetMacro(Exposure, double);
   ///@}
   ///@{
   /// Altitude of the scene's z = 0 (and of the dome's observer) above sea level,
   /// metres, [0, 1e6]. Default 0.
-  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 1.0e6);
+  virtual void SetSceneAltitudeMetres(double value);
+  virtual double GetSceneAltitudeMetresMinValue() { return 0.0; }
+  virtual double GetSceneAltitudeMetresMaxValue() { return 1.0e6; }
   vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
   ///@{
   /// Metres per scene unit, (0, 1e6]. Default 1.
-  vtkSetClampMacro(MetresPerUnit, double, 1e-6, 1.0e6);
+  virtual void SetMetresPerUnit(double value);
+  virtual double GetMetresPerUnitMinValue() { return 1e-6; }
+  virtual double GetMetresPerUnitMaxValue() { return 1.0e6; }
   vtkGetMacro(MetresPerUnit, double);
   ///@}
   ///@{
   /// Range of the aerial-perspective table, metres, [100, 1e6]. Default 1e5.
-  vtkSetClampMacro(MaxAerialDistanceMetres, double, 100.0, 1.0e6);
+  virtual void SetMaxAerialDistanceMetres(double value);
+  virtual double GetMaxAerialDistanceMetresMinValue() { return 100.0; }
+  virtual double GetMaxAerialDistanceMetresMaxValue() { return 1.0e6; }
   vtkGetMacro(MaxAerialDistanceMetres, double);
   ///@}
   ///@{

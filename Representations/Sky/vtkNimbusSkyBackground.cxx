@@ -15,6 +15,7 @@
 #include "vtkShaderProgram.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 vtkStandardNewMacro(vtkNimbusSkyBackground);
@@ -84,64 +85,77 @@ void vtkNimbusSkyBackground::ReleaseGraphicsResources(vtkWindow* window)
 
 int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
 {
-  auto* renderer = vtkRenderer::SafeDownCast(viewport);
-  if (!renderer || renderer->GetSelector())
+  // No exception leaves a render or a pipeline request (VTK does not catch).
+  try
   {
-    return 0; // nothing to pick: the sky is not a selectable prop
-  }
-  auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
-  if (!window)
-  {
-    vtkErrorMacro("vtkNimbusSkyBackground needs an OpenGL render window.");
-    return 0;
-  }
-  vtkOpenGLClearErrorMacro();
-  Internals& in = *this->Internal;
-  if (in.Window && in.Window != window)
-  {
-    in.Release(in.Window);
-  }
-  in.Window = window;
-  std::string error;
-  vtkCamera* camera = renderer->GetActiveCamera();
-  const double altitude =
-    nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
-  if (!in.SkyView.Update(window, this->Sky, altitude, error))
-  {
-    vtkErrorMacro("Sky tables: " << error);
-    return 0;
-  }
-  vtkShaderProgram* program =
-    nimbus::SkyViewTextures::ReadyQuad(window, in.Quad, vtkNimbusSkyBackgroundFS);
-  if (!program)
-  {
-    vtkErrorMacro("The sky background shader did not compile.");
-    return 0;
-  }
-  int width = 0, height = 0, x0 = 0, y0 = 0;
-  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
-  vtkNew<vtkMatrix4x4> inverse;
-  inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
-    static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
-  inverse->Invert();
-  program->SetUniformMatrix("inverseViewProjection", inverse);
-  program->SetUniform3f("cameraPosition", camera->GetPosition());
-  in.SkyView.Activate(program, this->Sky);
+    auto* renderer = vtkRenderer::SafeDownCast(viewport);
+    if (!renderer || renderer->GetSelector())
+    {
+      return 0; // nothing to pick: the sky is not a selectable prop
+    }
+    auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
+    if (!window)
+    {
+      vtkErrorMacro("vtkNimbusSkyBackground needs an OpenGL render window.");
+      return 0;
+    }
+    vtkOpenGLClearErrorMacro();
+    Internals& in = *this->Internal;
+    if (in.Window && in.Window != window)
+    {
+      in.Release(in.Window);
+    }
+    in.Window = window;
+    std::string error;
+    vtkCamera* camera = renderer->GetActiveCamera();
+    const double altitude =
+      nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
+    if (!in.SkyView.Update(window, this->Sky, altitude, error))
+    {
+      vtkErrorMacro("Sky tables: " << error);
+      return 0;
+    }
+    vtkShaderProgram* program =
+      nimbus::SkyViewTextures::ReadyQuad(window, in.Quad, vtkNimbusSkyBackgroundFS);
+    if (!program)
+    {
+      vtkErrorMacro("The sky background shader did not compile.");
+      return 0;
+    }
+    int width = 0, height = 0, x0 = 0, y0 = 0;
+    renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+    vtkNew<vtkMatrix4x4> inverse;
+    inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
+      static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
+    inverse->Invert();
+    program->SetUniformMatrix("inverseViewProjection", inverse);
+    program->SetUniform3f("cameraPosition", camera->GetPosition());
+    in.SkyView.Activate(program, this->Sky);
 
-  vtkOpenGLState* state = window->GetState();
-  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
-  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
-  vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(state);
-  vtkOpenGLState::ScopedglDepthMask depthMaskSaver(state);
-  state->vtkglDisable(GL_BLEND);
-  state->vtkglEnable(GL_DEPTH_TEST);
-  state->vtkglDepthFunc(GL_LEQUAL); // only where the depth is still the cleared 1
-  state->vtkglDepthMask(GL_FALSE);
-  in.Quad->Render();
-  in.SkyView.Deactivate();
-  ++this->NumberOfDraws;
-  vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyBackground::RenderOpaqueGeometry");
-  return 1;
+    vtkOpenGLState* state = window->GetState();
+    vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+    vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
+    vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(state);
+    vtkOpenGLState::ScopedglDepthMask depthMaskSaver(state);
+    state->vtkglDisable(GL_BLEND);
+    state->vtkglEnable(GL_DEPTH_TEST);
+    state->vtkglDepthFunc(GL_LEQUAL); // only where the depth is still the cleared 1
+    state->vtkglDepthMask(GL_FALSE);
+    in.Quad->Render();
+    in.SkyView.Deactivate();
+    ++this->NumberOfDraws;
+    vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyBackground::RenderOpaqueGeometry");
+    return 1;
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro("The sky background was not drawn: " << error.what());
+  }
+  catch (...)
+  {
+    vtkErrorMacro("The sky background was not drawn: an unknown exception.");
+  }
+  return 0;
 }
 
 void vtkNimbusSkyBackground::PrintSelf(ostream& os, vtkIndent indent)

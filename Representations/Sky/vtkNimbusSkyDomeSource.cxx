@@ -4,6 +4,7 @@
 
 #include "SpectralColor.h"
 
+#include "FiniteSetters.h"
 #include "vtkCellArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -20,9 +21,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 vtkStandardNewMacro(vtkNimbusSkyDomeSource);
 vtkCxxSetObjectMacro(vtkNimbusSkyDomeSource, Sky, vtkNimbusSky);
+
+// Non-finite values are refused (an error; the value is kept), finite ones clamped
+// (FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusSkyDomeSource, Radius);
+
+void vtkNimbusSkyDomeSource::SetCenter(double x, double y, double z)
+{
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+  {
+    vtkErrorMacro("SetCenter(" << x << ", " << y << ", " << z << "): not finite; Center stays "
+                               << this->Center[0] << ", " << this->Center[1] << ", "
+                               << this->Center[2] << ".");
+    return;
+  }
+  if (this->Center[0] != x || this->Center[1] != y || this->Center[2] != z)
+  {
+    this->Center[0] = x;
+    this->Center[1] = y;
+    this->Center[2] = z;
+    this->Modified();
+  }
+}
+
+void vtkNimbusSkyDomeSource::SetCenter(const double center[3])
+{
+  this->SetCenter(center[0], center[1], center[2]);
+}
 
 vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
 {
@@ -162,86 +191,99 @@ vtkMTimeType vtkNimbusSkyDomeSource::GetMTime()
 int vtkNimbusSkyDomeSource::RequestData(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
-  vtkNimbusSky* sky = this->Sky;
-  if (!sky)
+  // No exception leaves a render or a pipeline request (VTK does not catch).
+  try
   {
-    vtkErrorMacro("Sky is null: set a vtkNimbusSky");
-    return 0;
-  }
-  if (this->Preset >= 0)
-  {
-    sky->SetPreset(this->Preset);
-  }
-  const int rings = this->ElevationResolution, columns = this->AzimuthResolution;
-  vtkNew<vtkPoints> points;
-  vtkNew<vtkUnsignedCharArray> colors;
-  colors->SetName("Colors");
-  colors->SetNumberOfComponents(3);
-  vtkNew<vtkFloatArray> radiance;
-  radiance->SetName("Radiance");
-  radiance->SetNumberOfComponents(3);
-  double scale[3];
-  sky->GetDisplayScale(scale);
+    vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+    vtkNimbusSky* sky = this->Sky;
+    if (!sky)
+    {
+      vtkErrorMacro("Sky is null: set a vtkNimbusSky");
+      return 0;
+    }
+    if (this->Preset >= 0)
+    {
+      sky->SetPreset(this->Preset);
+    }
+    const int rings = this->ElevationResolution, columns = this->AzimuthResolution;
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkUnsignedCharArray> colors;
+    colors->SetName("Colors");
+    colors->SetNumberOfComponents(3);
+    vtkNew<vtkFloatArray> radiance;
+    radiance->SetName("Radiance");
+    radiance->SetNumberOfComponents(3);
+    double scale[3];
+    sky->GetDisplayScale(scale);
 
-  auto addPoint = [&](double elevationDeg, double azimuthDeg)
-  {
-    const double e = vtkMath::RadiansFromDegrees(elevationDeg);
-    const double a = vtkMath::RadiansFromDegrees(azimuthDeg);
-    const double d[3] = { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) };
-    points->InsertNextPoint(this->Center[0] + this->Radius * d[0],
-      this->Center[1] + this->Radius * d[1], this->Center[2] + this->Radius * d[2]);
-    double L[3];
-    sky->GetRadiance(d, L);
-    radiance->InsertNextTuple(L);
-    unsigned char c[3];
-    for (int i = 0; i < 3; ++i)
+    auto addPoint = [&](double elevationDeg, double azimuthDeg)
     {
-      c[i] = static_cast<unsigned char>(std::lround(255.0 * nimbus::SrgbEncode(L[i] * scale[i])));
-    }
-    colors->InsertNextTypedTuple(c);
-  };
-  // Ring i (0 = horizon) at elevation 90 (i/n)^1.5; the zenith is one point.
-  for (int i = 0; i < rings; ++i)
-  {
-    if (i % 4 == 0)
+      const double e = vtkMath::RadiansFromDegrees(elevationDeg);
+      const double a = vtkMath::RadiansFromDegrees(azimuthDeg);
+      const double d[3] = { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) };
+      points->InsertNextPoint(this->Center[0] + this->Radius * d[0],
+        this->Center[1] + this->Radius * d[1], this->Center[2] + this->Radius * d[2]);
+      double L[3];
+      sky->GetRadiance(d, L);
+      radiance->InsertNextTuple(L);
+      unsigned char c[3];
+      for (int i = 0; i < 3; ++i)
+      {
+        c[i] = static_cast<unsigned char>(std::lround(255.0 * nimbus::SrgbEncode(L[i] * scale[i])));
+      }
+      colors->InsertNextTypedTuple(c);
+    };
+    // Ring i (0 = horizon) at elevation 90 (i/n)^1.5; the zenith is one point.
+    for (int i = 0; i < rings; ++i)
     {
-      this->UpdateProgress(static_cast<double>(i) / rings);
+      if (i % 4 == 0)
+      {
+        this->UpdateProgress(static_cast<double>(i) / rings);
+      }
+      const double elevation = 90.0 * std::pow(static_cast<double>(i) / rings, 1.5);
+      for (int j = 0; j < columns; ++j)
+      {
+        addPoint(elevation, 360.0 * j / columns);
+      }
     }
-    const double elevation = 90.0 * std::pow(static_cast<double>(i) / rings, 1.5);
+    addPoint(90.0, 0.0);
+    const vtkIdType zenith = points->GetNumberOfPoints() - 1;
+
+    vtkNew<vtkCellArray> polys;
+    for (int i = 0; i + 1 < rings; ++i)
+    {
+      for (int j = 0; j < columns; ++j)
+      {
+        const vtkIdType a = static_cast<vtkIdType>(i) * columns + j;
+        const vtkIdType b = static_cast<vtkIdType>(i) * columns + (j + 1) % columns;
+        const vtkIdType quad[4] = { a, b, b + columns, a + columns };
+        polys->InsertNextCell(4, quad);
+      }
+    }
     for (int j = 0; j < columns; ++j)
     {
-      addPoint(elevation, 360.0 * j / columns);
+      const vtkIdType a = static_cast<vtkIdType>(rings - 1) * columns + j;
+      const vtkIdType b = static_cast<vtkIdType>(rings - 1) * columns + (j + 1) % columns;
+      const vtkIdType tri[3] = { a, b, zenith };
+      polys->InsertNextCell(3, tri);
     }
+    output->SetPoints(points);
+    output->SetPolys(polys);
+    output->GetPointData()->SetScalars(colors);
+    output->GetPointData()->AddArray(radiance);
+    vtkNimbusSkyDomeSource::AddSkyParameters(sky, output->GetFieldData());
+    this->UpdateProgress(1.0);
+    return 1;
   }
-  addPoint(90.0, 0.0);
-  const vtkIdType zenith = points->GetNumberOfPoints() - 1;
-
-  vtkNew<vtkCellArray> polys;
-  for (int i = 0; i + 1 < rings; ++i)
+  catch (const std::exception& error)
   {
-    for (int j = 0; j < columns; ++j)
-    {
-      const vtkIdType a = static_cast<vtkIdType>(i) * columns + j;
-      const vtkIdType b = static_cast<vtkIdType>(i) * columns + (j + 1) % columns;
-      const vtkIdType quad[4] = { a, b, b + columns, a + columns };
-      polys->InsertNextCell(4, quad);
-    }
+    vtkErrorMacro("The sky dome was not built: " << error.what());
   }
-  for (int j = 0; j < columns; ++j)
+  catch (...)
   {
-    const vtkIdType a = static_cast<vtkIdType>(rings - 1) * columns + j;
-    const vtkIdType b = static_cast<vtkIdType>(rings - 1) * columns + (j + 1) % columns;
-    const vtkIdType tri[3] = { a, b, zenith };
-    polys->InsertNextCell(3, tri);
+    vtkErrorMacro("The sky dome was not built: an unknown exception.");
   }
-  output->SetPoints(points);
-  output->SetPolys(polys);
-  output->GetPointData()->SetScalars(colors);
-  output->GetPointData()->AddArray(radiance);
-  vtkNimbusSkyDomeSource::AddSkyParameters(sky, output->GetFieldData());
-  this->UpdateProgress(1.0);
-  return 1;
+  return 0;
 }
 
 void vtkNimbusSkyDomeSource::PrintSelf(ostream& os, vtkIndent indent)

@@ -77,12 +77,15 @@ public:
 
   ///@{
   /// Radius of the dome, scene units, > 0. Default 10000.
-  vtkSetClampMacro(Radius, double, 1e-6, 1e30);
+  virtual void SetRadius(double value);
+  virtual double GetRadiusMinValue() { return 1e-6; }
+  virtual double GetRadiusMaxValue() { return 1e30; }
   vtkGetMacro(Radius, double);
   ///@}
   ///@{
   /// Centre of the dome (the observer), scene units. Default (0, 0, 0).
-  vtkSetVector3Macro(Center, double);
+  virtual void SetCenter(double x, double y, double z);
+  virtual void SetCenter(const double center[3]);
   vtkGetVector3Macro(Center, double);
   ///@}
   ///@{

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusSkyPass);
@@ -90,31 +91,44 @@ void vtkNimbusSkyPass::ReleaseGraphicsResources(vtkWindow* w)
 
 void vtkNimbusSkyPass::Render(const vtkRenderState* s)
 {
-  vtkOpenGLClearErrorMacro();
-  this->NumberOfRenderedProps = 0;
-  if (!this->DelegatePass)
+  // No exception leaves a render or a pipeline request (VTK does not catch).
+  try
   {
-    vtkErrorMacro(
-      "vtkNimbusSkyPass needs a delegate pass (SetDelegatePass, e.g. vtkRenderStepsPass)");
-    return;
+    vtkOpenGLClearErrorMacro();
+    this->NumberOfRenderedProps = 0;
+    if (!this->DelegatePass)
+    {
+      vtkErrorMacro(
+        "vtkNimbusSkyPass needs a delegate pass (SetDelegatePass, e.g. vtkRenderStepsPass)");
+      return;
+    }
+    if (!this->Sky)
+    {
+      vtkErrorMacro("vtkNimbusSkyPass needs a sky (SetSky)");
+      return;
+    }
+    vtkRenderer* renderer = s->GetRenderer();
+    auto* window = static_cast<vtkOpenGLRenderWindow*>(renderer->GetRenderWindow());
+    int x, y, width, height;
+    renderer->GetTiledSizeAndOrigin(&width, &height, &x, &y);
+    this->RenderDelegate(s, width, height);
+    const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(
+      this->Sky, renderer->GetActiveCamera()->GetPosition()[2]);
+    if (this->UpdateTables(window, cameraAltitude))
+    {
+      this->DrawSky(renderer, x, y, width, height);
+    }
+    vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyPass::Render");
   }
-  if (!this->Sky)
+  catch (const std::exception& error)
   {
-    vtkErrorMacro("vtkNimbusSkyPass needs a sky (SetSky)");
-    return;
+    vtkErrorMacro("The sky pass did not finish: " << error.what());
   }
-  vtkRenderer* renderer = s->GetRenderer();
-  auto* window = static_cast<vtkOpenGLRenderWindow*>(renderer->GetRenderWindow());
-  int x, y, width, height;
-  renderer->GetTiledSizeAndOrigin(&width, &height, &x, &y);
-  this->RenderDelegate(s, width, height);
-  const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(
-    this->Sky, renderer->GetActiveCamera()->GetPosition()[2]);
-  if (this->UpdateTables(window, cameraAltitude))
+  catch (...)
   {
-    this->DrawSky(renderer, x, y, width, height);
+    vtkErrorMacro("The sky pass did not finish: an unknown exception.");
   }
-  vtkOpenGLCheckErrorMacro("failed after vtkNimbusSkyPass::Render");
+  return;
 }
 
 void vtkNimbusSkyPass::RenderDelegate(const vtkRenderState* s, int width, int height)

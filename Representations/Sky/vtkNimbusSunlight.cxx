@@ -5,6 +5,7 @@
 #include "Atmosphere.h"
 #include "SpectralColor.h"
 
+#include "FiniteSetters.h"
 #include "vtkLight.h"
 #include "vtkMath.h"
 #include "vtkObjectFactory.h"
@@ -13,6 +14,12 @@
 #include <cmath>
 
 vtkStandardNewMacro(vtkNimbusSunlight);
+
+// Non-finite values are refused (an error; the value is kept), finite ones clamped
+// (FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusSunlight, SunElevationDegrees);
+nimbusDefineFiniteSetter(vtkNimbusSunlight, SunAzimuthDegrees);
+nimbusDefineFiniteSetter(vtkNimbusSunlight, SceneAltitudeMetres);
 
 namespace
 {

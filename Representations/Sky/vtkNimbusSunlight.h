@@ -37,19 +37,25 @@ public:
 
   ///@{
   /// Sun elevation above the horizon, degrees in [-90, 90]. Default 45.
-  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  virtual void SetSunElevationDegrees(double value);
+  virtual double GetSunElevationDegreesMinValue() { return -90.0; }
+  virtual double GetSunElevationDegreesMaxValue() { return 90.0; }
   vtkGetMacro(SunElevationDegrees, double);
   ///@}
 
   ///@{
   /// Sun azimuth from north (+y) toward east (+x), degrees. Default 135 (south-east).
-  vtkSetMacro(SunAzimuthDegrees, double);
+  virtual void SetSunAzimuthDegrees(double value);
+  virtual double GetSunAzimuthDegreesMinValue() { return -1e9; }
+  virtual double GetSunAzimuthDegreesMaxValue() { return 1e9; }
   vtkGetMacro(SunAzimuthDegrees, double);
   ///@}
 
   ///@{
   /// Altitude of the lit scene above sea level, metres (>= 0). Default 1500.
-  vtkSetClampMacro(SceneAltitudeMetres, double, 0.0, 1.0e5);
+  virtual void SetSceneAltitudeMetres(double value);
+  virtual double GetSceneAltitudeMetresMinValue() { return 0.0; }
+  virtual double GetSceneAltitudeMetresMaxValue() { return 1.0e5; }
   vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
 

@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -302,4 +303,111 @@ TEST(CloudAutomatonSource, BadInputGivesClearErrors)
   ASSERT_EQ(one.size(), 1u);
   EXPECT_TRUE(std::isfinite(one[0]));
   EXPECT_EQ(catcher.Errors.size(), 4u);
+}
+
+TEST(CloudAutomatonSource, ExtremeParametersAreRefusedWithMessages)
+{
+  const double NaN = std::nan("");
+  const double Inf = HUGE_VAL;
+  struct Case
+  {
+    const char* Name;
+    void (*Apply)(vtkNimbusCloudAutomatonSource*);
+    const char* Expected;
+  };
+  static double nan, inf;
+  nan = NaN;
+  inf = Inf;
+  const Case cases[] = {
+    // Escaped RequestData as std::invalid_argument (the smoothing's check) before.
+    { "SmoothingRadius NaN", [](vtkNimbusCloudAutomatonSource* s) { s->SetSmoothingRadius(nan); },
+      "SmoothingRadius" },
+    // Clamped silently to 1 before; refused now.
+    { "ExtinctionProbability +Inf",
+      [](vtkNimbusCloudAutomatonSource* s) { s->SetExtinctionProbability(inf); },
+      "ExtinctionProbability" },
+    { "InitialHumidity NaN", [](vtkNimbusCloudAutomatonSource* s) { s->SetInitialHumidity(nan); },
+      "InitialHumidity" },
+    { "StepDuration 1e308", [](vtkNimbusCloudAutomatonSource* s) { s->SetStepDuration(1e308); },
+      "StepDuration" },
+    { "StepDuration 1e-300", [](vtkNimbusCloudAutomatonSource* s) { s->SetStepDuration(1e-300); },
+      "StepDuration" },
+    { "Wind 1e308 m/s", [](vtkNimbusCloudAutomatonSource* s) { s->SetWind(1e308, 0); },
+      "cells per step" },
+    { "Shear 1e6 (m/s)/m", [](vtkNimbusCloudAutomatonSource* s) { s->SetShear(0, 1e6); },
+      "cells per step" },
+    { "Bounds 1e300 m",
+      [](vtkNimbusCloudAutomatonSource* s) { s->SetBounds(-1e300, 1e300, 0, 1000, 0, 1000); },
+      "Bounds" },
+    { "INT_MAX cells along x",
+      [](vtkNimbusCloudAutomatonSource* s)
+      {
+        s->SetDimensions(2147483647, 36, 12);
+        s->SetWind(0, 0);
+        s->SetShear(0, 0);
+      },
+      "memory budget" },
+    { "INT_MAX cubed cells",
+      [](vtkNimbusCloudAutomatonSource* s)
+      {
+        s->SetDimensions(2147483647, 2147483647, 2147483647);
+        s->SetWind(0, 0);
+        s->SetShear(0, 0);
+      },
+      "64 bits" },
+    { "tiny memory budget", [](vtkNimbusCloudAutomatonSource* s) { s->SetMemoryBudgetMiB(0.01); },
+      "memory budget" },
+    { "NaN memory budget", [](vtkNimbusCloudAutomatonSource* s) { s->SetMemoryBudgetMiB(nan); },
+      "MemoryBudgetMiB" },
+  };
+  for (const Case& c : cases)
+  {
+    vtkNew<vtkNimbusCloudAutomatonSource> source;
+    Configure(source);
+    MessageCatcher catcher(source);
+    c.Apply(source);
+    EXPECT_TRUE(DensityAt(source, 10.0).empty()) << c.Name;
+    ASSERT_EQ(catcher.Errors.size(), 1u) << c.Name << ": " << catcher.AllErrors();
+    EXPECT_NE(catcher.Errors[0].find(c.Expected), std::string::npos)
+      << c.Name << ": " << catcher.Errors[0];
+  }
+}
+
+TEST(CloudAutomatonSource, AMillionStepsAreRefusedWithAnEstimate)
+{
+  // The default 128 x 128 x 32 grid at step 1e6 ran for many minutes before.
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  source->SetNumberOfTimeSteps(1000000);
+  MessageCatcher catcher(source);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(DensityAt(source, 1.0e6).empty());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  ASSERT_EQ(catcher.Errors.size(), 1u) << catcher.AllErrors();
+  EXPECT_NE(catcher.Errors[0].find("cell updates"), std::string::npos) << catcher.Errors[0];
+  EXPECT_NE(catcher.Errors[0].find("1000000"), std::string::npos) << catcher.Errors[0];
+  // Nearby times still work, and the refusal left nothing broken.
+  EXPECT_EQ(DensityAt(source, 3.0).size(), 128u * 128u * 32u);
+  EXPECT_EQ(catcher.Errors.size(), 1u);
+}
+
+TEST(CloudAutomatonSource, BadInputMapValuesAreCounted)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  Configure(source);
+  MessageCatcher catcher(source);
+  vtkNew<vtkImageData> map;
+  map->SetDimensions(40, 36, 1);
+  vtkNew<vtkFloatArray> p;
+  p->SetName("p_hum");
+  p->SetNumberOfTuples(40 * 36);
+  p->FillValue(0.01f);
+  p->SetValue(3, std::nanf(""));
+  p->SetValue(5, -0.5f);
+  p->SetValue(7, HUGE_VALF);
+  map->GetPointData()->AddArray(p);
+  source->SetInputData(map);
+  EXPECT_TRUE(DensityAt(source, 0.0).empty());
+  ASSERT_EQ(catcher.Errors.size(), 1u);
+  EXPECT_NE(catcher.Errors[0].find("1 NaN, 1 infinite and 1 negative"), std::string::npos)
+    << catcher.Errors[0];
 }

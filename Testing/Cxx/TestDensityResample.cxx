@@ -374,3 +374,35 @@ TEST(DensityResample, NoCopyOnlyWhenTheArrayIsTheTexture)
   pairs->Fill(1.0);
   EXPECT_TRUE(nimbus::CloudDensityTexture::Resample(pairs, fits).IsCopy());
 }
+
+// The census the mapper's warning reports (NaN, infinite, negative, too large), with
+// and without downsampling, and the clamp that keeps block sums and k_cl rho finite.
+TEST(DensityResample, CensusAndTooLargeValues)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> values = { 1.0, nan, nan, inf, -inf, -2.0, -0.0, 1e300, 1e31, 3.0 };
+  const Dims n = { 10, 1, 1 };
+  for (const int limit : { 16, 2 })
+  {
+    const ResampledDensity out =
+      nimbus::ResampleDensity(values.data(), 1, PlanDensityResample(n, limit));
+    EXPECT_EQ(out.Census.NaN, 2u) << limit;
+    EXPECT_EQ(out.Census.Infinite, 2u) << limit;
+    EXPECT_EQ(out.Census.Negative, 1u) << limit; // -0 is not negative
+    EXPECT_EQ(out.NonFiniteCount, 4u) << limit;
+    EXPECT_EQ(out.TooLargeCount, 2u) << limit;
+    for (std::size_t i = 0; i < PlanDensityResample(n, limit).OutputSize(); ++i)
+    {
+      EXPECT_TRUE(std::isfinite(out.Data()[i]) && out.Data()[i] >= 0.0f) << limit << " " << i;
+      EXPECT_LE(out.Data()[i], nimbus::kMaximumDensity * (1 + 1e-6)) << limit << " " << i;
+    }
+  }
+  // Floats above the limit are not borrowed (they would reach the texture).
+  const std::vector<float> large = { 1.0f, 2e38f };
+  EXPECT_FALSE(nimbus::IsTextureReadyDensity(large.data(), large.size()));
+  const ResampledDensity clamped =
+    nimbus::ResampleDensity(large.data(), 1, PlanDensityResample({ 2, 1, 1 }, 16));
+  EXPECT_TRUE(clamped.IsCopy());
+  EXPECT_FLOAT_EQ(clamped.Data()[1], static_cast<float>(nimbus::kMaximumDensity));
+}

@@ -142,3 +142,98 @@ TEST(ImageCloudFilter, SampleImageAndErrors)
   ASSERT_EQ(catcher.Errors.size(), 3u);
   EXPECT_NE(catcher.Errors[2].find("layers"), std::string::npos) << catcher.Errors[2];
 }
+
+TEST(ImageCloudFilter, ArrayMessagesNameWhatTheInputHas)
+{
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  MessageCatcher catcher(filter);
+  // An unnamed array that is not the active scalars is used (it is an array, not "none").
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(16, 16, 1);
+  vtkNew<vtkUnsignedCharArray> unnamed;
+  unnamed->SetNumberOfTuples(256);
+  unnamed->FillValue(200);
+  image->GetPointData()->AddArray(unnamed);
+  filter->SetInputData(image);
+  filter->Update();
+  EXPECT_TRUE(catcher.Errors.empty()) << catcher.AllErrors();
+  EXPECT_GT(filter->GetOutput()->GetNumberOfPoints(), 0);
+
+  // A named request the input cannot satisfy: the message lists what there is.
+  filter->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "gray");
+  filter->Update();
+  ASSERT_EQ(catcher.Errors.size(), 1u);
+  EXPECT_NE(catcher.Errors[0].find("\"gray\""), std::string::npos) << catcher.Errors[0];
+  EXPECT_NE(catcher.Errors[0].find("an unnamed array (1 component)"), std::string::npos)
+    << catcher.Errors[0];
+  EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);
+
+  // No point arrays at all.
+  vtkNew<vtkImageData> bare;
+  bare->SetDimensions(16, 16, 1);
+  filter->SetInputData(bare);
+  filter->Update();
+  ASSERT_EQ(catcher.Errors.size(), 2u);
+  EXPECT_NE(catcher.Errors[1].find("no point arrays"), std::string::npos) << catcher.Errors[1];
+}
+
+TEST(ImageCloudFilter, NonFiniteAndNegativeIntensitiesAreCountedInAWarning)
+{
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(16, 16, 1);
+  vtkNew<vtkFloatArray> pixels;
+  pixels->SetName("radiance");
+  pixels->SetNumberOfTuples(256);
+  pixels->FillValue(180.0f);
+  pixels->SetValue(1, std::nanf(""));
+  pixels->SetValue(2, std::nanf(""));
+  pixels->SetValue(3, HUGE_VALF);
+  pixels->SetValue(4, -5.0f);
+  image->GetPointData()->SetScalars(pixels);
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  MessageCatcher catcher(filter);
+  filter->SetInputData(image);
+  filter->Update();
+  EXPECT_TRUE(catcher.Errors.empty()) << catcher.AllErrors();
+  ASSERT_EQ(catcher.Warnings.size(), 1u);
+  EXPECT_NE(catcher.Warnings[0].find("\"radiance\" has 2 NaN, 1 infinite and 1 negative values"),
+    std::string::npos)
+    << catcher.Warnings[0];
+  auto* rho = vtkFloatArray::SafeDownCast(filter->GetOutput()->GetPointData()->GetArray("density"));
+  ASSERT_NE(rho, nullptr);
+  double range[2];
+  rho->GetRange(range);
+  EXPECT_GE(range[0], 0.0);
+  EXPECT_TRUE(std::isfinite(range[1]));
+}
+
+TEST(ImageCloudFilter, SizeAndBudgetMessagesNameTheRealCause)
+{
+  auto image = DiscImage(300, 200, { { 150, 100, 60, 200 } }, 1);
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  MessageCatcher catcher(filter);
+  filter->SetInputData(image);
+  filter->SetMemoryBudgetMiB(4.0); // the cloud needs about 8 bytes x 300 x 200 x 40 points
+  filter->Update();
+  ASSERT_EQ(catcher.Errors.size(), 1u);
+  EXPECT_NE(catcher.Errors[0].find("memory budget"), std::string::npos) << catcher.Errors[0];
+  EXPECT_NE(catcher.Errors[0].find("300 x 200 x"), std::string::npos) << catcher.Errors[0];
+  EXPECT_EQ(catcher.Errors[0].find("raise VerticalSpacing, Ext"), std::string::npos)
+    << catcher.Errors[0];
+  EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);
+  EXPECT_EQ(filter->GetOpticalDepthMap()->GetNumberOfPoints(), 0);
+
+  // NaN in a clamped property, and an infinity that was clamped silently before.
+  filter->SetMemoryBudgetMiB(1024.0);
+  filter->SetGamma(std::nan(""));
+  filter->Update();
+  ASSERT_EQ(catcher.Errors.size(), 2u);
+  EXPECT_NE(catcher.Errors[1].find("Gamma"), std::string::npos) << catcher.Errors[1];
+  filter->SetGamma(1.0);
+  filter->SetMaximumOpticalDepth(HUGE_VAL);
+  filter->Update();
+  ASSERT_EQ(catcher.Errors.size(), 3u);
+  EXPECT_NE(catcher.Errors[2].find("MaximumOpticalDepth"), std::string::npos) << catcher.Errors[2];
+  filter->SetMaximumOpticalDepth(1e308); // finite: clamped to 1000, as the setter documents
+  EXPECT_EQ(filter->GetMaximumOpticalDepth(), 1000.0);
+}

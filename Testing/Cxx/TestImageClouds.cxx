@@ -210,3 +210,61 @@ TEST(ImageCloud, ExtremesAndErrors)
   // An absurd thickness is refused, not allocated: tau 1e6 at sigma 0.02 is 5e7 m.
   EXPECT_THROW(nimbus::BuildImageCloud({ 1.0e6 }, 1, 1, parameters), std::invalid_argument);
 }
+
+TEST(ImageCloud, GridMessagesNameTheRealCause)
+{
+  nimbus::ImageCloudParameters parameters;
+  auto message = [&](int nx, int ny, double tau)
+  {
+    try
+    {
+      nimbus::ImageCloudGrid(nx, ny, tau, parameters);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  // A 40000 x 40000 image of a thin cloud: few layers, too many points. This said "would
+  // need 52 layers ... raise VerticalSpacing" before.
+  const std::string large = message(40000, 40000, 30.0);
+  EXPECT_NE(large.find("40000 x 40000"), std::string::npos) << large;
+  EXPECT_NE(large.find("too large"), std::string::npos) << large;
+  EXPECT_EQ(large.find("layers, more than"), std::string::npos) << large;
+  // A thick cloud on a small image: the layers are the problem.
+  const std::string thick = message(8, 8, 1.0e6);
+  EXPECT_NE(thick.find("layers, more than 4096"), std::string::npos) << thick;
+  // Values beyond the ranges, NaN and infinities name the parameter.
+  for (const double bad : { 0.0, -1.0, 1e-300, 1e308, HUGE_VAL, std::nan("") })
+  {
+    parameters = nimbus::ImageCloudParameters();
+    parameters.PixelSize = bad;
+    EXPECT_NE(message(8, 8, 1.0).find("PixelSize"), std::string::npos) << bad;
+    parameters = nimbus::ImageCloudParameters();
+    parameters.VerticalSpacing = bad;
+    EXPECT_NE(message(8, 8, 1.0).find("VerticalSpacing"), std::string::npos) << bad;
+  }
+  parameters = nimbus::ImageCloudParameters();
+  parameters.BaseHeight = 1e308;
+  EXPECT_NE(message(8, 8, 1.0).find("BaseHeight"), std::string::npos);
+}
+
+TEST(ImageCloud, ColumnsThatAchieveNothingStayFinite)
+{
+  // The base transition covers the whole cloud (weights near 0): the fit multiplied the
+  // densities by 10 per iteration without bound; they are capped at 1e6 NominalDensity.
+  nimbus::ImageCloudParameters parameters;
+  parameters.BaseTransitionThickness = 1.0e8;
+  parameters.Iterations = 100;
+  const nimbus::ImageCloud cloud =
+    nimbus::BuildImageCloud(std::vector<double>(16, 20.0), 4, 4, parameters);
+  for (const nimbus::Metaball& ball : cloud.Balls)
+  {
+    ASSERT_LE(ball.Density, 1.0e6 * parameters.NominalDensity);
+  }
+  for (const float v : cloud.Density)
+  {
+    ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+  }
+}

@@ -1,0 +1,1077 @@
+// Extreme parameters for the three cloud sources (label fuzz): every numeric property of
+// vtkNimbusMetaballCloudSource, vtkNimbusCloudAutomatonSource and vtkNimbusImageCloudFilter
+// set in turn to 0, -1, 1e-300, 1e308, NaN, +-Inf, INT_MAX, INT_MIN and a typical value
+// (those the type allows), then random combinations with a fixed seed. Each run happens in
+// a forked child under an address-space limit (RLIMIT_AS, 3 GiB) and an alarm, and must end
+// in a clean error (an error message, empty outputs) or a valid output (the right
+// dimensions, finite non-negative densities) -- no crash, no abort inside VTK, no hang.
+// A progress observer sets AbortExecute when a run passes 2 s, so a long run must also stop
+// when asked. NaN and infinities must always be refused where the property is a parameter.
+// Then: AbortExecute stops the long paths quickly, and they report progress.
+#include "vtkNimbusCloudAutomatonSource.h"
+#include "vtkNimbusImageCloudFilter.h"
+#include "vtkNimbusMetaballCloudSource.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
+#include "vtkDataArray.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkUnsignedCharArray.h"
+
+#include "MessageCatcher.h"
+
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+using nimbus::testing::MessageCatcher;
+using Clock = std::chrono::steady_clock;
+
+constexpr rlim_t AddressSpaceLimit = rlim_t(3) << 30; // 3 GiB
+constexpr double AbortAfterSeconds = 2.0;             // the observer then sets AbortExecute
+constexpr unsigned AlarmSeconds = 15;                 // a child still running is killed
+
+const double NaN = std::numeric_limits<double>::quiet_NaN();
+const double Inf = std::numeric_limits<double>::infinity();
+
+double Seconds(Clock::time_point since)
+{
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// --- outcomes ----------------------------------------------------------------------------
+enum Outcome
+{
+  Valid = 0,    // no error, a valid output
+  Refused = 1,  // an error message and empty outputs
+  Aborted = 2,  // stopped by the 2 s observer, empty outputs
+  Invalid = 3,  // an output that is not valid (wrong size, NaN, negative ...)
+  Silent = 4,   // empty or partial output with no error message
+  NotEmpty = 5, // an error message but outputs not empty
+  Crashed = 6,  // killed by a signal (including the alarm) or an unexpected exit
+};
+
+const char* OutcomeName(int outcome)
+{
+  static const char* names[] = { "valid", "error", "aborted", "INVALID", "SILENT", "NOT-EMPTY",
+    "CRASH" };
+  return outcome >= 0 && outcome <= Crashed ? names[outcome] : "CRASH";
+}
+
+struct ChildResult
+{
+  int Outcome = Crashed;
+  double Seconds = 0.0;
+  std::string Text; // the child's note, or how it died
+};
+
+// Runs `body` in a forked child under the address-space limit. The child writes its note
+// to a pipe and exits with the outcome.
+ChildResult RunIsolated(const std::function<int(std::string&)>& body)
+{
+  int fds[2];
+  if (pipe(fds) != 0)
+  {
+    return { Crashed, 0.0, "pipe failed" };
+  }
+  std::cout.flush();
+  std::cerr.flush();
+  const Clock::time_point start = Clock::now();
+  const pid_t pid = fork();
+  if (pid == 0)
+  {
+    close(fds[0]);
+    rlimit limit{ AddressSpaceLimit, AddressSpaceLimit };
+    setrlimit(RLIMIT_AS, &limit);
+    alarm(AlarmSeconds);
+    std::string note;
+    int outcome = Crashed;
+    // An exception leaving the source would end ParaView: count it as a crash, and never let
+    // it reach gtest in this child.
+    try
+    {
+      outcome = body(note);
+    }
+    catch (const std::exception& error)
+    {
+      note = std::string("uncaught exception: ") + error.what();
+    }
+    catch (...)
+    {
+      note = "uncaught exception";
+    }
+    note = note.substr(0, 2000);
+    const ssize_t written = write(fds[1], note.data(), note.size());
+    (void)written;
+    close(fds[1]);
+    _exit(outcome);
+  }
+  close(fds[1]);
+  ChildResult result;
+  char buffer[4096];
+  ssize_t n;
+  while ((n = read(fds[0], buffer, sizeof(buffer))) > 0)
+  {
+    result.Text.append(buffer, static_cast<std::size_t>(n));
+  }
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  result.Seconds = Seconds(start);
+  if (WIFEXITED(status) && WEXITSTATUS(status) <= Crashed)
+  {
+    result.Outcome = WEXITSTATUS(status);
+  }
+  else
+  {
+    result.Outcome = Crashed;
+    std::ostringstream text;
+    if (WIFSIGNALED(status))
+    {
+      text << "killed by signal " << WTERMSIG(status) << " (" << strsignal(WTERMSIG(status)) << ")";
+    }
+    else
+    {
+      text << "exit status " << WEXITSTATUS(status);
+    }
+    result.Text = text.str() + "; " + result.Text;
+  }
+  return result;
+}
+
+// Sets AbortExecute once a run has lasted AbortAfterSeconds (from a progress event).
+struct Watchdog
+{
+  explicit Watchdog(vtkAlgorithm* algorithm)
+    : Algorithm(algorithm)
+  {
+    this->Callback->SetClientData(this);
+    this->Callback->SetCallback(
+      [](vtkObject*, unsigned long, void* clientData, void*)
+      {
+        auto* self = static_cast<Watchdog*>(clientData);
+        if (!self->Fired && Seconds(self->Start) > AbortAfterSeconds)
+        {
+          self->Fired = true;
+          self->Algorithm->SetAbortExecute(1);
+        }
+      });
+    algorithm->AddObserver(vtkCommand::ProgressEvent, this->Callback);
+  }
+  vtkAlgorithm* Algorithm;
+  Clock::time_point Start = Clock::now();
+  bool Fired = false;
+  vtkNew<vtkCallbackCommand> Callback;
+};
+
+// The message of a VTK error or warning text ("ERROR: In file, line n\nvtkX (0x..): message").
+std::string MessageOf(const std::string& text)
+{
+  const std::size_t colon = text.find("): ");
+  std::string message = colon == std::string::npos ? text : text.substr(colon + 3);
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
+  {
+    message.pop_back();
+  }
+  return message;
+}
+
+// The verdict on a density image: empty, or the expected size with values in [0, upper].
+int Judge(vtkImageData* image, const int expected[3], double upper, const MessageCatcher& messages,
+  bool aborted, std::string& note)
+{
+  const vtkIdType points = image->GetNumberOfPoints();
+  if (!messages.Errors.empty())
+  {
+    note = MessageOf(messages.Errors.front());
+    return points == 0 ? Refused : NotEmpty;
+  }
+  if (points == 0)
+  {
+    note = aborted ? "stopped by AbortExecute" : "empty output, no error";
+    return aborted ? Aborted : Silent;
+  }
+  int dims[3];
+  image->GetDimensions(dims);
+  if (dims[0] != expected[0] || dims[1] != expected[1] || dims[2] != expected[2])
+  {
+    std::ostringstream text;
+    text << "dimensions " << dims[0] << " x " << dims[1] << " x " << dims[2] << ", expected "
+         << expected[0] << " x " << expected[1] << " x " << expected[2];
+    note = text.str();
+    return Invalid;
+  }
+  auto* density = vtkFloatArray::SafeDownCast(image->GetPointData()->GetArray("density"));
+  if (!density || density->GetNumberOfTuples() != points)
+  {
+    note = "no float \"density\" array of the right size";
+    return Invalid;
+  }
+  const float* values = density->GetPointer(0);
+  float largest = 0.0f;
+  for (vtkIdType i = 0; i < points; ++i)
+  {
+    if (!(values[i] >= 0.0f && values[i] <= upper))
+    {
+      std::ostringstream text;
+      text << "density " << values[i] << " at point " << i;
+      note = text.str();
+      return Invalid;
+    }
+    largest = std::max(largest, values[i]);
+  }
+  std::ostringstream text;
+  text << points << " points, largest density " << largest
+       << (messages.Warnings.empty() ? "" : "; warning: " + MessageOf(messages.Warnings.front()));
+  note = text.str();
+  return Valid;
+}
+
+// --- the properties ------------------------------------------------------------------------
+// One numeric property (or one component of a vector property) and how to set it.
+template <typename Setup>
+struct Property
+{
+  std::string Name;
+  bool Integer;
+  // NaN and +-Inf must be refused (false where they have a documented meaning).
+  bool RefuseNonFinite;
+  std::function<void(Setup&, double)> Set;
+  double Typical;
+};
+
+std::vector<double> ValuesFor(bool integer, double typical)
+{
+  if (integer)
+  {
+    return { 0.0, -1.0, 1.0, double(INT_MAX), double(INT_MIN), typical };
+  }
+  return { 0.0, -1.0, 1e-300, 1e308, NaN, Inf, -Inf, double(INT_MAX), double(INT_MIN), typical };
+}
+
+int ToInt(double value)
+{
+  return static_cast<int>(std::clamp(value, double(INT_MIN), double(INT_MAX)));
+}
+
+std::string Show(double value)
+{
+  if (value == double(INT_MAX))
+  {
+    return "INT_MAX";
+  }
+  if (value == double(INT_MIN))
+  {
+    return "INT_MIN";
+  }
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// What a run of one source needs: the source's settings applied before Update.
+struct MetaballSetup
+{
+  vtkNimbusMetaballCloudSource* Source;
+  bool HasBall = false; // AddBall(Ball) before the update
+  double Ball[5] = { 0, 0, 1800, 500, 1 };
+};
+struct AutomatonSetup
+{
+  vtkNimbusCloudAutomatonSource* Source;
+  double Time = 5.5;   // requested time, s
+  bool HasMap = false; // a p_hum input map with MapValue at one cell
+  double MapValue = 0.01;
+};
+struct ImageSetup
+{
+  vtkNimbusImageCloudFilter* Filter;
+  double Nx = 24, Ny = 20;
+  bool HasPixel = false; // a float image with PixelValue at one pixel
+  double PixelValue = 200;
+};
+
+template <typename Setup, typename Vector>
+std::function<void(Setup&, double)> Component(
+  Vector get, int component, std::function<void(Setup&, const double*)> set, int size)
+{
+  return [get, component, set, size](Setup& setup, double value)
+  {
+    double v[6];
+    get(setup, v);
+    (void)size;
+    v[component] = value;
+    set(setup, v);
+  };
+}
+
+std::vector<Property<MetaballSetup>> MetaballProperties()
+{
+  using S = MetaballSetup;
+  std::vector<Property<S>> properties;
+  for (int a = 0; a < 3; ++a)
+  {
+    properties.push_back({ "Dimensions[" + std::to_string(a) + "]", true, true,
+      [a](S& s, double v)
+      {
+        int d[3];
+        s.Source->GetDimensions(d);
+        d[a] = ToInt(v);
+        s.Source->SetDimensions(d);
+      },
+      40 });
+  }
+  for (int a = 0; a < 6; ++a)
+  {
+    const double typical[6] = { -1500, 1500, -1500, 1500, 800, 2800 };
+    properties.push_back({ "Bounds[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double b[6];
+        s.Source->GetBounds(b);
+        b[a] = v;
+        s.Source->SetBounds(b);
+      },
+      typical[a] });
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    properties.push_back({ "BaseBallRadiusRange[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double r[2];
+        s.Source->GetBaseBallRadiusRange(r);
+        r[a] = v;
+        s.Source->SetBaseBallRadiusRange(r);
+      },
+      a == 0 ? 350.0 : 600.0 });
+  }
+  auto scalar = [&properties](const std::string& name, bool integer,
+                  std::function<void(vtkNimbusMetaballCloudSource*, double)> set, double typical)
+  {
+    properties.push_back(
+      { name, integer, true, [set](S& s, double v) { set(s.Source, v); }, typical });
+  };
+  scalar(
+    "Seed", true, [](vtkNimbusMetaballCloudSource* s, double v) { s->SetSeed(ToInt(v)); }, 7);
+  scalar(
+    "NumberOfLevels", true,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetNumberOfLevels(ToInt(v)); }, 3);
+  scalar(
+    "NumberOfBaseBalls", true,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetNumberOfBaseBalls(ToInt(v)); }, 10);
+  scalar(
+    "BallsPerLevel", true,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetBallsPerLevel(ToInt(v)); }, 60);
+  scalar(
+    "FootprintRadius", false,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetFootprintRadius(v); }, 700);
+  scalar(
+    "TowerHeight", false, [](vtkNimbusMetaballCloudSource* s, double v) { s->SetTowerHeight(v); },
+    600);
+  scalar(
+    "BallCountFactor", false,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetBallCountFactor(v); }, 2);
+  scalar(
+    "RadiusScalePerLevel", false,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetRadiusScalePerLevel(v); }, 0.5);
+  scalar(
+    "BallDensity", false, [](vtkNimbusMetaballCloudSource* s, double v) { s->SetBallDensity(v); },
+    1);
+  scalar(
+    "IsoValue", false, [](vtkNimbusMetaballCloudSource* s, double v) { s->SetIsoValue(v); }, 0.5);
+  scalar(
+    "BaseHeight", false, [](vtkNimbusMetaballCloudSource* s, double v) { s->SetBaseHeight(v); },
+    1000);
+  scalar(
+    "BaseTransitionThickness", false,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetBaseTransitionThickness(v); }, 100);
+  scalar(
+    "MemoryBudgetMiB", false,
+    [](vtkNimbusMetaballCloudSource* s, double v) { s->SetMemoryBudgetMiB(v); }, 2048);
+  const char* ball[5] = { "AddBall.x", "AddBall.y", "AddBall.z", "AddBall.radius",
+    "AddBall.density" };
+  const double typicalBall[5] = { 0, 0, 1800, 500, 1 };
+  for (int c = 0; c < 5; ++c)
+  {
+    properties.push_back({ ball[c], false, true,
+      [c](S& s, double v)
+      {
+        s.HasBall = true;
+        s.Ball[c] = v;
+      },
+      typicalBall[c] });
+  }
+  return properties;
+}
+
+std::vector<Property<AutomatonSetup>> AutomatonProperties()
+{
+  using S = AutomatonSetup;
+  std::vector<Property<S>> properties;
+  for (int a = 0; a < 3; ++a)
+  {
+    properties.push_back({ "Dimensions[" + std::to_string(a) + "]", true, true,
+      [a](S& s, double v)
+      {
+        int d[3];
+        s.Source->GetDimensions(d);
+        d[a] = ToInt(v);
+        s.Source->SetDimensions(d);
+      },
+      48 });
+  }
+  for (int a = 0; a < 6; ++a)
+  {
+    const double typical[6] = { -6400, 6400, -6400, 6400, 1000, 2600 };
+    properties.push_back({ "Bounds[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double b[6];
+        s.Source->GetBounds(b);
+        b[a] = v;
+        s.Source->SetBounds(b);
+      },
+      typical[a] });
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    properties.push_back({ "Wind[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double w[2];
+        s.Source->GetWind(w);
+        w[a] = v;
+        s.Source->SetWind(w);
+      },
+      12.0 });
+    properties.push_back({ "Shear[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double w[2];
+        s.Source->GetShear(w);
+        w[a] = v;
+        s.Source->SetShear(w);
+      },
+      0.01 });
+  }
+  auto scalar = [&properties](const std::string& name, bool integer, bool refuseNonFinite,
+                  std::function<void(vtkNimbusCloudAutomatonSource*, double)> set, double typical)
+  {
+    properties.push_back(
+      { name, integer, refuseNonFinite, [set](S& s, double v) { set(s.Source, v); }, typical });
+  };
+  using A = vtkNimbusCloudAutomatonSource;
+  scalar(
+    "Seed", true, true, [](A* s, double v) { s->SetSeed(ToInt(v)); }, 9);
+  // Probabilities and the smoothing radius: finite values are clamped by their setters,
+  // NaN and infinities refused.
+  scalar(
+    "ExtinctionProbability", false, true, [](A* s, double v) { s->SetExtinctionProbability(v); },
+    0.05);
+  scalar(
+    "HumidityProbability", false, true, [](A* s, double v) { s->SetHumidityProbability(v); },
+    0.002);
+  scalar(
+    "ActivationProbability", false, true, [](A* s, double v) { s->SetActivationProbability(v); },
+    0.0002);
+  scalar(
+    "InitialHumidity", false, true, [](A* s, double v) { s->SetInitialHumidity(v); }, 0.3);
+  scalar(
+    "InitialActivation", false, true, [](A* s, double v) { s->SetInitialActivation(v); }, 0.001);
+  scalar(
+    "StepDuration", false, true, [](A* s, double v) { s->SetStepDuration(v); }, 1.0);
+  scalar(
+    "NumberOfTimeSteps", true, true, [](A* s, double v) { s->SetNumberOfTimeSteps(ToInt(v)); },
+    100);
+  scalar(
+    "SmoothingRadius", false, true, [](A* s, double v) { s->SetSmoothingRadius(v); }, 2.5);
+  scalar(
+    "NumberOfThreads", true, true, [](A* s, double v) { s->SetNumberOfThreads(ToInt(v)); }, 2);
+  scalar(
+    "CheckpointInterval", true, true, [](A* s, double v) { s->SetCheckpointInterval(ToInt(v)); },
+    10);
+  scalar(
+    "MaximumNumberOfCheckpoints", true, true,
+    [](A* s, double v) { s->SetMaximumNumberOfCheckpoints(ToInt(v)); }, 16);
+  scalar(
+    "MemoryBudgetMiB", false, true, [](A* s, double v) { s->SetMemoryBudgetMiB(v); }, 2048);
+  // The requested time: NaN reads as time 0, infinities are clamped to the time range.
+  properties.push_back({ "UpdateTimeStep", false, false, [](S& s, double v) { s.Time = v; }, 3.5 });
+  // One cell of an input p_hum map: values outside [0, 1] are refused.
+  properties.push_back({ "p_hum map value", false, true,
+    [](S& s, double v)
+    {
+      s.HasMap = true;
+      s.MapValue = v;
+    },
+    0.01 });
+  return properties;
+}
+
+std::vector<Property<ImageSetup>> ImageProperties()
+{
+  using S = ImageSetup;
+  using F = vtkNimbusImageCloudFilter;
+  std::vector<Property<S>> properties;
+  for (int a = 0; a < 2; ++a)
+  {
+    properties.push_back({ "IntensityRange[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double r[2];
+        s.Filter->GetIntensityRange(r);
+        r[a] = v;
+        s.Filter->SetIntensityRange(r);
+      },
+      a == 0 ? 0.0 : 255.0 });
+  }
+  properties.push_back({ "image nx", true, true, [](S& s, double v) { s.Nx = v; }, 24 });
+  properties.push_back({ "image ny", true, true, [](S& s, double v) { s.Ny = v; }, 20 });
+  // Intensities may be anything: NaN reads as clear sky, infinities clamp (with a warning).
+  properties.push_back({ "pixel value", false, false,
+    [](S& s, double v)
+    {
+      s.HasPixel = true;
+      s.PixelValue = v;
+    },
+    200 });
+  auto scalar = [&properties](const std::string& name, bool integer,
+                  std::function<void(F*, double)> set, double typical)
+  {
+    properties.push_back(
+      { name, integer, true, [set](S& s, double v) { set(s.Filter, v); }, typical });
+  };
+  scalar(
+    "MappingType", true, [](F* f, double v) { f->SetMappingType(ToInt(v)); }, 1);
+  scalar(
+    "ClearIntensity", false, [](F* f, double v) { f->SetClearIntensity(v); }, 0.1);
+  scalar(
+    "WhiteIntensity", false, [](F* f, double v) { f->SetWhiteIntensity(v); }, 1.0);
+  scalar(
+    "Gamma", false, [](F* f, double v) { f->SetGamma(v); }, 1.5);
+  scalar(
+    "MaximumOpticalDepth", false, [](F* f, double v) { f->SetMaximumOpticalDepth(v); }, 30);
+  scalar(
+    "AsymmetryParameter", false, [](F* f, double v) { f->SetAsymmetryParameter(v); }, 0.85);
+  scalar(
+    "PixelSize", false, [](F* f, double v) { f->SetPixelSize(v); }, 100);
+  scalar(
+    "VerticalSpacing", false, [](F* f, double v) { f->SetVerticalSpacing(v); }, 50);
+  scalar(
+    "ExtinctionCoefficient", false, [](F* f, double v) { f->SetExtinctionCoefficient(v); }, 0.02);
+  scalar(
+    "NominalDensity", false, [](F* f, double v) { f->SetNominalDensity(v); }, 1);
+  scalar(
+    "BaseHeight", false, [](F* f, double v) { f->SetBaseHeight(v); }, 1000);
+  scalar(
+    "BaseTransitionThickness", false, [](F* f, double v) { f->SetBaseTransitionThickness(v); }, 50);
+  scalar(
+    "BallSpacing", true, [](F* f, double v) { f->SetBallSpacing(ToInt(v)); }, 2);
+  scalar(
+    "BallRadiusFactor", false, [](F* f, double v) { f->SetBallRadiusFactor(v); }, 3);
+  scalar(
+    "TopRoughness", false, [](F* f, double v) { f->SetTopRoughness(v); }, 0.6);
+  scalar(
+    "Iterations", true, [](F* f, double v) { f->SetIterations(ToInt(v)); }, 10);
+  scalar(
+    "Seed", true, [](F* f, double v) { f->SetSeed(ToInt(v)); }, 3);
+  scalar(
+    "MemoryBudgetMiB", false, [](F* f, double v) { f->SetMemoryBudgetMiB(v); }, 2048);
+  return properties;
+}
+
+// --- one run of each source ------------------------------------------------------------------
+int RunMetaball(const std::function<void(MetaballSetup&)>& apply, std::string& note)
+{
+  vtkNew<vtkNimbusMetaballCloudSource> source;
+  source->SetDimensions(24, 24, 16); // a cheap base: fractions of a millisecond per level
+  source->SetNumberOfLevels(2);
+  MessageCatcher messages(source);
+  Watchdog watchdog(source);
+  MetaballSetup setup{ source };
+  apply(setup);
+  if (setup.HasBall)
+  {
+    source->AddBall(setup.Ball[0], setup.Ball[1], setup.Ball[2], setup.Ball[3], setup.Ball[4]);
+  }
+  source->Update();
+  int expected[3];
+  source->GetDimensions(expected);
+  const int verdict = Judge(source->GetOutput(), expected, std::numeric_limits<float>::max(),
+    messages, watchdog.Fired, note);
+  if (verdict == Valid || verdict == Aborted)
+  {
+    // Port 1: finite ball radii and densities.
+    vtkPolyData* balls = source->GetMetaballs();
+    for (const char* name : { "radius", "density" })
+    {
+      vtkDataArray* array = balls->GetPointData()->GetArray(name);
+      for (vtkIdType i = 0; array && i < array->GetNumberOfTuples(); ++i)
+      {
+        if (!(std::isfinite(array->GetComponent(i, 0)) && array->GetComponent(i, 0) >= 0.0))
+        {
+          note = std::string("ball ") + name + " " + std::to_string(array->GetComponent(i, 0));
+          return Invalid;
+        }
+      }
+    }
+  }
+  return verdict;
+}
+
+int RunAutomaton(const std::function<void(AutomatonSetup&)>& apply, std::string& note)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  source->SetDimensions(24, 20, 6);
+  source->SetNumberOfTimeSteps(8);
+  source->SetNumberOfThreads(2);
+  MessageCatcher messages(source);
+  Watchdog watchdog(source);
+  AutomatonSetup setup{ source };
+  apply(setup);
+  vtkNew<vtkImageData> map;
+  if (setup.HasMap)
+  {
+    int d[3];
+    source->GetDimensions(d);
+    if (d[0] >= 1 && d[1] >= 1 && static_cast<double>(d[0]) * d[1] < 1.0e7)
+    {
+      map->SetDimensions(d[0], d[1], 1);
+      vtkNew<vtkFloatArray> p;
+      p->SetName("p_hum");
+      p->SetNumberOfTuples(static_cast<vtkIdType>(d[0]) * d[1]);
+      p->FillValue(0.002f);
+      p->SetValue(0, static_cast<float>(setup.MapValue));
+      map->GetPointData()->AddArray(p);
+      source->SetInputData(map);
+    }
+  }
+  source->UpdateTimeStep(setup.Time);
+  int expected[3];
+  source->GetDimensions(expected);
+  return Judge(source->GetOutput(), expected, 1.0 + 1e-5, messages, watchdog.Fired, note);
+}
+
+int RunImage(const std::function<void(ImageSetup&)>& apply, std::string& note)
+{
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  MessageCatcher messages(filter);
+  Watchdog watchdog(filter);
+  ImageSetup setup{ filter };
+  apply(setup);
+  vtkNew<vtkImageData> image;
+  const int nx = ToInt(setup.Nx), ny = ToInt(setup.Ny);
+  image->SetDimensions(nx, ny, 1);
+  if (nx >= 1 && ny >= 1 && static_cast<double>(nx) * ny <= 1.0e7)
+  {
+    // Two grey discs on a dark sea; a float image when one pixel is set to the case's value.
+    const bool floats = setup.HasPixel;
+    vtkSmartPointer<vtkDataArray> pixels = floats
+      ? vtkSmartPointer<vtkDataArray>::Take(vtkFloatArray::New())
+      : vtkSmartPointer<vtkDataArray>::Take(vtkUnsignedCharArray::New());
+    pixels->SetName("gray");
+    pixels->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny);
+    for (int y = 0; y < ny; ++y)
+    {
+      for (int x = 0; x < nx; ++x)
+      {
+        const bool disc =
+          std::hypot(x - 7.0, y - 7.0) < 5.0 || std::hypot(x - 17.0, y - 12.0) < 6.0;
+        pixels->SetComponent(x + static_cast<vtkIdType>(nx) * y, 0, disc ? 200.0 : 20.0);
+      }
+    }
+    if (floats)
+    {
+      pixels->SetComponent(
+        std::min<vtkIdType>(7 + 7 * nx, pixels->GetNumberOfTuples() - 1), 0, setup.PixelValue);
+    }
+    image->GetPointData()->SetScalars(pixels);
+  }
+  filter->SetInputData(image);
+  filter->Update();
+  const int expected[3] = { nx, ny, filter->GetOutput()->GetDimensions()[2] };
+  const int verdict = Judge(filter->GetOutput(), expected, std::numeric_limits<float>::max(),
+    messages, watchdog.Fired, note);
+  if (verdict == Valid && expected[2] < 2)
+  {
+    note = "a cloud of fewer than 2 layers";
+    return Invalid;
+  }
+  if (verdict == Valid)
+  {
+    vtkImageData* map = filter->GetOpticalDepthMap();
+    for (const char* name : { "optical_depth", "column_optical_depth" })
+    {
+      vtkDataArray* array = map->GetPointData()->GetArray(name);
+      if (!array || array->GetNumberOfTuples() != static_cast<vtkIdType>(nx) * ny)
+      {
+        note = std::string("map array ") + name + " missing";
+        return Invalid;
+      }
+      for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
+      {
+        const double v = array->GetComponent(i, 0);
+        if (!(std::isfinite(v) && v >= 0.0))
+        {
+          note = std::string("map ") + name + " " + std::to_string(v);
+          return Invalid;
+        }
+      }
+    }
+  }
+  return verdict;
+}
+
+// --- the sweeps -------------------------------------------------------------------------------
+struct Tally
+{
+  int Cases = 0;
+  double Seconds = 0.0, Slowest = 0.0;
+  std::map<std::string, int> Outcomes;
+};
+
+// Checks one run's result; `refuseNonFinite` demands an error for NaN or infinite values.
+void Check(const std::string& label, const ChildResult& result, bool mustRefuse, Tally& tally)
+{
+  ++tally.Cases;
+  tally.Seconds += result.Seconds;
+  tally.Slowest = std::max(tally.Slowest, result.Seconds);
+  ++tally.Outcomes[OutcomeName(result.Outcome)];
+  std::cout << "  " << label << " -> " << OutcomeName(result.Outcome) << " ("
+            << static_cast<int>(result.Seconds * 1000.0) << " ms): " << result.Text << "\n";
+  EXPECT_TRUE(result.Outcome == Valid || result.Outcome == Refused || result.Outcome == Aborted)
+    << label << ": " << OutcomeName(result.Outcome) << ": " << result.Text;
+  if (mustRefuse)
+  {
+    EXPECT_EQ(result.Outcome, Refused) << label << " must be refused: " << result.Text;
+  }
+  // A run stopped by the watchdog must have stopped soon after it fired.
+  EXPECT_LT(result.Seconds, AbortAfterSeconds + 3.0) << label << ": " << result.Text;
+}
+
+void PrintTally(const std::string& what, const Tally& tally)
+{
+  std::cout << what << ": " << tally.Cases << " cases in " << tally.Seconds << " s (slowest "
+            << tally.Slowest << " s);";
+  for (const auto& outcome : tally.Outcomes)
+  {
+    std::cout << " " << outcome.first << " " << outcome.second;
+  }
+  std::cout << "\n";
+}
+
+template <typename Setup>
+void SweepEachProperty(const std::vector<Property<Setup>>& properties,
+  int (*run)(const std::function<void(Setup&)>&, std::string&), const std::string& what)
+{
+  Tally tally;
+  for (const Property<Setup>& property : properties)
+  {
+    for (const double value : ValuesFor(property.Integer, property.Typical))
+    {
+      const ChildResult result = RunIsolated([&](std::string& note)
+        { return run([&](Setup& setup) { property.Set(setup, value); }, note); });
+      Check(property.Name + " = " + Show(value), result,
+        property.RefuseNonFinite && !std::isfinite(value), tally);
+    }
+  }
+  PrintTally(what, tally);
+}
+
+template <typename Setup>
+void SweepRandomCombinations(const std::vector<Property<Setup>>& properties,
+  int (*run)(const std::function<void(Setup&)>&, std::string&), const std::string& what,
+  unsigned seed, int cases)
+{
+  std::mt19937 random(seed);
+  Tally tally;
+  for (int c = 0; c < cases; ++c)
+  {
+    // Two to four properties, each a random value of its kind.
+    const int count = 2 + static_cast<int>(random() % 3);
+    std::vector<std::pair<const Property<Setup>*, double>> settings;
+    std::string label;
+    bool mustRefuse = false;
+    for (int k = 0; k < count; ++k)
+    {
+      const Property<Setup>& property = properties[random() % properties.size()];
+      const std::vector<double> values = ValuesFor(property.Integer, property.Typical);
+      // Typical values half of the time, so that combinations also run.
+      const double value = random() % 2 ? property.Typical : values[random() % values.size()];
+      settings.emplace_back(&property, value);
+      label += (k ? ", " : "") + property.Name + " = " + Show(value);
+    }
+    // Only the last setting of a property counts.
+    std::map<std::string, double> last;
+    for (const auto& setting : settings)
+    {
+      last[setting.first->Name] = setting.second;
+    }
+    for (const auto& setting : settings)
+    {
+      mustRefuse =
+        mustRefuse || (setting.first->RefuseNonFinite && !std::isfinite(last[setting.first->Name]));
+    }
+    const ChildResult result = RunIsolated(
+      [&](std::string& note)
+      {
+        return run(
+          [&](Setup& setup)
+          {
+            for (const auto& setting : settings)
+            {
+              setting.first->Set(setup, setting.second);
+            }
+          },
+          note);
+      });
+    Check("[" + label + "]", result, mustRefuse, tally);
+  }
+  PrintTally(what, tally);
+}
+}
+
+TEST(ExtremeParameters, MetaballCloudSource)
+{
+  SweepEachProperty(MetaballProperties(), &RunMetaball, "metaball source, each property");
+}
+
+TEST(ExtremeParameters, CloudAutomatonSource)
+{
+  SweepEachProperty(AutomatonProperties(), &RunAutomaton, "automaton source, each property");
+}
+
+TEST(ExtremeParameters, ImageCloudFilter)
+{
+  SweepEachProperty(ImageProperties(), &RunImage, "image cloud filter, each property");
+}
+
+TEST(ExtremeParameters, RandomCombinations)
+{
+  SweepRandomCombinations(
+    MetaballProperties(), &RunMetaball, "metaball source, random combinations", 20261128u, 60);
+  SweepRandomCombinations(
+    AutomatonProperties(), &RunAutomaton, "automaton source, random combinations", 1u, 60);
+  SweepRandomCombinations(
+    ImageProperties(), &RunImage, "image cloud filter, random combinations", 2u, 60);
+}
+
+// --- the reported cases, by name (also under the address-space limit) -------------------------
+TEST(ExtremeParameters, ReportedCases)
+{
+  Tally tally;
+  auto metaball = [&](const std::string& label,
+                    std::function<void(vtkNimbusMetaballCloudSource*)> set, const char* expected)
+  {
+    const ChildResult result = RunIsolated([&](std::string& note)
+      { return RunMetaball([&](MetaballSetup& s) { set(s.Source); }, note); });
+    Check(label, result, true, tally);
+    EXPECT_NE(result.Text.find(expected), std::string::npos) << label << ": " << result.Text;
+  };
+  metaball(
+    "metaball Dimensions 3000^3",
+    [](vtkNimbusMetaballCloudSource* s) { s->SetDimensions(3000, 3000, 3000); }, "memory budget");
+  metaball(
+    "metaball Dimensions (2^31-1)^3",
+    [](vtkNimbusMetaballCloudSource* s) { s->SetDimensions(INT_MAX, INT_MAX, INT_MAX); },
+    "64 bits");
+  metaball(
+    "metaball BallDensity 1e308", [](vtkNimbusMetaballCloudSource* s) { s->SetBallDensity(1e308); },
+    "BallDensity");
+  metaball(
+    "metaball NumberOfLevels 1000",
+    [](vtkNimbusMetaballCloudSource* s) { s->SetNumberOfLevels(1000); }, "NumberOfLevels");
+  metaball(
+    "metaball NumberOfLevels 60, BallCountFactor 1",
+    [](vtkNimbusMetaballCloudSource* s)
+    {
+      s->SetDimensions(400, 400, 400);
+      s->SetNumberOfLevels(60);
+      s->SetBallCountFactor(1.0);
+      s->SetRadiusScalePerLevel(1.0);
+    },
+    "updates");
+  auto automaton =
+    [&](const std::string& label, std::function<void(AutomatonSetup&)> set, const char* expected)
+  {
+    const ChildResult result =
+      RunIsolated([&](std::string& note) { return RunAutomaton(set, note); });
+    Check(label, result, true, tally);
+    EXPECT_NE(result.Text.find(expected), std::string::npos) << label << ": " << result.Text;
+  };
+  automaton(
+    "automaton SmoothingRadius NaN", [](AutomatonSetup& s) { s.Source->SetSmoothingRadius(NaN); },
+    "SmoothingRadius");
+  automaton(
+    "automaton time of a million steps, default grid",
+    [](AutomatonSetup& s)
+    {
+      s.Source->SetDimensions(128, 128, 32);
+      s.Source->SetNumberOfTimeSteps(1000000);
+      s.Time = 1.0e6;
+    },
+    "cell updates");
+  PrintTally("reported cases", tally);
+}
+
+// --- abort and progress ------------------------------------------------------------------------
+namespace
+{
+// Sets AbortExecute at the first progress event after `after` seconds; records the events.
+struct AbortAfter
+{
+  AbortAfter(vtkAlgorithm* algorithm, double after)
+    : Algorithm(algorithm)
+    , After(after)
+  {
+    this->Callback->SetClientData(this);
+    this->Callback->SetCallback(
+      [](vtkObject*, unsigned long, void* clientData, void* callData)
+      {
+        auto* self = static_cast<AbortAfter*>(clientData);
+        self->Progress.push_back(*static_cast<double*>(callData));
+        if (self->After >= 0.0 && !self->Fired && Seconds(self->Start) >= self->After)
+        {
+          self->Fired = true;
+          self->FiredAt = Clock::now();
+          self->Algorithm->SetAbortExecute(1);
+        }
+      });
+    algorithm->AddObserver(vtkCommand::ProgressEvent, this->Callback);
+  }
+  vtkAlgorithm* Algorithm;
+  double After;
+  Clock::time_point Start = Clock::now();
+  Clock::time_point FiredAt;
+  bool Fired = false;
+  std::vector<double> Progress;
+  vtkNew<vtkCallbackCommand> Callback;
+};
+
+// Runs `update` with an abort requested after 0.3 s: it must have fired, and Update must
+// return within `bound` seconds of it.
+void ExpectAbortStops(vtkAlgorithm* algorithm, const std::function<void()>& update,
+  vtkImageData* output, const char* what, double bound = 0.5)
+{
+  AbortAfter abort(algorithm, 0.3);
+  abort.Start = Clock::now();
+  update();
+  const double total = Seconds(abort.Start);
+  ASSERT_TRUE(abort.Fired) << what << " finished in " << total << " s before the abort";
+  ASSERT_GT(total, 0.3) << what;
+  const double afterAbort = Seconds(abort.FiredAt);
+  std::cout << what << ": aborted after " << total - afterAbort << " s, stopped " << afterAbort
+            << " s later, " << abort.Progress.size() << " progress events\n";
+  EXPECT_LT(afterAbort, bound) << what;
+  EXPECT_EQ(output->GetNumberOfPoints(), 0) << what;
+}
+}
+
+TEST(AbortAndProgress, MetaballCloudSource)
+{
+  // A single ball filling a 320^3 grid (33 million points per sampling), three levels.
+  vtkNew<vtkNimbusMetaballCloudSource> source;
+  source->SetDimensions(320, 320, 320);
+  source->SetNumberOfLevels(3);
+  source->SetBaseBallRadiusRange(1400, 1500);
+  ExpectAbortStops(
+    source, [&]() { source->Update(); }, source->GetOutput(), "metaball source");
+
+  // Progress: a single long sampling reports several times, in order, up to 1.
+  vtkNew<vtkNimbusMetaballCloudSource> one;
+  one->SetDimensions(256, 256, 256);
+  one->SetNumberOfLevels(0);
+  one->AddBall(0, 0, 1800, 3000, 1);
+  AbortAfter watch(one, -1.0);
+  one->Update();
+  std::cout << "metaball source, one sampling of 16.8 million points: " << watch.Progress.size()
+            << " progress events\n";
+  EXPECT_GE(watch.Progress.size(), 4u);
+  EXPECT_TRUE(std::is_sorted(watch.Progress.begin(), watch.Progress.end()));
+  EXPECT_EQ(watch.Progress.back(), 1.0);
+}
+
+TEST(AbortAndProgress, CloudAutomatonSource)
+{
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  source->SetDimensions(64, 64, 16);
+  source->SetNumberOfTimeSteps(200000);
+  ExpectAbortStops(
+    source, [&]() { source->UpdateTimeStep(200000.0); }, source->GetOutput(), "automaton source");
+  EXPECT_LT(source->GetNumberOfStepsComputed(), 200000);
+
+  vtkNew<vtkNimbusCloudAutomatonSource> watched;
+  watched->SetDimensions(32, 32, 8);
+  watched->SetNumberOfTimeSteps(2000);
+  AbortAfter watch(watched, -1.0);
+  watched->UpdateTimeStep(2000.0);
+  std::cout << "automaton source, 2000 steps: " << watch.Progress.size() << " progress events\n";
+  EXPECT_GE(watch.Progress.size(), 100u);
+  EXPECT_LE(watch.Progress.size(), 400u); // throttled, not one per step
+  EXPECT_TRUE(std::is_sorted(watch.Progress.begin(), watch.Progress.end()));
+  EXPECT_EQ(watch.Progress.back(), 1.0);
+}
+
+TEST(AbortAndProgress, ImageCloudFilter)
+{
+  // A bright, noisy image: about 1e9 grid-point updates per sampling at 400 x 400.
+  auto noise = [](int n)
+  {
+    vtkSmartPointer<vtkImageData> image = vtkSmartPointer<vtkImageData>::New();
+    image->SetDimensions(n, n, 1);
+    vtkNew<vtkUnsignedCharArray> pixels;
+    pixels->SetNumberOfTuples(static_cast<vtkIdType>(n) * n);
+    for (vtkIdType i = 0; i < pixels->GetNumberOfTuples(); ++i)
+    {
+      pixels->SetValue(i, static_cast<unsigned char>(100 + (i * 7919) % 156));
+    }
+    image->GetPointData()->SetScalars(pixels);
+    return image;
+  };
+  vtkSmartPointer<vtkImageData> large = noise(400);
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  filter->SetInputData(large);
+  filter->SetIterations(30);
+  MessageCatcher messages(filter);
+  ExpectAbortStops(
+    filter, [&]() { filter->Update(); }, filter->GetOutput(), "image cloud filter");
+  EXPECT_TRUE(messages.Errors.empty()) << messages.AllErrors();
+
+  vtkSmartPointer<vtkImageData> small = noise(120);
+  vtkNew<vtkNimbusImageCloudFilter> watched;
+  watched->SetInputData(small);
+  watched->SetIterations(3);
+  AbortAfter watch(watched, -1.0);
+  watched->Update();
+  std::cout << "image cloud filter, 120 x 120, 4 samplings: " << watch.Progress.size()
+            << " progress events\n";
+  EXPECT_GE(watch.Progress.size(), 6u);
+  EXPECT_TRUE(std::is_sorted(watch.Progress.begin(), watch.Progress.end()));
+  EXPECT_EQ(watch.Progress.back(), 1.0);
+}
