@@ -31,6 +31,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -1248,4 +1249,29 @@ TEST(Guard, NegativeChunkSizeDoesNotOverflowTheBuffer)
   std::istringstream in2(bytes);
   EXPECT_THROW(openvdb::io::unzipFromStream(in2, buffer, 16), openvdb::RuntimeError);
   EXPECT_EQ(buffer[16], 0) << "wrote past the 16-byte buffer";
+}
+
+TEST(ReadChecks, UnknownGridTypeIsSkippedNotFatal)
+{
+  // A grid type OpenVDB does not know (its type name changed in the file, same length):
+  // listed as unsupported and skipped; the other grid is read.
+  const std::string path = TempPath("unknown-type.vdb");
+  WriteGrids(path,
+    { FloatBlock("alien", openvdb::Coord(0), openvdb::Coord(2), 1.0, 1.0f),
+      FloatBlock("density", openvdb::Coord(0), openvdb::Coord(2), 1.0, 2.0f) });
+  std::vector<char> bytes = Bytes(path);
+  const vdb::FileLayout layout = vdb::ScanFile(path);
+  ASSERT_EQ(layout.Grids.size(), 2u);
+  ASSERT_EQ(layout.Grids[0].StoredName, "alien");
+  const std::string type = "Tree_float_5_4_3";
+  auto at = std::search(bytes.begin() + layout.Grids[0].DescriptorPos,
+    bytes.begin() + layout.Grids[0].GridPos, type.begin(), type.end());
+  ASSERT_NE(at, bytes.begin() + layout.Grids[0].GridPos);
+  at[8] = 'e'; // "Tree_floet_5_4_3"
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size());
+  int ok = 0;
+  std::string warnings;
+  const std::string errors = ReadErrors(path, 0, &ok, &warnings);
+  EXPECT_EQ(ok, 1) << errors;
+  EXPECT_TRUE(Contains(warnings, "'alien' (unknown type 'Tree_floet_5_4_3')")) << warnings;
 }
