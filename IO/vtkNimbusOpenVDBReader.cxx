@@ -534,8 +534,7 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
     array->SetNumberOfComponents(g->Components);
     // Within the budget (checked above), so VTK's allocation (which aborts on failure in
     // this VTK) is not asked for more than the budget allows.
-    array->SetNumberOfTuples(static_cast<vtkIdType>(voxels));
-    array->Fill(0.0);
+    array->SetNumberOfTuples(static_cast<vtkIdType>(voxels)); // ReadDense sets every value
     names.push_back(g->Name);
     targets.push_back(array->GetPointer(0));
     arrays.push_back(array);
