@@ -1,6 +1,7 @@
 #include "PathTracer.h"
 #include "MajorantGrid.h"
 #include "Math.h"
+#include "MemoryBudget.h"
 #include "ParallelFor.h"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace nimbus
@@ -921,10 +923,27 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     throw std::invalid_argument("RenderPathTraced: TargetRelativeError must be >= 0");
   }
   const auto start = std::chrono::steady_clock::now();
-  const Integrator integrator(context, settings);
   const Camera& camera = context.GetCamera();
   const int width = camera.GetWidth(), height = camera.GetHeight();
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  {
+    // Per pixel: running statistics, a slot in the list of active pixels and the
+    // two result images (3 floats each); checked before anything is allocated.
+    const double bytesPerPixel =
+      static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) + 2 * 3 * sizeof(float));
+    const double budget = settings.MemoryBudgetBytes > 0.0
+      ? settings.MemoryBudgetBytes
+      : static_cast<double>(DefaultMemoryBudgetBytes());
+    const std::string message = OverBudgetMessage("the path tracer's per-pixel buffers (" +
+        std::to_string(width) + "x" + std::to_string(height) + " pixels, " +
+        std::to_string(static_cast<int>(bytesPerPixel)) + " bytes each)",
+      bytesPerPixel * static_cast<double>(pixels), budget);
+    if (!message.empty())
+    {
+      throw std::length_error(message);
+    }
+  }
+  const Integrator integrator(context, settings);
   std::vector<PixelStatistics> statistics(pixels);
 
   const int threads = ResolveThreadCount(settings.Threads);
@@ -952,7 +971,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     // threads balanced and the per-chunk scratch rare.
     const std::size_t grain =
       std::max<std::size_t>(1, active.size() / (256 * static_cast<std::size_t>(threads)));
-    ParallelFor(active.size(), grain, threads,
+    ParallelFor(
+      active.size(), grain, threads,
       [&](std::size_t begin, std::size_t end)
       {
         PathState state;
@@ -994,6 +1014,17 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
         }
         paths += localPaths;
         truncated += localTruncated;
+      },
+      // Within a round too (the first round alone can take minutes): from the
+      // calling thread after each of its chunks; an exception thrown by progress
+      // (an abort) stops the round after the chunks being traced.
+      [&](std::size_t)
+      {
+        if (progress)
+        {
+          progress(std::min(
+            1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+        }
       });
     if (progress)
     {
