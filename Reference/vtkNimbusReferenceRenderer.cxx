@@ -338,15 +338,12 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
 
   // Never a silent NaN or infinity: a scene the reader accepts should not make
   // one, so one is a bug to report, not a picture to show.
-  const nimbus::ValueCensus census =
-    nimbus::TakeCensus(radiance.Pixels.data(), radiance.Pixels.size());
-  if (census.NaN != 0 || census.Infinite != 0)
+  // (The renderers check too; this guards any future one.)
+  const std::string nonFinite = nimbus::NonFiniteMessage(radiance);
+  if (!nonFinite.empty())
   {
-    nimbus::ValueCensus nonFinite = census;
-    nonFinite.Negative = 0; // linear sRGB may be negative (out-of-gamut spectra)
-    vtkErrorMacro(<< this->SceneFileName << ": the render has " << nimbus::DescribeCensus(nonFinite)
-                  << " among " << radiance.Pixels.size()
-                  << " pixel components; no image is output.");
+    vtkErrorMacro(<< this->SceneFileName << ": the render has " << nonFinite
+                  << "; no image is output.");
     return 0;
   }
 

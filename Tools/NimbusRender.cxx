@@ -184,11 +184,10 @@ int Run(int argc, char* argv[])
   std::copy(
     radiance->GetPointer(0), radiance->GetPointer(0) + linear.Pixels.size(), linear.Pixels.begin());
   // The renderer refuses non-finite pixels; checked again here, where files are written.
-  const nimbus::ValueCensus census = nimbus::TakeCensus(linear.Pixels.data(), linear.Pixels.size());
-  if (census.NaN != 0 || census.Infinite != 0)
+  const std::string nonFinite = nimbus::NonFiniteMessage(linear);
+  if (!nonFinite.empty())
   {
-    std::cerr << "nimbus-render: the render has " << census.NaN << " NaN and " << census.Infinite
-              << " infinite pixel components; nothing written\n";
+    std::cerr << "nimbus-render: the render has " << nonFinite << "; nothing written\n";
     return 1;
   }
 

@@ -1051,6 +1051,12 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       result.StandardError.At(i, j)[c] = static_cast<float>(statistics[k].StandardError(c));
     }
   }
+  // Never a silent NaN or infinity (a scene the reader accepts should not make one).
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error("RenderPathTraced: the image has " + nonFinite);
+  }
   result.Paths = paths.load();
   result.TruncatedPaths = truncated.load();
   result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);

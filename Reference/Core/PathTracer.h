@@ -123,7 +123,8 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
 /// exception propagates once the pixels being traced are done. Throws
 /// std::invalid_argument for MinSamplesPerPixel < 1 or MaxSamplesPerPixel <
 /// MinSamplesPerPixel or a negative / NaN target, and std::length_error, before
-/// allocating, when the per-pixel buffers would need more than MemoryBudgetBytes.
+/// allocating, when the per-pixel buffers would need more than MemoryBudgetBytes,
+/// and std::range_error when the image has a NaN or infinite pixel component.
 NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
 

@@ -162,10 +162,6 @@ Range AtLeast(double low)
 {
   return Range{ low, kInf, false, false };
 }
-Range Above(double low)
-{
-  return Range{ low, kInf, true, false };
-}
 Range Closed(double low, double high)
 {
   return Range{ low, high, false, false };

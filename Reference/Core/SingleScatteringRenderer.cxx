@@ -897,6 +897,12 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
     stepScale *= 0.5;
   }
   result.Image = std::move(previous);
+  // Never a silent NaN or infinity (a scene the reader accepts should not make one).
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error("RenderSingleScattering: the image has " + nonFinite);
+  }
   result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (progress)
   {

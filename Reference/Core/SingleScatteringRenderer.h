@@ -98,7 +98,8 @@ NIMBUSREFERENCE_EXPORT FloatImage RenderSingleScatteringPass(const RenderContext
 /// progress is monotonic and reaches 1 at the end; it may throw to stop the render
 /// (e.g. on a user's abort): the exception propagates once the rows being rendered
 /// are done. Throws std::length_error, before allocating, when the images would
-/// need more than MemoryBudgetBytes.
+/// need more than MemoryBudgetBytes, and std::range_error when the image has a
+/// NaN or infinite pixel component (NonFiniteMessage, FloatImage.h).
 NIMBUSREFERENCE_EXPORT SingleScatteringResult RenderSingleScattering(const RenderContext& context,
   const SingleScatteringSettings& settings, const std::function<void(double)>& progress = {});
 
