@@ -8,6 +8,8 @@
 #include "SingleScatteringRenderer.h"
 #include "vtkNimbusSceneDensitySource.h"
 
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -233,12 +235,32 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     vtkNew<vtkNimbusSceneDensitySource> sceneDensity;
     sceneDensity->SetSceneFileName(this->SceneFileName.c_str());
     sceneDensity->SetMemoryBudgetMiB(budget / 1048576.0);
+    // Its errors become part of this algorithm's one error (observers of this
+    // algorithm see why), its warnings are passed on as they come.
+    std::string densityErrors;
+    vtkNew<vtkCallbackCommand> relay;
+    relay->SetClientData(&densityErrors);
+    relay->SetCallback(
+      [](vtkObject*, unsigned long, void* clientData, void* callData)
+      {
+        auto* text = static_cast<std::string*>(clientData);
+        std::string message = static_cast<const char*>(callData);
+        const std::size_t object = message.find("): "); // "vtkClass (0x...): "
+        message = object == std::string::npos ? message : message.substr(object + 3);
+        while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
+        {
+          message.pop_back();
+        }
+        *text += (text->empty() ? "" : "; ") + message;
+      });
+    sceneDensity->AddObserver(vtkCommand::ErrorEvent, relay);
     sceneDensity->Update();
     volume = sceneDensity->GetOutput();
     arrayName = "density";
     if (volume->GetNumberOfPoints() == 0)
     {
-      vtkErrorMacro(<< this->SceneFileName << ": no density volume (see the errors above).");
+      vtkErrorMacro(<< "no density volume: "
+                    << (densityErrors.empty() ? std::string("(no reason given)") : densityErrors));
       return 0;
     }
   }

@@ -12,6 +12,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace nimbus
@@ -913,6 +914,9 @@ struct PixelStatistics
 PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
 {
+  // Paths the calling thread traces between progress reports within a pixel (a few
+  // milliseconds: ~15 us a path in a thick cloud).
+  constexpr std::uint64_t kPathsPerProgressCheck = 1024;
   if (settings.MinSamplesPerPixel < 1 || settings.MaxSamplesPerPixel < settings.MinSamplesPerPixel)
   {
     throw std::invalid_argument(
@@ -949,6 +953,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   const int threads = ResolveThreadCount(settings.Threads);
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
+  std::atomic<bool> stop{ false };
+  const std::thread::id caller = std::this_thread::get_id();
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
   const std::uint64_t maxSamples = static_cast<std::uint64_t>(settings.MaxSamplesPerPixel);
   for (;;)
@@ -977,6 +983,10 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       {
         PathState state;
         std::uint64_t localPaths = 0, localTruncated = 0;
+        // A chunk can be one pixel of a million samples: the calling thread also
+        // reports progress every kPathsPerProgressCheck of its paths, and when that
+        // throws (an abort) every thread leaves its chunk at its next path.
+        const bool reporter = progress && std::this_thread::get_id() == caller;
         for (std::size_t slot = begin; slot < end; ++slot)
         {
           const std::size_t k = active[slot];
@@ -997,6 +1007,24 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
             stats.Add(rgb);
             ++localPaths;
             localTruncated += state.Truncated ? 1 : 0;
+            if (stop.load(std::memory_order_relaxed))
+            {
+              return; // the render is being abandoned; its statistics do not matter
+            }
+            if (reporter && localPaths % kPathsPerProgressCheck == 0)
+            {
+              try
+              {
+                progress(std::min(1.0,
+                  static_cast<double>(paths.load() + localPaths) /
+                    (static_cast<double>(pixels) * maxSamples)));
+              }
+              catch (...)
+              {
+                stop = true;
+                throw;
+              }
+            }
           }
           if (stats.Count >= maxSamples)
           {
@@ -1017,13 +1045,21 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       },
       // Within a round too (the first round alone can take minutes): from the
       // calling thread after each of its chunks; an exception thrown by progress
-      // (an abort) stops the round after the chunks being traced.
+      // (an abort) makes every thread leave its chunk at its next path.
       [&](std::size_t)
       {
         if (progress)
         {
-          progress(std::min(
-            1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+          try // an exception here (an abort) stops the other threads too
+          {
+            progress(std::min(
+              1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+          }
+          catch (...)
+          {
+            stop = true;
+            throw;
+          }
         }
       });
     if (progress)
