@@ -223,4 +223,5 @@ void vtkNimbusSceneDensitySource::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "SceneFileName: " << this->SceneFileName << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }
