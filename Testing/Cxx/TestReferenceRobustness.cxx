@@ -465,4 +465,13 @@ TEST(ReferenceRobustness, PathTracingReportsProgressAndAborts)
   renderer->Modified();
   renderer->Update();
   EXPECT_TRUE(HasRadiance(renderer->GetOutput())) << messages.AllErrors();
+
+  // Single scattering stops too (after the rows being rendered).
+  renderer->SetModeToSingleScattering();
+  renderer->SetMaxRefinements(6);
+  renderer->SetRelativeTolerance(1e-12); // all 7 passes, were it not aborted
+  renderer->AddObserver(vtkCommand::ProgressEvent, abortOnProgress);
+  renderer->Update();
+  EXPECT_FALSE(HasRadiance(renderer->GetOutput()));
+  EXPECT_EQ(messages.AllErrors(), "");
 }
