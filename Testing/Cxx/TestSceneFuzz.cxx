@@ -1,11 +1,12 @@
 // Fuzzing the scene reader and the reference renderer: a few hundred mutants of the
 // project's scenes (Data/Scenes), made with a fixed seed, each either refused with a
 // clean message (std::invalid_argument starting with the key path, "scene...") or
-// accepted and rendered by vtkNimbusReferenceRenderer (8x6 pixels, single
-// scattering, one pass, a 16^3 density grid) to finite pixels. Every mutant runs in
-// a forked child under an address-space limit (RLIMIT_AS, 3 GiB) and a time limit
-// (alarm, 20 s): a crash, an abort, an escaping exception, a hang, a non-finite
-// pixel or a valid scene that fails to render fails the test.
+// accepted and rendered by vtkNimbusReferenceRenderer (8x6 pixels, a 16^3 density
+// grid; single scattering, one pass, then path tracing, one path per pixel) to
+// finite pixels. Every mutant runs in a forked child under an address-space limit
+// (RLIMIT_AS, 3 GiB) and a time limit (alarm, 20 s): a crash, an abort, an escaping
+// exception, a hang, a non-finite pixel or a valid scene that fails to render fails
+// the test.
 //
 // Mutations: a number scaled by 0, -1, 1e-308 ... 1e300 (often still valid), a value
 // replaced by an extreme (0, -1, +-1e308, 1e-308, huge integers,
@@ -395,6 +396,24 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
     if (!std::isfinite(radiance->GetValue(i)))
     {
       return { Outcome::NonFinite, "component " + std::to_string(i) };
+    }
+  }
+  // And one path per pixel through the path tracer.
+  renderer->SetModeToPathTracing();
+  renderer->SetMinSamplesPerPixel(1);
+  renderer->SetMaxSamplesPerPixel(1);
+  renderer->Update();
+  radiance =
+    vtkFloatArray::SafeDownCast(renderer->GetOutput()->GetPointData()->GetArray("radiance"));
+  if (!radiance)
+  {
+    return { Outcome::RenderFailed, "path tracing: " + messages.AllErrors() };
+  }
+  for (vtkIdType i = 0; i < radiance->GetNumberOfValues(); ++i)
+  {
+    if (!std::isfinite(radiance->GetValue(i)))
+    {
+      return { Outcome::NonFinite, "path tracing, component " + std::to_string(i) };
     }
   }
   return { Outcome::Rendered, std::to_string(radiance->GetNumberOfTuples()) + " pixels" };
