@@ -187,30 +187,49 @@ TEST(ReferenceRobustness, HugeSceneGridIsRefusedNotAborted)
 
 TEST(ReferenceRobustness, PathTracerChecksItsBuffersBeforeAllocating)
 {
-  const nimbus::SceneDescription scene =
-    nimbus::LoadScene(std::string(NIMBUS_TEST_DATA_DIR) + "/tiny_scene.json");
-  nimbus::SceneDescription big = scene;
-  big.Camera.Width = 16384; // the schema's largest image
-  big.Camera.Height = 16384;
-  const nimbus::RenderContext context(
-    big, nimbus::DensityGrid::Constant({ { -100, -100, 1400 } }, { { 100, 100, 1600 } }, 0.5f));
-  nimbus::PathTracingSettings settings;
-  settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1;
-  settings.MemoryBudgetBytes = 1 << 30;
-  try
-  {
-    nimbus::RenderPathTraced(context, settings);
-    FAIL() << "no error";
-  }
-  catch (const std::length_error& error)
-  {
-    EXPECT_STREQ(error.what(),
-      "the path tracer's per-pixel buffers (16384x16384 pixels, 112 bytes each) would need 28.0 "
-      "GiB, more than the memory budget of 1.0 GiB");
-  }
-  nimbus::SingleScatteringSettings single;
-  single.MemoryBudgetBytes = 1 << 30;
-  EXPECT_THROW(nimbus::RenderSingleScattering(context, single), std::length_error);
+  // In a child under the address-space limit: without the check this would ask
+  // for 28 GiB.
+  const int status = RunLimited(
+    []
+    {
+      nimbus::SceneDescription big =
+        nimbus::LoadScene(std::string(NIMBUS_TEST_DATA_DIR) + "/tiny_scene.json");
+      big.Camera.Width = 16384; // the schema's largest image
+      big.Camera.Height = 16384;
+      const nimbus::RenderContext context(
+        big, nimbus::DensityGrid::Constant({ { -100, -100, 1400 } }, { { 100, 100, 1600 } }, 0.5f));
+      nimbus::PathTracingSettings settings;
+      settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1;
+      settings.MemoryBudgetBytes = 1 << 30;
+      int failures = 0;
+      try
+      {
+        nimbus::RenderPathTraced(context, settings);
+        ++failures;
+      }
+      catch (const std::length_error& error)
+      {
+        const std::string expected = "the path tracer's per-pixel buffers (16384x16384 pixels, "
+                                     "112 bytes each) would need 28.0 GiB, more than the memory "
+                                     "budget of 1.0 GiB";
+        failures += error.what() == expected ? 0 : 1;
+        std::printf("%s\n", error.what());
+      }
+      nimbus::SingleScatteringSettings single;
+      single.MemoryBudgetBytes = 1 << 30;
+      try
+      {
+        nimbus::RenderSingleScattering(context, single);
+        ++failures;
+      }
+      catch (const std::length_error& error)
+      {
+        std::printf("%s\n", error.what());
+      }
+      return failures;
+    });
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
 TEST(ReferenceRobustness, NimbusRenderRefusesHugeImagesWithAMessage)
