@@ -413,11 +413,15 @@ const std::vector<ParameterSpec>& MetaballParameters()
   // Limits follow vtkNimbusMetaballCloudSource::CheckParameters, plus upper bounds
   // that keep a scene renderable (grid size, growth levels, ball counts, lengths
   // within kMaxLengthMetres, densities within kMaxBallDensity).
-  const Range length = Range{ 0.0, kMaxLengthMetres, true, false };
-  const Range lengthOrZero = Closed(0.0, kMaxLengthMetres);
+  // The source's lengths, coordinates and heights are bounded by 1e8 m
+  // (vtkNimbusMetaballCloudSource's MaximumLength), tighter than the scene's 1e9 m.
+  const double maxMetaballLength = 1.0e8;
+  const Range length = Range{ 0.0, maxMetaballLength, true, false };
+  const Range lengthOrZero = Closed(0.0, maxMetaballLength);
+  const Range coordinate = Closed(-maxMetaballLength, maxMetaballLength);
   static const std::vector<ParameterSpec> specs = {
     { "Dimensions", 3, ParameterKind::Integer, Finite(), 1, 2048 },
-    { "Bounds", 6, ParameterKind::Real, Coordinate(), 0, 0 },
+    { "Bounds", 6, ParameterKind::Real, coordinate, 0, 0 },
     { "Seed", 1, ParameterKind::Integer, Finite(), std::numeric_limits<std::int32_t>::min(),
       std::numeric_limits<std::int32_t>::max() },
     { "NumberOfLevels", 1, ParameterKind::Integer, Finite(), 0, 10 },
@@ -428,11 +432,12 @@ const std::vector<ParameterSpec>& MetaballParameters()
     { "BallsPerLevel", 1, ParameterKind::Integer, Finite(), 0, 1000000 },
     // Ball counts grow by this factor per level (their total is checked below).
     { "BallCountFactor", 1, ParameterKind::Real, Range{ 0.0, 1000.0, true, false }, 0, 0 },
-    { "RadiusScalePerLevel", 1, ParameterKind::Real, Range{ 0.0, 1000.0, true, false }, 0, 0 },
+    // Growth balls are no larger than their parents (the source's range).
+    { "RadiusScalePerLevel", 1, ParameterKind::Real, Range{ 0.0, 1.0, true, false }, 0, 0 },
     { "BallDensity", 1, ParameterKind::Real, Closed(0.0, kMaxBallDensity), 0, 0 },
     { "IsoValue", 1, ParameterKind::Real, Closed(-kMaxBallDensity, kMaxBallDensity), 0, 0 },
     { "FlatBase", 1, ParameterKind::Bool, Finite(), 0, 0 },
-    { "BaseHeight", 1, ParameterKind::Real, Coordinate(), 0, 0 },
+    { "BaseHeight", 1, ParameterKind::Real, coordinate, 0, 0 },
     { "BaseTransitionThickness", 1, ParameterKind::Real, lengthOrZero, 0, 0 },
   };
   return specs;
