@@ -1,12 +1,15 @@
 #include "vtkNimbusReferenceRenderer.h"
 
 #include "DensityGrid.h"
+#include "MemoryBudget.h"
 #include "PathTracer.h"
 #include "RenderContext.h"
 #include "SceneJson.h"
 #include "SingleScatteringRenderer.h"
 #include "vtkNimbusSceneDensitySource.h"
 
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -14,6 +17,7 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkMatrix3x3.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -33,6 +37,33 @@ struct vtkNimbusReferenceRenderer::vtkInternals
 
 namespace
 {
+/// Thrown by the progress callback when the user aborts (AbortExecute).
+struct RenderAborted
+{
+};
+
+/// Empty when the image's direction matrix is the identity (the renderers place
+/// the grid by origin and spacing only); else why it cannot be used.
+std::string DirectionMatrixProblem(vtkImageData* image)
+{
+  vtkMatrix3x3* direction = image->GetDirectionMatrix();
+  if (!direction || direction->IsIdentity())
+  {
+    return std::string();
+  }
+  std::string elements;
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      elements += (elements.empty() ? "" : " ") + std::to_string(direction->GetElement(i, j));
+    }
+  }
+  return "the density image has a direction matrix that is not the identity (" + elements +
+    "): the reference renderers place the grid by origin and spacing along x, y, z only. "
+    "Resample it onto an axis-aligned image (e.g. vtkImageReslice) first";
+}
+
 // vtkImageData point array -> DensityGrid (float), placed by origin, spacing and extent.
 nimbus::DensityGrid ToDensityGrid(vtkImageData* image, vtkDataArray* values)
 {
@@ -52,6 +83,7 @@ nimbus::DensityGrid ToDensityGrid(vtkImageData* image, vtkDataArray* values)
   std::vector<float> density(static_cast<std::size_t>(values->GetNumberOfTuples()));
   for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
   {
+    // Through double: a double array's huge values become +inf, caught by DensityGrid.
     density[static_cast<std::size_t>(i)] = static_cast<float>(values->GetComponent(i, 0));
   }
   return nimbus::DensityGrid(dims, first, step, std::move(density));
@@ -77,7 +109,8 @@ void AddFieldValue(vtkFieldData* fieldData, const char* name, double value)
 }
 
 vtkNimbusReferenceRenderer::vtkNimbusReferenceRenderer()
-  : Internals(new vtkInternals)
+  : MemoryBudgetMiB(nimbus::DefaultMemoryBudgetMiB())
+  , Internals(new vtkInternals)
 {
   this->SetNumberOfInputPorts(1);
 }
@@ -108,6 +141,11 @@ int vtkNimbusReferenceRenderer::RequestInformation(
   catch (const std::exception& error)
   {
     vtkErrorMacro(<< error.what());
+    return 0;
+  }
+  catch (...)
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": reading the scene failed (unknown exception)");
     return 0;
   }
   const nimbus::SceneDescription& scene = *this->Internals->Scene;
@@ -143,7 +181,51 @@ int vtkNimbusReferenceRenderer::RequestData(
   {
     return 0; // RequestInformation reported why
   }
+  // No exception leaves the algorithm: bad input ends in an error and an empty output.
+  try
+  {
+    return this->Render(inputVector, output);
+  }
+  catch (const RenderAborted&)
+  {
+    output->Initialize();
+    vtkDebugMacro(<< "Aborted.");
+    return 1;
+  }
+  catch (const std::exception& error)
+  {
+    output->Initialize();
+    vtkErrorMacro(<< "rendering failed: " << error.what());
+    return 0;
+  }
+  catch (...)
+  {
+    output->Initialize();
+    vtkErrorMacro(<< "rendering failed (unknown exception)");
+    return 0;
+  }
+}
+
+int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkImageData* output)
+{
   const nimbus::SceneDescription& scene = *this->Internals->Scene;
+  const double budget = this->MemoryBudgetMiB > 0.0
+    ? this->MemoryBudgetMiB * 1048576.0
+    : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
+  const double pixels =
+    static_cast<double>(scene.Camera.Width) * static_cast<double>(scene.Camera.Height);
+  // The output arrays (radiance and, for path tracing, its standard error: 3
+  // floats per pixel each), before the density is even made.
+  const double outputBytes = pixels * 3.0 * sizeof(float) * (this->Mode == PATH_TRACING ? 2 : 1);
+  std::string overBudget = nimbus::OverBudgetMessage("the rendered image (" +
+      std::to_string(scene.Camera.Width) + "x" + std::to_string(scene.Camera.Height) + " pixels)",
+    outputBytes, budget);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": " << overBudget
+                  << " (set MemoryBudgetMiB to allow more)");
+    return 0;
+  }
 
   // The density: the connected image, or the scene's own.
   vtkSmartPointer<vtkImageData> volume = vtkImageData::GetData(inputVector[0], 0);
@@ -152,12 +234,33 @@ int vtkNimbusReferenceRenderer::RequestData(
   {
     vtkNew<vtkNimbusSceneDensitySource> sceneDensity;
     sceneDensity->SetSceneFileName(this->SceneFileName.c_str());
+    sceneDensity->SetMemoryBudgetMiB(budget / 1048576.0);
+    // Its errors become part of this algorithm's one error (observers of this
+    // algorithm see why), its warnings are passed on as they come.
+    std::string densityErrors;
+    vtkNew<vtkCallbackCommand> relay;
+    relay->SetClientData(&densityErrors);
+    relay->SetCallback(
+      [](vtkObject*, unsigned long, void* clientData, void* callData)
+      {
+        auto* text = static_cast<std::string*>(clientData);
+        std::string message = static_cast<const char*>(callData);
+        const std::size_t object = message.find("): "); // "vtkClass (0x...): "
+        message = object == std::string::npos ? message : message.substr(object + 3);
+        while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
+        {
+          message.pop_back();
+        }
+        *text += (text->empty() ? "" : "; ") + message;
+      });
+    sceneDensity->AddObserver(vtkCommand::ErrorEvent, relay);
     sceneDensity->Update();
     volume = sceneDensity->GetOutput();
     arrayName = "density";
     if (volume->GetNumberOfPoints() == 0)
     {
-      vtkErrorMacro(<< this->SceneFileName << ": no density volume (see the errors above).");
+      vtkErrorMacro(<< "no density volume: "
+                    << (densityErrors.empty() ? std::string("(no reason given)") : densityErrors));
       return 0;
     }
   }
@@ -167,9 +270,23 @@ int vtkNimbusReferenceRenderer::RequestData(
     vtkErrorMacro(<< "The density input has no one-component point array '" << arrayName << "'.");
     return 0;
   }
+  const std::string directionProblem = DirectionMatrixProblem(volume);
+  if (!directionProblem.empty())
+  {
+    vtkErrorMacro(<< directionProblem << ".");
+    return 0;
+  }
+  // The float copy of the density for the renderers.
+  overBudget = nimbus::OverBudgetMessage("the density grid (" +
+      std::to_string(values->GetNumberOfTuples()) + " floats) and the rendered image",
+    static_cast<double>(values->GetNumberOfTuples()) * sizeof(float) + outputBytes, budget);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< overBudget << " (set MemoryBudgetMiB to allow more)");
+    return 0;
+  }
 
   std::unique_ptr<nimbus::RenderContext> context;
-  try
   {
     nimbus::DensityGrid grid;
     try
@@ -182,66 +299,73 @@ int vtkNimbusReferenceRenderer::RequestData(
     }
     context = std::make_unique<nimbus::RenderContext>(scene, std::move(grid));
   }
-  catch (const std::exception& error)
-  {
-    vtkErrorMacro(<< error.what());
-    return 0;
-  }
+  const double renderBudget =
+    budget - static_cast<double>(values->GetNumberOfTuples()) * sizeof(float) - outputBytes;
 
-  // Progress comes from worker threads too; only the calling thread reports it.
+  // Progress comes from worker threads too; only the calling thread reports it and
+  // looks for an abort (which stops the render after the pixels being worked on).
   const std::thread::id caller = std::this_thread::get_id();
   auto progress = [this, caller](double fraction)
   {
     if (std::this_thread::get_id() == caller)
     {
       this->UpdateProgress(std::min(1.0, std::max(0.0, fraction)));
+      if (this->CheckAbort())
+      {
+        throw RenderAborted();
+      }
     }
   };
 
   nimbus::FloatImage radiance, standardError;
   double estimatedError = 0.0, seconds = 0.0, samplesPerPixel = 0.0;
-  try
+  if (this->Mode == SINGLE_SCATTERING)
   {
-    if (this->Mode == SINGLE_SCATTERING)
-    {
-      nimbus::SingleScatteringSettings settings;
-      settings.StepScale = this->StepScale;
-      settings.RelativeTolerance = this->RelativeTolerance;
-      settings.MaxRefinements = this->MaxRefinements;
-      settings.Threads = this->NumberOfThreads;
-      nimbus::SingleScatteringResult result =
-        nimbus::RenderSingleScattering(*context, settings, progress);
-      radiance = std::move(result.Image);
-      estimatedError = result.EstimatedRelativeError;
-      seconds = result.Seconds;
-    }
-    else
-    {
-      nimbus::PathTracingSettings settings;
-      settings.MinSamplesPerPixel = this->MinSamplesPerPixel;
-      settings.MaxSamplesPerPixel = this->MaxSamplesPerPixel;
-      settings.TargetRelativeError = this->TargetRelativeError;
-      settings.MaxScatteringOrder = this->MaxScatteringOrder;
-      settings.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
-      settings.Threads = this->NumberOfThreads;
-      nimbus::PathTracingResult result = nimbus::RenderPathTraced(*context, settings, progress);
-      radiance = std::move(result.Image);
-      standardError = std::move(result.StandardError);
-      samplesPerPixel = result.MeanSamplesPerPixel;
-      seconds = result.Seconds;
-      // Image-wide relative error: RMS standard error over RMS radiance.
-      double sumError = 0.0, sumValue = 0.0;
-      for (std::size_t i = 0; i < radiance.Pixels.size(); ++i)
-      {
-        sumError += static_cast<double>(standardError.Pixels[i]) * standardError.Pixels[i];
-        sumValue += static_cast<double>(radiance.Pixels[i]) * radiance.Pixels[i];
-      }
-      estimatedError = sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
-    }
+    nimbus::SingleScatteringSettings settings;
+    settings.StepScale = this->StepScale;
+    settings.RelativeTolerance = this->RelativeTolerance;
+    settings.MaxRefinements = this->MaxRefinements;
+    settings.Threads = this->NumberOfThreads;
+    settings.MemoryBudgetBytes = std::max(1.0, renderBudget);
+    nimbus::SingleScatteringResult result =
+      nimbus::RenderSingleScattering(*context, settings, progress);
+    radiance = std::move(result.Image);
+    estimatedError = result.EstimatedRelativeError;
+    seconds = result.Seconds;
   }
-  catch (const std::exception& error)
+  else
   {
-    vtkErrorMacro(<< "rendering failed: " << error.what());
+    nimbus::PathTracingSettings settings;
+    settings.MinSamplesPerPixel = this->MinSamplesPerPixel;
+    settings.MaxSamplesPerPixel = this->MaxSamplesPerPixel;
+    settings.TargetRelativeError = this->TargetRelativeError;
+    settings.MaxScatteringOrder = this->MaxScatteringOrder;
+    settings.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
+    settings.Threads = this->NumberOfThreads;
+    settings.MemoryBudgetBytes = std::max(1.0, renderBudget);
+    nimbus::PathTracingResult result = nimbus::RenderPathTraced(*context, settings, progress);
+    radiance = std::move(result.Image);
+    standardError = std::move(result.StandardError);
+    samplesPerPixel = result.MeanSamplesPerPixel;
+    seconds = result.Seconds;
+    // Image-wide relative error: RMS standard error over RMS radiance.
+    double sumError = 0.0, sumValue = 0.0;
+    for (std::size_t i = 0; i < radiance.Pixels.size(); ++i)
+    {
+      sumError += static_cast<double>(standardError.Pixels[i]) * standardError.Pixels[i];
+      sumValue += static_cast<double>(radiance.Pixels[i]) * radiance.Pixels[i];
+    }
+    estimatedError = sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+  }
+
+  // Never a silent NaN or infinity: a scene the reader accepts should not make
+  // one, so one is a bug to report, not a picture to show.
+  // (The renderers check too; this guards any future one.)
+  const std::string nonFinite = nimbus::NonFiniteMessage(radiance);
+  if (!nonFinite.empty())
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": the render has " << nonFinite
+                  << "; no image is output.");
     return 0;
   }
 
@@ -288,4 +412,5 @@ void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaxScatteringOrder: " << this->MaxScatteringOrder << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }

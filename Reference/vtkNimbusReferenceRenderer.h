@@ -14,7 +14,14 @@
  * is the scene's own (a .vti file or the metaball source) unless a vtkImageData
  * is connected to input port 0 (optional), whose array DensityArrayName (point
  * data, any numeric type) is used instead, placed by its origin and spacing.
- * NaN, infinite or negative densities are an error naming the array.
+ * NaN, infinite or negative densities are an error naming the array and how
+ * many there are; so is a direction matrix other than the identity (the grid is
+ * placed by origin and spacing only). The image, the density's float copy and
+ * the renderers' buffers are checked against MemoryBudgetMiB before they are
+ * allocated; a render with a NaN or infinite pixel is an error (no output). No
+ * exception leaves the algorithm: errors are reported with vtkErrorMacro and the
+ * output is empty. Progress is reported during the render, and AbortExecute
+ * stops it within one chunk of pixels (the output is then empty).
  *
  * Output: vtkImageData of Width x Height points with the 3-component float
  * point array "radiance" (linear sRGB, relative units: the sun's illuminance is
@@ -29,6 +36,8 @@
 
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
+
+class vtkImageData;
 
 class NIMBUSREFERENCE_EXPORT vtkNimbusReferenceRenderer : public vtkImageAlgorithm
 {
@@ -104,6 +113,14 @@ public:
   vtkGetMacro(NumberOfThreads, int);
   ///@}
 
+  ///@{
+  /// Memory the render may allocate, MiB (image, density copy, renderer buffers;
+  /// also passed to the scene's density source). Default
+  /// nimbus::DefaultMemoryBudgetMiB() (Physics/MemoryBudget.h); <= 0: that default.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  ///@}
+
 protected:
   vtkNimbusReferenceRenderer();
   ~vtkNimbusReferenceRenderer() override;
@@ -125,8 +142,12 @@ protected:
   int MaxScatteringOrder = 0;
   int Seed = 1;
   int NumberOfThreads = 0;
+  double MemoryBudgetMiB;
 
 private:
+  // RequestData's work; throws on failure (RequestData reports it).
+  int Render(vtkInformationVector** inputVector, vtkImageData* output);
+
   // The scene parsed by RequestInformation, rendered by RequestData.
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -1,5 +1,6 @@
 #include "vtkNimbusSceneDensitySource.h"
 
+#include "MemoryBudget.h"
 #include "SceneJson.h"
 #include "vtkNimbusMetaballCloudSource.h"
 
@@ -56,11 +57,33 @@ const std::map<std::string, Setter>& MetaballSetters()
 }
 
 vtkNimbusSceneDensitySource::vtkNimbusSceneDensitySource()
+  : MemoryBudgetMiB(nimbus::DefaultMemoryBudgetMiB())
 {
   this->SetNumberOfInputPorts(0);
 }
 
 int vtkNimbusSceneDensitySource::RequestInformation(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  // No exception leaves the algorithm.
+  try
+  {
+    return this->SetUpInner(request, inputVector, outputVector);
+  }
+  catch (const std::exception& error)
+  {
+    this->Inner = nullptr;
+    vtkErrorMacro(<< this->SceneFileName << ": " << error.what());
+  }
+  catch (...)
+  {
+    this->Inner = nullptr;
+    vtkErrorMacro(<< this->SceneFileName << ": setting up the density failed (unknown exception)");
+  }
+  return 0;
+}
+
+int vtkNimbusSceneDensitySource::SetUpInner(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   this->Inner = nullptr;
@@ -124,6 +147,48 @@ int vtkNimbusSceneDensitySource::RequestData(
   {
     return 0;
   }
+  try
+  {
+    return this->MakeVolume(output);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": making the density failed: " << error.what());
+  }
+  catch (...)
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": making the density failed (unknown exception)");
+  }
+  output->Initialize();
+  return 0;
+}
+
+int vtkNimbusSceneDensitySource::MakeVolume(vtkImageData* output)
+{
+  // The size before the volume is made: an allowed but huge grid (2^30 points)
+  // must end in a message, not in VTK's abort on a failed allocation.
+  int whole[6];
+  this->Inner->GetOutputInformation(0)->Get(
+    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+  uint64_t points = 0;
+  const bool representable = whole[1] >= whole[0] && whole[3] >= whole[2] && whole[5] >= whole[4] &&
+    nimbus::CheckedProduct({ static_cast<uint64_t>(whole[1]) - whole[0] + 1,
+                             static_cast<uint64_t>(whole[3]) - whole[2] + 1,
+                             static_cast<uint64_t>(whole[5]) - whole[4] + 1 },
+      points);
+  const double budget = this->MemoryBudgetMiB > 0.0
+    ? this->MemoryBudgetMiB * 1048576.0
+    : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
+  const std::string overBudget = nimbus::OverBudgetMessage("the density volume (" +
+      std::to_string(whole[1] - whole[0] + 1) + "x" + std::to_string(whole[3] - whole[2] + 1) +
+      "x" + std::to_string(whole[5] - whole[4] + 1) + " points, 12 bytes each)",
+    representable ? 12.0 * static_cast<double>(points) : -1.0, budget);
+  if (!overBudget.empty())
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": " << overBudget
+                  << " (set MemoryBudgetMiB to allow more)");
+    return 0;
+  }
   this->Inner->Update();
   vtkImageData* volume = vtkImageData::SafeDownCast(this->Inner->GetOutputDataObject(0));
   vtkDataArray* values =
@@ -138,10 +203,19 @@ int vtkNimbusSceneDensitySource::RequestData(
   output->SetExtent(volume->GetExtent());
   output->SetOrigin(volume->GetOrigin());
   output->SetSpacing(volume->GetSpacing());
+  output->SetDirectionMatrix(volume->GetDirectionMatrix());
   vtkNew<vtkFloatArray> densityArray; // any numeric type is converted once, to float
   densityArray->DeepCopy(values);
   densityArray->SetName("density");
   output->GetPointData()->SetScalars(densityArray);
+  const nimbus::ValueCensus census = nimbus::TakeCensus(
+    densityArray->GetPointer(0), static_cast<std::size_t>(densityArray->GetNumberOfValues()));
+  if (!census.AllFiniteNonNegative())
+  {
+    vtkWarningMacro(<< this->SceneFileName << ": the density has " << nimbus::DescribeCensus(census)
+                    << " among " << densityArray->GetNumberOfValues()
+                    << " (densities must be finite and >= 0; the reference renderers refuse it)");
+  }
   return 1;
 }
 
@@ -149,4 +223,5 @@ void vtkNimbusSceneDensitySource::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "SceneFileName: " << this->SceneFileName << "\n";
+  os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
 }

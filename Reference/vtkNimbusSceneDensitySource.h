@@ -7,6 +7,12 @@
  * vtkNimbusMetaballCloudSource with the scene's parameters. The output's active
  * scalars are a float array named "density". Every Nimbus renderer (and the trade
  * harness) takes the density from here, so they all see the same volume.
+ *
+ * The output keeps the volume's direction matrix (a rotated .vti stays rotated;
+ * the reference renderer refuses it rather than ignore it). The volume's size
+ * (from its whole extent) is checked against MemoryBudgetMiB before it is made;
+ * NaN, infinite or negative densities are reported as a warning with their
+ * count. No exception leaves the algorithm (errors: vtkErrorMacro, empty output).
  */
 #ifndef vtkNimbusSceneDensitySource_h
 #define vtkNimbusSceneDensitySource_h
@@ -31,14 +37,26 @@ public:
   vtkGetCharFromStdStringMacro(SceneFileName);
   ///@}
 
+  ///@{
+  /// Memory the volume may take, MiB: the grid's points times 12 bytes (the inner
+  /// source's or reader's array, up to 8 bytes a value, and the float copy).
+  /// Default nimbus::DefaultMemoryBudgetMiB(); <= 0: that default.
+  vtkSetMacro(MemoryBudgetMiB, double);
+  vtkGetMacro(MemoryBudgetMiB, double);
+  ///@}
+
 protected:
   vtkNimbusSceneDensitySource();
   ~vtkNimbusSceneDensitySource() override = default;
 
   int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  // The work of RequestInformation and RequestData; they may throw.
+  int SetUpInner(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
+  int MakeVolume(vtkImageData* output);
 
   std::string SceneFileName;
+  double MemoryBudgetMiB;
 
 private:
   // The reader or metaball source the scene asks for, set up by RequestInformation.

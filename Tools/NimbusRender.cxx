@@ -8,7 +8,13 @@
 // Writes PREFIX.pfm (linear float RGB), PREFIX.vti (the same as vtkImageData,
 // with "standard_error" for path tracing) and PREFIX.png (exposure, clip, sRGB),
 // then prints one JSON line with the render's figures.
+//
+// Exit status: 0 on success; 1 when the scene cannot be read or rendered (the
+// message says why: a bad value with its key path, a size over the memory
+// budget, a render with NaN or infinite pixels); 2 for bad options. Nothing
+// aborts or leaves an uncaught exception.
 #include "FloatImage.h"
+#include "MemoryBudget.h"
 #include "vtkNimbusReferenceRenderer.h"
 
 #include "vtkDataArray.h"
@@ -49,9 +55,30 @@ double FieldValue(vtkImageData* image, const char* name)
   vtkDataArray* array = image->GetFieldData()->GetArray(name);
   return array ? array->GetTuple1(0) : 0.0;
 }
+
+int Run(int argc, char* argv[]);
 }
 
 int main(int argc, char* argv[])
+{
+  try
+  {
+    return Run(argc, argv);
+  }
+  catch (const std::exception& error)
+  {
+    std::cerr << "nimbus-render: " << error.what() << "\n";
+  }
+  catch (...)
+  {
+    std::cerr << "nimbus-render: failed (unknown exception)\n";
+  }
+  return 1;
+}
+
+namespace
+{
+int Run(int argc, char* argv[])
 {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")
   {
@@ -143,9 +170,26 @@ int main(int argc, char* argv[])
   }
   int dims[3];
   image->GetDimensions(dims);
+  // This program's own copies: the linear image (3 floats a pixel), the tone-mapped
+  // bytes and their VTK array (3 bytes a pixel each).
+  const std::string overBudget = nimbus::OverBudgetMessage("the output copies",
+    (3.0 * sizeof(float) + 6.0) * static_cast<double>(dims[0]) * dims[1],
+    static_cast<double>(nimbus::DefaultMemoryBudgetBytes()));
+  if (!overBudget.empty())
+  {
+    std::cerr << "nimbus-render: " << overBudget << "\n";
+    return 1;
+  }
   nimbus::FloatImage linear(dims[0], dims[1]);
   std::copy(
     radiance->GetPointer(0), radiance->GetPointer(0) + linear.Pixels.size(), linear.Pixels.begin());
+  // The renderer refuses non-finite pixels; checked again here, where files are written.
+  const std::string nonFinite = nimbus::NonFiniteMessage(linear);
+  if (!nonFinite.empty())
+  {
+    std::cerr << "nimbus-render: the render has " << nonFinite << "; nothing written\n";
+    return 1;
+  }
 
   try
   {
@@ -191,4 +235,5 @@ int main(int argc, char* argv[])
             << ", \"samples_per_pixel\": " << FieldValue(image, "SamplesPerPixel")
             << ", \"output\": \"" << output << "\"}" << std::endl;
   return 0;
+}
 }

@@ -117,6 +117,8 @@ public:
   int GetAtmosphereSteps();
   void SetMaximumTextureSize(int value);
   int GetMaximumTextureSize();
+  void SetTextureMemoryBudgetMiB(double value);
+  double GetTextureMemoryBudgetMiB();
   ///@}
 
   ///@{

@@ -1,5 +1,6 @@
 #include "Camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -12,6 +13,20 @@ Vector3 Scaled(const Vector3& a, double s)
 {
   return { { a[0] * s, a[1] * s, a[2] * s } };
 }
+
+/// v times the power of two (exact) that brings its largest component into [1, 2),
+/// so that its length neither overflows nor underflows; zero stays zero.
+Vector3 ScaledToOrderOne(const Vector3& v)
+{
+  const double largest = std::max({ std::abs(v[0]), std::abs(v[1]), std::abs(v[2]) });
+  if (!(largest > 0.0) || !std::isfinite(largest))
+  {
+    return v;
+  }
+  const int exponent = std::ilogb(largest);
+  return { { std::ldexp(v[0], -exponent), std::ldexp(v[1], -exponent),
+    std::ldexp(v[2], -exponent) } };
+}
 }
 
 Camera::Camera(const CameraDescription& d)
@@ -19,17 +34,29 @@ Camera::Camera(const CameraDescription& d)
   , Width(d.Width)
   , Height(d.Height)
 {
-  const Vector3 view{ { d.FocalPoint[0] - d.Position[0], d.FocalPoint[1] - d.Position[1],
-    d.FocalPoint[2] - d.Position[2] } };
-  const double viewLength = Length(view);
-  if (!(viewLength > 0.0) || !std::isfinite(viewLength))
+  // Finiteness first: an overflowing difference is not "equal points".
+  if (!IsFinite(d.Position) || !IsFinite(d.FocalPoint) || !IsFinite(d.ViewUp))
   {
-    throw std::invalid_argument("camera: position and focal point must differ and be finite");
+    throw std::invalid_argument("camera: position, focal point and view-up must be finite");
+  }
+  const Vector3 difference{ { d.FocalPoint[0] - d.Position[0], d.FocalPoint[1] - d.Position[1],
+    d.FocalPoint[2] - d.Position[2] } };
+  if (!IsFinite(difference))
+  {
+    throw std::invalid_argument(
+      "camera: position and focal point are too far apart (their difference overflows)");
+  }
+  const Vector3 view = ScaledToOrderOne(difference);
+  const double viewLength = Length(view);
+  if (!(viewLength > 0.0))
+  {
+    throw std::invalid_argument("camera: position and focal point must differ");
   }
   this->Forward = Scaled(view, 1.0 / viewLength);
-  const Vector3 right = Cross(this->Forward, d.ViewUp);
+  const Vector3 up = ScaledToOrderOne(d.ViewUp);
+  const Vector3 right = Cross(this->Forward, up);
   const double rightLength = Length(right);
-  if (!(rightLength > 1e-9 * Length(d.ViewUp)) || !std::isfinite(rightLength))
+  if (!(rightLength > 1e-9 * Length(up)) || !std::isfinite(rightLength))
   {
     throw std::invalid_argument("camera: view-up must not be parallel to the view direction");
   }

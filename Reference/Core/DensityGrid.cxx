@@ -1,4 +1,5 @@
 #include "DensityGrid.h"
+#include "MemoryBudget.h"
 
 #include <algorithm>
 #include <cmath>
@@ -36,8 +37,11 @@ DensityGrid::DensityGrid(const std::array<int, 3>& dims, const Vector3& origin,
     const float v = this->Values[i];
     if (!std::isfinite(v) || v < 0.0f)
     {
-      throw std::invalid_argument("nimbus::DensityGrid: density at point " + std::to_string(i) +
-        " is " + std::to_string(v) + "; densities must be finite and >= 0");
+      // How many, not only the first: one bad value is a glitch, a million a bad file.
+      const ValueCensus census = TakeCensus(this->Values.data(), this->Values.size());
+      throw std::invalid_argument("nimbus::DensityGrid: " + DescribeCensus(census) + " among " +
+        std::to_string(this->Values.size()) + " densities (the first at point " +
+        std::to_string(i) + ": " + std::to_string(v) + "); densities must be finite and >= 0");
     }
     this->Maximum = std::max(this->Maximum, static_cast<double>(v));
   }

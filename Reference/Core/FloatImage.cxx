@@ -1,5 +1,6 @@
 #include "FloatImage.h"
 
+#include "MemoryBudget.h"
 #include "SpectralColor.h"
 
 #include <cstdint>
@@ -7,9 +8,22 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace nimbus
 {
+
+std::string NonFiniteMessage(const FloatImage& image)
+{
+  ValueCensus census = TakeCensus(image.Pixels.data(), image.Pixels.size());
+  census.Negative = 0;
+  if (census.AllFiniteNonNegative())
+  {
+    return std::string();
+  }
+  return DescribeCensus(census) + " among " + std::to_string(image.Pixels.size()) +
+    " pixel components";
+}
 
 namespace
 {

@@ -39,6 +39,11 @@ struct NIMBUSREFERENCE_EXPORT FloatImage
   static FloatImage ReadPFM(const std::string& path);
 };
 
+/// Empty when every pixel component is finite; else how many are NaN and how many
+/// infinite, e.g. "3 NaN and 1 infinite values among 147 pixel components".
+/// (Negative components are allowed: linear sRGB of a saturated spectrum.)
+NIMBUSREFERENCE_EXPORT std::string NonFiniteMessage(const FloatImage& image);
+
 /// Display encoding for looking at a linear image: multiply by exposure, clip to
 /// [0, 1], apply the sRGB transfer function; 8-bit RGB, row 0 at the bottom.
 NIMBUSREFERENCE_EXPORT std::vector<unsigned char> ToneMap(const FloatImage& image, double exposure);

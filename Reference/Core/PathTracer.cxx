@@ -1,6 +1,7 @@
 #include "PathTracer.h"
 #include "MajorantGrid.h"
 #include "Math.h"
+#include "MemoryBudget.h"
 #include "ParallelFor.h"
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 namespace nimbus
@@ -911,6 +914,9 @@ struct PixelStatistics
 PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
 {
+  // Paths the calling thread traces between progress reports within a pixel (a few
+  // milliseconds: ~15 us a path in a thick cloud).
+  constexpr std::uint64_t kPathsPerProgressCheck = 1024;
   if (settings.MinSamplesPerPixel < 1 || settings.MaxSamplesPerPixel < settings.MinSamplesPerPixel)
   {
     throw std::invalid_argument(
@@ -921,15 +927,34 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     throw std::invalid_argument("RenderPathTraced: TargetRelativeError must be >= 0");
   }
   const auto start = std::chrono::steady_clock::now();
-  const Integrator integrator(context, settings);
   const Camera& camera = context.GetCamera();
   const int width = camera.GetWidth(), height = camera.GetHeight();
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  {
+    // Per pixel: running statistics, a slot in the list of active pixels and the
+    // two result images (3 floats each); checked before anything is allocated.
+    const double bytesPerPixel =
+      static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) + 2 * 3 * sizeof(float));
+    const double budget = settings.MemoryBudgetBytes > 0.0
+      ? settings.MemoryBudgetBytes
+      : static_cast<double>(DefaultMemoryBudgetBytes());
+    const std::string message = OverBudgetMessage("the path tracer's per-pixel buffers (" +
+        std::to_string(width) + "x" + std::to_string(height) + " pixels, " +
+        std::to_string(static_cast<int>(bytesPerPixel)) + " bytes each)",
+      bytesPerPixel * static_cast<double>(pixels), budget);
+    if (!message.empty())
+    {
+      throw std::length_error(message);
+    }
+  }
+  const Integrator integrator(context, settings);
   std::vector<PixelStatistics> statistics(pixels);
 
   const int threads = ResolveThreadCount(settings.Threads);
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
+  std::atomic<bool> stop{ false };
+  const std::thread::id caller = std::this_thread::get_id();
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
   const std::uint64_t maxSamples = static_cast<std::uint64_t>(settings.MaxSamplesPerPixel);
   for (;;)
@@ -952,11 +977,16 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     // threads balanced and the per-chunk scratch rare.
     const std::size_t grain =
       std::max<std::size_t>(1, active.size() / (256 * static_cast<std::size_t>(threads)));
-    ParallelFor(active.size(), grain, threads,
+    ParallelFor(
+      active.size(), grain, threads,
       [&](std::size_t begin, std::size_t end)
       {
         PathState state;
         std::uint64_t localPaths = 0, localTruncated = 0;
+        // A chunk can be one pixel of a million samples: the calling thread also
+        // reports progress every kPathsPerProgressCheck of its paths, and when that
+        // throws (an abort) every thread leaves its chunk at its next path.
+        const bool reporter = progress && std::this_thread::get_id() == caller;
         for (std::size_t slot = begin; slot < end; ++slot)
         {
           const std::size_t k = active[slot];
@@ -977,6 +1007,24 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
             stats.Add(rgb);
             ++localPaths;
             localTruncated += state.Truncated ? 1 : 0;
+            if (stop.load(std::memory_order_relaxed))
+            {
+              return; // the render is being abandoned; its statistics do not matter
+            }
+            if (reporter && localPaths % kPathsPerProgressCheck == 0)
+            {
+              try
+              {
+                progress(std::min(1.0,
+                  static_cast<double>(paths.load() + localPaths) /
+                    (static_cast<double>(pixels) * maxSamples)));
+              }
+              catch (...)
+              {
+                stop = true;
+                throw;
+              }
+            }
           }
           if (stats.Count >= maxSamples)
           {
@@ -994,6 +1042,25 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
         }
         paths += localPaths;
         truncated += localTruncated;
+      },
+      // Within a round too (the first round alone can take minutes): from the
+      // calling thread after each of its chunks; an exception thrown by progress
+      // (an abort) makes every thread leave its chunk at its next path.
+      [&](std::size_t)
+      {
+        if (progress)
+        {
+          try // an exception here (an abort) stops the other threads too
+          {
+            progress(std::min(
+              1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
+          }
+          catch (...)
+          {
+            stop = true;
+            throw;
+          }
+        }
       });
     if (progress)
     {
@@ -1019,6 +1086,12 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       result.Image.At(i, j)[c] = static_cast<float>(statistics[k].Mean[c]);
       result.StandardError.At(i, j)[c] = static_cast<float>(statistics[k].StandardError(c));
     }
+  }
+  // Never a silent NaN or infinity (a scene the reader accepts should not make one).
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error("RenderPathTraced: the image has " + nonFinite);
   }
   result.Paths = paths.load();
   result.TruncatedPaths = truncated.load();

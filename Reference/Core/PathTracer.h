@@ -99,6 +99,9 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// Extension: true = uniform jitter over the pixel (box filter); false = every
   /// path through the pixel centre, like the deterministic renderers.
   bool PixelJitter = true;
+  /// Bytes the per-pixel buffers may take (about 104 bytes per pixel); 0 =
+  /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
+  double MemoryBudgetBytes = 0.0;
 };
 
 struct NIMBUSREFERENCE_EXPORT PathTracingResult
@@ -115,9 +118,13 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
 /// Renders the context's camera view progressively: rounds of samples (first
 /// MinSamplesPerPixel, then doubling up to MaxSamplesPerPixel), per-pixel
 /// running mean and variance (Welford), per-pixel stop on TargetRelativeError.
-/// progress(fraction in [0, 1]) is called from the calling thread after each
-/// round. Throws std::invalid_argument for MinSamplesPerPixel < 1 or
-/// MaxSamplesPerPixel < MinSamplesPerPixel or a negative / NaN target.
+/// progress(fraction in [0, 1]) is called from the calling thread during and
+/// after each round; it may throw to stop the render (e.g. on a user's abort): the
+/// exception propagates once the pixels being traced are done. Throws
+/// std::invalid_argument for MinSamplesPerPixel < 1 or MaxSamplesPerPixel <
+/// MinSamplesPerPixel or a negative / NaN target, and std::length_error, before
+/// allocating, when the per-pixel buffers would need more than MemoryBudgetBytes,
+/// and std::range_error when the image has a NaN or infinite pixel component.
 NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
 

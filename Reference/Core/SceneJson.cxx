@@ -27,6 +27,40 @@ using Json = nlohmann::ordered_json;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Limits on values that cannot be physical, so that every scene the reader accepts
+// renders to finite pixels (docs/scene-format.md, "Limits"; 1e308 in any of these
+// made nimbus-render write Inf and NaN pixels). Lengths and positions, m: 1e9 m is
+// 2.6 times the distance to the Moon; a scene is at most an atmosphere wide.
+constexpr double kMaxLengthMetres = 1.0e9;
+// Radiometry, relative units (sun.illuminance is the luminance Y of the sun's
+// irradiance; the scenes use 1, the real sun is 1.3e5 lx): radiance is at most
+// illuminance x phase-function peak (< 1e5 /sr for g < 0.99) x ..., so 1e6 keeps
+// every pixel more than 20 orders of magnitude below the float limit (3.4e38).
+constexpr double kMaxRadiometric = 1.0e6;
+// Planet radii, m: from a 100 km moon to Jupiter (7.1e7 m).
+constexpr double kMinPlanetRadiusMetres = 1.0e5;
+constexpr double kMaxPlanetRadiusMetres = 1.0e8;
+// Air: Rayleigh scattering at sea level, 1/m: the Earth's is 1.35e-5 at 550 nm;
+// 1e-3 (74 times as much) already makes a scale height 8 optical depths thick.
+constexpr double kMaxRayleighPerMetre = 1.0e-3;
+// Aerosols, 1/m: 1e-2 is a fog with a visibility of 390 m (Koschmieder: 3.9/beta).
+constexpr double kMaxMiePerMetre = 1.0e-2;
+// Scale heights, m: below 1 m exp(-h/H) overflows 1 km below sea level; above
+// 1e6 m the air is uniform over any atmosphere the limits above allow.
+constexpr double kMinScaleHeightMetres = 1.0;
+constexpr double kMaxScaleHeightMetres = 1.0e6;
+// Cloud extinction per unit density, 1/m: 1e3 is a mean free path of 1 mm per unit
+// density; the reference renderers step in fractions of a grid spacing.
+constexpr double kMaxExtinctionPerDensity = 1.0e3;
+// Metaball cloud: densities and iso-values (dimensionless) and the total number of
+// balls (the source's cost is per ball; 1e6 balls take minutes).
+constexpr double kMaxBallDensity = 1.0e6;
+constexpr double kMaxBallCount = 1.0e6;
+/// Deepest nesting of arrays and objects a scene file may have. A scene needs 5
+/// (scene.medium.density.parameters.Bounds); deeper files are refused before
+/// they cost memory or time.
+constexpr std::size_t kMaxSceneNesting = 64;
+
 [[noreturn]] void Fail(const std::string& path, const std::string& what)
 {
   throw std::invalid_argument(path + ": " + what);
@@ -128,10 +162,6 @@ Range AtLeast(double low)
 {
   return Range{ low, kInf, false, false };
 }
-Range Above(double low)
-{
-  return Range{ low, kInf, true, false };
-}
 Range Closed(double low, double high)
 {
   return Range{ low, high, false, false };
@@ -139,6 +169,10 @@ Range Closed(double low, double high)
 Range Open(double low, double high)
 {
   return Range{ low, high, true, true };
+}
+Range Coordinate()
+{
+  return Closed(-kMaxLengthMetres, kMaxLengthMetres);
 }
 
 std::string NumberNoun(const Range& range)
@@ -257,10 +291,26 @@ std::vector<double> ReadNumbers(
   return values;
 }
 
-std::array<double, 3> ReadVector3(const Json& v, const std::string& path)
+std::array<double, 3> ReadVector3(
+  const Json& v, const std::string& path, const Range& range = Finite())
 {
-  const std::vector<double> x = ReadNumbers(v, path, 3, Finite());
+  const std::vector<double> x = ReadNumbers(v, path, 3, range);
   return { { x[0], x[1], x[2] } };
+}
+
+/// v times a power of two (exact) that brings its largest component into [1, 2):
+/// lengths and cross products of any finite vector then neither overflow nor
+/// underflow. A zero vector stays zero.
+std::array<double, 3> ScaledToOrderOne(const std::array<double, 3>& v)
+{
+  const double largest = std::max({ std::abs(v[0]), std::abs(v[1]), std::abs(v[2]) });
+  if (!(largest > 0.0) || !std::isfinite(largest))
+  {
+    return v;
+  }
+  const int exponent = std::ilogb(largest);
+  return { { std::ldexp(v[0], -exponent), std::ldexp(v[1], -exponent),
+    std::ldexp(v[2], -exponent) } };
 }
 
 //------------------------------------------------------------------------------
@@ -361,25 +411,34 @@ struct ParameterSpec
 const std::vector<ParameterSpec>& MetaballParameters()
 {
   // Limits follow vtkNimbusMetaballCloudSource::CheckParameters, plus upper bounds
-  // that keep a scene renderable (grid size, growth levels, ball counts).
+  // that keep a scene renderable (grid size, growth levels, ball counts, lengths
+  // within kMaxLengthMetres, densities within kMaxBallDensity).
+  // The source's lengths, coordinates and heights are bounded by 1e8 m
+  // (vtkNimbusMetaballCloudSource's MaximumLength), tighter than the scene's 1e9 m.
+  const double maxMetaballLength = 1.0e8;
+  const Range length = Range{ 0.0, maxMetaballLength, true, false };
+  const Range lengthOrZero = Closed(0.0, maxMetaballLength);
+  const Range coordinate = Closed(-maxMetaballLength, maxMetaballLength);
   static const std::vector<ParameterSpec> specs = {
     { "Dimensions", 3, ParameterKind::Integer, Finite(), 1, 2048 },
-    { "Bounds", 6, ParameterKind::Real, Finite(), 0, 0 },
+    { "Bounds", 6, ParameterKind::Real, coordinate, 0, 0 },
     { "Seed", 1, ParameterKind::Integer, Finite(), std::numeric_limits<std::int32_t>::min(),
       std::numeric_limits<std::int32_t>::max() },
     { "NumberOfLevels", 1, ParameterKind::Integer, Finite(), 0, 10 },
     { "NumberOfBaseBalls", 1, ParameterKind::Integer, Finite(), 1, 100000 },
-    { "BaseBallRadiusRange", 2, ParameterKind::Real, Above(0.0), 0, 0 },
-    { "FootprintRadius", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
-    { "TowerHeight", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+    { "BaseBallRadiusRange", 2, ParameterKind::Real, length, 0, 0 },
+    { "FootprintRadius", 1, ParameterKind::Real, lengthOrZero, 0, 0 },
+    { "TowerHeight", 1, ParameterKind::Real, lengthOrZero, 0, 0 },
     { "BallsPerLevel", 1, ParameterKind::Integer, Finite(), 0, 1000000 },
-    { "BallCountFactor", 1, ParameterKind::Real, Above(0.0), 0, 0 },
-    { "RadiusScalePerLevel", 1, ParameterKind::Real, Above(0.0), 0, 0 },
-    { "BallDensity", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
-    { "IsoValue", 1, ParameterKind::Real, Finite(), 0, 0 },
+    // Ball counts grow by this factor per level (their total is checked below).
+    { "BallCountFactor", 1, ParameterKind::Real, Range{ 0.0, 1000.0, true, false }, 0, 0 },
+    // Growth balls are no larger than their parents (the source's range).
+    { "RadiusScalePerLevel", 1, ParameterKind::Real, Range{ 0.0, 1.0, true, false }, 0, 0 },
+    { "BallDensity", 1, ParameterKind::Real, Closed(0.0, kMaxBallDensity), 0, 0 },
+    { "IsoValue", 1, ParameterKind::Real, Closed(-kMaxBallDensity, kMaxBallDensity), 0, 0 },
     { "FlatBase", 1, ParameterKind::Bool, Finite(), 0, 0 },
-    { "BaseHeight", 1, ParameterKind::Real, Finite(), 0, 0 },
-    { "BaseTransitionThickness", 1, ParameterKind::Real, AtLeast(0.0), 0, 0 },
+    { "BaseHeight", 1, ParameterKind::Real, coordinate, 0, 0 },
+    { "BaseTransitionThickness", 1, ParameterKind::Real, lengthOrZero, 0, 0 },
   };
   return specs;
 }
@@ -493,6 +552,30 @@ std::vector<std::pair<std::string, std::vector<double>>> ReadMetaballParameters(
         spec.Name, ReadParameter(v.at(spec.Name), path + "." + spec.Name, spec));
     }
   }
+  // The number of balls the source makes: the base balls, then BallsPerLevel times
+  // BallCountFactor^(level - 1) at each growth level (the source's defaults where
+  // a parameter is not given: 10, 3 levels, 60, 2).
+  double baseBalls = 10.0, levels = 3.0, perLevel = 60.0, factor = 2.0;
+  for (const auto& p : parameters)
+  {
+    const double x = p.second[0];
+    baseBalls = p.first == "NumberOfBaseBalls" ? x : baseBalls;
+    levels = p.first == "NumberOfLevels" ? x : levels;
+    perLevel = p.first == "BallsPerLevel" ? x : perLevel;
+    factor = p.first == "BallCountFactor" ? x : factor;
+  }
+  double total = baseBalls, count = perLevel;
+  for (int level = 1; level <= static_cast<int>(levels); ++level, count *= factor)
+  {
+    total += count;
+  }
+  if (!(total <= kMaxBallCount))
+  {
+    Fail(path,
+      "too many metaballs: NumberOfBaseBalls + BallsPerLevel x BallCountFactor^(level - 1) "
+      "over NumberOfLevels levels makes " +
+        FormatNumber(total) + ", more than " + FormatNumber(kMaxBallCount));
+  }
   return parameters;
 }
 
@@ -514,20 +597,22 @@ CameraDescription ReadCamera(const Json& v, const std::string& path)
   const ObjectReader r(
     v, path, { "position", "focal_point", "view_up", "view_angle", "width", "height" });
   CameraDescription c;
-  c.Position = ReadVector3(r.Require("position"), r.Key("position"));
-  c.FocalPoint = ReadVector3(r.Require("focal_point"), r.Key("focal_point"));
+  // Each coordinate is read and range-checked before the view direction is formed,
+  // so a huge coordinate is named as such (and their difference cannot overflow).
+  c.Position = ReadVector3(r.Require("position"), r.Key("position"), Coordinate());
+  c.FocalPoint = ReadVector3(r.Require("focal_point"), r.Key("focal_point"), Coordinate());
   r.Vector3("view_up", c.ViewUp);
   r.Number("view_angle", c.ViewAngle, Open(0.0, 180.0));
   r.Integer("width", c.Width, 1, 16384);
   r.Integer("height", c.Height, 1, 16384);
 
-  const std::array<double, 3> view = Subtract(c.FocalPoint, c.Position);
+  const std::array<double, 3> view = ScaledToOrderOne(Subtract(c.FocalPoint, c.Position));
   const double viewLength = Length(view);
-  if (!(viewLength > 0.0) || !std::isfinite(viewLength))
+  if (!(viewLength > 0.0))
   {
     Fail(r.Key("focal_point"), "must differ from camera.position");
   }
-  const std::array<double, 3>& up = c.ViewUp;
+  const std::array<double, 3> up = ScaledToOrderOne(c.ViewUp);
   const std::array<double, 3> cross{ { view[1] * up[2] - view[2] * up[1],
     view[2] * up[0] - view[0] * up[2], view[0] * up[1] - view[1] * up[0] } };
   if (!(Length(cross) > 1e-6 * viewLength * Length(up)) || !std::isfinite(Length(cross)))
@@ -594,7 +679,8 @@ PhaseComponentDescription ReadPhaseComponent(const Json& v, const std::string& p
   {
     r.Number("g", c.G, Closed(-1.0, 1.0)); // ignored by isotropic and rayleigh
   }
-  r.Number("weight", c.Weight, AtLeast(0.0));
+  // Relative (normalised over the components); bounded so that their sum is finite.
+  r.Number("weight", c.Weight, Closed(0.0, kMaxRadiometric));
   return c;
 }
 
@@ -605,7 +691,8 @@ MediumDescription ReadMedium(const Json& v, const std::string& path, const std::
       "multiple_scattering_constant" });
   MediumDescription m;
   m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
-  r.RequiredNumber("extinction_per_density", m.ExtinctionPerDensity, AtLeast(0.0));
+  r.RequiredNumber(
+    "extinction_per_density", m.ExtinctionPerDensity, Closed(0.0, kMaxExtinctionPerDensity));
   r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
   r.Number("multiple_scattering_constant", m.MultipleScatteringConstant, Closed(0.0, 100.0));
   if (r.Has("phase"))
@@ -658,9 +745,10 @@ SunParameters ReadSun(const Json& v, const std::string& path)
       Fail(r.Key("direction"),
         "give either direction or azimuth_degrees and elevation_degrees, not both");
     }
-    const std::array<double, 3> d = ReadVector3(r["direction"], r.Key("direction"));
+    const std::array<double, 3> d =
+      ScaledToOrderOne(ReadVector3(r["direction"], r.Key("direction")));
     const double horizontal = std::hypot(d[0], d[1]);
-    if (!(Length(d) > 0.0) || !std::isfinite(Length(d)))
+    if (!(Length(d) > 0.0))
     {
       Fail(r.Key("direction"), "must be a non-zero vector (toward the sun)");
     }
@@ -681,7 +769,7 @@ SunParameters ReadSun(const Json& v, const std::string& path)
     r.RequiredNumber("elevation_degrees", s.ElevationDegrees, Closed(-90.0, 90.0));
     r.RequiredNumber("azimuth_degrees", s.AzimuthDegrees, Closed(-360.0, 360.0));
   }
-  r.Number("illuminance", s.Illuminance, AtLeast(0.0));
+  r.Number("illuminance", s.Illuminance, Closed(0.0, kMaxRadiometric));
   r.Number("temperature_kelvin", s.TemperatureKelvin, Closed(1000.0, 100000.0));
   return s;
 }
@@ -695,12 +783,15 @@ SceneAtmosphere ReadAtmosphere(const Json& v, const std::string& path)
   SceneAtmosphere a;
   r.Bool("enabled", a.Enabled);
   r.Number("scene_altitude_metres", a.SceneAltitudeMetres, AtLeast(0.0));
-  r.Number("earth_radius_metres", a.EarthRadiusMetres, Above(0.0));
-  r.Number("top_radius_metres", a.TopRadiusMetres, Above(0.0));
-  r.Number("rayleigh_scattering_per_metre", a.RayleighScatteringPerMetre, AtLeast(0.0));
-  r.Number("rayleigh_scale_height_metres", a.RayleighScaleHeightMetres, Above(0.0));
-  r.Number("mie_scattering_per_metre", a.MieScatteringPerMetre, AtLeast(0.0));
-  r.Number("mie_scale_height_metres", a.MieScaleHeightMetres, Above(0.0));
+  const Range planet = Closed(kMinPlanetRadiusMetres, kMaxPlanetRadiusMetres);
+  const Range scaleHeight = Closed(kMinScaleHeightMetres, kMaxScaleHeightMetres);
+  r.Number("earth_radius_metres", a.EarthRadiusMetres, planet);
+  r.Number("top_radius_metres", a.TopRadiusMetres, planet);
+  r.Number("rayleigh_scattering_per_metre", a.RayleighScatteringPerMetre,
+    Closed(0.0, kMaxRayleighPerMetre));
+  r.Number("rayleigh_scale_height_metres", a.RayleighScaleHeightMetres, scaleHeight);
+  r.Number("mie_scattering_per_metre", a.MieScatteringPerMetre, Closed(0.0, kMaxMiePerMetre));
+  r.Number("mie_scale_height_metres", a.MieScaleHeightMetres, scaleHeight);
   r.Number("mie_albedo", a.MieAlbedo, Range{ 0.0, 1.0, true, false });
   r.Number("mie_g", a.MieG, Open(-1.0, 1.0));
   if (!(a.TopRadiusMetres > a.EarthRadiusMetres))
@@ -724,7 +815,7 @@ GroundDescription ReadGround(const Json& v, const std::string& path)
   const ObjectReader r(v, path, { "enabled", "height", "albedo" });
   GroundDescription g;
   r.Bool("enabled", g.Enabled);
-  r.Number("height", g.Height, Finite());
+  r.Number("height", g.Height, Coordinate());
   r.Number("albedo", g.Albedo, Closed(0.0, 1.0));
   return g;
 }
@@ -737,24 +828,32 @@ BackgroundDescription ReadBackground(const Json& v, const std::string& path)
   {
     b.Type = ReadEnum(r["type"], r.Key("type"), kBackgroundTypes);
   }
-  r.Number("radiance", b.Radiance, AtLeast(0.0));
+  r.Number("radiance", b.Radiance, Closed(0.0, kMaxRadiometric));
   return b;
 }
 
 //------------------------------------------------------------------------------
-/// Rejects duplicate keys (the JSON library would silently keep one) and keeps
-/// track of where the parser is, to name the key path of a syntax error.
+/// Rejects duplicate keys (the JSON library would silently keep one) and nesting
+/// deeper than kMaxSceneNesting, and keeps track of where the parser is, to name
+/// the key path of a syntax error. Each level holds only its own key or index (the
+/// path is joined when a message needs it), so memory is linear in the depth.
 class ParseTracker
 {
 public:
-  bool operator()(int, Json::parse_event_t event, Json& parsed)
+  bool operator()(int depth, Json::parse_event_t event, Json& parsed)
   {
     using Event = Json::parse_event_t;
     switch (event)
     {
       case Event::object_start:
       case Event::array_start:
-        this->Stack.push_back(Frame{ this->CurrentPath(), event == Event::array_start, 0, {}, {} });
+        if (this->Stack.size() >= kMaxSceneNesting || depth > static_cast<int>(kMaxSceneNesting))
+        {
+          Fail(this->CurrentPath(),
+            "arrays and objects nested deeper than " + std::to_string(kMaxSceneNesting) +
+              " levels (a scene needs 5)");
+        }
+        this->Stack.push_back(Frame{ event == Event::array_start, 0, {}, {} });
         break;
       case Event::key:
       {
@@ -762,7 +861,7 @@ public:
         frame.Key = parsed.get<std::string>();
         if (!frame.Keys.insert(frame.Key).second)
         {
-          Fail(frame.Path + "." + frame.Key, "duplicate key");
+          Fail(this->CurrentPath(), "duplicate key");
         }
         break;
       }
@@ -781,22 +880,27 @@ public:
   /// The path of the value being parsed now.
   std::string CurrentPath() const
   {
-    if (this->Stack.empty())
+    std::string path = "scene";
+    for (std::size_t level = 0; level < this->Stack.size(); ++level)
     {
-      return "scene";
+      const Frame& frame = this->Stack[level];
+      const bool innermost = level + 1 == this->Stack.size();
+      if (frame.IsArray)
+      {
+        // An enclosing array's current element is the one being parsed (Index).
+        path += "[" + std::to_string(frame.Index) + "]";
+      }
+      else if (!frame.Key.empty() || !innermost)
+      {
+        path += "." + frame.Key;
+      }
     }
-    const Frame& frame = this->Stack.back();
-    if (frame.IsArray)
-    {
-      return frame.Path + "[" + std::to_string(frame.Index) + "]";
-    }
-    return frame.Key.empty() ? frame.Path : frame.Path + "." + frame.Key;
+    return path;
   }
 
 private:
   struct Frame
   {
-    std::string Path;
     bool IsArray;
     std::size_t Index;
     std::set<std::string> Keys;

@@ -74,6 +74,7 @@
 #include "SingleScatteringRenderer.h"
 #include "MajorantGrid.h"
 #include "Math.h"
+#include "MemoryBudget.h"
 #include "ParallelFor.h"
 
 #include <algorithm>
@@ -82,6 +83,7 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 namespace nimbus
 {
@@ -815,6 +817,23 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
   const SingleScatteringSettings& settings, const std::function<void(double)>& progress)
 {
   CheckStepScale(settings.StepScale);
+  {
+    // Two images (the previous pass and this one) of 3 floats per pixel.
+    const Camera& camera = context.GetCamera();
+    const double bytes = 2.0 * 3.0 * sizeof(float) * static_cast<double>(camera.GetWidth()) *
+      static_cast<double>(camera.GetHeight());
+    const double budget = settings.MemoryBudgetBytes > 0.0
+      ? settings.MemoryBudgetBytes
+      : static_cast<double>(DefaultMemoryBudgetBytes());
+    const std::string message =
+      OverBudgetMessage("the single-scattering images (" + std::to_string(camera.GetWidth()) + "x" +
+          std::to_string(camera.GetHeight()) + " pixels, 2 x 3 floats each)",
+        bytes, budget);
+    if (!message.empty())
+    {
+      throw std::length_error(message);
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   const int maxRefinements = std::max(0, settings.MaxRefinements);
   const int maxPasses = maxRefinements + 1;
@@ -878,6 +897,12 @@ SingleScatteringResult RenderSingleScattering(const RenderContext& context,
     stepScale *= 0.5;
   }
   result.Image = std::move(previous);
+  // Never a silent NaN or infinity (a scene the reader accepts should not make one).
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error("RenderSingleScattering: the image has " + nonFinite);
+  }
   result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (progress)
   {

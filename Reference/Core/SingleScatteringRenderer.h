@@ -65,6 +65,9 @@ struct NIMBUSREFERENCE_EXPORT SingleScatteringSettings
   double RelativeTolerance = 1e-3; // stop when the estimated relative RMS error is below this
   int MaxRefinements = 6;          // at most this many step halvings (MaxRefinements + 1 passes)
   int Threads = 0;                 // 0 = hardware concurrency
+  /// Bytes the render may allocate (two images of Width x Height x 3 floats); 0 =
+  /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
+  double MemoryBudgetBytes = 0.0;
 };
 
 struct NIMBUSREFERENCE_EXPORT SingleScatteringResult
@@ -92,7 +95,11 @@ NIMBUSREFERENCE_EXPORT FloatImage RenderSingleScatteringPass(const RenderContext
 ///   ε ≈ RMS(I_{h/2} - I_h) / (2² - 1) / RMS(I_{h/2}),
 /// RMS over all pixels and the three linear sRGB channels (0 if both images are 0).
 /// Returns the finest image (not the extrapolated one, which need not be >= 0).
-/// progress is monotonic and reaches 1 at the end.
+/// progress is monotonic and reaches 1 at the end; it may throw to stop the render
+/// (e.g. on a user's abort): the exception propagates once the rows being rendered
+/// are done. Throws std::length_error, before allocating, when the images would
+/// need more than MemoryBudgetBytes, and std::range_error when the image has a
+/// NaN or infinite pixel component (NonFiniteMessage, FloatImage.h).
 NIMBUSREFERENCE_EXPORT SingleScatteringResult RenderSingleScattering(const RenderContext& context,
   const SingleScatteringSettings& settings, const std::function<void(double)>& progress = {});
 

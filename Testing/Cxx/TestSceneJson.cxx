@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -454,7 +455,8 @@ TEST(SceneJson, Errors)
   ExpectError(With("/camera/position", Json::array({ 0, 0 })),
     "scene.camera.position: expected an array of 3 numbers, got 2 elements");
   ExpectError(With("/camera/position", Json::array({ 0, "a", 0 })),
-    "scene.camera.position[1]: expected a finite number, got the string \"a\"");
+    "scene.camera.position[1]: expected a number in [-1000000000, 1000000000], got the string "
+    "\"a\"");
   ExpectError(With("/camera/focal_point", Json::array({ 0, -6000, 1500 })),
     "scene.camera.focal_point: must differ from camera.position");
   ExpectError(With("/camera/view_up", Json::array({ 0, 6000, 100 })), "scene.camera.view_up:");
@@ -470,9 +472,9 @@ TEST(SceneJson, Errors)
 
   // Medium.
   ExpectError(With("/medium/extinction_per_density", -1),
-    "scene.medium.extinction_per_density: expected a number >= 0, got -1");
+    "scene.medium.extinction_per_density: expected a number in [0, 1000], got -1");
   ExpectError(With("/medium/extinction_per_density", "0.02"),
-    "scene.medium.extinction_per_density: expected a number >= 0, got the string \"0.02\"");
+    "scene.medium.extinction_per_density: expected a number in [0, 1000], got the string \"0.02\"");
   ExpectError(With("/medium/single_scattering_albedo", 1.01),
     "scene.medium.single_scattering_albedo: expected a number in [0, 1], got 1.01");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "cornette_shanks", "g": 1.5}])")),
@@ -484,7 +486,7 @@ TEST(SceneJson, Errors)
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "henyey_greenstein"}])")),
     "scene.medium.phase[0]: missing required key \"g\"");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic", "weight": -1}])")),
-    "scene.medium.phase[0].weight: expected a number >= 0, got -1");
+    "scene.medium.phase[0].weight: expected a number in [0, 1000000], got -1");
   ExpectError(With("/medium/phase", Json::parse(R"([{"type": "isotropic", "weight": 0}])")),
     "scene.medium.phase: the weights must not all be zero");
   ExpectError(With("/medium/phase", Json::array()), "scene.medium.phase: expected at least one");
@@ -526,7 +528,8 @@ TEST(SceneJson, Errors)
   ExpectError(With(parameters + "/BaseBallRadiusRange", Json::array({ 600, 300 })),
     "scene.medium.density.parameters.BaseBallRadiusRange: expected min <= max");
   ExpectError(With(parameters + "/BaseBallRadiusRange", Json::array({ 0, 300 })),
-    "scene.medium.density.parameters.BaseBallRadiusRange[0]: expected a number > 0, got 0");
+    "scene.medium.density.parameters.BaseBallRadiusRange[0]: expected a number in (0, 100000000], "
+    "got 0");
   ExpectError(With(parameters + "/Seed", Json::array({ 1, 2 })),
     "scene.medium.density.parameters.Seed: expected 1 value, got 2");
   ExpectError(
@@ -534,13 +537,14 @@ TEST(SceneJson, Errors)
   ExpectError(With(parameters + "/NumberOfBaseBalls", 0),
     "scene.medium.density.parameters.NumberOfBaseBalls: expected an integer in [1, 100000], got 0");
   ExpectError(With(parameters + "/TowerHeight", -1),
-    "scene.medium.density.parameters.TowerHeight: expected a number >= 0, got -1");
+    "scene.medium.density.parameters.TowerHeight: expected a number in [0, 100000000], got -1");
   ExpectError(With(parameters + "/RadiusScalePerLevel", 0),
-    "scene.medium.density.parameters.RadiusScalePerLevel: expected a number > 0, got 0");
+    "scene.medium.density.parameters.RadiusScalePerLevel: expected a number in (0, 1], got 0");
   ExpectError(With(parameters + "/FlatBase", "yes"),
     "scene.medium.density.parameters.FlatBase: expected true or false");
   ExpectError(With(parameters + "/IsoValue", true),
-    "scene.medium.density.parameters.IsoValue: expected a finite number, got the boolean true");
+    "scene.medium.density.parameters.IsoValue: expected a number in [-1000000, 1000000], got the "
+    "boolean true");
   ExpectError(
     With(parameters, Json::array()), "scene.medium.density.parameters: expected an object");
 
@@ -549,8 +553,8 @@ TEST(SceneJson, Errors)
     "scene.sun.elevation_degrees: expected a number in [-90, 90], got 91");
   ExpectError(With("/sun/azimuth_degrees", 1000),
     "scene.sun.azimuth_degrees: expected a number in [-360, 360], got 1000");
-  ExpectError(
-    With("/sun/illuminance", -1), "scene.sun.illuminance: expected a number >= 0, got -1");
+  ExpectError(With("/sun/illuminance", -1),
+    "scene.sun.illuminance: expected a number in [0, 1000000], got -1");
   ExpectError(With("/sun/temperature_kelvin", 500),
     "scene.sun.temperature_kelvin: expected a number in [1000, 100000], got 500");
   ExpectError(With("/sun/direction", Json::array({ 0, 1, 1 })),
@@ -572,17 +576,17 @@ TEST(SceneJson, Errors)
   ExpectError(With("/atmosphere/top_radius_metres", 6000000),
     "scene.atmosphere.top_radius_metres: must be greater than earth_radius_metres");
   ExpectError(With("/atmosphere/earth_radius_metres", 0),
-    "scene.atmosphere.earth_radius_metres: expected a number > 0, got 0");
+    "scene.atmosphere.earth_radius_metres: expected a number in [100000, 100000000], got 0");
   ExpectError(With("/atmosphere/scene_altitude_metres", -1),
     "scene.atmosphere.scene_altitude_metres: expected a number >= 0, got -1");
   ExpectError(With("/atmosphere/scene_altitude_metres", 70000),
     "scene.atmosphere.scene_altitude_metres: must be below the top");
   ExpectError(With("/atmosphere/mie_scattering_per_metre", -1e-5),
-    "scene.atmosphere.mie_scattering_per_metre: expected a number >= 0");
+    "scene.atmosphere.mie_scattering_per_metre: expected a number in [0, 0.01]");
   ExpectError(With("/atmosphere/mie_scale_height_metres", 0),
-    "scene.atmosphere.mie_scale_height_metres: expected a number > 0");
+    "scene.atmosphere.mie_scale_height_metres: expected a number in [1, 1000000]");
   ExpectError(With("/atmosphere/rayleigh_scale_height_metres", -8000),
-    "scene.atmosphere.rayleigh_scale_height_metres: expected a number > 0");
+    "scene.atmosphere.rayleigh_scale_height_metres: expected a number in [1, 1000000]");
   ExpectError(With("/atmosphere/mie_albedo", 0),
     "scene.atmosphere.mie_albedo: expected a number in (0, 1], got 0");
   ExpectError(
@@ -590,12 +594,12 @@ TEST(SceneJson, Errors)
   ExpectError(With("/atmosphere/ozone", 1), "scene.atmosphere.ozone: unknown key");
   ExpectError(
     With("/ground/albedo", 1.5), "scene.ground.albedo: expected a number in [0, 1], got 1.5");
-  ExpectError(
-    With("/ground/height", nullptr), "scene.ground.height: expected a finite number, got null");
+  ExpectError(With("/ground/height", nullptr),
+    "scene.ground.height: expected a number in [-1000000000, 1000000000], got null");
   ExpectError(With("/background/type", "sky"),
     "scene.background.type: unknown value \"sky\" (known: black, constant, atmosphere)");
   ExpectError(With("/background/radiance", -0.5),
-    "scene.background.radiance: expected a number >= 0, got -0.5");
+    "scene.background.radiance: expected a number in [0, 1000000], got -0.5");
   ExpectError(With("/atmosphere/enabled", false),
     "scene.background.type: \"atmosphere\" needs atmosphere.enabled");
 }
@@ -794,4 +798,131 @@ TEST(SceneJson, Version1ErrorsNameTheVersion1Keys)
   j = MinimalJson();
   j["atmosphere"] = Json::parse(R"({"mie_scattering": 1e-5})");
   ExpectError(j, "scene.atmosphere.mie_scattering: unknown key");
+}
+
+//------------------------------------------------------------------------------
+// Bad input (the robustness issue): deep nesting, values that cannot be physical,
+// messages that name the real problem.
+
+/// MinimalJson with its "name" replaced by `depth` nested arrays around a 1.
+std::string NestedNameText(std::size_t depth)
+{
+  std::string text = MinimalJson().dump();
+  const std::string nested = std::string(depth, '[') + "1" + std::string(depth, ']');
+  const std::string key = "\"nimbus_scene\":2";
+  text.replace(text.find(key), key.size(), key + ",\"name\":" + nested);
+  return text;
+}
+
+TEST(SceneJson, DeepNestingIsRefusedQuicklyWithItsDepth)
+{
+  // 100 000 levels (200 KB): the key-path tracker copied the path at every level
+  // (quadratic: gigabytes); now each level holds its index, and the depth limit
+  // stops the parser at level 65.
+  const auto start = std::chrono::steady_clock::now();
+  ExpectErrorText(
+    NestedNameText(100000),
+    "scene.name" +
+      []
+      {
+        std::string p;
+        for (int i = 0; i < 63; ++i) // the root object is level 1
+        {
+          p += "[0]";
+        }
+        return p;
+      }() +
+      ": arrays and objects nested deeper than 64 levels (a scene needs 5)");
+  const double seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 1.0);
+  // Exactly at the limit (63 arrays inside the root object: 64 levels) the parser
+  // reads on, and the reader names the wrong type.
+  ExpectErrorText(NestedNameText(63), "scene.name: expected a string, got the array [[[[");
+  ExpectErrorText(NestedNameText(64), "scene.name[0]");
+  // Objects count as levels too; the message names the path.
+  std::string objects = "{\"nimbus_scene\":2,\"camera\":";
+  for (int i = 0; i < 70; ++i)
+  {
+    objects += "{\"a\":";
+  }
+  ExpectErrorText(objects, "scene.camera.a.a.a");
+}
+
+TEST(SceneJson, SyntaxErrorsInLongArraysNameTheirIndex)
+{
+  // The path is joined only when a message needs it; it still names the element.
+  std::string text = "{\"nimbus_scene\":2,\"name\":[";
+  for (int i = 0; i < 2000; ++i)
+  {
+    text += "{\"k\":[1,2,3]},";
+  }
+  text += "}";
+  ExpectErrorText(text, "scene.name[2000]: invalid JSON");
+}
+
+TEST(SceneJson, ValuesThatCannotBePhysicalAreRefused)
+{
+  // Each of these was accepted and made nimbus-render write Inf or NaN pixels.
+  ExpectError(With("/sun/illuminance", 1e308),
+    "scene.sun.illuminance: expected a number in [0, 1000000], got 1e+308");
+  ExpectError(With("/atmosphere", Json{ { "rayleigh_scattering_per_metre", 1e308 } }),
+    "scene.atmosphere.rayleigh_scattering_per_metre: expected a number in [0, 0.001], got 1e+308");
+  ExpectError(With("/atmosphere", Json{ { "top_radius_metres", 1e308 } }),
+    "scene.atmosphere.top_radius_metres: expected a number in [100000, 100000000], got 1e+308");
+  ExpectError(With("/background", Json{ { "type", "constant" }, { "radiance", 1e308 } }),
+    "scene.background.radiance: expected a number in [0, 1000000], got 1e+308");
+  ExpectError(With("/medium/extinction_per_density", 1e308),
+    "scene.medium.extinction_per_density: expected a number in [0, 1000], got 1e+308");
+  ExpectError(With("/atmosphere", Json{ { "mie_scale_height_metres", 1e-308 } }),
+    "scene.atmosphere.mie_scale_height_metres: expected a number in [1, 1000000], got 1e-308");
+  ExpectError(With("/ground", Json{ { "height", -1e308 } }),
+    "scene.ground.height: expected a number in [-1000000000, 1000000000], got -1e+308");
+  ExpectError(With("/medium/phase", Json{ { { "type", "isotropic" }, { "weight", 1e308 } } }),
+    "scene.medium.phase[0].weight: expected a number in [0, 1000000], got 1e+308");
+  ExpectError(
+    With("/medium/density/parameters", Json{ { "Bounds", { -1e308, 1e308, 0, 1, 0, 1 } } }),
+    "scene.medium.density.parameters.Bounds[0]: expected a number in [-100000000, 100000000]");
+  ExpectError(With("/medium/density/parameters", Json{ { "BallDensity", 1e308 } }),
+    "scene.medium.density.parameters.BallDensity: expected a number in [0, 1000000]");
+  // 1000 balls per level, doubling over 10 levels: 1 023 010 balls.
+  ExpectError(
+    With("/medium/density/parameters", Json{ { "BallsPerLevel", 1000 }, { "NumberOfLevels", 10 } }),
+    "scene.medium.density.parameters: too many metaballs: NumberOfBaseBalls + BallsPerLevel x "
+    "BallCountFactor^(level - 1) over NumberOfLevels levels makes 1023010, more than 1000000");
+  // The limits themselves are accepted.
+  EXPECT_NO_THROW(Parse(With("/sun/illuminance", 1e6)));
+  EXPECT_NO_THROW(Parse(With("/atmosphere",
+    Json{ { "rayleigh_scattering_per_metre", 1e-3 }, { "mie_scattering_per_metre", 1e-2 } })));
+  EXPECT_NO_THROW(Parse(With("/medium/density/parameters",
+    Json{ { "BallsPerLevel", 1000 }, { "NumberOfLevels", 9 }, { "NumberOfBaseBalls", 10 } })));
+}
+
+TEST(SceneJson, HugeCameraCoordinatesAreNamedNotCalledEqual)
+{
+  // Was "scene.camera.focal_point: must differ from camera.position" (the
+  // difference overflowed to Inf).
+  ExpectError(With("/camera/position", Json{ 1e308, -6000, 1500 }),
+    "scene.camera.position[0]: expected a number in [-1000000000, 1000000000], got 1e+308");
+  ExpectError(With("/camera/focal_point", Json{ 0, -1e308, 1600 }),
+    "scene.camera.focal_point[1]: expected a number in [-1000000000, 1000000000], got -1e+308");
+  // Opposite extremes within the limits: the difference is finite.
+  Json j = MinimalJson();
+  j["camera"]["position"] = Json{ -1e9, -1e9, 0 };
+  j["camera"]["focal_point"] = Json{ 1e9, 1e9, 10 };
+  EXPECT_NO_THROW(Parse(j));
+  ExpectError(With("/camera/focal_point", Json{ 0, -6000, 1500 }),
+    "scene.camera.focal_point: must differ from camera.position");
+  // Any finite view-up and sun direction, however large or small, is a direction.
+  j = MinimalJson();
+  j["camera"]["view_up"] = Json{ 1e308, 0, 1e308 };
+  EXPECT_NO_THROW(Parse(j));
+  j["camera"]["view_up"] = Json{ 0, 0, 1e-308 };
+  EXPECT_NO_THROW(Parse(j));
+  j["camera"]["view_up"] = Json{ 0, 6e307, 1e306 }; // parallel to the view (0, 6000, 100)
+  ExpectError(j, "scene.camera.view_up: must be non-zero and not parallel to the view direction");
+  Json sun = { { "direction", { 1e308, 1e308, 1e308 } } };
+  const SceneDescription s = Parse(With("/sun", sun));
+  EXPECT_NEAR(s.Sun.ElevationDegrees, std::atan(1.0 / std::sqrt(2.0)) * 180.0 / M_PI, 1e-12);
+  EXPECT_EQ(s.Sun.AzimuthDegrees, 45.0);
 }

@@ -1,5 +1,6 @@
 """The reference renderer through its VTK glue (vtkNimbusReferenceRenderer),
-from Python: finite images, determinism, and clear errors for bad density input."""
+from Python: finite images, determinism, and clear errors for bad density input,
+sizes over the memory budget and rotated density images."""
 import math
 import os
 import sys
@@ -87,6 +88,33 @@ class ReferenceRendererTest(unittest.TestCase):
             self.assertIn("density array 'density'", errors[0])
             self.assertIn("point 17", errors[0])
             self.assertIsNone(output.GetPointData().GetArray("radiance"), bad)
+
+    def test_memory_budget_is_a_property_and_refuses_with_a_message(self):
+        renderer = nimbus.vtkNimbusReferenceRenderer()
+        self.assertGreater(renderer.GetMemoryBudgetMiB(), 0.0)
+        renderer.SetSceneFileName(SCENE)
+        renderer.SetMemoryBudgetMiB(0.001)  # 1 KiB: less than the 24x18 image
+        errors = []
+
+        @calldata_type(VTK_STRING)
+        def on_error(obj, event, message):
+            errors.append(message)
+        renderer.AddObserver(vtkCommand.ErrorEvent, on_error)
+        renderer.GetExecutive().AddObserver(vtkCommand.ErrorEvent, lambda obj, event: None)
+        renderer.Update()
+        self.assertEqual(len(errors), 1, errors)
+        self.assertIn("the rendered image (24x18 pixels)", errors[0])
+        self.assertIn("more than the memory budget", errors[0])
+        self.assertIsNone(renderer.GetOutput().GetPointData().GetArray("radiance"))
+
+    def test_rotated_density_is_refused(self):
+        density = scene_density()
+        density.SetDirectionMatrix(0, -1, 0, 1, 0, 0, 0, 0, 1)
+        errors = []
+        output = render("single", density=density, errors=errors)
+        self.assertGreaterEqual(len(errors), 1)
+        self.assertIn("direction matrix that is not the identity", errors[0])
+        self.assertIsNone(output.GetPointData().GetArray("radiance"))
 
     def test_missing_scene_is_an_error(self):
         renderer = nimbus.vtkNimbusReferenceRenderer()

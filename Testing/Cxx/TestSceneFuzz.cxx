@@ -1,0 +1,559 @@
+// Fuzzing the scene reader and the reference renderer: a few hundred mutants of the
+// project's scenes (Data/Scenes), made with a fixed seed, each either refused with a
+// clean message (std::invalid_argument starting with the key path, "scene...") or
+// accepted and rendered by vtkNimbusReferenceRenderer (8x6 pixels, a 16^3 density
+// grid; single scattering, one pass, then path tracing, one path per pixel) to
+// finite pixels. Every mutant runs in a forked child under an address-space limit
+// (RLIMIT_AS, 3 GiB) and a time limit (alarm, 20 s): a crash, an abort, an escaping
+// exception, a hang, a non-finite pixel or a valid scene that fails to render fails
+// the test.
+//
+// Mutations: a number scaled by 0, -1, 1e-308 ... 1e300 (often still valid), a value
+// replaced by an extreme (0, -1, +-1e308, 1e-308, huge integers,
+// 1e400, NaN-ish strings and bare words, wrong types), several values at once, a
+// deleted key, a duplicated key, deep nesting (up to 100 000 levels), truncated
+// text, random byte flips.
+#include "MessageCatcher.h"
+#include "SceneJson.h"
+#include "vtkNimbusReferenceRenderer.h"
+
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkLogger.h"
+#include "vtkNew.h"
+#include "vtkOutputWindow.h"
+#include "vtkPointData.h"
+#include "vtkStringOutputWindow.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#ifndef NIMBUS_SCENES_DIR
+#error "NIMBUS_SCENES_DIR must name Data/Scenes"
+#endif
+
+namespace
+{
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+constexpr int kMutantsPerScene = 120;
+constexpr std::uint64_t kSeed = 20261128;
+constexpr unsigned long long kAddressSpaceLimit = 3ull << 30; // 3 GiB
+constexpr unsigned kSecondsPerMutant = 20;
+
+enum class Outcome : char
+{
+  Refused = 'R',    // clean message from the reader
+  Rendered = 'P',   // valid, rendered to finite pixels
+  OverBudget = 'B', // valid, refused by the renderer's memory budget (a clean message)
+  BadMessage = 'M', // refused, but not with a key-path message
+  RenderFailed = 'F',
+  NonFinite = 'N',
+  Escaped = 'E', // an exception left the renderer
+  Crashed = 'C', // signal, abort
+  TimedOut = 'T',
+};
+
+const char* Name(Outcome o)
+{
+  switch (o)
+  {
+    case Outcome::Refused:
+      return "refused with a message";
+    case Outcome::Rendered:
+      return "rendered, finite";
+    case Outcome::OverBudget:
+      return "refused by the memory budget";
+    case Outcome::BadMessage:
+      return "BAD MESSAGE";
+    case Outcome::RenderFailed:
+      return "VALID BUT NOT RENDERED";
+    case Outcome::NonFinite:
+      return "NON-FINITE PIXELS";
+    case Outcome::Escaped:
+      return "EXCEPTION ESCAPED";
+    case Outcome::Crashed:
+      return "CRASHED";
+    case Outcome::TimedOut:
+      return "TIMED OUT";
+  }
+  return "?";
+}
+
+/// The text and the kind of one mutant.
+struct Mutant
+{
+  std::string Kind;
+  std::string Text;
+};
+
+class Mutator
+{
+public:
+  explicit Mutator(std::uint64_t seed)
+    : Random(seed)
+  {
+  }
+
+  Mutant Make(const Json& base, int index)
+  {
+    switch (index % 8)
+    {
+      case 7:
+        return { "scale a number", this->Scale(base) };
+      case 0:
+        return { "replace", this->Replace(base, 1) };
+      case 1:
+        return { "replace several", this->Replace(base, 2 + this->Below(3)) };
+      case 2:
+        return { "delete key", this->Delete(base) };
+      case 3:
+        return { "duplicate key", this->Duplicate(base) };
+      case 4:
+        return { "deep nesting", this->Nest(base) };
+      case 5:
+        return { "truncate", this->Truncate(base) };
+      default:
+        return { "byte flips", this->Flip(base) };
+    }
+  }
+
+private:
+  std::size_t Below(std::size_t n) { return static_cast<std::size_t>(this->Random() % n); }
+
+  /// JSON pointers of every node below the root.
+  static void Collect(
+    const Json& node, const Json::json_pointer& at, std::vector<Json::json_pointer>& out)
+  {
+    if (node.is_object())
+    {
+      for (const auto& item : node.items())
+      {
+        out.push_back(at / item.key());
+        Collect(item.value(), at / item.key(), out);
+      }
+    }
+    else if (node.is_array())
+    {
+      for (std::size_t i = 0; i < node.size(); ++i)
+      {
+        out.push_back(at / i);
+        Collect(node[i], at / i, out);
+      }
+    }
+  }
+
+  /// Any node below the root; a number every other time (most of a scene's nodes
+  /// are numbers, but strings and containers would otherwise take a third).
+  Json::json_pointer AnyNode(const Json& j)
+  {
+    std::vector<Json::json_pointer> nodes;
+    Collect(j, Json::json_pointer(), nodes);
+    if (this->Below(2) == 0)
+    {
+      return nodes[this->Below(nodes.size())];
+    }
+    return AnyNumber(j, nodes);
+  }
+
+  Json::json_pointer AnyNumber(const Json& j, const std::vector<Json::json_pointer>& nodes)
+  {
+    std::vector<Json::json_pointer> numbers;
+    for (const auto& p : nodes)
+    {
+      if (j.at(p).is_number())
+      {
+        numbers.push_back(p);
+      }
+    }
+    return numbers[this->Below(numbers.size())];
+  }
+
+  Json::json_pointer AnyMember(const Json& j)
+  {
+    std::vector<Json::json_pointer> nodes;
+    Collect(j, Json::json_pointer(), nodes);
+    std::vector<Json::json_pointer> members;
+    for (const auto& p : nodes)
+    {
+      if (j.at(p.parent_pointer()).is_object())
+      {
+        members.push_back(p);
+      }
+    }
+    return members[this->Below(members.size())];
+  }
+
+  static std::string Substitute(std::string text, const std::string& from, const std::string& to)
+  {
+    for (std::size_t at = text.find(from); at != std::string::npos;
+         at = text.find(from, at + to.size()))
+    {
+      text.replace(at, from.size(), to);
+    }
+    return text;
+  }
+
+  std::string Extreme()
+  {
+    static const std::vector<std::string> tokens = { "0", "-1", "1e308", "-1e308", "1e-308",
+      "-1e-308", "-0", "4294967296", "2147483648", "9223372036854775807", "18446744073709551615",
+      "-9223372036854775809", "123456789012345678901234567890", "1e400", "-1e400", "NaN",
+      "Infinity", "-Infinity", "nan", "\"NaN\"", "\"inf\"", "\"-Infinity\"", "\"1e308\"", "true",
+      "false", "null", "[]", "{}", "\"\"", "\"text\"", "[1e308, 1e308, 1e308]", "[0, 0, 0]",
+      "[-1e308, 1e308, -1e308, 1e308, -1e308, 1e308]", "{\"type\": \"file\"}",
+      "[{\"type\": \"henyey_greenstein\", \"g\": 1, \"weight\": 1e308}]" };
+    return tokens[this->Below(tokens.size())];
+  }
+
+  std::string Replace(const Json& base, std::size_t count)
+  {
+    Json j = base;
+    std::vector<std::string> tokens;
+    for (std::size_t k = 0; k < count; ++k)
+    {
+      const std::string marker = "@@MUTANT" + std::to_string(k) + "@@";
+      const Json::json_pointer p = this->AnyNode(j);
+      if (j.contains(p)) // an earlier replacement may have removed it
+      {
+        j[p] = marker;
+        tokens.push_back(this->Extreme());
+      }
+    }
+    std::string text = j.dump(2);
+    for (std::size_t k = 0; k < tokens.size(); ++k)
+    {
+      text = Substitute(text, "\"@@MUTANT" + std::to_string(k) + "@@\"", tokens[k]);
+    }
+    return text;
+  }
+
+  /// A number times 0, -1, 1e-308, 1e-3, 1e3, 1e6, 1e9 or 1e300: often still valid,
+  /// so the renderer sees extreme but accepted values.
+  std::string Scale(const Json& base)
+  {
+    static const double factors[] = { 0.0, -1.0, 1e-308, 1e-3, 1e3, 1e6, 1e9, 1e300 };
+    Json j = base;
+    std::vector<Json::json_pointer> nodes;
+    Collect(j, Json::json_pointer(), nodes);
+    const Json::json_pointer p = this->AnyNumber(j, nodes);
+    j[p] = j[p].get<double>() * factors[this->Below(std::size(factors))];
+    return j.dump(2);
+  }
+
+  std::string Delete(const Json& base)
+  {
+    Json j = base;
+    const Json::json_pointer p = this->AnyMember(j);
+    j[p.parent_pointer()].erase(p.back());
+    return j.dump(2);
+  }
+
+  std::string Duplicate(const Json& base)
+  {
+    Json j = base;
+    const Json::json_pointer p = this->AnyMember(j);
+    const std::string key = p.back();
+    // The same value or an extreme one, under the same key, after the original.
+    j[p.parent_pointer()]["@@DUPLICATE@@"] = this->Below(2) ? j[p] : Json("@@VALUE@@");
+    std::string text = j.dump(2);
+    text = Substitute(text, "\"@@DUPLICATE@@\"", Json(key).dump());
+    return Substitute(text, "\"@@VALUE@@\"", this->Extreme());
+  }
+
+  std::string Nest(const Json& base)
+  {
+    static const std::size_t depths[] = { 2, 30, 62, 63, 64, 65, 1000, 100000 };
+    const std::size_t depth = depths[this->Below(std::size(depths))];
+    Json j = base;
+    j[this->AnyNode(j)] = "@@NEST@@";
+    const bool objects = this->Below(2) == 0;
+    std::string nested;
+    for (std::size_t i = 0; i < depth; ++i)
+    {
+      nested += objects ? "{\"a\": " : "[";
+    }
+    nested += "1";
+    for (std::size_t i = 0; i < depth; ++i)
+    {
+      nested += objects ? "}" : "]";
+    }
+    return Substitute(j.dump(2), "\"@@NEST@@\"", nested);
+  }
+
+  std::string Truncate(const Json& base)
+  {
+    const std::string text = base.dump(2);
+    return text.substr(0, this->Below(text.size()));
+  }
+
+  std::string Flip(const Json& base)
+  {
+    std::string text = base.dump(2);
+    const std::size_t flips = 1 + this->Below(8);
+    for (std::size_t k = 0; k < flips; ++k)
+    {
+      text[this->Below(text.size())] = static_cast<char>(this->Below(256));
+    }
+    return text;
+  }
+
+  std::mt19937_64 Random;
+};
+
+/// A project scene made cheap to render: 8x6 pixels, a 16^3 density grid.
+Json Cheap(const fs::path& file)
+{
+  std::ifstream in(file);
+  Json j = Json::parse(in);
+  j["camera"]["width"] = 8;
+  j["camera"]["height"] = 6;
+  Json& parameters = j["medium"]["density"]["parameters"];
+  if (parameters.is_object())
+  {
+    parameters["Dimensions"] = Json::array({ 16, 16, 16 });
+  }
+  return j;
+}
+
+/// In the child: what happens to one mutant.
+std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& sceneFile)
+{
+  nimbus::SceneDescription scene;
+  try
+  {
+    scene = nimbus::ParseScene(mutant.Text, NIMBUS_SCENES_DIR);
+  }
+  catch (const std::invalid_argument& error)
+  {
+    const std::string message = error.what();
+    const bool clean = message.rfind("scene", 0) == 0 && message.size() < 2000 &&
+      message.find(": ") != std::string::npos;
+    return { clean ? Outcome::Refused : Outcome::BadMessage, message };
+  }
+  catch (const std::exception& error)
+  {
+    return { Outcome::BadMessage, std::string("not std::invalid_argument: ") + error.what() };
+  }
+  // Valid: at most 8x6 pixels and 16 points per axis, whatever the mutant says.
+  scene.Camera.Width = std::min(scene.Camera.Width, 8);
+  scene.Camera.Height = std::min(scene.Camera.Height, 6);
+  for (auto& parameter : scene.Medium.Density.Parameters)
+  {
+    if (parameter.first == "Dimensions")
+    {
+      for (double& d : parameter.second)
+      {
+        d = std::min(d, 16.0);
+      }
+    }
+  }
+  std::ofstream(sceneFile) << nimbus::SceneToJson(scene);
+
+  vtkNew<vtkNimbusReferenceRenderer> renderer;
+  nimbus::testing::MessageCatcher messages(renderer);
+  renderer->SetSceneFileName(sceneFile.string().c_str());
+  renderer->SetModeToSingleScattering();
+  renderer->SetMaxRefinements(0);
+  renderer->SetStepScale(1.0);
+  renderer->SetNumberOfThreads(1);
+  try
+  {
+    renderer->Update();
+  }
+  catch (const std::exception& error)
+  {
+    return { Outcome::Escaped, error.what() };
+  }
+  auto* radiance =
+    vtkFloatArray::SafeDownCast(renderer->GetOutput()->GetPointData()->GetArray("radiance"));
+  if (!radiance)
+  {
+    const std::string errors = messages.AllErrors();
+    return { errors.find("memory budget") != std::string::npos ? Outcome::OverBudget
+                                                               : Outcome::RenderFailed,
+      errors };
+  }
+  for (vtkIdType i = 0; i < radiance->GetNumberOfValues(); ++i)
+  {
+    if (!std::isfinite(radiance->GetValue(i)))
+    {
+      return { Outcome::NonFinite, "component " + std::to_string(i) };
+    }
+  }
+  // And one path per pixel through the path tracer.
+  renderer->SetModeToPathTracing();
+  renderer->SetMinSamplesPerPixel(1);
+  renderer->SetMaxSamplesPerPixel(1);
+  renderer->Update();
+  radiance =
+    vtkFloatArray::SafeDownCast(renderer->GetOutput()->GetPointData()->GetArray("radiance"));
+  if (!radiance)
+  {
+    return { Outcome::RenderFailed, "path tracing: " + messages.AllErrors() };
+  }
+  for (vtkIdType i = 0; i < radiance->GetNumberOfValues(); ++i)
+  {
+    if (!std::isfinite(radiance->GetValue(i)))
+    {
+      return { Outcome::NonFinite, "path tracing, component " + std::to_string(i) };
+    }
+  }
+  return { Outcome::Rendered, std::to_string(radiance->GetNumberOfTuples()) + " pixels" };
+}
+
+/// Runs Judge in a forked child under the limits.
+std::pair<Outcome, std::string> JudgeInChild(const Mutant& mutant, const fs::path& sceneFile)
+{
+  int fds[2];
+  if (::pipe(fds) != 0)
+  {
+    return { Outcome::Crashed, "pipe failed" };
+  }
+  std::fflush(nullptr);
+  const pid_t child = ::fork();
+  if (child == 0)
+  {
+    ::close(fds[0]);
+    rlimit limit{ kAddressSpaceLimit, kAddressSpaceLimit };
+    ::setrlimit(RLIMIT_AS, &limit);
+    ::alarm(kSecondsPerMutant);
+    // Quiet: the renderer's errors are caught by its observer; the metaball
+    // source's warnings about odd parameters are expected.
+    vtkNew<vtkStringOutputWindow> quiet;
+    vtkOutputWindow::SetInstance(quiet);
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+    std::pair<Outcome, std::string> result;
+    try
+    {
+      result = Judge(mutant, sceneFile);
+    }
+    catch (const std::exception& error)
+    {
+      result = { Outcome::Escaped, error.what() };
+    }
+    catch (...)
+    {
+      result = { Outcome::Escaped, "unknown exception" };
+    }
+    const std::string report = std::string(1, static_cast<char>(result.first)) + result.second;
+    std::size_t written = 0;
+    while (written < report.size())
+    {
+      const ssize_t n = ::write(fds[1], report.data() + written, report.size() - written);
+      if (n <= 0)
+      {
+        break;
+      }
+      written += static_cast<std::size_t>(n);
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::string report;
+  char buffer[4096];
+  ssize_t n;
+  while ((n = ::read(fds[0], buffer, sizeof(buffer))) > 0)
+  {
+    report.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  if (WIFSIGNALED(status))
+  {
+    return { WTERMSIG(status) == SIGALRM ? Outcome::TimedOut : Outcome::Crashed,
+      "signal " + std::to_string(WTERMSIG(status)) };
+  }
+  if (report.empty())
+  {
+    return { Outcome::Crashed, "no report, exit status " + std::to_string(WEXITSTATUS(status)) };
+  }
+  return { static_cast<Outcome>(report[0]), report.substr(1) };
+}
+} // namespace
+
+TEST(SceneFuzz, MutantsAreRefusedCleanlyOrRenderFinite)
+{
+  std::vector<fs::path> scenes;
+  for (const auto& entry : fs::directory_iterator(NIMBUS_SCENES_DIR))
+  {
+    if (entry.path().extension() == ".json")
+    {
+      scenes.push_back(entry.path());
+    }
+  }
+  std::sort(scenes.begin(), scenes.end()); // a fixed order: the same mutants every run
+  ASSERT_GE(scenes.size(), 5u);
+  const fs::path work = fs::temp_directory_path() /
+    ("nimbus-scene-fuzz-" + std::to_string(::getpid()) + "-" +
+      std::to_string(std::random_device{}()));
+  fs::create_directories(work);
+
+  Mutator mutator(kSeed);
+  std::map<std::string, std::map<Outcome, int>> table;
+  std::map<Outcome, int> totals;
+  int mutants = 0;
+  double slowest = 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  for (const fs::path& file : scenes)
+  {
+    const Json base = Cheap(file);
+    // The unmutated (cheap) scene must render: the oracle is not vacuous.
+    const auto original = JudgeInChild({ "none", base.dump(2) }, work / "original.json");
+    EXPECT_EQ(original.first, Outcome::Rendered) << file << ": " << original.second;
+    for (int i = 0; i < kMutantsPerScene; ++i, ++mutants)
+    {
+      const Mutant mutant = mutator.Make(base, i);
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto result =
+        JudgeInChild(mutant, work / ("mutant" + std::to_string(mutants) + ".json"));
+      slowest = std::max(
+        slowest, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      ++table[mutant.Kind][result.first];
+      ++totals[result.first];
+      const bool fine = result.first == Outcome::Refused || result.first == Outcome::Rendered ||
+        result.first == Outcome::OverBudget;
+      EXPECT_TRUE(fine) << file.filename() << " mutant " << i << " (" << mutant.Kind
+                        << "): " << Name(result.first) << ": " << result.second
+                        << "\n--- text (first 600 bytes) ---\n"
+                        << mutant.Text.substr(0, 600);
+    }
+  }
+  const double seconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%d mutants of %zu scenes in %.1f s (slowest %.2f s), seed %llu, RLIMIT_AS %llu "
+              "MiB\n",
+    mutants, scenes.size(), seconds, slowest, static_cast<unsigned long long>(kSeed),
+    kAddressSpaceLimit >> 20);
+  for (const auto& row : table)
+  {
+    std::printf("  %-16s", row.first.c_str());
+    for (const auto& cell : row.second)
+    {
+      std::printf("  %s: %d", Name(cell.first), cell.second);
+    }
+    std::printf("\n");
+  }
+  // Both branches of the oracle are exercised.
+  EXPECT_GT(totals[Outcome::Refused], mutants / 4);
+  EXPECT_GT(totals[Outcome::Rendered], 10);
+  fs::remove_all(work);
+}
