@@ -77,6 +77,14 @@ private:
 /// to M: the file is truncated (an interrupted download or copy?)".
 FileLayout ScanFile(const std::string& path);
 
+/// True when OpenVDB's chunk readers in this process are the checked ones of
+/// VdbCompressionGuard.cxx: OpenVDB 10.0.x, and this library was loaded before libopenvdb
+/// (so libopenvdb's own calls bind to them). False when another module loaded libopenvdb
+/// first (e.g. `import pyopenvdb` before Nimbus in one Python process) or for another
+/// OpenVDB version; the reader then lets a separate process read each file first
+/// (VdbFileCheck.h).
+bool CompressionGuardInEffect();
+
 /// Writes `bytes` to `path` atomically (see above). Throws Error on failure, leaving an
 /// existing file untouched; the message names the cause ("No space left on device", "File
 /// too large", "Permission denied"). A target whose permission bits grant no write access

@@ -23,11 +23,69 @@
 #include <zlib.h>
 
 #include <cstdint>
+#include <cstring>
+#include <dlfcn.h>
 #include <istream>
 #include <limits>
+#include <link.h>
 #include <memory>
 
 #if OPENVDB_LIBRARY_MAJOR_VERSION_NUMBER == 10 && OPENVDB_LIBRARY_MINOR_VERSION_NUMBER == 0
+#define NIMBUS_COMPRESSION_GUARD 1
+#endif
+
+namespace
+{
+/// The position of each loaded object in the dynamic linker's list (load order).
+struct LoadOrder
+{
+  const char* OwnPath = nullptr;
+  int Own = -1;
+  int OpenVDB = -1;
+  int Index = 0;
+};
+
+int FindInLoadOrder(dl_phdr_info* info, size_t, void* data)
+{
+  auto* order = static_cast<LoadOrder*>(data);
+  const char* name = info->dlpi_name ? info->dlpi_name : "";
+  if (order->Own < 0 && order->OwnPath && std::strcmp(name, order->OwnPath) == 0)
+  {
+    order->Own = order->Index;
+  }
+  if (order->OpenVDB < 0 && std::strstr(name, "libopenvdb.so"))
+  {
+    order->OpenVDB = order->Index;
+  }
+  ++order->Index;
+  return 0;
+}
+} // namespace
+
+bool nimbus::vdb::CompressionGuardInEffect()
+{
+#ifdef NIMBUS_COMPRESSION_GUARD
+  Dl_info own{};
+  if (!dladdr(reinterpret_cast<void*>(&FindInLoadOrder), &own) || !own.dli_fname)
+  {
+    return false;
+  }
+  LoadOrder order;
+  order.OwnPath = own.dli_fname;
+  dl_iterate_phdr(&FindInLoadOrder, &order);
+  // Linked statically into the program (the sanitizer build): the program's definitions
+  // come first of all. Otherwise this library must precede libopenvdb.
+  if (order.Own < 0)
+  {
+    order.Own = 0;
+  }
+  return order.OpenVDB < 0 || order.Own < order.OpenVDB;
+#else
+  return false;
+#endif
+}
+
+#ifdef NIMBUS_COMPRESSION_GUARD
 
 namespace
 {

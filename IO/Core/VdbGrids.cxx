@@ -2,6 +2,9 @@
 #include "VdbGrids.h"
 
 #include "VdbArchive.h"
+#include "VdbFileCheck.h"
+
+#include "MemoryBudget.h"
 
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
@@ -53,6 +56,43 @@ std::string Vec3String(const std::array<double, 3>& v)
 }
 
 /// Fails with a clear message when `path` cannot be read as a regular file.
+/// Where OpenVDB's chunk readers are not the checked ones (CompressionGuardInEffect),
+/// a separate process reads the whole file first, once per file version (path, size,
+/// modification time), so that a damaged chunk crashes that process, not this one.
+void CheckInChildProcessUnlessGuarded(const std::string& path)
+{
+  if (CompressionGuardInEffect())
+  {
+    return;
+  }
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0)
+  {
+    return; // CheckReadable reports it
+  }
+  const std::string key = path + "|" + std::to_string(st.st_size) + "|" +
+    std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec);
+  static std::mutex mutex;
+  static std::vector<std::string> checked;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (std::find(checked.begin(), checked.end(), key) != checked.end())
+    {
+      return;
+    }
+  }
+  // 60 s, plus 1 s per 20 MB for the read itself.
+  const double timeoutSeconds = 60.0 + static_cast<double>(st.st_size) / 20.0e6;
+  const FileCheck check =
+    CheckFileInChildProcess(path, nimbus::DefaultMemoryBudgetBytes(), timeoutSeconds);
+  if (!check.Passed)
+  {
+    throw Error(check.Message);
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  checked.push_back(key);
+}
+
 void CheckReadable(const std::string& path)
 {
   struct stat st;
@@ -676,6 +716,7 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
   Initialize();
   CheckReadable(path);
   const FileLayout layout = ScanFile(path);
+  CheckInChildProcessUnlessGuarded(path);
   std::vector<GridInfo> result;
   std::string current;
   try
@@ -816,6 +857,7 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
     throw Error("ReadDense: empty index box");
   }
   const FileLayout layout = ScanFile(path);
+  CheckInChildProcessUnlessGuarded(path);
   std::string current;
   try
   {
