@@ -1,17 +1,17 @@
-// VdbFileCheck: reads a whole .vdb file in a separate process before Nimbus trusts it.
+// VdbFileCheck: reads a whole .vdb file in a separate process, so that a crash of
+// OpenVDB on a damaged file ends that process, not the user's session.
 //
-// OpenVDB 10.0 trusts the sizes written in a file. A damaged chunk-size field makes
-// io::bloscFromStream read up to the rest of the file into a buffer sized for one node
-// (it checks the size only after the read: a heap-buffer overflow, found by the
-// sanitizer build's fuzz test), and a size read from a truncated stream is uninitialised
-// memory, which OpenVDB then tries to allocate (hundreds of terabytes, or 17.5 GB of a
-// real machine). Nimbus cannot validate OpenVDB's tree encoding without re-implementing
-// it, so it lets OpenVDB read the whole file (topology and voxel buffers) in a forked
-// child with an address-space limit and a time limit first: a crash, an abort, an
-// exception or an exhausted limit there becomes a clear error in the reader, and the
-// process that holds the user's session (ParaView, Python) never runs OpenVDB on a file
-// that did not read cleanly. The cost is a second read of the file (measured in
-// docs/openvdb.md).
+// OpenVDB 10.0 trusts the sizes written in a file: a damaged chunk-size field makes
+// io::bloscFromStream / unzipFromStream read up to the rest of the file into a buffer
+// sized for one node (the size is checked only after the read: a heap-buffer overflow,
+// found by the fuzz tests). VdbCompressionGuard.cxx replaces both functions with checked
+// ones, which libopenvdb calls when this library was loaded before it. Where that is not
+// so (CompressionGuardInEffect() is false: `import pyopenvdb` before Nimbus in one Python
+// process, or another OpenVDB version), the reader lets OpenVDB read each file version in
+// a forked child first, under an address-space limit and a time limit: a crash, an abort,
+// an exception or an exhausted limit there becomes a clear error, and the reading process
+// never runs OpenVDB on a file that did not read cleanly. This is not a validation (the
+// layout scan, VdbArchive's ScanFile, is): it absorbs crashes. Cost: a second read.
 #ifndef NimbusVdbFileCheck_h
 #define NimbusVdbFileCheck_h
 
