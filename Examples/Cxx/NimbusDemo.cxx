@@ -35,7 +35,10 @@ namespace
 void Usage()
 {
   std::cout << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
-               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E] [--no-sky]\n";
+               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E] [--no-sky]\n"
+               "  W, H in [16, 8192] pixels; sun elevation in [-90, 90] degrees, azimuth within"
+               " +-1e6 degrees;\n  seed a 32-bit integer; k-multi in [0, 100]; exposure in"
+               " [0, 1e6]. A bad value exits with status 2.\n";
 }
 
 bool ParseNumber(const char* text, double& value)
@@ -78,7 +81,7 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--sun-azimuth" && hasValue)
     {
-      ok = ParseNumber(argv[++i], sunAzimuth);
+      ok = ParseNumber(argv[++i], sunAzimuth) && std::abs(sunAzimuth) <= 1.0e6;
     }
     else if (arg == "--k-multi" && hasValue)
     {
@@ -86,7 +89,7 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--exposure" && hasValue)
     {
-      ok = ParseNumber(argv[++i], exposure) && exposure >= 0.0;
+      ok = ParseNumber(argv[++i], exposure) && exposure >= 0.0 && exposure <= 1.0e6;
     }
     else if (arg == "--no-sky")
     {
@@ -94,7 +97,9 @@ int main(int argc, char* argv[])
     }
     else if (arg == "--seed" && hasValue)
     {
-      ok = ParseNumber(argv[++i], seed);
+      // An integer the source's int Seed holds (a cast of anything else is undefined).
+      ok = ParseNumber(argv[++i], seed) && seed == std::floor(seed) && seed >= -2147483648.0 &&
+        seed <= 2147483647.0;
     }
     else
     {
