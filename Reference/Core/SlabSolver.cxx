@@ -253,6 +253,225 @@ struct Layer
   std::vector<double> D; // beam: diffusely transmitted radiance
 };
 
+std::vector<double> Apply(const Matrix& m, const std::vector<double>& v)
+{
+  std::vector<double> out(m.Rows, 0.0);
+  for (int i = 0; i < m.Rows; ++i)
+  {
+    double sum = 0.0;
+    for (int j = 0; j < m.Cols; ++j)
+    {
+      sum += m(i, j) * v[j];
+    }
+    out[i] = sum;
+  }
+  return out;
+}
+
+// Pbar(mu_i, nu_j) (forward) and Pbar(-mu_i, nu_j) (backward), N x (N + 1): nu_j = mu_j,
+// then nu_N = mu0. Legendre series truncated at L = 2N - 1 (see the top of this file).
+void PhaseMatrices(
+  const Problem& problem, const std::vector<double>& mu, Matrix& forward, Matrix& backward)
+{
+  const int n = static_cast<int>(mu.size());
+  const int maxDegree = 2 * n - 1;
+  std::vector<double> chi(static_cast<std::size_t>(maxDegree) + 1, 0.0);
+  chi[0] = 1.0;
+  if (problem.PhaseFunction == Phase::HenyeyGreenstein)
+  {
+    for (int l = 1; l <= maxDegree; ++l)
+    {
+      chi[l] = chi[l - 1] * problem.Asymmetry;
+    }
+  }
+  std::vector<std::vector<double>> legendreAt(static_cast<std::size_t>(n) + 1);
+  for (int i = 0; i < n; ++i)
+  {
+    legendreAt[i] = Legendre(maxDegree, mu[i]);
+  }
+  legendreAt[n] = Legendre(maxDegree, problem.Mu0);
+  forward = Matrix(n, n + 1);
+  backward = Matrix(n, n + 1);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j <= n; ++j)
+    {
+      double f = 0.0;
+      double b = 0.0;
+      for (int l = 0; l <= maxDegree; ++l)
+      {
+        const double term = (2.0 * l + 1.0) * chi[l] * legendreAt[i][l] * legendreAt[j][l];
+        f += term;
+        b += (l % 2 == 0) ? term : -term; // P_l(-x) = (-1)^l P_l(x)
+      }
+      forward(i, j) = f;
+      backward(i, j) = b;
+    }
+  }
+}
+
+// The diamond-difference starting layer of thickness h: K [I+(h); I-(0)] = [S+; S-] with
+// N + 1 right-hand sides (N grid streams, then the beam).
+Layer StartLayer(double h, double omega, double mu0, const std::vector<double>& mu,
+  const std::vector<double>& w, const Matrix& forward, const Matrix& backward)
+{
+  const int n = static_cast<int>(mu.size());
+  Matrix k(2 * n, 2 * n);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      const double identity = i == j ? 1.0 : 0.0;
+      const double a = 0.5 * h * (identity - 0.5 * omega * w[j] * forward(i, j)) / mu[i];
+      const double b = 0.5 * h * 0.5 * omega * w[j] * backward(i, j) / mu[i];
+      k(i, j) = identity + a;
+      k(n + i, n + j) = identity + a;
+      k(i, n + j) = -b;
+      k(n + i, j) = -b;
+    }
+  }
+  Matrix rhs(2 * n, n + 1);
+  for (int j = 0; j <= n; ++j)
+  {
+    const double nu = j < n ? mu[j] : mu0;
+    const double c = j < n ? 0.5 * omega * w[j] : 0.25 * omega;
+    const double integral = -nu * std::expm1(-h / nu); // int_0^h exp(-t/nu) dt
+    for (int i = 0; i < n; ++i)
+    {
+      rhs(i, j) = c * forward(i, j) * integral / mu[i];
+      rhs(n + i, j) = c * backward(i, j) * integral / mu[i];
+    }
+  }
+  SolveInPlace(k, rhs);
+  Layer layer;
+  layer.R = Matrix(n, n);
+  layer.T = Matrix(n, n);
+  layer.U.assign(n, 0.0);
+  layer.D.assign(n, 0.0);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      layer.T(i, j) = rhs(i, j);
+      layer.R(i, j) = rhs(n + i, j);
+    }
+    layer.D[i] = rhs(i, n);
+    layer.U[i] = rhs(n + i, n);
+  }
+  return layer;
+}
+
+// Two copies of a layer of optical thickness `thickness`, one on the other (the doubling
+// equations at the top of this file).
+Layer Double(const Layer& layer, double thickness, const std::vector<double>& mu, double mu0)
+{
+  const int n = static_cast<int>(mu.size());
+  std::vector<double> e(n);
+  for (int i = 0; i < n; ++i)
+  {
+    e[i] = std::exp(-thickness / mu[i]);
+  }
+  const double e0 = std::exp(-thickness / mu0);
+  const Matrix& r = layer.R;
+  const Matrix& t = layer.T;
+
+  // S = (1 - r r)^{-1} r r.
+  const Matrix rr = Multiply(r, r);
+  Matrix system(n, n);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      system(i, j) = (i == j ? 1.0 : 0.0) - rr(i, j);
+    }
+  }
+  Matrix s = rr;
+  SolveInPlace(system, s);
+  // W = S E + t + S t.
+  const Matrix st = Multiply(s, t);
+  Matrix wm(n, n);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      wm(i, j) = s(i, j) * e[j] + t(i, j) + st(i, j);
+    }
+  }
+  // rV = r (W + E); r' = r + E rV + t rV;  t' = t W + t E + E W.
+  Matrix rv = Multiply(r, wm);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      rv(i, j) += r(i, j) * e[j];
+    }
+  }
+  const Matrix trv = Multiply(t, rv);
+  const Matrix tw = Multiply(t, wm);
+  Layer out;
+  out.R = Matrix(n, n);
+  out.T = Matrix(n, n);
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = 0; j < n; ++j)
+    {
+      out.R(i, j) = r(i, j) + e[i] * rv(i, j) + trv(i, j);
+      out.T(i, j) = tw(i, j) + t(i, j) * e[j] + e[i] * wm(i, j);
+    }
+  }
+  // Beam: x = d + e0 r u; D = x + S x; U = r D + e0 u; u' = u + E U + t U;
+  // d' = e0 d + E D + t D.
+  std::vector<double> x = Apply(r, layer.U);
+  for (int i = 0; i < n; ++i)
+  {
+    x[i] = layer.D[i] + e0 * x[i];
+  }
+  std::vector<double> down = Apply(s, x);
+  for (int i = 0; i < n; ++i)
+  {
+    down[i] += x[i];
+  }
+  std::vector<double> up = Apply(r, down);
+  for (int i = 0; i < n; ++i)
+  {
+    up[i] += e0 * layer.U[i];
+  }
+  const std::vector<double> tu = Apply(t, up);
+  const std::vector<double> td = Apply(t, down);
+  out.U.resize(n);
+  out.D.resize(n);
+  for (int i = 0; i < n; ++i)
+  {
+    out.U[i] = layer.U[i] + e[i] * up[i] + tu[i];
+    out.D[i] = e0 * layer.D[i] + e[i] * down[i] + td[i];
+  }
+  return out;
+}
+
+// Semi-infinite stopping rule: the doubled layer transmits nothing (diffuse and direct,
+// to rounding) and its reflection changed by at most a few units of rounding.
+bool Converged(
+  const Layer& before, const Layer& after, double thickness, const std::vector<double>& mu)
+{
+  const int n = static_cast<int>(mu.size());
+  double change = 0.0;
+  double size = 0.0;
+  double transmitted = 0.0;
+  for (int i = 0; i < n; ++i)
+  {
+    size = std::max(size, std::fabs(after.U[i]));
+    change = std::max(change, std::fabs(after.U[i] - before.U[i]));
+    transmitted = std::max(transmitted, std::fabs(after.D[i]) + std::exp(-thickness / mu[i]));
+    for (int j = 0; j < n; ++j)
+    {
+      size = std::max(size, std::fabs(after.R(i, j)));
+      change = std::max(change, std::fabs(after.R(i, j) - before.R(i, j)));
+      transmitted = std::max(transmitted, std::fabs(after.T(i, j)));
+    }
+  }
+  return change <= 1e-15 * size && transmitted <= 1e-15;
+}
+
 } // namespace
 
 void GaussLegendre01(int n, std::vector<double>& nodes, std::vector<double>& weights)
@@ -300,7 +519,6 @@ Result Solve(const Problem& problem)
 {
   Validate(problem);
   const int n = problem.QuadraturePoints;
-  const double omega = problem.SingleScatteringAlbedo;
   const double mu0 = problem.Mu0;
   const double tau = problem.OpticalThickness;
   const bool semiInfinite = std::isinf(tau);
@@ -319,256 +537,48 @@ Result Solve(const Problem& problem)
     return result;
   }
 
-  // Legendre coefficients chi_l, l = 0 ... 2N - 1.
-  const int maxDegree = 2 * n - 1;
-  std::vector<double> chi(static_cast<std::size_t>(maxDegree) + 1, 0.0);
-  chi[0] = 1.0;
-  if (problem.PhaseFunction == Phase::HenyeyGreenstein)
-  {
-    for (int l = 1; l <= maxDegree; ++l)
-    {
-      chi[l] = chi[l - 1] * problem.Asymmetry;
-    }
-  }
-  // Pbar(mu_i, nu_j) (forward) and Pbar(-mu_i, nu_j) (backward); nu = grid, then mu0.
-  std::vector<std::vector<double>> legendreAt(static_cast<std::size_t>(n) + 1);
-  for (int i = 0; i < n; ++i)
-  {
-    legendreAt[i] = Legendre(maxDegree, mu[i]);
-  }
-  legendreAt[n] = Legendre(maxDegree, mu0);
-  Matrix forward(n, n + 1);
-  Matrix backward(n, n + 1);
-  for (int i = 0; i < n; ++i)
-  {
-    for (int j = 0; j <= n; ++j)
-    {
-      double f = 0.0;
-      double b = 0.0;
-      for (int l = 0; l <= maxDegree; ++l)
-      {
-        const double term = (2.0 * l + 1.0) * chi[l] * legendreAt[i][l] * legendreAt[j][l];
-        f += term;
-        b += (l % 2 == 0) ? term : -term;
-      }
-      forward(i, j) = f;
-      backward(i, j) = b;
-    }
-  }
+  Matrix forward;
+  Matrix backward;
+  PhaseMatrices(problem, mu, forward, backward);
 
   // Starting layer thickness h = tau / 2^doublings <= InitialThickness. A semi-infinite
   // slab starts at InitialThickness and doubles until converged.
   int doublings = 0;
   double h = semiInfinite ? problem.InitialThickness : tau;
-  if (!semiInfinite)
+  while (!semiInfinite && h > problem.InitialThickness)
   {
-    while (h > problem.InitialThickness)
-    {
-      h *= 0.5;
-      ++doublings;
-    }
+    h *= 0.5;
+    ++doublings;
   }
   result.StartThickness = h;
+  Layer layer = StartLayer(h, problem.SingleScatteringAlbedo, mu0, mu, w, forward, backward);
 
-  // Diamond-difference starting layer: K [I+(h); I-(0)] = [S+; S-], N + 1 right-hand sides.
-  Layer layer;
-  {
-    Matrix k(2 * n, 2 * n);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        const double a =
-          0.5 * h * ((i == j ? 1.0 : 0.0) - 0.5 * omega * w[j] * forward(i, j)) / mu[i];
-        const double b = 0.5 * h * 0.5 * omega * w[j] * backward(i, j) / mu[i];
-        k(i, j) = (i == j ? 1.0 : 0.0) + a;
-        k(n + i, n + j) = (i == j ? 1.0 : 0.0) + a;
-        k(i, n + j) = -b;
-        k(n + i, j) = -b;
-      }
-    }
-    Matrix rhs(2 * n, n + 1);
-    for (int j = 0; j <= n; ++j)
-    {
-      const double nu = j < n ? mu[j] : mu0;
-      const double c = j < n ? 0.5 * omega * w[j] : 0.25 * omega;
-      const double integral = -nu * std::expm1(-h / nu); // int_0^h exp(-t/nu) dt
-      for (int i = 0; i < n; ++i)
-      {
-        rhs(i, j) = c * forward(i, j) * integral / mu[i];
-        rhs(n + i, j) = c * backward(i, j) * integral / mu[i];
-      }
-    }
-    SolveInPlace(k, rhs);
-    layer.R = Matrix(n, n);
-    layer.T = Matrix(n, n);
-    layer.U.assign(n, 0.0);
-    layer.D.assign(n, 0.0);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        layer.T(i, j) = rhs(i, j);
-        layer.R(i, j) = rhs(n + i, j);
-      }
-      layer.D[i] = rhs(i, n);
-      layer.U[i] = rhs(n + i, n);
-    }
-  }
-
-  double thickness = h;
   const int maxDoublings = 200;
+  double thickness = h;
   int done = 0;
-  for (;;)
+  while (semiInfinite || done < doublings)
   {
-    if (!semiInfinite && done == doublings)
-    {
-      break;
-    }
     if (done >= maxDoublings)
     {
       throw std::runtime_error("nimbus::slab: semi-infinite slab did not converge in " +
         std::to_string(maxDoublings) + " doublings");
     }
-    std::vector<double> e(n);
-    for (int i = 0; i < n; ++i)
-    {
-      e[i] = std::exp(-thickness / mu[i]);
-    }
-    const double e0 = std::exp(-thickness / mu0);
-    const Matrix& r = layer.R;
-    const Matrix& t = layer.T;
-
-    // S = (1 - r r)^{-1} r r.
-    Matrix rr = Multiply(r, r);
-    Matrix system(n, n);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        system(i, j) = (i == j ? 1.0 : 0.0) - rr(i, j);
-      }
-    }
-    Matrix s = rr;
-    SolveInPlace(system, s);
-    // W = S E + t + S t.
-    Matrix st = Multiply(s, t);
-    Matrix wm(n, n);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        wm(i, j) = s(i, j) * e[j] + t(i, j) + st(i, j);
-      }
-    }
-    // rV = r (W + E); r' = r + E rV + t rV.
-    Matrix rv = Multiply(r, wm);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        rv(i, j) += r(i, j) * e[j];
-      }
-    }
-    const Matrix trv = Multiply(t, rv);
-    Matrix newR(n, n);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        newR(i, j) = r(i, j) + e[i] * rv(i, j) + trv(i, j);
-      }
-    }
-    // t' = t W + t E + E W.
-    const Matrix tw = Multiply(t, wm);
-    Matrix newT(n, n);
-    for (int i = 0; i < n; ++i)
-    {
-      for (int j = 0; j < n; ++j)
-      {
-        newT(i, j) = tw(i, j) + t(i, j) * e[j] + e[i] * wm(i, j);
-      }
-    }
-    // Beam: x = d + e0 r u; D = x + S x; U = r D + e0 u; u' = u + E U + t U;
-    // d' = e0 d + E D + t D.
-    std::vector<double> x(n), down(n), up(n), newU(n), newD(n);
-    for (int i = 0; i < n; ++i)
-    {
-      double ru = 0.0;
-      for (int j = 0; j < n; ++j)
-      {
-        ru += r(i, j) * layer.U[j];
-      }
-      x[i] = layer.D[i] + e0 * ru;
-    }
-    for (int i = 0; i < n; ++i)
-    {
-      double sx = 0.0;
-      for (int j = 0; j < n; ++j)
-      {
-        sx += s(i, j) * x[j];
-      }
-      down[i] = x[i] + sx;
-    }
-    for (int i = 0; i < n; ++i)
-    {
-      double rd = 0.0;
-      for (int j = 0; j < n; ++j)
-      {
-        rd += r(i, j) * down[j];
-      }
-      up[i] = rd + e0 * layer.U[i];
-    }
-    for (int i = 0; i < n; ++i)
-    {
-      double tu = 0.0;
-      double td = 0.0;
-      for (int j = 0; j < n; ++j)
-      {
-        tu += t(i, j) * up[j];
-        td += t(i, j) * down[j];
-      }
-      newU[i] = layer.U[i] + e[i] * up[i] + tu;
-      newD[i] = e0 * layer.D[i] + e[i] * down[i] + td;
-    }
-
-    double change = 0.0;
-    double size = 0.0;
-    double transmitted = 0.0;
-    if (semiInfinite)
-    {
-      for (int i = 0; i < n; ++i)
-      {
-        size = std::max(size, std::fabs(newU[i]));
-        change = std::max(change, std::fabs(newU[i] - layer.U[i]));
-        for (int j = 0; j < n; ++j)
-        {
-          size = std::max(size, std::fabs(newR(i, j)));
-          change = std::max(change, std::fabs(newR(i, j) - r(i, j)));
-          transmitted = std::max(transmitted, std::fabs(newT(i, j)) + e[i] * e[i]);
-        }
-        transmitted = std::max(transmitted, std::fabs(newD[i]));
-      }
-    }
-    layer.R = std::move(newR);
-    layer.T = std::move(newT);
-    layer.U = std::move(newU);
-    layer.D = std::move(newD);
+    Layer doubled = Double(layer, thickness, mu, mu0);
     thickness *= 2.0;
     ++done;
-    // Converged when the layer transmits nothing and its reflection stopped changing,
-    // both to a few units of rounding.
-    if (semiInfinite && change <= 1e-15 * size && transmitted <= 1e-15)
+    const bool converged = semiInfinite && Converged(layer, doubled, thickness, mu);
+    layer = std::move(doubled);
+    if (converged)
     {
       break;
     }
   }
   result.Doublings = done;
 
-  const double direct = semiInfinite ? 0.0 : std::exp(-tau / mu0);
-  result.DirectTransmittance = direct;
+  result.DirectTransmittance = semiInfinite ? 0.0 : std::exp(-tau / mu0);
   result.ReflectedRadiance = layer.U;
   result.TransmittedRadiance = layer.D;
+  // Fluxes: 2 pi sum_i w_i mu_i I_i, divided by the incident pi mu0 (beam) or pi (diffuse).
   double reflected = 0.0;
   double transmitted = 0.0;
   double sphericalAlbedo = 0.0;
