@@ -5,7 +5,7 @@
 // mu_i, w_i the Gauss-Legendre nodes and weights on [0, 1]. The azimuth-averaged phase
 // function, normalised so that (1/2) int_{-1}^{1} Pbar(mu, mu') dmu' = 1, is
 //   Pbar(mu, mu') = sum_{l=0}^{L} (2l + 1) chi_l P_l(mu) P_l(mu'),   L = 2N - 1
-// (Hansen & Travis 1974 §2.4; chi_l = g^l for Henyey-Greenstein, van de Hulst 1980 §10.3).
+// (Hansen & Travis 1974 §2; chi_l = g^l for Henyey-Greenstein, van de Hulst 1980).
 // With L = 2N - 1 the double-Gauss grid integrates every P_l exactly over each hemisphere,
 // so sum_i w_i [Pbar(mu_i, nu) + Pbar(-mu_i, nu)] = 2 for any nu: scattering on the grid
 // conserves energy exactly.
@@ -36,7 +36,7 @@
 // S the source integrated over the layer and divided by mu_i; I-(0) is the reflected, I+(h)
 // the diffusely transmitted radiance.
 //
-// Doubling (Hansen & Travis 1974 §3.2, matrix-operator form): r, t are the diffuse
+// Doubling (Hansen & Travis 1974 §3, matrix-operator form): r, t are the diffuse
 // reflection and transmission operators on radiance vectors (quadrature weights inside),
 // E = diag(exp(-tau/mu_i)) the direct transmission, u, d the beam's reflected and
 // diffusely transmitted radiance, e0 = exp(-tau/mu0). The layer being homogeneous, it

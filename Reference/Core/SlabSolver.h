@@ -6,8 +6,8 @@
 // omega, phase function isotropic or Henyey-Greenstein (g), black (non-reflecting) lower
 // boundary, no emission. It is lit from above by a collimated beam of cosine mu0.
 //
-// Normalisation (van de Hulst 1980 "Multiple Light Scattering" §2.1; Hansen & Travis 1974
-// "Light scattering in planetary atmospheres" §3.2): the beam carries flux pi*F0 per unit
+// Normalisation (van de Hulst 1980 "Multiple Light Scattering"; Hansen & Travis 1974
+// "Light scattering in planetary atmospheres" §3): the beam carries flux pi*F0 per unit
 // area normal to it, F0 = 1, i.e. pi*mu0 per unit horizontal area. A radiance I is in units
 // of F0 (1/sr per unit F0), so I(mu) = mu0 * R(mu, mu0) with R van de Hulst's reflection
 // function; a white Lambertian ground would have I = mu0. Fluxes are reported as fractions
@@ -18,7 +18,7 @@
 // ordinates of Chandrasekhar 1960 ch. II with the double-Gauss split of Sykes 1951). A starting
 // layer of thickness tau / 2^n <= InitialThickness is solved by the diamond-difference
 // initialisation of Wiscombe 1976 (JQSRT 16, 637) and doubled n times with the
-// adding-doubling equations of Hansen & Travis 1974 §3.2, here in matrix-operator form
+// adding-doubling equations of Hansen & Travis 1974 §3, here in matrix-operator form
 // (Plass, Kattawar & Catchings 1973, Appl. Opt. 12, 314). Direct (unscattered) light is carried
 // exactly (exp(-tau/mu)) and never enters the diffuse matrices; the beam at mu0 is one extra column
 // (source term solved explicitly), so mu0 need not be a quadrature node.
@@ -37,7 +37,7 @@ namespace slab
 enum class Phase
 {
   Isotropic,       // p = 1/(4 pi); Asymmetry ignored
-  HenyeyGreenstein // Legendre coefficients chi_l = g^l (van de Hulst 1980 §10.3)
+  HenyeyGreenstein // Legendre coefficients chi_l = g^l (van de Hulst 1980)
 };
 
 struct NIMBUSREFERENCE_EXPORT Problem
