@@ -319,6 +319,7 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
 
   nimbus::FloatImage radiance, standardError;
   double estimatedError = 0.0, seconds = 0.0, samplesPerPixel = 0.0;
+  double stoppedAtTimeLimit = 0.0, reachedImageTarget = 0.0;
   if (this->Mode == SINGLE_SCATTERING)
   {
     nimbus::SingleScatteringSettings settings;
@@ -343,19 +344,24 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     settings.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
     settings.Threads = this->NumberOfThreads;
     settings.MemoryBudgetBytes = std::max(1.0, renderBudget);
+    settings.TimeLimitSeconds = this->TimeLimitSeconds;
+    settings.TargetImageRelativeError = this->TargetImageRelativeError;
+    this->CurrentImageRelativeError = 0.0;
+    this->CurrentSamplesPerPixel = 0.0;
+    settings.OnRound = [this](const nimbus::PathTracingRound& round)
+    {
+      this->CurrentImageRelativeError = round.ImageRelativeError;
+      this->CurrentSamplesPerPixel = round.MeanSamplesPerPixel;
+    };
     nimbus::PathTracingResult result = nimbus::RenderPathTraced(*context, settings, progress);
+    stoppedAtTimeLimit = result.StoppedAtTimeLimit ? 1.0 : 0.0;
+    reachedImageTarget = result.ReachedImageTarget ? 1.0 : 0.0;
     radiance = std::move(result.Image);
     standardError = std::move(result.StandardError);
     samplesPerPixel = result.MeanSamplesPerPixel;
     seconds = result.Seconds;
     // Image-wide relative error: RMS standard error over RMS radiance.
-    double sumError = 0.0, sumValue = 0.0;
-    for (std::size_t i = 0; i < radiance.Pixels.size(); ++i)
-    {
-      sumError += static_cast<double>(standardError.Pixels[i]) * standardError.Pixels[i];
-      sumValue += static_cast<double>(radiance.Pixels[i]) * radiance.Pixels[i];
-    }
-    estimatedError = sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+    estimatedError = result.ImageRelativeError;
   }
 
   // Never a silent NaN or infinity: a scene the reader accepts should not make
@@ -379,6 +385,11 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
   AddFieldValue(fieldData, "EstimatedRelativeError", estimatedError);
   AddFieldValue(fieldData, "RenderSeconds", seconds);
   AddFieldValue(fieldData, "SamplesPerPixel", samplesPerPixel);
+  if (this->Mode == PATH_TRACING)
+  {
+    AddFieldValue(fieldData, "StoppedAtTimeLimit", stoppedAtTimeLimit);
+    AddFieldValue(fieldData, "ReachedImageTarget", reachedImageTarget);
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -409,6 +420,8 @@ void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinSamplesPerPixel: " << this->MinSamplesPerPixel << "\n";
   os << indent << "MaxSamplesPerPixel: " << this->MaxSamplesPerPixel << "\n";
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
+  os << indent << "TimeLimitSeconds: " << this->TimeLimitSeconds << "\n";
+  os << indent << "TargetImageRelativeError: " << this->TargetImageRelativeError << "\n";
   os << indent << "MaxScatteringOrder: " << this->MaxScatteringOrder << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";

@@ -26,7 +26,8 @@
  * Output: vtkImageData of Width x Height points with the 3-component float
  * point array "radiance" (linear sRGB, relative units: the sun's illuminance is
  * the scene's sun.illuminance) and, for path tracing, "standard_error"; field
- * data "EstimatedRelativeError", "RenderSeconds", "SamplesPerPixel".
+ * data "EstimatedRelativeError", "RenderSeconds", "SamplesPerPixel" (and, for path
+ * tracing, "StoppedAtTimeLimit", "ReachedImageTarget").
  */
 #ifndef vtkNimbusReferenceRenderer_h
 #define vtkNimbusReferenceRenderer_h
@@ -108,6 +109,26 @@ public:
   ///@}
 
   ///@{
+  /// Path tracing: stop after the first round of samples that ends past
+  /// TimeLimitSeconds (s), or whose image-wide relative error (RMS standard error
+  /// over RMS radiance) is at or below TargetImageRelativeError; 0 = no such stop.
+  /// Field data "StoppedAtTimeLimit" and "ReachedImageTarget" say which ended it.
+  /// Defaults 0, 0.
+  vtkSetClampMacro(TimeLimitSeconds, double, 0.0, 1.0e9);
+  vtkGetMacro(TimeLimitSeconds, double);
+  vtkSetClampMacro(TargetImageRelativeError, double, 0.0, 1.0);
+  vtkGetMacro(TargetImageRelativeError, double);
+  ///@}
+
+  ///@{
+  /// Path tracing, during a render (for a progress display from a ProgressEvent
+  /// observer): the image-wide relative error and the mean samples per pixel after
+  /// the last finished round; 0 before the first.
+  vtkGetMacro(CurrentImageRelativeError, double);
+  vtkGetMacro(CurrentSamplesPerPixel, double);
+  ///@}
+
+  ///@{
   /// Worker threads (0: all cores). Default 0.
   vtkSetMacro(NumberOfThreads, int);
   vtkGetMacro(NumberOfThreads, int);
@@ -141,6 +162,10 @@ protected:
   double TargetRelativeError = 0.0;
   int MaxScatteringOrder = 0;
   int Seed = 1;
+  double TimeLimitSeconds = 0.0;
+  double TargetImageRelativeError = 0.0;
+  double CurrentImageRelativeError = 0.0;
+  double CurrentSamplesPerPixel = 0.0;
   int NumberOfThreads = 0;
   double MemoryBudgetMiB;
 

@@ -3,7 +3,13 @@
 //   nimbus-render SCENE.json [--mode single|path] [--output PREFIX]
 //     single scattering: [--step-scale S] [--tolerance T] [--max-refinements K]
 //     path tracing:      [--min-spp N] [--max-spp N] [--target-error E] [--max-order K] [--seed S]
-//     [--threads N] [--exposure X]
+//                        [--time-limit SECONDS] [--target-image-error E]
+//     [--threads N] [--exposure X] [--progress on|off]
+//
+// On a terminal (or with --progress on) a progress line on stderr shows the fraction
+// done, the time, and for path tracing the image-wide relative error after the last
+// round of samples and an estimate of the time left: to the image target when one is
+// set (the error falls as 1/sqrt(time)), else to the last round.
 //
 // Writes PREFIX.pfm (linear float RGB), PREFIX.vti (the same as vtkImageData,
 // with "standard_error" for path tracing) and PREFIX.png (exposure, clip, sRGB),
@@ -17,6 +23,8 @@
 #include "MemoryBudget.h"
 #include "vtkNimbusReferenceRenderer.h"
 
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -27,10 +35,13 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkXMLImageDataWriter.h"
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
+#include <unistd.h>
 
 namespace
 {
@@ -40,8 +51,96 @@ void Usage(std::ostream& os)
         "  single scattering: [--step-scale S] [--tolerance T] [--max-refinements K]\n"
         "  path tracing:      [--min-spp N] [--max-spp N] [--target-error E] [--max-order K]"
         " [--seed S]\n"
-        "  [--threads N] [--exposure X]\n";
+        "                     [--time-limit SECONDS] [--target-image-error E]\n"
+        "  [--threads N] [--exposure X] [--progress on|off]\n";
 }
+
+/// An integer option in [low, high] (a cast of anything else would be undefined).
+bool Integer(const char* text, double low, double high, int& value)
+{
+  char* end = nullptr;
+  const double number = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(number >= low && number <= high) ||
+    number != std::floor(number))
+  {
+    return false;
+  }
+  value = static_cast<int>(number);
+  return true;
+}
+
+/// The progress line: fraction, time, and for path tracing the error and time left.
+struct ProgressLine
+{
+  vtkNimbusReferenceRenderer* Renderer = nullptr;
+  std::chrono::steady_clock::time_point Start = std::chrono::steady_clock::now();
+  double LastPrinted = -1.0;
+
+  static std::string Duration(double seconds)
+  {
+    char text[32];
+    if (!std::isfinite(seconds) || seconds < 0.0)
+    {
+      return "?";
+    }
+    if (seconds < 90.0)
+    {
+      std::snprintf(text, sizeof(text), "%.0f s", seconds);
+    }
+    else if (seconds < 5400.0)
+    {
+      std::snprintf(text, sizeof(text), "%.1f min", seconds / 60.0);
+    }
+    else
+    {
+      std::snprintf(text, sizeof(text), "%.1f h", seconds / 3600.0);
+    }
+    return text;
+  }
+
+  void Print(double fraction)
+  {
+    const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - this->Start).count();
+    if (fraction < 1.0 && elapsed - this->LastPrinted < 0.25)
+    {
+      return; // at most four lines a second
+    }
+    this->LastPrinted = elapsed;
+    const int width = 30;
+    const int filled =
+      static_cast<int>(std::lround(std::min(1.0, std::max(0.0, fraction)) * width));
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar.resize(static_cast<std::size_t>(width), '.');
+    std::string detail;
+    const double error = this->Renderer->GetCurrentImageRelativeError();
+    if (this->Renderer->GetMode() == vtkNimbusReferenceRenderer::PATH_TRACING && error > 0.0)
+    {
+      char text[96];
+      std::snprintf(text, sizeof(text), "  %.0f spp  error %.2f %%",
+        this->Renderer->GetCurrentSamplesPerPixel(), 100.0 * error);
+      detail = text;
+      const double target = this->Renderer->GetTargetImageRelativeError();
+      double left = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : -1.0;
+      if (target > 0.0)
+      {
+        left = std::min(left, elapsed * ((error / target) * (error / target) - 1.0));
+        char goal[48];
+        std::snprintf(goal, sizeof(goal), " (target %.2f %%)", 100.0 * target);
+        detail += goal;
+      }
+      detail += "  left ~" + Duration(std::max(0.0, left));
+    }
+    std::fprintf(stderr, "\r[%s] %3.0f %%  %s%s   ", bar.c_str(), 100.0 * fraction,
+      Duration(elapsed).c_str(), detail.c_str());
+    std::fflush(stderr);
+  }
+
+  static void OnProgress(vtkObject*, unsigned long, void* clientData, void* callData)
+  {
+    static_cast<ProgressLine*>(clientData)->Print(*static_cast<double*>(callData));
+  }
+};
 
 bool Number(const char* text, double& value)
 {
@@ -89,6 +188,7 @@ int Run(int argc, char* argv[])
   renderer->SetSceneFileName(argv[1]);
   std::string output = "nimbus-render";
   double exposure = 6.0;
+  bool showProgress = isatty(STDERR_FILENO) != 0;
   for (int i = 2; i < argc; ++i)
   {
     const std::string option = argv[i];
@@ -99,6 +199,7 @@ int Run(int argc, char* argv[])
     }
     const char* value = argv[++i];
     double number = 0.0;
+    int integer = 0;
     const bool numeric = Number(value, number);
     if (option == "--mode" && std::string(value) == "single")
     {
@@ -120,33 +221,45 @@ int Run(int argc, char* argv[])
     {
       renderer->SetRelativeTolerance(number);
     }
-    else if (option == "--max-refinements" && numeric && number >= 0.0)
+    else if (option == "--max-refinements" && Integer(value, 0, 64, integer))
     {
-      renderer->SetMaxRefinements(static_cast<int>(number));
+      renderer->SetMaxRefinements(integer);
     }
-    else if (option == "--min-spp" && numeric && number >= 1.0)
+    else if (option == "--min-spp" && Integer(value, 1, 2147483647, integer))
     {
-      renderer->SetMinSamplesPerPixel(static_cast<int>(number));
+      renderer->SetMinSamplesPerPixel(integer);
     }
-    else if (option == "--max-spp" && numeric && number >= 1.0)
+    else if (option == "--max-spp" && Integer(value, 1, 2147483647, integer))
     {
-      renderer->SetMaxSamplesPerPixel(static_cast<int>(number));
+      renderer->SetMaxSamplesPerPixel(integer);
     }
     else if (option == "--target-error" && numeric && number >= 0.0)
     {
       renderer->SetTargetRelativeError(number);
     }
-    else if (option == "--max-order" && numeric && number >= 0.0)
+    else if (option == "--max-order" && Integer(value, 0, 2147483647, integer))
     {
-      renderer->SetMaxScatteringOrder(static_cast<int>(number));
+      renderer->SetMaxScatteringOrder(integer);
     }
-    else if (option == "--seed" && numeric)
+    else if (option == "--seed" && Integer(value, -2147483648.0, 2147483647, integer))
     {
-      renderer->SetSeed(static_cast<int>(number));
+      renderer->SetSeed(integer);
     }
-    else if (option == "--threads" && numeric && number >= 0.0)
+    else if (option == "--threads" && Integer(value, 0, 4096, integer))
     {
-      renderer->SetNumberOfThreads(static_cast<int>(number));
+      renderer->SetNumberOfThreads(integer);
+    }
+    else if (option == "--time-limit" && numeric && number >= 0.0 && number <= 1.0e9)
+    {
+      renderer->SetTimeLimitSeconds(number);
+    }
+    else if (option == "--target-image-error" && numeric && number >= 0.0 && number <= 1.0)
+    {
+      renderer->SetTargetImageRelativeError(number);
+    }
+    else if (option == "--progress" && (std::string(value) == "on" || std::string(value) == "off"))
+    {
+      showProgress = std::string(value) == "on";
     }
     else if (option == "--exposure" && numeric && number > 0.0)
     {
@@ -160,7 +273,20 @@ int Run(int argc, char* argv[])
     }
   }
 
+  ProgressLine progressLine;
+  progressLine.Renderer = renderer;
+  vtkNew<vtkCallbackCommand> progressCallback;
+  progressCallback->SetCallback(&ProgressLine::OnProgress);
+  progressCallback->SetClientData(&progressLine);
+  if (showProgress)
+  {
+    renderer->AddObserver(vtkCommand::ProgressEvent, progressCallback);
+  }
   renderer->Update();
+  if (showProgress)
+  {
+    std::fprintf(stderr, "\n");
+  }
   vtkImageData* image = renderer->GetOutput();
   auto* radiance = vtkFloatArray::SafeDownCast(image->GetPointData()->GetArray("radiance"));
   if (!radiance)
@@ -233,6 +359,10 @@ int Run(int argc, char* argv[])
             << ", \"seconds\": " << FieldValue(image, "RenderSeconds")
             << ", \"estimated_relative_error\": " << FieldValue(image, "EstimatedRelativeError")
             << ", \"samples_per_pixel\": " << FieldValue(image, "SamplesPerPixel")
+            << ", \"stopped_at_time_limit\": "
+            << (FieldValue(image, "StoppedAtTimeLimit") > 0.0 ? "true" : "false")
+            << ", \"reached_image_target\": "
+            << (FieldValue(image, "ReachedImageTarget") > 0.0 ? "true" : "false")
             << ", \"output\": \"" << output << "\"}" << std::endl;
   return 0;
 }

@@ -909,7 +909,34 @@ struct PixelStatistics
     return std::sqrt(std::max(0.0, this->M2[c]) / (n * (n - 1.0)));
   }
 };
+/// ImageRelativeError over the running statistics (channels 0-2).
+double ImageRelativeError(const std::vector<PixelStatistics>& statistics)
+{
+  double sumError = 0.0, sumValue = 0.0;
+  for (const PixelStatistics& stats : statistics)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      const double error = stats.StandardError(c);
+      sumError += error * error;
+      sumValue += stats.Mean[c] * stats.Mean[c];
+    }
+  }
+  return sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+}
 } // namespace
+
+double ImageRelativeError(const FloatImage& image, const FloatImage& standardError)
+{
+  double sumError = 0.0, sumValue = 0.0;
+  const std::size_t n = std::min(image.Pixels.size(), standardError.Pixels.size());
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    sumError += static_cast<double>(standardError.Pixels[i]) * standardError.Pixels[i];
+    sumValue += static_cast<double>(image.Pixels[i]) * image.Pixels[i];
+  }
+  return sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+}
 
 PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
@@ -925,6 +952,11 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   if (!(settings.TargetRelativeError >= 0.0))
   {
     throw std::invalid_argument("RenderPathTraced: TargetRelativeError must be >= 0");
+  }
+  if (!(settings.TimeLimitSeconds >= 0.0) || !(settings.TargetImageRelativeError >= 0.0))
+  {
+    throw std::invalid_argument(
+      "RenderPathTraced: TimeLimitSeconds and TargetImageRelativeError must be >= 0");
   }
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = context.GetCamera();
@@ -955,6 +987,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
   std::atomic<bool> stop{ false };
   const std::thread::id caller = std::this_thread::get_id();
+  int rounds = 0;
+  bool stoppedAtTimeLimit = false, reachedImageTarget = false;
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
   const std::uint64_t maxSamples = static_cast<std::uint64_t>(settings.MaxSamplesPerPixel);
   for (;;)
@@ -1067,6 +1101,35 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
       progress(std::min(
         1.0, static_cast<double>(paths.load()) / (static_cast<double>(pixels) * maxSamples)));
     }
+    ++rounds;
+    const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double imageError = ImageRelativeError(statistics);
+    if (settings.OnRound)
+    {
+      PathTracingRound round;
+      round.Round = rounds;
+      round.MeanSamplesPerPixel =
+        static_cast<double>(paths.load()) / static_cast<double>(std::max<std::size_t>(1, pixels));
+      round.Seconds = elapsed;
+      round.ImageRelativeError = imageError;
+      round.Pixels = pixels;
+      for (const PixelStatistics& stats : statistics)
+      {
+        round.ActivePixels += stats.Done ? 0 : 1;
+      }
+      settings.OnRound(round);
+    }
+    if (settings.TargetImageRelativeError > 0.0 && imageError <= settings.TargetImageRelativeError)
+    {
+      reachedImageTarget = true;
+      break;
+    }
+    if (settings.TimeLimitSeconds > 0.0 && elapsed >= settings.TimeLimitSeconds)
+    {
+      stoppedAtTimeLimit = true;
+      break;
+    }
     if (target >= maxSamples)
     {
       break;
@@ -1096,6 +1159,10 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   result.Paths = paths.load();
   result.TruncatedPaths = truncated.load();
   result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
+  result.ImageRelativeError = ImageRelativeError(result.Image, result.StandardError);
+  result.StoppedAtTimeLimit = stoppedAtTimeLimit;
+  result.ReachedImageTarget = reachedImageTarget;
+  result.Rounds = rounds;
   result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (progress)
   {

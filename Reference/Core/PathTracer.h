@@ -80,6 +80,8 @@ namespace nimbus
 /// a diffusing path needs ~tau^2 steps; the path is then cut (see above).
 constexpr std::uint64_t kMaxTrackingStepsPerPath = std::uint64_t(1) << 20;
 
+struct PathTracingRound;
+
 struct NIMBUSREFERENCE_EXPORT PathTracingSettings
 {
   int MinSamplesPerPixel = 16;
@@ -102,7 +104,32 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// Bytes the per-pixel buffers may take (about 104 bytes per pixel); 0 =
   /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
   double MemoryBudgetBytes = 0.0;
+  /// Stop after the first round that ends past this many seconds (0 = no limit). The
+  /// image is then unbiased with fewer samples; PathTracingResult says so.
+  double TimeLimitSeconds = 0.0;
+  /// Stop after the first round whose image-wide relative error (ImageRelativeError)
+  /// is at or below this (0 = no such target; the per-pixel target still applies).
+  double TargetImageRelativeError = 0.0;
+  /// Called on the calling thread after each round (for a progress display).
+  std::function<void(const PathTracingRound&)> OnRound;
 };
+
+/// The state after one round of samples.
+struct NIMBUSREFERENCE_EXPORT PathTracingRound
+{
+  int Round = 0;                    // 1 for the first
+  double MeanSamplesPerPixel = 0.0; // so far
+  double Seconds = 0.0;             // since the render started
+  double ImageRelativeError = 0.0;  // as PathTracingResult::ImageRelativeError, so far
+  std::size_t ActivePixels = 0;     // pixels that will get more samples
+  std::size_t Pixels = 0;
+};
+
+/// Image-wide relative error of a radiance image with its per-pixel standard error:
+/// the RMS standard error over the RMS radiance, all pixels and channels (0 for a
+/// black image).
+NIMBUSREFERENCE_EXPORT double ImageRelativeError(
+  const FloatImage& image, const FloatImage& standardError);
 
 struct NIMBUSREFERENCE_EXPORT PathTracingResult
 {
@@ -113,6 +140,10 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
   // Extensions.
   std::uint64_t Paths = 0;          // paths traced in total
   std::uint64_t TruncatedPaths = 0; // paths cut at kMaxTrackingStepsPerPath
+  double ImageRelativeError = 0.0;  // ImageRelativeError(Image, StandardError)
+  bool StoppedAtTimeLimit = false;  // TimeLimitSeconds ended the render
+  bool ReachedImageTarget = false;  // TargetImageRelativeError ended the render
+  int Rounds = 0;
 };
 
 /// Renders the context's camera view progressively: rounds of samples (first
@@ -122,7 +153,7 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
 /// after each round; it may throw to stop the render (e.g. on a user's abort): the
 /// exception propagates once the pixels being traced are done. Throws
 /// std::invalid_argument for MinSamplesPerPixel < 1 or MaxSamplesPerPixel <
-/// MinSamplesPerPixel or a negative / NaN target, and std::length_error, before
+/// MinSamplesPerPixel or a negative / NaN target or time limit, and std::length_error, before
 /// allocating, when the per-pixel buffers would need more than MemoryBudgetBytes,
 /// and std::range_error when the image has a NaN or infinite pixel component.
 NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,

@@ -663,6 +663,89 @@ TEST(PathTracer, RejectsBadSettings)
   s = Samples(4);
   s.TargetRelativeError = -1.0;
   EXPECT_THROW(nimbus::RenderPathTraced(context, s), std::invalid_argument);
+  s = Samples(4);
+  s.TimeLimitSeconds = std::nan("");
+  EXPECT_THROW(nimbus::RenderPathTraced(context, s), std::invalid_argument);
+  s = Samples(4);
+  s.TargetImageRelativeError = -0.5;
+  EXPECT_THROW(nimbus::RenderPathTraced(context, s), std::invalid_argument);
+}
+
+// Stopping rules for long renders: a time limit and an image-wide error target end
+// the render after a whole round (so every pixel has the same samples as it would in
+// an unlimited render's same round); the rounds are reported as they finish.
+TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
+{
+  SceneDescription scene = EmptyScene(8, 8);
+  scene.Sun.Illuminance = 1.0;
+  scene.Sun.ElevationDegrees = 30.0;
+  scene.Camera.Position = { { 0.0, -2500.0, 800.0 } };
+  scene.Camera.FocalPoint = { { 0.0, 0.0, 1000.0 } };
+  scene.Camera.ViewAngle = 40.0;
+  scene.Medium.ExtinctionPerDensity = 0.03;
+  scene.Medium.SingleScatteringAlbedo = 0.99;
+  const RenderContext context(scene, PuffGrid(17, { { -500.0, -500.0, 500.0 } }, 1000.0, 3));
+  PathTracingSettings settings;
+  settings.MinSamplesPerPixel = 4;
+  settings.MaxSamplesPerPixel = 64;
+  settings.Seed = 5;
+  settings.Threads = 2;
+  std::vector<nimbus::PathTracingRound> rounds;
+  settings.OnRound = [&rounds](const nimbus::PathTracingRound& r) { rounds.push_back(r); };
+  const PathTracingResult full = nimbus::RenderPathTraced(context, settings);
+  // Rounds of 4, 8, 16, 32, 64 samples; the error estimate falls round by round.
+  ASSERT_EQ(rounds.size(), 5u);
+  EXPECT_EQ(full.Rounds, 5);
+  EXPECT_FALSE(full.StoppedAtTimeLimit);
+  EXPECT_FALSE(full.ReachedImageTarget);
+  for (std::size_t r = 0; r < rounds.size(); ++r)
+  {
+    EXPECT_EQ(rounds[r].Round, static_cast<int>(r) + 1);
+    EXPECT_EQ(rounds[r].MeanSamplesPerPixel, 4.0 * (1 << r));
+    EXPECT_EQ(rounds[r].Pixels, 64u);
+    EXPECT_GT(rounds[r].ImageRelativeError, 0.0);
+    if (r > 0)
+    {
+      EXPECT_LT(rounds[r].ImageRelativeError, rounds[r - 1].ImageRelativeError);
+      EXPECT_GE(rounds[r].Seconds, rounds[r - 1].Seconds);
+    }
+  }
+  EXPECT_NEAR(
+    rounds.back().ImageRelativeError, full.ImageRelativeError, 1e-6 * full.ImageRelativeError);
+
+  // A time limit already passed at the end of the first round stops there.
+  rounds.clear();
+  settings.TimeLimitSeconds = 1e-9;
+  const PathTracingResult limited = nimbus::RenderPathTraced(context, settings);
+  EXPECT_TRUE(limited.StoppedAtTimeLimit);
+  EXPECT_EQ(limited.Rounds, 1);
+  EXPECT_EQ(limited.MeanSamplesPerPixel, 4.0);
+  settings.TimeLimitSeconds = 0.0;
+
+  // An image target between the errors of rounds 2 and 3 stops after round 3.
+  rounds.clear();
+  const PathTracingResult again = nimbus::RenderPathTraced(context, settings);
+  ASSERT_EQ(rounds.size(), 5u);
+  const double between = 0.5 * (rounds[1].ImageRelativeError + rounds[2].ImageRelativeError);
+  const std::vector<nimbus::PathTracingRound> unlimited = rounds;
+  rounds.clear();
+  settings.TargetImageRelativeError = between;
+  const PathTracingResult targeted = nimbus::RenderPathTraced(context, settings);
+  EXPECT_TRUE(targeted.ReachedImageTarget);
+  EXPECT_EQ(targeted.Rounds, 3);
+  EXPECT_EQ(targeted.MeanSamplesPerPixel, 16.0);
+  EXPECT_LE(targeted.ImageRelativeError, between);
+  // Without a stopping rule the same seed gives the same image as before (the rules
+  // only end the loop; they never change a sample).
+  EXPECT_EQ(0,
+    std::memcmp(again.Image.Pixels.data(), full.Image.Pixels.data(),
+      full.Image.Pixels.size() * sizeof(float)));
+  std::printf("image-wide relative error by round (4..64 spp):");
+  for (const auto& r : unlimited)
+  {
+    std::printf(" %.4f", r.ImageRelativeError);
+  }
+  std::printf("; target %.4f reached at 16 spp with %.4f\n", between, targeted.ImageRelativeError);
 }
 
 } // namespace
