@@ -51,6 +51,7 @@
 #include "SlabSolver.h"
 
 #include "Math.h"
+#include "Quadrature.h"
 
 #include <algorithm>
 #include <cmath>
@@ -480,38 +481,15 @@ void GaussLegendre01(int n, std::vector<double>& nodes, std::vector<double>& wei
   {
     throw std::invalid_argument("nimbus::slab: Gauss-Legendre needs n >= 1");
   }
-  nodes.assign(n, 0.0);
-  weights.assign(n, 0.0);
-  // Newton on P_n from Tricomi's initial guess (roots x_k in (-1, 1), then mapped).
-  for (int k = 0; k < (n + 1) / 2; ++k)
+  // The rule on [-1, 1] (Physics/Quadrature.h; nodes descending), mapped to [0, 1].
+  std::vector<double> x, w;
+  nimbus::GaussLegendre(n, x, w);
+  nodes.resize(n);
+  weights.resize(n);
+  for (int k = 0; k < n; ++k)
   {
-    double x = std::cos(kPi * (k + 0.75) / (n + 0.5));
-    double derivative = 1.0;
-    for (int iteration = 0; iteration < 100; ++iteration)
-    {
-      double p0 = 1.0;
-      double p1 = x;
-      for (int l = 2; l <= n; ++l)
-      {
-        const double p2 = ((2.0 * l - 1.0) * x * p1 - (l - 1.0) * p0) / l;
-        p0 = p1;
-        p1 = p2;
-      }
-      // p1 = P_n(x), p0 = P_{n-1}(x); P_n' = n (x P_n - P_{n-1}) / (x^2 - 1).
-      derivative = n * (x * p1 - p0) / (x * x - 1.0);
-      const double step = p1 / derivative;
-      x -= step;
-      if (std::fabs(step) < 1e-16)
-      {
-        break;
-      }
-    }
-    // Weight on [-1, 1]: 2 / ((1 - x^2) P_n'(x)^2); on [0, 1] half of it.
-    const double w = 1.0 / ((1.0 - x * x) * derivative * derivative);
-    nodes[n - 1 - k] = 0.5 * (1.0 + x);
-    nodes[k] = 0.5 * (1.0 - x);
-    weights[k] = w;
-    weights[n - 1 - k] = w;
+    nodes[k] = 0.5 * (1.0 - x[k]);
+    weights[k] = 0.5 * w[k];
   }
 }
 

@@ -491,12 +491,11 @@ TEST(PathTracer, ForwardScatteringBrighterForPositiveG)
 // 5. Determinism: a scene with everything on (cloud puffs, atmosphere, ground,
 // sun, adaptive stopping). Same seed -> identical bytes; 1 vs 4 threads ->
 // identical bytes; another seed -> different.
-TEST(PathTracer, Deterministic)
+/// A cloud of puffs 1 km across seen from 2.5 km with the sun at 30 degrees (no air,
+/// no ground unless a test adds them): the scene of the determinism and stopping tests.
+SceneDescription PuffCloudScene(int width, int height)
 {
-  SceneDescription scene = EmptyScene(8, 8);
-  scene.Atmosphere.Enabled = true;
-  scene.Ground.Enabled = true;
-  scene.Background.Type = "atmosphere";
+  SceneDescription scene = EmptyScene(width, height);
   scene.Sun.Illuminance = 1.0;
   scene.Sun.ElevationDegrees = 30.0;
   scene.Camera.Position = { { 0.0, -2500.0, 800.0 } };
@@ -504,7 +503,21 @@ TEST(PathTracer, Deterministic)
   scene.Camera.ViewAngle = 40.0;
   scene.Medium.ExtinctionPerDensity = 0.03;
   scene.Medium.SingleScatteringAlbedo = 0.99;
-  const RenderContext context(scene, PuffGrid(17, { { -500.0, -500.0, 500.0 } }, 1000.0, 3));
+  return scene;
+}
+
+DensityGrid PuffCloud()
+{
+  return PuffGrid(17, { { -500.0, -500.0, 500.0 } }, 1000.0, 3);
+}
+
+TEST(PathTracer, Deterministic)
+{
+  SceneDescription scene = PuffCloudScene(8, 8);
+  scene.Atmosphere.Enabled = true;
+  scene.Ground.Enabled = true;
+  scene.Background.Type = "atmosphere";
+  const RenderContext context(scene, PuffCloud());
   PathTracingSettings settings;
   settings.MinSamplesPerPixel = 8;
   settings.MaxSamplesPerPixel = 64;
@@ -677,15 +690,7 @@ TEST(PathTracer, RejectsBadSettings)
 // measured RMS of d over the estimated sqrt(mean(se(N)^2 + se(16N)^2)) should be 1.
 TEST(PathTracer, StandardErrorMatchesTheTrueError)
 {
-  SceneDescription scene = EmptyScene(32, 32);
-  scene.Sun.Illuminance = 1.0;
-  scene.Sun.ElevationDegrees = 30.0;
-  scene.Camera.Position = { { 0.0, -2500.0, 800.0 } };
-  scene.Camera.FocalPoint = { { 0.0, 0.0, 1000.0 } };
-  scene.Camera.ViewAngle = 40.0;
-  scene.Medium.ExtinctionPerDensity = 0.03;
-  scene.Medium.SingleScatteringAlbedo = 0.99;
-  const RenderContext context(scene, PuffGrid(17, { { -500.0, -500.0, 500.0 } }, 1000.0, 3));
+  const RenderContext context(PuffCloudScene(32, 32), PuffCloud());
   PathTracingSettings settings;
   settings.Threads = 2;
   settings.Seed = 11;
@@ -727,15 +732,7 @@ TEST(PathTracer, StandardErrorMatchesTheTrueError)
 // an unlimited render's same round); the rounds are reported as they finish.
 TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
 {
-  SceneDescription scene = EmptyScene(8, 8);
-  scene.Sun.Illuminance = 1.0;
-  scene.Sun.ElevationDegrees = 30.0;
-  scene.Camera.Position = { { 0.0, -2500.0, 800.0 } };
-  scene.Camera.FocalPoint = { { 0.0, 0.0, 1000.0 } };
-  scene.Camera.ViewAngle = 40.0;
-  scene.Medium.ExtinctionPerDensity = 0.03;
-  scene.Medium.SingleScatteringAlbedo = 0.99;
-  const RenderContext context(scene, PuffGrid(17, { { -500.0, -500.0, 500.0 } }, 1000.0, 3));
+  const RenderContext context(PuffCloudScene(8, 8), PuffCloud());
   PathTracingSettings settings;
   settings.MinSamplesPerPixel = 4;
   settings.MaxSamplesPerPixel = 64;
