@@ -120,6 +120,28 @@ uint64_t CheckedChunk(std::istream& is, int64_t size, size_t numBytes, bool& com
   }
   return bytes;
 }
+
+/// What both chunk readers do first: read and check the chunk size, then skip the chunk
+/// (no data wanted) or read an uncompressed one into `data`. Returns the size of a
+/// compressed chunk still to be read and expanded, 0 when the chunk is done.
+uint64_t ReadChunkUnlessCompressed(std::istream& is, char* data, size_t numBytes)
+{
+  int64_t size = 0;
+  is.read(reinterpret_cast<char*>(&size), 8);
+  bool compressed = false;
+  const uint64_t bytes = CheckedChunk(is, size, numBytes, compressed);
+  if (!data)
+  {
+    is.seekg(static_cast<std::streamoff>(bytes), std::ios_base::cur);
+    return 0;
+  }
+  if (!compressed)
+  {
+    is.read(data, static_cast<std::streamsize>(bytes));
+    return 0;
+  }
+  return bytes;
+}
 }
 
 namespace openvdb
@@ -132,18 +154,9 @@ namespace io
 
 void bloscFromStream(std::istream& is, char* data, size_t numBytes)
 {
-  Int64 size = 0;
-  is.read(reinterpret_cast<char*>(&size), 8);
-  bool compressed = false;
-  const uint64_t bytes = CheckedChunk(is, size, numBytes, compressed);
-  if (!data)
+  const uint64_t bytes = ReadChunkUnlessCompressed(is, data, numBytes);
+  if (bytes == 0)
   {
-    is.seekg(static_cast<std::streamoff>(bytes), std::ios_base::cur);
-    return;
-  }
-  if (!compressed)
-  {
-    is.read(data, static_cast<std::streamsize>(bytes));
     return;
   }
   std::unique_ptr<char[]> chunk(new char[bytes]);
@@ -164,18 +177,9 @@ void bloscFromStream(std::istream& is, char* data, size_t numBytes)
 
 void unzipFromStream(std::istream& is, char* data, size_t numBytes)
 {
-  Int64 size = 0;
-  is.read(reinterpret_cast<char*>(&size), 8);
-  bool compressed = false;
-  const uint64_t bytes = CheckedChunk(is, size, numBytes, compressed);
-  if (!data)
+  const uint64_t bytes = ReadChunkUnlessCompressed(is, data, numBytes);
+  if (bytes == 0)
   {
-    is.seekg(static_cast<std::streamoff>(bytes), std::ios_base::cur);
-    return;
-  }
-  if (!compressed)
-  {
-    is.read(data, static_cast<std::streamsize>(bytes));
     return;
   }
   std::unique_ptr<Bytef[]> chunk(new Bytef[bytes]);
