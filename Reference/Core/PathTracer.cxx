@@ -103,6 +103,99 @@ struct SunTable
   }
 };
 
+/// The cloud's optical depth toward the sun at every grid point, estimated by short
+/// characteristics (one upwind step per point, see BuildSunDepth): only an estimate,
+/// used to decide how often to estimate the sun's contribution at a point
+/// (NextEventProbability); the estimates themselves stay exact in expectation whatever
+/// its error, only their variance depends on it.
+/// Sun next-event estimation runs with probability min(1, T_est / kSunDepthReference)
+/// (at least kSunDepthMinimumProbability), weighted by its inverse: deep inside a
+/// thick cloud most estimates would be ~0 after a ratio-tracking walk. T_est is the
+/// largest transmittance at the corners of the grid cell (conservative).
+constexpr double kSunDepthReference = 0.02;
+constexpr double kSunDepthMinimumProbability = 0.01;
+
+struct SunDepthLattice
+{
+  std::array<int, 3> Dims{ { 0, 0, 0 } };
+  Vector3 Origin{ { 0.0, 0.0, 0.0 } }, Spacing{ { 1.0, 1.0, 1.0 } };
+  std::vector<float> Depth; // [i + Dims[0] (j + Dims[1] k)]
+
+  bool Empty() const { return this->Depth.empty(); }
+  /// The smallest lattice depth at the corners of the cell holding p (0 outside).
+  double MinimumDepth(const Vector3& p) const
+  {
+    int i0[3], d[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const double x = (p[a] - this->Origin[a]) / this->Spacing[a];
+      if (!(x >= 0.0 && x <= this->Dims[a] - 1))
+      {
+        return 0.0;
+      }
+      i0[a] = std::min(std::max(0, this->Dims[a] - 2), static_cast<int>(x));
+      d[a] = this->Dims[a] > 1 ? 1 : 0;
+    }
+    const std::size_t nx = static_cast<std::size_t>(this->Dims[0]);
+    const std::size_t nxy = nx * static_cast<std::size_t>(this->Dims[1]);
+    const float* v = this->Depth.data() + i0[0] + i0[1] * nx + i0[2] * nxy;
+    const std::size_t dx = d[0], dy = d[1] * nx, dz = d[2] * nxy;
+    return std::min({ v[0], v[dx], v[dy], v[dx + dy], v[dz], v[dz + dx], v[dz + dy],
+      v[dz + dx + dy] });
+  }
+};
+
+/// The atmosphere's optical lengths toward the sun over the whole atmosphere, for
+/// next-event estimation at air and ground points (outside the cloud box, where
+/// SunTable does not reach): nodes uniform in r in [r_min, r_top] and in u in [-1, 1],
+/// mu_s = u |u| (finer near the horizon, where the slant path grows fastest); ln L_R and
+/// ln L_M bilinear in (r, u), so the exponential fall-off with altitude is interpolated
+/// exactly and only the slant geometry is not. Each cell is
+/// checked at its centre against the exact lengths; a cell whose error in ln T at any
+/// wavelength exceeds kGlobalSunTableTolerance, or that touches the earth's shadow, is
+/// marked invalid and its points are evaluated exactly (as are points outside the
+/// table). So the table never adds more than that error where it is used.
+constexpr double kGlobalSunTableTolerance = 1e-4;
+constexpr int kGlobalSunTableRadii = 129;
+constexpr int kGlobalSunTableCosines = 1025;
+
+struct GlobalSunTable
+{
+  double RMin = 0.0, RTop = 0.0;
+  std::vector<double> LR, LM; // ln of the lengths (m), [j * kGlobalSunTableRadii + i]
+  std::vector<unsigned char> CellValid;
+
+  bool Empty() const { return this->LR.empty(); }
+  bool Lookup(double r, double mu, double& lR, double& lM) const
+  {
+    if (this->LR.empty() || !(r >= this->RMin && r <= this->RTop) || !(mu >= -1.0 && mu <= 1.0))
+    {
+      return false;
+    }
+    const double x = (r - this->RMin) / (this->RTop - this->RMin) * (kGlobalSunTableRadii - 1);
+    const double y =
+      0.5 * (std::copysign(std::sqrt(std::abs(mu)), mu) + 1.0) * (kGlobalSunTableCosines - 1);
+    const int i = std::min(kGlobalSunTableRadii - 2, static_cast<int>(x));
+    const int j = std::min(kGlobalSunTableCosines - 2, static_cast<int>(y));
+    if (!this->CellValid[static_cast<std::size_t>(j) * (kGlobalSunTableRadii - 1) + i])
+    {
+      return false;
+    }
+    const double fx = x - i, fy = y - j;
+    const std::size_t k = static_cast<std::size_t>(j) * kGlobalSunTableRadii + i;
+    auto bilinear = [&](const std::vector<double>& v)
+    {
+      const double a = v[k] + fx * (v[k + 1] - v[k]);
+      const double b =
+        v[k + kGlobalSunTableRadii] + fx * (v[k + kGlobalSunTableRadii + 1] - v[k + kGlobalSunTableRadii]);
+      return a + fy * (b - a);
+    };
+    lR = std::exp(bilinear(this->LR));
+    lM = std::exp(bilinear(this->LM));
+    return true;
+  }
+};
+
 /// A ray with what its majorant pieces need.
 struct Ray
 {
@@ -122,6 +215,13 @@ enum class Scatterer
   Ground
 };
 
+enum class SegmentEndKind
+{
+  Leaves, // background
+  Ground,
+  Earth // black (the same convention as SingleScatteringRenderer)
+};
+
 enum class FlightEnd
 {
   Collision, // real scattering event at the returned t
@@ -136,6 +236,7 @@ struct PathState
   std::vector<double> Weight;   // spectral throughput
   std::vector<double> Radiance; // spectral estimate of the path
   std::vector<double> SunTransmittance;
+  std::vector<double> SavedWeight; // the path's throughput during a sun-peak flight
   std::uint64_t Steps = 0;
   bool Truncated = false;
 };
@@ -225,11 +326,32 @@ public:
     {
       this->BuildSunTable();
     }
+    if (this->Air && this->SunOn && settings.TabulatedAirTransmittance)
+    {
+      this->BuildAirSunTable();
+    }
+    if (this->HasCloud && this->SunOn && settings.SunDepthRoulette)
+    {
+      this->BuildSunDepth();
+    }
   }
 
   int GetWavelengths() const { return this->Wavelengths; }
 
   void BuildSunTable();
+  void BuildSunDepth();
+  void BuildAirSunTable();
+  /// Probability with which the sun's contribution is estimated at p (1 outside the
+  /// cloud box or without the lattice).
+  double NextEventProbability(const Vector3& p) const
+  {
+    if (this->SunDepth.Empty())
+    {
+      return 1.0;
+    }
+    const double estimate = std::exp(-this->SunDepth.MinimumDepth(p));
+    return std::min(1.0, std::max(kSunDepthMinimumProbability, estimate / kSunDepthReference));
+  }
 
   /// One camera path through image point (x, y); the spectral estimate goes to
   /// state.Radiance, its linear sRGB to rgb.
@@ -268,7 +390,14 @@ private:
     const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state) const;
   /// Adds the sun's single-scattered contribution at p (next-event estimation).
   void SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
-    PathState& state) const;
+    PathState& state, double weight = 1.0) const;
+  /// Where a ray from its origin ends: tEnd and what lies there.
+  double SegmentEnd(const Ray& ray, SegmentEndKind& kind) const;
+  /// The sun-peak strategy at vertex p (see TracePath): samples a direction from the
+  /// cloud's phase function about the sun, flies along it and, at a cloud scattering
+  /// event, adds the sun's contribution with the balance-heuristic weight.
+  void SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scatterer scatterer,
+    PathRandom& rng, PathState& state) const;
 
   const RenderContext& Context;
   const PathTracingSettings& Settings;
@@ -287,6 +416,8 @@ private:
   double AirMajorantInCloudBox = 0.0; // at the box's lowest altitude, 1/m
   double CloudBoxMinRadius = 0.0;     // distance from the earth centre to the box, m
   SunTable SunLengths;
+  SunDepthLattice SunDepth; // empty = next-event estimation everywhere
+  GlobalSunTable AirSunLengths; // empty = exact outside the cloud box
   Vector3 Sun;
   std::vector<double> SunIrradiance;
   bool SunOn = false;
@@ -386,6 +517,192 @@ void Integrator::BuildSunTable()
       return;
     }
   }
+}
+
+void Integrator::BuildAirSunTable()
+{
+  const Vector3& sun = this->Sun;
+  const AtmosphereParameters& parameters = this->Air->GetParameters();
+  GlobalSunTable table;
+  // Lowest point a path can reach: the ground plane's height above the scene origin
+  // (the plane is flat, so it only rises away from it), else the earth's surface.
+  table.RMin = this->EarthRadius;
+  if (this->Context.HasGround())
+  {
+    table.RMin = std::max(table.RMin,
+      std::sqrt(Dot(this->Context.EarthCentred({ { 0.0, 0.0, this->Context.GetGroundHeight() } }),
+        this->Context.EarthCentred({ { 0.0, 0.0, this->Context.GetGroundHeight() } }))) - 1.0);
+  }
+  table.RTop = parameters.TopRadiusMetres;
+  if (!(table.RTop > table.RMin))
+  {
+    return;
+  }
+  const Vector3 helper =
+    std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
+  Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
+    sun[0] * helper[1] - sun[1] * helper[0] } };
+  const double perpLength = std::sqrt(Dot(perp, perp));
+  for (double& c : perp)
+  {
+    c /= perpLength;
+  }
+  auto radius = [&](double x) { return table.RMin + x * (table.RTop - table.RMin); };
+  auto cosine = [](double u) { return u * std::abs(u); };
+  // Exact lengths at (r, mu); false where the earth hides the sun.
+  auto exact = [&](double r, double mu, double& lR, double& lM)
+  {
+    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]),
+      r * (mu * sun[1] + sinTheta * perp[1]), r * (mu * sun[2] + sinTheta * perp[2]) } };
+    const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
+    lR = lengths.RayleighLengthMetres;
+    lM = lengths.MieLengthMetres;
+    return !lengths.HitsGround;
+  };
+  const int nx = kGlobalSunTableRadii, ny = kGlobalSunTableCosines;
+  table.LR.assign(static_cast<std::size_t>(nx) * ny, 0.0);
+  table.LM.assign(table.LR.size(), 0.0);
+  std::vector<unsigned char> lit(table.LR.size(), 0);
+  table.CellValid.assign(static_cast<std::size_t>(nx - 1) * (ny - 1), 0);
+  const int threads = ResolveThreadCount(this->Settings.Threads);
+  ParallelFor(table.LR.size(), 64, threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      for (std::size_t k = begin; k < end; ++k)
+      {
+        const int i = static_cast<int>(k % nx), j = static_cast<int>(k / nx);
+        double lR, lM;
+        const bool sunlit =
+          exact(radius(static_cast<double>(i) / (nx - 1)), cosine(-1.0 + 2.0 * j / (ny - 1)), lR, lM);
+        // At the top the lengths are 0: no logarithm, and the cells there stay exact.
+        lit[k] = sunlit && lR > 0.0 && lM > 0.0 ? 1 : 0;
+        table.LR[k] = lit[k] ? std::log(lR) : 0.0;
+        table.LM[k] = lit[k] ? std::log(lM) : 0.0;
+      }
+    });
+  const double betaMax = std::max(this->BetaRMax, this->BetaMt);
+  ParallelFor(table.CellValid.size(), 64, threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      for (std::size_t c = begin; c < end; ++c)
+      {
+        const int i = static_cast<int>(c % (nx - 1)), j = static_cast<int>(c / (nx - 1));
+        const std::size_t k = static_cast<std::size_t>(j) * nx + i;
+        if (!(lit[k] && lit[k + 1] && lit[k + nx] && lit[k + nx + 1]))
+        {
+          continue;
+        }
+        double lR, lM;
+        const double r = radius((i + 0.5) / (nx - 1)), mu = cosine(-1.0 + 2.0 * (j + 0.5) / (ny - 1));
+        if (!exact(r, mu, lR, lM))
+        {
+          continue;
+        }
+        const double tR = std::exp(
+          0.25 * (table.LR[k] + table.LR[k + 1] + table.LR[k + nx] + table.LR[k + nx + 1]));
+        const double tM = std::exp(
+          0.25 * (table.LM[k] + table.LM[k + 1] + table.LM[k + nx] + table.LM[k + nx + 1]));
+        table.CellValid[c] =
+          betaMax * (std::abs(tR - lR) + std::abs(tM - lM)) <= kGlobalSunTableTolerance ? 1 : 0;
+      }
+    });
+  this->AirSunLengths = std::move(table);
+}
+
+void Integrator::BuildSunDepth()
+{
+  // Short characteristics: tau(p) = tau(q) + sigma(midpoint) |q - p|, q where the ray
+  // from p toward the sun leaves p's cell (a face of lattice points one step nearer the
+  // sun along each axis), tau(q) bilinear on that face (0 outside the grid). Visiting
+  // the points from the sun's side along every axis computes the face before p. O(N).
+  const std::array<int, 3>& n = this->Grid.GetDimensions();
+  SunDepthLattice lattice;
+  lattice.Dims = n;
+  lattice.Origin = this->Grid.GetLower();
+  lattice.Spacing = this->Grid.GetSpacing();
+  const std::size_t nx = static_cast<std::size_t>(n[0]), nxy = nx * static_cast<std::size_t>(n[1]);
+  lattice.Depth.assign(nxy * static_cast<std::size_t>(n[2]), 0.0f);
+  const double extinctionPerDensity = this->Context.GetScene().Medium.ExtinctionPerDensity;
+  int step[3];
+  double exitDistance = kInfinity;
+  int exitAxis = -1;
+  for (int a = 0; a < 3; ++a)
+  {
+    step[a] = this->Sun[a] > 0.0 ? 1 : -1;
+    if (n[a] > 1 && this->Sun[a] != 0.0)
+    {
+      const double d = this->Grid.GetSpacing()[a] / std::abs(this->Sun[a]);
+      if (d < exitDistance)
+      {
+        exitDistance = d;
+        exitAxis = a;
+      }
+    }
+  }
+  if (exitAxis < 0)
+  {
+    return; // one point, or the sun along an axis of one point: nothing to shade
+  }
+  // Fractions along the two other axes where the ray crosses the exit face.
+  int other[2], o = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (a != exitAxis)
+    {
+      other[o++] = a;
+    }
+  }
+  double fraction[2];
+  for (int m = 0; m < 2; ++m)
+  {
+    const int a = other[m];
+    fraction[m] = n[a] > 1 ? std::abs(this->Sun[a]) * exitDistance / this->Grid.GetSpacing()[a] : 0.0;
+  }
+  auto depthAt = [&](int i, int j, int k) -> double
+  {
+    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2])
+    {
+      return 0.0;
+    }
+    return lattice.Depth[static_cast<std::size_t>(i) + j * nx + k * nxy];
+  };
+  for (int kk = 0; kk < n[2]; ++kk)
+  {
+    const int k = step[2] > 0 ? n[2] - 1 - kk : kk;
+    for (int jj = 0; jj < n[1]; ++jj)
+    {
+      const int j = step[1] > 0 ? n[1] - 1 - jj : jj;
+      for (int ii = 0; ii < n[0]; ++ii)
+      {
+        const int i = step[0] > 0 ? n[0] - 1 - ii : ii;
+        int base[3] = { i, j, k };
+        base[exitAxis] += step[exitAxis];
+        // The face's four points: base, and base stepped along each other axis.
+        double face[2][2];
+        for (int u = 0; u < 2; ++u)
+        {
+          for (int v = 0; v < 2; ++v)
+          {
+            int c[3] = { base[0], base[1], base[2] };
+            c[other[0]] += u * (n[other[0]] > 1 ? step[other[0]] : 0);
+            c[other[1]] += v * (n[other[1]] > 1 ? step[other[1]] : 0);
+            face[u][v] = depthAt(c[0], c[1], c[2]);
+          }
+        }
+        const double f0 = std::min(1.0, fraction[0]), f1 = std::min(1.0, fraction[1]);
+        const double upwind = (1 - f0) * ((1 - f1) * face[0][0] + f1 * face[0][1]) +
+          f0 * ((1 - f1) * face[1][0] + f1 * face[1][1]);
+        const Vector3 p{ { lattice.Origin[0] + i * lattice.Spacing[0],
+          lattice.Origin[1] + j * lattice.Spacing[1], lattice.Origin[2] + k * lattice.Spacing[2] } };
+        const double sigma =
+          extinctionPerDensity * this->Grid.Sample(Along(p, this->Sun, 0.5 * exitDistance));
+        lattice.Depth[static_cast<std::size_t>(i) + j * nx + k * nxy] =
+          static_cast<float>(upwind + sigma * exitDistance);
+      }
+    }
+  }
+  this->SunDepth = std::move(lattice);
 }
 
 double Integrator::Piece(const Ray& ray, double t, double tEnd, bool withAir, double& tNext,
@@ -649,8 +966,8 @@ double Integrator::CloudTransmittance(
   }
 }
 
-void Integrator::SunNextEvent(
-  const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng, PathState& state) const
+void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer,
+  PathRandom& rng, PathState& state, double weight) const
 {
   // Radiance toward -d from the sun's irradiance E(lambda) arriving along -s:
   //   L = f * E * T_cloud * T_atm(lambda),
@@ -698,7 +1015,9 @@ void Integrator::SunNextEvent(
   double lR, lM;
   const Vector3 q = this->Air ? this->Context.EarthCentred(p) : p;
   const double r = std::sqrt(Dot(q, q));
-  if (this->Air && this->SunLengths.Lookup(r, Dot(q, s) / r, lR, lM))
+  if (this->Air &&
+    (this->SunLengths.Lookup(r, Dot(q, s) / r, lR, lM) ||
+      this->AirSunLengths.Lookup(r, Dot(q, s) / r, lR, lM)))
   {
     // tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M (Atmosphere.h).
     transmittance.resize(this->Wavelengths);
@@ -711,11 +1030,105 @@ void Integrator::SunNextEvent(
   {
     this->Context.SunAtmosphereTransmittance(p, transmittance);
   }
-  const double k = f * cloud;
+  const double k = f * cloud * weight;
   for (int i = 0; i < this->Wavelengths; ++i)
   {
     state.Radiance[i] += state.Weight[i] * k * this->SunIrradiance[i] * state.SunTransmittance[i];
   }
+}
+
+double Integrator::SegmentEnd(const Ray& ray, SegmentEndKind& kind) const
+{
+  const double tGround = this->Context.IntersectGround(ray.Origin, ray.Direction, 0.0);
+  double tEnd = tGround;
+  kind = std::isfinite(tGround) ? SegmentEndKind::Ground : SegmentEndKind::Leaves;
+  if (this->Air)
+  {
+    const double tTop = this->Context.DistanceToTopOfAtmosphere(ray.Origin, ray.Direction);
+    // Earth sphere (reached only with the ground plane disabled or beyond the
+    // plane's hit): the path ends there with no radiance.
+    const Vector3& q = ray.EarthOrigin;
+    const double r = std::sqrt(Dot(q, q));
+    const double c = (r - this->EarthRadius) * (r + this->EarthRadius);
+    const double b = Dot(q, ray.Direction);
+    double tEarth = kInfinity;
+    if (c > 0.0 && b < 0.0 && b * b - c >= 0.0)
+    {
+      tEarth = c / (-b + std::sqrt(b * b - c));
+    }
+    if (tTop < tEnd)
+    {
+      tEnd = tTop;
+      kind = SegmentEndKind::Leaves;
+    }
+    if (tEarth < tEnd)
+    {
+      tEnd = tEarth;
+      kind = SegmentEndKind::Earth;
+    }
+  }
+  return tEnd;
+}
+
+void Integrator::SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scatterer scatterer,
+  PathRandom& rng, PathState& state) const
+{
+  // Strategy B of the sun's contribution at the next vertex (TracePath): a direction
+  // d from the cloud's phase function about the sun, pdf p_B(d) = p_c(s . d); the
+  // vertex's own scattering f(d) and the pdf p_A(d) of its usual sampler; a flight
+  // along d to x''; if x'' is a cloud scattering event, the sun's contribution there,
+  //   W f(d) / p_B(d) * p_c(s . d) T_sun E * p_B / (p_A + p_B) = W f p_B / (p_A + p_B) T_sun E
+  // (balance heuristic, Veach 1997 Eq. 9.4), i.e. SunNextEvent with weight
+  // f / (p_A + p_B) on the throughput.
+  auto uniform = [&rng]() { return rng.Uniform(); };
+  const PhaseFunctionMixture& phase = this->Context.GetCloudPhase();
+  const Vector3 d = DirectionFromCosine(this->Sun, phase.Sample(uniform), rng.Uniform());
+  const double pB = phase.Evaluate(Dot(this->Sun, d));
+  double f = 0.0, pA = 0.0;
+  switch (scatterer)
+  {
+    case Scatterer::Cloud:
+      f = pA = phase.Evaluate(Dot(incoming, d));
+      break;
+    case Scatterer::Ground:
+      f = d[2] > 0.0 ? this->Context.GetGroundAlbedo() / kPi * d[2] : 0.0;
+      pA = d[2] > 0.0 ? d[2] / kPi : 0.0;
+      break;
+    default:
+      return; // only cloud and ground vertices use the strategy
+  }
+  if (!(f > 0.0) || !(pA + pB > 0.0))
+  {
+    return;
+  }
+  const Ray ray = this->MakeRay(p, d);
+  if (!ray.CrossesCloud)
+  {
+    return; // no cloud scattering event can happen along d
+  }
+  // Russian roulette as for the sun next event at p (x'' lies nearer the sun).
+  const double probability = this->NextEventProbability(p);
+  if (probability < 1.0 && rng.Uniform() >= probability)
+  {
+    return;
+  }
+  state.SavedWeight = state.Weight;
+  const double k = f / ((pA + pB) * probability);
+  for (double& w : state.Weight)
+  {
+    w *= k;
+  }
+  SegmentEndKind kind;
+  // Cloud events lie inside the box: the flight can stop at its far side.
+  const double tEnd = std::min(this->SegmentEnd(ray, kind), ray.CloudFar);
+  double t;
+  Scatterer next = Scatterer::None;
+  if (this->FreeFlight(ray, tEnd, rng, state, t, next) == FlightEnd::Collision &&
+    next == Scatterer::Cloud)
+  {
+    this->SunNextEvent(Along(ray.Origin, ray.Direction, t), d, next, rng, state);
+  }
+  state.Weight.swap(state.SavedWeight);
 }
 
 void Integrator::TracePath(
@@ -730,42 +1143,20 @@ void Integrator::TracePath(
   Ray ray = this->MakeRay(camera.GetPosition(), camera.RayDirection(x, y));
   const int maxOrder = this->Settings.MaxScatteringOrder;
   const int rouletteOrder = this->Settings.RussianRouletteOrder;
+  // Sun-peak sampling (TracePath's second strategy): the sun's contribution at a cloud
+  // scattering event is p_c(s . d) T_sun E, and p_c's forward peak (g = 0.85: up to ~90x
+  // its mean) makes it spiky when the previous vertex happened to send the path toward
+  // the sun. Each cloud or ground vertex therefore also samples a direction about the
+  // sun (SunPeakEstimate), and the usual strategy's contribution at a cloud event is
+  // weighted by p_A / (p_A + p_B), p_A the pdf of the direction actually sampled at the
+  // previous vertex, p_B = p_c(s . d): both weighted contributions are bounded by
+  // min(p_A, p_B) T_sun E.
+  const bool sunPeak = this->Settings.SunPeakSampling && this->SunOn && this->HasCloud;
+  double previousPdf = 0.0; // p_A of the current direction; 0 = no sun-peak partner
   for (int order = 0;;)
   {
-    // Where the ray leaves the scene or meets the ground.
-    const double tGround = this->Context.IntersectGround(ray.Origin, ray.Direction, 0.0);
-    double tEnd = tGround;
-    enum class End
-    {
-      Leaves, // background
-      Ground,
-      Earth // black (the same convention as SingleScatteringRenderer)
-    } endKind = std::isfinite(tGround) ? End::Ground : End::Leaves;
-    if (this->Air)
-    {
-      const double tTop = this->Context.DistanceToTopOfAtmosphere(ray.Origin, ray.Direction);
-      // Earth sphere (reached only with the ground plane disabled or beyond the
-      // plane's hit): the path ends there with no radiance.
-      const Vector3& q = ray.EarthOrigin;
-      const double r = std::sqrt(Dot(q, q));
-      const double c = (r - this->EarthRadius) * (r + this->EarthRadius);
-      const double b = Dot(q, ray.Direction);
-      double tEarth = kInfinity;
-      if (c > 0.0 && b < 0.0 && b * b - c >= 0.0)
-      {
-        tEarth = c / (-b + std::sqrt(b * b - c));
-      }
-      if (tTop < tEnd)
-      {
-        tEnd = tTop;
-        endKind = End::Leaves;
-      }
-      if (tEarth < tEnd)
-      {
-        tEnd = tEarth;
-        endKind = End::Earth;
-      }
-    }
+    SegmentEndKind endKind;
+    const double tEnd = this->SegmentEnd(ray, endKind);
     double t;
     Scatterer scatterer = Scatterer::None;
     const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer);
@@ -776,11 +1167,11 @@ void Integrator::TracePath(
     Vector3 p;
     if (end == FlightEnd::Boundary)
     {
-      if (endKind == End::Earth)
+      if (endKind == SegmentEndKind::Earth)
       {
         break;
       }
-      if (endKind == End::Leaves)
+      if (endKind == SegmentEndKind::Leaves)
       {
         for (int i = 0; i < n; ++i)
         {
@@ -804,18 +1195,40 @@ void Integrator::TracePath(
     ++order;
     if (this->SunOn)
     {
-      this->SunNextEvent(p, ray.Direction, scatterer, rng, state);
-      if (state.Truncated)
+      double weight = 1.0;
+      if (previousPdf > 0.0 && scatterer == Scatterer::Cloud)
       {
-        break;
+        weight = previousPdf /
+          (previousPdf + this->Context.GetCloudPhase().Evaluate(Dot(this->Sun, ray.Direction)));
+      }
+      // Russian roulette on the estimate by the sun-depth lattice (weight / P if run).
+      const double probability = this->NextEventProbability(p);
+      if (probability >= 1.0 || rng.Uniform() < probability)
+      {
+        this->SunNextEvent(p, ray.Direction, scatterer, rng, state, weight / probability);
+        if (state.Truncated)
+        {
+          break;
+        }
       }
     }
     if (maxOrder > 0 && order >= maxOrder)
     {
       break;
     }
-    // Next direction.
+    const bool usePeak =
+      sunPeak && (scatterer == Scatterer::Cloud || scatterer == Scatterer::Ground);
+    if (usePeak)
+    {
+      this->SunPeakEstimate(p, ray.Direction, scatterer, rng, state);
+      if (state.Truncated)
+      {
+        break;
+      }
+    }
+    // Next direction, and its pdf for the sun-peak weight at the next vertex.
     Vector3 direction;
+    double pdf = 0.0;
     auto uniform = [&rng]() { return rng.Uniform(); };
     switch (scatterer)
     {
@@ -831,6 +1244,7 @@ void Integrator::TracePath(
         {
           direction[2] = 1e-12;
         }
+        pdf = direction[2] / kPi;
         const double albedo = this->Context.GetGroundAlbedo();
         for (int i = 0; i < n; ++i)
         {
@@ -848,10 +1262,14 @@ void Integrator::TracePath(
         break;
       case Scatterer::Cloud:
       default:
-        direction = DirectionFromCosine(
-          ray.Direction, this->Context.GetCloudPhase().Sample(uniform), rng.Uniform());
+      {
+        const double mu = this->Context.GetCloudPhase().Sample(uniform);
+        direction = DirectionFromCosine(ray.Direction, mu, rng.Uniform());
+        pdf = this->Context.GetCloudPhase().Evaluate(mu);
         break;
+      }
     }
+    previousPdf = usePeak ? pdf : 0.0;
     // Russian roulette on the largest spectral weight.
     if (rouletteOrder >= 0 && order >= rouletteOrder)
     {

@@ -101,6 +101,18 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// Extension: true = uniform jitter over the pixel (box filter); false = every
   /// path through the pixel centre, like the deterministic renderers.
   bool PixelJitter = true;
+  /// Sun-peak sampling: at each cloud or ground vertex, also a direction from the
+  /// cloud's phase function about the sun, combined with the usual direction by the
+  /// balance heuristic (see PathTracer.cxx). Unbiased either way; false = off.
+  bool SunPeakSampling = true;
+  /// Sun-depth roulette: inside the cloud, estimate the sun's contribution only with
+  /// probability min(1, T_est / 0.05) (weighted by its inverse), T_est from a lattice of
+  /// the cloud's optical depth toward the sun. Unbiased either way; false = always.
+  bool SunDepthRoulette = true;
+  /// The atmosphere's transmittance toward the sun at air and ground points from a
+  /// table checked cell by cell against the exact integral (error in ln T <= 1e-4 where
+  /// used, exact elsewhere); false = the exact integral at every point.
+  bool TabulatedAirTransmittance = true;
   /// Bytes the per-pixel buffers may take (about 104 bytes per pixel); 0 =
   /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
   double MemoryBudgetBytes = 0.0;
