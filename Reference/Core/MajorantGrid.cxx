@@ -7,11 +7,15 @@
 namespace nimbus
 {
 
-MajorantGrid::MajorantGrid(const DensityGrid& grid, int dilation)
+MajorantGrid::MajorantGrid(const DensityGrid& grid, int dilation, int blockVoxels)
 {
   if (dilation < 0)
   {
     throw std::invalid_argument("nimbus::MajorantGrid: the dilation must be >= 0 points");
+  }
+  if (blockVoxels < 1)
+  {
+    throw std::invalid_argument("nimbus::MajorantGrid: a block must have >= 1 voxel per edge");
   }
   if (grid.IsEmpty())
   {
@@ -31,12 +35,12 @@ MajorantGrid::MajorantGrid(const DensityGrid& grid, int dilation)
     }
     const int voxels = n[a] - 1;
     const int d = std::min(dilation, n[a]); // enough to reach every point
-    this->Blocks[a] = (voxels + BlockVoxels - 1) / BlockVoxels;
-    this->BlockSize[a] = BlockVoxels * grid.GetSpacing()[a];
+    this->Blocks[a] = (voxels + blockVoxels - 1) / blockVoxels;
+    this->BlockSize[a] = blockVoxels * grid.GetSpacing()[a];
     for (int c = 0; c < this->Blocks[a]; ++c)
     {
       ranges[a].push_back(
-        { std::max(0, c * BlockVoxels - d), std::min(n[a] - 1, (c + 1) * BlockVoxels + d) });
+        { std::max(0, c * blockVoxels - d), std::min(n[a] - 1, (c + 1) * blockVoxels + d) });
     }
   }
   // Separable running maximum: x, then y, then z.

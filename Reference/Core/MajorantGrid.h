@@ -1,9 +1,10 @@
 // Block maxima of a DensityGrid, for the reference renderers' majorants (delta and
 // ratio tracking in the path tracer) and empty-space skipping (single scattering).
 //
-// The grid's voxels are grouped into blocks of BlockVoxels^3: along an axis with n > 1
-// points, block b covers the voxels [4b, 4b + 4) (the last block fewer), i.e. the
-// points [4b, min(n - 1, 4b + 4)]; an axis with one point has one block. A block's
+// The grid's voxels are grouped into blocks of B^3 voxels (B = BlockVoxels = 4 unless
+// the constructor is given another size): along an axis with n > 1 points, block c
+// covers the voxels [Bc, Bc + B) (the last block fewer), i.e. the points
+// [Bc, min(n - 1, Bc + B)]; an axis with one point has one block. A block's
 // maximum is the largest density over its points widened by `dilation` points on
 // every side (clipped to the grid). Trilinear interpolation never exceeds the values
 // at the corners of its voxel, so the maximum bounds the density over the closed
@@ -29,21 +30,22 @@ class NIMBUSREFERENCE_EXPORT MajorantGrid
 public:
   using Vector3 = nimbus::Vector3;
 
-  /// Voxels per block edge.
+  /// Voxels per block edge, by default.
   static constexpr int BlockVoxels = 4;
 
   /// No blocks.
   MajorantGrid() = default;
   /// The block maxima of grid with `dilation` >= 0 points added on every side of a
-  /// block (clipped to the grid). An empty grid has no blocks. Throws
-  /// std::invalid_argument for a negative dilation.
-  MajorantGrid(const DensityGrid& grid, int dilation);
+  /// block (clipped to the grid), blocks of `blockVoxels` >= 1 voxels per edge. An empty
+  /// grid has no blocks. Throws std::invalid_argument for a negative dilation or a
+  /// block size < 1.
+  MajorantGrid(const DensityGrid& grid, int dilation, int blockVoxels = BlockVoxels);
 
   /// Blocks along x, y, z.
   const std::array<int, 3>& GetBlocks() const { return this->Blocks; }
   /// Lower corner of the grid's box (DensityGrid::GetLower), m.
   const Vector3& GetLower() const { return this->Lower; }
-  /// Block edge, m: BlockVoxels spacings, or the box's thickness along an axis with one
+  /// Block edge, m: B spacings, or the box's thickness along an axis with one
   /// point. Block (i, j, k) starts at GetLower() + (i, j, k) * GetBlockSize(); the last
   /// block along an axis may end at the box.
   const Vector3& GetBlockSize() const { return this->BlockSize; }

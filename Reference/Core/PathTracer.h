@@ -113,6 +113,11 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// table checked cell by cell against the exact integral (error in ln T <= 1e-4 where
   /// used, exact elsewhere); false = the exact integral at every point.
   bool TabulatedAirTransmittance = true;
+  /// Incremental DDA over the cloud's majorant blocks of MajorantBlockVoxels^3 voxels
+  /// (no dilation: the traversal keeps every point in its block); false = 4^3 blocks
+  /// dilated by one point, the block located from the position at every piece.
+  bool BlockTraversal = true;
+  int MajorantBlockVoxels = 4;
   /// Bytes the per-pixel buffers may take (about 104 bytes per pixel); 0 =
   /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
   double MemoryBudgetBytes = 0.0;

@@ -1,7 +1,8 @@
 // Efficiency of the path tracer's variance and cost techniques, each measured
 // separately on the same scenes in one run (a bench CLI, not a test).
 //
-//   BenchPathTracer [--size W H] [--seconds S] [--threads N] [--seed K] SCENE.json...
+//   BenchPathTracer [--size W H] [--seconds S] [--threads N] [--seed K] [--block-voxels B]
+//                   SCENE.json...
 //
 // For each scene (its camera resized to W x H, default 80 x 60) the path tracer runs
 // for about S seconds (default 10; rounds of doubling samples, so a run ends after the
@@ -44,6 +45,8 @@ std::vector<Technique> Techniques()
       [](nimbus::PathTracingSettings& s, bool on) { s.SunPeakSampling = on; } },
     { "air-sun-table",
       [](nimbus::PathTracingSettings& s, bool on) { s.TabulatedAirTransmittance = on; } },
+    { "dda-blocks",
+      [](nimbus::PathTracingSettings& s, bool on) { s.BlockTraversal = on; } },
     { "sun-depth-roulette",
       [](nimbus::PathTracingSettings& s, bool on) { s.SunDepthRoulette = on; } },
   };
@@ -86,7 +89,7 @@ struct Run
 
 int main(int argc, char* argv[])
 {
-  int width = 80, height = 60, threads = 0;
+  int width = 80, height = 60, threads = 0, blockVoxels = 4;
   double seconds = 10.0;
   std::uint64_t seed = 1;
   std::vector<std::string> scenes;
@@ -101,6 +104,10 @@ int main(int argc, char* argv[])
     else if (a == "--seconds" && i + 1 < argc)
     {
       seconds = std::atof(argv[++i]);
+    }
+    else if (a == "--block-voxels" && i + 1 < argc)
+    {
+      blockVoxels = std::atoi(argv[++i]);
     }
     else if (a == "--threads" && i + 1 < argc)
     {
@@ -118,11 +125,11 @@ int main(int argc, char* argv[])
     {
       std::fprintf(stderr,
         "usage: BenchPathTracer [--size W H] [--seconds S] [--threads N] [--seed K] "
-        "SCENE.json...\n");
+        "[--block-voxels B] SCENE.json...\n");
       return 2;
     }
   }
-  if (scenes.empty() || width < 1 || height < 1 || !(seconds > 0.0))
+  if (scenes.empty() || width < 1 || height < 1 || !(seconds > 0.0) || blockVoxels < 1)
   {
     std::fprintf(stderr, "BenchPathTracer: need scenes, a positive size and seconds\n");
     return 2;
@@ -147,6 +154,7 @@ int main(int argc, char* argv[])
       settings.TimeLimitSeconds = seconds;
       settings.Threads = threads;
       settings.Seed = seed;
+      settings.MajorantBlockVoxels = blockVoxels;
       configure(settings);
       const nimbus::PathTracingResult result = nimbus::RenderPathTraced(context, settings);
       Run run;

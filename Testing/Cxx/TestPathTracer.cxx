@@ -741,7 +741,8 @@ TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
   std::vector<nimbus::PathTracingRound> rounds;
   settings.OnRound = [&rounds](const nimbus::PathTracingRound& r) { rounds.push_back(r); };
   const PathTracingResult full = nimbus::RenderPathTraced(context, settings);
-  // Rounds of 4, 8, 16, 32, 64 samples; the error estimate falls round by round.
+  // Rounds of 4, 8, 16, 32, 64 samples; the error estimate falls (not necessarily at
+  // every round: on 64 pixels a rare large sample can raise it for a round).
   ASSERT_EQ(rounds.size(), 5u);
   EXPECT_EQ(full.Rounds, 5);
   EXPECT_FALSE(full.StoppedAtTimeLimit);
@@ -754,10 +755,11 @@ TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
     EXPECT_GT(rounds[r].ImageRelativeError, 0.0);
     if (r > 0)
     {
-      EXPECT_LT(rounds[r].ImageRelativeError, rounds[r - 1].ImageRelativeError);
       EXPECT_GE(rounds[r].Seconds, rounds[r - 1].Seconds);
     }
   }
+  // 16 times the samples: ideally 4 times less error; at least 2.
+  EXPECT_LT(rounds.back().ImageRelativeError, 0.5 * rounds.front().ImageRelativeError);
   EXPECT_NEAR(
     rounds.back().ImageRelativeError, full.ImageRelativeError, 1e-6 * full.ImageRelativeError);
 
@@ -770,18 +772,27 @@ TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
   EXPECT_EQ(limited.MeanSamplesPerPixel, 4.0);
   settings.TimeLimitSeconds = 0.0;
 
-  // An image target between the errors of rounds 2 and 3 stops after round 3.
+  // An image target between the first round whose error is below every earlier
+  // round's and the lowest earlier error stops after that round.
   rounds.clear();
   const PathTracingResult again = nimbus::RenderPathTraced(context, settings);
   ASSERT_EQ(rounds.size(), 5u);
-  const double between = 0.5 * (rounds[1].ImageRelativeError + rounds[2].ImageRelativeError);
+  std::size_t stopRound = 1;
+  double lowestBefore = rounds[0].ImageRelativeError;
+  while (stopRound < rounds.size() && !(rounds[stopRound].ImageRelativeError < lowestBefore))
+  {
+    lowestBefore = std::min(lowestBefore, rounds[stopRound].ImageRelativeError);
+    ++stopRound;
+  }
+  ASSERT_LT(stopRound, rounds.size());
+  const double between = 0.5 * (lowestBefore + rounds[stopRound].ImageRelativeError);
   const std::vector<nimbus::PathTracingRound> unlimited = rounds;
   rounds.clear();
   settings.TargetImageRelativeError = between;
   const PathTracingResult targeted = nimbus::RenderPathTraced(context, settings);
   EXPECT_TRUE(targeted.ReachedImageTarget);
-  EXPECT_EQ(targeted.Rounds, 3);
-  EXPECT_EQ(targeted.MeanSamplesPerPixel, 16.0);
+  EXPECT_EQ(targeted.Rounds, static_cast<int>(stopRound) + 1);
+  EXPECT_EQ(targeted.MeanSamplesPerPixel, 4.0 * (1 << stopRound));
   EXPECT_LE(targeted.ImageRelativeError, between);
   // Without a stopping rule the same seed gives the same image as before (the rules
   // only end the loop; they never change a sample).
@@ -793,7 +804,8 @@ TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
   {
     std::printf(" %.4f", r.ImageRelativeError);
   }
-  std::printf("; target %.4f reached at 16 spp with %.4f\n", between, targeted.ImageRelativeError);
+  std::printf("; target %.4f reached at %.0f spp with %.4f\n", between,
+    targeted.MeanSamplesPerPixel, targeted.ImageRelativeError);
 }
 
 } // namespace
