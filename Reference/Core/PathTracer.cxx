@@ -1452,6 +1452,117 @@ double ImageRelativeError(const std::vector<PixelStatistics>& statistics)
 }
 } // namespace
 
+namespace
+{
+/// Adaptive sampling's pilot: MinSamplesPerPixel paths per pixel from a stream of
+/// their own (sample indices from 2^40 on, so the render's samples are independent of
+/// them and the pilot is not part of the image: the number of samples a pixel gets
+/// then depends on nothing the pixel's estimate uses, and the estimate stays
+/// unbiased). For the image-wide error sum_i V_i / n_i at a fixed cost sum_i n_i c_i the
+/// best allocation is n_i ~ sqrt(V_i / c_i) (V_i a pixel's per-path variance, c_i its
+/// cost per path): V_i and c_i (tracking steps + kPathOverheadSteps) come from the pilot,
+/// smoothed over 3 x 3 pixels (a pilot's variance is noisy), V_i floored at 1e-3 of
+/// the image's mean; the shares are normalised to mean 1 and clamped to
+/// [1/kMaxShare, kMaxShare] (renormalised), so no pixel is starved.
+constexpr double kPathOverheadSteps = 8.0;
+constexpr double kMaxShare = 8.0;
+
+std::vector<double> SampleShares(const Integrator& integrator, const PathTracingSettings& settings,
+  int width, int height, int threads)
+{
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  std::vector<double> variance(pixels, 0.0), cost(pixels, 0.0);
+  const std::uint64_t pilot = static_cast<std::uint64_t>(std::max(2, settings.MinSamplesPerPixel));
+  ParallelFor(pixels, std::max<std::size_t>(1, pixels / (64 * static_cast<std::size_t>(threads))),
+    threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      PathState state;
+      for (std::size_t k = begin; k < end; ++k)
+      {
+        const int i = static_cast<int>(k % static_cast<std::size_t>(width));
+        const int j = static_cast<int>(k / static_cast<std::size_t>(width));
+        PixelStatistics stats;
+        double steps = 0.0;
+        for (std::uint64_t sample = 0; sample < pilot; ++sample)
+        {
+          PathRandom rng(settings.Seed, k, (std::uint64_t(1) << 40) + sample);
+          double x = i + 0.5, y = j + 0.5;
+          if (settings.PixelJitter)
+          {
+            x = i + rng.Uniform();
+            y = j + rng.Uniform();
+          }
+          double rgb[3];
+          integrator.TracePath(x, y, rng, state, rgb);
+          stats.Add(rgb);
+          steps += static_cast<double>(state.Steps);
+        }
+        const double n = static_cast<double>(stats.Count);
+        variance[k] = (stats.M2[0] + stats.M2[1] + stats.M2[2]) / std::max(1.0, n - 1.0);
+        cost[k] = steps / n + kPathOverheadSteps;
+      }
+    });
+  // 3 x 3 box filter of both.
+  auto smooth = [&](const std::vector<double>& v)
+  {
+    std::vector<double> out(pixels, 0.0);
+    for (int j = 0; j < height; ++j)
+    {
+      for (int i = 0; i < width; ++i)
+      {
+        double sum = 0.0;
+        int count = 0;
+        for (int dj = -1; dj <= 1; ++dj)
+        {
+          for (int di = -1; di <= 1; ++di)
+          {
+            const int ii = i + di, jj = j + dj;
+            if (ii >= 0 && jj >= 0 && ii < width && jj < height)
+            {
+              sum += v[static_cast<std::size_t>(jj) * width + ii];
+              ++count;
+            }
+          }
+        }
+        out[static_cast<std::size_t>(j) * width + i] = sum / count;
+      }
+    }
+    return out;
+  };
+  variance = smooth(variance);
+  cost = smooth(cost);
+  double meanVariance = 0.0;
+  for (double v : variance)
+  {
+    meanVariance += v / static_cast<double>(pixels);
+  }
+  std::vector<double> share(pixels, 1.0);
+  if (!(meanVariance > 0.0))
+  {
+    return share; // nothing random anywhere: uniform
+  }
+  for (std::size_t k = 0; k < pixels; ++k)
+  {
+    share[k] = std::sqrt(std::max(variance[k], 1e-3 * meanVariance) / cost[k]);
+  }
+  // Normalise to mean 1, clamp, renormalise (twice is enough to settle).
+  for (int pass = 0; pass < 3; ++pass)
+  {
+    double mean = 0.0;
+    for (double v : share)
+    {
+      mean += v / static_cast<double>(pixels);
+    }
+    for (double& v : share)
+    {
+      v = std::min(kMaxShare, std::max(1.0 / kMaxShare, v / mean));
+    }
+  }
+  return share;
+}
+} // namespace
+
 double ImageRelativeError(const FloatImage& image, const FloatImage& standardError)
 {
   double sumError = 0.0, sumValue = 0.0;
@@ -1491,8 +1602,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   {
     // Per pixel: running statistics, a slot in the list of active pixels and the
     // two result images (3 floats each); checked before anything is allocated.
-    const double bytesPerPixel =
-      static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) + 2 * 3 * sizeof(float));
+    const double bytesPerPixel = static_cast<double>(sizeof(PixelStatistics) +
+      sizeof(std::size_t) + 2 * 3 * sizeof(float) + (settings.AdaptiveSampling ? 40 : 0));
     const double budget = settings.MemoryBudgetBytes > 0.0
       ? settings.MemoryBudgetBytes
       : static_cast<double>(DefaultMemoryBudgetBytes());
@@ -1507,8 +1618,20 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   }
   const Integrator integrator(context, settings);
   std::vector<PixelStatistics> statistics(pixels);
-
   const int threads = ResolveThreadCount(settings.Threads);
+  // Adaptive sampling: each pixel's share of the samples from a pilot.
+  const std::vector<double> share = settings.AdaptiveSampling
+    ? SampleShares(integrator, settings, width, height, threads)
+    : std::vector<double>();
+  auto pixelTarget = [&share](std::size_t k, std::uint64_t meanTarget) -> std::uint64_t
+  {
+    if (share.empty())
+    {
+      return meanTarget;
+    }
+    return std::max<std::uint64_t>(
+      1, static_cast<std::uint64_t>(std::llround(share[k] * static_cast<double>(meanTarget))));
+  };
 
   std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
   std::atomic<bool> stop{ false };
@@ -1553,7 +1676,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
           PixelStatistics& stats = statistics[k];
           const int i = static_cast<int>(k % static_cast<std::size_t>(width));
           const int j = static_cast<int>(k / static_cast<std::size_t>(width));
-          while (stats.Count < target)
+          const std::uint64_t roundTarget = pixelTarget(k, target);
+          while (stats.Count < roundTarget)
           {
             PathRandom rng(settings.Seed, k, stats.Count);
             double x = i + 0.5, y = j + 0.5;
@@ -1586,7 +1710,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
               }
             }
           }
-          if (stats.Count >= maxSamples)
+          if (stats.Count >= pixelTarget(k, maxSamples))
           {
             stats.Done = true;
           }

@@ -118,6 +118,12 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// dilated by one point, the block located from the position at every piece.
   bool BlockTraversal = true;
   int MajorantBlockVoxels = 4;
+  /// Adaptive sampling: a pilot of MinSamplesPerPixel paths per pixel (not part of the
+  /// image) gives each pixel a share s_i of the samples, s_i ~ sqrt(variance / cost)
+  /// (mean 1, within [1/8, 8]); round targets and MaxSamplesPerPixel are then means
+  /// over the image and pixel i gets s_i times them. Cuts the image-wide error at a
+  /// given time; unbiased (the shares do not depend on the image's samples).
+  bool AdaptiveSampling = false;
   /// Bytes the per-pixel buffers may take (about 104 bytes per pixel); 0 =
   /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
   double MemoryBudgetBytes = 0.0;

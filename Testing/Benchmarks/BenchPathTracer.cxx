@@ -47,6 +47,8 @@ std::vector<Technique> Techniques()
       [](nimbus::PathTracingSettings& s, bool on) { s.TabulatedAirTransmittance = on; } },
     { "dda-blocks",
       [](nimbus::PathTracingSettings& s, bool on) { s.BlockTraversal = on; } },
+    { "adaptive-sampling",
+      [](nimbus::PathTracingSettings& s, bool on) { s.AdaptiveSampling = on; } },
     { "sun-depth-roulette",
       [](nimbus::PathTracingSettings& s, bool on) { s.SunDepthRoulette = on; } },
   };
@@ -149,7 +151,7 @@ int main(int argc, char* argv[])
     auto render = [&](const std::function<void(nimbus::PathTracingSettings&)>& configure)
     {
       nimbus::PathTracingSettings settings;
-      settings.MinSamplesPerPixel = 4;
+      settings.MinSamplesPerPixel = 16;
       settings.MaxSamplesPerPixel = 1 << 24;
       settings.TimeLimitSeconds = seconds;
       settings.Threads = threads;
