@@ -25,6 +25,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -62,6 +63,28 @@ std::string DirectionMatrixProblem(vtkImageData* image)
   return "the density image has a direction matrix that is not the identity (" + elements +
     "): the reference renderers place the grid by origin and spacing along x, y, z only. "
     "Resample it onto an axis-aligned image (e.g. vtkImageReslice) first";
+}
+
+// "45 s", "12 min", "3.4 h".
+std::string FormatDuration(double seconds)
+{
+  std::ostringstream text;
+  text.precision(seconds < 3600.0 ? 0 : 2);
+  text << std::fixed;
+  if (seconds < 120.0)
+  {
+    text << seconds << " s";
+  }
+  else if (seconds < 3600.0 * 2.0)
+  {
+    text << seconds / 60.0 << " min";
+  }
+  else
+  {
+    text.precision(1);
+    text << seconds / 3600.0 << " h";
+  }
+  return text.str();
 }
 
 // vtkImageData point array -> DensityGrid (float), placed by origin, spacing and extent.
@@ -348,6 +371,35 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     settings.TargetImageRelativeError = this->TargetImageRelativeError;
     this->CurrentImageRelativeError = 0.0;
     this->CurrentSamplesPerPixel = 0.0;
+    this->EstimatedSecondsToTarget = 0.0;
+    if (this->TargetImageRelativeError > 0.0)
+    {
+      // Before the render, a pilot's forecast of the time to the target; said when it
+      // is over the time limit (or over an hour without one).
+      const nimbus::PathTracingEstimate estimate = nimbus::EstimatePathTracingTime(
+        *context, settings, this->TargetImageRelativeError);
+      this->EstimatedSecondsToTarget = estimate.SecondsToTarget;
+      const double limit = this->TimeLimitSeconds;
+      if ((limit > 0.0 && estimate.SecondsToTarget > limit) ||
+        (limit == 0.0 && estimate.SecondsToTarget > 3600.0))
+      {
+        std::ostringstream message;
+        message.precision(2);
+        message << this->SceneFileName << ": a pilot (" << estimate.PilotPixels << " pixels x "
+                << estimate.PilotSamplesPerPixel << " samples, " << estimate.PilotSeconds
+                << " s) forecasts about " << FormatDuration(estimate.SecondsToTarget)
+                << " to reach an image error of " << 100.0 * this->TargetImageRelativeError
+                << " %";
+        if (limit > 0.0)
+        {
+          const double reachable = this->TargetImageRelativeError *
+            std::sqrt(estimate.SecondsToTarget / std::max(limit, 1e-9));
+          message << "; the time limit of " << FormatDuration(limit)
+                  << " will end the render first, at about " << 100.0 * reachable << " %";
+        }
+        vtkWarningMacro(<< message.str() << ".");
+      }
+    }
     settings.OnRound = [this](const nimbus::PathTracingRound& round)
     {
       this->CurrentImageRelativeError = round.ImageRelativeError;
@@ -389,6 +441,7 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
   {
     AddFieldValue(fieldData, "StoppedAtTimeLimit", stoppedAtTimeLimit);
     AddFieldValue(fieldData, "ReachedImageTarget", reachedImageTarget);
+    AddFieldValue(fieldData, "EstimatedSecondsToTarget", this->EstimatedSecondsToTarget);
   }
   this->UpdateProgress(1.0);
   return 1;

@@ -128,6 +128,13 @@ public:
   vtkGetMacro(CurrentSamplesPerPixel, double);
   ///@}
 
+  /// Path tracing with a TargetImageRelativeError: before the render a pilot
+  /// (nimbus::EstimatePathTracingTime: 1/16 of the pixels at 32 samples) forecasts the
+  /// time to the target (s; also field data "EstimatedSecondsToTarget"), and a warning
+  /// says so when that is over TimeLimitSeconds (or over an hour without a limit).
+  /// 0 before a render or without a target.
+  vtkGetMacro(EstimatedSecondsToTarget, double);
+
   ///@{
   /// Worker threads (0: all cores). Default 0.
   vtkSetMacro(NumberOfThreads, int);
@@ -164,6 +171,7 @@ protected:
   int Seed = 1;
   double TimeLimitSeconds = 0.0;
   double TargetImageRelativeError = 0.0;
+  double EstimatedSecondsToTarget = 0.0;
   double CurrentImageRelativeError = 0.0;
   double CurrentSamplesPerPixel = 0.0;
   int NumberOfThreads = 0;

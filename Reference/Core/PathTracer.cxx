@@ -1575,6 +1575,64 @@ double ImageRelativeError(const FloatImage& image, const FloatImage& standardErr
   return sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
 }
 
+PathTracingEstimate EstimatePathTracingTime(const RenderContext& context,
+  const PathTracingSettings& settings, double targetImageRelativeError, int pilotSamples,
+  int stride)
+{
+  if (!(targetImageRelativeError > 0.0) || pilotSamples < 2 || stride < 1)
+  {
+    throw std::invalid_argument(
+      "EstimatePathTracingTime: need a target > 0, >= 2 pilot samples and a stride >= 1");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const Integrator integrator(context, settings);
+  const auto traced = std::chrono::steady_clock::now();
+  const double setupSeconds = std::chrono::duration<double>(traced - start).count();
+  const Camera& camera = context.GetCamera();
+  const int width = camera.GetWidth(), height = camera.GetHeight();
+  const int columns = (width + stride - 1) / stride, rows = (height + stride - 1) / stride;
+  const std::size_t pilotPixels = static_cast<std::size_t>(columns) * rows;
+  std::vector<PixelStatistics> statistics(pilotPixels);
+  const int threads = ResolveThreadCount(settings.Threads);
+  ParallelFor(pilotPixels, 1, threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      PathState state;
+      for (std::size_t q = begin; q < end; ++q)
+      {
+        const int i = static_cast<int>(q % columns) * stride + (stride - 1) / 2;
+        const int j = static_cast<int>(q / columns) * stride + (stride - 1) / 2;
+        const int ci = std::min(i, width - 1), cj = std::min(j, height - 1);
+        const std::size_t k = static_cast<std::size_t>(cj) * width + ci;
+        for (int sample = 0; sample < pilotSamples; ++sample)
+        {
+          PathRandom rng(settings.Seed, k, (std::uint64_t(1) << 41) + sample);
+          double x = ci + 0.5, y = cj + 0.5;
+          if (settings.PixelJitter)
+          {
+            x = ci + rng.Uniform();
+            y = cj + rng.Uniform();
+          }
+          double rgb[3];
+          integrator.TracePath(x, y, rng, state, rgb);
+          statistics[q].Add(rgb);
+        }
+      }
+    });
+  PathTracingEstimate estimate;
+  estimate.PilotSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  estimate.PilotRelativeError = ImageRelativeError(statistics);
+  estimate.PilotPixels = pilotPixels;
+  estimate.PilotSamplesPerPixel = pilotSamples;
+  // The tables the render builds once, plus the pilot's tracing scaled up.
+  const double tracingSeconds = estimate.PilotSeconds - setupSeconds;
+  const double ratio = estimate.PilotRelativeError / targetImageRelativeError;
+  estimate.SecondsToTarget = setupSeconds + tracingSeconds *
+      (static_cast<double>(width) * height / static_cast<double>(pilotPixels)) * ratio * ratio;
+  return estimate;
+}
+
 PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
 {

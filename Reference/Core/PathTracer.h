@@ -6,12 +6,13 @@
 // (no emission), with T = exp(-int sigma_t), by unbiased estimators:
 //
 //  - Free flights: delta tracking against a piecewise-constant majorant
-//    sigma_bar(t) = cloud macro-cell majorant (max density of a 4^3-voxel block,
-//    dilated by one grid point, x ExtinctionPerDensity) + atmosphere majorant
-//    (max over wavelengths of beta_R(lambda) rho_R(h_min) + beta_M,ext rho_M(h_min),
-//    h_min the lowest altitude on the piece: pieces of <= 50 km outside the cloud
-//    box, the box's lowest altitude inside it). Majorants bound sigma_t: no bias.
-//    A tentative collision is charged to the cloud or to the atmosphere in
+//    sigma_bar(t) = cloud block majorant (max density of a 4^3-voxel block of the
+//    MajorantGrid x ExtinctionPerDensity, the blocks visited by an incremental 3-D DDA,
+//    Amanatides & Woo 1987, so no dilation is needed; BlockTraversal) + atmosphere
+//    majorant (max over wavelengths of beta_R(lambda) rho_R(h_min) + beta_M,ext
+//    rho_M(h_min), h_min the lowest altitude on the piece: pieces of <= 50 km outside
+//    the cloud box, the box's lowest altitude inside it). Majorants bound sigma_t: no
+//    bias. A tentative collision is charged to the cloud or to the atmosphere in
 //    proportion to their majorants, so only one of the two is evaluated.
 //  - Spectral: one path carries a throughput vector over all wavelength samples
 //    of the context (spectral tracking with history-aware collision
@@ -22,16 +23,30 @@
 //    differ. Cost: O(N_lambda) per tentative collision.
 //  - Next-event estimation to the sun at every real scattering event and ground
 //    hit: cloud transmittance by ratio tracking (with Russian roulette below
-//    0.1) x the atmosphere's sun transmittance (RenderContext::
-//    SunAtmosphereTransmittance; 0 where the earth hides the sun; inside the
-//    cloud box from a (r, mu_s) table of the exact optical lengths whose
-//    interpolation error is verified < 1e-6 in ln T, else exact) x 0 if the
-//    sun is below the horizon of the enabled ground plane without atmosphere.
+//    0.1) x the atmosphere's sun transmittance: inside the cloud box from a (r, mu_s)
+//    table of the exact optical lengths whose interpolation error is verified < 1e-6
+//    in ln T; elsewhere from a whole-atmosphere table of ln L_R, ln L_M checked cell
+//    by cell (< 1e-4 in ln T where used; TabulatedAirTransmittance), else exact
+//    (RenderContext::SunAtmosphereTransmittance; 0 where the earth hides the sun) x 0
+//    if the sun is below the horizon of the enabled ground plane without atmosphere.
+//    Inside the cloud the estimate runs with probability min(1, T_est / 0.02) (at
+//    least 0.01), weighted by its inverse, T_est from a short-characteristics lattice
+//    of the cloud's optical depth toward the sun (SunDepthRoulette).
+//  - Sun-peak sampling (SunPeakSampling, Veach's balance heuristic): at each cloud or
+//    ground vertex a second direction is drawn from the cloud's phase function about
+//    the sun and followed to its next event; if that is a cloud scattering event, the
+//    sun's contribution there is added with weight p_B / (p_A + p_B), and the usual
+//    path's contribution at a cloud event with p_A / (p_A + p_B) (p_A the pdf of the
+//    direction the previous vertex drew, p_B = p_c(s . d)). The sun is a delta light,
+//    so phase sampling never hits it: the two strategies are two ways of reaching the
+//    vertex whose sun estimate p_c(s . d) T_sun E is spiky when d is near s.
 //  - New directions: phase-function sampling of the component that scattered
 //    (cloud mixture, Rayleigh, Cornette-Shanks g = mie_g); cosine-weighted at the
 //    ground (weight *= albedo).
 //  - Russian roulette from RussianRouletteOrder bounces on: survive with
 //    probability min(1, max_lambda weight).
+//  - Adaptive sampling (AdaptiveSampling, off by default): a pilot whose samples are
+//    not part of the image sets each pixel's share of the samples.
 //
 // Phase-function convention (PhaseFunctions.h): mu = dot(propagation direction
 // of the incident light, scattered direction). For NEE the light propagates
@@ -50,12 +65,11 @@
 // ratio-tracking steps + ground hits together) is truncated (contribution so far
 // kept, slightly biased low) and counted in PathTracingResult::TruncatedPaths.
 //
-// Measured (g++ 12 -O2, 2 shared cores): a 49^3 puff cloud, 2 km wide, optical
-// depth ~50, albedo 0.99, with atmosphere and ground, 64x64: ~15 us per path;
-// per-path relative standard deviation ~2.5 (sky pixels ~1.7: an optically thin
-// atmosphere collides rarely; cloud pixels 3-5: NEE of a delta sun through a
-// peaked phase function), so 1 % relative RMSE takes ~6e4 paths per pixel,
-// ~20-25 min on 2 cores.
+// Measured (g++ 12 -O2, 2 shared cores, BenchPathTracer at 80 x 60): 4-30 us per
+// path on the five harness scenes; per-path relative standard deviation ~1.5-2.5 (a
+// lit cloud pixel: 2.1; 1 % of its paths carry 61 % of the second moment, each with
+// one sun estimate at the lit surface while heading sunward, phase 1.2-6.3 against a
+// median of 0.06). The time to 1 % image-wide is in docs/ground-truth.md.
 //
 // Determinism: sample k of pixel (i, j) draws from a counter-based generator
 // seeded by (Seed, pixel index, k) and each pixel's running statistics are
@@ -168,6 +182,28 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
   bool ReachedImageTarget = false;  // TargetImageRelativeError ended the render
   int Rounds = 0;
 };
+
+/// A pilot's forecast of a render's time to an image-wide error target.
+struct NIMBUSREFERENCE_EXPORT PathTracingEstimate
+{
+  double SecondsToTarget = 0.0;     // forecast for the whole image, settings' threads
+  double PilotSeconds = 0.0;        // what the pilot took
+  double PilotRelativeError = 0.0;  // its image-wide relative error
+  std::size_t PilotPixels = 0;      // pixels it traced
+  int PilotSamplesPerPixel = 0;
+};
+
+/// Before a long render: traces every `stride`-th pixel along x and y (at least one)
+/// with `pilotSamples` paths each (a stream of their own; about pilotSamples / stride^2
+/// samples per pixel of the whole image's cost) and forecasts the time for the whole
+/// image to reach `targetImageRelativeError` with settings' threads, from the N^-1/2
+/// law: t = t_pilot (pixels / pilot pixels) (e_pilot / target)^2. A pilot of a few
+/// dozen samples sees few of the rare large samples, so it errs short (measured in
+/// docs/ground-truth.md). Throws std::invalid_argument for a target <= 0, pilotSamples
+/// < 2 or stride < 1.
+NIMBUSREFERENCE_EXPORT PathTracingEstimate EstimatePathTracingTime(const RenderContext& context,
+  const PathTracingSettings& settings, double targetImageRelativeError, int pilotSamples = 32,
+  int stride = 4);
 
 /// Renders the context's camera view progressively: rounds of samples (first
 /// MinSamplesPerPixel, then doubling up to MaxSamplesPerPixel), per-pixel

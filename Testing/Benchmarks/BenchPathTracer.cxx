@@ -6,13 +6,15 @@
 //
 // For each scene (its camera resized to W x H, default 80 x 60) the path tracer runs
 // for about S seconds (default 10; rounds of doubling samples, so a run ends after the
-// first round past S) with every technique on ("all"), with each technique off in turn
-// ("-name"), and with none ("none"). Efficiency = 1 / (relative error^2 x seconds), the
+// first round past S) with PathTracingSettings' defaults ("all"), with each default
+// technique off in turn ("defaults - name") or alone ("only name"), with an optional
+// technique added ("defaults + name"), and with none ("none"). Efficiency = 1 / (relative error^2 x seconds), the
 // relative error being the image-wide one (ImageRelativeError); it does not depend on
 // the run's length, and the time to a target error e at the scene's own size is
 //     t(e) = err^2 seconds / e^2 x (scene pixels / bench pixels).
-// The table gives that time for 1 % and, per technique, its speed-up: eff(all) /
-// eff(all without it) and eff(none with it) / eff(none).
+// The table gives that time for 1 % and, per technique, its speed-up: eff(defaults) /
+// eff(defaults without it) and eff(it alone) / eff(none) (optional techniques:
+// eff(defaults with it) / eff(defaults)).
 #include "PathTracer.h"
 #include "RenderContext.h"
 #include "SceneJson.h"
@@ -36,6 +38,7 @@ struct Technique
 {
   const char* Name;
   std::function<void(nimbus::PathTracingSettings&, bool)> Set;
+  bool OnByDefault = true; // in PathTracingSettings; "all" is the defaults
 };
 
 std::vector<Technique> Techniques()
@@ -48,7 +51,7 @@ std::vector<Technique> Techniques()
     { "dda-blocks",
       [](nimbus::PathTracingSettings& s, bool on) { s.BlockTraversal = on; } },
     { "adaptive-sampling",
-      [](nimbus::PathTracingSettings& s, bool on) { s.AdaptiveSampling = on; } },
+      [](nimbus::PathTracingSettings& s, bool on) { s.AdaptiveSampling = on; }, false },
     { "sun-depth-roulette",
       [](nimbus::PathTracingSettings& s, bool on) { s.SunDepthRoulette = on; } },
   };
@@ -172,37 +175,51 @@ int main(int argc, char* argv[])
         name.c_str(), run.Spp, run.Seconds, run.Error, run.Efficiency(), t1);
       std::fflush(stdout);
     };
-    const Run all = render([&](nimbus::PathTracingSettings& s)
-      { for (const Technique& t : techniques) t.Set(s, true); });
-    report("all", all);
+    // "all": the defaults (every technique that is on by default).
+    auto defaults = [&](nimbus::PathTracingSettings& s)
+    {
+      for (const Technique& t : techniques)
+      {
+        t.Set(s, t.OnByDefault);
+      }
+    };
+    const Run all = render(defaults);
+    report("all (defaults)", all);
     const Run none = render([&](nimbus::PathTracingSettings& s)
       { for (const Technique& t : techniques) t.Set(s, false); });
     report("none", none);
+    std::printf("| %s | **defaults vs none** | | | | %.2fx | |\n", scene.Name.c_str(),
+      all.Efficiency() / none.Efficiency());
     for (const Technique& technique : techniques)
     {
-      if (techniques.size() > 1)
+      if (!technique.OnByDefault)
       {
-        const Run without = render([&](nimbus::PathTracingSettings& s)
+        const Run plus = render([&](nimbus::PathTracingSettings& s)
           {
-            for (const Technique& t : techniques) t.Set(s, true);
-            technique.Set(s, false);
-          });
-        report(std::string("-") + technique.Name, without);
-        const Run only = render([&](nimbus::PathTracingSettings& s)
-          {
-            for (const Technique& t : techniques) t.Set(s, false);
+            defaults(s);
             technique.Set(s, true);
           });
-        report(std::string("only ") + technique.Name, only);
-        std::printf("| %s | **%s speed-up** | | | | all/without %.2fx, with/none %.2fx | |\n",
-          scene.Name.c_str(), technique.Name, all.Efficiency() / without.Efficiency(),
-          only.Efficiency() / none.Efficiency());
+        report(std::string("defaults + ") + technique.Name, plus);
+        std::printf("| %s | **%s speed-up** | | | | defaults+it/defaults %.2fx | |\n",
+          scene.Name.c_str(), technique.Name, plus.Efficiency() / all.Efficiency());
+        std::fflush(stdout);
+        continue;
       }
-      else
-      {
-        std::printf("| %s | **%s speed-up** | | | | %.2fx | |\n", scene.Name.c_str(),
-          technique.Name, all.Efficiency() / none.Efficiency());
-      }
+      const Run without = render([&](nimbus::PathTracingSettings& s)
+        {
+          defaults(s);
+          technique.Set(s, false);
+        });
+      report(std::string("defaults - ") + technique.Name, without);
+      const Run only = render([&](nimbus::PathTracingSettings& s)
+        {
+          for (const Technique& t : techniques) t.Set(s, false);
+          technique.Set(s, true);
+        });
+      report(std::string("only ") + technique.Name, only);
+      std::printf("| %s | **%s speed-up** | | | | defaults/without %.2fx, only/none %.2fx | |\n",
+        scene.Name.c_str(), technique.Name, all.Efficiency() / without.Efficiency(),
+        only.Efficiency() / none.Efficiency());
       std::fflush(stdout);
     }
   }

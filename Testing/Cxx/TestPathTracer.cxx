@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 namespace
@@ -884,4 +885,34 @@ TEST(PathTracer, SpeedTechniquesAreUnbiased)
   ExpectSameImage(render(false, true, false, false, 24), none, "sun-depth roulette vs none");
   ExpectSameImage(render(false, false, true, false, 25), none, "air transmittance table vs none");
   ExpectSameImage(render(false, false, false, true, 26), none, "block traversal vs none");
+}
+
+// The pilot that forecasts a render's time to an image target: deterministic for a seed,
+// 1/stride^2 of the pixels, a longer forecast for a tighter target, clean refusals.
+TEST(PathTracer, PilotForecastsTheTimeToATarget)
+{
+  const RenderContext context(PuffCloudScene(18, 10), PuffCloud());
+  PathTracingSettings settings;
+  settings.Threads = 2;
+  settings.Seed = 3;
+  const nimbus::PathTracingEstimate loose =
+    nimbus::EstimatePathTracingTime(context, settings, 0.05, 16, 4);
+  const nimbus::PathTracingEstimate tight =
+    nimbus::EstimatePathTracingTime(context, settings, 0.005, 16, 4);
+  EXPECT_EQ(loose.PilotPixels, 5u * 3u); // ceil(18/4) x ceil(10/4)
+  EXPECT_EQ(loose.PilotSamplesPerPixel, 16);
+  EXPECT_GT(loose.PilotRelativeError, 0.0);
+  EXPECT_EQ(loose.PilotRelativeError, tight.PilotRelativeError); // same seed, same paths
+  EXPECT_TRUE(std::isfinite(tight.SecondsToTarget));
+  EXPECT_GT(tight.SecondsToTarget, loose.SecondsToTarget);
+  // Stride 1 traces every pixel.
+  EXPECT_EQ(nimbus::EstimatePathTracingTime(context, settings, 0.05, 2, 1).PilotPixels, 180u);
+  EXPECT_THROW(nimbus::EstimatePathTracingTime(context, settings, 0.0), std::invalid_argument);
+  EXPECT_THROW(nimbus::EstimatePathTracingTime(context, settings, 0.01, 1), std::invalid_argument);
+  EXPECT_THROW(
+    nimbus::EstimatePathTracingTime(context, settings, 0.01, 16, 0), std::invalid_argument);
+  std::printf("pilot: %zu pixels x %d samples, error %.3f, %.3f s; forecast %.2f s for 5 %%, "
+              "%.1f s for 0.5 %%\n",
+    loose.PilotPixels, loose.PilotSamplesPerPixel, loose.PilotRelativeError, loose.PilotSeconds,
+    loose.SecondsToTarget, tight.SecondsToTarget);
 }
