@@ -376,8 +376,8 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     {
       // Before the render, a pilot's forecast of the time to the target; said when it
       // is over the time limit (or over an hour without one).
-      const nimbus::PathTracingEstimate estimate = nimbus::EstimatePathTracingTime(
-        *context, settings, this->TargetImageRelativeError);
+      const nimbus::PathTracingEstimate estimate =
+        nimbus::EstimatePathTracingTime(*context, settings, this->TargetImageRelativeError);
       this->EstimatedSecondsToTarget = estimate.SecondsToTarget;
       const double limit = this->TimeLimitSeconds;
       if ((limit > 0.0 && estimate.SecondsToTarget > limit) ||
@@ -388,8 +388,7 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
         message << this->SceneFileName << ": a pilot (" << estimate.PilotPixels << " pixels x "
                 << estimate.PilotSamplesPerPixel << " samples, " << estimate.PilotSeconds
                 << " s) forecasts about " << FormatDuration(estimate.SecondsToTarget)
-                << " to reach an image error of " << 100.0 * this->TargetImageRelativeError
-                << " %";
+                << " to reach an image error of " << 100.0 * this->TargetImageRelativeError << " %";
         if (limit > 0.0)
         {
           const double reachable = this->TargetImageRelativeError *

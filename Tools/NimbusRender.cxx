@@ -364,8 +364,8 @@ int Run(int argc, char* argv[])
             << ", \"reached_image_target\": "
             << (FieldValue(image, "ReachedImageTarget") > 0.0 ? "true" : "false")
             << ", \"estimated_seconds_to_target\": "
-            << FieldValue(image, "EstimatedSecondsToTarget")
-            << ", \"output\": \"" << output << "\"}" << std::endl;
+            << FieldValue(image, "EstimatedSecondsToTarget") << ", \"output\": \"" << output
+            << "\"}" << std::endl;
   return 0;
 }
 }

@@ -140,8 +140,8 @@ struct SunDepthLattice
     const std::size_t nxy = nx * static_cast<std::size_t>(this->Dims[1]);
     const float* v = this->Depth.data() + i0[0] + i0[1] * nx + i0[2] * nxy;
     const std::size_t dx = d[0], dy = d[1] * nx, dz = d[2] * nxy;
-    return std::min({ v[0], v[dx], v[dy], v[dx + dy], v[dz], v[dz + dx], v[dz + dy],
-      v[dz + dx + dy] });
+    return std::min(
+      { v[0], v[dx], v[dy], v[dx + dy], v[dz], v[dz + dx], v[dz + dy], v[dz + dx + dy] });
   }
 };
 
@@ -157,6 +157,8 @@ struct SunDepthLattice
 /// table). So the table never adds more than that error where it is used.
 constexpr double kGlobalSunTableTolerance = 1e-4;
 constexpr int kGlobalSunTableRadii = 129;
+/// Renders of fewer paths than this evaluate the air's transmittance exactly instead.
+constexpr double kAirSunTableMinimumPaths = 65536.0;
 constexpr int kGlobalSunTableCosines = 1025;
 
 struct GlobalSunTable
@@ -186,8 +188,8 @@ struct GlobalSunTable
     auto bilinear = [&](const std::vector<double>& v)
     {
       const double a = v[k] + fx * (v[k + 1] - v[k]);
-      const double b =
-        v[k + kGlobalSunTableRadii] + fx * (v[k + kGlobalSunTableRadii + 1] - v[k + kGlobalSunTableRadii]);
+      const double b = v[k + kGlobalSunTableRadii] +
+        fx * (v[k + kGlobalSunTableRadii + 1] - v[k + kGlobalSunTableRadii]);
       return a + fy * (b - a);
     };
     lR = std::exp(bilinear(this->LR));
@@ -410,7 +412,13 @@ public:
     {
       this->BuildSunTable();
     }
-    if (this->Air && this->SunOn && settings.TabulatedAirTransmittance)
+    // The air table takes ~0.3 s to build: only for renders long enough to repay it.
+    const Camera& camera = context.GetCamera();
+    const double plannedPaths = static_cast<double>(camera.GetWidth()) * camera.GetHeight() *
+      std::max(1, settings.MaxSamplesPerPixel);
+    const bool longRender = plannedPaths >= kAirSunTableMinimumPaths ||
+      settings.TimeLimitSeconds > 0.0 || settings.TargetImageRelativeError > 0.0;
+    if (this->Air && this->SunOn && settings.TabulatedAirTransmittance && longRender)
     {
       this->BuildAirSunTable();
     }
@@ -500,7 +508,7 @@ private:
   double AirMajorantInCloudBox = 0.0; // at the box's lowest altitude, 1/m
   double CloudBoxMinRadius = 0.0;     // distance from the earth centre to the box, m
   SunTable SunLengths;
-  SunDepthLattice SunDepth; // empty = next-event estimation everywhere
+  SunDepthLattice SunDepth;     // empty = next-event estimation everywhere
   GlobalSunTable AirSunLengths; // empty = exact outside the cloud box
   Vector3 Sun;
   std::vector<double> SunIrradiance;
@@ -615,7 +623,8 @@ void Integrator::BuildAirSunTable()
   {
     table.RMin = std::max(table.RMin,
       std::sqrt(Dot(this->Context.EarthCentred({ { 0.0, 0.0, this->Context.GetGroundHeight() } }),
-        this->Context.EarthCentred({ { 0.0, 0.0, this->Context.GetGroundHeight() } }))) - 1.0);
+        this->Context.EarthCentred({ { 0.0, 0.0, this->Context.GetGroundHeight() } }))) -
+        1.0);
   }
   table.RTop = parameters.TopRadiusMetres;
   if (!(table.RTop > table.RMin))
@@ -657,8 +666,8 @@ void Integrator::BuildAirSunTable()
       {
         const int i = static_cast<int>(k % nx), j = static_cast<int>(k / nx);
         double lR, lM;
-        const bool sunlit =
-          exact(radius(static_cast<double>(i) / (nx - 1)), cosine(-1.0 + 2.0 * j / (ny - 1)), lR, lM);
+        const bool sunlit = exact(
+          radius(static_cast<double>(i) / (nx - 1)), cosine(-1.0 + 2.0 * j / (ny - 1)), lR, lM);
         // At the top the lengths are 0: no logarithm, and the cells there stay exact.
         lit[k] = sunlit && lR > 0.0 && lM > 0.0 ? 1 : 0;
         table.LR[k] = lit[k] ? std::log(lR) : 0.0;
@@ -678,7 +687,8 @@ void Integrator::BuildAirSunTable()
           continue;
         }
         double lR, lM;
-        const double r = radius((i + 0.5) / (nx - 1)), mu = cosine(-1.0 + 2.0 * (j + 0.5) / (ny - 1));
+        const double r = radius((i + 0.5) / (nx - 1)),
+                     mu = cosine(-1.0 + 2.0 * (j + 0.5) / (ny - 1));
         if (!exact(r, mu, lR, lM))
         {
           continue;
@@ -741,7 +751,8 @@ void Integrator::BuildSunDepth()
   for (int m = 0; m < 2; ++m)
   {
     const int a = other[m];
-    fraction[m] = n[a] > 1 ? std::abs(this->Sun[a]) * exitDistance / this->Grid.GetSpacing()[a] : 0.0;
+    fraction[m] =
+      n[a] > 1 ? std::abs(this->Sun[a]) * exitDistance / this->Grid.GetSpacing()[a] : 0.0;
   }
   auto depthAt = [&](int i, int j, int k) -> double
   {
@@ -778,7 +789,8 @@ void Integrator::BuildSunDepth()
         const double upwind = (1 - f0) * ((1 - f1) * face[0][0] + f1 * face[0][1]) +
           f0 * ((1 - f1) * face[1][0] + f1 * face[1][1]);
         const Vector3 p{ { lattice.Origin[0] + i * lattice.Spacing[0],
-          lattice.Origin[1] + j * lattice.Spacing[1], lattice.Origin[2] + k * lattice.Spacing[2] } };
+          lattice.Origin[1] + j * lattice.Spacing[1],
+          lattice.Origin[2] + k * lattice.Spacing[2] } };
         const double sigma =
           extinctionPerDensity * this->Grid.Sample(Along(p, this->Sun, 0.5 * exitDistance));
         lattice.Depth[static_cast<std::size_t>(i) + j * nx + k * nxy] =
@@ -1628,8 +1640,9 @@ PathTracingEstimate EstimatePathTracingTime(const RenderContext& context,
   // The tables the render builds once, plus the pilot's tracing scaled up.
   const double tracingSeconds = estimate.PilotSeconds - setupSeconds;
   const double ratio = estimate.PilotRelativeError / targetImageRelativeError;
-  estimate.SecondsToTarget = setupSeconds + tracingSeconds *
-      (static_cast<double>(width) * height / static_cast<double>(pilotPixels)) * ratio * ratio;
+  estimate.SecondsToTarget = setupSeconds +
+    tracingSeconds * (static_cast<double>(width) * height / static_cast<double>(pilotPixels)) *
+      ratio * ratio;
   return estimate;
 }
 
@@ -1660,8 +1673,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   {
     // Per pixel: running statistics, a slot in the list of active pixels and the
     // two result images (3 floats each); checked before anything is allocated.
-    const double bytesPerPixel = static_cast<double>(sizeof(PixelStatistics) +
-      sizeof(std::size_t) + 2 * 3 * sizeof(float) + (settings.AdaptiveSampling ? 40 : 0));
+    const double bytesPerPixel = static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) +
+      2 * 3 * sizeof(float) + (settings.AdaptiveSampling ? 40 : 0));
     const double budget = settings.MemoryBudgetBytes > 0.0
       ? settings.MemoryBudgetBytes
       : static_cast<double>(DefaultMemoryBudgetBytes());

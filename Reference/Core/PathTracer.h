@@ -125,7 +125,9 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   bool SunDepthRoulette = true;
   /// The atmosphere's transmittance toward the sun at air and ground points from a
   /// table checked cell by cell against the exact integral (error in ln T <= 1e-4 where
-  /// used, exact elsewhere); false = the exact integral at every point.
+  /// used, exact elsewhere); false = the exact integral at every point. The table
+  /// (~0.3 s) is built only for renders of >= 65536 planned paths (pixels x
+  /// MaxSamplesPerPixel) or with a time limit or image target.
   bool TabulatedAirTransmittance = true;
   /// Incremental DDA over the cloud's majorant blocks of MajorantBlockVoxels^3 voxels
   /// (no dilation: the traversal keeps every point in its block); false = 4^3 blocks
@@ -186,10 +188,10 @@ struct NIMBUSREFERENCE_EXPORT PathTracingResult
 /// A pilot's forecast of a render's time to an image-wide error target.
 struct NIMBUSREFERENCE_EXPORT PathTracingEstimate
 {
-  double SecondsToTarget = 0.0;     // forecast for the whole image, settings' threads
-  double PilotSeconds = 0.0;        // what the pilot took
-  double PilotRelativeError = 0.0;  // its image-wide relative error
-  std::size_t PilotPixels = 0;      // pixels it traced
+  double SecondsToTarget = 0.0;    // forecast for the whole image, settings' threads
+  double PilotSeconds = 0.0;       // what the pilot took
+  double PilotRelativeError = 0.0; // its image-wide relative error
+  std::size_t PilotPixels = 0;     // pixels it traced
   int PilotSamplesPerPixel = 0;
 };
 

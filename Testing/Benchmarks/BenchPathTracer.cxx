@@ -8,8 +8,8 @@
 // for about S seconds (default 10; rounds of doubling samples, so a run ends after the
 // first round past S) with PathTracingSettings' defaults ("all"), with each default
 // technique off in turn ("defaults - name") or alone ("only name"), with an optional
-// technique added ("defaults + name"), and with none ("none"). Efficiency = 1 / (relative error^2 x seconds), the
-// relative error being the image-wide one (ImageRelativeError); it does not depend on
+// technique added ("defaults + name"), and with none ("none"). Efficiency = 1 / (relative error^2 x
+// seconds), the relative error being the image-wide one (ImageRelativeError); it does not depend on
 // the run's length, and the time to a target error e at the scene's own size is
 //     t(e) = err^2 seconds / e^2 x (scene pixels / bench pixels).
 // The table gives that time for 1 % and, per technique, its speed-up: eff(defaults) /
@@ -44,14 +44,12 @@ struct Technique
 std::vector<Technique> Techniques()
 {
   return {
-    { "sun-peak",
-      [](nimbus::PathTracingSettings& s, bool on) { s.SunPeakSampling = on; } },
+    { "sun-peak", [](nimbus::PathTracingSettings& s, bool on) { s.SunPeakSampling = on; } },
     { "air-sun-table",
       [](nimbus::PathTracingSettings& s, bool on) { s.TabulatedAirTransmittance = on; } },
-    { "dda-blocks",
-      [](nimbus::PathTracingSettings& s, bool on) { s.BlockTraversal = on; } },
-    { "adaptive-sampling",
-      [](nimbus::PathTracingSettings& s, bool on) { s.AdaptiveSampling = on; }, false },
+    { "dda-blocks", [](nimbus::PathTracingSettings& s, bool on) { s.BlockTraversal = on; } },
+    { "adaptive-sampling", [](nimbus::PathTracingSettings& s, bool on) { s.AdaptiveSampling = on; },
+      false },
     { "sun-depth-roulette",
       [](nimbus::PathTracingSettings& s, bool on) { s.SunDepthRoulette = on; } },
   };
@@ -140,8 +138,9 @@ int main(int argc, char* argv[])
     return 2;
   }
   const std::vector<Technique> techniques = Techniques();
-  std::printf("| scene | configuration | spp | seconds | relative error | "
-              "efficiency | time to 1 %% at the scene's size (2 cores) |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+    "| scene | configuration | spp | seconds | relative error | "
+    "efficiency | time to 1 %% at the scene's size (2 cores) |\n|---|---|---|---|---|---|---|\n");
   std::fflush(stdout);
   for (const std::string& file : scenes)
   {
@@ -185,8 +184,12 @@ int main(int argc, char* argv[])
     };
     const Run all = render(defaults);
     report("all (defaults)", all);
-    const Run none = render([&](nimbus::PathTracingSettings& s)
-      { for (const Technique& t : techniques) t.Set(s, false); });
+    const Run none = render(
+      [&](nimbus::PathTracingSettings& s)
+      {
+        for (const Technique& t : techniques)
+          t.Set(s, false);
+      });
     report("none", none);
     std::printf("| %s | **defaults vs none** | | | | %.2fx | |\n", scene.Name.c_str(),
       all.Efficiency() / none.Efficiency());
@@ -194,7 +197,8 @@ int main(int argc, char* argv[])
     {
       if (!technique.OnByDefault)
       {
-        const Run plus = render([&](nimbus::PathTracingSettings& s)
+        const Run plus = render(
+          [&](nimbus::PathTracingSettings& s)
           {
             defaults(s);
             technique.Set(s, true);
@@ -205,15 +209,18 @@ int main(int argc, char* argv[])
         std::fflush(stdout);
         continue;
       }
-      const Run without = render([&](nimbus::PathTracingSettings& s)
+      const Run without = render(
+        [&](nimbus::PathTracingSettings& s)
         {
           defaults(s);
           technique.Set(s, false);
         });
       report(std::string("defaults - ") + technique.Name, without);
-      const Run only = render([&](nimbus::PathTracingSettings& s)
+      const Run only = render(
+        [&](nimbus::PathTracingSettings& s)
         {
-          for (const Technique& t : techniques) t.Set(s, false);
+          for (const Technique& t : techniques)
+            t.Set(s, false);
           technique.Set(s, true);
         });
       report(std::string("only ") + technique.Name, only);

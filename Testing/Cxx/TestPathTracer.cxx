@@ -817,8 +817,8 @@ namespace
 // TabulatedAirTransmittance, BlockTraversal) change how the integral is sampled, never
 // its value: images with a technique on and with every technique off agree within
 // their standard errors, pixel by pixel.
-void ExpectSameImage(const nimbus::PathTracingResult& a, const nimbus::PathTracingResult& b,
-  const char* what)
+void ExpectSameImage(
+  const nimbus::PathTracingResult& a, const nimbus::PathTracingResult& b, const char* what)
 {
   double sumZ2 = 0.0, sumDifference = 0.0, sumVariance = 0.0;
   int count = 0, outliers = 0;
@@ -841,8 +841,8 @@ void ExpectSameImage(const nimbus::PathTracingResult& a, const nimbus::PathTraci
   const double rmsZ = std::sqrt(sumZ2 / std::max(1, count));
   // The whole image's sum: a bias too small to see in one pixel adds up here.
   const double imageZ = sumDifference / std::sqrt(sumVariance);
-  std::printf("%s: RMS z %.3f over %d pixel channels, %d beyond 4 sigma; image sum z %.2f\n",
-    what, rmsZ, count, outliers, imageZ);
+  std::printf("%s: RMS z %.3f over %d pixel channels, %d beyond 4 sigma; image sum z %.2f\n", what,
+    rmsZ, count, outliers, imageZ);
   EXPECT_LT(std::abs(imageZ), 4.0);
   EXPECT_GT(count, 400);
   EXPECT_LE(outliers, count / 100);
@@ -866,8 +866,8 @@ TEST(PathTracer, SpeedTechniquesAreUnbiased)
   scene.Sun.AzimuthDegrees = 0.0;
   scene.Sun.ElevationDegrees = 20.0;
   const RenderContext context(scene, PuffCloud());
-  auto render = [&](bool peak, bool roulette, bool table, bool blocks, std::uint64_t seed,
-                  int samples = 512)
+  auto render =
+    [&](bool peak, bool roulette, bool table, bool blocks, std::uint64_t seed, int samples = 512)
   {
     PathTracingSettings settings;
     settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = samples;

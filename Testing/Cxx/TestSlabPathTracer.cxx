@@ -223,7 +223,6 @@ TEST(SlabPathTracer, RadiancesMatchAddingDoubling)
   std::printf("total %.1f s\n", seconds);
 }
 
-
 // Henyey-Greenstein g = 0.85 (the clouds' asymmetry) and the thick, nearly white slabs of the
 // clouds (omega up to 0.999, tau up to 100), with the sun at the zenith. With normal incidence
 // the radiance field does not depend on the azimuth, so the solver's azimuth-averaged (m = 0)
