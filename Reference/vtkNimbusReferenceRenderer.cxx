@@ -1,6 +1,7 @@
 #include "vtkNimbusReferenceRenderer.h"
 
 #include "DensityGrid.h"
+#include "DensityGridFromImage.h"
 #include "MemoryBudget.h"
 #include "PathTracer.h"
 #include "RenderContext.h"
@@ -85,31 +86,6 @@ std::string FormatDuration(double seconds)
     text << seconds / 3600.0 << " h";
   }
   return text.str();
-}
-
-// vtkImageData point array -> DensityGrid (float), placed by origin, spacing and extent.
-nimbus::DensityGrid ToDensityGrid(vtkImageData* image, vtkDataArray* values)
-{
-  int extent[6];
-  image->GetExtent(extent);
-  double origin[3], spacing[3];
-  image->GetOrigin(origin);
-  image->GetSpacing(spacing);
-  std::array<int, 3> dims;
-  nimbus::DensityGrid::Vector3 first, step;
-  for (int a = 0; a < 3; ++a)
-  {
-    dims[a] = extent[2 * a + 1] - extent[2 * a] + 1;
-    first[a] = origin[a] + extent[2 * a] * spacing[a];
-    step[a] = spacing[a];
-  }
-  std::vector<float> density(static_cast<std::size_t>(values->GetNumberOfTuples()));
-  for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
-  {
-    // Through double: a double array's huge values become +inf, caught by DensityGrid.
-    density[static_cast<std::size_t>(i)] = static_cast<float>(values->GetComponent(i, 0));
-  }
-  return nimbus::DensityGrid(dims, first, step, std::move(density));
 }
 
 vtkSmartPointer<vtkFloatArray> ToArray(const nimbus::FloatImage& image, const char* name)
@@ -314,7 +290,7 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     nimbus::DensityGrid grid;
     try
     {
-      grid = ToDensityGrid(volume, values);
+      grid = nimbus::DensityGridFromImage(volume, values);
     }
     catch (const std::invalid_argument& error)
     {

@@ -431,6 +431,9 @@ public:
   int GetWavelengths() const { return this->Wavelengths; }
 
   void BuildSunTable();
+  /// Exact optical lengths L_R, L_M (m) toward the sun from radius r and sun cosine mu;
+  /// false where the earth hides the sun.
+  bool ExactSunLengths(double r, double mu, double& lR, double& lM) const;
   void BuildSunDepth();
   void BuildAirSunTable();
   /// Probability with which the sun's contribution is estimated at p (1 outside the
@@ -517,6 +520,29 @@ private:
   std::vector<double> ToRgb;
 };
 
+bool Integrator::ExactSunLengths(double r, double mu, double& lR, double& lM) const
+{
+  // The lengths depend on a point only through r and mu_s (spherical symmetry): any
+  // point will do, here one in the plane of the sun and a perpendicular direction.
+  const Vector3& sun = this->Sun;
+  const Vector3 helper =
+    std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
+  Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
+    sun[0] * helper[1] - sun[1] * helper[0] } };
+  const double perpLength = std::sqrt(Dot(perp, perp));
+  for (double& c : perp)
+  {
+    c /= perpLength;
+  }
+  const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+  const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]), r * (mu * sun[1] + sinTheta * perp[1]),
+    r * (mu * sun[2] + sinTheta * perp[2]) } };
+  const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
+  lR = lengths.RayleighLengthMetres;
+  lM = lengths.MieLengthMetres;
+  return !lengths.HitsGround;
+}
+
 void Integrator::BuildSunTable()
 {
   const Vector3& sun = this->Sun;
@@ -541,26 +567,8 @@ void Integrator::BuildSunTable()
   const double muPad = 0.05 * (muHi - muLo) + 1e-9;
   muLo = std::max(-1.0, muLo - muPad);
   muHi = std::min(1.0, muHi + muPad);
-  // Any unit vector perpendicular to the sun direction.
-  const Vector3 helper =
-    std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
-  Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
-    sun[0] * helper[1] - sun[1] * helper[0] } };
-  const double perpLength = std::sqrt(Dot(perp, perp));
-  for (double& c : perp)
-  {
-    c /= perpLength;
-  }
-  auto exact = [&](double r, double mu, double& lR, double& lM)
-  {
-    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]),
-      r * (mu * sun[1] + sinTheta * perp[1]), r * (mu * sun[2] + sinTheta * perp[2]) } };
-    const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
-    lR = lengths.RayleighLengthMetres;
-    lM = lengths.MieLengthMetres;
-    return !lengths.HitsGround;
-  };
+  auto exact = [this](double r, double mu, double& lR, double& lM)
+  { return this->ExactSunLengths(r, mu, lR, lM); };
   const double betaMax = std::max(this->BetaRMax, this->BetaMt);
   for (int nR = 17; nR <= 257; nR = 2 * nR - 1)
   {
@@ -613,7 +621,6 @@ void Integrator::BuildSunTable()
 
 void Integrator::BuildAirSunTable()
 {
-  const Vector3& sun = this->Sun;
   const AtmosphereParameters& parameters = this->Air->GetParameters();
   GlobalSunTable table;
   // Lowest point a path can reach: the ground plane's height above the scene origin
@@ -631,28 +638,10 @@ void Integrator::BuildAirSunTable()
   {
     return;
   }
-  const Vector3 helper =
-    std::abs(sun[2]) < 0.9 ? Vector3{ { 0.0, 0.0, 1.0 } } : Vector3{ { 1.0, 0.0, 0.0 } };
-  Vector3 perp{ { sun[1] * helper[2] - sun[2] * helper[1], sun[2] * helper[0] - sun[0] * helper[2],
-    sun[0] * helper[1] - sun[1] * helper[0] } };
-  const double perpLength = std::sqrt(Dot(perp, perp));
-  for (double& c : perp)
-  {
-    c /= perpLength;
-  }
   auto radius = [&](double x) { return table.RMin + x * (table.RTop - table.RMin); };
   auto cosine = [](double u) { return u * std::abs(u); };
-  // Exact lengths at (r, mu); false where the earth hides the sun.
-  auto exact = [&](double r, double mu, double& lR, double& lM)
-  {
-    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-    const Vector3 q{ { r * (mu * sun[0] + sinTheta * perp[0]),
-      r * (mu * sun[1] + sinTheta * perp[1]), r * (mu * sun[2] + sinTheta * perp[2]) } };
-    const OpticalLengths lengths = this->Air->OpticalLengthsToTop(q, sun);
-    lR = lengths.RayleighLengthMetres;
-    lM = lengths.MieLengthMetres;
-    return !lengths.HitsGround;
-  };
+  auto exact = [this](double r, double mu, double& lR, double& lM)
+  { return this->ExactSunLengths(r, mu, lR, lM); };
   const int nx = kGlobalSunTableRadii, ny = kGlobalSunTableCosines;
   table.LR.assign(static_cast<std::size_t>(nx) * ny, 0.0);
   table.LM.assign(table.LR.size(), 0.0);
@@ -1447,6 +1436,22 @@ struct PixelStatistics
     return std::sqrt(std::max(0.0, this->M2[c]) / (n * (n - 1.0)));
   }
 };
+/// Sample `stream` of pixel k = (i, j): the path's generator is seeded by (Seed, k,
+/// stream) only, so the sample does not depend on the thread or on other pixels. The
+/// image's samples use streams 0, 1, ...; the pilots use streams from 2^40 and 2^41.
+void TraceSample(const Integrator& integrator, const PathTracingSettings& settings, std::size_t k,
+  int i, int j, std::uint64_t stream, PathState& state, double rgb[3])
+{
+  PathRandom rng(settings.Seed, k, stream);
+  double x = i + 0.5, y = j + 0.5;
+  if (settings.PixelJitter)
+  {
+    x = i + rng.Uniform();
+    y = j + rng.Uniform();
+  }
+  integrator.TracePath(x, y, rng, state, rgb);
+}
+
 /// ImageRelativeError over the running statistics (channels 0-2).
 double ImageRelativeError(const std::vector<PixelStatistics>& statistics)
 {
@@ -1498,15 +1503,8 @@ std::vector<double> SampleShares(const Integrator& integrator, const PathTracing
         double steps = 0.0;
         for (std::uint64_t sample = 0; sample < pilot; ++sample)
         {
-          PathRandom rng(settings.Seed, k, (std::uint64_t(1) << 40) + sample);
-          double x = i + 0.5, y = j + 0.5;
-          if (settings.PixelJitter)
-          {
-            x = i + rng.Uniform();
-            y = j + rng.Uniform();
-          }
           double rgb[3];
-          integrator.TracePath(x, y, rng, state, rgb);
+          TraceSample(integrator, settings, k, i, j, (std::uint64_t(1) << 40) + sample, state, rgb);
           stats.Add(rgb);
           steps += static_cast<double>(state.Steps);
         }
@@ -1618,15 +1616,9 @@ PathTracingEstimate EstimatePathTracingTime(const RenderContext& context,
         const std::size_t k = static_cast<std::size_t>(cj) * width + ci;
         for (int sample = 0; sample < pilotSamples; ++sample)
         {
-          PathRandom rng(settings.Seed, k, (std::uint64_t(1) << 41) + sample);
-          double x = ci + 0.5, y = cj + 0.5;
-          if (settings.PixelJitter)
-          {
-            x = ci + rng.Uniform();
-            y = cj + rng.Uniform();
-          }
           double rgb[3];
-          integrator.TracePath(x, y, rng, state, rgb);
+          TraceSample(
+            integrator, settings, k, ci, cj, (std::uint64_t(1) << 41) + sample, state, rgb);
           statistics[q].Add(rgb);
         }
       }
@@ -1750,15 +1742,8 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
           const std::uint64_t roundTarget = pixelTarget(k, target);
           while (stats.Count < roundTarget)
           {
-            PathRandom rng(settings.Seed, k, stats.Count);
-            double x = i + 0.5, y = j + 0.5;
-            if (settings.PixelJitter)
-            {
-              x = i + rng.Uniform();
-              y = j + rng.Uniform();
-            }
             double rgb[3];
-            integrator.TracePath(x, y, rng, state, rgb);
+            TraceSample(integrator, settings, k, i, j, stats.Count, state, rgb);
             stats.Add(rgb);
             ++localPaths;
             localTruncated += state.Truncated ? 1 : 0;

@@ -15,6 +15,7 @@
 // The table gives that time for 1 % and, per technique, its speed-up: eff(defaults) /
 // eff(defaults without it) and eff(it alone) / eff(none) (optional techniques:
 // eff(defaults with it) / eff(defaults)).
+#include "DensityGridFromImage.h"
 #include "PathTracer.h"
 #include "RenderContext.h"
 #include "SceneJson.h"
@@ -61,26 +62,7 @@ nimbus::DensityGrid SceneGrid(const std::string& file)
   source->SetSceneFileName(file.c_str());
   source->Update();
   vtkImageData* image = source->GetOutput();
-  vtkDataArray* values = image->GetPointData()->GetArray(0);
-  int extent[6];
-  image->GetExtent(extent);
-  double origin[3], spacing[3];
-  image->GetOrigin(origin);
-  image->GetSpacing(spacing);
-  std::array<int, 3> dims;
-  nimbus::DensityGrid::Vector3 first, step;
-  for (int a = 0; a < 3; ++a)
-  {
-    dims[a] = extent[2 * a + 1] - extent[2 * a] + 1;
-    first[a] = origin[a] + extent[2 * a] * spacing[a];
-    step[a] = spacing[a];
-  }
-  std::vector<float> density(static_cast<std::size_t>(values->GetNumberOfTuples()));
-  for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
-  {
-    density[static_cast<std::size_t>(i)] = static_cast<float>(values->GetComponent(i, 0));
-  }
-  return nimbus::DensityGrid(dims, first, step, std::move(density));
+  return nimbus::DensityGridFromImage(image, image->GetPointData()->GetArray(0));
 }
 
 struct Run

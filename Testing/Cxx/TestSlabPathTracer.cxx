@@ -139,6 +139,16 @@ Estimate PathTrace(double tau, double omega, double mu0, double mu, bool reflect
   return out;
 }
 
+/// The solver's quadrature cosine nearest kViewCosine.
+std::size_t NearestNode(const nimbus::slab::Result& solved)
+{
+  std::size_t node = 0;
+  for (std::size_t i = 1; i < solved.Mu.size(); ++i)
+    if (std::abs(solved.Mu[i] - kViewCosine) < std::abs(solved.Mu[node] - kViewCosine))
+      node = i;
+  return node;
+}
+
 struct Case
 {
   double Omega, Tau, Mu0;
@@ -185,10 +195,7 @@ TEST(SlabPathTracer, RadiancesMatchAddingDoubling)
     const double widthBias =
       0.25 * k.Omega * std::exp(-(1.0 - k.Omega) * 1.0e4 * k.Tau) / (1.0 - k.Omega);
     const double bias = quadratureBias + widthBias;
-    std::size_t node = 0;
-    for (std::size_t i = 1; i < solved.Mu.size(); ++i)
-      if (std::abs(solved.Mu[i] - kViewCosine) < std::abs(solved.Mu[node] - kViewCosine))
-        node = i;
+    const std::size_t node = NearestNode(solved);
     const double mu = solved.Mu[node];
     for (const bool reflected : { true, false })
     {
@@ -285,10 +292,7 @@ TEST(SlabPathTracer, HenyeyGreensteinAndThickSlabsAtNormalIncidence)
     const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
     const double bias = std::abs(solved.Reflectance - fine.Reflectance) +
       std::abs(solved.DiffuseTransmittance - fine.DiffuseTransmittance);
-    std::size_t node = 0;
-    for (std::size_t i = 1; i < solved.Mu.size(); ++i)
-      if (std::abs(solved.Mu[i] - kViewCosine) < std::abs(solved.Mu[node] - kViewCosine))
-        node = i;
+    const std::size_t node = NearestNode(solved);
     const double mu = solved.Mu[node];
     for (const bool reflected : { true, false })
     {
