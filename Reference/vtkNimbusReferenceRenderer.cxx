@@ -450,6 +450,7 @@ void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TargetRelativeError: " << this->TargetRelativeError << "\n";
   os << indent << "TimeLimitSeconds: " << this->TimeLimitSeconds << "\n";
   os << indent << "TargetImageRelativeError: " << this->TargetImageRelativeError << "\n";
+  os << indent << "EstimatedSecondsToTarget: " << this->EstimatedSecondsToTarget << "\n";
   os << indent << "MaxScatteringOrder: " << this->MaxScatteringOrder << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
