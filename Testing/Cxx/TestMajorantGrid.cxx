@@ -370,3 +370,51 @@ TEST(MajorantGrid, OneVoxelGrid)
   EXPECT_EQ(majorants.GetBlockSize()[0], 4 * 400.0);
   EXPECT_EQ(majorants.GetLower()[2], 1000.0);
 }
+
+// Other block sizes (the path tracer measured 2, 4 and 8): counts ceil((n - 1) / B), the
+// maximum over each block's points [B c, min(n - 1, B c + B)] per axis, which bounds the
+// trilinear density anywhere in the block; B < 1 is refused.
+TEST(MajorantGrid, OtherBlockSizes)
+{
+  std::mt19937 rng(777);
+  const std::array<int, 3> dims{ { 11, 7, 9 } };
+  const DensityGrid grid = RandomGrid(dims, rng);
+  const std::vector<float>& values = grid.GetValues();
+  for (const int b : { 1, 2, 3, 5, 8, 20 })
+  {
+    SCOPED_TRACE("block size " + std::to_string(b));
+    const MajorantGrid majorants(grid, 0, b);
+    const std::array<int, 3>& blocks = majorants.GetBlocks();
+    for (int a = 0; a < 3; ++a)
+    {
+      ASSERT_EQ(blocks[a], (dims[a] - 1 + b - 1) / b);
+      EXPECT_DOUBLE_EQ(majorants.GetBlockSize()[a], b * grid.GetSpacing()[a]);
+    }
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int k = 0; k < blocks[2]; ++k)
+      for (int j = 0; j < blocks[1]; ++j)
+        for (int i = 0; i < blocks[0]; ++i)
+        {
+          const int c[3] = { i, j, k };
+          float brute = 0.0f;
+          for (int z = b * k; z <= std::min(dims[2] - 1, b * k + b); ++z)
+            for (int y = b * j; y <= std::min(dims[1] - 1, b * j + b); ++y)
+              for (int x = b * i; x <= std::min(dims[0] - 1, b * i + b); ++x)
+                brute = std::max(brute, values[x + dims[0] * (y + dims[1] * z)]);
+          const double maximum = majorants.GetMaximum(majorants.GetIndex(i, j, k));
+          EXPECT_EQ(maximum, static_cast<double>(brute));
+          for (int s = 0; s < 20; ++s)
+          {
+            Vector3 p;
+            for (int a = 0; a < 3; ++a)
+            {
+              const double lo = b * c[a], hi = std::min(dims[a] - 1, b * c[a] + b);
+              p[a] = grid.GetOrigin()[a] + (lo + unit(rng) * (hi - lo)) * grid.GetSpacing()[a];
+            }
+            ASSERT_LE(grid.Sample(p), maximum);
+          }
+        }
+  }
+  EXPECT_THROW(MajorantGrid(grid, 0, 0), std::invalid_argument);
+  EXPECT_THROW(MajorantGrid(grid, 0, -3), std::invalid_argument);
+}
