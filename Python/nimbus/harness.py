@@ -10,9 +10,27 @@ writes a CSV and an error-vs-time plot: the Pareto front users choose from.
 
 Renderers: ``vtk-gpu`` (VTK's vtkGPUVolumeRayCastMapper with the scene's optics
 mapped onto its transfer functions; needs a display: run it through
-Testing/with-display.sh), ``single`` (Nimbus's single-scattering reference at
-coarser steps) and ``path`` (the Monte Carlo path tracer at fewer samples).
-``--settings FILE.json`` replaces a renderer's default list of settings.
+Testing/with-display.sh), ``svs`` (Nimbus's shadow-view-slice mapper; setting
+``k_multi`` overrides the scene's multiple-scattering constant), ``single``
+(Nimbus's single-scattering reference at coarser steps) and ``path`` (the Monte
+Carlo path tracer at fewer samples). ``--settings FILE.json`` replaces a
+renderer's default list of settings.
+
+The reference (``--reference``): ``path`` is the Monte Carlo path tracer with full
+multiple scattering, run for a time budget (--reference-seconds, default 600 s;
+its image-wide error is printed and stored); ``single`` is converged single
+scattering. ``auto`` (the default) judges each setting by what it models: settings
+that model single scattering only (the ``single`` renderer, ``svs`` with k_multi
+0) against ``single``, every other one against ``path``. Every row, table and plot
+names its reference.
+
+The path-traced reference is noisy. Its noise adds to the squared error of every
+image measured against it, so RMSE (and PSNR) are corrected for it: RMSE^2 =
+mean((image - reference)^2) - mean(sigma_ref^2) - mean(sigma_image^2), sigma the
+per-pixel standard errors the path tracer reports (sigma_image: the sky-only
+reference that vtk-gpu composites over, times (1 - alpha)). ``rmse_raw`` is the
+uncorrected value and ``reference_noise`` the reference's RMS standard error.
+Relative L1 and max abs are not corrected (read them with reference_noise in mind).
 
 References are rendered once and cached in --cache-dir under a hash of the scene
 file (canonical JSON), the density file it names (bytes) and the reference's own
@@ -38,8 +56,14 @@ from vtkmodules.vtkIOImage import vtkPNGWriter
 # The reference each scene is measured against (see --reference).
 REFERENCE_SETTINGS = {
     "single": {"mode": "single", "step_scale": 0.5, "tolerance": 1e-3, "max_refinements": 6},
-    "path": {"mode": "path", "min_spp": 64, "max_spp": 4096, "target_error": 0.01, "seed": 1},
+    # Full multiple scattering for a time budget (seconds; --reference-seconds). 1 % image-wide
+    # takes 51 min to 7 h per scene on 2 cores (docs/ground-truth.md), so the budget decides the
+    # reference's own error, and the metrics are corrected for it (see the module text).
+    "path": {"mode": "path", "min_spp": 16, "max_spp": 1 << 20, "time_limit": 600.0,
+             "seed": 1},
 }
+# The sky-only path-traced reference (vtk-gpu's background) gets this share of the budget.
+SKY_BUDGET_SHARE = 0.25
 
 # Default quality settings per renderer: each dict is one point of the trade curve.
 DEFAULT_SETTINGS = {
@@ -64,6 +88,8 @@ DEFAULT_SETTINGS = {
 # 1/VTK_SCALE fills VTK's 8-bit framebuffer. 8-bit quantisation then costs at most
 # 1/(2*255*VTK_SCALE) = 6.5e-4 in radiance, below every error the table reports.
 VTK_SCALE = 3.0
+# Plots draw RMSEs below this (0 after the noise correction) at this value.
+PLOT_RMSE_FLOOR = 1e-6
 # Exposure of the PNGs the harness writes for looking at (not used in any metric).
 DISPLAY_EXPOSURE = 6.0
 
@@ -109,6 +135,8 @@ def configure_reference_renderer(renderer, settings, threads=0):
         renderer.SetTargetRelativeError(settings.get("target_error", 0.0))
         renderer.SetMaxScatteringOrder(settings.get("max_order", 0))
         renderer.SetSeed(settings.get("seed", 1))
+        renderer.SetTimeLimitSeconds(settings.get("time_limit", 0.0))
+        renderer.SetTargetImageRelativeError(settings.get("target_image_error", 0.0))
     renderer.SetNumberOfThreads(threads)
 
 
@@ -128,15 +156,31 @@ def render_reference_mode(scene_path, settings, density=None):
     return vtk_to_numpy(radiance).reshape(height, width, 3).astype(np.float32), output
 
 
+def standard_error_of(output):
+    """The per-pixel standard error (H x W x 3 float32) of a path-traced output, or None."""
+    array = output.GetPointData().GetArray("standard_error")
+    if array is None:
+        return None
+    width, height, _ = output.GetDimensions()
+    return vtk_to_numpy(array).reshape(height, width, 3).astype(np.float32)
+
+
 def cached_image(cache_dir, key, compute):
-    """An image from the cache, or computed and stored (npy, float32)."""
+    """(image, standard error or None, cached?) from the cache, or computed and stored.
+
+    compute() returns (image, standard error or None); both are stored as float32 npy
+    (KEY.npy, KEY-stderr.npy)."""
     os.makedirs(cache_dir, exist_ok=True)
     path = os.path.join(cache_dir, key + ".npy")
+    error_path = os.path.join(cache_dir, key + "-stderr.npy")
     if os.path.exists(path):
-        return np.load(path), True
-    image = compute()
+        error = np.load(error_path) if os.path.exists(error_path) else None
+        return np.load(path), error, True
+    image, error = compute()
+    if error is not None:
+        np.save(error_path, error)
     np.save(path, image)
-    return image, False
+    return image, error, False
 
 
 def zero_density(scene_path):
@@ -152,14 +196,43 @@ def zero_density(scene_path):
 
 # --- error metrics ----------------------------------------------------------------------------
 
-def error_metrics(image, reference):
+def error_metrics(image, reference, reference_error=None, image_error=None):
+    """RMSE, relative L1, max abs and PSNR of image against reference.
+
+    reference_error / image_error: per-pixel standard errors of a Monte Carlo reference
+    and of the noisy part of the image (None = exact). Independent zero-mean noise adds
+    its variance to the expected squared difference, so the corrected RMSE is
+    sqrt(max(0, mean(d^2) - mean(sigma_ref^2) - mean(sigma_image^2))); "rmse_raw" is
+    sqrt(mean(d^2)) and "reference_noise" the reference's RMS standard error."""
     difference = image.astype(np.float64) - reference.astype(np.float64)
-    rmse = float(np.sqrt(np.mean(difference ** 2)))
+    mean_square = float(np.mean(difference ** 2))
+    noise = 0.0
+    reference_noise = 0.0
+    if reference_error is not None:
+        reference_noise = float(np.mean(reference_error.astype(np.float64) ** 2))
+        noise += reference_noise
+    if image_error is not None:
+        noise += float(np.mean(image_error.astype(np.float64) ** 2))
+    rmse = math.sqrt(max(0.0, mean_square - noise))
     relative_l1 = float(np.sum(np.abs(difference)) / max(np.sum(np.abs(reference)), 1e-30))
     max_abs = float(np.max(np.abs(difference)))
     peak = float(np.max(reference))
     psnr = float(20.0 * math.log10(peak / rmse)) if rmse > 0 and peak > 0 else float("inf")
-    return {"rmse": rmse, "relative_l1": relative_l1, "max_abs": max_abs, "psnr_db": psnr}
+    return {"rmse": rmse, "rmse_raw": math.sqrt(mean_square),
+            "reference_noise": math.sqrt(reference_noise), "relative_l1": relative_l1,
+            "max_abs": max_abs, "psnr_db": psnr}
+
+
+def models_single_scattering_only(renderer_name, settings, scene):
+    """True for settings whose renderer models single scattering alone (judged by the
+    single-scattering reference under --reference auto)."""
+    if renderer_name == "single":
+        return True
+    if renderer_name == "svs":
+        k_multi = settings.get("k_multi",
+                               scene.get("medium", {}).get("multiple_scattering_constant", 0.0))
+        return k_multi == 0
+    return False
 
 
 # --- renderers --------------------------------------------------------------------------------
@@ -173,6 +246,7 @@ class ReferenceModeRenderer:
 
     def render(self, settings):
         merged = dict(REFERENCE_SETTINGS[self.mode])
+        merged.pop("time_limit", None)  # a trade point is its sample count, not the budget
         merged.update(settings)
         merged["mode"] = self.mode
         image, _ = render_reference_mode(self.scene_path, merged)
@@ -217,7 +291,7 @@ class VtkGpuRenderer:
       phase component's g).
     """
 
-    def __init__(self, scene_path, sky_image):
+    def __init__(self, scene_path, sky_image, sky_error=None):
         from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkLight,
                                                  vtkRenderWindow, vtkRenderer, vtkVolume,
                                                  vtkVolumeProperty, vtkWindowToImageFilter)
@@ -227,6 +301,8 @@ class VtkGpuRenderer:
         scene = load_scene(scene_path)
         self.scene = scene
         self.sky = sky_image
+        self.sky_error = sky_error
+        self.noise = None  # standard error of the last image's noisy part (the sky)
         density = nimbus.vtkNimbusSceneDensitySource()
         density.SetSceneFileName(scene_path)
         density.Update()
@@ -334,6 +410,8 @@ class VtkGpuRenderer:
         rgba = read_framebuffer(self.window, self.capture_class, 4)
         cloud = rgba[..., :3] / VTK_SCALE  # back to the scene's linear radiance units
         alpha = rgba[..., 3:4]
+        if self.sky_error is not None:
+            self.noise = (1.0 - alpha) * self.sky_error
         return cloud + (1.0 - alpha) * self.sky
 
     def close(self):
@@ -350,7 +428,8 @@ class SvsRenderer:
     mapper (CaptureRadiance); "constant" is that radiance in the 8-bit
     framebuffer (radiance x VTK_SCALE, quantisation <= 6.5e-4).
     Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
-    atmosphere_steps, unlit (the unlit compositing floor, for timing only).
+    atmosphere_steps, unlit (the unlit compositing floor, for timing only), k_multi
+    (000 Eq. 1's multiple-scattering constant; default the scene's).
     """
 
     def __init__(self, scene_path):
@@ -363,6 +442,7 @@ class SvsRenderer:
         density.SetSceneFileName(scene_path)
         density.Update()
         self.mapper = configure_svs_mapper(nimbus.vtkNimbusCloudVolumeMapper(), scene)
+        self.k_multi = scene["medium"].get("multiple_scattering_constant", 0.0)
         self.mapper.SetInputConnection(density.GetOutputPort())
         self.mapper.SetExposure(VTK_SCALE)
         self.volume = vtkVolume()
@@ -398,6 +478,7 @@ class SvsRenderer:
         self.mapper.SetShadowSurfaceSize(int(settings.get("shadow", 512)))
         self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 64)))
         self.mapper.SetUnlit(bool(settings.get("unlit", False)))
+        self.mapper.SetMultipleScattering(float(settings.get("k_multi", self.k_multi)))
         self.window.Render()
         if self.float_capture:
             radiance = self.mapper.GetRadianceImage()
@@ -471,13 +552,18 @@ def plot(rows, title, path):
     import matplotlib.pyplot as plt
 
     figure, axis = plt.subplots(figsize=(7, 4.5), dpi=100)
-    for renderer in sorted({row["renderer"] for row in rows}):
-        mine = [row for row in rows if row["renderer"] == renderer]
-        axis.scatter([r["median_seconds"] for r in mine], [r["rmse"] for r in mine],
-                     label=renderer, s=20)
+    # One series per renderer and kind of reference ("svs vs path"); a corrected RMSE of 0
+    # (within the reference's noise) is drawn at the floor.
+    def series(row):
+        return f"{row['renderer']} vs {row.get('reference', '?').split()[0]}"
+
+    for name in sorted({series(row) for row in rows}):
+        mine = [row for row in rows if series(row) == name]
+        axis.scatter([r["median_seconds"] for r in mine],
+                     [max(r["rmse"], PLOT_RMSE_FLOOR) for r in mine], label=name, s=20)
         front = pareto_front(mine)
-        axis.plot([r["median_seconds"] for r in front], [r["rmse"] for r in front], "-",
-                  linewidth=1)
+        axis.plot([r["median_seconds"] for r in front],
+                  [max(r["rmse"], PLOT_RMSE_FLOOR) for r in front], "-", linewidth=1)
     axis.set_xscale("log")
     axis.set_yscale("log")
     axis.set_xlabel("render time (s, median)")
@@ -540,6 +626,60 @@ def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
     return rows
 
 
+class SceneReferences:
+    """A scene's reference images (and the sky-only ones), rendered on first use and cached."""
+
+    def __init__(self, scene_path, scene_name, cache_dir, output_dir, reference_seconds):
+        self.scene_path = scene_path
+        self.scene_name = scene_name
+        self.cache_dir = cache_dir
+        self.output_dir = output_dir
+        self.reference_seconds = reference_seconds
+        self.images = {}
+
+    def settings(self, name, sky=False):
+        settings = dict(REFERENCE_SETTINGS[name])
+        if "time_limit" in settings:
+            share = SKY_BUDGET_SHARE if sky else 1.0
+            settings["time_limit"] = float(self.reference_seconds) * share
+        return settings
+
+    def get(self, name, sky=False):
+        """(image, standard error or None, label) of reference `name` (sky-only if sky)."""
+        if (name, sky) in self.images:
+            return self.images[(name, sky)]
+        settings = self.settings(name, sky)
+        what = "sky-only reference" if sky else "reference"
+        key = scene_hash(self.scene_path, {"sky_only": settings} if sky else settings)
+
+        def compute():
+            density = zero_density(self.scene_path) if sky else None
+            image, output = render_reference_mode(self.scene_path, settings, density=density)
+            field = output.GetFieldData()
+            error = field.GetArray("EstimatedRelativeError").GetValue(0)
+            seconds = field.GetArray("RenderSeconds").GetValue(0)
+            spp = field.GetArray("SamplesPerPixel").GetValue(0)
+            print(f"{self.scene_name}: {what} ({name}) rendered in {seconds:.1f} s, "
+                  f"{spp:.4g} samples per pixel, estimated relative error {error:.2e}",
+                  flush=True)
+            return image, standard_error_of(output)
+
+        prefix = f"{self.scene_name}-sky-{name}" if sky else f"{self.scene_name}-{name}"
+        image, error, cached = cached_image(self.cache_dir, f"{prefix}-{key}", compute)
+        if cached:
+            print(f"{self.scene_name}: {what} ({name}) from the cache", flush=True)
+        label = name
+        if error is not None:
+            rms = float(np.sqrt(np.mean(error.astype(np.float64) ** 2)))
+            mean = float(np.sqrt(np.mean(image.astype(np.float64) ** 2)))
+            label = f"{name} (±{100.0 * rms / max(mean, 1e-30):.2g} %)"
+        if not sky:
+            write_png(image, os.path.join(self.output_dir,
+                                          f"{self.scene_name}-reference-{name}.png"))
+        self.images[(name, sky)] = (image, error, label)
+        return self.images[(name, sky)]
+
+
 def run(arguments):
     parser = argparse.ArgumentParser(prog="python3 -m nimbus.harness", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -547,10 +687,16 @@ def run(arguments):
     parser.add_argument("--renderer", action="append", choices=sorted(DEFAULT_SETTINGS),
                         help="renderer(s) to measure (default: vtk-gpu)")
     parser.add_argument("--settings", help="JSON file: a list of settings (one renderer only)")
-    parser.add_argument("--reference", choices=sorted(REFERENCE_SETTINGS), default="single",
-                        help="the ground truth: converged single scattering (default; what the "
-                             "fast renderers implement) or Monte Carlo path tracing (full "
-                             "multiple scattering; 1%% RMSE takes hours here, see docs)")
+    parser.add_argument("--reference", choices=["auto"] + sorted(REFERENCE_SETTINGS),
+                        default="auto",
+                        help="the ground truth: 'path' (Monte Carlo, full multiple scattering, "
+                             "for --reference-seconds), 'single' (converged single "
+                             "scattering), or 'auto' (default): 'single' for settings that "
+                             "model single scattering only, 'path' for the others")
+    parser.add_argument("--reference-seconds", type=float,
+                        default=REFERENCE_SETTINGS["path"]["time_limit"],
+                        help="time budget of a path-traced reference (default %(default)g s; "
+                             "the sky-only one gets a quarter). Part of the cache key.")
     parser.add_argument("--repeats", type=int, default=3, help="renders per setting (median)")
     parser.add_argument("--output-dir", default="harness-output")
     parser.add_argument("--cache-dir", default=None,
@@ -569,29 +715,25 @@ def run(arguments):
         parser.error("--settings needs exactly one --renderer")
     if args.repeats < 1:
         parser.error("--repeats must be >= 1")
+    if not (args.reference_seconds > 0 and math.isfinite(args.reference_seconds)):
+        parser.error("--reference-seconds must be a positive number of seconds")
     cache_dir = args.cache_dir or os.path.join(args.output_dir, "reference-cache")
     os.makedirs(args.output_dir, exist_ok=True)
 
     all_rows = []
+    used_references = set()
     for scene_path in args.scenes:
         scene_path = os.path.abspath(scene_path)
         scene_name = os.path.splitext(os.path.basename(scene_path))[0]
-        reference_settings = REFERENCE_SETTINGS[args.reference]
-        key = scene_hash(scene_path, reference_settings)
+        scene = load_scene(scene_path)
+        references = SceneReferences(scene_path, scene_name, cache_dir, args.output_dir,
+                                     args.reference_seconds)
 
-        def compute_reference():
-            image, output = render_reference_mode(scene_path, reference_settings)
-            error = output.GetFieldData().GetArray("EstimatedRelativeError").GetValue(0)
-            seconds = output.GetFieldData().GetArray("RenderSeconds").GetValue(0)
-            print(f"{scene_name}: reference ({args.reference}) rendered in {seconds:.1f} s, "
-                  f"estimated relative error {error:.2e}", flush=True)
-            return image
-
-        reference, cached = cached_image(cache_dir, f"{scene_name}-{args.reference}-{key}",
-                                         compute_reference)
-        if cached:
-            print(f"{scene_name}: reference ({args.reference}) from the cache", flush=True)
-        write_png(reference, os.path.join(args.output_dir, f"{scene_name}-reference.png"))
+        def reference_name(renderer_name, settings):
+            if args.reference != "auto":
+                return args.reference
+            return "single" if models_single_scattering_only(renderer_name, settings,
+                                                             scene) else "path"
 
         scene_rows = []
         for renderer_name in renderers:
@@ -601,60 +743,64 @@ def run(arguments):
             else:
                 settings_list = DEFAULT_SETTINGS[renderer_name]
             if renderer_name == "vtk-gpu":
-                sky_key = scene_hash(scene_path, {"sky_only": reference_settings})
-
-                def compute_sky():
-                    image, _ = render_reference_mode(scene_path, reference_settings,
-                                                     density=zero_density(scene_path))
-                    return image
-
-                sky, _ = cached_image(cache_dir, f"{scene_name}-sky-{args.reference}-{sky_key}",
-                                      compute_sky)
-                renderer = VtkGpuRenderer(scene_path, sky)
+                # VTK has no sky: its cloud goes over the sky-only version of the reference
+                # that judges it (every vtk-gpu setting has the same one).
+                sky, sky_error, _ = references.get(reference_name("vtk-gpu", {}), sky=True)
+                renderer = VtkGpuRenderer(scene_path, sky, sky_error)
             elif renderer_name == "svs":
                 renderer = SvsRenderer(scene_path)
             else:
                 renderer = ReferenceModeRenderer(scene_path, renderer_name)
             try:
                 for index, settings in enumerate(settings_list):
+                    name = reference_name(renderer_name, settings)
+                    reference, reference_error, label = references.get(name)
+                    used_references.add(name)
                     image, seconds = measure(renderer, settings, args.repeats)
                     row = {"scene": scene_name, "renderer": renderer_name,
                            "setting": setting_label(settings),
                            "settings_json": json.dumps(settings, sort_keys=True),
-                           "median_seconds": seconds, "reference": args.reference}
-                    row.update(error_metrics(image, reference))
+                           "median_seconds": seconds, "reference": label}
+                    row.update(error_metrics(image, reference, reference_error,
+                                             getattr(renderer, "noise", None)))
                     scene_rows.append(row)
                     print(f"{scene_name} {renderer_name} [{row['setting']}]: "
-                          f"{seconds:.3f} s, RMSE {row['rmse']:.4g}, "
+                          f"{seconds:.3f} s, RMSE {row['rmse']:.4g} vs {label}, "
                           f"PSNR {row['psnr_db']:.1f} dB", flush=True)
                     write_png(image, os.path.join(
                         args.output_dir, f"{scene_name}-{renderer_name}-{index}.png"))
             finally:
                 renderer.close()
-        plot(scene_rows, f"{scene_name} (reference: {args.reference})",
+        plot(scene_rows, f"{scene_name} (reference: {reference_title(scene_rows)})",
              os.path.join(args.output_dir, f"{scene_name}-trade.png"))
         all_rows.extend(scene_rows)
 
-    fields = ["scene", "renderer", "setting", "median_seconds", "rmse", "relative_l1",
-              "max_abs", "psnr_db", "reference", "settings_json"]
+    fields = ["scene", "renderer", "setting", "median_seconds", "rmse", "rmse_raw",
+              "reference_noise", "relative_l1", "max_abs", "psnr_db", "reference",
+              "settings_json"]
     csv_path = os.path.join(args.output_dir, "trade.csv")
     with open(csv_path, "w", newline="") as stream:
         writer = csv.DictWriter(stream, fieldnames=fields)
         writer.writeheader()
         writer.writerows(all_rows)
-    plot(all_rows, f"all scenes (reference: {args.reference})",
+    plot(all_rows, f"all scenes (reference: {', '.join(sorted(used_references))})",
          os.path.join(args.output_dir, "trade.png"))
     if args.markdown:
         with open(args.markdown, "w") as stream:
             stream.write("| scene | renderer | setting | median time (s) | RMSE | rel. L1 | "
-                         "max abs | PSNR (dB) |\n|---|---|---|---|---|---|---|---|\n")
+                         "max abs | PSNR (dB) | reference |\n"
+                         "|---|---|---|---|---|---|---|---|---|\n")
             for row in all_rows:
                 stream.write(f"| {row['scene']} | {row['renderer']} | {row['setting']} | "
                              f"{row['median_seconds']:.3f} | {row['rmse']:.4g} | "
                              f"{row['relative_l1']:.3f} | {row['max_abs']:.3g} | "
-                             f"{row['psnr_db']:.1f} |\n")
+                             f"{row['psnr_db']:.1f} | {row['reference']} |\n")
     print(csv_path)
     return 0
+
+
+def reference_title(rows):
+    return ", ".join(sorted({row["reference"] for row in rows})) or "none"
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
-"""The trade harness runs end to end on a tiny scene: reference (cached on the
-second run), VTK's GPU mapper, the SVS mapper and the reference renderer's own
-trade curve, CSV with every metric, plots."""
+"""The trade harness runs end to end on a tiny scene: references (cached on the
+second run; path-traced for multiple-scattering settings, single scattering for the
+others), VTK's GPU mapper, the SVS mapper and the reference renderer's own trade
+curve, CSV with every metric, plots; the RMSE's correction for a noisy reference."""
 import csv
 import math
 import os
@@ -8,6 +9,8 @@ import shutil
 import sys
 import tempfile
 import unittest
+
+import numpy as np
 
 from nimbus import harness
 
@@ -22,8 +25,11 @@ class HarnessTest(unittest.TestCase):
         shutil.rmtree(self.output, ignore_errors=True)
 
     def run_harness(self, *extra):
+        # A 2 s budget for the path-traced reference (the tiny scene then has ~6 %
+        # image-wide error, measured): this test checks the plumbing, not the figures.
         return harness.run([SCENE, "--renderer", "vtk-gpu", "--renderer", "single",
-                            "--repeats", "1", "--output-dir", self.output, *extra])
+                            "--repeats", "1", "--reference-seconds", "2",
+                            "--output-dir", self.output, *extra])
 
     def test_csv_plot_and_cache(self):
         self.assertEqual(self.run_harness("--markdown", os.path.join(self.output, "t.md")), 0)
@@ -32,20 +38,62 @@ class HarnessTest(unittest.TestCase):
         expected = len(harness.DEFAULT_SETTINGS["vtk-gpu"]) + len(harness.DEFAULT_SETTINGS["single"])
         self.assertEqual(len(rows), expected)
         for row in rows:
-            for field in ("median_seconds", "rmse", "relative_l1", "max_abs"):
+            for field in ("median_seconds", "rmse", "rmse_raw", "reference_noise",
+                          "relative_l1", "max_abs"):
                 self.assertTrue(math.isfinite(float(row[field])), (field, row))
                 self.assertGreaterEqual(float(row[field]), 0.0)
+            self.assertLessEqual(float(row["rmse"]), float(row["rmse_raw"]))
+            # --reference auto: single scattering judges the single-scattering renderer,
+            # the path tracer (with its error in the label) judges VTK's mapper.
+            if row["renderer"] == "single":
+                self.assertEqual(row["reference"], "single")
+                self.assertEqual(float(row["reference_noise"]), 0.0)
+            else:
+                self.assertRegex(row["reference"], r"^path \(±[0-9.e+-]+ %\)$")
+                self.assertGreater(float(row["reference_noise"]), 0.0)
         single = [float(r["rmse"]) for r in rows if r["renderer"] == "single"]
         # Finer steps approach the reference (the last one is the reference's own step).
         self.assertEqual(single, sorted(single, reverse=True))
-        for name in ("trade.png", "tiny_scene-trade.png", "tiny_scene-reference.png", "t.md"):
+        for name in ("trade.png", "tiny_scene-trade.png", "tiny_scene-reference-single.png",
+                     "tiny_scene-reference-path.png", "t.md"):
             self.assertTrue(os.path.getsize(os.path.join(self.output, name)) > 0, name)
+        with open(os.path.join(self.output, "t.md")) as stream:
+            self.assertIn("| reference |", stream.readline())
         cache = os.listdir(os.path.join(self.output, "reference-cache"))
-        self.assertEqual(len(cache), 2)  # the reference and the sky-only reference
+        # single: the image; path and its sky-only version: image + standard error each.
+        self.assertEqual(len(cache), 5, cache)
+        self.assertEqual(len([name for name in cache if name.endswith("-stderr.npy")]), 2)
         # A second run takes the references from the cache.
         self.assertEqual(self.run_harness(), 0)
         self.assertEqual(sorted(os.listdir(os.path.join(self.output, "reference-cache"))),
                          sorted(cache))
+
+    def test_noise_correction_recovers_the_error_against_the_truth(self):
+        # An image with a known error against the truth, judged by references with
+        # Gaussian noise of known standard error (and a noisy image part, as vtk-gpu's
+        # composited path-traced sky): the corrected RMSE is the RMSE against the truth,
+        # whatever the noise, while the raw one grows with it.
+        generator = np.random.default_rng(7)
+        truth = generator.uniform(0.0, 0.2, size=(96, 128, 3))
+        image = truth + generator.normal(0.0, 0.004, size=truth.shape)
+        true_rmse = float(np.sqrt(np.mean((image - truth) ** 2)))
+        for sigma in (0.001, 0.004, 0.016):
+            error = np.full(truth.shape, sigma)
+            reference = truth + generator.normal(0.0, 1.0, size=truth.shape) * error
+            metrics = harness.error_metrics(image, reference, error)
+            self.assertAlmostEqual(metrics["reference_noise"], sigma, places=12)
+            self.assertGreater(metrics["rmse_raw"], true_rmse)
+            # 36864 values: the mean square's relative sampling error is ~1.5 %.
+            self.assertLess(abs(metrics["rmse"] / true_rmse - 1.0), 0.05 if sigma < 0.01 else 0.15,
+                            (sigma, metrics, true_rmse))
+            noisy = image + generator.normal(0.0, 1.0, size=truth.shape) * error
+            both = harness.error_metrics(noisy, reference, error, error)
+            self.assertLess(abs(both["rmse"] / true_rmse - 1.0), 0.05 if sigma < 0.01 else 0.2,
+                            (sigma, both, true_rmse))
+        # Without noise information nothing is subtracted.
+        plain = harness.error_metrics(image, truth)
+        self.assertAlmostEqual(plain["rmse"], true_rmse, places=12)
+        self.assertEqual(plain["rmse"], plain["rmse_raw"])
 
     def test_svs_mapper_converges_to_the_reference(self):
         settings = os.path.join(self.output, "svs.json")
