@@ -47,10 +47,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <vector>
 
 namespace
@@ -80,7 +82,7 @@ struct Estimate
 /// Path-traced radiance of the slab at view cosine mu, from above (reflected) or below
 /// (transmitted), in the solver's units (see the header comment).
 Estimate PathTrace(double tau, double omega, double mu0, double mu, bool reflected, int samples,
-  std::uint64_t seed, double g = 0.0)
+  std::uint64_t seed, double g = 0.0, double sunAzimuthDegrees = 0.0)
 {
   SceneDescription scene;
   scene.Camera.Width = kPixels;
@@ -91,7 +93,7 @@ Estimate PathTrace(double tau, double omega, double mu0, double mu, bool reflect
   scene.Background.Type = "black";
   scene.Background.Radiance = 0.0;
   scene.Sun.Illuminance = 1.0;
-  scene.Sun.AzimuthDegrees = 0.0;
+  scene.Sun.AzimuthDegrees = sunAzimuthDegrees;
   scene.Sun.ElevationDegrees = std::asin(mu0) * 180.0 / kPi;
   scene.Medium.ExtinctionPerDensity = tau / kThickness;
   scene.Medium.SingleScatteringAlbedo = omega;
@@ -331,6 +333,212 @@ TEST(SlabPathTracer, HenyeyGreensteinAndThickSlabsAtNormalIncidence)
   std::printf("%d radiances, RMS z %.2f, total %.1f s\n", count, rmsZ,
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   EXPECT_LT(rmsZ, 1.6);
+}
+
+/// Henyey-Greenstein phase function normalised to 4 pi (P = 4 pi p).
+double HenyeyGreenstein4Pi(double g, double cosine)
+{
+  return (1.0 - g * g) / std::pow(1.0 + g * g - 2.0 * g * cosine, 1.5);
+}
+
+/// The singly scattered radiance of the slab in the solver's units at relative azimuth phi
+/// (phi = 0: the view direction's horizontal part along the beam's): reflected (view mu up)
+///   I1 = (omega / 4) mu0 / (mu + mu0) P(cos Theta) [1 - exp(-tau (1/mu + 1/mu0))],
+///   cos Theta = -mu mu0 + sqrt(1 - mu^2) sqrt(1 - mu0^2) cos phi,
+/// transmitted (view mu down, mu != mu0)
+///   I1 = (omega / 4) mu0 / (mu - mu0) P(cos Theta) [exp(-tau/mu) - exp(-tau/mu0)],
+///   cos Theta = mu mu0 + sqrt(1 - mu^2) sqrt(1 - mu0^2) cos phi.
+double SingleScattered(
+  double tau, double omega, double g, double mu0, double mu, bool reflected, double phi)
+{
+  const double across = std::sqrt((1.0 - mu * mu) * (1.0 - mu0 * mu0)) * std::cos(phi);
+  if (reflected)
+  {
+    return 0.25 * omega * mu0 / (mu + mu0) * HenyeyGreenstein4Pi(g, -mu * mu0 + across) *
+      -std::expm1(-tau * (1.0 / mu + 1.0 / mu0));
+  }
+  return 0.25 * omega * mu0 / (mu - mu0) * HenyeyGreenstein4Pi(g, mu * mu0 + across) *
+    (std::exp(-tau / mu) - std::exp(-tau / mu0));
+}
+
+/// The standard deviation, over the random offset u, of the K-render azimuth rule
+/// (1/K) sum_k f(2 pi (k + u) / K) applied to the singly scattered radiance, against its exact
+/// azimuthal mean (a 4096-point rule; the periodic trapezoid rule converges exponentially).
+/// The rule's error is set by the Fourier terms of order K, 2K, ... of the radiance in the
+/// azimuth; single scattering carries the sharpest azimuthal structure (the HG forward peak),
+/// orders >= 2 see the phase function convolved with itself and are smoother.
+double SingleScatteringAzimuthSpread(
+  double tau, double omega, double g, double mu0, double mu, bool reflected, int renders)
+{
+  constexpr int kFine = 4096, kOffsets = 256;
+  double exact = 0.0;
+  for (int i = 0; i < kFine; ++i)
+    exact += SingleScattered(tau, omega, g, mu0, mu, reflected, 2.0 * kPi * i / kFine);
+  exact /= kFine;
+  double sum2 = 0.0;
+  for (int j = 0; j < kOffsets; ++j)
+  {
+    double rule = 0.0;
+    for (int k = 0; k < renders; ++k)
+      rule += SingleScattered(
+        tau, omega, g, mu0, mu, reflected, 2.0 * kPi * (k + (j + 0.5) / kOffsets) / renders);
+    rule /= renders;
+    sum2 += (rule - exact) * (rule - exact);
+  }
+  return std::sqrt(sum2 / kOffsets);
+}
+
+/// The azimuthal mean of the path-traced radiance at view cosine mu (see the test below): K
+/// renders with the sun at azimuths 360 (k + u) / K degrees, k = 0 ... K - 1, one offset u
+/// uniform in [0, 1), each render with seeds of its own.
+struct AzimuthMean
+{
+  Estimate Mean;       // the mean of the K renders; Sigma from their own standard errors
+  double Halves = 0.0; // (mean of the even-k renders) - (mean of the odd-k renders)
+  double HalvesSigma = 0.0;
+  double Lowest = 0.0, Highest = 0.0; // the smallest and largest render (green)
+};
+
+AzimuthMean PathTraceAzimuthMean(double tau, double omega, double mu0, double mu, bool reflected,
+  double g, int renders, int samples, double offset, std::uint64_t& seed)
+{
+  AzimuthMean out;
+  std::array<double, 3> variance{ { 0.0, 0.0, 0.0 } };
+  double half[2] = { 0.0, 0.0 };
+  double halfVariance = 0.0;
+  out.Lowest = HUGE_VAL;
+  out.Highest = -HUGE_VAL;
+  for (int k = 0; k < renders; ++k)
+  {
+    const double azimuth = 360.0 * (k + offset) / renders;
+    const Estimate e = PathTrace(tau, omega, mu0, mu, reflected, samples, seed++, g, azimuth);
+    for (int c = 0; c < 3; ++c)
+    {
+      out.Mean.Value[c] += e.Value[c] / renders;
+      variance[c] += e.Sigma[c] * e.Sigma[c];
+    }
+    half[k % 2] += e.Value[1];
+    halfVariance += e.Sigma[1] * e.Sigma[1];
+    out.Lowest = std::min(out.Lowest, e.Value[1]);
+    out.Highest = std::max(out.Highest, e.Value[1]);
+    out.Mean.Seconds += e.Seconds;
+    out.Mean.Truncated += e.Truncated;
+  }
+  for (int c = 0; c < 3; ++c)
+    out.Mean.Sigma[c] = std::sqrt(variance[c]) / renders;
+  const double halfCount = 0.5 * renders;
+  out.Halves = (half[0] - half[1]) / halfCount;
+  out.HalvesSigma = std::sqrt(halfVariance) / halfCount;
+  return out;
+}
+
+TEST(SlabPathTracer, HenyeyGreensteinAtObliqueIncidence)
+{
+  struct View
+  {
+    double Mu;              // the solver node nearest this is used
+    int ReflectedSamples;   // per pixel, all renders together; 0: not compared
+    int TransmittedSamples; // per pixel, all renders together; 0: not compared
+  };
+  struct ObliqueCase
+  {
+    double Mu0, Omega, Tau;
+    std::vector<View> Views;
+  };
+  constexpr double kG = 0.85;
+  const char* scaleText = std::getenv("NIMBUS_SLAB_SCALE");
+  const double scale = scaleText ? std::atof(scaleText) : 1.0;
+  const char* rendersText = std::getenv("NIMBUS_SLAB_RENDERS");
+  const int renders = rendersText ? std::atoi(rendersText) : 32;
+  const std::vector<ObliqueCase> cases = {
+    { 0.5, 0.5, 1.0, { { 0.7, 8192, 8192 } } },
+    { 0.5, 0.9, 1.0, { { 0.7, 8192, 8192 }, { 0.3, 4096, 4096 }, { 0.95, 4096, 4096 } } },
+    { 0.5, 0.99, 1.0, { { 0.7, 8192, 8192 } } },
+    { 0.5, 0.999, 1.0, { { 0.7, 8192, 8192 }, { 0.3, 4096, 4096 }, { 0.95, 4096, 4096 } } },
+    { 0.5, 0.5, 10.0, { { 0.7, 8192, 0 } } },
+    { 0.5, 0.9, 10.0, { { 0.7, 4096, 4096 }, { 0.3, 2048, 0 }, { 0.95, 2048, 4096 } } },
+    { 0.5, 0.99, 10.0, { { 0.7, 2048, 2048 } } },
+    { 0.5, 0.999, 10.0, { { 0.7, 2048, 2048 }, { 0.3, 2048, 2048 }, { 0.95, 2048, 2048 } } },
+    { 0.5, 0.5, 100.0, { { 0.7, 8192, 0 } } },
+    { 0.5, 0.9, 100.0, { { 0.7, 2048, 0 } } },
+    { 0.5, 0.99, 100.0, { { 0.7, 512, 0 }, { 0.3, 512, 0 }, { 0.95, 512, 0 } } },
+    { 0.5, 0.999, 100.0, { { 0.7, 512, 0 } } },
+    { 0.2, 0.5, 1.0, { { 0.7, 8192, 8192 } } },
+    { 0.2, 0.9, 1.0, { { 0.7, 8192, 8192 }, { 0.3, 4096, 0 }, { 0.95, 8192, 4096 } } },
+    { 0.2, 0.99, 1.0, { { 0.7, 8192, 8192 } } },
+    { 0.2, 0.999, 1.0, { { 0.7, 8192, 8192 } } },
+    { 0.2, 0.5, 10.0, { { 0.7, 8192, 0 } } },
+    { 0.2, 0.9, 10.0, { { 0.7, 4096, 16384 } } },
+    { 0.2, 0.99, 10.0, { { 0.7, 2048, 4096 }, { 0.3, 2048, 0 } } },
+    { 0.2, 0.999, 10.0, { { 0.7, 2048, 2048 } } },
+    { 0.2, 0.5, 100.0, { { 0.7, 8192, 0 } } },
+    { 0.2, 0.9, 100.0, { { 0.7, 2048, 0 } } },
+    { 0.2, 0.99, 100.0, { { 0.7, 1536, 0 } } },
+    { 0.2, 0.999, 100.0, { { 0.7, 768, 0 } } },
+  };
+  const auto start = std::chrono::steady_clock::now();
+  std::uint64_t seed = 901;
+  std::mt19937_64 offsets(20261129);
+  double sumZ2 = 0.0, sumHalvesZ2 = 0.0;
+  int count = 0;
+  for (const ObliqueCase& k : cases)
+  {
+    nimbus::slab::Problem problem;
+    problem.OpticalThickness = k.Tau;
+    problem.SingleScatteringAlbedo = k.Omega;
+    problem.Mu0 = k.Mu0;
+    problem.PhaseFunction = nimbus::slab::Phase::HenyeyGreenstein;
+    problem.Asymmetry = kG;
+    problem.QuadraturePoints = 2 * kQuadrature;
+    const nimbus::slab::Result solved = nimbus::slab::Solve(problem);
+    problem.QuadraturePoints = 4 * kQuadrature;
+    const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
+    const double bias = std::abs(solved.Reflectance - fine.Reflectance) +
+      std::abs(solved.DiffuseTransmittance - fine.DiffuseTransmittance);
+    for (const View& view : k.Views)
+    {
+      std::size_t node = 0;
+      for (std::size_t i = 1; i < solved.Mu.size(); ++i)
+        if (std::abs(solved.Mu[i] - view.Mu) < std::abs(solved.Mu[node] - view.Mu))
+          node = i;
+      const double mu = solved.Mu[node];
+      for (const bool reflected : { true, false })
+      {
+        const int total = reflected ? view.ReflectedSamples : view.TransmittedSamples;
+        if (total == 0)
+          continue;
+        const double truth =
+          reflected ? solved.ReflectedRadiance[node] : solved.TransmittedRadiance[node];
+        const int samples = std::max(1, static_cast<int>(scale * total / renders));
+        const double offset = std::uniform_real_distribution<double>(0.0, 1.0)(offsets);
+        AzimuthMean pt = PathTraceAzimuthMean(
+          k.Tau, k.Omega, k.Mu0, mu, reflected, kG, renders, samples, offset, seed);
+        // The azimuth rule's own spread (over u), from single scattering, joins the error bar.
+        const double spread =
+          SingleScatteringAzimuthSpread(k.Tau, k.Omega, kG, k.Mu0, mu, reflected, renders);
+        const double halfSpread =
+          SingleScatteringAzimuthSpread(k.Tau, k.Omega, kG, k.Mu0, mu, reflected, renders / 2);
+        for (double& sigma : pt.Mean.Sigma)
+          sigma = std::hypot(sigma, spread);
+        char name[64];
+        std::snprintf(name, sizeof(name), "mu0 %.1f omega %.3f tau %3.0f", k.Mu0, k.Omega, k.Tau);
+        const double z = CheckRadiance(name, mu, reflected, pt.Mean, truth, bias, false, 28);
+        const double halvesZ = pt.Halves / std::hypot(pt.HalvesSigma, 2.0 * halfSpread);
+        std::printf("%28s azimuth: renders %.2e ... %.2e, rule spread %.0e (K/2: %.0e), "
+                    "halves z %+5.2f\n",
+          "", pt.Lowest, pt.Highest, spread, halfSpread, halvesZ);
+        sumZ2 += z * z;
+        sumHalvesZ2 += halvesZ * halvesZ;
+        ++count;
+      }
+    }
+  }
+  const double rmsZ = std::sqrt(sumZ2 / count);
+  const double rmsHalvesZ = std::sqrt(sumHalvesZ2 / count);
+  std::printf("%d radiances, RMS z %.2f, RMS halves z %.2f, total %.1f s\n", count, rmsZ,
+    rmsHalvesZ, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  EXPECT_LT(rmsZ, 1.6);
+  EXPECT_LT(rmsHalvesZ, 1.6);
 }
 
 } // namespace
