@@ -10,7 +10,8 @@
 // along a direction of cosine mu (a Gauss node of the solver, so no interpolation): from above
 // (d_z = -mu) for the reflected radiance I(-mu), from below (d_z = +mu) for the transmitted
 // I(+mu). Isotropic scattering makes both radiances independent of the azimuth, which is what
-// the solver's m = 0 term gives. The background is black and the sun a delta, so the camera
+// the solver's m = 0 term gives (for HG at oblique incidence the last test averages renders
+// over the sun's azimuth instead). The background is black and the sun a delta, so the camera
 // never sees the direct beam: the transmitted image is the diffuse part only, as in the solver.
 //
 // Units. The solver's beam carries pi F0 per unit area normal to it and reports a radiance I in
@@ -472,16 +473,15 @@ AzimuthMean PathTraceAzimuthMean(double tau, double omega, double mu0, double mu
 // radiances where measurable). Not compared: transmission through tau = 100 (the beam's
 // diffuse transmittance is 1e-30 ... 6e-4 for omega <= 0.99; for omega = 0.999 the radiance
 // at mu = 0.7 is 1.7e-2 with mu0 = 0.5, measured with a 13 % error bar from 1024 paths per
-// pixel in 2.3 s), through tau =
-// 10 with omega = 0.5 (9e-5 and 1.2e-5 of F0), and the transmitted radiance at mu = 0.30 with
-// mu0 = 0.2 (6 degrees from the forward peak: the single-scattering spread at K = 32 is 8e-3
-// of its value; it would need K = 64). The fluxes R and T are not compared: R = 2 sum_i w_i mu_i
-// I(-mu_i) / mu0 needs the radiance at all 64 nodes (the solver gives radiances only at its
-// nodes, so a coarser rule's quadrature error could not be bounded), 40-100 s per case.
-// Thresholds as in the other tests: every channel within 4 sigma plus the solver bias bound
-// (N = 64 against N = 128), an error bar under 5 % of the value, RMS z below 1.6. Measured in
-// docs/ground-truth.md; NIMBUS_SLAB_SCALE multiplies the samples, NIMBUS_SLAB_RENDERS sets K
-// (even).
+// pixel in 2.3 s), through tau = 10 with omega = 0.5 (9e-5 and 1.2e-5 of F0), and the
+// transmitted radiance at mu = 0.30 with mu0 = 0.2 (6 degrees from the forward peak: the
+// single-scattering spread at K = 32 is 8e-3 of its value; it would need K = 64). The fluxes
+// R and T are not compared: R = 2 sum_i w_i mu_i I(-mu_i) / mu0 needs the radiance at all 64 nodes
+// (the solver gives radiances only at its nodes, so a coarser rule's quadrature error could not be
+// bounded), 40-100 s per case. Thresholds as in the other tests: every channel within 4 sigma plus
+// the solver bias bound (N = 64 against N = 128), an error bar under 5 % of the value, RMS z
+// below 1.6. Measured in docs/ground-truth.md; NIMBUS_SLAB_SCALE multiplies the samples,
+// NIMBUS_SLAB_RENDERS sets K (even).
 TEST(SlabPathTracer, HenyeyGreensteinAtObliqueIncidence)
 {
   struct View
