@@ -1638,6 +1638,21 @@ PathTracingEstimate EstimatePathTracingTime(const RenderContext& context,
   return estimate;
 }
 
+std::uint64_t NextRoundTarget(
+  std::uint64_t target, std::uint64_t maxSamples, double secondsLeft, double secondsPerSample)
+{
+  std::uint64_t next = target > maxSamples / 2 ? maxSamples : 2 * target;
+  if (std::isfinite(secondsLeft) && secondsPerSample > 0.0)
+  {
+    const double fits = std::floor(std::max(0.0, secondsLeft) / secondsPerSample);
+    if (fits < static_cast<double>(next - target))
+    {
+      next = target + std::max<std::uint64_t>(1, static_cast<std::uint64_t>(fits));
+    }
+  }
+  return std::max(std::min(next, maxSamples), std::min(target + 1, maxSamples));
+}
+
 PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
 {
@@ -1703,6 +1718,9 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   bool stoppedAtTimeLimit = false, reachedImageTarget = false;
   std::uint64_t target = static_cast<std::uint64_t>(settings.MinSamplesPerPixel);
   const std::uint64_t maxSamples = static_cast<std::uint64_t>(settings.MaxSamplesPerPixel);
+  std::uint64_t previousTarget = 0; // what the round before the current one reached
+  double roundStart =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (;;)
   {
     std::vector<std::size_t> active;
@@ -1840,7 +1858,15 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     {
       break;
     }
-    target = std::min(maxSamples, 2 * target);
+    // The cost of one more sample on every active pixel, from this round.
+    const double secondsPerSample = (elapsed - roundStart) /
+      static_cast<double>(std::max<std::uint64_t>(1, target - previousTarget));
+    const double secondsLeft = settings.TimeLimitSeconds > 0.0
+      ? settings.TimeLimitSeconds - elapsed
+      : std::numeric_limits<double>::infinity();
+    previousTarget = target;
+    roundStart = elapsed;
+    target = NextRoundTarget(target, maxSamples, secondsLeft, secondsPerSample);
   }
 
   PathTracingResult result;

@@ -144,7 +144,10 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// nimbus::DefaultMemoryBudgetBytes() (Physics/MemoryBudget.h).
   double MemoryBudgetBytes = 0.0;
   /// Stop after the first round that ends past this many seconds (0 = no limit). The
-  /// image is then unbiased with fewer samples; PathTracingResult says so.
+  /// image is then unbiased with fewer samples; PathTracingResult says so. Rounds double
+  /// the samples per pixel, but with a limit a round is cut to what the time left allows
+  /// at the last round's cost (NextRoundTarget), so the render ends near the limit, not
+  /// up to twice past it.
   double TimeLimitSeconds = 0.0;
   /// Stop after the first round whose image-wide relative error (ImageRelativeError)
   /// is at or below this (0 = no such target; the per-pixel target still applies).
@@ -169,6 +172,14 @@ struct NIMBUSREFERENCE_EXPORT PathTracingRound
 /// black image).
 NIMBUSREFERENCE_EXPORT double ImageRelativeError(
   const FloatImage& image, const FloatImage& standardError);
+
+/// The samples per pixel (mean over the image) the next round brings every active pixel
+/// to, after a round that brought them to `target`: 2 * target, at most maxSamples; with a
+/// time limit (secondsLeft finite) at most target + secondsLeft / secondsPerSample, the
+/// samples that fit in the time left at the cost of one more sample per active pixel
+/// (measured on the last round), and always at least target + 1.
+NIMBUSREFERENCE_EXPORT std::uint64_t NextRoundTarget(
+  std::uint64_t target, std::uint64_t maxSamples, double secondsLeft, double secondsPerSample);
 
 struct NIMBUSREFERENCE_EXPORT PathTracingResult
 {

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -731,6 +732,42 @@ TEST(PathTracer, StandardErrorMatchesTheTrueError)
 // Stopping rules for long renders: a time limit and an image-wide error target end
 // the render after a whole round (so every pixel has the same samples as it would in
 // an unlimited render's same round); the rounds are reported as they finish.
+TEST(PathTracer, TimeLimitCutsTheLastRound)
+{
+  using nimbus::NextRoundTarget;
+  const double unlimited = std::numeric_limits<double>::infinity();
+  // Without a limit, rounds double up to the maximum.
+  EXPECT_EQ(NextRoundTarget(16, 1 << 20, unlimited, 1.0), 32u);
+  EXPECT_EQ(NextRoundTarget(600000, 1 << 20, unlimited, 1.0), std::uint64_t(1) << 20);
+  EXPECT_EQ(NextRoundTarget(1 << 20, 1 << 20, unlimited, 1.0), std::uint64_t(1) << 20);
+  EXPECT_EQ(NextRoundTarget(16, 1 << 20, unlimited, 0.0), 32u);
+  // With one: what fits in the time left at the measured cost, at least one more sample.
+  EXPECT_EQ(NextRoundTarget(1024, 1 << 20, 100.0, 1.0), 1124u);
+  EXPECT_EQ(NextRoundTarget(1024, 1 << 20, 100.9, 1.0), 1124u);
+  EXPECT_EQ(NextRoundTarget(1024, 1 << 20, 0.5, 1.0), 1025u);
+  EXPECT_EQ(NextRoundTarget(1024, 1 << 20, -3.0, 1.0), 1025u);
+  EXPECT_EQ(NextRoundTarget(1024, 1 << 20, 5000.0, 1.0), 2048u); // never more than double
+  EXPECT_EQ(NextRoundTarget(1024, 1100, 5000.0, 1.0), 1100u);
+  EXPECT_EQ(NextRoundTarget(1100, 1100, 5000.0, 1.0), 1100u);
+
+  // A render with a 1 s limit ends near it. Doubling rounds would end anywhere up to
+  // ~2 s past it (the last round as long as all before it); the cut round ends at
+  // limit + the cost misjudged in one round. The bound leaves room for a loaded machine.
+  const RenderContext context(PuffCloudScene(8, 8), PuffCloud());
+  PathTracingSettings settings;
+  settings.MinSamplesPerPixel = 1;
+  settings.MaxSamplesPerPixel = 1 << 24;
+  settings.Seed = 9;
+  settings.Threads = 2;
+  settings.TimeLimitSeconds = 1.0;
+  const PathTracingResult result = nimbus::RenderPathTraced(context, settings);
+  EXPECT_TRUE(result.StoppedAtTimeLimit);
+  EXPECT_GE(result.Seconds, 1.0);
+  EXPECT_LT(result.Seconds, 1.5);
+  std::printf("1 s limit: ended at %.3f s after %d rounds, %.0f samples per pixel\n",
+    result.Seconds, result.Rounds, result.MeanSamplesPerPixel);
+}
+
 TEST(PathTracer, TimeLimitAndImageTargetStopAfterARound)
 {
   const RenderContext context(PuffCloudScene(8, 8), PuffCloud());
