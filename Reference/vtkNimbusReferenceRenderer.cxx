@@ -210,9 +210,11 @@ int vtkNimbusReferenceRenderer::RequestData(
 namespace
 {
 /// The grids of a version-3 scene beyond the main density (RenderContext's SceneFields):
-/// additional media and "array" emission fields, read from their .vti files (each file
+/// additional media (a .vti array, or a metaball cloud made by vtkNimbusSceneDensitySource
+/// with Medium = i + 1) and "array" emission fields, read from their .vti files (each file
 /// once). Throws std::invalid_argument naming the scene key of what cannot be read.
-nimbus::SceneFields SceneFieldsOf(const nimbus::SceneDescription& scene)
+nimbus::SceneFields SceneFieldsOf(
+  const nimbus::SceneDescription& scene, const std::string& sceneFile, double budgetMiB)
 {
   nimbus::SceneFields fields;
   std::map<std::string, vtkSmartPointer<vtkImageData>> images;
@@ -260,14 +262,32 @@ nimbus::SceneFields SceneFieldsOf(const nimbus::SceneDescription& scene)
   {
     const nimbus::AdditionalMediumDescription& m = scene.Media[i];
     const std::string key = "scene.media[" + std::to_string(i) + "]";
-    if (m.Density.Type != "file")
+    if (m.Density.Type == "file")
     {
-      throw std::invalid_argument(key +
-        ".density: vtkNimbusReferenceRenderer reads additional media from .vti files (type "
-        "\"file\"); it does not generate a \"" +
-        m.Density.Type + "\" for them");
+      fields.MediaDensities.push_back(grid(m.Density.Path, m.Density.ArrayName, key + ".density"));
     }
-    fields.MediaDensities.push_back(grid(m.Density.Path, m.Density.ArrayName, key + ".density"));
+    else
+    {
+      vtkNew<vtkNimbusSceneDensitySource> source;
+      source->SetSceneFileName(sceneFile.c_str());
+      source->SetMedium(static_cast<int>(i) + 1);
+      source->SetMemoryBudgetMiB(budgetMiB);
+      source->Update();
+      vtkImageData* volume = source->GetOutput();
+      vtkDataArray* values = volume->GetPointData()->GetArray("density");
+      if (!values || volume->GetNumberOfPoints() == 0)
+      {
+        throw std::invalid_argument(key + ".density: the " + m.Density.Type + " was not made");
+      }
+      try
+      {
+        fields.MediaDensities.push_back(nimbus::DensityGridFromImage(volume, values));
+      }
+      catch (const std::invalid_argument& error)
+      {
+        throw std::invalid_argument(key + ".density: " + error.what());
+      }
+    }
     fields.MediaEmissions.emplace_back();
     if (m.Emission.Enabled && m.Emission.Source == "array")
     {
@@ -370,7 +390,8 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     {
       throw std::invalid_argument("density array '" + arrayName + "': " + error.what());
     }
-    context = std::make_unique<nimbus::RenderContext>(scene, std::move(grid), SceneFieldsOf(scene));
+    context = std::make_unique<nimbus::RenderContext>(
+      scene, std::move(grid), SceneFieldsOf(scene, this->SceneFileName, budget / 1048576.0));
   }
   const double renderBudget =
     budget - static_cast<double>(values->GetNumberOfTuples()) * sizeof(float) - outputBytes;

@@ -609,11 +609,28 @@ TEST(ReferenceRobustness, Version3ScenesRenderOrNameWhatIsMissing)
               "' has no one-component point array 'nope'"),
     std::string::npos)
     << errors;
+  // A metaball cloud as the additional medium: made by vtkNimbusSceneDensitySource
+  // (Medium 1); its grid is not the cube's, which is an error naming the key.
   EXPECT_FALSE(render(WriteVersion3Scene("version3-metaballs", vti.string(), "heat",
-                        "{\"type\": \"metaball_cloud\"}"),
+                        "{\"type\": \"metaball_cloud\", \"parameters\": {\"Dimensions\": "
+                        "[8, 8, 8]}}"),
     true, errors));
-  EXPECT_NE(errors.find("scene.media[0].density: vtkNimbusReferenceRenderer reads additional "
-                        "media from .vti files"),
+  EXPECT_NE(errors.find("scene: media[0].density must be on the main density's grid (8x8x8 "
+                        "points, origin (-350"),
     std::string::npos)
     << errors;
+  {
+    vtkNew<vtkNimbusSceneDensitySource> source;
+    MessageCatcher messages(source);
+    source->SetSceneFileName(good.c_str());
+    source->SetMedium(2);
+    source->Update();
+    EXPECT_NE(
+      messages.AllErrors().find("Medium 2 asks for media[1], but the scene has 1 additional media"),
+      std::string::npos)
+      << messages.AllErrors();
+    source->SetMedium(1);
+    source->Update();
+    EXPECT_EQ(source->GetOutput()->GetNumberOfPoints(), 512);
+  }
 }
