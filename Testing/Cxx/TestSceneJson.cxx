@@ -10,9 +10,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -1287,4 +1289,39 @@ TEST(SceneJson, Version3HashCoversTheNewFields)
     EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
       << "changing " << mutation.first << " did not change the hash";
   }
+}
+
+// The annotated example of docs/scene-format.md (version 3, with a point light and a
+// lightning channel) is a valid scene, and says what the notes under it say.
+TEST(SceneJson, DocumentedExampleParses)
+{
+  std::ifstream in(NIMBUS_SCENE_FORMAT_DOC);
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t section = doc.find("## Annotated example");
+  ASSERT_NE(section, std::string::npos);
+  const std::size_t begin = doc.find("```json\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = doc.find("```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const SceneDescription s = nimbus::ParseScene(doc.substr(begin + 8, end - begin - 8), "/docs");
+  ASSERT_EQ(s.Lights.size(), 2u);
+  EXPECT_EQ(s.Lights[0].Type, "point");
+  EXPECT_EQ(s.Lights[0].Intensity, 2e5);
+  EXPECT_EQ(s.Lights[1].Type, "polyline");
+  EXPECT_EQ(s.Lights[1].Vertices.size(), 4u);
+  EXPECT_EQ(s.Lights[1].TemperatureKelvin, 28000.0);
+  double length = 0.0;
+  for (std::size_t i = 1; i < s.Lights[1].Vertices.size(); ++i)
+  {
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = s.Lights[1].Vertices[i][a] - s.Lights[1].Vertices[i - 1][a];
+      d2 += d * d;
+    }
+    length += std::sqrt(d2);
+  }
+  std::printf("documented channel: %.0f m, %.3g Y/sr in all\n", length,
+    length * s.Lights[1].IntensityPerMetre);
+  EXPECT_NEAR(length, 2600.0, 200.0); // "about 2.6 km long"
 }
