@@ -844,6 +844,57 @@ void RequireArray(const Json& v, const std::string& path, std::size_t limit, con
   }
 }
 
+/// A metaball parameter's value as the source will use it: the given one, else the
+/// source's default (vtkNimbusMetaballCloudSource; docs/scene-format.md).
+std::vector<double> EffectiveMetaballParameter(
+  const DensitySourceDescription& d, const std::string& name)
+{
+  for (const auto& p : d.Parameters)
+  {
+    if (p.first == name)
+    {
+      return p.second;
+    }
+  }
+  if (name == "Dimensions")
+  {
+    return { 96.0, 96.0, 64.0 };
+  }
+  return { -1500.0, 1500.0, -1500.0, 1500.0, 800.0, 2800.0 }; // Bounds
+}
+
+/// Every medium is on the main medium's grid. Between two metaball clouds that is known
+/// here (the grid is their Dimensions and Bounds); a file's grid is checked by the
+/// renderer (RenderContext), which reads it.
+void RequireSameMetaballGrid(const DensitySourceDescription& main,
+  const DensitySourceDescription& extra, const std::string& path)
+{
+  if (main.Type != "metaball_cloud" || extra.Type != "metaball_cloud")
+  {
+    return;
+  }
+  for (const char* name : { "Dimensions", "Bounds" })
+  {
+    const std::vector<double> a = EffectiveMetaballParameter(main, name);
+    const std::vector<double> b = EffectiveMetaballParameter(extra, name);
+    if (a != b)
+    {
+      std::string mine, theirs;
+      for (std::size_t k = 0; k < a.size(); ++k)
+      {
+        mine += (k ? ", " : "") + FormatNumber(a[k]);
+      }
+      for (std::size_t k = 0; k < b.size(); ++k)
+      {
+        theirs += (k ? ", " : "") + FormatNumber(b[k]);
+      }
+      Fail(path + ".density.parameters." + name,
+        std::string("every medium must be on the main medium's grid: medium.density's ") + name +
+          " is [" + mine + "], this one's [" + theirs + "]");
+    }
+  }
+}
+
 const std::vector<std::string> kLightTypes = { "point", "polyline" };
 
 LightDescription ReadLight(const Json& v, const std::string& path)
@@ -1391,8 +1442,9 @@ SceneDescription ReadScene(
     RequireArray(r["media"], r.Key("media"), kMaxAdditionalMedia, "media");
     for (std::size_t i = 0; i < r["media"].size(); ++i)
     {
-      s.Media.push_back(ReadAdditionalMedium(
-        r["media"][i], r.Key("media") + "[" + std::to_string(i) + "]", baseDirectory));
+      const std::string mediumPath = r.Key("media") + "[" + std::to_string(i) + "]";
+      s.Media.push_back(ReadAdditionalMedium(r["media"][i], mediumPath, baseDirectory));
+      RequireSameMetaballGrid(s.Medium.Density, s.Media.back().Density, mediumPath);
     }
   }
 

@@ -337,7 +337,8 @@ Json Cheap(const fs::path& file)
 }
 
 /// A version-3 scene from a project scene: a point light inside the cloud, a lightning
-/// channel (polyline) through it to the ground, and emission from the density. Its
+/// channel (polyline) through it to the ground, emission from the density, and emitting
+/// smoke as a second medium on the cloud's grid. Its
 /// mutants reach the new keys (and bad values of them) as the others reach the old ones.
 Json WithVersion3Features(Json j)
 {
@@ -345,6 +346,13 @@ Json WithVersion3Features(Json j)
   j["name"] = j["name"].get<std::string>() + "_lit";
   j["medium"]["emission"] = Json::parse(
     R"({"source": "from_density", "radiance_per_metre": 0.001, "temperature_kelvin": 1200})");
+  // Smoke: another metaball cloud on the same grid, emitting, with its own phase.
+  Json smoke = Json::parse(R"({"density": {"type": "metaball_cloud"}, "extinction_per_density":
+    0.02, "single_scattering_albedo": 0.4, "phase": {"type": "henyey_greenstein", "g": 0.3},
+    "emission": {"source": "from_density", "radiance_per_metre": 0.002}})");
+  smoke["density"]["parameters"] = j["medium"]["density"]["parameters"];
+  smoke["density"]["parameters"]["Seed"] = 99;
+  j["media"] = Json::array({ smoke });
   j["lights"] = Json::parse(R"([
     {"type": "point", "position": [0, 0, 1500], "intensity": 1e5, "temperature_kelvin": 3000},
     {"type": "polyline", "vertices": [[200, 0, 2500], [150, 40, 1200], [260, 10, 0]],
@@ -375,15 +383,23 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
   // Valid: at most 8x6 pixels and 16 points per axis, whatever the mutant says.
   scene.Camera.Width = std::min(scene.Camera.Width, 8);
   scene.Camera.Height = std::min(scene.Camera.Height, 6);
-  for (auto& parameter : scene.Medium.Density.Parameters)
+  auto clamp = [](nimbus::DensitySourceDescription& density)
   {
-    if (parameter.first == "Dimensions")
+    for (auto& parameter : density.Parameters)
     {
-      for (double& d : parameter.second)
+      if (parameter.first == "Dimensions")
       {
-        d = std::min(d, 16.0);
+        for (double& d : parameter.second)
+        {
+          d = std::min(d, 16.0);
+        }
       }
     }
+  };
+  clamp(scene.Medium.Density);
+  for (auto& medium : scene.Media)
+  {
+    clamp(medium.Density);
   }
   std::ofstream(sceneFile) << nimbus::SceneToJson(scene);
 

@@ -1239,6 +1239,22 @@ TEST(SceneJson, Version3Errors)
     "scene.media[0].multiple_scattering_constant: unknown key (known: density, "
     "extinction_per_density, single_scattering_albedo, phase, emission)");
   {
+    // Two metaball clouds share a grid only with the same Dimensions and Bounds (the
+    // source's defaults where omitted).
+    Json j = MinimalJson();
+    j["nimbus_scene"] = 3;
+    j["media"] = Json::parse(R"([{"density": {"type": "metaball_cloud", "parameters":
+      {"Dimensions": [96, 96, 64], "Seed": 5}}, "extinction_per_density": 0.01}])");
+    EXPECT_NO_THROW(Parse(j));
+    j["media"][0]["density"]["parameters"]["Dimensions"] = Json::array({ 32, 32, 32 });
+    ExpectError(j,
+      "scene.media[0].density.parameters.Dimensions: every medium must be on the main medium's "
+      "grid: medium.density's Dimensions is [96, 96, 64], this one's [32, 32, 32]");
+    j["media"][0]["density"]["parameters"].erase("Dimensions");
+    j["media"][0]["density"]["parameters"]["Bounds"] = Json::array({ -1, 1, -1, 1, 0, 1 });
+    ExpectError(j, "scene.media[0].density.parameters.Bounds: every medium must be on the main");
+  }
+  {
     Json many = Version3Json();
     for (int i = 0; i < 16; ++i)
     {
