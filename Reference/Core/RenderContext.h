@@ -79,6 +79,9 @@ public:
   /// the offending field's name). `fields` holds the grids of additional media and of
   /// "array" emission fields (version 3); a scene that needs one it lacks is an error.
   RenderContext(const SceneDescription& scene, DensityGrid grid, SceneFields fields = {});
+  /// Not copied or moved: GetMedia() points into the context's own grids.
+  RenderContext(const RenderContext&) = delete;
+  RenderContext& operator=(const RenderContext&) = delete;
 
   const SceneDescription& GetScene() const { return this->Scene; }
   const Camera& GetCamera() const { return this->ViewCamera; }
