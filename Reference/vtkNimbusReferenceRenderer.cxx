@@ -23,9 +23,11 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkXMLImageDataReader.h"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -205,6 +207,98 @@ int vtkNimbusReferenceRenderer::RequestData(
   }
 }
 
+namespace
+{
+/// The grids of a version-3 scene beyond the main density (RenderContext's SceneFields):
+/// additional media (a .vti array, or a metaball cloud made by vtkNimbusSceneDensitySource
+/// with Medium = i + 1) and "array" emission fields, read from their .vti files (each file
+/// once). Throws std::invalid_argument naming the scene key of what cannot be read.
+nimbus::SceneFields SceneFieldsOf(
+  const nimbus::SceneDescription& scene, const std::string& sceneFile, double budgetMiB)
+{
+  nimbus::SceneFields fields;
+  std::map<std::string, vtkSmartPointer<vtkImageData>> images;
+  auto grid = [&images](const std::string& path, const std::string& array,
+                const std::string& key) -> nimbus::DensityGrid
+  {
+    vtkSmartPointer<vtkImageData>& image = images[path];
+    if (!image)
+    {
+      vtkNew<vtkXMLImageDataReader> reader;
+      if (!reader->CanReadFile(path.c_str()))
+      {
+        throw std::invalid_argument(key + ": cannot read '" + path + "' as a VTK image (.vti)");
+      }
+      reader->SetFileName(path.c_str());
+      reader->Update();
+      image = reader->GetOutput();
+    }
+    vtkDataArray* values = image->GetPointData()->GetArray(array.c_str());
+    if (!values || values->GetNumberOfComponents() != 1)
+    {
+      throw std::invalid_argument(
+        key + ": '" + path + "' has no one-component point array '" + array + "'");
+    }
+    const std::string direction = DirectionMatrixProblem(image);
+    if (!direction.empty())
+    {
+      throw std::invalid_argument(key + ": " + direction);
+    }
+    try
+    {
+      return nimbus::DensityGridFromImage(image, values);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      throw std::invalid_argument(key + ": array '" + array + "': " + error.what());
+    }
+  };
+  if (scene.Medium.Emission.Enabled && scene.Medium.Emission.Source == "array")
+  {
+    fields.Emission = grid(
+      scene.Medium.Density.Path, scene.Medium.Emission.ArrayName, "scene.medium.emission.array");
+  }
+  for (std::size_t i = 0; i < scene.Media.size(); ++i)
+  {
+    const nimbus::AdditionalMediumDescription& m = scene.Media[i];
+    const std::string key = "scene.media[" + std::to_string(i) + "]";
+    if (m.Density.Type == "file")
+    {
+      fields.MediaDensities.push_back(grid(m.Density.Path, m.Density.ArrayName, key + ".density"));
+    }
+    else
+    {
+      vtkNew<vtkNimbusSceneDensitySource> source;
+      source->SetSceneFileName(sceneFile.c_str());
+      source->SetMedium(static_cast<int>(i) + 1);
+      source->SetMemoryBudgetMiB(budgetMiB);
+      source->Update();
+      vtkImageData* volume = source->GetOutput();
+      vtkDataArray* values = volume->GetPointData()->GetArray("density");
+      if (!values || volume->GetNumberOfPoints() == 0)
+      {
+        throw std::invalid_argument(key + ".density: the " + m.Density.Type + " was not made");
+      }
+      try
+      {
+        fields.MediaDensities.push_back(nimbus::DensityGridFromImage(volume, values));
+      }
+      catch (const std::invalid_argument& error)
+      {
+        throw std::invalid_argument(key + ".density: " + error.what());
+      }
+    }
+    fields.MediaEmissions.emplace_back();
+    if (m.Emission.Enabled && m.Emission.Source == "array")
+    {
+      fields.MediaEmissions.back() =
+        grid(m.Density.Path, m.Emission.ArrayName, key + ".emission.array");
+    }
+  }
+  return fields;
+}
+} // namespace
+
 int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkImageData* output)
 {
   const nimbus::SceneDescription& scene = *this->Internals->Scene;
@@ -296,7 +390,8 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     {
       throw std::invalid_argument("density array '" + arrayName + "': " + error.what());
     }
-    context = std::make_unique<nimbus::RenderContext>(scene, std::move(grid));
+    context = std::make_unique<nimbus::RenderContext>(
+      scene, std::move(grid), SceneFieldsOf(scene, this->SceneFileName, budget / 1048576.0));
   }
   const double renderBudget =
     budget - static_cast<double>(values->GetNumberOfTuples()) * sizeof(float) - outputBytes;

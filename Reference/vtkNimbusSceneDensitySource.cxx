@@ -102,14 +102,24 @@ int vtkNimbusSceneDensitySource::SetUpInner(
     vtkErrorMacro(<< error.what());
     return 0;
   }
-  const nimbus::DensitySourceDescription& density = scene.Medium.Density;
+  if (this->Medium > static_cast<int>(scene.Media.size()))
+  {
+    vtkErrorMacro(<< this->SceneFileName << ": Medium " << this->Medium << " asks for media["
+                  << this->Medium - 1 << "], but the scene has " << scene.Media.size()
+                  << " additional media");
+    return 0;
+  }
+  const nimbus::DensitySourceDescription& density =
+    this->Medium == 0 ? scene.Medium.Density : scene.Media[this->Medium - 1].Density;
+  const std::string key =
+    this->Medium == 0 ? "medium" : "media[" + std::to_string(this->Medium - 1) + "]";
   if (density.Type == "file")
   {
     vtkNew<vtkXMLImageDataReader> reader;
     if (!reader->CanReadFile(density.Path.c_str()))
     {
-      vtkErrorMacro(<< this->SceneFileName << ": medium.density.path: cannot read '" << density.Path
-                    << "' as a VTK image (.vti)");
+      vtkErrorMacro(<< this->SceneFileName << ": " << key << ".density.path: cannot read '"
+                    << density.Path << "' as a VTK image (.vti)");
       return 0;
     }
     reader->SetFileName(density.Path.c_str());
@@ -224,4 +234,5 @@ void vtkNimbusSceneDensitySource::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "SceneFileName: " << this->SceneFileName << "\n";
   os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
+  os << indent << "Medium: " << this->Medium << "\n";
 }

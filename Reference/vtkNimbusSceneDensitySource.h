@@ -2,7 +2,8 @@
  * @class   vtkNimbusSceneDensitySource
  * @brief   The density volume a Nimbus scene file describes, as vtkImageData.
  *
- * Reads the scene (JSON, docs/scene-format.md) and produces its medium's density:
+ * Reads the scene (JSON, docs/scene-format.md) and produces its medium's density
+ * (or, with Medium = i >= 1, that of the scene's additional medium media[i - 1]):
  * either the point-data array of a .vti file or the output of
  * vtkNimbusMetaballCloudSource with the scene's parameters. The output's active
  * scalars are a float array named "density". Every Nimbus renderer (and the trade
@@ -38,6 +39,14 @@ public:
   ///@}
 
   ///@{
+  /// Which medium's density: 0 (default) the scene's `medium`, i >= 1 its additional
+  /// medium `media[i - 1]` (scene format version 3). A medium the scene does not have is
+  /// an error naming how many it has.
+  vtkSetClampMacro(Medium, int, 0, 64);
+  vtkGetMacro(Medium, int);
+  ///@}
+
+  ///@{
   /// Memory the volume may take, MiB: the grid's points times 12 bytes (the inner
   /// source's or reader's array, up to 8 bytes a value, and the float copy).
   /// Default nimbus::DefaultMemoryBudgetMiB(); <= 0: that default.
@@ -57,6 +66,7 @@ protected:
 
   std::string SceneFileName;
   double MemoryBudgetMiB;
+  int Medium = 0;
 
 private:
   // The reader or metaball source the scene asks for, set up by RequestInformation.

@@ -107,17 +107,43 @@ def load_scene(path):
     return json.loads(text)
 
 
+def version3_features(scene):
+    """The scene format's version-3 features a canonical scene (load_scene) uses: only the
+    path tracer renders them (docs/scene-format.md); the fast renderers refuse them."""
+    features = []
+    if scene.get("lights"):
+        features.append("point and polyline lights (scene.lights)")
+    media = scene.get("media", [])
+    if "emission" in scene["medium"] or any("emission" in m for m in media):
+        features.append("emission (scene.medium.emission, scene.media[i].emission)")
+    if media:
+        features.append("additional media (scene.media)")
+    return features
+
+
+def refuse_version3_features(scene_path, scene, renderer):
+    """A renderer that does not render lights, emission or more media says so by name,
+    rather than render the scene without them."""
+    features = version3_features(scene)
+    if features:
+        raise ValueError(f"{scene_path}: the {renderer} does not render {', '.join(features)}; "
+                         "render this scene with the path tracer (--renderer path)")
+
+
 def scene_hash(scene_path, reference):
     """Hash of everything the reference image depends on."""
     scene = load_scene(scene_path)
     digest = hashlib.sha256()
     digest.update(json.dumps(scene, sort_keys=True).encode())
     digest.update(json.dumps(reference, sort_keys=True).encode())
-    density = scene.get("medium", {}).get("density", {})
-    if density.get("type") == "file":
-        density_path = os.path.join(os.path.dirname(os.path.abspath(scene_path)), density["path"])
-        with open(density_path, "rb") as stream:
-            digest.update(stream.read())
+    densities = [scene.get("medium", {}).get("density", {})]
+    densities += [m.get("density", {}) for m in scene.get("media", [])]
+    for density in densities:
+        if density.get("type") == "file":
+            density_path = os.path.join(os.path.dirname(os.path.abspath(scene_path)),
+                                        density["path"])
+            with open(density_path, "rb") as stream:
+                digest.update(stream.read())
     return digest.hexdigest()[:16]
 
 
@@ -299,6 +325,7 @@ class VtkGpuRenderer:
         import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
 
         scene = load_scene(scene_path)
+        refuse_version3_features(scene_path, scene, "VTK GPU mapper")
         self.scene = scene
         self.sky = sky_image
         self.sky_error = sky_error
@@ -438,6 +465,7 @@ class SvsRenderer:
         import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
 
         scene = load_scene(scene_path)
+        refuse_version3_features(scene_path, scene, "SVS mapper")
         density = nimbus.vtkNimbusSceneDensitySource()
         density.SetSceneFileName(scene_path)
         density.Update()

@@ -21,6 +21,8 @@ namespace nimbus
 namespace
 {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+/// The main medium and the additional ones (SceneJson's limit is 16 additional).
+constexpr std::size_t kMaxMediaInPathTracer = 17;
 /// Ratio tracking plays Russian roulette once its transmittance falls below this.
 constexpr double kRatioTrackingRouletteThreshold = 0.1;
 
@@ -320,7 +322,9 @@ struct PathState
   std::vector<double> Weight;   // spectral throughput
   std::vector<double> Radiance; // spectral estimate of the path
   std::vector<double> SunTransmittance;
-  std::vector<double> SavedWeight; // the path's throughput during a sun-peak flight
+  std::vector<double> SavedWeight;        // the path's throughput during a sun-peak flight
+  std::vector<double> LightTransmittance; // air transmittance toward a light
+  int Medium = 0; // the medium of the last cloud scattering event (RenderContext::GetMedia)
   std::uint64_t Steps = 0;
   bool Truncated = false;
 };
@@ -331,11 +335,13 @@ public:
   Integrator(const RenderContext& context, const PathTracingSettings& settings)
     : Context(context)
     , Settings(settings)
-    , Grid(context.GetGrid())
+    , Grid(context.GetExtinctionGrid())
+    , Media(context.GetMedia())
     , Air(context.GetAtmosphere())
   {
     this->Wavelengths = static_cast<int>(context.GetWavelengths().size());
-    this->HasCloud = !this->Grid.IsEmpty() && context.CloudMajorant() > 0.0;
+    this->Emission = context.HasEmission();
+    this->HasCloud = !this->Grid.IsEmpty() && (context.CloudMajorant() > 0.0 || this->Emission);
     if (this->HasCloud)
     {
       // Coarse majorant grid of the cloud: sigma_bar per block of 4^3 voxels, the
@@ -346,7 +352,7 @@ public:
       this->Macro = settings.BlockTraversal
         ? MajorantGrid(this->Grid, 0, settings.MajorantBlockVoxels)
         : MajorantGrid(this->Grid, 1);
-      const double extinctionPerDensity = context.GetScene().Medium.ExtinctionPerDensity;
+      const double extinctionPerDensity = context.GetExtinctionScale();
       const std::array<int, 3>& blocks = this->Macro.GetBlocks();
       this->Majorant.resize(static_cast<std::size_t>(blocks[0]) * blocks[1] * blocks[2]);
       for (std::size_t i = 0; i < this->Majorant.size(); ++i)
@@ -355,6 +361,32 @@ public:
       }
       const Vector3& size = this->Macro.GetBlockSize();
       this->MinCellSize = std::min({ size[0], size[1], size[2] });
+      if (this->Emission)
+      {
+        // Emission is collected at tentative collisions (FreeFlight), so the majorant
+        // must be positive wherever eta is, also where the medium does not attenuate
+        // (an "array" field, or extinction_per_density 0): such blocks get at least
+        // one tentative collision per block edge on average. Any majorant >= sigma_t
+        // is unbiased; this only sets how finely the emission is sampled there.
+        const double floor = 1.0 / this->MinCellSize;
+        for (const MediumComponent& m : this->Media)
+        {
+          if (!m.Emits)
+          {
+            continue;
+          }
+          const MajorantGrid emitting = settings.BlockTraversal
+            ? MajorantGrid(*m.EmissionField, 0, settings.MajorantBlockVoxels)
+            : MajorantGrid(*m.EmissionField, 1);
+          for (std::size_t i = 0; i < this->Majorant.size(); ++i)
+          {
+            if (!emitting.IsEmpty(i))
+            {
+              this->Majorant[i] = std::max(this->Majorant[i], floor);
+            }
+          }
+        }
+      }
     }
     this->CloudAlbedo = context.GetCloudAlbedo();
     if (this->Air)
@@ -426,6 +458,13 @@ public:
     {
       this->BuildSunDepth();
     }
+    // Lights: one element is chosen per vertex with probability proportional to its
+    // intensity (its power / 4 pi), by binary search in the cumulative table.
+    for (const LightElement& light : context.GetLightElements())
+    {
+      this->LightTotal += light.Intensity;
+      this->LightCdf.push_back(this->LightTotal);
+    }
   }
 
   int GetWavelengths() const { return this->Wavelengths; }
@@ -477,12 +516,27 @@ private:
     return this->BetaRMax * this->Air->Density(altitude, this->ScaleHeightR) +
       this->BetaMt * this->Air->Density(altitude, this->ScaleHeightM);
   }
-  /// Delta tracking (spectral tracking) from t = 0 to tEnd.
+  /// Delta tracking (spectral tracking) from t = 0 to tEnd. With collectEmission, the
+  /// media's emission is added to state.Radiance at the tentative collisions.
   FlightEnd FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, PathState& state, double& t,
-    Scatterer& scatterer) const;
-  /// Cloud transmittance from p toward the sun by ratio tracking (unbiased).
-  double CloudTransmittance(
-    const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state) const;
+    Scatterer& scatterer, bool collectEmission = false) const;
+  /// Cloud transmittance from p along a unit direction, up to the distance tMax (m), by
+  /// ratio tracking (unbiased).
+  double CloudTransmittance(const Vector3& p, const Vector3& direction, PathRandom& rng,
+    PathState& state, double tMax = kInfinity) const;
+  /// Adds one light's contribution at p (next-event estimation to a light element
+  /// chosen in proportion to its intensity; a point along a segment, uniformly).
+  void LightNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
+    PathState& state) const;
+  /// Adds the media's emission at a tentative collision charged to the cloud.
+  void AddEmission(const Vector3& p, double cloudMajorant, PathState& state) const;
+  /// Which medium scattered at a real cloud scattering event at p.
+  int ChooseScatteringMedium(const Vector3& p, PathRandom& rng) const;
+  /// The phase function of the medium that scattered at a cloud event.
+  const PhaseFunctionMixture& CloudPhaseAt(const PathState& state) const
+  {
+    return this->Media[static_cast<std::size_t>(state.Medium)].Phase;
+  }
   /// Adds the sun's single-scattered contribution at p (next-event estimation).
   void SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
     PathState& state, double weight = 1.0) const;
@@ -496,10 +550,14 @@ private:
 
   const RenderContext& Context;
   const PathTracingSettings& Settings;
-  const DensityGrid& Grid;
+  const DensityGrid& Grid; // the extinction grid (RenderContext::GetExtinctionGrid)
+  const std::vector<MediumComponent>& Media;
   const Atmosphere* Air;
   int Wavelengths = 0;
   bool HasCloud = false;
+  bool Emission = false;
+  std::vector<double> LightCdf; // cumulative intensities of the light elements, Y/sr
+  double LightTotal = 0.0;
   MajorantGrid Macro;
   std::vector<double> Majorant; // sigma_bar per block of Macro, 1/m
   double MinCellSize = 1.0;
@@ -706,7 +764,7 @@ void Integrator::BuildSunDepth()
   lattice.Spacing = this->Grid.GetSpacing();
   const std::size_t nx = static_cast<std::size_t>(n[0]), nxy = nx * static_cast<std::size_t>(n[1]);
   lattice.Depth.assign(nxy * static_cast<std::size_t>(n[2]), 0.0f);
-  const double extinctionPerDensity = this->Context.GetScene().Medium.ExtinctionPerDensity;
+  const double extinctionPerDensity = this->Context.GetExtinctionScale();
   int step[3];
   double exitDistance = kInfinity;
   int exitAxis = -1;
@@ -889,7 +947,7 @@ double Integrator::Piece(const Ray& ray, double t, double tEnd, bool withAir, do
 }
 
 FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, PathState& state,
-  double& t, Scatterer& scatterer) const
+  double& t, Scatterer& scatterer, bool collectEmission) const
 {
   const int n = this->Wavelengths;
   std::vector<double>& w = state.Weight;
@@ -935,9 +993,26 @@ FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, P
     const Vector3 p = Along(ray.Origin, ray.Direction, t);
     if (rng.Uniform() * majorant < cloudMajorant)
     {
+      if (collectEmission && this->Emission)
+      {
+        this->AddEmission(p, cloudMajorant, state);
+      }
       // Grey: every wavelength gets the same factor.
       const double sigmaC = this->Context.CloudExtinction(p);
-      const double sigmaCs = this->CloudAlbedo * sigmaC;
+      double sigmaCs = this->CloudAlbedo * sigmaC;
+      if (this->Media.size() > 1)
+      {
+        // Several media: sigma_s = sigma_t sum_i a_i s_i / sum_i s_i, s_i = k_i rho_i(p)
+        // (sigma_t from the summed grid, the ratio from the media's own grids).
+        double extinction = 0.0, scattering = 0.0;
+        for (const MediumComponent& m : this->Media)
+        {
+          const double s = m.ExtinctionPerDensity * m.Density->Sample(p);
+          extinction += s;
+          scattering += m.Albedo * s;
+        }
+        sigmaCs = extinction > 0.0 ? sigmaC * (scattering / extinction) : 0.0;
+      }
       const double sigmaCn = std::max(0.0, cloudMajorant - sigmaC);
       const double total = sigmaCs + sigmaCn;
       if (!(total > 0.0))
@@ -952,6 +1027,7 @@ FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, P
       if (rng.Uniform() * total < sigmaCs)
       {
         scatterer = Scatterer::Cloud;
+        state.Medium = this->Media.size() > 1 ? this->ChooseScatteringMedium(p, rng) : 0;
         return FlightEnd::Collision;
       }
       continue;
@@ -1010,7 +1086,7 @@ FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, P
 }
 
 double Integrator::CloudTransmittance(
-  const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state) const
+  const Vector3& p, const Vector3& direction, PathRandom& rng, PathState& state, double tMax) const
 {
   if (!this->HasCloud)
   {
@@ -1021,7 +1097,8 @@ double Integrator::CloudTransmittance(
   ray.Direction = direction;
   ray.EarthOrigin = p;
   ray.CrossesCloud = this->Grid.IntersectRay(p, direction, 0.0, ray.CloudNear, ray.CloudFar);
-  if (!ray.CrossesCloud)
+  ray.CloudFar = std::min(ray.CloudFar, tMax);
+  if (!ray.CrossesCloud || !(ray.CloudNear < ray.CloudFar))
   {
     return 1.0;
   }
@@ -1088,7 +1165,7 @@ void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scat
   switch (scatterer)
   {
     case Scatterer::Cloud:
-      f = this->Context.GetCloudPhase().Evaluate(mu);
+      f = this->CloudPhaseAt(state).Evaluate(mu);
       break;
     case Scatterer::Rayleigh:
       f = this->Air->RayleighPhase(mu);
@@ -1146,6 +1223,156 @@ void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scat
   }
 }
 
+void Integrator::AddEmission(const Vector3& p, double cloudMajorant, PathState& state) const
+{
+  // Emission by the collision estimator (pbrt-v4 volpath, Pharr, Jakob & Humphreys,
+  // "Physically Based Rendering" 4th ed., Sec. 14.2): the source term int T eta dt of
+  // the RTE is estimated at every tentative collision as w eta(p) / sigma_bar. The
+  // collisions charged to the cloud come at rate sigma_bar_c (a thinning of the
+  // majorant's), so here the divisor is cloudMajorant. eta(p, lambda) = sum_i
+  // EmissionScale_i field_i(p) spectrum_i(lambda), Y/(sr m).
+  for (const MediumComponent& m : this->Media)
+  {
+    if (!m.Emits)
+    {
+      continue;
+    }
+    const double eta = m.EmissionScale * m.EmissionField->Sample(p) / cloudMajorant;
+    if (eta > 0.0)
+    {
+      for (int i = 0; i < this->Wavelengths; ++i)
+      {
+        state.Radiance[i] += state.Weight[i] * eta * m.EmissionSpectrum[i];
+      }
+    }
+  }
+}
+
+int Integrator::ChooseScatteringMedium(const Vector3& p, PathRandom& rng) const
+{
+  // The medium that scattered, with probability a_i s_i / sum_j a_j s_j (s_i = k_i
+  // rho_i(p)): a real collision picks medium i with probability s_i / sigma_t and it
+  // scatters with probability a_i; given that the event is a scattering, this is
+  // the conditional probability.
+  double total = 0.0;
+  double weights[kMaxMediaInPathTracer];
+  const std::size_t count = std::min(this->Media.size(), kMaxMediaInPathTracer);
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const MediumComponent& m = this->Media[i];
+    weights[i] = m.Albedo * m.ExtinctionPerDensity * m.Density->Sample(p);
+    total += weights[i];
+  }
+  double u = rng.Uniform() * total;
+  for (std::size_t i = 0; i + 1 < count; ++i)
+  {
+    if (u < weights[i])
+    {
+      return static_cast<int>(i);
+    }
+    u -= weights[i];
+  }
+  // The last medium with a positive weight (rounding never picks a zero one).
+  for (std::size_t i = count; i-- > 0;)
+  {
+    if (weights[i] > 0.0)
+    {
+      return static_cast<int>(i);
+    }
+  }
+  return 0;
+}
+
+void Integrator::LightNextEvent(
+  const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng, PathState& state) const
+{
+  // One light element k with probability P_k = I_k / I_total, and on a segment a point
+  // y uniform in length (pdf 1 / length): for intensity per metre I_l = I_k / length,
+  // the estimate of sum_k int f T I_l / r^2 dl is f T I_total / r^2 (a point: the
+  // same with y its position). Radiance toward -d:
+  //   L = f(omega) I_total T_cloud(p, y) T_air(p, y, lambda) S_k(lambda) / r^2,
+  // omega = (y - p) / r, f the phase function at mu = dot(omega, d) (the light
+  // propagates along -omega and leaves along -d) or albedo/pi cos at the ground.
+  const double u = rng.Uniform() * this->LightTotal;
+  const std::size_t k = std::min(this->LightCdf.size() - 1,
+    static_cast<std::size_t>(
+      std::upper_bound(this->LightCdf.begin(), this->LightCdf.end(), u) - this->LightCdf.begin()));
+  const LightElement& light = this->Context.GetLightElements()[k];
+  Vector3 y = light.A;
+  if (light.IsSegment)
+  {
+    const double v = rng.Uniform();
+    for (int a = 0; a < 3; ++a)
+    {
+      y[a] = light.A[a] + v * (light.B[a] - light.A[a]);
+    }
+  }
+  Vector3 omega{ { y[0] - p[0], y[1] - p[1], y[2] - p[2] } };
+  const double r2 = Dot(omega, omega);
+  const double r = std::sqrt(r2);
+  if (!(r > 0.0) || !std::isfinite(r))
+  {
+    return; // the light at the vertex itself: a point of zero measure
+  }
+  for (double& c : omega)
+  {
+    c /= r;
+  }
+  double f;
+  switch (scatterer)
+  {
+    case Scatterer::Cloud:
+      f = this->CloudPhaseAt(state).Evaluate(Dot(omega, d));
+      break;
+    case Scatterer::Rayleigh:
+      f = this->Air->RayleighPhase(Dot(omega, d));
+      break;
+    case Scatterer::Mie:
+      f = this->Air->MiePhase(Dot(omega, d));
+      break;
+    case Scatterer::Ground:
+      f = this->Context.GetGroundAlbedo() / kPi * std::max(0.0, omega[2]);
+      break;
+    default:
+      f = 0.0;
+  }
+  if (!(f > 0.0))
+  {
+    return;
+  }
+  // The ground plane hides a light on its other side.
+  if (this->Context.HasGround() && scatterer != Scatterer::Ground)
+  {
+    const double h = this->Context.GetGroundHeight();
+    if ((p[2] >= h) != (y[2] >= h))
+    {
+      return;
+    }
+  }
+  const double cloud = this->CloudTransmittance(p, omega, rng, state, r);
+  if (!(cloud > 0.0))
+  {
+    return;
+  }
+  const double k0 = f * cloud * this->LightTotal / r2;
+  const std::vector<double>& spectrum = this->Context.GetLightSpectra()[light.Light];
+  if (this->Air)
+  {
+    this->Context.AtmosphereTransmittanceBetween(p, y, state.LightTransmittance);
+    for (int i = 0; i < this->Wavelengths; ++i)
+    {
+      state.Radiance[i] += state.Weight[i] * k0 * spectrum[i] * state.LightTransmittance[i];
+    }
+  }
+  else
+  {
+    for (int i = 0; i < this->Wavelengths; ++i)
+    {
+      state.Radiance[i] += state.Weight[i] * k0 * spectrum[i];
+    }
+  }
+}
+
 double Integrator::SegmentEnd(const Ray& ray, SegmentEndKind& kind) const
 {
   const double tGround = this->Context.IntersectGround(ray.Origin, ray.Direction, 0.0);
@@ -1194,10 +1421,12 @@ void Integrator::SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scat
   const Vector3 d = DirectionFromCosine(this->Sun, phase.Sample(uniform), rng.Uniform());
   const double pB = phase.Evaluate(Dot(this->Sun, d));
   double f = 0.0, pA = 0.0;
+  const int vertexMedium = state.Medium;
   switch (scatterer)
   {
     case Scatterer::Cloud:
-      f = pA = phase.Evaluate(Dot(incoming, d));
+      // The vertex's own phase: that of the medium that scattered there.
+      f = pA = this->CloudPhaseAt(state).Evaluate(Dot(incoming, d));
       break;
     case Scatterer::Ground:
       f = d[2] > 0.0 ? this->Context.GetGroundAlbedo() / kPi * d[2] : 0.0;
@@ -1238,6 +1467,7 @@ void Integrator::SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scat
     this->SunNextEvent(Along(ray.Origin, ray.Direction, t), d, next, rng, state);
   }
   state.Weight.swap(state.SavedWeight);
+  state.Medium = vertexMedium; // the path continues from p
 }
 
 void Integrator::TracePath(
@@ -1248,6 +1478,7 @@ void Integrator::TracePath(
   state.Radiance.assign(n, 0.0);
   state.Steps = 0;
   state.Truncated = false;
+  state.Medium = 0;
   const Camera& camera = this->Context.GetCamera();
   Ray ray = this->MakeRay(camera.GetPosition(), camera.RayDirection(x, y));
   const int maxOrder = this->Settings.MaxScatteringOrder;
@@ -1268,7 +1499,7 @@ void Integrator::TracePath(
     const double tEnd = this->SegmentEnd(ray, endKind);
     double t;
     Scatterer scatterer = Scatterer::None;
-    const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer);
+    const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer, true);
     if (end == FlightEnd::Truncated || end == FlightEnd::Absorbed)
     {
       break;
@@ -1319,6 +1550,14 @@ void Integrator::TracePath(
         {
           break;
         }
+      }
+    }
+    if (this->LightTotal > 0.0)
+    {
+      this->LightNextEvent(p, ray.Direction, scatterer, rng, state);
+      if (state.Truncated)
+      {
+        break;
       }
     }
     if (maxOrder > 0 && order >= maxOrder)
@@ -1372,9 +1611,10 @@ void Integrator::TracePath(
       case Scatterer::Cloud:
       default:
       {
-        const double mu = this->Context.GetCloudPhase().Sample(uniform);
+        const PhaseFunctionMixture& phase = this->CloudPhaseAt(state);
+        const double mu = phase.Sample(uniform);
         direction = DirectionFromCosine(ray.Direction, mu, rng.Uniform());
-        pdf = this->Context.GetCloudPhase().Evaluate(mu);
+        pdf = phase.Evaluate(mu);
         break;
       }
     }

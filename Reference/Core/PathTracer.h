@@ -1,9 +1,21 @@
 // Monte Carlo volumetric path tracer: the full-multiple-scattering ground truth
 // for the scenes of RenderContext (cloud + Rayleigh/Mie atmosphere + Lambertian
-// ground + background + directional sun). Everything physical comes from the
+// ground + background + directional sun; since scene format version 3 also point and
+// polyline lights, emitting media and several media). Everything physical comes from the
 // RenderContext; this file only integrates the radiative transfer equation
-//     L(x, w) = int_0^d T(x, x_t) [sigma_s(x_t) int p(w', w) L(x_t, w') dw'] dt + T(x, x_d) L_d
-// (no emission), with T = exp(-int sigma_t), by unbiased estimators:
+//     L(x, w) = int_0^d T(x, x_t) [eta(x_t) + sigma_s(x_t) int p(w', w) L(x_t, w') dw'] dt
+//               + T(x, x_d) L_d
+// with T = exp(-int sigma_t) and eta the media's emission (Y/(sr m)), by unbiased
+// estimators:
+//
+//  - Version 3 (docs/ground-truth.md, "Lights, emission and several media"): lights by
+//    next-event estimation at every vertex (one element chosen by intensity, a point
+//    uniform along a segment; ratio tracking to a finite distance, the air's exact
+//    transmittance); emission by the collision estimator w eta / sigma_bar_c at each
+//    tentative collision charged to the cloud (blocks that emit get a majorant of at
+//    least 1 / block edge); several media through the summed extinction grid, the
+//    scattering medium chosen with probability a_i sigma_t,i / sigma_s and its phase used
+//    at that vertex. None of it runs, or draws a random number, in scenes without it.
 //
 //  - Free flights: delta tracking against a piecewise-constant majorant
 //    sigma_bar(t) = cloud block majorant (max density of a 4^3-voxel block of the

@@ -30,14 +30,58 @@
 namespace nimbus
 {
 
+/// The grids of a version-3 scene beyond the main medium's density, all on the main
+/// density's grid geometry (same dimensions, origin and spacing; checked).
+struct NIMBUSREFERENCE_EXPORT SceneFields
+{
+  /// scene.Media[i]'s density, one per additional medium.
+  std::vector<DensityGrid> MediaDensities;
+  /// scene.Medium.Emission's field when its source is "array" (else empty).
+  DensityGrid Emission;
+  /// scene.Media[i].Emission's field when its source is "array" (else empty or absent).
+  std::vector<DensityGrid> MediaEmissions;
+};
+
+/// One participating medium at run time: the main one (index 0) or an additional one.
+/// sigma_t(p) = ExtinctionPerDensity density(p), sigma_s = Albedo sigma_t; emission
+/// coefficient eta(p, lambda) = EmissionScale field(p) EmissionSpectrum(lambda),
+/// Y/(sr m) (EmissionSpectrum has luminance 1; field = the density for "from_density").
+struct NIMBUSREFERENCE_EXPORT MediumComponent
+{
+  const DensityGrid* Density = nullptr;
+  double ExtinctionPerDensity = 0.0;
+  double Albedo = 0.0;
+  PhaseFunctionMixture Phase;
+  bool Emits = false;
+  const DensityGrid* EmissionField = nullptr; // Density for "from_density"
+  double EmissionScale = 0.0;
+  std::vector<double> EmissionSpectrum;
+};
+
+/// A light of the scene broken into elements for next-event estimation: a point or one
+/// straight segment of a polyline. Intensity is the element's total luminous-like
+/// intensity, Y/sr: a point's `intensity`, a segment's intensity_per_metre x length.
+struct NIMBUSREFERENCE_EXPORT LightElement
+{
+  Vector3 A{ { 0.0, 0.0, 0.0 } }; // the point, or the segment's first end, m
+  Vector3 B{ { 0.0, 0.0, 0.0 } }; // the segment's second end (= A for a point), m
+  double Intensity = 0.0;         // Y / sr
+  bool IsSegment = false;
+  int Light = 0; // index in scene.Lights (and in GetLightSpectra())
+};
+
 class NIMBUSREFERENCE_EXPORT RenderContext
 {
 public:
   using Vector3 = nimbus::Vector3;
 
   /// Validates the parts the renderers rely on (throws std::invalid_argument with
-  /// the offending field's name).
-  RenderContext(const SceneDescription& scene, DensityGrid grid);
+  /// the offending field's name). `fields` holds the grids of additional media and of
+  /// "array" emission fields (version 3); a scene that needs one it lacks is an error.
+  RenderContext(const SceneDescription& scene, DensityGrid grid, SceneFields fields = {});
+  /// Not copied or moved: GetMedia() points into the context's own grids.
+  RenderContext(const RenderContext&) = delete;
+  RenderContext& operator=(const RenderContext&) = delete;
 
   const SceneDescription& GetScene() const { return this->Scene; }
   const Camera& GetCamera() const { return this->ViewCamera; }
@@ -62,14 +106,36 @@ public:
   /// Irradiance at the top of the atmosphere per wavelength sample (luminance Y = Illuminance).
   const std::vector<double>& GetSunIrradiance() const { return this->Light->GetSunIrradiance(); }
 
-  // --- cloud (wavelength independent)
-  /// sigma_t = ExtinctionPerDensity * density(p), 1/m.
+  // --- cloud (wavelength independent): the sum over the media
+  /// sigma_t = sum_i ExtinctionPerDensity_i * density_i(p), 1/m: the extinction grid
+  /// (the main density, or the sum of the media's extinctions on the shared grid)
+  /// times its scale.
   double CloudExtinction(const Vector3& p) const
   {
-    return this->ExtinctionPerDensity * this->Grid.Sample(p);
+    return this->ExtinctionScale * this->GetExtinctionGrid().Sample(p);
   }
   /// Majorant of CloudExtinction over the grid, 1/m.
-  double CloudMajorant() const { return this->ExtinctionPerDensity * this->Grid.GetMaximum(); }
+  double CloudMajorant() const
+  {
+    return this->ExtinctionScale * this->GetExtinctionGrid().GetMaximum();
+  }
+  /// The grid whose values times GetExtinctionScale() are sigma_t (1/m): the main
+  /// density with ExtinctionPerDensity when there is one medium (so one-medium scenes
+  /// are computed exactly as before version 3), else the summed extinction with 1.
+  /// Trilinear interpolation is linear, so the sum interpolates as the media do.
+  const DensityGrid& GetExtinctionGrid() const
+  {
+    return this->Media.size() > 1 ? this->SummedExtinction : this->Grid;
+  }
+  double GetExtinctionScale() const { return this->ExtinctionScale; }
+  /// The media: [0] the main one, then scene.Media in order.
+  const std::vector<MediumComponent>& GetMedia() const { return this->Media; }
+  bool HasAdditionalMedia() const { return this->Media.size() > 1; }
+  bool HasEmission() const { return this->AnyEmission; }
+  /// Point lights and polyline segments (scene.Lights), with positive intensity.
+  const std::vector<LightElement>& GetLightElements() const { return this->Lights; }
+  /// Per scene light: the blackbody spectrum at the sample wavelengths, luminance 1.
+  const std::vector<std::vector<double>>& GetLightSpectra() const { return this->LightSpectra; }
   double GetCloudAlbedo() const { return this->Scene.Medium.SingleScatteringAlbedo; }
   const PhaseFunctionMixture& GetCloudPhase() const { return this->CloudPhase; }
 
@@ -115,12 +181,21 @@ public:
   bool BackgroundIsAtmosphere() const { return this->Scene.Background.Type == "atmosphere"; }
 
 private:
+  void SetUpVersion3(const SceneDescription& scene);
+
   SceneDescription Scene;
   Camera ViewCamera;
   DensityGrid Grid;
   std::unique_ptr<SunAndAir> Light;
   double ExtinctionPerDensity;
   PhaseFunctionMixture CloudPhase;
+  SceneFields Fields; // owns the additional grids the Media point to
+  DensityGrid SummedExtinction;
+  double ExtinctionScale = 0.0;
+  std::vector<MediumComponent> Media;
+  bool AnyEmission = false;
+  std::vector<LightElement> Lights;
+  std::vector<std::vector<double>> LightSpectra;
   std::vector<double> BackgroundRadiance;
 };
 

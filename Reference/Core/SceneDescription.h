@@ -51,6 +51,21 @@ struct DensitySourceDescription
   std::vector<std::pair<std::string, std::vector<double>>> Parameters;
 };
 
+/// Version 3: a per-voxel emission field (hot smoke). The source term added along a
+/// ray is eta(x) ds, eta(x) = RadiancePerMetre * field(x): radiance (luminance Y,
+/// relative units) emitted per metre of path per unit field value, Y/(sr m), with the
+/// blackbody spectrum of TemperatureKelvin normalised to luminance 1 (as the sun's).
+/// The field is the medium's density ("from_density") or another point-data array
+/// of the medium's .vti ("array"; only for "file" densities), on the density's grid.
+struct EmissionDescription
+{
+  bool Enabled = false;
+  std::string Source = "from_density"; // "from_density" or "array"
+  std::string ArrayName;               // "array": the point-data array of the density's file
+  double RadiancePerMetre = 0.0;       // Y / (sr m) per unit field value
+  double TemperatureKelvin = 1500.0;   // K, blackbody spectrum
+};
+
 struct MediumDescription
 {
   DensitySourceDescription Density;
@@ -63,6 +78,39 @@ struct MediumDescription
   /// tracer simulates multiple scattering itself and ignores it.
   double MultipleScatteringConstant = 0.0;
   std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
+  EmissionDescription Emission; // version 3; disabled by default
+};
+
+/// Version 3: a light other than the sun. Lights have zero measure (points, lines):
+/// camera rays never see them directly; they light the scene by next-event estimation.
+/// Radiometry in the sun's relative units: a point light of Intensity I (luminance Y
+/// per steradian) at distance d in vacuum gives the irradiance Y = I / d^2 at normal
+/// incidence, as a sun of illuminance I / d^2 would.
+struct LightDescription
+{
+  std::string Type = "point"; // "point" or "polyline"
+  /// "point": the light's position, m.
+  std::array<double, 3> Position{ { 0.0, 0.0, 0.0 } };
+  /// "point": radiant intensity's luminance, Y / sr (isotropic).
+  double Intensity = 1.0;
+  /// "polyline" (a lightning channel): at least 2 vertices, m.
+  std::vector<std::array<double, 3>> Vertices;
+  /// "polyline": each element dl of the channel radiates isotropically with intensity
+  /// IntensityPerMetre dl: Y / (sr m).
+  double IntensityPerMetre = 1.0;
+  double TemperatureKelvin = 6500.0; // K, blackbody spectrum normalised to luminance 1
+};
+
+/// Version 3: a medium beside the main one (smoke beside cloud), with its own density
+/// (on the main medium's grid geometry), albedo, phase and optional emission. The total
+/// extinction is the sum over the media.
+struct AdditionalMediumDescription
+{
+  DensitySourceDescription Density;
+  double ExtinctionPerDensity = 0.02;   // 1/m per unit density
+  double SingleScatteringAlbedo = 0.99; // sigma_s / sigma_t
+  std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
+  EmissionDescription Emission;
 };
 
 struct GroundDescription
@@ -84,7 +132,7 @@ struct BackgroundDescription
 
 struct SceneDescription
 {
-  static constexpr int kFormatVersion = 2;
+  static constexpr int kFormatVersion = 3;
   std::string Name;
   std::string Description;
   CameraDescription Camera;
@@ -95,6 +143,18 @@ struct SceneDescription
   BackgroundDescription Background;
   /// Wavelengths the renderers sample (SpectralSamples; 16 = measured ΔE 0.02).
   int SpectralSamples = 16;
+  std::vector<LightDescription> Lights;           // version 3
+  std::vector<AdditionalMediumDescription> Media; // version 3
+
+  /// True when the scene uses a version-3 feature (lights, emission, media).
+  bool UsesVersion3Features() const
+  {
+    if (!this->Lights.empty() || !this->Media.empty() || this->Medium.Emission.Enabled)
+    {
+      return true;
+    }
+    return false;
+  }
 };
 
 } // namespace nimbus

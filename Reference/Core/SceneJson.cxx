@@ -56,6 +56,22 @@ constexpr double kMaxExtinctionPerDensity = 1.0e3;
 // balls (the source's cost is per ball; 1e6 balls take minutes).
 constexpr double kMaxBallDensity = 1.0e6;
 constexpr double kMaxBallCount = 1.0e6;
+// Version 3. Lights: a point light of intensity I (Y/sr) gives the irradiance I/d^2
+// at distance d; 1e12 Y/sr gives the largest sun illuminance (1e6) at 1 km, and stays
+// below 1e30 at 1 nm (the pixel limit is 3.4e38). The same bound per metre of a
+// polyline channel. Temperatures: 500 K (dull red, hot smoke) to 100000 K.
+constexpr double kMaxLightIntensity = 1.0e12;
+constexpr double kMinLightTemperatureKelvin = 500.0;
+constexpr double kMaxLightTemperatureKelvin = 100000.0;
+// Lights and vertices a scene may hold: next-event estimation samples one light from
+// a table of them (cost log N per sample); a lightning channel needs ~1000 vertices.
+constexpr std::size_t kMaxLights = 1024;
+constexpr std::size_t kMaxPolylineVertices = 100000;
+// Emission coefficient per unit field value, Y/(sr m): 1e6 per metre of path keeps the
+// pixels finite through 1e9 m of glowing medium (1e15 < 3.4e38).
+constexpr double kMaxEmissionPerMetre = 1.0e6;
+// Additional media: each one adds a density grid (memory) and a lookup per collision.
+constexpr std::size_t kMaxAdditionalMedia = 16;
 /// Deepest nesting of arrays and objects a scene file may have. A scene needs 5
 /// (scene.medium.density.parameters.Bounds); deeper files are refused before
 /// they cost memory or time.
@@ -684,11 +700,97 @@ PhaseComponentDescription ReadPhaseComponent(const Json& v, const std::string& p
   return c;
 }
 
-MediumDescription ReadMedium(const Json& v, const std::string& path, const std::string& base)
+std::vector<PhaseComponentDescription> ReadPhase(const Json& phase, const std::string& phasePath)
 {
-  const ObjectReader r(v, path,
-    { "density", "extinction_per_density", "single_scattering_albedo", "phase",
-      "multiple_scattering_constant" });
+  std::vector<PhaseComponentDescription> components;
+  if (phase.is_object())
+  {
+    components.push_back(ReadPhaseComponent(phase, phasePath));
+  }
+  else if (phase.is_array())
+  {
+    if (phase.empty())
+    {
+      Fail(phasePath, "expected at least one phase component, got an empty array");
+    }
+    for (std::size_t i = 0; i < phase.size(); ++i)
+    {
+      components.push_back(ReadPhaseComponent(phase[i], phasePath + "[" + std::to_string(i) + "]"));
+    }
+  }
+  else
+  {
+    Fail(
+      phasePath, "expected a phase component (object) or an array of them, got " + Describe(phase));
+  }
+  double total = 0.0;
+  for (const auto& c : components)
+  {
+    total += c.Weight;
+  }
+  if (!(total > 0.0) || !std::isfinite(total))
+  {
+    Fail(phasePath, "the weights must not all be zero");
+  }
+  return components;
+}
+
+const std::vector<std::string> kEmissionSources = { "from_density", "array" };
+
+/// Version 3: medium.emission and media[i].emission.
+EmissionDescription ReadEmission(
+  const Json& v, const std::string& path, const DensitySourceDescription& density)
+{
+  const ObjectReader r(v, path, { "source", "array", "radiance_per_metre", "temperature_kelvin" });
+  EmissionDescription e;
+  e.Enabled = true;
+  e.Source = ReadEnum(r.Require("source"), r.Key("source"), kEmissionSources);
+  if (e.Source == "array")
+  {
+    if (density.Type != "file")
+    {
+      Fail(r.Key("source"),
+        "\"array\" reads another point-data array of the density's .vti, so it needs a "
+        "\"file\" density (this density is \"" +
+          density.Type + "\"; use \"from_density\")");
+    }
+    e.ArrayName = ReadString(r.Require("array"), r.Key("array"), false);
+  }
+  else if (r.Has("array"))
+  {
+    Fail(r.Key("array"), "only used by source \"array\" (this emission is \"from_density\")");
+  }
+  r.RequiredNumber("radiance_per_metre", e.RadiancePerMetre, Closed(0.0, kMaxEmissionPerMetre));
+  r.Number("temperature_kelvin", e.TemperatureKelvin,
+    Closed(kMinLightTemperatureKelvin, kMaxLightTemperatureKelvin));
+  return e;
+}
+
+/// A key that only version 3 knows, in an older file: the same error as any unknown
+/// key, saying which version it needs.
+void RefuseVersion3Key(const Json& v, const std::string& path, const std::string& key, int version,
+  const std::vector<std::string>& known)
+{
+  if (version < 3 && v.is_object() && v.contains(key))
+  {
+    Fail(path + "." + key,
+      "unknown key (known: " + Join(known) + "); \"" + key +
+        "\" needs format version 3 (\"nimbus_scene\": 3), this file is version " +
+        std::to_string(version));
+  }
+}
+
+MediumDescription ReadMedium(
+  const Json& v, const std::string& path, const std::string& base, int version)
+{
+  std::vector<std::string> known = { "density", "extinction_per_density",
+    "single_scattering_albedo", "phase", "multiple_scattering_constant" };
+  RefuseVersion3Key(v, path, "emission", version, known);
+  if (version >= 3)
+  {
+    known.push_back("emission");
+  }
+  const ObjectReader r(v, path, known);
   MediumDescription m;
   m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
   r.RequiredNumber(
@@ -697,40 +799,149 @@ MediumDescription ReadMedium(const Json& v, const std::string& path, const std::
   r.Number("multiple_scattering_constant", m.MultipleScatteringConstant, Closed(0.0, 100.0));
   if (r.Has("phase"))
   {
-    const Json& phase = r["phase"];
-    const std::string phasePath = r.Key("phase");
-    m.Phase.clear();
-    if (phase.is_object())
-    {
-      m.Phase.push_back(ReadPhaseComponent(phase, phasePath));
-    }
-    else if (phase.is_array())
-    {
-      if (phase.empty())
-      {
-        Fail(phasePath, "expected at least one phase component, got an empty array");
-      }
-      for (std::size_t i = 0; i < phase.size(); ++i)
-      {
-        m.Phase.push_back(ReadPhaseComponent(phase[i], phasePath + "[" + std::to_string(i) + "]"));
-      }
-    }
-    else
-    {
-      Fail(phasePath,
-        "expected a phase component (object) or an array of them, got " + Describe(phase));
-    }
-    double total = 0.0;
-    for (const auto& c : m.Phase)
-    {
-      total += c.Weight;
-    }
-    if (!(total > 0.0) || !std::isfinite(total))
-    {
-      Fail(phasePath, "the weights must not all be zero");
-    }
+    m.Phase = ReadPhase(r["phase"], r.Key("phase"));
+  }
+  if (r.Has("emission"))
+  {
+    m.Emission = ReadEmission(r["emission"], r.Key("emission"), m.Density);
   }
   return m;
+}
+
+AdditionalMediumDescription ReadAdditionalMedium(
+  const Json& v, const std::string& path, const std::string& base)
+{
+  const ObjectReader r(v, path,
+    { "density", "extinction_per_density", "single_scattering_albedo", "phase", "emission" });
+  AdditionalMediumDescription m;
+  m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
+  r.RequiredNumber(
+    "extinction_per_density", m.ExtinctionPerDensity, Closed(0.0, kMaxExtinctionPerDensity));
+  r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
+  if (r.Has("phase"))
+  {
+    m.Phase = ReadPhase(r["phase"], r.Key("phase"));
+  }
+  if (r.Has("emission"))
+  {
+    m.Emission = ReadEmission(r["emission"], r.Key("emission"), m.Density);
+  }
+  return m;
+}
+
+/// An array of at most `limit` elements.
+void RequireArray(const Json& v, const std::string& path, std::size_t limit, const char* what)
+{
+  if (!v.is_array())
+  {
+    Fail(path, std::string("expected an array of ") + what + ", got " + Describe(v));
+  }
+  if (v.size() > limit)
+  {
+    Fail(path,
+      "expected at most " + std::to_string(limit) + " " + what + ", got " +
+        std::to_string(v.size()));
+  }
+}
+
+/// A metaball parameter's value as the source will use it: the given one, else the
+/// source's default (vtkNimbusMetaballCloudSource; docs/scene-format.md).
+std::vector<double> EffectiveMetaballParameter(
+  const DensitySourceDescription& d, const std::string& name)
+{
+  for (const auto& p : d.Parameters)
+  {
+    if (p.first == name)
+    {
+      return p.second;
+    }
+  }
+  if (name == "Dimensions")
+  {
+    return { 96.0, 96.0, 64.0 };
+  }
+  return { -1500.0, 1500.0, -1500.0, 1500.0, 800.0, 2800.0 }; // Bounds
+}
+
+/// Every medium is on the main medium's grid. Between two metaball clouds that is known
+/// here (the grid is their Dimensions and Bounds); a file's grid is checked by the
+/// renderer (RenderContext), which reads it.
+void RequireSameMetaballGrid(const DensitySourceDescription& main,
+  const DensitySourceDescription& extra, const std::string& path)
+{
+  if (main.Type != "metaball_cloud" || extra.Type != "metaball_cloud")
+  {
+    return;
+  }
+  for (const char* name : { "Dimensions", "Bounds" })
+  {
+    const std::vector<double> a = EffectiveMetaballParameter(main, name);
+    const std::vector<double> b = EffectiveMetaballParameter(extra, name);
+    if (a != b)
+    {
+      std::string mine, theirs;
+      for (std::size_t k = 0; k < a.size(); ++k)
+      {
+        mine += (k ? ", " : "") + FormatNumber(a[k]);
+      }
+      for (std::size_t k = 0; k < b.size(); ++k)
+      {
+        theirs += (k ? ", " : "") + FormatNumber(b[k]);
+      }
+      Fail(path + ".density.parameters." + name,
+        std::string("every medium must be on the main medium's grid: medium.density's ") + name +
+          " is [" + mine + "], this one's [" + theirs + "]");
+    }
+  }
+}
+
+const std::vector<std::string> kLightTypes = { "point", "polyline" };
+
+LightDescription ReadLight(const Json& v, const std::string& path)
+{
+  if (!v.is_object())
+  {
+    Fail(path, "expected an object, got " + Describe(v));
+  }
+  LightDescription l;
+  if (!v.contains("type"))
+  {
+    Fail(path, "missing required key \"type\" (known: " + Join(kLightTypes) + ")");
+  }
+  l.Type = ReadEnum(v.at("type"), path + ".type", kLightTypes);
+  const Range temperature = Closed(kMinLightTemperatureKelvin, kMaxLightTemperatureKelvin);
+  const Range intensity = Closed(0.0, kMaxLightIntensity);
+  if (l.Type == "point")
+  {
+    const ObjectReader r(v, path, { "type", "position", "intensity", "temperature_kelvin" });
+    l.Position = ReadVector3(r.Require("position"), r.Key("position"), Coordinate());
+    r.RequiredNumber("intensity", l.Intensity, intensity);
+    r.Number("temperature_kelvin", l.TemperatureKelvin, temperature);
+    return l;
+  }
+  const ObjectReader r(
+    v, path, { "type", "vertices", "intensity_per_metre", "temperature_kelvin" });
+  const Json& vertices = r.Require("vertices");
+  const std::string verticesPath = r.Key("vertices");
+  RequireArray(vertices, verticesPath, kMaxPolylineVertices, "vertices ([x, y, z], m)");
+  if (vertices.size() < 2)
+  {
+    Fail(verticesPath, "expected at least 2 vertices, got " + std::to_string(vertices.size()));
+  }
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+  {
+    l.Vertices.push_back(
+      ReadVector3(vertices[i], verticesPath + "[" + std::to_string(i) + "]", Coordinate()));
+    if (i > 0 && l.Vertices[i] == l.Vertices[i - 1])
+    {
+      Fail(verticesPath + "[" + std::to_string(i) + "]",
+        "a segment of zero length: the same point as vertex " + std::to_string(i - 1) +
+          " (drop one of them)");
+    }
+  }
+  r.RequiredNumber("intensity_per_metre", l.IntensityPerMetre, intensity);
+  r.Number("temperature_kelvin", l.TemperatureKelvin, temperature);
+  return l;
 }
 
 SunParameters ReadSun(const Json& v, const std::string& path)
@@ -980,6 +1191,54 @@ Json ParameterJson(const std::string& name, const std::vector<double>& values)
   return array;
 }
 
+Json DensityJson(const DensitySourceDescription& d)
+{
+  Json density;
+  density["type"] = d.Type;
+  density["path"] = d.Path;
+  density["array"] = d.ArrayName;
+  density["parameters"] = Json::object();
+  // Canonical order: the source's property order, then any others as stored.
+  std::vector<std::pair<std::string, std::vector<double>>> parameters = d.Parameters;
+  const std::vector<std::string> names = MetaballParameterNames();
+  auto rank = [&names](const std::string& name)
+  { return std::find(names.begin(), names.end(), name) - names.begin(); };
+  std::stable_sort(parameters.begin(), parameters.end(),
+    [&rank](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
+  for (const auto& p : parameters)
+  {
+    density["parameters"][p.first] = ParameterJson(p.first, p.second);
+  }
+  return density;
+}
+
+Json PhaseJson(const std::vector<PhaseComponentDescription>& phase)
+{
+  Json array = Json::array();
+  for (const auto& p : phase)
+  {
+    Json component;
+    component["type"] = p.Type;
+    component["g"] = p.G;
+    component["weight"] = p.Weight;
+    array.push_back(component);
+  }
+  return array;
+}
+
+Json EmissionJson(const EmissionDescription& e)
+{
+  Json emission;
+  emission["source"] = e.Source;
+  if (e.Source == "array")
+  {
+    emission["array"] = e.ArrayName;
+  }
+  emission["radiance_per_metre"] = e.RadiancePerMetre;
+  emission["temperature_kelvin"] = e.TemperatureKelvin;
+  return emission;
+}
+
 Json ToJson(const SceneDescription& s)
 {
   Json j;
@@ -997,37 +1256,17 @@ Json ToJson(const SceneDescription& s)
   j["camera"]["height"] = c.Height;
 
   const MediumDescription& m = s.Medium;
-  Json density;
-  density["type"] = m.Density.Type;
-  density["path"] = m.Density.Path;
-  density["array"] = m.Density.ArrayName;
-  density["parameters"] = Json::object();
-  // Canonical order: the source's property order, then any others as stored.
-  std::vector<std::pair<std::string, std::vector<double>>> parameters = m.Density.Parameters;
-  const std::vector<std::string> names = MetaballParameterNames();
-  auto rank = [&names](const std::string& name)
-  { return std::find(names.begin(), names.end(), name) - names.begin(); };
-  std::stable_sort(parameters.begin(), parameters.end(),
-    [&rank](const auto& a, const auto& b) { return rank(a.first) < rank(b.first); });
-  for (const auto& p : parameters)
-  {
-    density["parameters"][p.first] = ParameterJson(p.first, p.second);
-  }
-  j["medium"]["density"] = density;
+  j["medium"]["density"] = DensityJson(m.Density);
   j["medium"]["extinction_per_density"] = m.ExtinctionPerDensity;
   j["medium"]["single_scattering_albedo"] = m.SingleScatteringAlbedo;
   if (m.MultipleScatteringConstant != 0.0)
   {
     j["medium"]["multiple_scattering_constant"] = m.MultipleScatteringConstant;
   }
-  j["medium"]["phase"] = Json::array();
-  for (const auto& p : m.Phase)
+  j["medium"]["phase"] = PhaseJson(m.Phase);
+  if (m.Emission.Enabled)
   {
-    Json component;
-    component["type"] = p.Type;
-    component["g"] = p.G;
-    component["weight"] = p.Weight;
-    j["medium"]["phase"].push_back(component);
+    j["medium"]["emission"] = EmissionJson(m.Emission);
   }
 
   j["sun"]["azimuth_degrees"] = s.Sun.AzimuthDegrees;
@@ -1055,6 +1294,51 @@ Json ToJson(const SceneDescription& s)
   j["background"]["radiance"] = s.Background.Radiance;
 
   j["spectral_samples"] = s.SpectralSamples;
+
+  // Version 3's keys only when used: a scene without them reads as a version-2 file
+  // would (and its canonical text differs from version 2's only in the version).
+  if (!s.Lights.empty())
+  {
+    j["lights"] = Json::array();
+  }
+  for (const LightDescription& l : s.Lights)
+  {
+    Json light;
+    light["type"] = l.Type;
+    if (l.Type == "point")
+    {
+      light["position"] = Vector3Json(l.Position);
+      light["intensity"] = l.Intensity;
+    }
+    else
+    {
+      light["vertices"] = Json::array();
+      for (const auto& vertex : l.Vertices)
+      {
+        light["vertices"].push_back(Vector3Json(vertex));
+      }
+      light["intensity_per_metre"] = l.IntensityPerMetre;
+    }
+    light["temperature_kelvin"] = l.TemperatureKelvin;
+    j["lights"].push_back(light);
+  }
+  if (!s.Media.empty())
+  {
+    j["media"] = Json::array();
+  }
+  for (const AdditionalMediumDescription& extra : s.Media)
+  {
+    Json medium;
+    medium["density"] = DensityJson(extra.Density);
+    medium["extinction_per_density"] = extra.ExtinctionPerDensity;
+    medium["single_scattering_albedo"] = extra.SingleScatteringAlbedo;
+    medium["phase"] = PhaseJson(extra.Phase);
+    if (extra.Emission.Enabled)
+    {
+      medium["emission"] = EmissionJson(extra.Emission);
+    }
+    j["media"].push_back(medium);
+  }
   return j;
 }
 
@@ -1107,11 +1391,18 @@ void WritePretty(const Json& v, int indent, std::string& out)
 namespace
 {
 SceneDescription ReadScene(
-  const Json& root, const std::string& path, const std::string& baseDirectory)
+  const Json& root, const std::string& path, const std::string& baseDirectory, int version)
 {
-  const ObjectReader r(root, path,
-    { "nimbus_scene", "name", "description", "camera", "medium", "sun", "atmosphere", "ground",
-      "background", "spectral_samples" });
+  std::vector<std::string> known = { "nimbus_scene", "name", "description", "camera", "medium",
+    "sun", "atmosphere", "ground", "background", "spectral_samples" };
+  RefuseVersion3Key(root, path, "lights", version, known);
+  RefuseVersion3Key(root, path, "media", version, known);
+  if (version >= 3)
+  {
+    known.push_back("lights");
+    known.push_back("media");
+  }
+  const ObjectReader r(root, path, known);
   SceneDescription s;
   if (r.Has("name"))
   {
@@ -1122,7 +1413,7 @@ SceneDescription ReadScene(
     s.Description = ReadString(r["description"], r.Key("description"));
   }
   s.Camera = ReadCamera(r.Require("camera"), r.Key("camera"));
-  s.Medium = ReadMedium(r.Require("medium"), r.Key("medium"), baseDirectory);
+  s.Medium = ReadMedium(r.Require("medium"), r.Key("medium"), baseDirectory, version);
   s.Sun = ReadSun(r.Require("sun"), r.Key("sun"));
   if (r.Has("atmosphere"))
   {
@@ -1137,6 +1428,25 @@ SceneDescription ReadScene(
     s.Background = ReadBackground(r["background"], r.Key("background"));
   }
   r.Integer("spectral_samples", s.SpectralSamples, 3, 256);
+  if (r.Has("lights"))
+  {
+    RequireArray(r["lights"], r.Key("lights"), kMaxLights, "lights");
+    for (std::size_t i = 0; i < r["lights"].size(); ++i)
+    {
+      s.Lights.push_back(
+        ReadLight(r["lights"][i], r.Key("lights") + "[" + std::to_string(i) + "]"));
+    }
+  }
+  if (r.Has("media"))
+  {
+    RequireArray(r["media"], r.Key("media"), kMaxAdditionalMedia, "media");
+    for (std::size_t i = 0; i < r["media"].size(); ++i)
+    {
+      const std::string mediumPath = r.Key("media") + "[" + std::to_string(i) + "]";
+      s.Media.push_back(ReadAdditionalMedium(r["media"][i], mediumPath, baseDirectory));
+      RequireSameMetaballGrid(s.Medium.Density, s.Media.back().Density, mediumPath);
+    }
+  }
 
   if (s.Background.Type == "atmosphere" && !s.Atmosphere.Enabled)
   {
@@ -1184,7 +1494,7 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
         Describe(version));
   }
   const std::string number = version.dump();
-  if (number != "1" && number != std::to_string(SceneDescription::kFormatVersion))
+  if (number != "1" && number != "2" && number != std::to_string(SceneDescription::kFormatVersion))
   {
     Fail(path + ".nimbus_scene",
       "unsupported format version " + number + "; this build of Nimbus reads " + versions);
@@ -1194,14 +1504,14 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
     MigrateSceneVersion1(root);
     try
     {
-      return ReadScene(root, path, baseDirectory);
+      return ReadScene(root, path, baseDirectory, 1);
     }
     catch (const std::invalid_argument& error)
     {
       throw std::invalid_argument(InSceneVersion1Words(error.what()));
     }
   }
-  return ReadScene(root, path, baseDirectory);
+  return ReadScene(root, path, baseDirectory, number == "2" ? 2 : 3);
 }
 
 SceneDescription LoadScene(const std::string& path)

@@ -1,11 +1,13 @@
 // The versioned JSON scene file (format: docs/scene-format.md).
 //
-//   {"nimbus_scene": 2, "camera": {...}, "medium": {...}, "sun": {...}, ...}
+//   {"nimbus_scene": 3, "camera": {...}, "medium": {...}, "sun": {...}, ...}
 //
-// Version 2 names the sun's and the air's parameters as Physics/Sun.h and
+// Version 3 adds lights (point, polyline), per-voxel emission and additional media;
+// version 2 names the sun's and the air's parameters as Physics/Sun.h and
 // Physics/Atmosphere.h do, with their units ("elevation_degrees",
 // "mie_scattering_per_metre"). Version-1 files still load: their keys are renamed
-// on reading (the table in docs/scene-format.md); SceneToJson writes version 2.
+// on reading (the table in docs/scene-format.md); version-2 files are version-3
+// files without the new keys. SceneToJson writes version 3.
 //
 // ParseScene/LoadScene validate everything they read and throw
 // std::invalid_argument with a message that starts with the key path of the

@@ -4,7 +4,9 @@
 // Version 1 named the sun's and the air's parameters without their units; version 2
 // names them as Physics/Sun.h and Physics/Atmosphere.h do (and as the mapper, the
 // sky, the Python API and the plugin do). A version-1 file is read by renaming
-// those keys; nothing else changed. Private to SceneJson.cxx.
+// those keys; nothing else changed. Version 3 only added keys (lights, media,
+// medium.emission): a version-2 file needs no migration, and SceneJson.cxx refuses the
+// new keys in older files. Private to SceneJson.cxx.
 #ifndef NimbusSceneMigration_h
 #define NimbusSceneMigration_h
 

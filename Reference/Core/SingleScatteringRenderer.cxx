@@ -124,6 +124,37 @@ void CheckStepScale(double stepScale)
   }
 }
 
+/// The version-3 features (docs/scene-format.md) this renderer does not render: an
+/// error naming them, rather than an image without them.
+void RefuseVersion3Features(const SceneDescription& scene)
+{
+  std::string missing;
+  auto add = [&missing](const std::string& what)
+  { missing += (missing.empty() ? "" : ", ") + what; };
+  if (!scene.Lights.empty())
+  {
+    add("point and polyline lights (scene.lights)");
+  }
+  bool emission = scene.Medium.Emission.Enabled;
+  for (const auto& m : scene.Media)
+  {
+    emission = emission || m.Emission.Enabled;
+  }
+  if (emission)
+  {
+    add("emission (scene.medium.emission, scene.media[i].emission)");
+  }
+  if (!scene.Media.empty())
+  {
+    add("additional media (scene.media)");
+  }
+  if (!missing.empty())
+  {
+    throw std::invalid_argument("the single-scattering renderer does not render " + missing +
+      "; render this scene with the path tracer");
+  }
+}
+
 /// Everything a ray needs that depends only on the context and the step; shared
 /// (read-only) by the threads.
 class Integrator
@@ -137,6 +168,7 @@ public:
     , N(context.GetNumberOfWavelengths())
   {
     CheckStepScale(stepScale);
+    RefuseVersion3Features(context.GetScene());
     this->HasGrid = !this->Grid.IsEmpty() && this->Ctx.CloudMajorant() > 0.0;
     const double spacing = this->Grid.IsEmpty() ? 100.0 : this->Grid.GetMinimumSpacing();
     this->Step = stepScale * spacing; // m

@@ -494,3 +494,143 @@ TEST(ReferenceRobustness, PathTracingReportsProgressAndAborts)
   EXPECT_FALSE(HasRadiance(renderer->GetOutput()));
   EXPECT_EQ(messages.AllErrors(), "");
 }
+
+//------------------------------------------------------------------------------
+// Scene format version 3 through vtkNimbusReferenceRenderer: additional media and
+// "array" emission fields are read from their .vti files; the path tracer renders them
+// with a point light to finite pixels; single scattering refuses them by name; a NaN in
+// an emission array is counted and named as a density's is; what the renderer cannot
+// read is named by its scene key.
+
+namespace
+{
+std::string Replaced(std::string text, const std::string& from, const std::string& to)
+{
+  const std::size_t at = text.find(from);
+  if (at == std::string::npos)
+  {
+    ADD_FAILURE() << "no " << from;
+    return text;
+  }
+  return text.replace(at, from.size(), to);
+}
+
+/// tiny_scene.json as version 3 with a file density (the cube), emission from the
+/// array `emission`, an additional medium from the array `medium`, and a point light.
+std::string WriteVersion3Scene(const std::string& name, const std::string& vti,
+  const std::string& emission, const std::string& mediumDensity)
+{
+  std::ifstream in(std::string(NIMBUS_TEST_DATA_DIR) + "/tiny_scene.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = Replaced(text, "\"nimbus_scene\": 2", "\"nimbus_scene\": 3");
+  text = Replaced(text,
+    "\"type\": \"metaball_cloud\",\n      \"parameters\": {\n        \"Dimensions\": [24, 24, "
+    "16],\n        \"NumberOfLevels\": 1,\n        \"Seed\": 2\n      }",
+    "\"type\": \"file\", \"path\": \"" + vti + "\"");
+  text = Replaced(text, "\"single_scattering_albedo\": 0.99,",
+    "\"single_scattering_albedo\": 0.99, \"emission\": {\"source\": \"array\", \"array\": \"" +
+      emission + "\", \"radiance_per_metre\": 0.001},");
+  text = Replaced(text, "\"spectral_samples\": 8",
+    "\"spectral_samples\": 8, \"media\": [{\"density\": " + mediumDensity +
+      ", \"extinction_per_density\": 0.02, \"single_scattering_albedo\": 0.3, \"phase\": "
+      "{\"type\": \"isotropic\"}}], \"lights\": [{\"type\": \"point\", \"position\": [0, "
+      "-1000, 1500], \"intensity\": 1e6}]");
+  const fs::path path = TemporaryDirectory() / (name + ".json");
+  std::ofstream(path) << text;
+  return path.string();
+}
+} // namespace
+
+TEST(ReferenceRobustness, Version3ScenesRenderOrNameWhatIsMissing)
+{
+  vtkSmartPointer<vtkImageData> cube = Cube();
+  for (const char* name : { "heat", "soot", "heatnan" })
+  {
+    vtkNew<vtkFloatArray> values;
+    values->SetName(name);
+    values->SetNumberOfTuples(512);
+    values->FillValue(0.5f);
+    if (std::string(name) == "heatnan")
+    {
+      values->SetValue(17, std::numeric_limits<float>::quiet_NaN());
+    }
+    cube->GetPointData()->AddArray(values);
+  }
+  const fs::path vti = TemporaryDirectory() / "version3.vti";
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetFileName(vti.string().c_str());
+  writer->SetInputData(cube);
+  ASSERT_EQ(writer->Write(), 1);
+  const std::string soot =
+    "{\"type\": \"file\", \"path\": \"" + vti.string() + "\", \"array\": \"soot\"}";
+  auto render = [](const std::string& scene, bool pathTracing, std::string& errors)
+  {
+    vtkNew<vtkNimbusReferenceRenderer> renderer;
+    MessageCatcher messages(renderer);
+    renderer->SetSceneFileName(scene.c_str());
+    renderer->SetNumberOfThreads(1);
+    renderer->SetMaxRefinements(0);
+    if (pathTracing)
+    {
+      renderer->SetModeToPathTracing();
+      renderer->SetMinSamplesPerPixel(2);
+      renderer->SetMaxSamplesPerPixel(2);
+    }
+    renderer->Update();
+    errors = messages.AllErrors();
+    vtkImageData* output = renderer->GetOutput();
+    if (!HasRadiance(output))
+    {
+      return false;
+    }
+    vtkDataArray* radiance = output->GetPointData()->GetArray("radiance");
+    for (vtkIdType i = 0; i < radiance->GetNumberOfValues(); ++i)
+    {
+      EXPECT_TRUE(std::isfinite(radiance->GetVariantValue(i).ToDouble()));
+    }
+    return true;
+  };
+  std::string errors;
+  const std::string good = WriteVersion3Scene("version3", vti.string(), "heat", soot);
+  EXPECT_TRUE(render(good, true, errors)) << errors;
+  EXPECT_FALSE(render(good, false, errors));
+  EXPECT_NE(errors.find("the single-scattering renderer does not render point and polyline "
+                        "lights (scene.lights), emission"),
+    std::string::npos)
+    << errors;
+  EXPECT_FALSE(
+    render(WriteVersion3Scene("version3-nan", vti.string(), "heatnan", soot), true, errors));
+  EXPECT_NE(errors.find("scene.medium.emission.array: array 'heatnan': nimbus::DensityGrid: 1 NaN"),
+    std::string::npos)
+    << errors;
+  EXPECT_FALSE(
+    render(WriteVersion3Scene("version3-missing", vti.string(), "nope", soot), true, errors));
+  EXPECT_NE(errors.find("scene.medium.emission.array: '" + vti.string() +
+              "' has no one-component point array 'nope'"),
+    std::string::npos)
+    << errors;
+  // A metaball cloud as the additional medium: made by vtkNimbusSceneDensitySource
+  // (Medium 1); its grid is not the cube's, which is an error naming the key.
+  EXPECT_FALSE(render(WriteVersion3Scene("version3-metaballs", vti.string(), "heat",
+                        "{\"type\": \"metaball_cloud\", \"parameters\": {\"Dimensions\": "
+                        "[8, 8, 8]}}"),
+    true, errors));
+  EXPECT_NE(errors.find("scene: media[0].density must be on the main density's grid (8x8x8 "
+                        "points, origin (-350"),
+    std::string::npos)
+    << errors;
+  {
+    vtkNew<vtkNimbusSceneDensitySource> source;
+    MessageCatcher messages(source);
+    source->SetSceneFileName(good.c_str());
+    source->SetMedium(2);
+    source->Update();
+    EXPECT_NE(
+      messages.AllErrors().find("Medium 2 asks for media[1], but the scene has 1 additional media"),
+      std::string::npos)
+      << messages.AllErrors();
+    source->SetMedium(1);
+    source->Update();
+    EXPECT_EQ(source->GetOutput()->GetNumberOfPoints(), 512);
+  }
+}

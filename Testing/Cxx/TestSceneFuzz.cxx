@@ -8,6 +8,9 @@
 // exception, a hang, a non-finite pixel or a valid scene that fails to render fails
 // the test.
 //
+// One more base scene adds version 3's lights (point, polyline) and emission to the first
+// project scene, so that its mutants carry bad values of the new keys.
+//
 // Mutations: a number scaled by 0, -1, 1e-308 ... 1e300 (often still valid), a value
 // replaced by an extreme (0, -1, +-1e308, 1e-308, huge integers,
 // 1e400, NaN-ish strings and bare words, wrong types), several values at once, a
@@ -333,6 +336,31 @@ Json Cheap(const fs::path& file)
   return j;
 }
 
+/// A version-3 scene from a project scene: a point light inside the cloud, a lightning
+/// channel (polyline) through it to the ground, emission from the density, and emitting
+/// smoke as a second medium on the cloud's grid. Its
+/// mutants reach the new keys (and bad values of them) as the others reach the old ones.
+Json WithVersion3Features(Json j)
+{
+  j["nimbus_scene"] = 3;
+  j["name"] = j["name"].get<std::string>() + "_lit";
+  j["medium"]["emission"] = Json::parse(
+    R"({"source": "from_density", "radiance_per_metre": 0.001, "temperature_kelvin": 1200})");
+  // Smoke: another metaball cloud on the same grid, emitting, with its own phase.
+  Json smoke = Json::parse(R"({"density": {"type": "metaball_cloud"}, "extinction_per_density":
+    0.02, "single_scattering_albedo": 0.4, "phase": {"type": "henyey_greenstein", "g": 0.3},
+    "emission": {"source": "from_density", "radiance_per_metre": 0.002}})");
+  smoke["density"]["parameters"] = j["medium"]["density"]["parameters"];
+  smoke["density"]["parameters"]["Seed"] = 99;
+  j["media"] = Json::array({ smoke });
+  j["lights"] = Json::parse(R"([
+    {"type": "point", "position": [0, 0, 1500], "intensity": 1e5, "temperature_kelvin": 3000},
+    {"type": "polyline", "vertices": [[200, 0, 2500], [150, 40, 1200], [260, 10, 0]],
+     "intensity_per_metre": 1000, "temperature_kelvin": 25000}
+  ])");
+  return j;
+}
+
 /// In the child: what happens to one mutant.
 std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& sceneFile)
 {
@@ -355,21 +383,31 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
   // Valid: at most 8x6 pixels and 16 points per axis, whatever the mutant says.
   scene.Camera.Width = std::min(scene.Camera.Width, 8);
   scene.Camera.Height = std::min(scene.Camera.Height, 6);
-  for (auto& parameter : scene.Medium.Density.Parameters)
+  auto clamp = [](nimbus::DensitySourceDescription& density)
   {
-    if (parameter.first == "Dimensions")
+    for (auto& parameter : density.Parameters)
     {
-      for (double& d : parameter.second)
+      if (parameter.first == "Dimensions")
       {
-        d = std::min(d, 16.0);
+        for (double& d : parameter.second)
+        {
+          d = std::min(d, 16.0);
+        }
       }
     }
+  };
+  clamp(scene.Medium.Density);
+  for (auto& medium : scene.Media)
+  {
+    clamp(medium.Density);
   }
   std::ofstream(sceneFile) << nimbus::SceneToJson(scene);
 
   vtkNew<vtkNimbusReferenceRenderer> renderer;
   nimbus::testing::MessageCatcher messages(renderer);
   renderer->SetSceneFileName(sceneFile.string().c_str());
+  // Version-3 features are the path tracer's: single scattering refuses them by name.
+  const bool refusedBySingleScattering = scene.UsesVersion3Features();
   renderer->SetModeToSingleScattering();
   renderer->SetMaxRefinements(0);
   renderer->SetStepScale(1.0);
@@ -384,14 +422,24 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
   }
   auto* radiance =
     vtkFloatArray::SafeDownCast(renderer->GetOutput()->GetPointData()->GetArray("radiance"));
-  if (!radiance)
+  if (refusedBySingleScattering)
+  {
+    const std::string errors = messages.AllErrors();
+    if (radiance ||
+      errors.find("the single-scattering renderer does not render") == std::string::npos)
+    {
+      return { Outcome::RenderFailed,
+        "single scattering did not refuse a version-3 scene: " + errors };
+    }
+  }
+  else if (!radiance)
   {
     const std::string errors = messages.AllErrors();
     return { errors.find("memory budget") != std::string::npos ? Outcome::OverBudget
                                                                : Outcome::RenderFailed,
       errors };
   }
-  for (vtkIdType i = 0; i < radiance->GetNumberOfValues(); ++i)
+  for (vtkIdType i = 0; radiance && i < radiance->GetNumberOfValues(); ++i)
   {
     if (!std::isfinite(radiance->GetValue(i)))
     {
@@ -502,6 +550,7 @@ TEST(SceneFuzz, MutantsAreRefusedCleanlyOrRenderFinite)
   }
   std::sort(scenes.begin(), scenes.end()); // a fixed order: the same mutants every run
   ASSERT_GE(scenes.size(), 5u);
+  scenes.push_back(scenes.front()); // again, with the version-3 features (below)
   const fs::path work = fs::temp_directory_path() /
     ("nimbus-scene-fuzz-" + std::to_string(::getpid()) + "-" +
       std::to_string(std::random_device{}()));
@@ -513,9 +562,10 @@ TEST(SceneFuzz, MutantsAreRefusedCleanlyOrRenderFinite)
   int mutants = 0;
   double slowest = 0.0;
   const auto start = std::chrono::steady_clock::now();
-  for (const fs::path& file : scenes)
+  for (std::size_t s = 0; s < scenes.size(); ++s)
   {
-    const Json base = Cheap(file);
+    const fs::path& file = scenes[s];
+    const Json base = s + 1 == scenes.size() ? WithVersion3Features(Cheap(file)) : Cheap(file);
     // The unmutated (cheap) scene must render: the oracle is not vacuous.
     const auto original = JudgeInChild({ "none", base.dump(2) }, work / "original.json");
     EXPECT_EQ(original.first, Outcome::Rendered) << file << ": " << original.second;

@@ -10,9 +10,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -78,6 +80,50 @@ void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
   EXPECT_EQ(a.Background.Type, b.Background.Type);
   EXPECT_EQ(a.Background.Radiance, b.Background.Radiance);
   EXPECT_EQ(a.SpectralSamples, b.SpectralSamples);
+  // Version 3.
+  auto sameEmission = [](const nimbus::EmissionDescription& x, const nimbus::EmissionDescription& y)
+  {
+    EXPECT_EQ(x.Enabled, y.Enabled);
+    EXPECT_EQ(x.Source, y.Source);
+    EXPECT_EQ(x.ArrayName, y.ArrayName);
+    EXPECT_EQ(x.RadiancePerMetre, y.RadiancePerMetre);
+    EXPECT_EQ(x.TemperatureKelvin, y.TemperatureKelvin);
+  };
+  sameEmission(a.Medium.Emission, b.Medium.Emission);
+  ASSERT_EQ(a.Lights.size(), b.Lights.size());
+  for (std::size_t i = 0; i < a.Lights.size(); ++i)
+  {
+    EXPECT_EQ(a.Lights[i].Type, b.Lights[i].Type);
+    EXPECT_EQ(a.Lights[i].TemperatureKelvin, b.Lights[i].TemperatureKelvin);
+    if (a.Lights[i].Type == "point")
+    {
+      EXPECT_EQ(a.Lights[i].Position, b.Lights[i].Position);
+      EXPECT_EQ(a.Lights[i].Intensity, b.Lights[i].Intensity);
+    }
+    else
+    {
+      EXPECT_EQ(a.Lights[i].Vertices, b.Lights[i].Vertices);
+      EXPECT_EQ(a.Lights[i].IntensityPerMetre, b.Lights[i].IntensityPerMetre);
+    }
+  }
+  ASSERT_EQ(a.Media.size(), b.Media.size());
+  for (std::size_t i = 0; i < a.Media.size(); ++i)
+  {
+    EXPECT_EQ(a.Media[i].Density.Type, b.Media[i].Density.Type);
+    EXPECT_EQ(a.Media[i].Density.Path, b.Media[i].Density.Path);
+    EXPECT_EQ(a.Media[i].Density.ArrayName, b.Media[i].Density.ArrayName);
+    EXPECT_EQ(a.Media[i].Density.Parameters, b.Media[i].Density.Parameters);
+    EXPECT_EQ(a.Media[i].ExtinctionPerDensity, b.Media[i].ExtinctionPerDensity);
+    EXPECT_EQ(a.Media[i].SingleScatteringAlbedo, b.Media[i].SingleScatteringAlbedo);
+    ASSERT_EQ(a.Media[i].Phase.size(), b.Media[i].Phase.size());
+    for (std::size_t k = 0; k < a.Media[i].Phase.size(); ++k)
+    {
+      EXPECT_EQ(a.Media[i].Phase[k].Type, b.Media[i].Phase[k].Type);
+      EXPECT_EQ(a.Media[i].Phase[k].G, b.Media[i].Phase[k].G);
+      EXPECT_EQ(a.Media[i].Phase[k].Weight, b.Media[i].Phase[k].Weight);
+    }
+    sameEmission(a.Media[i].Emission, b.Media[i].Emission);
+  }
 }
 
 /// The smallest valid scene text.
@@ -129,6 +175,44 @@ SceneDescription NonDefaultScene()
   s.Ground = { false, 12.0, 0.35 };
   s.Background = { "constant", 0.125 };
   s.SpectralSamples = 24;
+  return s;
+}
+
+/// NonDefaultScene with every version-3 feature: a point light, a polyline, emission
+/// from an array, and two additional media (one emitting from its density).
+SceneDescription Version3Scene()
+{
+  SceneDescription s = NonDefaultScene();
+  s.Name = "version3";
+  s.Medium.Emission = { true, "array", "temperature", 0.25, 1200.0 };
+  nimbus::LightDescription point;
+  point.Type = "point";
+  point.Position = { { 10.0, -20.0, 1500.5 } };
+  point.Intensity = 2.5e6;
+  point.TemperatureKelvin = 3000.0;
+  nimbus::LightDescription channel;
+  channel.Type = "polyline";
+  channel.Vertices = { { { 0.0, 0.0, 3000.0 } }, { { 50.0, 10.0, 2000.0 } },
+    { { 20.0, -30.0, 0.0 } } };
+  channel.IntensityPerMetre = 1.0e4;
+  channel.TemperatureKelvin = 28000.0;
+  s.Lights = { point, channel };
+  nimbus::AdditionalMediumDescription smoke;
+  smoke.Density.Type = "file";
+  smoke.Density.Path = "/data/clouds/smoke.vti";
+  smoke.Density.ArrayName = "soot";
+  smoke.ExtinctionPerDensity = 0.5;
+  smoke.SingleScatteringAlbedo = 0.3;
+  smoke.Phase = { { "henyey_greenstein", 0.4, 1.0 } };
+  smoke.Emission = { true, "from_density", "", 2.0, 900.0 };
+  nimbus::AdditionalMediumDescription haze;
+  haze.Density.Type = "file";
+  haze.Density.Path = "/data/clouds/cloud.vti";
+  haze.Density.ArrayName = "haze";
+  haze.ExtinctionPerDensity = 0.001;
+  haze.SingleScatteringAlbedo = 1.0;
+  haze.Phase = { { "isotropic", 0.85, 1.0 } };
+  s.Media = { smoke, haze };
   return s;
 }
 
@@ -268,7 +352,8 @@ TEST(SceneJson, ProjectScenesPhysics)
 
 TEST(SceneJson, RoundTrip)
 {
-  for (const SceneDescription& s : { SceneDescription{}, NonDefaultScene(), MetaballScene() })
+  for (const SceneDescription& s :
+    { SceneDescription{}, NonDefaultScene(), MetaballScene(), Version3Scene() })
   {
     SCOPED_TRACE(s.Name);
     const std::string text = nimbus::SceneToJson(s);
@@ -292,7 +377,11 @@ TEST(SceneJson, CanonicalForm)
 {
   const std::string text = nimbus::SceneToJson(MetaballScene());
   // Fixed key order, integers and booleans where the property is one.
-  EXPECT_LT(text.find("\"nimbus_scene\": 2"), text.find("\"camera\""));
+  EXPECT_LT(text.find("\"nimbus_scene\": 3"), text.find("\"camera\""));
+  // Version 3's keys are written only when used.
+  EXPECT_EQ(text.find("\"lights\""), std::string::npos);
+  EXPECT_EQ(text.find("\"media\""), std::string::npos);
+  EXPECT_EQ(text.find("\"emission\""), std::string::npos);
   EXPECT_NE(text.find("\"Seed\": -7"), std::string::npos);
   EXPECT_NE(text.find("\"FlatBase\": false"), std::string::npos);
   EXPECT_NE(text.find("\"width\": 256"), std::string::npos);
@@ -317,7 +406,8 @@ TEST(SceneJson, HashStable)
   EXPECT_EQ(nimbus::SceneHash(s), hash);
   // Pinned: the canonical form (and so every cached reference image's key) changes only
   // on purpose. Update this when a field is added or the format changes deliberately.
-  EXPECT_EQ(hash, "5e1d742df6799b74"); // format version 2
+  // Version 3 changed it from 5e1d742df6799b74 (version 2) by the version number alone.
+  EXPECT_EQ(hash, "da42e138a75ee723"); // format version 3
   EXPECT_EQ(nimbus::SceneHash(nimbus::ParseScene(nimbus::SceneToJson(s), "")), hash);
   // Formatting and key order of the text do not matter, only the description.
   Json a = MinimalJson(), b = Json::parse(R"({
@@ -411,7 +501,8 @@ TEST(SceneJson, Errors)
   ExpectErrorText("{\"nimbus_scene\": 2,", "scene");
   ExpectErrorText("[1, 2]", "scene: expected an object");
   ExpectError(Without("/nimbus_scene"), "scene: missing required key \"nimbus_scene\"");
-  ExpectError(With("/nimbus_scene", 3), "scene.nimbus_scene: unsupported format version 3");
+  ExpectError(With("/nimbus_scene", 4),
+    "scene.nimbus_scene: unsupported format version 4; this build of Nimbus reads versions 1 to 3");
   ExpectError(With("/nimbus_scene", 0), "scene.nimbus_scene: unsupported format version 0");
   ExpectError(With("/nimbus_scene", "2"), "scene.nimbus_scene: expected the format version");
   ExpectError(With("/nimbus_scene", 1.5), "scene.nimbus_scene: expected the format version");
@@ -772,8 +863,8 @@ TEST(SceneJson, Version1FilesLoadAsTheSameScene)
     ASSERT_TRUE(written[key[0]].contains(key[2])) << key[2];
   }
   ExpectSameScene(Parse(AsVersion1(written)), Parse(written));
-  // Written back, a version-1 scene is version 2.
-  EXPECT_NE(nimbus::SceneToJson(old).find("\"nimbus_scene\": 2"), std::string::npos);
+  // Written back, a version-1 scene is version 3.
+  EXPECT_NE(nimbus::SceneToJson(old).find("\"nimbus_scene\": 3"), std::string::npos);
 }
 
 TEST(SceneJson, Version1ErrorsNameTheVersion1Keys)
@@ -925,4 +1016,328 @@ TEST(SceneJson, HugeCameraCoordinatesAreNamedNotCalledEqual)
   const SceneDescription s = Parse(With("/sun", sun));
   EXPECT_NEAR(s.Sun.ElevationDegrees, std::atan(1.0 / std::sqrt(2.0)) * 180.0 / M_PI, 1e-12);
   EXPECT_EQ(s.Sun.AzimuthDegrees, 45.0);
+}
+
+//------------------------------------------------------------------------------
+// Version 3: lights (point, polyline), per-voxel emission, additional media.
+
+namespace
+{
+/// MinimalJson as version 3 with every new key.
+Json Version3Json()
+{
+  Json j = MinimalJson();
+  j["nimbus_scene"] = 3;
+  j["medium"]["density"] = Json::parse(R"({"type": "file", "path": "grids/c.vti"})");
+  j["medium"]["emission"] =
+    Json::parse(R"({"source": "array", "array": "heat", "radiance_per_metre": 0.5})");
+  j["lights"] = Json::parse(R"([
+    {"type": "point", "position": [0, 0, 1000], "intensity": 1e6, "temperature_kelvin": 3200},
+    {"type": "polyline", "vertices": [[0, 0, 3000], [100, 0, 2000], [100, 50, 0]],
+     "intensity_per_metre": 2e4}
+  ])");
+  j["media"] = Json::parse(R"([
+    {"density": {"type": "file", "path": "grids/smoke.vti", "array": "soot"},
+     "extinction_per_density": 0.3, "single_scattering_albedo": 0.4,
+     "phase": {"type": "henyey_greenstein", "g": 0.5},
+     "emission": {"source": "from_density", "radiance_per_metre": 3, "temperature_kelvin": 900}}
+  ])");
+  return j;
+}
+
+Json V3With(const std::string& pointer, const Json& value)
+{
+  Json j = Version3Json();
+  j[Json::json_pointer(pointer)] = value;
+  return j;
+}
+
+Json V3Without(const std::string& pointer)
+{
+  Json j = Version3Json();
+  const Json::json_pointer p(pointer);
+  j[p.parent_pointer()].erase(p.back());
+  return j;
+}
+} // namespace
+
+TEST(SceneJson, Version3KeysParse)
+{
+  const SceneDescription s = Parse(Version3Json(), "/scenes");
+  EXPECT_TRUE(s.UsesVersion3Features());
+  EXPECT_TRUE(s.Medium.Emission.Enabled);
+  EXPECT_EQ(s.Medium.Emission.Source, "array");
+  EXPECT_EQ(s.Medium.Emission.ArrayName, "heat");
+  EXPECT_EQ(s.Medium.Emission.RadiancePerMetre, 0.5);
+  EXPECT_EQ(s.Medium.Emission.TemperatureKelvin, 1500.0); // default
+  ASSERT_EQ(s.Lights.size(), 2u);
+  EXPECT_EQ(s.Lights[0].Type, "point");
+  EXPECT_EQ(s.Lights[0].Position, (std::array<double, 3>{ { 0.0, 0.0, 1000.0 } }));
+  EXPECT_EQ(s.Lights[0].Intensity, 1e6);
+  EXPECT_EQ(s.Lights[0].TemperatureKelvin, 3200.0);
+  EXPECT_EQ(s.Lights[1].Type, "polyline");
+  ASSERT_EQ(s.Lights[1].Vertices.size(), 3u);
+  EXPECT_EQ(s.Lights[1].Vertices[2], (std::array<double, 3>{ { 100.0, 50.0, 0.0 } }));
+  EXPECT_EQ(s.Lights[1].IntensityPerMetre, 2e4);
+  EXPECT_EQ(s.Lights[1].TemperatureKelvin, 6500.0); // default
+  ASSERT_EQ(s.Media.size(), 1u);
+  EXPECT_EQ(s.Media[0].Density.Path, "/scenes/grids/smoke.vti"); // resolved like medium's
+  EXPECT_EQ(s.Media[0].Density.ArrayName, "soot");
+  EXPECT_EQ(s.Media[0].ExtinctionPerDensity, 0.3);
+  EXPECT_EQ(s.Media[0].SingleScatteringAlbedo, 0.4);
+  ASSERT_EQ(s.Media[0].Phase.size(), 1u);
+  EXPECT_EQ(s.Media[0].Phase[0].G, 0.5);
+  EXPECT_TRUE(s.Media[0].Emission.Enabled);
+  EXPECT_EQ(s.Media[0].Emission.Source, "from_density");
+  EXPECT_EQ(s.Media[0].Emission.TemperatureKelvin, 900.0);
+  // Canonical round trip.
+  const std::string text = nimbus::SceneToJson(s);
+  EXPECT_NE(text.find("\"lights\""), std::string::npos);
+  const SceneDescription back = nimbus::ParseScene(text, "/elsewhere");
+  ExpectSameScene(back, s);
+  EXPECT_EQ(nimbus::SceneToJson(back), text);
+  // Empty arrays are allowed and mean no lights / no media.
+  Json j = Version3Json();
+  j["lights"] = Json::array();
+  j["media"] = Json::array();
+  j["medium"].erase("emission");
+  const SceneDescription none = Parse(j);
+  EXPECT_FALSE(none.UsesVersion3Features());
+}
+
+TEST(SceneJson, Version3KeysNeedVersion3)
+{
+  // A version-2 (or 1) file with a version-3 key: an unknown key, saying which version.
+  Json j = MinimalJson();
+  j["lights"] = Json::array();
+  ExpectError(j,
+    "scene.lights: unknown key (known: nimbus_scene, name, description, camera, medium, sun, "
+    "atmosphere, ground, background, spectral_samples); \"lights\" needs format version 3 "
+    "(\"nimbus_scene\": 3), this file is version 2");
+  j = MinimalJson();
+  j["media"] = Json::array();
+  ExpectError(j, "scene.media: unknown key (known: ");
+  j = MinimalJson();
+  j["medium"]["emission"] = Json::parse(R"({"source": "from_density", "radiance_per_metre": 1})");
+  ExpectError(j, "scene.medium.emission: unknown key (known: density, ");
+  ExpectError(AsVersion1(j), "scene.medium.emission: unknown key");
+  // The same keys in version 3 are fine, and a version-2 file still reads as before.
+  j["nimbus_scene"] = 3;
+  EXPECT_NO_THROW(Parse(j));
+  Json v2 = MinimalJson(), v3 = MinimalJson();
+  v3["nimbus_scene"] = 3;
+  ExpectSameScene(Parse(v2), Parse(v3));
+  EXPECT_EQ(nimbus::SceneHash(Parse(v2)), nimbus::SceneHash(Parse(v3)));
+}
+
+TEST(SceneJson, Version3Errors)
+{
+  // Lights.
+  ExpectError(V3With("/lights", 1), "scene.lights: expected an array of lights, got 1");
+  ExpectError(V3With("/lights", Json::array({ Json::array() })),
+    "scene.lights[0]: expected an object, got the array []");
+  ExpectError(V3With("/lights/0/type", "spot"),
+    "scene.lights[0].type: unknown value \"spot\" (known: point, polyline)");
+  ExpectError(
+    V3Without("/lights/0/type"), "scene.lights[0]: missing required key \"type\" (known: point");
+  ExpectError(
+    V3Without("/lights/0/position"), "scene.lights[0]: missing required key \"position\"");
+  ExpectError(
+    V3Without("/lights/0/intensity"), "scene.lights[0]: missing required key \"intensity\"");
+  ExpectError(V3With("/lights/0/position/2", 2e9),
+    "scene.lights[0].position[2]: expected a number in [-1000000000, 1000000000], got 2000000000");
+  ExpectError(V3With("/lights/0/position", Json::array({ 1, 2 })),
+    "scene.lights[0].position: expected an array of 3 numbers, got 2 elements");
+  ExpectError(V3With("/lights/0/intensity", -1),
+    "scene.lights[0].intensity: expected a number in [0, 1000000000000], got -1");
+  ExpectError(V3With("/lights/0/intensity", 1e13),
+    "scene.lights[0].intensity: expected a number in [0, 1000000000000], got 10000000000000");
+  ExpectError(V3With("/lights/0/temperature_kelvin", 100),
+    "scene.lights[0].temperature_kelvin: expected a number in [500, 100000], got 100");
+  ExpectError(V3With("/lights/0/vertices", Json::array()),
+    "scene.lights[0].vertices: unknown key (known: type, position, intensity, "
+    "temperature_kelvin)");
+  ExpectError(V3With("/lights/1/intensity", 1),
+    "scene.lights[1].intensity: unknown key (known: type, vertices, intensity_per_metre, "
+    "temperature_kelvin)");
+  ExpectError(V3With("/lights/1/vertices", Json::parse("[[0, 0, 0]]")),
+    "scene.lights[1].vertices: expected at least 2 vertices, got 1");
+  ExpectError(V3With("/lights/1/vertices", 5),
+    "scene.lights[1].vertices: expected an array of vertices ([x, y, z], m), got 5");
+  ExpectError(V3With("/lights/1/vertices/1", Json::parse("[0, 0, 3000]")),
+    "scene.lights[1].vertices[1]: a segment of zero length: the same point as vertex 0");
+  ExpectError(V3With("/lights/1/vertices/2/0", "x"),
+    "scene.lights[1].vertices[2][0]: expected a number in [-1000000000, 1000000000], got the "
+    "string \"x\"");
+  ExpectError(V3With("/lights/1/intensity_per_metre", 1e300),
+    "scene.lights[1].intensity_per_metre: expected a number in [0, 1000000000000], got 1e+300");
+  ExpectError(V3Without("/lights/1/intensity_per_metre"),
+    "scene.lights[1]: missing required key \"intensity_per_metre\"");
+  {
+    Json many = Version3Json();
+    many["lights"] = Json::array();
+    for (int i = 0; i < 1025; ++i)
+    {
+      many["lights"].push_back(Version3Json()["lights"][0]);
+    }
+    ExpectError(many, "scene.lights: expected at most 1024 lights, got 1025");
+    Json vertices = Json::array();
+    for (int i = 0; i < 100001; ++i)
+    {
+      vertices.push_back(Json::array({ i, 0, 0 }));
+    }
+    ExpectError(V3With("/lights/1/vertices", vertices),
+      "scene.lights[1].vertices: expected at most 100000 vertices ([x, y, z], m), got 100001");
+  }
+  // Emission.
+  ExpectError(V3With("/medium/emission", 1), "scene.medium.emission: expected an object, got 1");
+  ExpectError(
+    V3Without("/medium/emission/source"), "scene.medium.emission: missing required key \"source\"");
+  ExpectError(V3With("/medium/emission/source", "temperature"),
+    "scene.medium.emission.source: unknown value \"temperature\" (known: from_density, array)");
+  ExpectError(
+    V3Without("/medium/emission/array"), "scene.medium.emission: missing required key \"array\"");
+  ExpectError(V3With("/medium/emission/array", ""),
+    "scene.medium.emission.array: expected a non-empty string");
+  ExpectError(V3Without("/medium/emission/radiance_per_metre"),
+    "scene.medium.emission: missing required key \"radiance_per_metre\"");
+  ExpectError(V3With("/medium/emission/radiance_per_metre", -0.5),
+    "scene.medium.emission.radiance_per_metre: expected a number in [0, 1000000], got -0.5");
+  ExpectError(V3With("/medium/emission/radiance_per_metre", 1e7),
+    "scene.medium.emission.radiance_per_metre: expected a number in [0, 1000000], got 10000000");
+  ExpectError(V3With("/medium/emission/temperature_kelvin", 1e6),
+    "scene.medium.emission.temperature_kelvin: expected a number in [500, 100000], got 1000000");
+  ExpectError(V3With("/medium/emission/glow", 1),
+    "scene.medium.emission.glow: unknown key (known: source, array, radiance_per_metre, "
+    "temperature_kelvin)");
+  ExpectError(V3With("/media/0/emission/array", "heat"),
+    "scene.media[0].emission.array: only used by source \"array\"");
+  {
+    Json j = Version3Json();
+    j["medium"]["density"] = Json::parse(R"({"type": "metaball_cloud"})");
+    ExpectError(j,
+      "scene.medium.emission.source: \"array\" reads another point-data array of the "
+      "density's .vti, so it needs a \"file\" density (this density is \"metaball_cloud\"");
+  }
+  // Media.
+  ExpectError(V3With("/media", Json::object()), "scene.media: expected an array of media, got");
+  ExpectError(V3With("/media/0", 1), "scene.media[0]: expected an object, got 1");
+  ExpectError(V3Without("/media/0/density"), "scene.media[0]: missing required key \"density\"");
+  ExpectError(V3Without("/media/0/extinction_per_density"),
+    "scene.media[0]: missing required key \"extinction_per_density\"");
+  ExpectError(V3With("/media/0/extinction_per_density", 1001),
+    "scene.media[0].extinction_per_density: expected a number in [0, 1000], got 1001");
+  ExpectError(V3With("/media/0/single_scattering_albedo", 1.5),
+    "scene.media[0].single_scattering_albedo: expected a number in [0, 1], got 1.5");
+  ExpectError(
+    V3With("/media/0/phase/g", 2), "scene.media[0].phase.g: expected a number in [-1, 1], got 2");
+  ExpectError(V3With("/media/0/phase", Json::array()),
+    "scene.media[0].phase: expected at least one phase component");
+  ExpectError(V3With("/media/0/density/type", "cloud"),
+    "scene.media[0].density.type: unknown value \"cloud\"");
+  ExpectError(V3With("/media/0/multiple_scattering_constant", 1),
+    "scene.media[0].multiple_scattering_constant: unknown key (known: density, "
+    "extinction_per_density, single_scattering_albedo, phase, emission)");
+  {
+    // Two metaball clouds share a grid only with the same Dimensions and Bounds (the
+    // source's defaults where omitted).
+    Json j = MinimalJson();
+    j["nimbus_scene"] = 3;
+    j["media"] = Json::parse(R"([{"density": {"type": "metaball_cloud", "parameters":
+      {"Dimensions": [96, 96, 64], "Seed": 5}}, "extinction_per_density": 0.01}])");
+    EXPECT_NO_THROW(Parse(j));
+    j["media"][0]["density"]["parameters"]["Dimensions"] = Json::array({ 32, 32, 32 });
+    ExpectError(j,
+      "scene.media[0].density.parameters.Dimensions: every medium must be on the main medium's "
+      "grid: medium.density's Dimensions is [96, 96, 64], this one's [32, 32, 32]");
+    j["media"][0]["density"]["parameters"].erase("Dimensions");
+    j["media"][0]["density"]["parameters"]["Bounds"] = Json::array({ -1, 1, -1, 1, 0, 1 });
+    ExpectError(j, "scene.media[0].density.parameters.Bounds: every medium must be on the main");
+  }
+  {
+    Json many = Version3Json();
+    for (int i = 0; i < 16; ++i)
+    {
+      many["media"].push_back(many["media"][0]);
+    }
+    ExpectError(many, "scene.media: expected at most 16 media, got 17");
+  }
+}
+
+TEST(SceneJson, Version3HashCoversTheNewFields)
+{
+  using Mutation = std::pair<const char*, std::function<void(SceneDescription&)>>;
+  const std::vector<Mutation> mutations = {
+    { "a light moves", [](SceneDescription& s) { s.Lights[0].Position[2] += 1e-6; } },
+    { "Light.Intensity", [](SceneDescription& s) { s.Lights[0].Intensity *= 1.01; } },
+    { "Light.Temperature", [](SceneDescription& s) { s.Lights[0].TemperatureKelvin += 1; } },
+    { "Light.Vertices", [](SceneDescription& s) { s.Lights[1].Vertices[1][0] += 1; } },
+    { "Light.Vertices.size",
+      [](SceneDescription& s) {
+        s.Lights[1].Vertices.push_back({ { 0.0, 0.0, -5.0 } });
+      } },
+    { "Light.IntensityPerMetre", [](SceneDescription& s) { s.Lights[1].IntensityPerMetre += 1; } },
+    { "Lights.size", [](SceneDescription& s) { s.Lights.pop_back(); } },
+    { "Lights.order", [](SceneDescription& s) { std::swap(s.Lights[0], s.Lights[1]); } },
+    { "Emission.Enabled", [](SceneDescription& s) { s.Medium.Emission.Enabled = false; } },
+    { "Emission.Source", [](SceneDescription& s) { s.Medium.Emission.Source = "from_density"; } },
+    { "Emission.ArrayName", [](SceneDescription& s) { s.Medium.Emission.ArrayName += "x"; } },
+    { "Emission.RadiancePerMetre",
+      [](SceneDescription& s) { s.Medium.Emission.RadiancePerMetre += 1; } },
+    { "Emission.TemperatureKelvin",
+      [](SceneDescription& s) { s.Medium.Emission.TemperatureKelvin += 1; } },
+    { "Media.size", [](SceneDescription& s) { s.Media.pop_back(); } },
+    { "Media.Density.Path", [](SceneDescription& s) { s.Media[0].Density.Path += "x"; } },
+    { "Media.Density.ArrayName", [](SceneDescription& s) { s.Media[1].Density.ArrayName += "x"; } },
+    { "Media.ExtinctionPerDensity",
+      [](SceneDescription& s) { s.Media[0].ExtinctionPerDensity += 1; } },
+    { "Media.SingleScatteringAlbedo",
+      [](SceneDescription& s) { s.Media[0].SingleScatteringAlbedo += 0.1; } },
+    { "Media.Phase", [](SceneDescription& s) { s.Media[0].Phase[0].G += 0.1; } },
+    { "Media.Emission", [](SceneDescription& s) { s.Media[0].Emission.RadiancePerMetre += 0.1; } },
+  };
+  const SceneDescription base = Version3Scene();
+  std::set<std::string> hashes = { nimbus::SceneHash(base) };
+  for (const auto& mutation : mutations)
+  {
+    SceneDescription changed = base;
+    mutation.second(changed);
+    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
+      << "changing " << mutation.first << " did not change the hash";
+  }
+}
+
+// The annotated example of docs/scene-format.md (version 3, with a point light and a
+// lightning channel) is a valid scene, and says what the notes under it say.
+TEST(SceneJson, DocumentedExampleParses)
+{
+  std::ifstream in(NIMBUS_SCENE_FORMAT_DOC);
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t section = doc.find("## Annotated example");
+  ASSERT_NE(section, std::string::npos);
+  const std::size_t begin = doc.find("```json\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = doc.find("```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const SceneDescription s = nimbus::ParseScene(doc.substr(begin + 8, end - begin - 8), "/docs");
+  ASSERT_EQ(s.Lights.size(), 2u);
+  EXPECT_EQ(s.Lights[0].Type, "point");
+  EXPECT_EQ(s.Lights[0].Intensity, 2e5);
+  EXPECT_EQ(s.Lights[1].Type, "polyline");
+  EXPECT_EQ(s.Lights[1].Vertices.size(), 4u);
+  EXPECT_EQ(s.Lights[1].TemperatureKelvin, 28000.0);
+  double length = 0.0;
+  for (std::size_t i = 1; i < s.Lights[1].Vertices.size(); ++i)
+  {
+    double d2 = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = s.Lights[1].Vertices[i][a] - s.Lights[1].Vertices[i - 1][a];
+      d2 += d * d;
+    }
+    length += std::sqrt(d2);
+  }
+  std::printf("documented channel: %.0f m, %.3g Y/sr in all\n", length,
+    length * s.Lights[1].IntensityPerMetre);
+  EXPECT_NEAR(length, 2600.0, 200.0); // "about 2.6 km long"
 }

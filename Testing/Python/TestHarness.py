@@ -107,6 +107,27 @@ class HarnessTest(unittest.TestCase):
         self.assertEqual(rmse, sorted(rmse, reverse=True))
         self.assertLess(rmse[-1], 4e-4)
 
+    def test_fast_renderers_refuse_version3_features(self):
+        # Lights (scene format version 3) are the path tracer's: the GPU mappers say so by
+        # name instead of rendering the scene without them.
+        with open(SCENE) as stream:
+            text = stream.read()
+        text = text.replace('"nimbus_scene": 2', '"nimbus_scene": 3').replace(
+            '"spectral_samples": 8',
+            '"spectral_samples": 8, "lights": [{"type": "point", "position": [0, 0, 1500], '
+            '"intensity": 1e5}]')
+        path = os.path.join(self.output, "lit.json")
+        with open(path, "w") as stream:
+            stream.write(text)
+        scene = harness.load_scene(path)
+        self.assertEqual(harness.version3_features(scene),
+                         ["point and polyline lights (scene.lights)"])
+        self.assertEqual(harness.version3_features(harness.load_scene(SCENE)), [])
+        for make in (lambda: harness.VtkGpuRenderer(path, None),
+                     lambda: harness.SvsRenderer(path)):
+            with self.assertRaisesRegex(ValueError, "does not render point and polyline lights"):
+                make()
+
 
 if __name__ == "__main__":
     result = unittest.main(exit=False, verbosity=2).result
