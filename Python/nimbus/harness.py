@@ -770,6 +770,9 @@ def run(arguments):
                     settings_list = json.load(stream)
             else:
                 settings_list = DEFAULT_SETTINGS[renderer_name]
+            if renderer_name in ("vtk-gpu", "svs"):  # before any reference is rendered
+                refuse_version3_features(scene_path, scene, {"vtk-gpu": "VTK GPU mapper",
+                                                             "svs": "SVS mapper"}[renderer_name])
             if renderer_name == "vtk-gpu":
                 # VTK has no sky: its cloud goes over the sky-only version of the reference
                 # that judges it (every vtk-gpu setting has the same one).
