@@ -780,6 +780,25 @@ void RefuseVersion3Key(const Json& v, const std::string& path, const std::string
   }
 }
 
+/// What the main medium and an additional one share: density, extinction, albedo,
+/// phase and (version 3) emission.
+template <class Medium>
+void ReadMediumOptics(const ObjectReader& r, const std::string& base, Medium& m)
+{
+  m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
+  r.RequiredNumber(
+    "extinction_per_density", m.ExtinctionPerDensity, Closed(0.0, kMaxExtinctionPerDensity));
+  r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
+  if (r.Has("phase"))
+  {
+    m.Phase = ReadPhase(r["phase"], r.Key("phase"));
+  }
+  if (r.Has("emission"))
+  {
+    m.Emission = ReadEmission(r["emission"], r.Key("emission"), m.Density);
+  }
+}
+
 MediumDescription ReadMedium(
   const Json& v, const std::string& path, const std::string& base, int version)
 {
@@ -792,19 +811,8 @@ MediumDescription ReadMedium(
   }
   const ObjectReader r(v, path, known);
   MediumDescription m;
-  m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
-  r.RequiredNumber(
-    "extinction_per_density", m.ExtinctionPerDensity, Closed(0.0, kMaxExtinctionPerDensity));
-  r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
+  ReadMediumOptics(r, base, m);
   r.Number("multiple_scattering_constant", m.MultipleScatteringConstant, Closed(0.0, 100.0));
-  if (r.Has("phase"))
-  {
-    m.Phase = ReadPhase(r["phase"], r.Key("phase"));
-  }
-  if (r.Has("emission"))
-  {
-    m.Emission = ReadEmission(r["emission"], r.Key("emission"), m.Density);
-  }
   return m;
 }
 
@@ -814,18 +822,7 @@ AdditionalMediumDescription ReadAdditionalMedium(
   const ObjectReader r(v, path,
     { "density", "extinction_per_density", "single_scattering_albedo", "phase", "emission" });
   AdditionalMediumDescription m;
-  m.Density = ReadDensity(r.Require("density"), r.Key("density"), base);
-  r.RequiredNumber(
-    "extinction_per_density", m.ExtinctionPerDensity, Closed(0.0, kMaxExtinctionPerDensity));
-  r.Number("single_scattering_albedo", m.SingleScatteringAlbedo, Closed(0.0, 1.0));
-  if (r.Has("phase"))
-  {
-    m.Phase = ReadPhase(r["phase"], r.Key("phase"));
-  }
-  if (r.Has("emission"))
-  {
-    m.Emission = ReadEmission(r["emission"], r.Key("emission"), m.Density);
-  }
+  ReadMediumOptics(r, base, m);
   return m;
 }
 

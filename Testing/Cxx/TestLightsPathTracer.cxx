@@ -6,6 +6,7 @@
 // sun, no atmosphere, a black background, so that only the feature under test lights
 // the pixel.
 #include "Math.h"
+#include "MonteCarloAgreement.h"
 #include "PathTracer.h"
 #include "PhaseFunctions.h"
 #include "SingleScatteringRenderer.h"
@@ -644,30 +645,13 @@ TEST(LightsPathTracer, SpeedTechniquesStayUnbiasedWithVersion3Features)
   };
   const PathTracingResult off = render(false, 41, 1024);
   const PathTracingResult on = render(true, 42, 1024);
-  double sumZ2 = 0.0, sumDifference = 0.0, sumVariance = 0.0, sumOff = 0.0;
-  int count = 0, outliers = 0;
-  for (std::size_t i = 0; i < on.Image.Pixels.size(); ++i)
-  {
-    EXPECT_TRUE(std::isfinite(on.Image.Pixels[i]) && std::isfinite(off.Image.Pixels[i]));
-    sumOff += off.Image.Pixels[i];
-    const double sigma = std::hypot(static_cast<double>(on.StandardError.Pixels[i]),
-      static_cast<double>(off.StandardError.Pixels[i]));
-    if (!(sigma > 0.0))
-    {
-      continue;
-    }
-    const double difference = static_cast<double>(on.Image.Pixels[i]) - off.Image.Pixels[i];
-    sumDifference += difference;
-    sumVariance += sigma * sigma;
-    sumZ2 += difference * difference / (sigma * sigma);
-    outliers += std::abs(difference / sigma) > 4.0 ? 1 : 0;
-    ++count;
-  }
-  const double rmsZ = std::sqrt(sumZ2 / std::max(1, count));
-  const double imageZ = sumDifference / std::sqrt(sumVariance);
+  const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(on, off);
+  EXPECT_TRUE(agreement.Finite);
+  const double rmsZ = agreement.RmsZ, imageZ = agreement.ImageSumZ;
+  const int count = agreement.Count, outliers = agreement.Outliers;
   std::printf("version-3 scene, techniques on vs off: RMS z %.3f over %d pixel channels, %d "
               "beyond 4 sigma; image sum z %.2f, its relative se %.2f %% (%.1f s and %.1f s)\n",
-    rmsZ, count, outliers, imageZ, 100.0 * std::sqrt(sumVariance) / sumOff, on.Seconds,
+    rmsZ, count, outliers, imageZ, 100.0 * agreement.ImageSumRelativeError, on.Seconds,
     off.Seconds);
   EXPECT_EQ(count, 3 * 12 * 8);
   EXPECT_LE(outliers, 2);

@@ -4,6 +4,7 @@
 // form, the phase-function sign convention, determinism across seeds and thread
 // counts, calibration of the standard-error estimate, and stability cases.
 #include "Math.h"
+#include "MonteCarloAgreement.h"
 #include "PathTracer.h"
 
 #include <gtest/gtest.h>
@@ -857,27 +858,9 @@ namespace
 void ExpectSameImage(
   const nimbus::PathTracingResult& a, const nimbus::PathTracingResult& b, const char* what)
 {
-  double sumZ2 = 0.0, sumDifference = 0.0, sumVariance = 0.0;
-  int count = 0, outliers = 0;
-  for (std::size_t i = 0; i < a.Image.Pixels.size(); ++i)
-  {
-    const double sigma = std::hypot(static_cast<double>(a.StandardError.Pixels[i]),
-      static_cast<double>(b.StandardError.Pixels[i]));
-    if (!(sigma > 0.0))
-    {
-      continue;
-    }
-    const double difference = static_cast<double>(a.Image.Pixels[i]) - b.Image.Pixels[i];
-    sumDifference += difference;
-    sumVariance += sigma * sigma;
-    const double z = difference / sigma;
-    sumZ2 += z * z;
-    outliers += std::abs(z) > 4.0 ? 1 : 0;
-    ++count;
-  }
-  const double rmsZ = std::sqrt(sumZ2 / std::max(1, count));
-  // The whole image's sum: a bias too small to see in one pixel adds up here.
-  const double imageZ = sumDifference / std::sqrt(sumVariance);
+  const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(a, b);
+  const double rmsZ = agreement.RmsZ, imageZ = agreement.ImageSumZ;
+  const int count = agreement.Count, outliers = agreement.Outliers;
   std::printf("%s: RMS z %.3f over %d pixel channels, %d beyond 4 sigma; image sum z %.2f\n", what,
     rmsZ, count, outliers, imageZ);
   EXPECT_LT(std::abs(imageZ), 4.0);

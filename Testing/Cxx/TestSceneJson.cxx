@@ -251,20 +251,29 @@ void ExpectError(const Json& j, const std::string& prefix)
   ExpectErrorText(j.dump(), prefix);
 }
 
-/// MinimalJson with one value set (JSON pointer) or removed (value omitted).
-Json With(const std::string& pointer, const Json& value)
+/// A scene with one value set (JSON pointer) or removed.
+Json Set(Json j, const std::string& pointer, const Json& value)
 {
-  Json j = MinimalJson();
   j[Json::json_pointer(pointer)] = value;
   return j;
 }
 
-Json Without(const std::string& pointer)
+Json Remove(Json j, const std::string& pointer)
 {
-  Json j = MinimalJson();
   const Json::json_pointer p(pointer);
   j[p.parent_pointer()].erase(p.back());
   return j;
+}
+
+/// MinimalJson with one value set or removed.
+Json With(const std::string& pointer, const Json& value)
+{
+  return Set(MinimalJson(), pointer, value);
+}
+
+Json Without(const std::string& pointer)
+{
+  return Remove(MinimalJson(), pointer);
 }
 
 fs::path MakeTemporaryDirectory(const std::string& name)
@@ -1047,17 +1056,12 @@ Json Version3Json()
 
 Json V3With(const std::string& pointer, const Json& value)
 {
-  Json j = Version3Json();
-  j[Json::json_pointer(pointer)] = value;
-  return j;
+  return Set(Version3Json(), pointer, value);
 }
 
 Json V3Without(const std::string& pointer)
 {
-  Json j = Version3Json();
-  const Json::json_pointer p(pointer);
-  j[p.parent_pointer()].erase(p.back());
-  return j;
+  return Remove(Version3Json(), pointer);
 }
 } // namespace
 
