@@ -129,7 +129,9 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   bool PixelJitter = true;
   /// Sun-peak sampling: at each cloud or ground vertex, also a direction from the
   /// cloud's phase function about the sun, combined with the usual direction by the
-  /// balance heuristic (see PathTracer.cxx). Unbiased either way; false = off.
+  /// balance heuristic (see PathTracer.cxx). Unbiased either way; false = off. Runs only
+  /// when the cloud's phase function peaks at >= 2x its mean (not for isotropic or
+  /// Rayleigh scattering, where it would only cost time).
   bool SunPeakSampling = true;
   /// Sun-depth roulette: inside the cloud, estimate the sun's contribution only with
   /// probability min(1, T_est / 0.05) (weighted by its inverse), T_est from a lattice of
