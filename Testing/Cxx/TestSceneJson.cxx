@@ -427,9 +427,28 @@ TEST(SceneJson, HashStable)
   EXPECT_EQ(nimbus::SceneHash(Parse(a)), nimbus::SceneHash(Parse(b)));
 }
 
+namespace
+{
+/// A named change of one field of a scene.
+using Mutation = std::pair<const char*, std::function<void(SceneDescription&)>>;
+
+/// Each mutation of base gives a hash that neither base nor any other mutation has.
+void ExpectEachMutationChangesTheHash(
+  const SceneDescription& base, const std::vector<Mutation>& mutations)
+{
+  std::set<std::string> hashes = { nimbus::SceneHash(base) };
+  for (const auto& mutation : mutations)
+  {
+    SceneDescription changed = base;
+    mutation.second(changed);
+    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
+      << "changing " << mutation.first << " did not change the hash";
+  }
+}
+} // namespace
+
 TEST(SceneJson, HashSensitiveToEveryField)
 {
-  using Mutation = std::pair<const char*, std::function<void(SceneDescription&)>>;
   const std::vector<Mutation> mutations = {
     { "Name", [](SceneDescription& s) { s.Name += "x"; } },
     { "Description", [](SceneDescription& s) { s.Description += "x"; } },
@@ -482,18 +501,10 @@ TEST(SceneJson, HashSensitiveToEveryField)
     { "Background.Radiance", [](SceneDescription& s) { s.Background.Radiance += 0.01; } },
     { "SpectralSamples", [](SceneDescription& s) { s.SpectralSamples += 1; } },
   };
-  const SceneDescription base = NonDefaultScene();
-  std::set<std::string> hashes = { nimbus::SceneHash(base) };
-  for (const auto& mutation : mutations)
-  {
-    SceneDescription changed = base;
-    mutation.second(changed);
-    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
-      << "changing " << mutation.first << " did not change the hash";
-  }
+  ExpectEachMutationChangesTheHash(NonDefaultScene(), mutations);
   // And each metaball parameter's value.
   const SceneDescription metaballs = MetaballScene();
-  hashes = { nimbus::SceneHash(metaballs) };
+  std::set<std::string> hashes = { nimbus::SceneHash(metaballs) };
   for (std::size_t i = 0; i < metaballs.Medium.Density.Parameters.size(); ++i)
   {
     SceneDescription changed = metaballs;
@@ -1270,7 +1281,6 @@ TEST(SceneJson, Version3Errors)
 
 TEST(SceneJson, Version3HashCoversTheNewFields)
 {
-  using Mutation = std::pair<const char*, std::function<void(SceneDescription&)>>;
   const std::vector<Mutation> mutations = {
     { "a light moves", [](SceneDescription& s) { s.Lights[0].Position[2] += 1e-6; } },
     { "Light.Intensity", [](SceneDescription& s) { s.Lights[0].Intensity *= 1.01; } },
@@ -1300,15 +1310,7 @@ TEST(SceneJson, Version3HashCoversTheNewFields)
     { "Media.Phase", [](SceneDescription& s) { s.Media[0].Phase[0].G += 0.1; } },
     { "Media.Emission", [](SceneDescription& s) { s.Media[0].Emission.RadiancePerMetre += 0.1; } },
   };
-  const SceneDescription base = Version3Scene();
-  std::set<std::string> hashes = { nimbus::SceneHash(base) };
-  for (const auto& mutation : mutations)
-  {
-    SceneDescription changed = base;
-    mutation.second(changed);
-    EXPECT_TRUE(hashes.insert(nimbus::SceneHash(changed)).second)
-      << "changing " << mutation.first << " did not change the hash";
-  }
+  ExpectEachMutationChangesTheHash(Version3Scene(), mutations);
 }
 
 // The annotated example of docs/scene-format.md (version 3, with a point light and a

@@ -143,6 +143,25 @@ Estimate PathTrace(double tau, double omega, double mu0, double mu, bool reflect
   return out;
 }
 
+/// The solver at N Gauss points, and its bias bound: how much R and T move when N doubles.
+struct SolvedSlab
+{
+  nimbus::slab::Result Result;
+  double QuadratureBias = 0.0;
+};
+
+SolvedSlab SolveWithQuadratureBias(nimbus::slab::Problem problem, int points)
+{
+  problem.QuadraturePoints = points;
+  SolvedSlab out;
+  out.Result = nimbus::slab::Solve(problem);
+  problem.QuadraturePoints = 2 * points;
+  const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
+  out.QuadratureBias = std::abs(out.Result.Reflectance - fine.Reflectance) +
+    std::abs(out.Result.DiffuseTransmittance - fine.DiffuseTransmittance);
+  return out;
+}
+
 /// The solver's quadrature cosine nearest kViewCosine.
 std::size_t NearestNode(const nimbus::slab::Result& solved)
 {
@@ -219,12 +238,9 @@ TEST(SlabPathTracer, RadiancesMatchAddingDoubling)
     problem.OpticalThickness = k.Tau;
     problem.SingleScatteringAlbedo = k.Omega;
     problem.Mu0 = k.Mu0;
-    problem.QuadraturePoints = kQuadrature;
-    const nimbus::slab::Result solved = nimbus::slab::Solve(problem);
-    problem.QuadraturePoints = 2 * kQuadrature;
-    const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
-    const double quadratureBias = std::abs(solved.Reflectance - fine.Reflectance) +
-      std::abs(solved.DiffuseTransmittance - fine.DiffuseTransmittance);
+    const SolvedSlab slab = SolveWithQuadratureBias(problem, kQuadrature);
+    const nimbus::slab::Result& solved = slab.Result;
+    const double quadratureBias = slab.QuadratureBias;
     const double widthBias =
       0.25 * k.Omega * std::exp(-(1.0 - k.Omega) * 1.0e4 * k.Tau) / (1.0 - k.Omega);
     const double bias = quadratureBias + widthBias;
@@ -304,12 +320,9 @@ TEST(SlabPathTracer, HenyeyGreensteinAndThickSlabsAtNormalIncidence)
       problem.PhaseFunction = nimbus::slab::Phase::HenyeyGreenstein;
       problem.Asymmetry = k.G;
     }
-    problem.QuadraturePoints = 2 * kQuadrature;
-    const nimbus::slab::Result solved = nimbus::slab::Solve(problem);
-    problem.QuadraturePoints = 4 * kQuadrature;
-    const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
-    const double bias = std::abs(solved.Reflectance - fine.Reflectance) +
-      std::abs(solved.DiffuseTransmittance - fine.DiffuseTransmittance);
+    const SolvedSlab slab = SolveWithQuadratureBias(problem, 2 * kQuadrature);
+    const nimbus::slab::Result& solved = slab.Result;
+    const double bias = slab.QuadratureBias;
     const std::size_t node = NearestNode(solved);
     const double mu = solved.Mu[node];
     for (const bool reflected : { true, false })
@@ -542,12 +555,9 @@ TEST(SlabPathTracer, HenyeyGreensteinAtObliqueIncidence)
     problem.Mu0 = k.Mu0;
     problem.PhaseFunction = nimbus::slab::Phase::HenyeyGreenstein;
     problem.Asymmetry = kG;
-    problem.QuadraturePoints = 2 * kQuadrature;
-    const nimbus::slab::Result solved = nimbus::slab::Solve(problem);
-    problem.QuadraturePoints = 4 * kQuadrature;
-    const nimbus::slab::Result fine = nimbus::slab::Solve(problem);
-    const double bias = std::abs(solved.Reflectance - fine.Reflectance) +
-      std::abs(solved.DiffuseTransmittance - fine.DiffuseTransmittance);
+    const SolvedSlab slab = SolveWithQuadratureBias(problem, 2 * kQuadrature);
+    const nimbus::slab::Result& solved = slab.Result;
+    const double bias = slab.QuadratureBias;
     for (const View& view : k.Views)
     {
       std::size_t node = 0;
