@@ -1177,8 +1177,10 @@ const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
     const std::vector<double> viewKey = { settings.Sun.ElevationDegrees, altitude };
     if (!in.CloudSkyView || viewKey != in.CloudSkyViewKey)
     {
-      in.CloudSkyView =
-        std::make_unique<nimbus::SkyViewLut>(*in.CloudSky, settings.Sun.ElevationDegrees, altitude);
+      // 64 x (32 + 16): the solver looks up a few dozen directions (the background's
+      // 128 x (64 + 32) takes 0.36 s on 2 cores).
+      in.CloudSkyView = std::make_unique<nimbus::SkyViewLut>(
+        *in.CloudSky, settings.Sun.ElevationDegrees, altitude, 64, 32, 16);
       in.CloudSkyViewKey = viewKey;
     }
   }
