@@ -329,24 +329,33 @@ public:
   void SkyOrderOne(std::vector<float>& coefficients)
   {
     const std::size_t n = this->Grid.NumberOfPoints();
-    std::vector<float> radiance(3 * n);
+    const std::size_t nd = this->Directions.size();
     const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
-    for (std::size_t m = 0; m < this->Directions.size(); ++m)
+    // The optical depths of all directions (the directions over threads), then the
+    // projections in a fixed order (results do not depend on the threads).
+    std::vector<std::vector<float>> depths(nd);
+    ParallelFor(nd, 1, this->Options.Threads,
+      [&](std::size_t begin, std::size_t end)
+      {
+        for (std::size_t m = begin; m < end; ++m)
+        {
+          depths[m] = SweptOpticalDepth(this->Grid, this->Grid.Extinction, this->Directions[m], 1);
+        }
+      });
+    Report(this->Progress, 0.5);
+    std::vector<float> radiance(3 * n);
+    for (std::size_t m = 0; m < nd; ++m)
     {
-      const Vector3& s = this->Directions[m];
-      const Rgb sky = this->SkyToward(s);
-      const std::vector<float> depth =
-        SweptOpticalDepth(this->Grid, this->Grid.Extinction, s, this->Options.Threads);
+      const Rgb sky = this->SkyToward(this->Directions[m]);
       for (std::size_t i = 0; i < n; ++i)
       {
-        const double t = std::exp(-static_cast<double>(depth[i]));
+        const double t = std::exp(-static_cast<double>(depths[m][i]));
         for (int c = 0; c < 3; ++c)
         {
           radiance[3 * i + c] = static_cast<float>(sky[c] * t);
         }
       }
-      this->Project(radiance, s, 1.0, k1, coefficients);
-      Report(this->Progress, 0.9 * (m + 1) / this->Directions.size());
+      this->Project(radiance, this->Directions[m], 1.0, k1, coefficients);
     }
   }
 
@@ -482,11 +491,19 @@ public:
     std::vector<float> source(nd * 3 * n, 0.0f); // S_k(x, s_m)
     if (this->Options.SkyLight && this->Lighting.Sky)
     {
+      std::vector<Rgb> sky(nd);
       for (std::size_t m = 0; m < nd; ++m)
       {
-        this->Transport(
-          scaledGrid, m, this->SkyToward(this->Directions[m]), nullptr, &order[m * 3 * n]);
+        sky[m] = this->SkyToward(this->Directions[m]); // on this thread: Sky may not be thread-safe
       }
+      ParallelFor(nd, 1, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          for (std::size_t m = begin; m < end; ++m)
+          {
+            this->Transport(scaledGrid, m, sky[m], nullptr, &order[m * 3 * n]);
+          }
+        });
       total = order;
     }
     const int maximumOrder = std::max(2, this->Options.Orders);
@@ -494,46 +511,45 @@ public:
     int computed = 0;
     for (int k = 1; k <= maximumOrder; ++k)
     {
-      // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1).
-      ParallelFor(n, 1024, this->Options.Threads,
+      // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1):
+      // per direction m a sum of whole fields (contiguous, vectorised), the
+      // directions over threads; then each direction's sweep, the directions over
+      // threads (each sweep is sequential plane by plane).
+      const std::size_t fieldSize = 3 * n;
+      ParallelFor(nd, 1, this->Options.Threads,
         [&](std::size_t begin, std::size_t end)
         {
-          std::vector<double> in(3 * nd);
-          for (std::size_t i = begin; i < end; ++i)
+          for (std::size_t m = begin; m < end; ++m)
           {
+            float* out = &source[m * fieldSize];
+            if (k == 1)
+            {
+              std::copy(&firstSource[m * fieldSize], &firstSource[m * fieldSize] + fieldSize, out);
+            }
+            else
+            {
+              std::fill(out, out + fieldSize, 0.0f);
+            }
             for (std::size_t q = 0; q < nd; ++q)
             {
-              for (int c = 0; c < 3; ++c)
+              const float w = static_cast<float>(albedoScaled * matrix[m * nd + q]);
+              const float* in = &order[q * fieldSize];
+              for (std::size_t j = 0; j < fieldSize; ++j)
               {
-                in[3 * q + c] = order[(q * n + i) * 3 + c];
-              }
-            }
-            for (std::size_t m = 0; m < nd; ++m)
-            {
-              double s[3] = { 0, 0, 0 };
-              const double* row = &matrix[m * nd];
-              for (std::size_t q = 0; q < nd; ++q)
-              {
-                s[0] += row[q] * in[3 * q];
-                s[1] += row[q] * in[3 * q + 1];
-                s[2] += row[q] * in[3 * q + 2];
-              }
-              for (int c = 0; c < 3; ++c)
-              {
-                double v = albedoScaled * s[c];
-                if (k == 1)
-                {
-                  v += firstSource[(m * n + i) * 3 + c];
-                }
-                source[(m * n + i) * 3 + c] = static_cast<float>(v);
+                out[j] += w * in[j];
               }
             }
           }
         });
-      for (std::size_t m = 0; m < nd; ++m)
-      {
-        this->Transport(scaledGrid, m, Rgb{ { 0, 0, 0 } }, &source[m * 3 * n], &order[m * 3 * n]);
-      }
+      ParallelFor(nd, 1, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          for (std::size_t m = begin; m < end; ++m)
+          {
+            this->Transport(
+              scaledGrid, m, Rgb{ { 0, 0, 0 } }, &source[m * fieldSize], &order[m * fieldSize]);
+          }
+        });
       previousEnergy = energy;
       energy = { { 0, 0, 0 } };
       for (std::size_t q = 0; q < order.size(); ++q)
@@ -617,7 +633,7 @@ private:
     const DirectionSweep sweep(grid, this->Directions[m]);
     const double t = sweep.GetStep();
     const std::vector<float>& sigma = grid.Extinction;
-    sweep.Run(this->Options.Threads,
+    sweep.Run(1, // the callers run the directions in parallel
       [&](std::size_t index, const DirectionSweep::Upstream& up)
       {
         double lUp[3] = { boundary[0] * up.Outside, boundary[1] * up.Outside,
@@ -837,7 +853,7 @@ double EstimateMultipleScatteringBytes(
       bytes += 2.0 * n * kCoefficients * sizeof(float) + 3.0 * n * sizeof(float);
       break;
     case MultipleScatteringMethod::Octaves:
-      bytes += 3.0 * n * sizeof(float);
+      bytes += (nd + 3.0) * n * sizeof(float); // every direction's depths, one radiance
       break;
     case MultipleScatteringMethod::None:
     default:
