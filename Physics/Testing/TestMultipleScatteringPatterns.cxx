@@ -381,6 +381,33 @@ TEST(ReferencePatterns, StochasticSelectionIsUnbiased)
   }
 }
 
+// Where the cloud is the uniform sample space (uniform extinction, light and sun depth,
+// the pattern inside the cloud), the kept paths carry exactly the share r of the
+// total, so dividing their sum by r gives the full sum of J_2's c_00 (float rounding).
+TEST(ReferencePatterns, KeptShareRestoresTheTotalInAUniformCloud)
+{
+  const ExtinctionGrid grid =
+    MakeGrid(13, 13, 13, { { 10, 10, 10 } }, [](int, int, int) { return 0.02; });
+  const std::vector<float> depth(grid.NumberOfPoints(), 0.3f);
+  CloudOptics optics; // Cornette-Shanks, g = 0.85
+  DirectionalLight sun;
+  sun.ToLight = nimbus::Normalized({ { 0.3, -0.4, 1.0 } });
+  MultipleScatteringOptions options = FullPattern(2);
+  options.PatternRadius = 6;
+  const std::size_t centre = 12 * grid.Index(6, 6, 6);
+  const std::vector<float> all = Solve(grid, optics, sun, options, depth);
+  for (const double r : { 0.5, 0.8, 0.95 })
+  {
+    options.PatternContribution = r;
+    const std::vector<float> kept = Solve(grid, optics, sun, options, depth);
+    for (int ch = 0; ch < 3; ++ch)
+    {
+      EXPECT_NEAR(kept[centre + 4 * ch], all[centre + 4 * ch], 1e-5 * all[centre + 4 * ch])
+        << "r " << r;
+    }
+  }
+}
+
 TEST(ReferencePatterns, IndependentOfThreads)
 {
   const ExtinctionGrid grid = MakeGrid(14, 13, 12, { { 20, 20, 25 } },
