@@ -100,7 +100,10 @@ struct NIMBUSPHYSICS_EXPORT DirectionalLight
   Vector3 ToLight{ { 0, 0, 1 } };
   Rgb ConstantIrradiance{ { 1, 1, 1 } };
   std::function<Rgb(double z)> Irradiance;
-  Rgb IrradianceAt(double z) const { return this->Irradiance ? this->Irradiance(z) : this->ConstantIrradiance; }
+  Rgb IrradianceAt(double z) const
+  {
+    return this->Irradiance ? this->Irradiance(z) : this->ConstantIrradiance;
+  }
 };
 
 /// A point light (lightning, issue 16): world position [m] and radiant intensity
@@ -126,10 +129,10 @@ struct NIMBUSPHYSICS_EXPORT CloudLighting
 struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
 {
   MultipleScatteringMethod Method = MultipleScatteringMethod::DiscreteDirections;
-  /// The highest order computed explicitly (>= 2). DiscreteDirections adds the rest
-  /// as a geometric series when ExtrapolateHigherOrders; ReferencePatterns stops there
-  /// (the paper: 3).
-  int Orders = 16;
+  /// The highest order computed explicitly (>= 2). DiscreteDirections stops earlier
+  /// when an order carries < 1e-5 of the total and adds the rest as a geometric series
+  /// when ExtrapolateHigherOrders; ReferencePatterns stops there (the paper: 3).
+  int Orders = 32;
   bool ExtrapolateHigherOrders = true;
   /// Directions of the discrete-direction system and of the sky-light look-ups
   /// (>= 6): a spherical Fibonacci set of equal solid angles 4 pi / n.

@@ -1,0 +1,1019 @@
+#include "MultipleScattering.h"
+
+#include "MultipleScatteringPatterns.h"
+#include "ParallelFor.h"
+#include "Quadrature.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace nimbus
+{
+#ifdef NIMBUS_NO_REFERENCE_PATTERNS
+void AddReferencePatternOrders(const ExtinctionGrid&, const CloudOptics&, const DirectionalLight&,
+  const MultipleScatteringOptions&, const std::vector<float>&, std::vector<float>&,
+  const std::function<void(double)>&)
+{
+  throw std::runtime_error("multiple scattering: reference patterns are not built in yet");
+}
+#endif
+
+namespace
+{
+constexpr double kY00 = 0.28209479177387814; // 1 / (2 sqrt(pi))
+constexpr double kY1 = 0.4886025119029199;   // sqrt(3 / (4 pi))
+constexpr int kCoefficients = 12;            // 4 SH x RGB
+
+std::array<double, 4> ShBasis(const Vector3& w)
+{
+  return { { kY00, kY1 * w[1], kY1 * w[2], kY1 * w[0] } };
+}
+
+// World vector -> the grid's frame (components along Axes).
+Vector3 ToGridFrame(const ExtinctionGrid& grid, const Vector3& v)
+{
+  return { { Dot(v, grid.Axes[0]), Dot(v, grid.Axes[1]), Dot(v, grid.Axes[2]) } };
+}
+
+bool FiniteRgb(const Rgb& c)
+{
+  return std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]);
+}
+
+//------------------------------------------------------------------------------
+// Transport along one direction by slices (the discrete-direction system's
+// transport, 003 Eq. 1's extinction term g_ij along the sampled direction).
+// Semi-Lagrangian short characteristics: the grid is swept plane by plane along the
+// axis a where the direction of travel d advances fastest in grid indices; each
+// point's upstream point lies one plane back, at fractional offsets < 1 in the other
+// two axes, and is read bilinearly from that plane (points outside the grid give
+// the boundary's value). Along the segment of length t [m] between them:
+//   L = L_up exp(-tau) + S (1 - exp(-tau)),  tau = t (sigma_up + sigma) / 2,
+// S the mean of the source functions at both ends (sigma_s J / sigma_t). Each plane's
+// points are independent: the plane is split over threads.
+class DirectionSweep
+{
+public:
+  DirectionSweep(const ExtinctionGrid& grid, const Vector3& travelWorld)
+    : Grid(grid)
+  {
+    const Vector3 d = ToGridFrame(grid, travelWorld);
+    Vector3 e; // grid indices per metre travelled
+    for (int c = 0; c < 3; ++c)
+    {
+      e[c] = d[c] / grid.Spacing[c];
+    }
+    this->Axis = 0;
+    for (int c = 1; c < 3; ++c)
+    {
+      if (std::abs(e[c]) > std::abs(e[this->Axis]))
+      {
+        this->Axis = c;
+      }
+    }
+    this->Step = 1.0 / std::abs(e[this->Axis]); // metres per plane
+    this->Forward = e[this->Axis] > 0.0;
+    this->B = (this->Axis + 1) % 3;
+    this->C = (this->Axis + 2) % 3;
+    this->OffsetB = -e[this->B] * this->Step; // in [-1, 1]
+    this->OffsetC = -e[this->C] * this->Step;
+  }
+
+  // Runs body(plane, index-of-point, upstream) for every point in sweep order,
+  // plane after plane; `upstream` gives the bilinear weights of the upstream point
+  // in the previous plane (or none: outside).
+  struct Upstream
+  {
+    bool Inside = false; // false: every corner is outside (the boundary)
+    std::size_t Index[4] = { 0, 0, 0, 0 };
+    double Weight[4] = { 0, 0, 0, 0 }; // of the corners inside
+    double Outside = 1.0;              // weight of the boundary (corners outside)
+  };
+
+  template <class Body>
+  void Run(int threads, const Body& body) const
+  {
+    const auto& n = this->Grid.Dimensions;
+    const int planes = n[this->Axis];
+    const std::size_t planeSize = static_cast<std::size_t>(n[this->B]) * n[this->C];
+    for (int p = 0; p < planes; ++p)
+    {
+      const int plane = this->Forward ? p : planes - 1 - p;
+      const int previous = this->Forward ? plane - 1 : plane + 1;
+      const bool hasPrevious = p > 0;
+      ParallelFor(planeSize, planeSize > 4096 ? 1024 : planeSize, threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          for (std::size_t q = begin; q < end; ++q)
+          {
+            const int ib = static_cast<int>(q % n[this->B]);
+            const int ic = static_cast<int>(q / n[this->B]);
+            int ijk[3];
+            ijk[this->Axis] = plane;
+            ijk[this->B] = ib;
+            ijk[this->C] = ic;
+            const std::size_t index = this->Grid.Index(ijk[0], ijk[1], ijk[2]);
+            Upstream up;
+            if (hasPrevious)
+            {
+              this->Locate(previous, ib + this->OffsetB, ic + this->OffsetC, up);
+            }
+            body(index, up);
+          }
+        });
+    }
+  }
+
+  double GetStep() const { return this->Step; }
+
+private:
+  void Locate(int plane, double b, double c, Upstream& up) const
+  {
+    const auto& n = this->Grid.Dimensions;
+    const int b0 = static_cast<int>(std::floor(b));
+    const int c0 = static_cast<int>(std::floor(c));
+    const double fb = b - b0;
+    const double fc = c - c0;
+    up.Outside = 0.0;
+    int corner = 0;
+    for (int dc = 0; dc < 2; ++dc)
+    {
+      for (int db = 0; db < 2; ++db, ++corner)
+      {
+        const double w = (db ? fb : 1.0 - fb) * (dc ? fc : 1.0 - fc);
+        const int jb = b0 + db;
+        const int jc = c0 + dc;
+        if (jb < 0 || jb >= n[this->B] || jc < 0 || jc >= n[this->C])
+        {
+          up.Weight[corner] = 0.0;
+          up.Outside += w;
+          continue;
+        }
+        int ijk[3];
+        ijk[this->Axis] = plane;
+        ijk[this->B] = jb;
+        ijk[this->C] = jc;
+        up.Index[corner] = this->Grid.Index(ijk[0], ijk[1], ijk[2]);
+        up.Weight[corner] = w;
+        up.Inside = true;
+      }
+    }
+  }
+
+  const ExtinctionGrid& Grid;
+  int Axis = 0, B = 1, C = 2;
+  bool Forward = true;
+  double Step = 1.0;
+  double OffsetB = 0.0, OffsetC = 0.0;
+};
+
+// Optical depth along the direction of travel, from the grid's boundary (0) to
+// every point, of `extinction` (the trapezoid rule on the sweep's segments).
+std::vector<float> SweptOpticalDepth(const ExtinctionGrid& grid,
+  const std::vector<float>& extinction, const Vector3& travelWorld, int threads)
+{
+  std::vector<float> depth(grid.NumberOfPoints(), 0.0f);
+  const DirectionSweep sweep(grid, travelWorld);
+  const double t = sweep.GetStep();
+  sweep.Run(threads,
+    [&](std::size_t index, const DirectionSweep::Upstream& up)
+    {
+      double tauUp = 0.0, sigmaUp = 0.0;
+      for (int c = 0; c < 4; ++c)
+      {
+        if (up.Weight[c] > 0.0)
+        {
+          tauUp += up.Weight[c] * depth[up.Index[c]];
+          sigmaUp += up.Weight[c] * extinction[up.Index[c]];
+        }
+      }
+      // The first plane: the segment upstream lies outside the grid, where the
+      // extinction is 0 (trilinear inside [0, n-1] only).
+      depth[index] =
+        up.Inside ? static_cast<float>(tauUp + 0.5 * t * (sigmaUp + extinction[index])) : 0.0f;
+    });
+  return depth;
+}
+
+// The phase function the discrete directions carry after the delta-M truncation
+// (Wiscombe 1977): f = k_2 (the second Legendre coefficient), the rest an HG lobe
+// with g' = (k_1 - f)/(1 - f). No truncation where the phase has no forward peak
+// (k_1 <= k_2, e.g. isotropic or Rayleigh).
+struct TruncatedPhase
+{
+  double F = 0.0;
+  bool Hg = false;
+  double G = 0.0;
+  CloudOptics Original;
+  double Evaluate(double mu) const
+  {
+    return this->Hg ? HenyeyGreenstein(mu, this->G)
+                    : EvaluatePhaseFunction(this->Original.Phase, mu, this->Original.G);
+  }
+};
+
+TruncatedPhase Truncate(const CloudOptics& optics)
+{
+  TruncatedPhase phase;
+  phase.Original = optics;
+  const double k1 = PhaseLegendreCoefficient(optics, 1);
+  const double k2 = PhaseLegendreCoefficient(optics, 2);
+  if (k2 > 0.0 && k1 > k2 && k2 < 0.999)
+  {
+    phase.F = k2;
+    phase.Hg = true;
+    phase.G = (k1 - k2) / (1.0 - k2);
+  }
+  return phase;
+}
+
+// Transmittance-free straight march of the extinction from a point to a light at
+// `light` (grid coordinates), clipped to the grid (trapezoid, steps <= 0.5 cell).
+double OpticalDepthBetween(
+  const ExtinctionGrid& grid, const Vector3& fromIndex, const Vector3& toIndex)
+{
+  Vector3 delta{ { toIndex[0] - fromIndex[0], toIndex[1] - fromIndex[1],
+    toIndex[2] - fromIndex[2] } };
+  double metres = 0.0;
+  double longest = 0.0;
+  for (int c = 0; c < 3; ++c)
+  {
+    metres += delta[c] * grid.Spacing[c] * delta[c] * grid.Spacing[c];
+    longest = std::max(longest, std::abs(delta[c]));
+  }
+  metres = std::sqrt(metres);
+  if (!(metres > 0.0))
+  {
+    return 0.0;
+  }
+  // Clip the segment to the grid's box [0, n-1] (slab test) so lights far away cost
+  // only the part of the march inside the cloud.
+  double t0 = 0.0, t1 = 1.0;
+  for (int c = 0; c < 3; ++c)
+  {
+    const double lo = -0.5, hi = grid.Dimensions[c] - 0.5;
+    if (std::abs(delta[c]) < 1e-12)
+    {
+      if (fromIndex[c] < lo || fromIndex[c] > hi)
+      {
+        return 0.0;
+      }
+      continue;
+    }
+    double a = (lo - fromIndex[c]) / delta[c];
+    double b = (hi - fromIndex[c]) / delta[c];
+    if (a > b)
+    {
+      std::swap(a, b);
+    }
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  }
+  if (t1 <= t0)
+  {
+    return 0.0;
+  }
+  const int steps = std::max(1, static_cast<int>(std::ceil(2.0 * longest * (t1 - t0))));
+  double sum = 0.0;
+  for (int s = 0; s <= steps; ++s)
+  {
+    const double u = t0 + (t1 - t0) * s / steps;
+    const double sigma = ExtinctionAt(
+      grid, fromIndex[0] + u * delta[0], fromIndex[1] + u * delta[1], fromIndex[2] + u * delta[2]);
+    sum += (s == 0 || s == steps) ? 0.5 * sigma : sigma;
+  }
+  return sum * metres * (t1 - t0) / steps;
+}
+
+Vector3 GridCoordinates(const ExtinctionGrid& grid, const Vector3& world)
+{
+  const Vector3 rel{ { world[0] - grid.Origin[0], world[1] - grid.Origin[1],
+    world[2] - grid.Origin[2] } };
+  const Vector3 local = ToGridFrame(grid, rel);
+  return { { local[0] / grid.Spacing[0], local[1] / grid.Spacing[1], local[2] / grid.Spacing[2] } };
+}
+
+void Report(const std::function<void(double)>& progress, double fraction)
+{
+  if (progress)
+  {
+    progress(std::min(1.0, std::max(0.0, fraction)));
+  }
+}
+
+//------------------------------------------------------------------------------
+// Order 1 of the sky and the ground (004 §3.5) and, for DiscreteDirections, every
+// order of everything: see SolveMultipleScattering.
+class DiscreteDirectionSolver
+{
+public:
+  DiscreteDirectionSolver(const ExtinctionGrid& grid, const CloudOptics& optics,
+    const CloudLighting& lighting, const MultipleScatteringOptions& options,
+    const std::function<void(double)>& progress)
+    : Grid(grid)
+    , Optics(optics)
+    , Lighting(lighting)
+    , Options(options)
+    , Progress(progress)
+  {
+    this->Directions = FibonacciDirections(options.NumberOfDirections);
+    this->SolidAngle = 4.0 * kPi / static_cast<double>(this->Directions.size());
+  }
+
+  // Sky light of order 1 only, with the cloud's true optics (Octaves and
+  // ReferencePatterns): J = integral p(w . s) L_sky(s) T(x, s) ds.
+  void SkyOrderOne(std::vector<float>& coefficients)
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    std::vector<float> radiance(3 * n);
+    const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
+    for (std::size_t m = 0; m < this->Directions.size(); ++m)
+    {
+      const Vector3& s = this->Directions[m];
+      const Rgb sky = this->SkyToward(s);
+      const std::vector<float> depth =
+        SweptOpticalDepth(this->Grid, this->Grid.Extinction, s, this->Options.Threads);
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const double t = std::exp(-static_cast<double>(depth[i]));
+        for (int c = 0; c < 3; ++c)
+        {
+          radiance[3 * i + c] = static_cast<float>(sky[c] * t);
+        }
+      }
+      this->Project(radiance, s, 1.0, k1, coefficients);
+      Report(this->Progress, 0.9 * (m + 1) / this->Directions.size());
+    }
+  }
+
+  // Every order (003 Eq. 1 iterated): returns the delta-M fraction used.
+  double AllOrders(std::vector<float>& coefficients, MultipleScatteringField& field)
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nd = this->Directions.size();
+    const TruncatedPhase phase = Truncate(this->Optics);
+    const double albedo = this->Optics.Albedo;
+    // 003 Eq. 1 after the delta-M scaling: sigma_t' = (1 - f a) sigma_t,
+    // a' = a (1 - f) / (1 - f a).
+    const double scale = 1.0 - phase.F * albedo;
+    const double albedoScaled = scale > 0.0 ? albedo * (1.0 - phase.F) / scale : 0.0;
+    std::vector<float> extinction(this->Grid.Extinction);
+    for (float& e : extinction)
+    {
+      e = static_cast<float>(e * scale);
+    }
+    ExtinctionGrid scaledGrid = this->Grid;
+    scaledGrid.Extinction = extinction;
+
+    // The phase matrix between directions, rows normalised to 1 so that a
+    // scattering neither makes nor loses light: P[m][m'] = p'(s_m . s_m') dw / norm.
+    std::vector<double> matrix(nd * nd);
+    for (std::size_t m = 0; m < nd; ++m)
+    {
+      double sum = 0.0;
+      for (std::size_t q = 0; q < nd; ++q)
+      {
+        const double v = phase.Evaluate(Dot(this->Directions[m], this->Directions[q]));
+        matrix[m * nd + q] = v;
+        sum += v;
+      }
+      for (std::size_t q = 0; q < nd; ++q)
+      {
+        matrix[m * nd + q] /= sum;
+      }
+    }
+
+    // The first scattering of the sun and the point lights, as a source function
+    // per direction: S1(x, m) = a' J'(x, s_m) (per unit sigma_t').
+    std::vector<float> firstSource(nd * 3 * n, 0.0f);
+    if (this->Lighting.HasSun)
+    {
+      const Vector3& toSun = this->Lighting.Sun.ToLight;
+      const Vector3 travel{ { -toSun[0], -toSun[1], -toSun[2] } };
+      const std::vector<float> depth =
+        SweptOpticalDepth(scaledGrid, extinction, travel, this->Options.Threads);
+      std::vector<double> lobe(nd);
+      double sum = 0.0;
+      for (std::size_t m = 0; m < nd; ++m)
+      {
+        lobe[m] = phase.Evaluate(Dot(this->Directions[m], travel));
+        sum += lobe[m];
+      }
+      for (std::size_t m = 0; m < nd; ++m)
+      {
+        lobe[m] /= sum; // sum over m of lobe x (4 pi / nd) ... = 1 per unit solid angle
+        lobe[m] /= this->SolidAngle;
+      }
+      ParallelFor(n, 4096, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          for (std::size_t i = begin; i < end; ++i)
+          {
+            const Vector3 p = this->Grid.Position(static_cast<double>(i % this->Grid.Dimensions[0]),
+              static_cast<double>((i / this->Grid.Dimensions[0]) % this->Grid.Dimensions[1]),
+              static_cast<double>(i /
+                (static_cast<std::size_t>(this->Grid.Dimensions[0]) * this->Grid.Dimensions[1])));
+            const Rgb e = this->Lighting.Sun.IrradianceAt(p[2]);
+            const double t = std::exp(-static_cast<double>(depth[i]));
+            for (std::size_t m = 0; m < nd; ++m)
+            {
+              for (int c = 0; c < 3; ++c)
+              {
+                firstSource[(m * n + i) * 3 + c] =
+                  static_cast<float>(albedoScaled * lobe[m] * e[c] * t);
+              }
+            }
+          }
+        });
+    }
+    for (const PointLight& light : this->Lighting.PointLights)
+    {
+      const Vector3 lightIndex = GridCoordinates(this->Grid, light.Position);
+      ParallelFor(n, 256, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          std::vector<double> lobe(nd);
+          for (std::size_t i = begin; i < end; ++i)
+          {
+            if (extinction[i] <= 0.0f)
+            {
+              continue;
+            }
+            const Vector3 idx{
+              { static_cast<double>(i % this->Grid.Dimensions[0]),
+                static_cast<double>((i / this->Grid.Dimensions[0]) % this->Grid.Dimensions[1]),
+                static_cast<double>(i /
+                  (static_cast<std::size_t>(this->Grid.Dimensions[0]) * this->Grid.Dimensions[1])) }
+            };
+            const Vector3 p = this->Grid.Position(idx[0], idx[1], idx[2]);
+            Vector3 d{ { p[0] - light.Position[0], p[1] - light.Position[1],
+              p[2] - light.Position[2] } };
+            const double minimum = 0.5 *
+              std::min({ this->Grid.Spacing[0], this->Grid.Spacing[1], this->Grid.Spacing[2] });
+            const double r = std::max(Length(d), minimum);
+            d = Normalized(Length(d) > 0.0 ? d : Vector3{ { 0, 0, 1 } });
+            const double t = std::exp(-OpticalDepthBetween(scaledGrid, lightIndex, idx));
+            double sum = 0.0;
+            for (std::size_t m = 0; m < nd; ++m)
+            {
+              lobe[m] = phase.Evaluate(Dot(this->Directions[m], d));
+              sum += lobe[m];
+            }
+            for (std::size_t m = 0; m < nd; ++m)
+            {
+              const double w = albedoScaled * lobe[m] / (sum * this->SolidAngle) * t / (r * r);
+              for (int c = 0; c < 3; ++c)
+              {
+                firstSource[(m * n + i) * 3 + c] += static_cast<float>(w * light.Intensity[c]);
+              }
+            }
+          }
+        });
+    }
+    Report(this->Progress, 0.05);
+
+    // Order 0 of the sky: its light through the cloud, unscattered.
+    std::vector<float> order(nd * 3 * n, 0.0f);  // L_k(x, s_m)
+    std::vector<float> total(nd * 3 * n, 0.0f);  // sum of the orders so far
+    std::vector<float> source(nd * 3 * n, 0.0f); // S_k(x, s_m)
+    if (this->Options.SkyLight && this->Lighting.Sky)
+    {
+      for (std::size_t m = 0; m < nd; ++m)
+      {
+        this->Transport(
+          scaledGrid, m, this->SkyToward(this->Directions[m]), nullptr, &order[m * 3 * n]);
+      }
+      total = order;
+    }
+    const int maximumOrder = std::max(2, this->Options.Orders);
+    Rgb previousEnergy{ { 0, 0, 0 } }, energy{ { 0, 0, 0 } }, sumEnergy{ { 0, 0, 0 } };
+    int computed = 0;
+    for (int k = 1; k <= maximumOrder; ++k)
+    {
+      // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1).
+      ParallelFor(n, 1024, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          std::vector<double> in(3 * nd);
+          for (std::size_t i = begin; i < end; ++i)
+          {
+            for (std::size_t q = 0; q < nd; ++q)
+            {
+              for (int c = 0; c < 3; ++c)
+              {
+                in[3 * q + c] = order[(q * n + i) * 3 + c];
+              }
+            }
+            for (std::size_t m = 0; m < nd; ++m)
+            {
+              double s[3] = { 0, 0, 0 };
+              const double* row = &matrix[m * nd];
+              for (std::size_t q = 0; q < nd; ++q)
+              {
+                s[0] += row[q] * in[3 * q];
+                s[1] += row[q] * in[3 * q + 1];
+                s[2] += row[q] * in[3 * q + 2];
+              }
+              for (int c = 0; c < 3; ++c)
+              {
+                double v = albedoScaled * s[c];
+                if (k == 1)
+                {
+                  v += firstSource[(m * n + i) * 3 + c];
+                }
+                source[(m * n + i) * 3 + c] = static_cast<float>(v);
+              }
+            }
+          }
+        });
+      for (std::size_t m = 0; m < nd; ++m)
+      {
+        this->Transport(scaledGrid, m, Rgb{ { 0, 0, 0 } }, &source[m * 3 * n], &order[m * 3 * n]);
+      }
+      previousEnergy = energy;
+      energy = { { 0, 0, 0 } };
+      for (std::size_t q = 0; q < order.size(); ++q)
+      {
+        total[q] += order[q];
+        energy[q % 3] += order[q];
+      }
+      for (int c = 0; c < 3; ++c)
+      {
+        sumEnergy[c] += energy[c];
+      }
+      computed = k;
+      Report(this->Progress, 0.05 + 0.85 * k / maximumOrder);
+      bool converged = true;
+      for (int c = 0; c < 3; ++c)
+      {
+        converged = converged && energy[c] <= 1e-5 * sumEnergy[c];
+      }
+      if (converged)
+      {
+        break;
+      }
+    }
+    field.OrdersComputed = computed;
+    // The orders beyond: a geometric series with the ratio of the last two orders'
+    // energies, the spectral radius of the scattering operator once its dominant
+    // mode has taken over (Aitken's extrapolation).
+    for (int c = 0; c < 3; ++c)
+    {
+      const double ratio = previousEnergy[c] > 0.0 ? energy[c] / previousEnergy[c] : 0.0;
+      field.LastOrderRatio[c] = ratio;
+      field.TailShare[c] = 0.0;
+    }
+    if (this->Options.ExtrapolateHigherOrders && computed == maximumOrder)
+    {
+      Rgb factor{ { 0, 0, 0 } };
+      for (int c = 0; c < 3; ++c)
+      {
+        const double r = std::min(field.LastOrderRatio[c], 0.999);
+        factor[c] = r > 0.0 ? r / (1.0 - r) : 0.0;
+        const double tail = factor[c] * energy[c];
+        field.TailShare[c] = sumEnergy[c] + tail > 0.0 ? tail / (sumEnergy[c] + tail) : 0.0;
+      }
+      for (std::size_t q = 0; q < order.size(); ++q)
+      {
+        total[q] += static_cast<float>(factor[q % 3] * order[q]);
+      }
+    }
+    // J(x, w) = integral p(w . s) L(x, s) ds with the cloud's own phase function:
+    // in SH, degree l scaled by k_l.
+    const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
+    for (std::size_t m = 0; m < nd; ++m)
+    {
+      this->Project(std::vector<float>(total.begin() + m * 3 * n, total.begin() + (m + 1) * 3 * n),
+        this->Directions[m], 1.0, k1, coefficients);
+    }
+    return phase.F;
+  }
+
+private:
+  // The radiance arriving from the sky that travels along s (looking toward -s).
+  Rgb SkyToward(const Vector3& s) const
+  {
+    if (!this->Options.SkyLight || !this->Lighting.Sky)
+    {
+      return { { 0, 0, 0 } };
+    }
+    Rgb v = this->Lighting.Sky(Vector3{ { -s[0], -s[1], -s[2] } });
+    for (double& c : v)
+    {
+      c = std::isfinite(c) ? std::max(0.0, c) : 0.0;
+    }
+    return v;
+  }
+
+  // out(x) for direction m: the boundary's radiance `boundary` carried in, plus
+  // the source function `source` (per point, RGB; nullptr: 0) along the way.
+  void Transport(const ExtinctionGrid& grid, std::size_t m, const Rgb& boundary,
+    const float* source, float* out) const
+  {
+    const DirectionSweep sweep(grid, this->Directions[m]);
+    const double t = sweep.GetStep();
+    const std::vector<float>& sigma = grid.Extinction;
+    sweep.Run(this->Options.Threads,
+      [&](std::size_t index, const DirectionSweep::Upstream& up)
+      {
+        double lUp[3] = { boundary[0] * up.Outside, boundary[1] * up.Outside,
+          boundary[2] * up.Outside };
+        // Upstream: the radiance (the boundary's where corners are outside), the
+        // extinction (0 outside) and the emission sigma S (0 outside).
+        double emissionUp[3] = { 0, 0, 0 };
+        double sigmaUp = 0.0;
+        if (up.Inside)
+        {
+          for (int q = 0; q < 4; ++q)
+          {
+            const double w = up.Weight[q];
+            if (w > 0.0)
+            {
+              const std::size_t j = up.Index[q];
+              sigmaUp += w * sigma[j];
+              for (int c = 0; c < 3; ++c)
+              {
+                lUp[c] += w * out[3 * j + c];
+                if (source)
+                {
+                  emissionUp[c] += w * sigma[j] * source[3 * j + c];
+                }
+              }
+            }
+          }
+        }
+        const double sigmaSum = sigmaUp + sigma[index];
+        const double tau = up.Inside ? 0.5 * t * sigmaSum : 0.0;
+        const double transmittance = std::exp(-tau);
+        for (int c = 0; c < 3; ++c)
+        {
+          // The segment's source function: the extinction-weighted mean of both ends'
+          // (a constant source stays constant where the extinction varies).
+          const double s = source && sigmaSum > 0.0
+            ? (emissionUp[c] + sigma[index] * source[3 * index + c]) / sigmaSum
+            : 0.0;
+          out[3 * index + c] =
+            static_cast<float>(lUp[c] * transmittance + s * (1.0 - transmittance));
+        }
+      });
+  }
+
+  // coefficients += SH projection of radiance(x) arriving along s, weighted by the
+  // direction's solid angle, with degree l scaled by k_l (k_0, k_1).
+  void Project(const std::vector<float>& radiance, const Vector3& s, double k0, double k1,
+    std::vector<float>& coefficients) const
+  {
+    const auto y = ShBasis(s);
+    const double k[4] = { k0, k1, k1, k1 };
+    const std::size_t n = this->Grid.NumberOfPoints();
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        const double l = radiance[3 * i + c] * this->SolidAngle;
+        for (int b = 0; b < 4; ++b)
+        {
+          coefficients[i * kCoefficients + 4 * c + b] += static_cast<float>(k[b] * y[b] * l);
+        }
+      }
+    }
+  }
+
+  const ExtinctionGrid& Grid;
+  const CloudOptics& Optics;
+  const CloudLighting& Lighting;
+  const MultipleScatteringOptions& Options;
+  const std::function<void(double)>& Progress;
+  std::vector<Vector3> Directions;
+  double SolidAngle = 1.0;
+};
+} // namespace
+
+//------------------------------------------------------------------------------
+Vector3 ExtinctionGrid::Position(double i, double j, double k) const
+{
+  Vector3 p = this->Origin;
+  const double u[3] = { i * this->Spacing[0], j * this->Spacing[1], k * this->Spacing[2] };
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      p[c] += u[a] * this->Axes[a][c];
+    }
+  }
+  return p;
+}
+
+double ExtinctionAt(const ExtinctionGrid& grid, double i, double j, double k)
+{
+  const double x[3] = { i, j, k };
+  int i0[3];
+  double f[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(x[a] >= 0.0) || x[a] > grid.Dimensions[a] - 1)
+    {
+      // Outside, but a one-point-thick axis holds its value over +-0.5.
+      if (grid.Dimensions[a] == 1 && std::abs(x[a]) <= 0.5)
+      {
+        i0[a] = 0;
+        f[a] = 0.0;
+        continue;
+      }
+      return 0.0;
+    }
+    i0[a] = std::min(static_cast<int>(x[a]), grid.Dimensions[a] - 2);
+    i0[a] = std::max(i0[a], 0);
+    f[a] = grid.Dimensions[a] > 1 ? x[a] - i0[a] : 0.0;
+  }
+  double sum = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double w = 1.0;
+    int idx[3];
+    bool skip = false;
+    for (int a = 0; a < 3; ++a)
+    {
+      const int bit = (corner >> a) & 1;
+      w *= bit ? f[a] : 1.0 - f[a];
+      idx[a] = i0[a] + bit;
+      skip = skip || idx[a] >= grid.Dimensions[a];
+    }
+    if (!skip && w > 0.0)
+    {
+      sum += w * grid.Extinction[grid.Index(idx[0], idx[1], idx[2])];
+    }
+  }
+  return sum;
+}
+
+std::vector<float> OpticalDepthToward(
+  const ExtinctionGrid& grid, const Vector3& toLight, int threads)
+{
+  const Vector3 travel{ { -toLight[0], -toLight[1], -toLight[2] } };
+  return SweptOpticalDepth(grid, grid.Extinction, travel, threads);
+}
+
+std::vector<Vector3> FibonacciDirections(int n)
+{
+  std::vector<Vector3> directions;
+  n = std::max(1, n);
+  directions.reserve(static_cast<std::size_t>(n));
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i)
+  {
+    const double z = 1.0 - (2.0 * i + 1.0) / n;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden * i;
+    directions.push_back({ { r * std::cos(phi), r * std::sin(phi), z } });
+  }
+  return directions;
+}
+
+double PhaseLegendreCoefficient(const CloudOptics& optics, int l)
+{
+  if (l == 0)
+  {
+    return 1.0;
+  }
+  if (optics.Phase == PhaseFunctionKind::HenyeyGreenstein)
+  {
+    return std::pow(ClampAsymmetry(optics.G), l); // HG: k_l = g^l
+  }
+  // 2 pi integral p(mu) P_l(mu) dmu by Gauss-Legendre on [-1, 1], split at 0.9 and
+  // 0.99 where a forward peak lives (512 nodes per piece: k_1 to 1e-9 at g = 0.99).
+  static const double kBreaks[4] = { -1.0, 0.9, 0.99, 1.0 };
+  std::vector<double> x, w;
+  GaussLegendre(512, x, w);
+  double sum = 0.0;
+  for (int piece = 0; piece < 3; ++piece)
+  {
+    const double a = kBreaks[piece], b = kBreaks[piece + 1];
+    for (std::size_t q = 0; q < x.size(); ++q)
+    {
+      const double mu = 0.5 * (a + b) + 0.5 * (b - a) * x[q];
+      const double pl = l == 1 ? mu : 0.5 * (3.0 * mu * mu - 1.0);
+      sum += 0.5 * (b - a) * w[q] * EvaluatePhaseFunction(optics.Phase, mu, optics.G) * pl;
+    }
+  }
+  return 2.0 * kPi * sum;
+}
+
+Rgb EvaluateInScattering(const float* coefficients, const Vector3& w)
+{
+  const auto y = ShBasis(w);
+  Rgb out{ { 0, 0, 0 } };
+  for (int c = 0; c < 3; ++c)
+  {
+    double v = 0.0;
+    for (int b = 0; b < 4; ++b)
+    {
+      v += coefficients[4 * c + b] * y[b];
+    }
+    out[c] = std::max(0.0, v);
+  }
+  return out;
+}
+
+double EstimateMultipleScatteringBytes(
+  const ExtinctionGrid& grid, const MultipleScatteringOptions& options)
+{
+  const double n =
+    static_cast<double>(grid.Dimensions[0]) * grid.Dimensions[1] * grid.Dimensions[2];
+  double bytes = n * kCoefficients * sizeof(float) + 2.0 * n * sizeof(float); // field, depths
+  const double nd = std::max(1, options.NumberOfDirections);
+  switch (options.Method)
+  {
+    case MultipleScatteringMethod::DiscreteDirections:
+      // the lights' first scattering, this order, the sum and the source: 4 x nd x RGB
+      bytes += 4.0 * nd * 3.0 * n * sizeof(float) + n * sizeof(float);
+      break;
+    case MultipleScatteringMethod::ReferencePatterns:
+      // two orders' fields and the radiance of one direction
+      bytes += 2.0 * n * kCoefficients * sizeof(float) + 3.0 * n * sizeof(float);
+      break;
+    case MultipleScatteringMethod::Octaves:
+      bytes += 3.0 * n * sizeof(float);
+      break;
+    case MultipleScatteringMethod::None:
+    default:
+      bytes = 0.0;
+  }
+  return bytes;
+}
+
+std::string CheckMultipleScatteringInput(const ExtinctionGrid& grid, const CloudOptics& optics,
+  const CloudLighting& lighting, const MultipleScatteringOptions& options)
+{
+  std::ostringstream message;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (grid.Dimensions[a] < 1)
+    {
+      message << "the grid needs at least one point per axis (dimensions " << grid.Dimensions[0]
+              << " x " << grid.Dimensions[1] << " x " << grid.Dimensions[2] << ")";
+      return message.str();
+    }
+    if (!(grid.Spacing[a] > 0.0) || !std::isfinite(grid.Spacing[a]))
+    {
+      message << "the grid's spacing must be finite and > 0 metres (axis " << a << ": "
+              << grid.Spacing[a] << ")";
+      return message.str();
+    }
+    if (!IsFinite(grid.Axes[a]) || std::abs(Length(grid.Axes[a]) - 1.0) > 1e-6 ||
+      !std::isfinite(grid.Origin[a]))
+    {
+      return "the grid's origin must be finite and its axes unit vectors";
+    }
+    for (int b = a + 1; b < 3; ++b)
+    {
+      if (std::abs(Dot(grid.Axes[a], grid.Axes[b])) > 1e-6)
+      {
+        return "the grid's axes must be orthogonal";
+      }
+    }
+  }
+  if (grid.Extinction.size() != grid.NumberOfPoints())
+  {
+    message << "the grid has " << grid.Extinction.size() << " extinction values for "
+            << grid.NumberOfPoints() << " points";
+    return message.str();
+  }
+  for (float e : grid.Extinction)
+  {
+    if (!(e >= 0.0f) || !std::isfinite(e))
+    {
+      message << "extinction must be finite and >= 0 per metre (found " << e << ")";
+      return message.str();
+    }
+  }
+  if (!(optics.Albedo >= 0.0 && optics.Albedo <= 1.0))
+  {
+    message << "the single-scattering albedo must be in [0, 1] (" << optics.Albedo << ")";
+    return message.str();
+  }
+  if (!std::isfinite(optics.G) || std::abs(optics.G) > 1.0)
+  {
+    message << "the phase asymmetry g must be in [-1, 1] (" << optics.G << ")";
+    return message.str();
+  }
+  if (lighting.HasSun)
+  {
+    if (!IsFinite(lighting.Sun.ToLight) || std::abs(Length(lighting.Sun.ToLight) - 1.0) > 1e-6)
+    {
+      return "the direction toward the sun must be a finite unit vector";
+    }
+    if (!lighting.Sun.Irradiance && !FiniteRgb(lighting.Sun.ConstantIrradiance))
+    {
+      return "the sun's irradiance must be finite";
+    }
+  }
+  for (const PointLight& light : lighting.PointLights)
+  {
+    if (!IsFinite(light.Position) || !FiniteRgb(light.Intensity))
+    {
+      return "a point light's position and intensity must be finite";
+    }
+  }
+  if (options.Method == MultipleScatteringMethod::ReferencePatterns &&
+    !lighting.PointLights.empty())
+  {
+    return "reference patterns (004 §3.4) are built for the sun; use the discrete-direction "
+           "method for point lights";
+  }
+  if (options.Orders < 2 || options.Orders > 10000)
+  {
+    message << "orders must be in [2, 10000] (" << options.Orders << ")";
+    return message.str();
+  }
+  if (options.NumberOfDirections < 6 || options.NumberOfDirections > 4096)
+  {
+    message << "the number of directions must be in [6, 4096] (" << options.NumberOfDirections
+            << ")";
+    return message.str();
+  }
+  if (options.Octaves < 1 || options.Octaves > 64)
+  {
+    message << "octaves must be in [1, 64] (" << options.Octaves << ")";
+    return message.str();
+  }
+  for (double v : { options.OctaveExtinctionScale, options.OctaveScatteringScale,
+         options.OctaveAsymmetryScale, options.PatternSelection })
+  {
+    if (!(v > 0.0 && v <= 1.0))
+    {
+      message << "octave scales and the pattern selection must be in (0, 1] (" << v << ")";
+      return message.str();
+    }
+  }
+  if (!(options.PatternContribution > 0.0 && options.PatternContribution <= 1.0))
+  {
+    message << "the pattern contribution must be in (0, 1] (" << options.PatternContribution << ")";
+    return message.str();
+  }
+  if (options.PatternRadius < 1 || options.PatternRadius > 64)
+  {
+    message << "the pattern radius must be in [1, 64] points (" << options.PatternRadius << ")";
+    return message.str();
+  }
+  return "";
+}
+
+MultipleScatteringField SolveMultipleScattering(const ExtinctionGrid& grid,
+  const CloudOptics& optics, const CloudLighting& lighting,
+  const MultipleScatteringOptions& options, const std::function<void(double fraction)>& progress)
+{
+  const std::string problem = CheckMultipleScatteringInput(grid, optics, lighting, options);
+  if (!problem.empty())
+  {
+    throw std::invalid_argument("multiple scattering: " + problem);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  MultipleScatteringField field;
+  field.Dimensions = grid.Dimensions;
+  field.Coefficients.assign(grid.NumberOfPoints() * kCoefficients, 0.0f);
+  DiscreteDirectionSolver solver(grid, optics, lighting, options, progress);
+  switch (options.Method)
+  {
+    case MultipleScatteringMethod::None:
+      break;
+    case MultipleScatteringMethod::Octaves:
+      if (options.SkyLight && lighting.Sky)
+      {
+        solver.SkyOrderOne(field.Coefficients);
+      }
+      break;
+    case MultipleScatteringMethod::ReferencePatterns:
+      if (options.SkyLight && lighting.Sky)
+      {
+        solver.SkyOrderOne(field.Coefficients);
+      }
+      if (lighting.HasSun)
+      {
+        const std::vector<float> depth =
+          OpticalDepthToward(grid, lighting.Sun.ToLight, options.Threads);
+        AddReferencePatternOrders(
+          grid, optics, lighting.Sun, options, depth, field.Coefficients, progress);
+        field.OrdersComputed = options.Orders;
+      }
+      break;
+    case MultipleScatteringMethod::DiscreteDirections:
+      field.ForwardPeakFraction = solver.AllOrders(field.Coefficients, field);
+      break;
+  }
+  for (float& c : field.Coefficients)
+  {
+    if (!std::isfinite(c))
+    {
+      throw std::range_error("multiple scattering: the solver produced a non-finite value");
+    }
+  }
+  Report(progress, 1.0);
+  field.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return field;
+}
+} // namespace nimbus
