@@ -74,8 +74,8 @@ namespace nimbus
 {
 namespace
 {
-constexpr double kY00 = 0.282095; // Y_00
-constexpr double kY1 = 0.488603;  // Y_1m / (w_y, w_z, w_x)
+constexpr double kY00 = 0.28209479177387814; // Y_00 = 1 / (2 sqrt(pi))
+constexpr double kY1 = 0.4886025119029199;   // Y_1m / (w_y, w_z, w_x) = sqrt(3 / (4 pi))
 
 /// One offset o of a reference pattern: the source j = P + o of point P.
 struct PatternOffset

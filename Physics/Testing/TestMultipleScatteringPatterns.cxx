@@ -27,8 +27,8 @@ using nimbus::PhaseFunctionKind;
 using nimbus::Rgb;
 using nimbus::Vector3;
 
-constexpr double kY00 = 0.282095;
-constexpr double kY1 = 0.488603;
+constexpr double kY00 = 0.28209479177387814; // 1 / (2 sqrt(pi)), as EvaluateInScattering
+constexpr double kY1 = 0.4886025119029199;   // sqrt(3 / (4 pi))
 
 /// A grid of nx x ny x nz points with extinction sigma(i, j, k) [1/m].
 ExtinctionGrid MakeGrid(
