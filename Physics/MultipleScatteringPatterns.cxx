@@ -26,8 +26,7 @@
 //   w(o) = exp(-sigma_mean r) dV / r^2                      (orders >= 3: the order-n
 //                                                            field has no sun peak)
 // over the cube of offsets of half-width PatternRadius (clipped to the grid), the self
-// offset excluded (its 1/r^2 singularity is integrable but not a path between two
-// voxels; leaving it out underestimates the order-2 light of thick cells a little).
+// offset o = 0 excluded (1/r^2 is singular there).
 // The paper's pattern is view-dependent (it multiplies the outgoing phase p(w . s) for
 // the viewing direction w); J here is stored for all w, so the outgoing phase is
 // averaged over w (its mean over the sphere is 1/(4 pi), a constant) and dropped.
@@ -44,6 +43,19 @@
 // share to the whole pattern, exact where the real field's share equals the uniform
 // sample space's (the paper's own assumption: "the contribution pattern ... is close
 // to the reference pattern of uniform density").
+//
+// The self cell. The lattice sum leaves out the light P's own cell scatters into P,
+// which in a uniform medium is the share 1 - exp(-sigma R) of an order (R = 0.62 h, the
+// radius of the sphere of a cell's volume): 6 % at sigma h = 0.1, 22 % at 0.4, 39 % at
+// 0.8, and cloud cells are often thicker. So every order adds the closed form for that
+// sphere, with sigma_t, sigma_s and J_n held at their values at P (not a pattern
+// offset: always evaluated, exactly, never scaled):
+//   integral_sphere sigma_s J_n(P, s) exp(-sigma r) / r^2 dV  over directions
+//     = albedo (1 - exp(-sigma_P R)) J_n(P, s) ds,
+//   c_lm += albedo (1 - exp(-sigma_P R)) k_l c^(n)_lm(P)          (n >= 2)
+//   c_lm += albedo (1 - exp(-sigma_P R)) k_l^2 Y_lm(-L_sun) E_sun T_sun   (n = 1).
+// With it, order 2 in a uniform cube is within 1.4 % of the continuous volume integral
+// at sigma h = 0.4 (TestMultipleScatteringPatterns, Order2ApproachesTheContinuousIntegral).
 //
 // Transmittance T = exp(-tau): trapezoid rule along the segment j -> P with one step
 // per grid step along the offset's longest axis (the march of OpticalDepthToward);
@@ -343,6 +355,14 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
     ? BuildReferencePattern(grid, optics, toLight, options, sigmaMean, false)
     : ReferencePattern();
 
+  // The self cell: the radius [m] of the sphere of a cell's volume, and the SH of the
+  // sun light's direction of travel -L_sun.
+  const double selfRadius =
+    std::cbrt(3.0 * grid.Spacing[0] * grid.Spacing[1] * grid.Spacing[2] / (4.0 * kPi));
+  const double k1 = PhaseLegendreCoefficient(optics, 1);
+  const std::array<double, 4> sunHarmonics{ { kY00, -kY1 * toLight[1], -kY1 * toLight[2],
+    -kY1 * toLight[0] } };
+
   std::vector<float> previous; // J_n, 12 floats per point (n >= 2)
   std::vector<float> current(12 * count, 0.0f);
   const int orders = options.Orders - 1; // orders 2..Orders
@@ -366,7 +386,7 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
       {
         float* out = current.data() + 12 * p;
         std::fill(out, out + 12, 0.0f);
-        if (!needed[p] || n2 == 0)
+        if (!needed[p])
         {
           continue;
         }
@@ -432,12 +452,30 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
             }
           }
         }
+        // The self cell, a sphere of the cell's volume around P (see the file comment):
+        // sigma_s integral_0^R exp(-sigma r) dr = albedo (1 - exp(-sigma_P R)) [1] times
+        // the order-n light at P projected through the phase function.
+        double self[3][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
+        if (sigmaP > 0.0)
+        {
+          const double share = -optics.Albedo * std::expm1(-sigmaP * selfRadius);
+          for (int ch = 0; ch < 3; ++ch)
+          {
+            for (int lm = 0; lm < 4; ++lm)
+            {
+              const double kl = lm == 0 ? 1.0 : k1;
+              // J_1(P, s) = p(s . -L) E T projects to k_l Y_lm(-L) E T (Funk-Hecke).
+              self[ch][lm] = fromSun ? share * kl * kl * sunHarmonics[lm] * sunLight[3 * p + ch]
+                                     : share * kl * previous[12 * p + 4 * ch + lm];
+            }
+          }
+        }
         float* total = coefficients.data() + 12 * p;
         for (int ch = 0; ch < 3; ++ch)
         {
           for (int lm = 0; lm < 4; ++lm)
           {
-            out[4 * ch + lm] = static_cast<float>(scale * c[ch][lm]);
+            out[4 * ch + lm] = static_cast<float>(scale * c[ch][lm] + self[ch][lm]);
             total[4 * ch + lm] += out[4 * ch + lm];
           }
         }

@@ -130,9 +130,10 @@ std::vector<float> Solve(const ExtinctionGrid& grid, const CloudOptics& optics,
 }
 
 /// The orders 2 (and 3) of J at every point by brute force over all pairs of grid
-/// points, for extinction that is affine in the grid coordinates: then the trilinear
-/// extinction and the trapezoid rule are exact, tau(j -> P) = r (sigma_j + sigma_P) / 2.
-/// k1: the phase function's first Legendre coefficient, given here independently.
+/// points (plus each point's self cell, the solver's closed form), for extinction that is affine in
+/// the grid coordinates: then the trilinear extinction and the trapezoid rule are exact, tau(j ->
+/// P) = r (sigma_j + sigma_P) / 2. k1: the phase function's first Legendre coefficient, given here
+/// independently.
 struct BruteForce
 {
   std::vector<float> Order2, Order3;
@@ -156,6 +157,7 @@ BruteForce BruteForceOrders(const ExtinctionGrid& grid, const CloudOptics& optic
     }
   }
   const double dV = grid.Spacing[0] * grid.Spacing[1] * grid.Spacing[2];
+  const double selfRadius = std::cbrt(3.0 * dV / (4.0 * nimbus::kPi));
   const Vector3 fromSun{ { -sun.ToLight[0], -sun.ToLight[1], -sun.ToLight[2] } };
   // previous == nullptr: order 2 from the sun; else from that order's SH field.
   const auto gather = [&](const std::vector<float>* previous)
@@ -197,6 +199,20 @@ BruteForce BruteForceOrders(const ExtinctionGrid& grid, const CloudOptics& optic
           c[4 * ch + 1] += e * k1 * kY1 * s[1];
           c[4 * ch + 2] += e * k1 * kY1 * s[2];
           c[4 * ch + 3] += e * k1 * kY1 * s[0];
+        }
+      }
+      // The self cell (a sphere of the cell's volume): albedo (1 - exp(-sigma R)) times
+      // the order-n light at p through the phase function.
+      const double share = optics.Albedo * (1.0 - std::exp(-grid.Extinction[p] * selfRadius));
+      const double harmonics[4] = { kY00, kY1 * fromSun[1], kY1 * fromSun[2], kY1 * fromSun[0] };
+      for (int ch = 0; ch < 3; ++ch)
+      {
+        for (int lm = 0; lm < 4; ++lm)
+        {
+          const double kl = lm == 0 ? 1.0 : k1;
+          c[4 * ch + lm] += !previous ? share * kl * kl * harmonics[lm] *
+              sun.IrradianceAt(position[p][2])[ch] * std::exp(-double(sunDepth[p]))
+                                      : share * kl * (*previous)[12 * p + 4 * ch + lm];
         }
       }
       for (int m = 0; m < 12; ++m)
@@ -317,6 +333,102 @@ TEST(ReferencePatterns, ForwardScatteringCarriesLightAwayFromTheSun)
   for (int lm = 1; lm < 4; ++lm)
   {
     EXPECT_NEAR(iso[centre + lm], 0.0f, 1e-5f * iso[centre + 0]);
+  }
+}
+
+// Order 2 at points of a uniform cube against the continuous integral over the cube
+// (midpoint rule in directions and distance), with the exact optical depth toward the
+// sun: the lattice sum plus the self cell approximates the volume integral. The cube
+// is the grid's points' cells, the grid's box grown by half a cell.
+TEST(ReferencePatterns, Order2ApproachesTheContinuousIntegral)
+{
+  const int n = 17;
+  const double h = 10.0, side = n * h; // the cloud: [0, side]^3, points at (i + 1/2) h
+  const Vector3 toLight = nimbus::Normalized({ { 0.2, 0.1, 1.0 } });
+  // Distance from x (box coordinates [m]) to the box's surface along d.
+  const auto exit = [side](const Vector3& x, const Vector3& d)
+  {
+    double t = 1e300;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (d[a] > 1e-12)
+      {
+        t = std::min(t, (side - x[a]) / d[a]);
+      }
+      else if (d[a] < -1e-12)
+      {
+        t = std::min(t, -x[a] / d[a]);
+      }
+    }
+    return std::max(0.0, t);
+  };
+  for (const double sigma : { 0.01, 0.04 }) // tau per cell 0.1 and 0.4
+  {
+    ExtinctionGrid grid =
+      MakeGrid(n, n, n, { { h, h, h } }, [sigma](int, int, int) { return sigma; });
+    grid.Origin = { { h / 2, h / 2, h / 2 } };
+    std::vector<float> depth(grid.NumberOfPoints());
+    for (int k = 0; k < n; ++k)
+    {
+      for (int j = 0; j < n; ++j)
+      {
+        for (int i = 0; i < n; ++i)
+        {
+          depth[grid.Index(i, j, k)] = static_cast<float>(
+            sigma * exit({ { (i + 0.5) * h, (j + 0.5) * h, (k + 0.5) * h } }, toLight));
+        }
+      }
+    }
+    CloudOptics optics;
+    optics.Albedo = 1.0;
+    optics.Phase = PhaseFunctionKind::HenyeyGreenstein;
+    optics.G = 0.5;
+    DirectionalLight sun;
+    sun.ToLight = toLight;
+    const std::vector<float> solved = Solve(grid, optics, sun, FullPattern(2), depth);
+    for (const std::array<int, 3> point : { std::array<int, 3>{ { 8, 8, 8 } },
+           std::array<int, 3>{ { 8, 8, 14 } }, std::array<int, 3>{ { 3, 10, 5 } } })
+    {
+      const Vector3 P{ { (point[0] + 0.5) * h, (point[1] + 0.5) * h, (point[2] + 0.5) * h } };
+      // c_lm = k_l integral over the direction t toward the source (light travels
+      // along s = -t) of Y_lm(s) integral_0^exit albedo sigma p(s . -L) exp(-sigma r)
+      // exp(-sigma exit(P + r t, L)) dr.
+      const int thetas = 64, phis = 128, steps = 128;
+      double c[4] = { 0, 0, 0, 0 };
+      for (int it = 0; it < thetas; ++it)
+      {
+        const double mu = -1.0 + (it + 0.5) * 2.0 / thetas, st = std::sqrt(1.0 - mu * mu);
+        for (int ip = 0; ip < phis; ++ip)
+        {
+          const double phi = (ip + 0.5) * 2.0 * nimbus::kPi / phis;
+          const Vector3 t{ { st * std::cos(phi), st * std::sin(phi), mu } };
+          const Vector3 s{ { -t[0], -t[1], -t[2] } };
+          const double rmax = exit(P, t), dr = rmax / steps;
+          double radial = 0.0;
+          for (int ir = 0; ir < steps; ++ir)
+          {
+            const double r = (ir + 0.5) * dr;
+            radial += std::exp(-sigma * r - sigma * exit(nimbus::Along(P, t, r), toLight)) * dr;
+          }
+          const double e = optics.Albedo * sigma * radial *
+            nimbus::HenyeyGreenstein(-nimbus::Dot(s, toLight), optics.G) * (2.0 / thetas) *
+            (2.0 * nimbus::kPi / phis);
+          c[0] += e * kY00;
+          c[1] += e * optics.G * kY1 * s[1];
+          c[2] += e * optics.G * kY1 * s[2];
+          c[3] += e * optics.G * kY1 * s[0];
+        }
+      }
+      const std::size_t at = 12 * grid.Index(point[0], point[1], point[2]);
+      for (int lm = 0; lm < 4; ++lm)
+      {
+        // Measured: c_00 within 0.1 % (tau per cell 0.1) and 1.4 % (0.4), c_1m within
+        // 1.7 % of c_00; without the self cell c_00 is 6 % and 22 % low.
+        EXPECT_NEAR(solved[at + lm], c[lm], (lm == 0 ? 0.025 : 0.03) * std::abs(c[0]))
+          << "sigma " << sigma << " point " << point[0] << " " << point[1] << " " << point[2]
+          << " coefficient " << lm;
+      }
+    }
   }
 }
 
