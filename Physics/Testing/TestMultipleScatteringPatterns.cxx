@@ -342,7 +342,7 @@ TEST(ReferencePatterns, ForwardScatteringCarriesLightAwayFromTheSun)
 // is the grid's points' cells, the grid's box grown by half a cell.
 TEST(ReferencePatterns, Order2ApproachesTheContinuousIntegral)
 {
-  const int n = 17;
+  const int n = 13;
   const double h = 10.0, side = n * h; // the cloud: [0, side]^3, points at (i + 1/2) h
   const Vector3 toLight = nimbus::Normalized({ { 0.2, 0.1, 1.0 } });
   // Distance from x (box coordinates [m]) to the box's surface along d.
@@ -386,8 +386,8 @@ TEST(ReferencePatterns, Order2ApproachesTheContinuousIntegral)
     DirectionalLight sun;
     sun.ToLight = toLight;
     const std::vector<float> solved = Solve(grid, optics, sun, FullPattern(2), depth);
-    for (const std::array<int, 3> point : { std::array<int, 3>{ { 8, 8, 8 } },
-           std::array<int, 3>{ { 8, 8, 14 } }, std::array<int, 3>{ { 3, 10, 5 } } })
+    for (const std::array<int, 3> point : { std::array<int, 3>{ { 6, 6, 6 } },
+           std::array<int, 3>{ { 6, 6, 11 } }, std::array<int, 3>{ { 2, 8, 4 } } })
     {
       const Vector3 P{ { (point[0] + 0.5) * h, (point[1] + 0.5) * h, (point[2] + 0.5) * h } };
       // c_lm = k_l integral over the direction t toward the source (light travels
@@ -422,8 +422,8 @@ TEST(ReferencePatterns, Order2ApproachesTheContinuousIntegral)
       const std::size_t at = 12 * grid.Index(point[0], point[1], point[2]);
       for (int lm = 0; lm < 4; ++lm)
       {
-        // Measured: c_00 within 0.1 % (tau per cell 0.1) and 1.4 % (0.4), c_1m within
-        // 1.7 % of c_00; without the self cell c_00 is 6 % and 22 % low.
+        // Measured: c_00 within 0.2 % (tau per cell 0.1) and 1.5 % (0.4), c_1m within
+        // 2.4 % of c_00; without the self cell c_00 is 6 % and 22 % low.
         EXPECT_NEAR(solved[at + lm], c[lm], (lm == 0 ? 0.025 : 0.03) * std::abs(c[0]))
           << "sigma " << sigma << " point " << point[0] << " " << point[1] << " " << point[2]
           << " coefficient " << lm;
