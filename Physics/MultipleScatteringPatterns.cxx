@@ -34,15 +34,28 @@
 // (the paper's r = 0.8) of the total are kept: n2 offsets covering the share c.
 //
 // Stochastic selection (004 §3.4). At each point n1 = ceil(PatternSelection n2) of the
-// n2 kept offsets are drawn uniformly without replacement (a partial Fisher-Yates
-// shuffle seeded from Seed, the order and the point index: independent of the
-// threads), and their sum is scaled by (n2 / n1) / c. The paper writes the estimate as
-// "I r n2/n1"; multiplying by r <= 1 would make a truncated sum smaller still, so we
-// read it as I (n2 / n1) / r: n2/n1 makes the subset's sum an unbiased estimate of the
-// kept offsets' sum (each is drawn with probability n1/n2), and 1/c extends the kept
-// share to the whole pattern, exact where the real field's share equals the uniform
-// sample space's (the paper's own assumption: "the contribution pattern ... is close
-// to the reference pattern of uniform density").
+// n2 kept offsets are drawn, seeded from Seed, the order and the point index
+// (independent of the threads), and the estimate is divided by c. The paper draws the
+// n1 uniformly and writes the estimate as "I r n2/n1"; multiplying by r <= 1 would make
+// a truncated sum smaller still, so we read it as I (n2 / n1) / r: n2/n1 makes the
+// subset's sum an unbiased estimate of the kept offsets' sum (each is drawn with
+// probability n1/n2), and 1/c extends the kept share to the whole pattern, exact where
+// the real field's share equals the uniform sample space's (the paper's own assumption:
+// "the contribution pattern ... is close to the reference pattern of uniform density").
+// Drawn uniformly, though, a forward-scattering pattern is noisy: with the defaults
+// (Cornette-Shanks g = 0.85, r = 0.8, radius 6) the order-2 pattern keeps ~45 offsets,
+// the heaviest holding 30 % of their weight, and a quarter of them drawn uniformly
+// misses it 3 times in 4: 42 % rms per point (30 % for order 3; a 32^3 cloud, the
+// defaults, against PatternSelection = 1). So we follow the
+// paper's remedy, "to use these voxels with high possibility we can improve the
+// accuracy": offset i is drawn with probability proportional to its weight w_i, by
+// systematic sampling (n1 equally spaced points u0 + m, m < n1, on the cumulative
+// weights scaled to n1, u0 uniform in [0, 1)), and counts (W / n1) / w_i per draw
+// (W: the kept offsets' total weight). Unbiased for the kept offsets' sum (offset i is
+// drawn n1 w_i / W times on average), exact where the field is the uniform sample
+// space's, and the heaviest offsets are evaluated at every point (once, with their
+// draws counted): 3.4 % rms per point for order 2, 2.9 % for order 3, at the same cost.
+// PatternSelection = 1 evaluates every kept offset once.
 //
 // The self cell. The lattice sum leaves out the light P's own cell scatters into P,
 // which in a uniform medium is the share 1 - exp(-sigma R) of an order (R = 0.62 h, the
@@ -54,7 +67,7 @@
 //     = albedo (1 - exp(-sigma_P R)) J_n(P, s) ds,
 //   c_lm += albedo (1 - exp(-sigma_P R)) k_l c^(n)_lm(P)          (n >= 2)
 //   c_lm += albedo (1 - exp(-sigma_P R)) k_l^2 Y_lm(-L_sun) E_sun T_sun   (n = 1).
-// With it, order 2 in a uniform cube is within 1.4 % of the continuous volume integral
+// With it, order 2 in a uniform cube is within 1.5 % of the continuous volume integral
 // at sigma h = 0.4 (TestMultipleScatteringPatterns, Order2ApproachesTheContinuousIntegral).
 //
 // Transmittance T = exp(-tau): trapezoid rule along the segment j -> P with one step
@@ -115,7 +128,8 @@ struct ReferencePattern
 {
   std::vector<PatternOffset> Kept; // the n2 kept offsets, largest weight first
   std::vector<StencilTap> Stencil;
-  double CoveredShare = 1.0; // c: the kept offsets' share of the pattern's total weight
+  std::vector<double> Cumulative; // sum of the kept weights up to and including each
+  double CoveredShare = 1.0;      // c: the kept offsets' share of the pattern's total weight
 };
 
 /// SplitMix64's finaliser (Steele et al. 2014).
@@ -219,6 +233,12 @@ ReferencePattern BuildReferencePattern(const ExtinctionGrid& grid, const CloudOp
     pattern.Kept.push_back(all[o]);
   }
   pattern.CoveredShare = options.PatternContribution < 1.0 ? kept / total : 1.0;
+  double cumulative = 0.0;
+  for (const PatternOffset& offset : pattern.Kept)
+  {
+    cumulative += offset.Weight;
+    pattern.Cumulative.push_back(cumulative);
+  }
 
   // Transmittance stencils: the interior trapezoid samples P + (m / M) o, m = 1..M-1,
   // on the planes of the longest axis a; bilinear in the other two axes.
@@ -375,13 +395,15 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
       std::max<std::size_t>(1,
         static_cast<std::size_t>(
           std::ceil(options.PatternSelection * static_cast<double>(n2) - 1e-9))));
-    // 004 §3.4: I (n2 / n1) / r, see the file comment.
-    const double scale = n2 > 0 ? static_cast<double>(n2) / n1 / pattern.CoveredShare : 0.0;
+    // 004 §3.4: the estimate of the kept offsets' sum / r, see the file comment.
+    const double scale = n2 > 0 ? 1.0 / pattern.CoveredShare : 0.0;
+    const double keptWeight = n2 > 0 ? pattern.Cumulative.back() : 0.0; // W
     const bool fromSun = order == 2;
 
     const auto body = [&](std::size_t begin, std::size_t end)
     {
-      std::vector<std::uint32_t> shuffled(n2);
+      std::vector<std::pair<std::uint32_t, double>> drawn; // (kept offset, its factor)
+      drawn.reserve(n1);
       for (std::size_t p = begin; p < end; ++p)
       {
         float* out = current.data() + 12 * p;
@@ -393,24 +415,43 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
         const int pi = static_cast<int>(p % n[0]);
         const int pj = static_cast<int>((p / n[0]) % n[1]);
         const int pk = static_cast<int>(p / (static_cast<std::size_t>(n[0]) * n[1]));
-        std::iota(shuffled.begin(), shuffled.end(), std::uint32_t{ 0 });
-        std::uint64_t state = Mix(Mix(Mix(options.Seed) ^ static_cast<std::uint64_t>(order)) ^ p);
-        if (n1 < n2)
+        drawn.clear();
+        if (n1 == n2)
         {
-          for (std::size_t m = 0; m < n1; ++m) // partial Fisher-Yates
+          for (std::size_t i = 0; i < n2; ++i)
           {
-            state = Mix(state);
-            const double u = static_cast<double>(state >> 11) * 0x1.0p-53;
-            const std::size_t pick =
-              m + std::min(n2 - m - 1, static_cast<std::size_t>(u * (n2 - m)));
-            std::swap(shuffled[m], shuffled[pick]);
+            drawn.emplace_back(static_cast<std::uint32_t>(i), 1.0);
+          }
+        }
+        else // systematic sampling proportional to the weights
+        {
+          const std::uint64_t state =
+            Mix(Mix(Mix(options.Seed) ^ static_cast<std::uint64_t>(order)) ^ p);
+          const double u0 = static_cast<double>(state >> 11) * 0x1.0p-53; // [0, 1)
+          std::size_t i = 0;
+          for (std::size_t m = 0; m < n1; ++m)
+          {
+            const double target = (u0 + static_cast<double>(m)) * keptWeight / n1;
+            while (i + 1 < n2 && pattern.Cumulative[i] <= target)
+            {
+              ++i;
+            }
+            const double factor = keptWeight / (n1 * pattern.Kept[i].Weight);
+            if (!drawn.empty() && drawn.back().first == i)
+            {
+              drawn.back().second += factor;
+            }
+            else
+            {
+              drawn.emplace_back(static_cast<std::uint32_t>(i), factor);
+            }
           }
         }
         const double sigmaP = sigmaT[p];
         double c[3][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
-        for (std::size_t m = 0; m < n1; ++m)
+        for (const std::pair<std::uint32_t, double>& draw : drawn)
         {
-          const PatternOffset& offset = pattern.Kept[shuffled[m]];
+          const PatternOffset& offset = pattern.Kept[draw.first];
           const int si = pi + offset.Step[0], sj = pj + offset.Step[1], sk = pk + offset.Step[2];
           if (si < 0 || si >= n[0] || sj < 0 || sj >= n[1] || sk < 0 || sk >= n[2])
           {
@@ -430,7 +471,8 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
           }
           const double tau = sum * offset.Distance / offset.Intervals;
           // sigma_s T dV / r^2 [1/m]: times J [radiance] the irradiance E_j at P.
-          const double transport = optics.Albedo * sigmaSource * std::exp(-tau) * offset.Geometry;
+          const double transport =
+            draw.second * optics.Albedo * sigmaSource * std::exp(-tau) * offset.Geometry;
           Rgb J;
           if (fromSun)
           {

@@ -432,8 +432,10 @@ TEST(ReferencePatterns, Order2ApproachesTheContinuousIntegral)
   }
 }
 
-// 004 §3.4's stochastic selection, read as sum (n2 / n1) / r: the mean over seeds of
-// the order-2 field approaches the one with every kept path evaluated.
+// 004 §3.4's stochastic selection (drawn in proportion to the pattern's weights, see
+// MultipleScatteringPatterns.cxx): the mean over seeds of the order-2 field approaches
+// the one with every kept path evaluated (measured |mean - expected| < 1 standard
+// error with 2000 seeds), and one estimate's spread is moderate.
 TEST(ReferencePatterns, StochasticSelectionIsUnbiased)
 {
   const ExtinctionGrid grid = MakeGrid(12, 12, 12, { { 20, 20, 20 } },
@@ -486,6 +488,8 @@ TEST(ReferencePatterns, StochasticSelectionIsUnbiased)
       const double standardError = std::sqrt(variance / x.size());
       const double expected = reference[probes[probe] + m];
       EXPECT_GT(standardError, 1e-4 * expected) << "the selection is not random";
+      // The spread of one estimate: measured 9-15 % (drawn uniformly: 29-34 %).
+      EXPECT_LT(std::sqrt(variance), 0.2 * expected) << "probe " << probe;
       EXPECT_LT(std::abs(mean - expected), 4.0 * standardError)
         << "probe " << probe << " coefficient " << m << ": mean " << mean << " expected "
         << expected << " standard error " << standardError;
