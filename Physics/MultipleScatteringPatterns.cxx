@@ -79,8 +79,10 @@
 // Cost: points x n1 x (Orders - 1) x (segment samples ~ PatternRadius, 4 grid reads
 // each). Points whose 3x3x3 neighbourhood has no extinction are skipped (J there is
 // never used: the mapper's trilinear extinction is 0 around them) and sources with no
-// extinction are skipped. Memory: two extra fields of 12 floats per point (one when
-// Orders = 2).
+// extinction are skipped. Measured (2-core machine, shared): a 32^3 grid holding an
+// 11.5k-point cloud, radius 6, Orders 3, the other options default: 0.07 s on 1 thread
+// (PatternSelection 1: 0.2 s); a 32^3 grid full of cloud: 0.17 s. Memory per point:
+// two fields of 12 floats (one when Orders = 2), 3 floats of sun light and 1 byte.
 #include "MultipleScatteringPatterns.h"
 
 #include "ParallelFor.h"
