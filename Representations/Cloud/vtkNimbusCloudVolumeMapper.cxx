@@ -5,6 +5,7 @@
 #include "CloudDensityTexture.h"
 #include "FiniteSetters.h"
 #include "MemoryBudget.h"
+#include "MultipleScatteringTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 
@@ -35,6 +36,7 @@
 #include "vtkOpenGLState.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
+#include "vtkSMPTools.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 #include "vtkVolume.h"
@@ -59,6 +61,7 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, ExtinctionPerDensity);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Albedo);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, CloudG);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScattering);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScatteringMemoryBudgetMiB);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunAzimuthDegrees);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunElevationDegrees);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunIlluminance);
@@ -242,6 +245,18 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   std::array<float, 16> WorldToTexture{};
   std::array<float, 16> WorldToBox{};
   vtkNew<vtkMatrix4x4> WorldToNdc;
+  vtkNew<vtkMatrix4x4> DataToWorld;
+
+  // The density's source (for the multiple-scattering grid).
+  vtkImageData* Image = nullptr;
+  vtkDataArray* Scalars = nullptr;
+  bool CellData = false;
+
+  // Multiple scattering this frame: the solver's texture, the delta-M forward
+  // fraction and the octaves (1: none).
+  bool ScatteringTexture = false;
+  double ForwardPeakFraction = 0.0;
+  int Octaves = 1;
 };
 
 struct vtkNimbusCloudVolumeMapper::Internals
@@ -250,6 +265,15 @@ struct vtkNimbusCloudVolumeMapper::Internals
 
   // Density volume (000: the "volume texture").
   nimbus::CloudDensityTexture Density;
+
+  // Multiple scattering (issue 14): the solver's texture, and the sky it sees
+  // (a sky model of the mapper's own air, built only when the sky light needs it).
+  nimbus::MultipleScatteringTexture Scattering;
+  std::string LastScatteringError;
+  std::unique_ptr<nimbus::SkyModel> CloudSky;
+  std::vector<double> CloudSkyKey;
+  std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
+  std::vector<double> CloudSkyViewKey;
 
   // Atmosphere texture (000 §3), keyed by the parameters it depends on.
   vtkNew<vtkTextureObject> AtmosphereTexture;
@@ -293,6 +317,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   void Release(vtkWindow* window)
   {
     this->Density.Release(window);
+    this->Scattering.Release(window);
     for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
            Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
            SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
@@ -475,6 +500,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     frame.FramebuffersPushed = false;
     return false;
   }
+  this->UpdateMultipleScattering(frame);
   this->BeginPasses(frame);
   this->ClearShadowSurface(frame);
   this->RenderIntervalPhase(frame);
@@ -540,6 +566,9 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
   std::string error;
   const bool ok =
     in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error);
+  frame.Image = image;
+  frame.Scalars = scalars;
+  frame.CellData = cellFlag != 0;
   for (const std::string& warning : warnings)
   {
     vtkWarningMacro(<< warning);
@@ -656,6 +685,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   {
     return false;
   }
+  frame.DataToWorld->DeepCopy(dataToWorld);
   const double* boxOrigin = density.GetBoxOrigin();
   const double* boxSize = density.GetBoxSize();
   for (int c = 0; c < 8; ++c)
@@ -928,6 +958,13 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
   {
     in.AtmosphereTexture->Activate();
   }
+  if (frame.ScatteringTexture)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      in.Scattering.GetTexture(c)->Activate();
+    }
+  }
   frame.State->vtkglDisable(GL_DEPTH_TEST);
   frame.State->vtkglDepthMask(GL_FALSE);
 }
@@ -949,6 +986,238 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   {
     in.AtmosphereTexture->Deactivate();
   }
+  if (frame.ScatteringTexture)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      in.Scattering.GetTexture(c)->Deactivate();
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+// Multiple scattering (issue 14): the solver's term, re-solved only when the
+// density, the sun, the air, the ground, the optics or the method's knobs change.
+void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const FrameSettings& settings = frame.Settings;
+  const int method = this->Unlit ? MultipleScatteringNone : this->MultipleScatteringMethod;
+  frame.Octaves = method == MultipleScatteringOctaves ? this->Octaves : 1;
+  frame.ScatteringTexture = false;
+  frame.ForwardPeakFraction = 0.0;
+  if (method == MultipleScatteringNone ||
+    (method == MultipleScatteringOctaves &&
+      !(this->SkyLight && (frame.Atmosphere || frame.Ground))))
+  {
+    return; // nothing to precompute (octaves alone live in the shader)
+  }
+  nimbus::MultipleScatteringTexture::Request request;
+  nimbus::MultipleScatteringOptions& options = request.Options;
+  options.Method = static_cast<nimbus::MultipleScatteringMethod>(method);
+  options.Orders = this->MultipleScatteringOrders;
+  options.NumberOfDirections = this->MultipleScatteringDirections;
+  options.SkyLight = this->SkyLight;
+  options.PatternRadius = this->PatternRadius;
+  options.PatternContribution = this->PatternContribution;
+  options.PatternSelection = this->PatternSelection;
+  options.Threads = vtkSMPTools::GetEstimatedNumberOfThreads();
+  request.Optics = { this->Albedo, nimbus::PhaseFunctionKind::CornetteShanks, this->CloudG };
+  request.ExtinctionPerDensity = this->ExtinctionPerDensity;
+  request.Downsampling = this->MultipleScatteringDownsampling;
+  int textureDims[3];
+  in.Density.GetDimensions(textureDims);
+  int pointDims[3];
+  frame.Image->GetDimensions(pointDims);
+  for (int k = 0; k < 3; ++k)
+  {
+    const int samples = frame.CellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    request.TextureDimensions[k] = std::max(textureDims[k], 1);
+    request.TextureFactors[k] =
+      (samples + request.TextureDimensions[k] - 1) / request.TextureDimensions[k];
+  }
+  request.MetresPerUnit = settings.MetresPerUnit;
+  request.BudgetBytes = this->MultipleScatteringMemoryBudgetMiB > 0.0
+    ? this->MultipleScatteringMemoryBudgetMiB * 1024.0 * 1024.0
+    : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
+
+  // The light: the sun as the slices see it (the atmosphere table's E_sun(z)), and
+  // the sky and the ground as seen from the cloud's middle (004 §3.5).
+  nimbus::CloudLighting& lighting = request.Lighting;
+  lighting.Sun.ToLight = frame.ToSun;
+  const nimbus::AtmosphereTable& table = in.Table;
+  if (frame.Atmosphere && table.HasAtmosphere)
+  {
+    lighting.Sun.Irradiance = [&table](double z)
+    {
+      auto e = table.Lookup(0, z);
+      for (double& c : e)
+      {
+        c = std::max(c, 0.0);
+      }
+      return e;
+    };
+  }
+  else
+  {
+    lighting.Sun.ConstantIrradiance = table.SunIrradianceTop;
+  }
+  double zMiddle = 0.0;
+  for (const auto& corner : frame.Corners)
+  {
+    zMiddle += corner[2] / static_cast<double>(frame.Corners.size());
+  }
+  if (this->SkyLight && frame.Atmosphere)
+  {
+    const nimbus::SkyViewLut* view = this->CloudSkyView(frame, zMiddle * settings.MetresPerUnit);
+    if (!view)
+    {
+      return;
+    }
+    // The sky's radiance is relative to its own sun; the mapper's sun may be brighter.
+    const nimbus::SkyModel& model = *in.CloudSky;
+    const auto skySun = model.GetSpectrum().ToLinearSrgb(model.GetSunIrradiance());
+    nimbus::Rgb scale{ { 0, 0, 0 } };
+    for (int c = 0; c < 3; ++c)
+    {
+      scale[c] = skySun[c] > 0.0 ? table.SunIrradianceTop[c] / skySun[c] : 0.0;
+    }
+    const double azimuth = settings.Sun.AzimuthDegrees;
+    lighting.Sky = [view, scale, azimuth](const nimbus::Vector3& w)
+    {
+      auto radiance = view->Radiance(w, azimuth);
+      for (int c = 0; c < 3; ++c)
+      {
+        radiance[c] *= scale[c];
+      }
+      return radiance;
+    };
+  }
+  else if (this->SkyLight && frame.Ground)
+  {
+    // No air: the ground alone, lit by the sun (Lambertian, albedo / pi).
+    const double cosSun = std::max(frame.ToSun[2], 0.0);
+    nimbus::Rgb ground{ { 0, 0, 0 } };
+    for (int c = 0; c < 3; ++c)
+    {
+      ground[c] = settings.GroundAlbedo / nimbus::kPi * cosSun * table.SunIrradianceTop[c];
+    }
+    lighting.Sky = [ground](const nimbus::Vector3& w) {
+      return w[2] < 0.0 ? ground : nimbus::Rgb{ { 0, 0, 0 } };
+    };
+  }
+
+  const nimbus::SceneAtmosphere& air = settings.Air;
+  request.Key = { static_cast<double>(method), static_cast<double>(options.Orders),
+    static_cast<double>(options.NumberOfDirections), options.SkyLight ? 1.0 : 0.0,
+    static_cast<double>(options.Threads), this->Albedo, this->CloudG, this->ExtinctionPerDensity,
+    static_cast<double>(request.Downsampling), request.MetresPerUnit, request.BudgetBytes,
+    frame.ToSun[0], frame.ToSun[1], frame.ToSun[2], settings.Sun.Illuminance,
+    settings.Sun.TemperatureKelvin, frame.Atmosphere ? 1.0 : 0.0, frame.Ground ? 1.0 : 0.0,
+    air.SceneAltitudeMetres, air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG,
+    settings.GroundAlbedo, settings.GroundHeight };
+  if (method == MultipleScatteringReferencePatterns)
+  {
+    request.Key.insert(request.Key.end(),
+      { static_cast<double>(options.PatternRadius), options.PatternContribution,
+        options.PatternSelection });
+  }
+  const double solvesBefore = in.Scattering.GetNumberOfSolves();
+  std::string error;
+  const bool ok = in.Scattering.Update(
+    frame.Window, frame.Image, frame.Scalars, frame.CellData, frame.DataToWorld,
+    static_cast<double>(in.Density.GetNumberOfUploads()), request,
+    [this](double fraction) { this->UpdateProgress(fraction); }, error);
+  if (!ok)
+  {
+    if (error != in.LastScatteringError)
+    {
+      vtkErrorMacro(<< error);
+      in.LastScatteringError = error;
+    }
+    return;
+  }
+  in.LastScatteringError.clear();
+  if (in.Scattering.GetNumberOfSolves() != solvesBefore)
+  {
+    vtkDebugMacro(<< "multiple scattering solved in " << in.Scattering.GetLastSolveSeconds()
+                  << " s");
+  }
+  frame.ScatteringTexture = in.Scattering.HasTexture();
+  frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
+}
+
+// The sky seen from the cloud at altitude `cloudAltitude` above the scene [m]: a
+// sky model of the frame's air (built when the air or the ground changes) and its
+// sky-view table for the sun's elevation. nullptr (after an error) when the air is
+// refused.
+const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
+  const FrameState& frame, double cloudAltitude)
+{
+  Internals& in = *this->Internal;
+  const FrameSettings& settings = frame.Settings;
+  const nimbus::SceneAtmosphere& air = settings.Air;
+  const double groundAlbedo = frame.Ground ? settings.GroundAlbedo : 0.0;
+  const std::vector<double> modelKey = { air.RayleighScatteringPerMetre, air.MieScatteringPerMetre,
+    air.MieG, air.MieAlbedo, air.RayleighScaleHeightMetres, air.MieScaleHeightMetres,
+    air.EarthRadiusMetres, air.TopRadiusMetres, groundAlbedo, settings.Sun.TemperatureKelvin };
+  try
+  {
+    if (!in.CloudSky || modelKey != in.CloudSkyKey)
+    {
+      nimbus::SkyParameters parameters;
+      parameters.Atmosphere = air;
+      parameters.GroundAlbedo = groundAlbedo;
+      parameters.SunTemperatureKelvin = settings.Sun.TemperatureKelvin;
+      in.CloudSkyView.reset();
+      in.CloudSky = std::make_unique<nimbus::SkyModel>(parameters);
+      in.CloudSkyKey = modelKey;
+    }
+    const double altitude = std::max(0.0, air.SceneAltitudeMetres + cloudAltitude);
+    const std::vector<double> viewKey = { settings.Sun.ElevationDegrees, altitude };
+    if (!in.CloudSkyView || viewKey != in.CloudSkyViewKey)
+    {
+      // 64 x (32 + 16): the solver looks up a few dozen directions (the background's
+      // 128 x (64 + 32) takes 0.36 s on 2 cores).
+      in.CloudSkyView = std::make_unique<nimbus::SkyViewLut>(
+        *in.CloudSky, settings.Sun.ElevationDegrees, altitude, 64, 32, 16);
+      in.CloudSkyViewKey = viewKey;
+    }
+  }
+  catch (const std::exception& error)
+  {
+    in.CloudSky.reset();
+    in.CloudSkyView.reset();
+    const std::string message = std::string("The sky light on the cloud is off: ") + error.what();
+    if (message != in.LastScatteringError)
+    {
+      vtkErrorMacro(<< message);
+      in.LastScatteringError = message;
+    }
+    return nullptr;
+  }
+  return in.CloudSkyView.get();
+}
+
+int vtkNimbusCloudVolumeMapper::GetNumberOfMultipleScatteringSolves() const
+{
+  return this->Internal->Scattering.GetNumberOfSolves();
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastMultipleScatteringSeconds() const
+{
+  return this->Internal->Scattering.GetLastSolveSeconds();
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastMultipleScatteringBytes() const
+{
+  return this->Internal->Scattering.GetLastEstimatedBytes();
+}
+
+void vtkNimbusCloudVolumeMapper::GetMultipleScatteringGridDimensions(int dims[3]) const
+{
+  const auto& d = this->Internal->Scattering.GetGridDimensions();
+  std::copy(d.begin(), d.end(), dims);
 }
 
 //------------------------------------------------------------------------------
@@ -1083,6 +1352,27 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
   sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
   sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   sliceProgram->SetUniformi("unlit", this->Unlit ? 1 : 0);
+  // Multiple scattering (issue 14). Without a texture the samplers name the
+  // density's unit (a 3-D texture, never read), so no unit has two sampler types.
+  sliceProgram->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+  sliceProgram->SetUniformi("scatteringTextureOn", frame.ScatteringTexture ? 1 : 0);
+  const char* scatteringSamplers[3] = { "scatteringRed", "scatteringGreen", "scatteringBlue" };
+  for (int c = 0; c < 3; ++c)
+  {
+    sliceProgram->SetUniformi(scatteringSamplers[c],
+      (frame.ScatteringTexture ? in.Scattering.GetTexture(c) : in.Density.GetTexture())
+        ->GetTextureUnit());
+  }
+  const auto& scale = in.Scattering.GetTextureScale();
+  const float scatteringScale[3] = { static_cast<float>(scale[0]), static_cast<float>(scale[1]),
+    static_cast<float>(scale[2]) };
+  sliceProgram->SetUniform3f("scatteringTextureScale", scatteringScale);
+  sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
+  sliceProgram->SetUniformi("octaves", frame.Octaves);
+  const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
+    static_cast<float>(this->OctaveScatteringScale),
+    static_cast<float>(this->OctaveAsymmetryScale) };
+  sliceProgram->SetUniform3f("octaveScales", octaveScales);
   vtkShaderProgram* shadowProgram = nullptr;
   if (!this->Unlit)
   {
@@ -1217,6 +1507,20 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Albedo: " << this->Albedo << "\n";
   os << indent << "CloudG: " << this->CloudG << "\n";
   os << indent << "MultipleScattering (k_multi): " << this->MultipleScattering << "\n";
+  static const char* methods[4] = { "None", "Octaves", "ReferencePatterns", "DiscreteDirections" };
+  os << indent << "MultipleScatteringMethod: " << methods[this->MultipleScatteringMethod] << "\n";
+  os << indent << "MultipleScatteringOrders: " << this->MultipleScatteringOrders << "\n";
+  os << indent << "MultipleScatteringDownsampling: " << this->MultipleScatteringDownsampling
+     << "\n";
+  os << indent << "MultipleScatteringDirections: " << this->MultipleScatteringDirections << "\n";
+  os << indent << "SkyLight: " << (this->SkyLight ? "on" : "off") << "\n";
+  os << indent << "Octaves: " << this->Octaves << " (scales a " << this->OctaveExtinctionScale
+     << ", b " << this->OctaveScatteringScale << ", c " << this->OctaveAsymmetryScale << ")\n";
+  os << indent << "PatternRadius: " << this->PatternRadius
+     << ", PatternContribution: " << this->PatternContribution
+     << ", PatternSelection: " << this->PatternSelection << "\n";
+  os << indent << "MultipleScatteringMemoryBudgetMiB: " << this->MultipleScatteringMemoryBudgetMiB
+     << (this->MultipleScatteringMemoryBudgetMiB > 0.0 ? "" : " (default)") << "\n";
   os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
   os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
   os << indent << "SunIlluminance: " << this->SunIlluminance << "\n";

@@ -71,6 +71,10 @@
 
 class vtkImageData;
 class vtkMatrix4x4;
+namespace nimbus
+{
+class SkyViewLut;
+}
 class vtkNimbusSky;
 class vtkNimbusSkyBackground;
 class vtkRenderer;
@@ -106,6 +110,80 @@ public:
   virtual double GetMultipleScatteringMinValue() { return 0.0; }
   virtual double GetMultipleScatteringMaxValue() { return 100.0; }
   vtkGetMacro(MultipleScattering, double);
+  ///@}
+
+  /// How the light scattered more than once is computed (issue 14; see
+  /// Physics/MultipleScattering.h and docs/multiple-scattering.md). The single
+  /// scattering of the sun stays exact per sample (the slices); these add the rest:
+  enum MultipleScatteringMethods
+  {
+    /// Nothing but k_multi (000 Eq. 1's constant, MultipleScattering above).
+    MultipleScatteringNone = 0,
+    /// Wrenninge et al. 2013's octaves in the shader (no precompute for the sun),
+    /// plus the sky and the ground's light of order 1 (004 §3.5) when SkyLight.
+    MultipleScatteringOctaves = 1,
+    /// 004 §3.4's reference patterns, orders 2..MultipleScatteringOrders, plus
+    /// the sky and ground light of order 1 (004 §3.5).
+    MultipleScatteringReferencePatterns = 2,
+    /// 003 Eq. 1's discrete-direction system iterated to all orders for the sun,
+    /// the sky and the ground (the default).
+    MultipleScatteringDiscreteDirections = 3
+  };
+
+  ///@{
+  /// The method (MultipleScatteringMethods; default DiscreteDirections).
+  vtkSetClampMacro(MultipleScatteringMethod, int, 0, 3);
+  vtkGetMacro(MultipleScatteringMethod, int);
+  void SetMultipleScatteringMethodToNone() { this->SetMultipleScatteringMethod(0); }
+  void SetMultipleScatteringMethodToOctaves() { this->SetMultipleScatteringMethod(1); }
+  void SetMultipleScatteringMethodToReferencePatterns() { this->SetMultipleScatteringMethod(2); }
+  void SetMultipleScatteringMethodToDiscreteDirections() { this->SetMultipleScatteringMethod(3); }
+  /// Orders computed explicitly (reference patterns: the highest order, the paper
+  /// used 3; discrete directions: the rest is a geometric series). Default 32.
+  vtkSetClampMacro(MultipleScatteringOrders, int, 2, 1000);
+  vtkGetMacro(MultipleScatteringOrders, int);
+  /// The solver's grid: the density texture's texels in blocks of this many per
+  /// axis (default 4: a 128^3 cloud is solved on 32^3).
+  vtkSetClampMacro(MultipleScatteringDownsampling, int, 1, 256);
+  vtkGetMacro(MultipleScatteringDownsampling, int);
+  /// Directions of the discrete-direction system and of the sky-light look-ups
+  /// (default 26, as 003 used).
+  vtkSetClampMacro(MultipleScatteringDirections, int, 6, 1024);
+  vtkGetMacro(MultipleScatteringDirections, int);
+  /// Light from the sky and the ground on the cloud (004 §3.5; default on).
+  vtkSetMacro(SkyLight, bool);
+  vtkGetMacro(SkyLight, bool);
+  vtkBooleanMacro(SkyLight, bool);
+  /// Octaves: terms including the single scattering (1..16, default 4) and the
+  /// per-octave scales of extinction a, scattering b and asymmetry c (0..1, 0.5).
+  vtkSetClampMacro(Octaves, int, 1, 16);
+  vtkGetMacro(Octaves, int);
+  vtkSetClampMacro(OctaveExtinctionScale, double, 0.01, 1.0);
+  vtkGetMacro(OctaveExtinctionScale, double);
+  vtkSetClampMacro(OctaveScatteringScale, double, 0.01, 1.0);
+  vtkGetMacro(OctaveScatteringScale, double);
+  vtkSetClampMacro(OctaveAsymmetryScale, double, 0.01, 1.0);
+  vtkGetMacro(OctaveAsymmetryScale, double);
+  /// Reference patterns: the sample space's half-width in grid points (default
+  /// 6), the share of the contribution its kept paths cover (0.8, the paper's r)
+  /// and the fraction of them evaluated per point (0.25).
+  vtkSetClampMacro(PatternRadius, int, 1, 64);
+  vtkGetMacro(PatternRadius, int);
+  vtkSetClampMacro(PatternContribution, double, 0.01, 1.0);
+  vtkGetMacro(PatternContribution, double);
+  vtkSetClampMacro(PatternSelection, double, 0.01, 1.0);
+  vtkGetMacro(PatternSelection, double);
+  /// Memory the solver may take, MiB (0, the default: half of the physical memory).
+  /// Estimated before allocating; above it the term is off, with an error.
+  virtual void SetMultipleScatteringMemoryBudgetMiB(double value);
+  virtual double GetMultipleScatteringMemoryBudgetMiBMinValue() { return 0.0; }
+  virtual double GetMultipleScatteringMemoryBudgetMiBMaxValue() { return 1e12; }
+  vtkGetMacro(MultipleScatteringMemoryBudgetMiB, double);
+  /// Solves so far, the last one's seconds, its estimated bytes and grid.
+  int GetNumberOfMultipleScatteringSolves() const;
+  double GetLastMultipleScatteringSeconds() const;
+  double GetLastMultipleScatteringBytes() const;
+  void GetMultipleScatteringGridDimensions(int dims[3]) const;
   ///@}
 
   ///@{
@@ -307,6 +385,19 @@ protected:
   double Albedo = 0.99;
   double CloudG = 0.85;
   double MultipleScattering = 0.0;
+  int MultipleScatteringMethod = MultipleScatteringDiscreteDirections;
+  int MultipleScatteringOrders = 32;
+  int MultipleScatteringDownsampling = 4;
+  int MultipleScatteringDirections = 26;
+  bool SkyLight = true;
+  int Octaves = 4;
+  double OctaveExtinctionScale = 0.5;
+  double OctaveScatteringScale = 0.5;
+  double OctaveAsymmetryScale = 0.5;
+  int PatternRadius = 6;
+  double PatternContribution = 0.8;
+  double PatternSelection = 0.25;
+  double MultipleScatteringMemoryBudgetMiB = 0.0;
   double SunAzimuthDegrees = 135.0;
   double SunElevationDegrees = 45.0;
   double SunIlluminance = 1.0;
@@ -358,6 +449,8 @@ private:
   bool ComputeDataToWorld(vtkVolume* volume, vtkMatrix4x4* dataToWorld);
   void CopySceneColorAndDepth(FrameState& frame);
   bool UpdateAtmosphereTable(FrameState& frame);
+  void UpdateMultipleScattering(FrameState& frame);
+  const nimbus::SkyViewLut* CloudSkyView(const FrameState& frame, double cloudAltitude);
   void BeginPasses(const FrameState& frame);
   void ClearShadowSurface(const FrameState& frame);
   void RenderIntervalPhase(const FrameState& frame);

@@ -16,6 +16,50 @@ uniform float sliceSpacing;       // Delta d (world)
 uniform float sunStepMetres;      // Delta s = Delta d / dot(n, -L) [m] (000 Eq. 10)
 uniform int shaftsOn;             // atmosphere in cloud shadow
 uniform int unlit;                // benchmark floor: composite the slices without lighting
+// Multiple scattering (issue 14; Physics/MultipleScattering.h).
+uniform float cloudG;                 // Cornette-Shanks asymmetry of the cloud
+uniform int scatteringTextureOn;      // the solver's in-scattered radiance J(x, w)
+uniform sampler3D scatteringRed;      // SH c_00, c_1-1, c_10, c_11 of J, per channel
+uniform sampler3D scatteringGreen;
+uniform sampler3D scatteringBlue;
+uniform vec3 scatteringTextureScale;  // density texture coordinates -> these textures'
+uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
+uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
+uniform vec3 octaveScales;            // a (extinction), b (scattering), c (asymmetry)
+
+// J(p, w) of the solver: the radiance the cloud's particles at p scatter toward w
+// (w the direction of travel) per unit scattering coefficient, beyond the sun's
+// single scattering (degree-1 spherical harmonics, clamped at 0).
+vec3 InScattering(vec3 p, vec3 w)
+{
+  vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * scatteringTextureScale;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return max(vec3(dot(texture(scatteringRed, tc), y), dot(texture(scatteringGreen, tc), y),
+               dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+}
+
+// The sun's light scattered more than once that the mapper evaluates per sample,
+// as a multiple of sigma_s E_sun: the part of the forward peak the delta-M solve
+// left on the sun's direction, p(mu) (exp(-(1 - f albedo) tau) - exp(-tau)), and
+// the octaves sum_{i>=1} b^i p(mu; c^i g) exp(-a^i tau).
+float SunMultipleScattering(float mu, float tau)
+{
+  float sum = 0.0;
+  if (forwardPeakFraction > 0.0)
+  {
+    sum += CornetteShanks(mu, cloudG) *
+      (exp(-(1.0 - forwardPeakFraction * cloudAlbedo) * tau) - exp(-tau));
+  }
+  float a = 1.0, b = 1.0, c = 1.0;
+  for (int i = 1; i < octaves; ++i)
+  {
+    a *= octaveScales.x;
+    b *= octaveScales.y;
+    c *= octaveScales.z;
+    sum += b * CornetteShanks(mu, c * cloudG) * exp(-a * tau);
+  }
+  return sum;
+}
 
 void main()
 {
@@ -65,9 +109,16 @@ void main()
     {
       float altitude = Altitude(p);
       // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
-      float sunTransmittance = exp(-(ShadowDepth(p) + 0.5 * sigma * sunStepMetres));
-      source = cloudAlbedo * sigma * intervalAndPhase.y * sunTransmittance *
+      float sunDepth = ShadowDepth(p) + 0.5 * sigma * sunStepMetres;
+      float sunTransmittance = exp(-sunDepth);
+      float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+      source = cloudAlbedo * sigma *
+        (intervalAndPhase.y * sunTransmittance + SunMultipleScattering(mu, sunDepth)) *
         SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
+      if (scatteringTextureOn != 0 && sigma > 0.0)
+      {
+        source += cloudAlbedo * sigma * InScattering(p, -direction);
+      }
       if (atmosphereOn != 0)
       {
         vec3 air = AirSource(altitude, intervalAndPhase.zw);            // 000 Eq. 8, atmosphere

@@ -1,0 +1,266 @@
+#include "MultipleScatteringTexture.h"
+
+#include "CloudDensityTexture.h"
+#include "MemoryBudget.h"
+
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkTextureObject.h"
+#include "vtk_glew.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace nimbus
+{
+MultipleScatteringTexture::MultipleScatteringTexture() = default;
+MultipleScatteringTexture::~MultipleScatteringTexture() = default;
+
+vtkTextureObject* MultipleScatteringTexture::GetTexture(int channel) const
+{
+  return this->Textures[channel].GetPointer();
+}
+
+bool MultipleScatteringTexture::BuildGrid(vtkImageData* image, vtkDataArray* scalars, bool cellData,
+  vtkMatrix4x4* dataToWorld, const Request& request, ExtinctionGrid& grid,
+  std::array<int, 3>& factors, std::string& error)
+{
+  int pointDims[3];
+  image->GetDimensions(pointDims);
+  DensityResamplePlan plan;
+  for (int k = 0; k < 3; ++k)
+  {
+    const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    plan.InputDimensions[k] = samples;
+    factors[k] =
+      std::min(samples, std::max(1, request.Downsampling) * std::max(1, request.TextureFactors[k]));
+    plan.Factors[k] = factors[k];
+    plan.OutputDimensions[k] = (samples + factors[k] - 1) / factors[k];
+  }
+  const ResampledDensity density = CloudDensityTexture::Resample(scalars, plan);
+  grid.Dimensions = plan.OutputDimensions;
+  grid.Extinction.resize(plan.OutputSize());
+  const float* values = density.Data();
+  for (std::size_t i = 0; i < grid.Extinction.size(); ++i)
+  {
+    grid.Extinction[i] = static_cast<float>(request.ExtinctionPerDensity * values[i]);
+  }
+
+  // Where grid point (i, j, k) sits: input sample position D i + (D - 1)/2 per axis
+  // (cells: their centres), through the data -> world matrix, in metres.
+  double origin[3], spacing[3];
+  int extent[6];
+  image->GetOrigin(origin);
+  image->GetSpacing(spacing);
+  image->GetExtent(extent);
+  auto worldOf = [&](const double index[3])
+  {
+    double data[4] = { 0, 0, 0, 1 }, world[4];
+    for (int k = 0; k < 3; ++k)
+    {
+      const double sample = factors[k] * index[k] + 0.5 * (factors[k] - 1) + (cellData ? 0.5 : 0.0);
+      data[k] = origin[k] + (extent[2 * k] + sample) * spacing[k];
+    }
+    dataToWorld->MultiplyPoint(data, world);
+    return Vector3{ { world[0] / world[3] * request.MetresPerUnit,
+      world[1] / world[3] * request.MetresPerUnit, world[2] / world[3] * request.MetresPerUnit } };
+  };
+  const double zero[3] = { 0, 0, 0 };
+  grid.Origin = worldOf(zero);
+  for (int k = 0; k < 3; ++k)
+  {
+    double step[3] = { 0, 0, 0 };
+    step[k] = 1.0;
+    Vector3 axis = worldOf(step);
+    for (int c = 0; c < 3; ++c)
+    {
+      axis[c] -= grid.Origin[c];
+    }
+    double length = Length(axis);
+    if (!(length > 0.0) || !std::isfinite(length))
+    {
+      // A zero spacing: one metre (the axis is one sample thick, nothing travels it).
+      axis = { { 0, 0, 0 } };
+      axis[k] = 1.0;
+      length = 1.0;
+    }
+    grid.Spacing[k] = length;
+    grid.Axes[k] = { { axis[0] / length, axis[1] / length, axis[2] / length } };
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = a + 1; b < 3; ++b)
+    {
+      if (std::abs(Dot(grid.Axes[a], grid.Axes[b])) > 1e-6)
+      {
+        error = "the volume's matrix shears the density grid; multiple scattering needs "
+                "orthogonal axes";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+bool MultipleScatteringTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
+  vtkDataArray* scalars, bool cellData, vtkMatrix4x4* dataToWorld, double densityVersion,
+  const Request& request, const std::function<void(double)>& progress, std::string& error)
+{
+  std::vector<double> key = request.Key;
+  key.push_back(densityVersion);
+  for (int k = 0; k < 16; ++k)
+  {
+    key.push_back(dataToWorld->GetData()[k]);
+  }
+  if (this->Valid && key == this->SolvedKey)
+  {
+    return true;
+  }
+  if (!this->Valid && key == this->FailedKey)
+  {
+    error = this->FailedError; // not tried again until something changes
+    return false;
+  }
+  const bool ok =
+    this->Solve(window, image, scalars, cellData, dataToWorld, request, key, progress, error);
+  this->FailedKey = ok ? std::vector<double>() : key;
+  this->FailedError = ok ? std::string() : error;
+  return ok;
+}
+
+bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageData* image,
+  vtkDataArray* scalars, bool cellData, vtkMatrix4x4* dataToWorld, const Request& request,
+  const std::vector<double>& key, const std::function<void(double)>& progress, std::string& error)
+{
+  this->Valid = false;
+  this->Textured = false;
+  this->SolvedKey.clear();
+  const auto start = std::chrono::steady_clock::now();
+  if (request.Options.Method == MultipleScatteringMethod::None)
+  {
+    this->Field = MultipleScatteringField();
+    this->Valid = true;
+    this->SolvedKey = key;
+    return true;
+  }
+
+  ExtinctionGrid grid;
+  std::array<int, 3> factors{ { 1, 1, 1 } };
+  // The estimate before any allocation: the grid's own floats plus the solver's.
+  {
+    int pointDims[3];
+    image->GetDimensions(pointDims);
+    ExtinctionGrid shape;
+    for (int k = 0; k < 3; ++k)
+    {
+      const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+      const int f = std::min(
+        samples, std::max(1, request.Downsampling) * std::max(1, request.TextureFactors[k]));
+      shape.Dimensions[k] = (samples + f - 1) / f;
+    }
+    const double points =
+      static_cast<double>(shape.Dimensions[0]) * shape.Dimensions[1] * shape.Dimensions[2];
+    this->LastEstimatedBytes =
+      EstimateMultipleScatteringBytes(shape, request.Options) + 4.0 * points;
+    if (request.BudgetBytes > 0.0 && this->LastEstimatedBytes > request.BudgetBytes)
+    {
+      std::ostringstream message;
+      message << "Multiple scattering on a " << shape.Dimensions[0] << "x" << shape.Dimensions[1]
+              << "x" << shape.Dimensions[2] << " grid: "
+              << OverBudgetMessage("the solver", this->LastEstimatedBytes, request.BudgetBytes)
+              << ". Raise the grid downsampling, use fewer directions or raise "
+                 "MultipleScatteringMemoryBudgetMiB; the cloud is drawn without it.";
+      error = message.str();
+      return false;
+    }
+  }
+  if (!BuildGrid(image, scalars, cellData, dataToWorld, request, grid, factors, error))
+  {
+    error = "Multiple scattering: " + error + "; the cloud is drawn without it.";
+    return false;
+  }
+  try
+  {
+    this->Field =
+      SolveMultipleScattering(grid, request.Optics, request.Lighting, request.Options, progress);
+  }
+  catch (const std::exception& problem)
+  {
+    error = std::string("Multiple scattering failed: ") + problem.what() +
+      "; the cloud is drawn without it.";
+    return false;
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    // Density texture coordinate u = (s + 0.5) / (n_tex f) for input sample
+    // position s; this texture's v = (s + 0.5) / (n' D).
+    this->TextureScale[k] = static_cast<double>(request.TextureDimensions[k]) *
+      request.TextureFactors[k] / (static_cast<double>(grid.Dimensions[k]) * factors[k]);
+  }
+  bool any = false;
+  for (float c : this->Field.Coefficients)
+  {
+    any = any || c != 0.0f;
+  }
+  if (any)
+  {
+    const std::size_t points = grid.NumberOfPoints();
+    std::vector<float> channel(4 * points);
+    for (int c = 0; c < 3; ++c)
+    {
+      for (std::size_t i = 0; i < points; ++i)
+      {
+        for (int b = 0; b < 4; ++b)
+        {
+          channel[4 * i + b] = this->Field.Coefficients[12 * i + 4 * c + b];
+        }
+      }
+      vtkTextureObject* texture = this->Textures[c];
+      texture->SetContext(window);
+      texture->ReleaseGraphicsResources(window);
+      texture->SetWrapS(vtkTextureObject::ClampToEdge);
+      texture->SetWrapT(vtkTextureObject::ClampToEdge);
+      texture->SetWrapR(vtkTextureObject::ClampToEdge);
+      texture->SetMinificationFilter(vtkTextureObject::Linear);
+      texture->SetMagnificationFilter(vtkTextureObject::Linear);
+      for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
+      {
+        // errors of earlier GL calls are not this upload's
+      }
+      if (!texture->Create3DFromRaw(grid.Dimensions[0], grid.Dimensions[1], grid.Dimensions[2], 4,
+            VTK_FLOAT, channel.data()) ||
+        glGetError() == GL_OUT_OF_MEMORY)
+      {
+        for (auto& t : this->Textures)
+        {
+          t->ReleaseGraphicsResources(window);
+        }
+        error = "Could not upload the multiple-scattering texture (" + FormatBytes(48.0 * points) +
+          "; GL out of memory?); the cloud is drawn without it.";
+        return false;
+      }
+    }
+    this->Textured = true;
+  }
+  ++this->Solves;
+  this->Valid = true;
+  this->SolvedKey = key;
+  this->LastSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return true;
+}
+
+void MultipleScatteringTexture::Release(vtkWindow* window)
+{
+  for (auto& t : this->Textures)
+  {
+    t->ReleaseGraphicsResources(window);
+  }
+  this->Valid = false;
+  this->Textured = false;
+  this->SolvedKey.clear();
+}
+} // namespace nimbus
