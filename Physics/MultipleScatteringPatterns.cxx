@@ -70,6 +70,13 @@
 // With it, order 2 in a uniform cube is within 1.5 % of the continuous volume integral
 // at sigma h = 0.4 (TestMultipleScatteringPatterns, Order2ApproachesTheContinuousIntegral).
 //
+// Accuracy against a forward Monte Carlo reference (1e6 photons, a 32^3 sphere of
+// cloud, 20 m cells, sigma_t <= 0.05 /m, Cornette-Shanks g = 0.85, albedo 0.99, the
+// default pattern options), at a lit point 70 m under the top: order 2 within 8 % in
+// c_00 and 1 % in c_10, order 3 35 % high in c_00 (the clamp of the degree-1 field and
+// the 1/c extension). Many orders compound such biases: orders 2..64 came out 1.6-1.9
+// times the Monte Carlo's at three points. Keep Orders near the paper's 3.
+//
 // Transmittance T = exp(-tau): trapezoid rule along the segment j -> P with one step
 // per grid step along the offset's longest axis (the march of OpticalDepthToward);
 // the interior samples lie on grid planes of that axis, so each is a bilinear
