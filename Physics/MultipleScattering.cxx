@@ -1003,6 +1003,7 @@ MultipleScatteringField SolveMultipleScattering(const ExtinctionGrid& grid,
       break;
     case MultipleScatteringMethod::DiscreteDirections:
       field.ForwardPeakFraction = solver.AllOrders(field.Coefficients, field);
+      field.TruncatedG = Truncate(optics).G;
       break;
   }
   for (float& c : field.Coefficients)

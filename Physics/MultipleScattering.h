@@ -169,6 +169,8 @@ struct NIMBUSPHYSICS_EXPORT MultipleScatteringField
   /// that peak carries, sigma_s p(w . L) E (exp(-(1 - f albedo) tau) - exp(-tau)),
   /// tau the cloud's optical depth toward the sun, to its single scattering.
   double ForwardPeakFraction = 0.0;
+  /// The asymmetry g' of the HG phase function that stands for the rest.
+  double TruncatedG = 0.0;
   int OrdersComputed = 0;
   /// Per channel: the ratio of the last two orders' energies and the share of the
   /// total that the geometric tail added (DiscreteDirections).

@@ -79,7 +79,13 @@ DEFAULT_SETTINGS = {
         {"shading": "volumetric", "sample_distance": 0.5, "reach": 1.0},
         {"shading": "volumetric", "sample_distance": 0.25, "reach": 1.0},
     ],
-    "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)],
+    # SVS: single scattering over slices (ms "none", the scene's k_multi), then the
+    # multiple-scattering methods (issue 14) at 256 slices over their knobs.
+    "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)]
+    + [{"ms": "octaves", "octaves": n} for n in (2, 4, 8)]
+    + [{"ms": "patterns", "orders": n} for n in (2, 3)]
+    + [{"ms": "directions", "downsampling": d, "directions": n}
+       for d, n in ((8, 26), (4, 14), (4, 26), (4, 50), (2, 26))],
     "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }
@@ -257,7 +263,7 @@ def models_single_scattering_only(renderer_name, settings, scene):
     if renderer_name == "svs":
         k_multi = settings.get("k_multi",
                                scene.get("medium", {}).get("multiple_scattering_constant", 0.0))
-        return k_multi == 0
+        return k_multi == 0 and settings.get("ms", "none") == "none"
     return False
 
 
@@ -445,6 +451,9 @@ class VtkGpuRenderer:
         self.window.Finalize()
 
 
+SVS_METHODS = {"none": 0, "octaves": 1, "patterns": 2, "directions": 3}
+
+
 class SvsRenderer:
     """Nimbus's shadow-view-slice mapper (vtkNimbusCloudVolumeMapper, paper 000).
 
@@ -456,7 +465,11 @@ class SvsRenderer:
     framebuffer (radiance x VTK_SCALE, quantisation <= 6.5e-4).
     Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
     atmosphere_steps, unlit (the unlit compositing floor, for timing only), k_multi
-    (000 Eq. 1's multiple-scattering constant; default the scene's).
+    (000 Eq. 1's multiple-scattering constant; default the scene's), and the
+    multiple-scattering term (issue 14): ms (none, the default here, octaves,
+    patterns or directions), orders, downsampling, directions, sky_light (bool),
+    octaves, pattern_radius, pattern_selection. The row also reports the last
+    solve's seconds (precompute_seconds) and the solver's memory (ms_mib).
     """
 
     def __init__(self, scene_path):
@@ -471,6 +484,7 @@ class SvsRenderer:
         density.Update()
         self.mapper = configure_svs_mapper(nimbus.vtkNimbusCloudVolumeMapper(), scene)
         self.k_multi = scene["medium"].get("multiple_scattering_constant", 0.0)
+        self.extra = {}
         self.mapper.SetInputConnection(density.GetOutputPort())
         self.mapper.SetExposure(VTK_SCALE)
         self.volume = vtkVolume()
@@ -507,7 +521,22 @@ class SvsRenderer:
         self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 64)))
         self.mapper.SetUnlit(bool(settings.get("unlit", False)))
         self.mapper.SetMultipleScattering(float(settings.get("k_multi", self.k_multi)))
+        self.mapper.SetMultipleScatteringMethod(SVS_METHODS[settings.get("ms", "none")])
+        self.mapper.SetMultipleScatteringOrders(int(settings.get("orders", 32 if settings.get(
+            "ms") == "directions" else 3)))
+        self.mapper.SetMultipleScatteringDownsampling(int(settings.get("downsampling", 4)))
+        self.mapper.SetMultipleScatteringDirections(int(settings.get("directions", 26)))
+        self.mapper.SetSkyLight(bool(settings.get("sky_light", True)))
+        self.mapper.SetOctaves(int(settings.get("octaves", 4)))
+        self.mapper.SetPatternRadius(int(settings.get("pattern_radius", 6)))
+        self.mapper.SetPatternSelection(float(settings.get("pattern_selection", 0.25)))
+        solves = self.mapper.GetNumberOfMultipleScatteringSolves()
         self.window.Render()
+        if self.mapper.GetNumberOfMultipleScatteringSolves() != solves:
+            self.extra = {"precompute_seconds": self.mapper.GetLastMultipleScatteringSeconds(),
+                          "ms_mib": self.mapper.GetLastMultipleScatteringBytes() / 2 ** 20}
+        elif settings.get("ms", "none") == "none":
+            self.extra = {"precompute_seconds": 0.0, "ms_mib": 0.0}
         if self.float_capture:
             radiance = self.mapper.GetRadianceImage()
             width, height, _ = radiance.GetDimensions()
@@ -583,7 +612,10 @@ def plot(rows, title, path):
     # One series per renderer and kind of reference ("svs vs path"); a corrected RMSE of 0
     # (within the reference's noise) is drawn at the floor.
     def series(row):
-        return f"{row['renderer']} vs {row.get('reference', '?').split()[0]}"
+        name = row["renderer"]
+        if name == "svs":  # one series per multiple-scattering method
+            name += " " + json.loads(row.get("settings_json", "{}")).get("ms", "none")
+        return f"{name} vs {row.get('reference', '?').split()[0]}"
 
     for name in sorted({series(row) for row in rows}):
         mine = [row for row in rows if series(row) == name]
@@ -794,6 +826,7 @@ def run(arguments):
                            "median_seconds": seconds, "reference": label}
                     row.update(error_metrics(image, reference, reference_error,
                                              getattr(renderer, "noise", None)))
+                    row.update(getattr(renderer, "extra", {}))
                     scene_rows.append(row)
                     print(f"{scene_name} {renderer_name} [{row['setting']}]: "
                           f"{seconds:.3f} s, RMSE {row['rmse']:.4g} vs {label}, "
@@ -808,10 +841,10 @@ def run(arguments):
 
     fields = ["scene", "renderer", "setting", "median_seconds", "rmse", "rmse_raw",
               "reference_noise", "relative_l1", "max_abs", "psnr_db", "reference",
-              "settings_json"]
+              "precompute_seconds", "ms_mib", "settings_json"]
     csv_path = os.path.join(args.output_dir, "trade.csv")
     with open(csv_path, "w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=fields)
+        writer = csv.DictWriter(stream, fieldnames=fields, restval="")
         writer.writeheader()
         writer.writerows(all_rows)
     plot(all_rows, f"all scenes (reference: {', '.join(sorted(used_references))})",
@@ -819,13 +852,17 @@ def run(arguments):
     if args.markdown:
         with open(args.markdown, "w") as stream:
             stream.write("| scene | renderer | setting | median time (s) | RMSE | rel. L1 | "
-                         "max abs | PSNR (dB) | reference |\n"
-                         "|---|---|---|---|---|---|---|---|---|\n")
+                         "max abs | PSNR (dB) | reference | precompute (s) | solver MiB |\n"
+                         "|---|---|---|---|---|---|---|---|---|---|---|\n")
             for row in all_rows:
+                precompute = row.get("precompute_seconds", "")
+                memory = row.get("ms_mib", "")
                 stream.write(f"| {row['scene']} | {row['renderer']} | {row['setting']} | "
                              f"{row['median_seconds']:.3f} | {row['rmse']:.4g} | "
                              f"{row['relative_l1']:.3f} | {row['max_abs']:.3g} | "
-                             f"{row['psnr_db']:.1f} | {row['reference']} |\n")
+                             f"{row['psnr_db']:.1f} | {row['reference']} | "
+                             f"{'' if precompute == '' else format(precompute, '.3f')} | "
+                             f"{'' if memory == '' else format(memory, '.1f')} |\n")
     print(csv_path)
     return 0
 

@@ -44,6 +44,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <new>
@@ -256,6 +257,7 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   // fraction and the octaves (1: none).
   bool ScatteringTexture = false;
   double ForwardPeakFraction = 0.0;
+  double TruncatedG = 0.0;
   int Octaves = 1;
 };
 
@@ -270,6 +272,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // (a sky model of the mapper's own air, built only when the sky light needs it).
   nimbus::MultipleScatteringTexture Scattering;
   std::string LastScatteringError;
+  double LastPrecomputeSeconds = 0.0;
   std::unique_ptr<nimbus::SkyModel> CloudSky;
   std::vector<double> CloudSkyKey;
   std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
@@ -1001,6 +1004,7 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
 void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
 {
   Internals& in = *this->Internal;
+  const auto start = std::chrono::steady_clock::now();
   const FrameSettings& settings = frame.Settings;
   const int method = this->Unlit ? MultipleScatteringNone : this->MultipleScatteringMethod;
   frame.Octaves = method == MultipleScatteringOctaves ? this->Octaves : 1;
@@ -1140,11 +1144,14 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   in.LastScatteringError.clear();
   if (in.Scattering.GetNumberOfSolves() != solvesBefore)
   {
-    vtkDebugMacro(<< "multiple scattering solved in " << in.Scattering.GetLastSolveSeconds()
-                  << " s");
+    // The whole precompute: the sky (when rebuilt), the grid, the solve, the upload.
+    in.LastPrecomputeSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    vtkDebugMacro(<< "multiple scattering: " << in.LastPrecomputeSeconds << " s");
   }
   frame.ScatteringTexture = in.Scattering.HasTexture();
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
+  frame.TruncatedG = in.Scattering.GetField().TruncatedG;
 }
 
 // The sky seen from the cloud at altitude `cloudAltitude` above the scene [m]: a
@@ -1206,7 +1213,7 @@ int vtkNimbusCloudVolumeMapper::GetNumberOfMultipleScatteringSolves() const
 
 double vtkNimbusCloudVolumeMapper::GetLastMultipleScatteringSeconds() const
 {
-  return this->Internal->Scattering.GetLastSolveSeconds();
+  return this->Internal->LastPrecomputeSeconds;
 }
 
 double vtkNimbusCloudVolumeMapper::GetLastMultipleScatteringBytes() const
@@ -1368,6 +1375,7 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
     static_cast<float>(scale[2]) };
   sliceProgram->SetUniform3f("scatteringTextureScale", scatteringScale);
   sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
+  sliceProgram->SetUniformf("truncatedG", static_cast<float>(frame.TruncatedG));
   sliceProgram->SetUniformi("octaves", frame.Octaves);
   const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
     static_cast<float>(this->OctaveScatteringScale),

@@ -179,7 +179,8 @@ public:
   virtual double GetMultipleScatteringMemoryBudgetMiBMinValue() { return 0.0; }
   virtual double GetMultipleScatteringMemoryBudgetMiBMaxValue() { return 1e12; }
   vtkGetMacro(MultipleScatteringMemoryBudgetMiB, double);
-  /// Solves so far, the last one's seconds, its estimated bytes and grid.
+  /// Solves so far, the last one's seconds (the sky model and table when rebuilt,
+  /// the grid, the solve, the upload), its estimated bytes and grid.
   int GetNumberOfMultipleScatteringSolves() const;
   double GetLastMultipleScatteringSeconds() const;
   double GetLastMultipleScatteringBytes() const;

@@ -24,6 +24,7 @@ uniform sampler3D scatteringGreen;
 uniform sampler3D scatteringBlue;
 uniform vec3 scatteringTextureScale;  // density texture coordinates -> these textures'
 uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
+uniform float truncatedG;             // delta-M g' of the truncated phase function
 uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
 uniform vec3 octaveScales;            // a (extinction), b (scattering), c (asymmetry)
 
@@ -47,7 +48,9 @@ float SunMultipleScattering(float mu, float tau)
   float sum = 0.0;
   if (forwardPeakFraction > 0.0)
   {
-    sum += CornetteShanks(mu, cloudG) *
+    // delta-M: the beam's excess scatters out of it at sigma_s (1 - f) into the
+    // truncated phase function, HG with g' = (k_1 - f) / (1 - f).
+    sum += (1.0 - forwardPeakFraction) * HenyeyGreenstein(mu, truncatedG) *
       (exp(-(1.0 - forwardPeakFraction * cloudAlbedo) * tau) - exp(-tau));
   }
   float a = 1.0, b = 1.0, c = 1.0;
