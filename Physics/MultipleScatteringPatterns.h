@@ -9,7 +9,10 @@
 namespace nimbus
 {
 /// sunDepth: the cloud's optical depth toward the sun at every grid point
-/// (OpticalDepthToward). `progress(fraction)` as in SolveMultipleScattering.
+/// (OpticalDepthToward). `progress(fraction)` as in SolveMultipleScattering (fractions
+/// of this call's work, ending at 1). The result does not depend on options.Threads.
+/// Throws std::invalid_argument when sunDepth, coefficients or grid.Extinction do not
+/// match the grid. Method, the cost and how it departs from the paper: the .cxx file.
 void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& optics,
   const DirectionalLight& sun, const MultipleScatteringOptions& options,
   const std::vector<float>& sunDepth, std::vector<float>& coefficients,
