@@ -13,15 +13,6 @@
 
 namespace nimbus
 {
-#ifdef NIMBUS_NO_REFERENCE_PATTERNS
-void AddReferencePatternOrders(const ExtinctionGrid&, const CloudOptics&, const DirectionalLight&,
-  const MultipleScatteringOptions&, const std::vector<float>&, std::vector<float>&,
-  const std::function<void(double)>&)
-{
-  throw std::runtime_error("multiple scattering: reference patterns are not built in yet");
-}
-#endif
-
 namespace
 {
 constexpr double kY00 = 0.28209479177387814; // 1 / (2 sqrt(pi))
@@ -849,8 +840,8 @@ double EstimateMultipleScatteringBytes(
       bytes += 4.0 * nd * 3.0 * n * sizeof(float) + n * sizeof(float);
       break;
     case MultipleScatteringMethod::ReferencePatterns:
-      // two orders' fields and the radiance of one direction
-      bytes += 2.0 * n * kCoefficients * sizeof(float) + 3.0 * n * sizeof(float);
+      // two orders' fields, the radiance of one direction, a mask, the sky's depths
+      bytes += 2.0 * n * kCoefficients * sizeof(float) + (nd + 3.0) * n * sizeof(float) + n;
       break;
     case MultipleScatteringMethod::Octaves:
       bytes += (nd + 3.0) * n * sizeof(float); // every direction's depths, one radiance
@@ -1004,19 +995,27 @@ MultipleScatteringField SolveMultipleScattering(const ExtinctionGrid& grid,
       }
       break;
     case MultipleScatteringMethod::ReferencePatterns:
+    {
+      // The sky pass reports 0 ... 0.2, the patterns 0.2 ... 1.
+      const std::function<void(double)> skyProgress = [&progress](double f)
+      { Report(progress, 0.2 * f); };
+      const std::function<void(double)> patternProgress = [&progress](double f)
+      { Report(progress, 0.2 + 0.8 * f); };
       if (options.SkyLight && lighting.Sky)
       {
-        solver.SkyOrderOne(field.Coefficients);
+        DiscreteDirectionSolver skySolver(grid, optics, lighting, options, skyProgress);
+        skySolver.SkyOrderOne(field.Coefficients);
       }
       if (lighting.HasSun)
       {
         const std::vector<float> depth =
           OpticalDepthToward(grid, lighting.Sun.ToLight, options.Threads);
         AddReferencePatternOrders(
-          grid, optics, lighting.Sun, options, depth, field.Coefficients, progress);
+          grid, optics, lighting.Sun, options, depth, field.Coefficients, patternProgress);
         field.OrdersComputed = options.Orders;
       }
       break;
+    }
     case MultipleScatteringMethod::DiscreteDirections:
       field.ForwardPeakFraction = solver.AllOrders(field.Coefficients, field);
       field.TruncatedG = Truncate(optics).G;

@@ -522,8 +522,10 @@ class SvsRenderer:
         self.mapper.SetUnlit(bool(settings.get("unlit", False)))
         self.mapper.SetMultipleScattering(float(settings.get("k_multi", self.k_multi)))
         self.mapper.SetMultipleScatteringMethod(SVS_METHODS[settings.get("ms", "none")])
-        self.mapper.SetMultipleScatteringOrders(int(settings.get("orders", 32 if settings.get(
-            "ms") == "directions" else 3)))
+        if settings.get("ms") == "patterns":
+            self.mapper.SetPatternOrders(int(settings.get("orders", 3)))
+        else:
+            self.mapper.SetMultipleScatteringOrders(int(settings.get("orders", 32)))
         self.mapper.SetMultipleScatteringDownsampling(int(settings.get("downsampling", 4)))
         self.mapper.SetMultipleScatteringDirections(int(settings.get("directions", 26)))
         self.mapper.SetSkyLight(bool(settings.get("sky_light", True)))

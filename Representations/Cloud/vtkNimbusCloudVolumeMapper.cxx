@@ -1019,7 +1019,8 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   nimbus::MultipleScatteringTexture::Request request;
   nimbus::MultipleScatteringOptions& options = request.Options;
   options.Method = static_cast<nimbus::MultipleScatteringMethod>(method);
-  options.Orders = this->MultipleScatteringOrders;
+  options.Orders = method == MultipleScatteringReferencePatterns ? this->PatternOrders
+                                                                 : this->MultipleScatteringOrders;
   options.NumberOfDirections = this->MultipleScatteringDirections;
   options.SkyLight = this->SkyLight;
   options.PatternRadius = this->PatternRadius;
@@ -1524,7 +1525,8 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SkyLight: " << (this->SkyLight ? "on" : "off") << "\n";
   os << indent << "Octaves: " << this->Octaves << " (scales a " << this->OctaveExtinctionScale
      << ", b " << this->OctaveScatteringScale << ", c " << this->OctaveAsymmetryScale << ")\n";
-  os << indent << "PatternRadius: " << this->PatternRadius
+  os << indent << "PatternOrders: " << this->PatternOrders
+     << ", PatternRadius: " << this->PatternRadius
      << ", PatternContribution: " << this->PatternContribution
      << ", PatternSelection: " << this->PatternSelection << "\n";
   os << indent << "MultipleScatteringMemoryBudgetMiB: " << this->MultipleScatteringMemoryBudgetMiB

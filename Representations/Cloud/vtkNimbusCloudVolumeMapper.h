@@ -138,8 +138,9 @@ public:
   void SetMultipleScatteringMethodToOctaves() { this->SetMultipleScatteringMethod(1); }
   void SetMultipleScatteringMethodToReferencePatterns() { this->SetMultipleScatteringMethod(2); }
   void SetMultipleScatteringMethodToDiscreteDirections() { this->SetMultipleScatteringMethod(3); }
-  /// Orders computed explicitly (reference patterns: the highest order, the paper
-  /// used 3; discrete directions: the rest is a geometric series). Default 32.
+  /// Discrete directions: the scatterings iterated explicitly (N: the radiance
+  /// scattered 1..N times, so J of orders 2..N+1; stops earlier once converged; the
+  /// rest is a geometric series). Default 32.
   vtkSetClampMacro(MultipleScatteringOrders, int, 2, 1000);
   vtkGetMacro(MultipleScatteringOrders, int);
   /// The solver's grid: the density texture's texels in blocks of this many per
@@ -164,7 +165,12 @@ public:
   vtkGetMacro(OctaveScatteringScale, double);
   vtkSetClampMacro(OctaveAsymmetryScale, double, 0.01, 1.0);
   vtkGetMacro(OctaveAsymmetryScale, double);
-  /// Reference patterns: the sample space's half-width in grid points (default
+  /// Reference patterns: the highest order (2..8, default 3 as in 004; each order's
+  /// small bias compounds: with all orders the sum comes out 1.6-1.9x a Monte Carlo
+  /// reference, see docs/multiple-scattering.md),
+  vtkSetClampMacro(PatternOrders, int, 2, 8);
+  vtkGetMacro(PatternOrders, int);
+  /// the sample space's half-width in grid points (default
   /// 6), the share of the contribution its kept paths cover (0.8, the paper's r)
   /// and the fraction of them evaluated per point (0.25).
   vtkSetClampMacro(PatternRadius, int, 1, 64);
@@ -395,6 +401,7 @@ protected:
   double OctaveExtinctionScale = 0.5;
   double OctaveScatteringScale = 0.5;
   double OctaveAsymmetryScale = 0.5;
+  int PatternOrders = 3;
   int PatternRadius = 6;
   double PatternContribution = 0.8;
   double PatternSelection = 0.25;
