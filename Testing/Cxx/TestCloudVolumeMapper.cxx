@@ -184,6 +184,83 @@ bool FacingSun(const Context& c)
     c.CompareWithBaseline();
 }
 
+// Multiple scattering (issue 14), the default method (discrete directions): the lit
+// side at noon is bright inside, not grey; backlit, the cloud glows through instead
+// of going black. Octaves and reference patterns at noon.
+bool MultipleScatteringNoon(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMultipleScatteringMethodToDiscreteDirections();
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(65);
+  s.Render(c.Png());
+  int grid[3];
+  s.Mapper->GetMultipleScatteringGridDimensions(grid);
+  return Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 1, "one solve") &&
+    Check(grid[0] == 12 && grid[1] == 12 && grid[2] == 8,
+      "48x48x32 / 4 -> " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" +
+        std::to_string(grid[2])) &&
+    c.CompareWithBaseline();
+}
+
+bool MultipleScatteringBacklit(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMultipleScatteringMethodToDiscreteDirections();
+  s.Mapper->SetSunAzimuthDegrees(0);
+  s.Mapper->SetSunElevationDegrees(14);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool MultipleScatteringOctaves(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMultipleScatteringMethodToOctaves();
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(65);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool MultipleScatteringPatterns(const Context& c)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMultipleScatteringMethodToReferencePatterns();
+  s.Mapper->SetSunAzimuthDegrees(135);
+  s.Mapper->SetSunElevationDegrees(65);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+// The solve is keyed: a camera move reuses it, a sun move, a new density or a new
+// knob solves again, and the same settings again do not.
+bool MultipleScatteringResolvesOnlyOnChange(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetMultipleScatteringMethodToDiscreteDirections();
+  s.Mapper->SetMultipleScatteringOrders(4);
+  s.Render();
+  bool ok = Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 1, "first frame: one solve");
+  s.LookFrom({ 1000, -6000, 1800 }, { 0, 0, 1600 }, 35);
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 1, "camera move: no solve");
+  s.Mapper->SetSunElevationDegrees(s.Mapper->GetSunElevationDegrees() + 5.0);
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 2, "sun move: a solve");
+  s.Mapper->SetMultipleScatteringDirections(14);
+  s.Render();
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 3, "new directions: one solve");
+  s.Mapper->SetInputData(MakeCloud(2));
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 4, "new density: a solve");
+  s.Mapper->SetMultipleScatteringMethodToNone();
+  s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 4, "method none: no solve");
+  return ok;
+}
+
 bool GroundShadows(const Context& c)
 {
   Scene s(MakeCloud());
@@ -583,7 +660,12 @@ int main(int argc, char* argv[])
     { "HugeOpticalThickness", HugeOpticalThickness }, { "CameraInsideVolume", CameraInsideVolume },
     { "LightingChangeKeepsVolume", LightingChangeKeepsVolume }, { "Downsampling", Downsampling },
     { "ReallocatedTargets", ReallocatedTargets }, { "DataLayouts", DataLayouts },
-    { "ViewportsAndParallelProjection", ViewportsAndParallelProjection } };
+    { "ViewportsAndParallelProjection", ViewportsAndParallelProjection },
+    { "MultipleScatteringNoon", MultipleScatteringNoon },
+    { "MultipleScatteringBacklit", MultipleScatteringBacklit },
+    { "MultipleScatteringOctaves", MultipleScatteringOctaves },
+    { "MultipleScatteringPatterns", MultipleScatteringPatterns },
+    { "MultipleScatteringResolvesOnlyOnChange", MultipleScatteringResolvesOnlyOnChange } };
   if (argc != 4 || !cases.count(argv[1]))
   {
     std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";
