@@ -120,6 +120,12 @@ public:
   }
 
   double GetStep() const { return this->Step; }
+  int GetAxis() const { return this->Axis; }
+  int GetB() const { return this->B; }
+  int GetC() const { return this->C; }
+  bool GetForward() const { return this->Forward; }
+  double GetOffsetB() const { return this->OffsetB; }
+  double GetOffsetC() const { return this->OffsetC; }
 
 private:
   void Locate(int plane, double b, double c, Upstream& up) const
@@ -543,10 +549,14 @@ public:
         });
       previousEnergy = energy;
       energy = { { 0, 0, 0 } };
-      for (std::size_t q = 0; q < order.size(); ++q)
+      for (std::size_t q = 0; q < order.size(); q += 3)
       {
         total[q] += order[q];
-        energy[q % 3] += order[q];
+        total[q + 1] += order[q + 1];
+        total[q + 2] += order[q + 2];
+        energy[0] += order[q];
+        energy[1] += order[q + 1];
+        energy[2] += order[q + 2];
       }
       for (int c = 0; c < 3; ++c)
       {
@@ -617,56 +627,92 @@ private:
   }
 
   // out(x) for direction m: the boundary's radiance `boundary` carried in, plus
-  // the source function `source` (per point, RGB; nullptr: 0) along the way.
+  // the source function `source` (per point, RGB; nullptr: 0) along the way. The
+  // sweep of DirectionSweep written out for speed (the solver's inner loop): the
+  // upstream point's bilinear weights are the same for every point of a direction,
+  // only the corners outside the grid (the boundary's radiance, no extinction, no
+  // source) differ. Along the segment: L = L_up e^-tau + S (1 - e^-tau) with
+  // tau = t (sigma_up + sigma) / 2 and S the extinction-weighted mean source.
   void Transport(const ExtinctionGrid& grid, std::size_t m, const Rgb& boundary,
     const float* source, float* out) const
   {
     const DirectionSweep sweep(grid, this->Directions[m]);
-    const double t = sweep.GetStep();
-    const std::vector<float>& sigma = grid.Extinction;
-    sweep.Run(1, // the callers run the directions in parallel
-      [&](std::size_t index, const DirectionSweep::Upstream& up)
+    const auto& n = grid.Dimensions;
+    const int axis = sweep.GetAxis(), axisB = sweep.GetB(), axisC = sweep.GetC();
+    const std::ptrdiff_t stride[3] = { 1, n[0], static_cast<std::ptrdiff_t>(n[0]) * n[1] };
+    const std::ptrdiff_t sA = stride[axis], sB = stride[axisB], sC = stride[axisC];
+    const int nA = n[axis], nB = n[axisB], nC = n[axisC];
+    const float t = static_cast<float>(sweep.GetStep());
+    const int b0 = static_cast<int>(std::floor(sweep.GetOffsetB()));
+    const int c0 = static_cast<int>(std::floor(sweep.GetOffsetC()));
+    const float fb = static_cast<float>(sweep.GetOffsetB() - b0);
+    const float fc = static_cast<float>(sweep.GetOffsetC() - c0);
+    const float weight[4] = { (1 - fb) * (1 - fc), fb * (1 - fc), (1 - fb) * fc, fb * fc };
+    const int cornerB[4] = { 0, 1, 0, 1 }, cornerC[4] = { 0, 0, 1, 1 };
+    const float* sigma = grid.Extinction.data();
+    const float edge[3] = { static_cast<float>(boundary[0]), static_cast<float>(boundary[1]),
+      static_cast<float>(boundary[2]) };
+    for (int p = 0; p < nA; ++p)
+    {
+      const int plane = sweep.GetForward() ? p : nA - 1 - p;
+      const std::ptrdiff_t previous = sweep.GetForward() ? -sA : sA;
+      for (int ic = 0; ic < nC; ++ic)
       {
-        double lUp[3] = { boundary[0] * up.Outside, boundary[1] * up.Outside,
-          boundary[2] * up.Outside };
-        // Upstream: the radiance (the boundary's where corners are outside), the
-        // extinction (0 outside) and the emission sigma S (0 outside).
-        double emissionUp[3] = { 0, 0, 0 };
-        double sigmaUp = 0.0;
-        if (up.Inside)
+        for (int ib = 0; ib < nB; ++ib)
         {
+          const std::ptrdiff_t index = plane * sA + ib * sB + ic * sC;
+          float* o = out + 3 * index;
+          if (p == 0)
+          {
+            // Upstream of the first plane lies outside the grid: no extinction.
+            o[0] = edge[0];
+            o[1] = edge[1];
+            o[2] = edge[2];
+            continue;
+          }
+          float lUp[3] = { 0, 0, 0 }, emissionUp[3] = { 0, 0, 0 };
+          float sigmaUp = 0.0f, outside = 0.0f;
+          const std::ptrdiff_t up = index + previous;
+          const bool interior =
+            ib + b0 >= 0 && ib + b0 + 1 < nB && ic + c0 >= 0 && ic + c0 + 1 < nC;
           for (int q = 0; q < 4; ++q)
           {
-            const double w = up.Weight[q];
-            if (w > 0.0)
+            const int jb = ib + b0 + cornerB[q], jc = ic + c0 + cornerC[q];
+            if (!interior && (jb < 0 || jb >= nB || jc < 0 || jc >= nC))
             {
-              const std::size_t j = up.Index[q];
-              sigmaUp += w * sigma[j];
-              for (int c = 0; c < 3; ++c)
-              {
-                lUp[c] += w * out[3 * j + c];
-                if (source)
-                {
-                  emissionUp[c] += w * sigma[j] * source[3 * j + c];
-                }
-              }
+              outside += weight[q];
+              continue;
+            }
+            const std::ptrdiff_t j = up + (b0 + cornerB[q]) * sB + (c0 + cornerC[q]) * sC;
+            const float w = weight[q];
+            const float sj = sigma[j];
+            sigmaUp += w * sj;
+            const float* lj = out + 3 * j;
+            lUp[0] += w * lj[0];
+            lUp[1] += w * lj[1];
+            lUp[2] += w * lj[2];
+            if (source)
+            {
+              const float* sj3 = source + 3 * j;
+              emissionUp[0] += w * sj * sj3[0];
+              emissionUp[1] += w * sj * sj3[1];
+              emissionUp[2] += w * sj * sj3[2];
             }
           }
+          const float sigmaHere = sigma[index];
+          const float sigmaSum = sigmaUp + sigmaHere;
+          const float transmittance = std::exp(-0.5f * t * sigmaSum);
+          for (int c = 0; c < 3; ++c)
+          {
+            const float l = lUp[c] + outside * edge[c];
+            const float s = source && sigmaSum > 0.0f
+              ? (emissionUp[c] + sigmaHere * source[3 * index + c]) / sigmaSum
+              : 0.0f;
+            o[c] = l * transmittance + s * (1.0f - transmittance);
+          }
         }
-        const double sigmaSum = sigmaUp + sigma[index];
-        const double tau = up.Inside ? 0.5 * t * sigmaSum : 0.0;
-        const double transmittance = std::exp(-tau);
-        for (int c = 0; c < 3; ++c)
-        {
-          // The segment's source function: the extinction-weighted mean of both ends'
-          // (a constant source stays constant where the extinction varies).
-          const double s = source && sigmaSum > 0.0
-            ? (emissionUp[c] + sigma[index] * source[3 * index + c]) / sigmaSum
-            : 0.0;
-          out[3 * index + c] =
-            static_cast<float>(lUp[c] * transmittance + s * (1.0 - transmittance));
-        }
-      });
+      }
+    }
   }
 
   // coefficients += SH projection of radiance(x) arriving along s, weighted by the
