@@ -258,6 +258,7 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   bool ScatteringTexture = false;
   double ForwardPeakFraction = 0.0;
   double TruncatedG = 0.0;
+  double ScatteringScale = 1.0; // this frame's illuminance / the solve's
   int Octaves = 1;
 };
 
@@ -273,6 +274,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   nimbus::MultipleScatteringTexture Scattering;
   std::string LastScatteringError;
   double LastPrecomputeSeconds = 0.0;
+  double SolvedIlluminance = 0.0; // the sun's illuminance of the last solve
   std::unique_ptr<nimbus::SkyModel> CloudSky;
   std::vector<double> CloudSkyKey;
   std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
@@ -1117,7 +1119,9 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     static_cast<double>(options.NumberOfDirections), options.SkyLight ? 1.0 : 0.0,
     static_cast<double>(options.Threads), this->Albedo, this->CloudG, this->ExtinctionPerDensity,
     static_cast<double>(request.Downsampling), request.MetresPerUnit, request.BudgetBytes,
-    frame.ToSun[0], frame.ToSun[1], frame.ToSun[2], settings.Sun.Illuminance,
+    // Not the sun's illuminance itself: the answer is linear in it, so a new
+    // illuminance only rescales the texture (ScatteringScale), without a solve.
+    frame.ToSun[0], frame.ToSun[1], frame.ToSun[2], settings.Sun.Illuminance > 0.0 ? 1.0 : 0.0,
     settings.Sun.TemperatureKelvin, frame.Atmosphere ? 1.0 : 0.0, frame.Ground ? 1.0 : 0.0,
     air.SceneAltitudeMetres, air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG,
     settings.GroundAlbedo, settings.GroundHeight };
@@ -1148,9 +1152,12 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     // The whole precompute: the sky (when rebuilt), the grid, the solve, the upload.
     in.LastPrecomputeSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    in.SolvedIlluminance = settings.Sun.Illuminance;
     vtkDebugMacro(<< "multiple scattering: " << in.LastPrecomputeSeconds << " s");
   }
   frame.ScatteringTexture = in.Scattering.HasTexture();
+  frame.ScatteringScale =
+    in.SolvedIlluminance > 0.0 ? settings.Sun.Illuminance / in.SolvedIlluminance : 1.0;
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
   frame.TruncatedG = in.Scattering.GetField().TruncatedG;
 }
@@ -1364,6 +1371,7 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
   // density's unit (a 3-D texture, never read), so no unit has two sampler types.
   sliceProgram->SetUniformf("cloudG", static_cast<float>(this->CloudG));
   sliceProgram->SetUniformi("scatteringTextureOn", frame.ScatteringTexture ? 1 : 0);
+  sliceProgram->SetUniformf("scatteringScale", static_cast<float>(frame.ScatteringScale));
   const char* scatteringSamplers[3] = { "scatteringRed", "scatteringGreen", "scatteringBlue" };
   for (int c = 0; c < 3; ++c)
   {

@@ -23,6 +23,7 @@ uniform sampler3D scatteringRed;      // SH c_00, c_1-1, c_10, c_11 of J, per ch
 uniform sampler3D scatteringGreen;
 uniform sampler3D scatteringBlue;
 uniform vec3 scatteringTextureScale;  // density texture coordinates -> these textures'
+uniform float scatteringScale;        // the sun's illuminance now / at the solve (J is linear in it)
 uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
 uniform float truncatedG;             // delta-M g' of the truncated phase function
 uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
@@ -35,8 +36,9 @@ vec3 InScattering(vec3 p, vec3 w)
 {
   vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * scatteringTextureScale;
   vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
-  return max(vec3(dot(texture(scatteringRed, tc), y), dot(texture(scatteringGreen, tc), y),
-               dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+  return scatteringScale * max(vec3(dot(texture(scatteringRed, tc), y),
+                                 dot(texture(scatteringGreen, tc), y),
+                                 dot(texture(scatteringBlue, tc), y)), vec3(0.0));
 }
 
 // The sun's light scattered more than once that the mapper evaluates per sample,

@@ -248,6 +248,15 @@ bool MultipleScatteringResolvesOnlyOnChange(const Context&)
   s.Mapper->SetSunElevationDegrees(s.Mapper->GetSunElevationDegrees() + 5.0);
   s.Render();
   ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 2, "sun move: a solve");
+  // Linear in the sun's illuminance: a new illuminance rescales, and doubling it
+  // doubles the frame's radiance (exposure halved: the same 8-bit image).
+  const auto before = s.Render();
+  s.Mapper->SetSunIlluminance(2.0);
+  s.Mapper->SetExposure(s.Mapper->GetExposure() / 2.0);
+  const auto doubled = s.Render();
+  ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 2, "illuminance: no solve");
+  ok &= Check(Rmse(before, doubled) < 0.6,
+    "double illuminance, half exposure: RMSE " + std::to_string(Rmse(before, doubled)) + " < 0.6");
   s.Mapper->SetMultipleScatteringDirections(14);
   s.Render();
   s.Render();
