@@ -166,7 +166,7 @@ struct NIMBUSPHYSICS_EXPORT MultipleScatteringField
   std::vector<float> Coefficients;
   /// The fraction f of the cloud's scattering the solver moved into the forward
   /// direction (delta-M; 0 unless DiscreteDirections). The mapper adds the sun light
-  /// that peak carries, sigma_s p(w . L) E (exp(-(1 - f albedo) tau) - exp(-tau)),
+  /// that peak carries, sigma_s (1 - f) p(w . L) E (exp(-(1 - f albedo) tau) - exp(-tau)),
   /// tau the cloud's optical depth toward the sun, to its single scattering.
   double ForwardPeakFraction = 0.0;
   /// The asymmetry g' of the HG phase function that stands for the rest.

@@ -257,7 +257,6 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   // fraction and the octaves (1: none).
   bool ScatteringTexture = false;
   double ForwardPeakFraction = 0.0;
-  double TruncatedG = 0.0;
   double ScatteringScale = 1.0; // this frame's illuminance / the solve's
   int Octaves = 1;
 };
@@ -1159,7 +1158,6 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   frame.ScatteringScale =
     in.SolvedIlluminance > 0.0 ? settings.Sun.Illuminance / in.SolvedIlluminance : 1.0;
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
-  frame.TruncatedG = in.Scattering.GetField().TruncatedG;
 }
 
 // The sky seen from the cloud at altitude `cloudAltitude` above the scene [m]: a
@@ -1384,7 +1382,6 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
     static_cast<float>(scale[2]) };
   sliceProgram->SetUniform3f("scatteringTextureScale", scatteringScale);
   sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
-  sliceProgram->SetUniformf("truncatedG", static_cast<float>(frame.TruncatedG));
   sliceProgram->SetUniformi("octaves", frame.Octaves);
   const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
     static_cast<float>(this->OctaveScatteringScale),
