@@ -524,6 +524,7 @@ bool ViewportsAndParallelProjection(const Context&)
     otherMapper->SetExposure(4.0);
     otherMapper->SetEncodeSrgb(true);
     otherMapper->SetMultipleScatteringMethod(method);
+    otherMapper->AirMultipleScatteringOff();
     vtkNew<vtkVolume> otherVolume;
     otherVolume->SetMapper(otherMapper);
     vtkNew<vtkRenderer> other;
