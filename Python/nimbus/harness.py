@@ -263,7 +263,8 @@ def models_single_scattering_only(renderer_name, settings, scene):
     if renderer_name == "svs":
         k_multi = settings.get("k_multi",
                                scene.get("medium", {}).get("multiple_scattering_constant", 0.0))
-        return k_multi == 0 and settings.get("ms", "none") == "none"
+        return (k_multi == 0 and settings.get("ms", "none") == "none"
+                and not settings.get("air_ms", True))
     return False
 
 
@@ -468,8 +469,11 @@ class SvsRenderer:
     (000 Eq. 1's multiple-scattering constant; default the scene's), and the
     multiple-scattering term (issue 14): ms (none, the default here, octaves,
     patterns or directions), orders, downsampling, directions, sky_light (bool),
-    octaves, pattern_radius, pattern_selection. The row also reports the last
-    solve's seconds (precompute_seconds) and the solver's memory (ms_mib).
+    octaves, pattern_radius, pattern_selection; air_ms (bool, default true: the
+    air's multiple scattering and the sky's light on the ground, AirMultipleScattering;
+    only with it off are k_multi = 0 and ms none judged as single scattering). The
+    row also reports the last solve's seconds (precompute_seconds) and the solver's
+    memory (ms_mib).
     """
 
     def __init__(self, scene_path):
@@ -529,6 +533,7 @@ class SvsRenderer:
         self.mapper.SetMultipleScatteringDownsampling(int(settings.get("downsampling", 4)))
         self.mapper.SetMultipleScatteringDirections(int(settings.get("directions", 26)))
         self.mapper.SetSkyLight(bool(settings.get("sky_light", True)))
+        self.mapper.SetAirMultipleScattering(bool(settings.get("air_ms", True)))
         self.mapper.SetOctaves(int(settings.get("octaves", 4)))
         self.mapper.SetPatternRadius(int(settings.get("pattern_radius", 6)))
         self.mapper.SetPatternSelection(float(settings.get("pattern_selection", 0.25)))

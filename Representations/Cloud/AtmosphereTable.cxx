@@ -1,5 +1,7 @@
 #include "AtmosphereTable.h"
 
+#include "Sky.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -27,12 +29,18 @@ std::array<double, 3> AtmosphereTable::Lookup(int row, double z) const
   return value;
 }
 
-AtmosphereTable BuildAtmosphereTable(
-  const SunAndAir& sunAndAir, double zMin, double zMax, int samples)
+AtmosphereTable BuildAtmosphereTable(const SunAndAir& sunAndAir, double zMin, double zMax,
+  int samples, const SkyModel* multipleScattering)
 {
   if (!std::isfinite(zMin) || !std::isfinite(zMax) || !(zMax > zMin) || samples < 2)
   {
     throw std::invalid_argument("atmosphere table needs zMax > zMin (finite) and >= 2 samples");
+  }
+  if (multipleScattering &&
+    multipleScattering->GetSunIrradiance().size() != sunAndAir.GetSunIrradiance().size())
+  {
+    throw std::invalid_argument(
+      "atmosphere table: the sky model must have the sun and air's wavelength count");
   }
   AtmosphereTable table;
   const std::vector<double>& sun = sunAndAir.GetSunIrradiance();
@@ -68,9 +76,35 @@ AtmosphereTable BuildAtmosphereTable(
   table.Samples = samples;
   table.ZMin = zMin;
   table.ZMax = zMax;
-  table.Data.assign(static_cast<std::size_t>(AtmosphereTable::kRows) * samples * 4, 1.0f);
   std::vector<double> transmittance, irradiance(n), rayleigh(n);
   const Atmosphere& atmosphere = *sunAndAir.GetAtmosphere();
+
+  // Multiple scattering (rows 4, 5): the sky model's spectra in this table's sun
+  // units, per wavelength (see the header).
+  const SkyModel* sky = multipleScattering;
+  std::vector<double> toTableSun(n, 0.0), meanRadiance(n), multiple(n);
+  const double muS = sunAndAir.GetSunDirection()[2];
+  if (sky)
+  {
+    const std::vector<double>& skySun = sky->GetSunIrradiance();
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      toTableSun[k] = skySun[k] > 0.0 ? sun[k] / skySun[k] : 0.0;
+    }
+    std::vector<double> groundSky(n);
+    sky->LookupGroundSkyIrradiance(muS, groundSky.data());
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      groundSky[k] *= toTableSun[k];
+    }
+    const std::array<double, 3> groundRgb = sunAndAir.ToLinearSrgb(groundSky);
+    for (int c = 0; c < 3; ++c)
+    {
+      table.GroundSkyIrradiance[c] = std::max(groundRgb[c], 0.0);
+    }
+    table.HasMultipleScattering = true;
+  }
+  table.Data.assign(static_cast<std::size_t>(AtmosphereTable::kRows) * samples * 4, 1.0f);
   for (int i = 0; i < samples; ++i)
   {
     const double z = zMin + (zMax - zMin) * i / (samples - 1);
@@ -82,6 +116,18 @@ AtmosphereTable BuildAtmosphereTable(
     {
       irradiance[k] = sun[k] * transmittance[k];
       rayleigh[k] = betaR[k] * rhoR * irradiance[k];
+    }
+    std::array<double, 3> multipleRgb{ { 0.0, 0.0, 0.0 } };
+    if (sky)
+    {
+      // The sky model's own radius and densities: the same air (its key).
+      sky->LookupMultipleScattering(air.EarthRadiusMetres + h, muS, meanRadiance.data());
+      const double mieS = table.MieScatteringSeaLevel * rhoM;
+      for (std::size_t k = 0; k < n; ++k)
+      {
+        multiple[k] = (betaR[k] * rhoR + mieS) * meanRadiance[k] * toTableSun[k];
+      }
+      multipleRgb = sunAndAir.ToLinearSrgb(multiple);
     }
     const std::array<double, 3> sunRgb = sunAndAir.ToLinearSrgb(irradiance);
     const std::array<double, 3> rayleighRgb = sunAndAir.ToLinearSrgb(rayleigh);
@@ -100,6 +146,8 @@ AtmosphereTable BuildAtmosphereTable(
       put(1, c, rayleighRgb[c]);
       put(2, c, table.MieScatteringSeaLevel * rhoM * sunRgb[c]);
       put(3, c, table.RayleighExtinctionSeaLevel[c] * rhoR + table.MieExtinctionSeaLevel * rhoM);
+      put(4, c, multipleRgb[c]);
+      put(5, c, table.GroundSkyIrradiance[c]);
     }
   }
   return table;

@@ -283,6 +283,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkTextureObject> AtmosphereTexture;
   std::vector<double> AtmosphereKey;
   nimbus::AtmosphereTable Table;
+  // The air's multiple scattering (AirMultipleScattering): a sky model of the air.
+  std::unique_ptr<nimbus::SkyModel> AirSky;
+  std::vector<double> AirSkyKey;
 
   // Sampling-interval and Mie-phase texture (000 §4.4), keyed likewise.
   vtkNew<vtkTextureObject> IntervalPhase;
@@ -866,19 +869,45 @@ bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
     (std::min(boxZMin, frame.Ground ? settings.GroundHeight : boxZMin)) * settings.MetresPerUnit;
   const nimbus::SceneAtmosphere& air = settings.Air;
   const double zHigh = air.TopRadiusMetres - air.EarthRadiusMetres - air.SceneAltitudeMetres;
-  const std::vector<double> atmosphereKey = { settings.Sun.AzimuthDegrees,
-    settings.Sun.ElevationDegrees, settings.Sun.Illuminance, settings.Sun.TemperatureKelvin,
-    air.Enabled ? 1.0 : 0.0, air.SceneAltitudeMetres, air.EarthRadiusMetres, air.TopRadiusMetres,
+  const std::vector<double> tableKey = { settings.Sun.AzimuthDegrees, settings.Sun.ElevationDegrees,
+    settings.Sun.Illuminance, settings.Sun.TemperatureKelvin, air.Enabled ? 1.0 : 0.0,
+    air.SceneAltitudeMetres, air.EarthRadiusMetres, air.TopRadiusMetres,
     air.RayleighScaleHeightMetres, air.MieScaleHeightMetres, air.RayleighScatteringPerMetre,
     air.MieScatteringPerMetre, air.MieAlbedo, air.MieG, zLow };
+  // The air's multiple scattering needs a sky model of the air (and of the ground
+  // it reflects from), built only when it is on and those changed.
+  const bool airMultiple = this->AirMultipleScattering && frame.Atmosphere;
+  const double groundAlbedo = frame.Ground ? settings.GroundAlbedo : 0.0;
+  const std::vector<double> skyKey = { air.RayleighScatteringPerMetre, air.MieScatteringPerMetre,
+    air.MieG, air.MieAlbedo, air.RayleighScaleHeightMetres, air.MieScaleHeightMetres,
+    air.EarthRadiusMetres, air.TopRadiusMetres, groundAlbedo, settings.Sun.TemperatureKelvin };
+  std::vector<double> atmosphereKey = tableKey;
+  atmosphereKey.push_back(airMultiple ? 1.0 : 0.0);
+  if (airMultiple)
+  {
+    atmosphereKey.insert(atmosphereKey.end(), skyKey.begin(), skyKey.end());
+  }
   if (atmosphereKey == in.AtmosphereKey)
   {
     return true;
   }
   try
   {
-    const nimbus::SunAndAir sunAndAir(settings.Sun, air, 16);
-    in.Table = nimbus::BuildAtmosphereTable(sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024);
+    const int wavelengths = 16;
+    const nimbus::SunAndAir sunAndAir(settings.Sun, air, wavelengths);
+    if (airMultiple && (!in.AirSky || skyKey != in.AirSkyKey))
+    {
+      in.AirSky.reset();
+      nimbus::SkyParameters parameters;
+      parameters.Atmosphere = air;
+      parameters.GroundAlbedo = groundAlbedo;
+      parameters.SunTemperatureKelvin = settings.Sun.TemperatureKelvin;
+      parameters.Wavelengths = wavelengths;
+      in.AirSky = std::make_unique<nimbus::SkyModel>(parameters);
+      in.AirSkyKey = skyKey;
+    }
+    in.Table = nimbus::BuildAtmosphereTable(
+      sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024, airMultiple ? in.AirSky.get() : nullptr);
   }
   catch (const std::exception& error)
   {
@@ -1545,6 +1574,7 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MieG: " << this->MieG << "\n";
   os << indent << "RayleighScatteringPerMetre: " << this->RayleighScatteringPerMetre << "\n";
   os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
+  os << indent << "AirMultipleScattering: " << (this->AirMultipleScattering ? "on" : "off") << "\n";
   os << indent << "Ground: " << this->Ground << "\n";
   os << indent << "GroundHeight: " << this->GroundHeight << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";

@@ -244,6 +244,21 @@ public:
   ///@}
 
   ///@{
+  /// Multiple scattering in the air (default on; needs Atmosphere): the air's
+  /// source gains the isotropic term of the scattering orders >= 2 of Hillaire 2020
+  /// (§5.5), (sigma_s,R rho_R + sigma_s,M rho_M) M_ms(r, mu_s), and the ground the
+  /// sky's light, albedo/pi E_sky(mu_s), both from a nimbus::SkyModel of the
+  /// frame's air and ground albedo (Physics/Sky.h; built only when this is on and
+  /// the air or the albedo changed). Neither term is shadowed by the cloud (the
+  /// light of the higher orders comes from the whole sky, not the sun's direction;
+  /// the cloud's occlusion of the sky is ignored). Off: single scattering in the
+  /// air and a ground lit by the sun alone (as 000).
+  vtkSetMacro(AirMultipleScattering, bool);
+  vtkGetMacro(AirMultipleScattering, bool);
+  vtkBooleanMacro(AirMultipleScattering, bool);
+  ///@}
+
+  ///@{
   /// Ground plane z = GroundHeight (world units) with a grey Lambertian albedo.
   vtkSetMacro(Ground, bool);
   vtkGetMacro(Ground, bool);
@@ -415,6 +430,7 @@ protected:
   double MieG = 0.76;
   double RayleighScatteringPerMetre = 13.5e-6;
   double SceneAltitudeMetres = 0.0;
+  bool AirMultipleScattering = true;
   bool Ground = true;
   double GroundHeight = 0.0;
   double GroundAlbedo = 0.2;

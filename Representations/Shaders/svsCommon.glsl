@@ -27,7 +27,9 @@ uniform vec3 shadowW;
 uniform vec2 shadowExtent;
 
 uniform int atmosphereOn;
-uniform sampler2D atmosphereTable;  // rows: sun, Rayleigh source, Mie source, extinction
+uniform sampler2D atmosphereTable;  // rows: sun, Rayleigh source, Mie source, extinction,
+                                    // multiple-scattering source, ground sky irradiance
+                                    // (AtmosphereTable.h)
 uniform vec2 atmosphereZRange;      // z of the first and last column [m]
 uniform vec3 rayleighExtinction0;   // sea level [1/m], per channel
 uniform float mieExtinction0;       // sea level [1/m]
@@ -126,7 +128,7 @@ vec3 AtmosphereRow(int row, float altitude)
   float x = clamp((z - atmosphereZRange.x) / (atmosphereZRange.y - atmosphereZRange.x), 0.0, 1.0);
   ivec2 size = textureSize(atmosphereTable, 0);
   float u = (0.5 + x * float(size.x - 1)) / float(size.x);
-  return texture(atmosphereTable, vec2(u, (float(row) + 0.5) / 4.0)).rgb;
+  return texture(atmosphereTable, vec2(u, (float(row) + 0.5) / float(size.y))).rgb;
 }
 
 // Sun light scattered by the air per metre at altitude h toward the pixel's view
@@ -135,6 +137,14 @@ vec3 AirSource(float altitude, vec2 rayleighAndHazePhase)
 {
   return AtmosphereRow(1, altitude) * rayleighAndHazePhase.x +
     AtmosphereRow(2, altitude) * rayleighAndHazePhase.y;
+}
+
+// Light of the scattering orders >= 2 scattered by the air per metre at altitude h
+// (isotropic: no phase factor; 0 when AirMultipleScattering is off). Not shadowed
+// by the cloud: it comes from the whole sky, not from the sun's direction.
+vec3 AirMultipleSource(float altitude)
+{
+  return AtmosphereRow(4, altitude);
 }
 
 vec3 SunIrradiance(float altitude)
@@ -201,6 +211,12 @@ float ShadowDepth(vec3 p)
 vec3 GroundRadiance(vec3 g, float cloudDepthToSun)
 {
   float cosSun = max(sunDirection.z, 0.0);
-  return groundAlbedo / kPi * cosSun * SunIrradiance(Altitude(g)) *
+  vec3 radiance = groundAlbedo / kPi * cosSun * SunIrradiance(Altitude(g)) *
     exp(-cloudDepthToSun);
+  if (atmosphereOn != 0)
+  {
+    // The sky's light (AirMultipleScattering; 0 when off), not shadowed by the cloud.
+    radiance += groundAlbedo / kPi * AtmosphereRow(5, Altitude(g));
+  }
+  return radiance;
 }

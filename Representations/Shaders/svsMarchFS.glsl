@@ -65,6 +65,9 @@ void main()
       {
         air *= exp(-ShadowDepth(p));
       }
+      vec3 multiple = AirMultipleSource(altitude);
+      air += multiple;
+      clearAir += multiple;
       vec3 stepTransmittance = exp(-AtmosphereRow(3, altitude) * dt);
       // Exact for constant coefficients over the step: (1 - T_step) / k_atm.
       vec3 extinction = AtmosphereRow(3, altitude);

@@ -129,8 +129,10 @@ void main()
       if (atmosphereOn != 0)
       {
         vec3 air = AirSource(altitude, intervalAndPhase.zw);            // 000 Eq. 8, atmosphere
-        source += air * (shaftsOn != 0 ? sunTransmittance : 1.0);
-        clearColor = air * AtmosphereViewTransmittance(origin, direction, t) * stepMetres;
+        vec3 multiple = AirMultipleSource(altitude);
+        source += air * (shaftsOn != 0 ? sunTransmittance : 1.0) + multiple;
+        clearColor =
+          (air + multiple) * AtmosphereViewTransmittance(origin, direction, t) * stepMetres;
       }
       source *= AtmosphereViewTransmittance(origin, direction, t);
     }

@@ -106,6 +106,9 @@ struct Scene
     // The compositing over the sky is what these cases test (baselines from before
     // the multiple-scattering texture).
     this->Mapper->SetMultipleScatteringMethodToNone();
+    // Baseline from before the air's multiple scattering (with it, distant clouds
+    // fade a little more into the sky, as the sky's own aerial perspective does).
+    this->Mapper->AirMultipleScatteringOff();
     this->Mapper->SetNumberOfSlices(128);
     this->Window->SetSize(kWidth, kHeight);
     this->Window->SetMultiSamples(0);

@@ -65,6 +65,9 @@ struct Scene
     this->Mapper->SetMultipleScatteringMethodToNone();
     this->Mapper->SetExposure(4.0);
     this->Mapper->SetEncodeSrgb(true);
+    // The cases test the single-scattering features of 000: their baselines have
+    // no multiple scattering in the air.
+    this->Mapper->AirMultipleScatteringOff();
     this->Volume->SetMapper(this->Mapper);
     this->Renderer->AddVolume(this->Volume);
     this->Renderer->SetBackground(0, 0, 0);
@@ -607,6 +610,7 @@ bool ViewportsAndParallelProjection(const Context&)
     otherMapper->SetExposure(4.0);
     otherMapper->SetEncodeSrgb(true);
     otherMapper->SetMultipleScatteringMethod(method);
+    otherMapper->AirMultipleScatteringOff();
     vtkNew<vtkVolume> otherVolume;
     otherVolume->SetMapper(otherMapper);
     vtkNew<vtkRenderer> other;

@@ -1,5 +1,6 @@
 // Shadow-view-slice geometry (000 §4.2) and the atmosphere texture (000 §3), plain C++.
 #include "AtmosphereTable.h"
+#include "Sky.h"
 #include "SliceGeometry.h"
 
 #include <gtest/gtest.h>
@@ -203,6 +204,149 @@ TEST(AtmosphereTable, NonNegativeOutOfGamutSuns)
         EXPECT_GE(value, 0.0) << elevation << " deg, " << kelvin << " K";
       }
     }
+  }
+}
+
+// The air's multiple scattering (rows 4 and 5, AirMultipleScattering): a sky model
+// of the same air, small tables (the rows only look it up).
+namespace
+{
+nimbus::SkyParameters SmallSky(const nimbus::AtmosphereParameters& air, double groundAlbedo)
+{
+  nimbus::SkyParameters p;
+  p.Atmosphere = air;
+  p.GroundAlbedo = groundAlbedo;
+  p.Wavelengths = 16;
+  p.ScatteringMuSSize = 16;
+  p.ScatteringRSize = 8;
+  p.ScatteringZenithDirections = 8;
+  p.ScatteringAzimuthDirections = 4;
+  p.ScatteringSteps = 16;
+  p.TransmittanceMuSize = 64;
+  p.TransmittanceRSize = 16;
+  return p;
+}
+}
+
+TEST(AtmosphereTable, MultipleScatteringRowsZeroWithoutSkyModelOrAir)
+{
+  nimbus::SunParameters sun;
+  sun.ElevationDegrees = 40.0;
+  const nimbus::SceneAtmosphere air;
+  const nimbus::SunAndAir sunAndAir(sun, air, 16);
+  const nimbus::AtmosphereTable table = nimbus::BuildAtmosphereTable(sunAndAir, 0.0, 1.0e5, 64);
+  EXPECT_FALSE(table.HasMultipleScattering);
+  for (double z : { 0.0, 3000.0, 9.0e4 })
+  {
+    for (int row : { 4, 5 })
+    {
+      const auto v = table.Lookup(row, z);
+      EXPECT_EQ(v[0] + v[1] + v[2], 0.0) << "row " << row << " z " << z;
+    }
+  }
+  // No atmosphere: nothing, even with a sky model.
+  const nimbus::SkyModel sky(SmallSky(air, 0.2));
+  nimbus::SceneAtmosphere none;
+  none.Enabled = false;
+  const nimbus::SunAndAir vacuum(sun, none, 16);
+  const nimbus::AtmosphereTable empty = nimbus::BuildAtmosphereTable(vacuum, 0.0, 1.0e5, 64, &sky);
+  EXPECT_FALSE(empty.HasAtmosphere);
+  EXPECT_FALSE(empty.HasMultipleScattering);
+  EXPECT_EQ(empty.Samples, 0);
+  EXPECT_EQ(
+    empty.GroundSkyIrradiance[0] + empty.GroundSkyIrradiance[1] + empty.GroundSkyIrradiance[2],
+    0.0);
+  // A sky model of another wavelength count is refused.
+  nimbus::SkyParameters other = SmallSky(air, 0.2);
+  other.Wavelengths = 12;
+  const nimbus::SkyModel otherSky(other);
+  EXPECT_THROW(
+    nimbus::BuildAtmosphereTable(sunAndAir, 0.0, 1.0e5, 64, &otherSky), std::invalid_argument);
+}
+
+TEST(AtmosphereTable, MultipleScatteringMatchesTheSkyModel)
+{
+  nimbus::SunParameters sun;
+  sun.ElevationDegrees = 40.0;
+  sun.Illuminance = 2.5; // the table is relative to this sun, the sky model to luminance 1
+  nimbus::SceneAtmosphere air;
+  air.SceneAltitudeMetres = 300.0;
+  const nimbus::SunAndAir sunAndAir(sun, air, 16);
+  const nimbus::SkyModel sky(SmallSky(air, 0.2));
+  const double top = air.TopRadiusMetres - air.EarthRadiusMetres - air.SceneAltitudeMetres;
+  const nimbus::AtmosphereTable table =
+    nimbus::BuildAtmosphereTable(sunAndAir, -300.0, top, 1024, &sky);
+  ASSERT_TRUE(table.HasMultipleScattering);
+  // Positive and finite where there is air, and a fraction of the single scattering.
+  for (double z : { -300.0, 0.0, 1000.0, 5000.0, 20000.0 })
+  {
+    const auto m = table.Lookup(4, z);
+    const auto rayleigh = table.Lookup(1, z), mie = table.Lookup(2, z);
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_TRUE(std::isfinite(m[c]) && m[c] > 0.0) << "z " << z << " c " << c;
+    }
+    // Rows 1 and 2 times the mean phase 1/(4 pi): the isotropic single scattering.
+    const double single = nimbus::LinearSrgbLuminance(rayleigh) / (4.0 * nimbus::kPi) +
+      nimbus::LinearSrgbLuminance(mie) / (4.0 * nimbus::kPi);
+    const double ratio = nimbus::LinearSrgbLuminance(m) / single;
+    std::cout << "z " << z << ": multiple / isotropic single scattering " << ratio << "\n";
+    EXPECT_GT(ratio, 0.05);
+    EXPECT_LT(ratio, 2.0);
+  }
+  // Independently at h = 1300 m: sigma_s(l) M_ms(l) from the sky model's own air,
+  // times the illuminance, through the sky model's spectrum -> sRGB map.
+  const double z = 1000.0, h = air.SceneAltitudeMetres + z;
+  const nimbus::Atmosphere& atmosphere = sky.GetAtmosphere();
+  const std::vector<double>& wavelengths = sky.GetSpectrum().GetWavelengths();
+  const double muS = std::sin(40.0 * nimbus::kPi / 180.0);
+  std::vector<double> mean(wavelengths.size()), source(wavelengths.size()),
+    ground(wavelengths.size());
+  sky.LookupMultipleScattering(air.EarthRadiusMetres + h, muS, mean.data());
+  sky.LookupGroundSkyIrradiance(muS, ground.data());
+  const double rhoR = atmosphere.Density(h, air.RayleighScaleHeightMetres);
+  const double rhoM = atmosphere.Density(h, air.MieScaleHeightMetres);
+  for (std::size_t l = 0; l < wavelengths.size(); ++l)
+  {
+    source[l] = sun.Illuminance * mean[l] *
+      (atmosphere.RayleighScattering(wavelengths[l]) * rhoR +
+        atmosphere.MieScattering(550.0) * rhoM);
+    ground[l] *= sun.Illuminance;
+  }
+  const auto expected = sky.GetSpectrum().ToLinearSrgb(source);
+  const auto expectedGround = sky.GetSpectrum().ToLinearSrgb(ground);
+  const auto m = table.Lookup(4, z), g = table.Lookup(5, z);
+  for (int c = 0; c < 3; ++c)
+  {
+    EXPECT_NEAR(m[c], expected[c], 2e-3 * expected[c]) << "c " << c;
+    EXPECT_NEAR(g[c], expectedGround[c], 1e-5 * expectedGround[c]) << "c " << c;
+    EXPECT_NEAR(table.GroundSkyIrradiance[c], expectedGround[c], 1e-5 * expectedGround[c]);
+  }
+  // The sky lights a horizontal ground with a fraction of the sun's irradiance on it.
+  const double sunOnGround = nimbus::LinearSrgbLuminance(table.Lookup(0, -300.0)) * muS;
+  const double skyOnGround = nimbus::LinearSrgbLuminance(table.GroundSkyIrradiance);
+  std::cout << "sky / sun irradiance of the ground at 40 deg: " << skyOnGround / sunOnGround
+            << "\n";
+  EXPECT_GT(skyOnGround / sunOnGround, 0.05);
+  EXPECT_LT(skyOnGround / sunOnGround, 0.6);
+}
+
+TEST(AtmosphereTable, MultipleScatteringGrowsWithHaze)
+{
+  nimbus::SunParameters sun;
+  sun.ElevationDegrees = 30.0;
+  nimbus::SceneAtmosphere clear, hazy;
+  hazy.MieScatteringPerMetre = 4.0 * clear.MieScatteringPerMetre;
+  double previous = 0.0;
+  for (const nimbus::SceneAtmosphere* air : { &clear, &hazy })
+  {
+    const nimbus::SunAndAir sunAndAir(sun, *air, 16);
+    const nimbus::SkyModel sky(SmallSky(*air, 0.2));
+    const nimbus::AtmosphereTable table =
+      nimbus::BuildAtmosphereTable(sunAndAir, 0.0, 1.0e5, 512, &sky);
+    const double value = nimbus::LinearSrgbLuminance(table.Lookup(4, 500.0));
+    EXPECT_GT(value, 1.5 * previous);
+    previous = value;
   }
 }
 

@@ -98,7 +98,10 @@ class HarnessTest(unittest.TestCase):
     def test_svs_mapper_converges_to_the_reference(self):
         settings = os.path.join(self.output, "svs.json")
         with open(settings, "w") as stream:
-            stream.write('[{"slices": 8}, {"slices": 32}, {"slices": 128}]')
+            # Single scattering (no multiple scattering in the air): judged by the
+            # single-scattering reference.
+            stream.write('[{"slices": 8, "air_ms": false}, {"slices": 32, "air_ms": false}, '
+                         '{"slices": 128, "air_ms": false}]')
         self.assertEqual(harness.run([SCENE, "--renderer", "svs", "--settings", settings,
                                       "--repeats", "1", "--output-dir", self.output]), 0)
         with open(os.path.join(self.output, "trade.csv")) as stream:
