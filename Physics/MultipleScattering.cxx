@@ -402,6 +402,7 @@ public:
       const Vector3 travel{ { -toSun[0], -toSun[1], -toSun[2] } };
       const std::vector<float> depth =
         SweptOpticalDepth(scaledGrid, extinction, travel, this->Options.Threads);
+      const double sunStep = DirectionSweep(scaledGrid, travel).GetStep(); // [m] per plane
       std::vector<double> lobe(nd);
       double sum = 0.0;
       for (std::size_t m = 0; m < nd; ++m)
@@ -424,7 +425,16 @@ public:
               static_cast<double>(i /
                 (static_cast<std::size_t>(this->Grid.Dimensions[0]) * this->Grid.Dimensions[1])));
             const Rgb e = this->Lighting.Sun.IrradianceAt(p[2]);
-            const double t = std::exp(-static_cast<double>(depth[i]));
+            // The sun's transmittance averaged over the point's cell along the sun
+            // (from d - half to d + half in optical depth, clipped at the grid's
+            // edge), not at the point: in a cell many optical depths thick the sunlit
+            // layer is thinner than the cell, and the point value would lose most of
+            // the light the cell takes from the beam. Measured: cumulonimbus RMSE
+            // 0.032 -> 0.018 against the path tracer, cumulus_noon 0.0067 -> 0.0064.
+            const double d = depth[i];
+            const double half = 0.5 * extinction[i] * sunStep;
+            const double a = std::max(0.0, d - half), b = d + half;
+            const double t = b - a > 1e-6 ? (std::exp(-a) - std::exp(-b)) / (b - a) : std::exp(-d);
             for (std::size_t m = 0; m < nd; ++m)
             {
               for (int c = 0; c < 3; ++c)
