@@ -9,10 +9,10 @@
  * point or cell array is the cloud density; the colour and opacity transfer
  * functions are not used.
  *
- * The cloud, sun, atmosphere, ground and quality parameters are forwarded to
- * the mapper as they are set (see vtkNimbusCloudVolumeMapper for their units
- * and the equations they enter). Like the mapper settings of the superclass
- * (e.g. SetBlendMode) they do not call MarkModified(): a lighting change
+ * The cloud, multiple-scattering, sun, atmosphere, ground and quality
+ * parameters are forwarded to the mapper as they are set (see
+ * vtkNimbusCloudVolumeMapper for their units and the equations they enter). Like the mapper
+ * settings of the superclass (e.g. SetBlendMode) they do not call MarkModified(): a lighting change
  * re-renders the delivered data and never re-executes the representation, so
  * the density texture is not uploaded again.
  */
@@ -53,6 +53,41 @@ public:
   double GetCloudG();
   void SetMultipleScattering(double value);
   double GetMultipleScattering();
+  ///@}
+
+  ///@{
+  /// Multiple scattering (vtkNimbusCloudVolumeMapper::MultipleScatteringMethods):
+  /// the method (0 None, 1 Octaves, 2 Reference patterns, 3 Discrete directions),
+  /// explicit orders, solver grid downsampling [texels per cell], directions, sky
+  /// and ground light; the octaves' count and per-octave scales; the reference
+  /// patterns' radius [cells], contribution and selection; the solver's memory
+  /// budget [MiB; 0: half of the physical memory].
+  void SetMultipleScatteringMethod(int value);
+  int GetMultipleScatteringMethod();
+  void SetMultipleScatteringOrders(int value);
+  int GetMultipleScatteringOrders();
+  void SetMultipleScatteringDownsampling(int value);
+  int GetMultipleScatteringDownsampling();
+  void SetMultipleScatteringDirections(int value);
+  int GetMultipleScatteringDirections();
+  void SetSkyLight(bool value);
+  bool GetSkyLight();
+  void SetOctaves(int value);
+  int GetOctaves();
+  void SetOctaveExtinctionScale(double value);
+  double GetOctaveExtinctionScale();
+  void SetOctaveScatteringScale(double value);
+  double GetOctaveScatteringScale();
+  void SetOctaveAsymmetryScale(double value);
+  double GetOctaveAsymmetryScale();
+  void SetPatternRadius(int value);
+  int GetPatternRadius();
+  void SetPatternContribution(double value);
+  double GetPatternContribution();
+  void SetPatternSelection(double value);
+  double GetPatternSelection();
+  void SetMultipleScatteringMemoryBudgetMiB(double value);
+  double GetMultipleScatteringMemoryBudgetMiB();
   ///@}
 
   ///@{
