@@ -128,6 +128,8 @@ public:
   double GetGroundAlbedo();
   void SetShafts(bool value);
   bool GetShafts();
+  void SetAirMultipleScattering(bool value);
+  bool GetAirMultipleScattering();
   ///@}
 
   ///@{

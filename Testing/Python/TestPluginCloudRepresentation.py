@@ -212,6 +212,8 @@ def main():
     # The baseline predates the multiple-scattering solver: these checks keep the
     # k_multi-only cloud it shows (check_multiple_scattering covers the methods).
     display.MultipleScatteringMethod = 0
+    display.MultipleScattering = 3.0  # the k_multi default of the baseline's time
+    display.AirMultipleScattering = 0
     display.SunAzimuthDegrees = 135.0
     display.SunElevationDegrees = 60.0
     display.NumberOfSlices = 192

@@ -84,6 +84,11 @@ def check_cloud_under_sky(view, check, sky, args):
     cloud_display.SetRepresentationType("Cloud")
     ColorBy(cloud_display, ("POINTS", "density"))
     cloud_display.NumberOfSlices = 64
+    # The compositing over the sky is what this checks; its baseline predates the
+    # multiple-scattering solver (k_multi 3, the representation's default then).
+    cloud_display.MultipleScatteringMethod = 0
+    cloud_display.MultipleScattering = 3.0
+    cloud_display.AirMultipleScattering = 0
     # From the south, looking north at the cloud; the sunset sun is on the left (west).
     view.CameraPosition = [0.0, -6000.0, 1500.0]
     view.CameraFocalPoint = [0.0, 0.0, 1600.0]
