@@ -84,8 +84,9 @@ DEFAULT_SETTINGS = {
     "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)]
     + [{"ms": "octaves", "octaves": n} for n in (2, 4, 8)]
     + [{"ms": "patterns", "orders": n} for n in (2, 3)]
-    + [{"ms": "directions", "downsampling": d, "directions": n}
-       for d, n in ((8, 26), (4, 14), (4, 26), (4, 50), (2, 26))],
+    + [{"ms": "directions", "downsampling": d, "directions": n, "orders": k}
+       for d, n, k in ((8, 26, 32), (4, 26, 8), (4, 14, 32), (4, 26, 32), (4, 50, 32),
+                       (3, 26, 32), (2, 26, 32))],
     "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }
@@ -468,7 +469,8 @@ class SvsRenderer:
     atmosphere_steps, unlit (the unlit compositing floor, for timing only), k_multi
     (000 Eq. 1's multiple-scattering constant; default the scene's), and the
     multiple-scattering term (issue 14): ms (none, the default here, octaves,
-    patterns or directions), orders, downsampling, directions, sky_light (bool),
+    patterns or directions), orders, downsampling (0: the mapper's automatic
+    choice), directions, sky_light (bool),
     octaves, pattern_radius, pattern_selection; air_ms (bool, default true: the
     air's multiple scattering and the sky's light on the ground, AirMultipleScattering;
     only with it off are k_multi = 0 and ms none judged as single scattering). The
@@ -530,7 +532,7 @@ class SvsRenderer:
             self.mapper.SetPatternOrders(int(settings.get("orders", 3)))
         else:
             self.mapper.SetMultipleScatteringOrders(int(settings.get("orders", 32)))
-        self.mapper.SetMultipleScatteringDownsampling(int(settings.get("downsampling", 4)))
+        self.mapper.SetMultipleScatteringDownsampling(int(settings.get("downsampling", 0)))
         self.mapper.SetMultipleScatteringDirections(int(settings.get("directions", 26)))
         self.mapper.SetSkyLight(bool(settings.get("sky_light", True)))
         self.mapper.SetAirMultipleScattering(bool(settings.get("air_ms", True)))

@@ -1059,9 +1059,12 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   options.Threads = vtkSMPTools::GetEstimatedNumberOfThreads();
   request.Optics = { this->Albedo, nimbus::PhaseFunctionKind::CornetteShanks, this->CloudG };
   request.ExtinctionPerDensity = this->ExtinctionPerDensity;
-  request.Downsampling = this->MultipleScatteringDownsampling;
   int textureDims[3];
   in.Density.GetDimensions(textureDims);
+  const int longest = std::max({ textureDims[0], textureDims[1], textureDims[2], 1 });
+  request.Downsampling = this->MultipleScatteringDownsampling > 0
+    ? this->MultipleScatteringDownsampling
+    : (longest + kAutomaticScatteringGridSide - 1) / kAutomaticScatteringGridSide;
   int pointDims[3];
   frame.Image->GetDimensions(pointDims);
   for (int k = 0; k < 3; ++k)
@@ -1554,7 +1557,7 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MultipleScatteringMethod: " << methods[this->MultipleScatteringMethod] << "\n";
   os << indent << "MultipleScatteringOrders: " << this->MultipleScatteringOrders << "\n";
   os << indent << "MultipleScatteringDownsampling: " << this->MultipleScatteringDownsampling
-     << "\n";
+     << (this->MultipleScatteringDownsampling == 0 ? " (automatic)" : "") << "\n";
   os << indent << "MultipleScatteringDirections: " << this->MultipleScatteringDirections << "\n";
   os << indent << "SkyLight: " << (this->SkyLight ? "on" : "off") << "\n";
   os << indent << "Octaves: " << this->Octaves << " (scales a " << this->OctaveExtinctionScale

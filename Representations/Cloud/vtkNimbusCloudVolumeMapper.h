@@ -144,8 +144,10 @@ public:
   vtkSetClampMacro(MultipleScatteringOrders, int, 2, 1000);
   vtkGetMacro(MultipleScatteringOrders, int);
   /// The solver's grid: the density texture's texels in blocks of this many per
-  /// axis (default 4: a 128^3 cloud is solved on 32^3).
-  vtkSetClampMacro(MultipleScatteringDownsampling, int, 1, 256);
+  /// axis; 0 (the default): automatic, the smallest factor that leaves at most
+  /// kAutomaticScatteringGridSide (32) points along the longest side (a 128^3
+  /// cloud is solved on 32^3, a 96^3 one on 32^3 with blocks of 3).
+  vtkSetClampMacro(MultipleScatteringDownsampling, int, 0, 256);
   vtkGetMacro(MultipleScatteringDownsampling, int);
   /// Directions of the discrete-direction system and of the sky-light look-ups
   /// (default 26, as 003 used).
@@ -191,6 +193,7 @@ public:
   double GetLastMultipleScatteringSeconds() const;
   double GetLastMultipleScatteringBytes() const;
   void GetMultipleScatteringGridDimensions(int dims[3]) const;
+  static constexpr int kAutomaticScatteringGridSide = 32;
   ///@}
 
   ///@{
@@ -409,7 +412,7 @@ protected:
   double MultipleScattering = 0.0;
   int MultipleScatteringMethod = MultipleScatteringDiscreteDirections;
   int MultipleScatteringOrders = 32;
-  int MultipleScatteringDownsampling = 4;
+  int MultipleScatteringDownsampling = 0;
   int MultipleScatteringDirections = 26;
   bool SkyLight = true;
   int Octaves = 4;

@@ -200,9 +200,9 @@ bool MultipleScatteringNoon(const Context& c)
   int grid[3];
   s.Mapper->GetMultipleScatteringGridDimensions(grid);
   return Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 1, "one solve") &&
-    Check(grid[0] == 12 && grid[1] == 12 && grid[2] == 8,
-      "48x48x32 / 4 -> " + std::to_string(grid[0]) + "x" + std::to_string(grid[1]) + "x" +
-        std::to_string(grid[2])) &&
+    Check(grid[0] == 24 && grid[1] == 24 && grid[2] == 16,
+      "48x48x32, automatic downsampling (2) -> " + std::to_string(grid[0]) + "x" +
+        std::to_string(grid[1]) + "x" + std::to_string(grid[2])) &&
     c.CompareWithBaseline();
 }
 

@@ -64,7 +64,7 @@ def cloud_mapper(view):
 MULTIPLE_SCATTERING = {
     "MultipleScatteringMethod": (3, 1),
     "MultipleScatteringOrders": (32, 3),
-    "MultipleScatteringDownsampling": (4, 8),
+    "MultipleScatteringDownsampling": (0, 8),
     "MultipleScatteringDirections": (26, 14),
     "SkyLight": (1, 0),
     "Octaves": (4, 3),
