@@ -176,37 +176,6 @@ TEST(AtmosphereTable, RowsFollowTheAtmosphere)
   EXPECT_THROW(nimbus::BuildAtmosphereTable(sunAndAir, 10.0, 0.0, 16), std::invalid_argument);
 }
 
-// Radiance is never negative: a sun at (or just below) the horizon, or a 1000 K sun,
-// has a spectrum outside the sRGB gamut, whose linear-sRGB channels are partly
-// negative; the table clips them at 0 (before: the mapper's radiance reached
-// -4e-5 at 0 deg and -6e-3 for 1000 K, measured with TestCloudMapperStability).
-TEST(AtmosphereTable, NonNegativeOutOfGamutSuns)
-{
-  const nimbus::SceneAtmosphere air;
-  const double top = air.TopRadiusMetres - air.EarthRadiusMetres;
-  for (const double elevation : { 0.0, -0.5, 2.0, 90.0 })
-  {
-    for (const double kelvin : { 1000.0, 5778.0, 40000.0 })
-    {
-      nimbus::SunParameters sun;
-      sun.ElevationDegrees = elevation;
-      sun.TemperatureKelvin = kelvin;
-      const nimbus::SunAndAir sunAndAir(sun, air, 16);
-      const nimbus::AtmosphereTable table =
-        nimbus::BuildAtmosphereTable(sunAndAir, -100.0, top, 256);
-      for (const float value : table.Data)
-      {
-        ASSERT_TRUE(std::isfinite(value) && value >= 0.0f)
-          << elevation << " deg, " << kelvin << " K: " << value;
-      }
-      for (const double value : table.SunIrradianceTop)
-      {
-        EXPECT_GE(value, 0.0) << elevation << " deg, " << kelvin << " K";
-      }
-    }
-  }
-}
-
 // The air's multiple scattering (rows 4 and 5, AirMultipleScattering): a sky model
 // of the same air, small tables (the rows only look it up).
 namespace
@@ -226,6 +195,49 @@ nimbus::SkyParameters SmallSky(const nimbus::AtmosphereParameters& air, double g
   p.TransmittanceRSize = 16;
   return p;
 }
+}
+
+// Radiance is never negative: a sun at (or just below) the horizon, or a 1000 K sun,
+// has a spectrum outside the sRGB gamut, whose linear-sRGB channels are partly
+// negative; the table clips them at 0 (before: the mapper's radiance reached
+// -4e-5 at 0 deg and -6e-3 for 1000 K, measured with TestCloudMapperStability).
+// With and without the sky model's multiple-scattering rows.
+TEST(AtmosphereTable, NonNegativeOutOfGamutSuns)
+{
+  const nimbus::SceneAtmosphere air;
+  const double top = air.TopRadiusMetres - air.EarthRadiusMetres;
+  for (const double elevation : { 0.0, -0.5, 2.0, 90.0 })
+  {
+    for (const double kelvin : { 1000.0, 5778.0, 40000.0 })
+    {
+      nimbus::SunParameters sun;
+      sun.ElevationDegrees = elevation;
+      sun.TemperatureKelvin = kelvin;
+      const nimbus::SunAndAir sunAndAir(sun, air, 16);
+      nimbus::SkyParameters skyParameters = SmallSky(air, 0.3);
+      skyParameters.SunTemperatureKelvin = kelvin;
+      const nimbus::SkyModel sky(skyParameters);
+      for (const nimbus::SkyModel* multiple :
+        { static_cast<const nimbus::SkyModel*>(nullptr), &sky })
+      {
+        const nimbus::AtmosphereTable table =
+          nimbus::BuildAtmosphereTable(sunAndAir, -100.0, top, 256, multiple);
+        for (const float value : table.Data)
+        {
+          ASSERT_TRUE(std::isfinite(value) && value >= 0.0f)
+            << elevation << " deg, " << kelvin << " K: " << value;
+        }
+        for (const double value : table.GroundSkyIrradiance)
+        {
+          ASSERT_TRUE(std::isfinite(value) && value >= 0.0) << elevation << " deg, " << kelvin;
+        }
+        for (const double value : table.SunIrradianceTop)
+        {
+          EXPECT_GE(value, 0.0) << elevation << " deg, " << kelvin << " K";
+        }
+      }
+    }
+  }
 }
 
 TEST(AtmosphereTable, MultipleScatteringRowsZeroWithoutSkyModelOrAir)
