@@ -82,6 +82,7 @@ DEFAULT_SETTINGS = {
     # SVS: single scattering over slices (ms "none", the scene's k_multi), then the
     # multiple-scattering methods (issue 14) at 256 slices over their knobs.
     "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)]
+    + [{"slices": 256, "k_multi": k} for k in (2, 4, 8)]
     + [{"ms": "octaves", "octaves": n} for n in (2, 4, 8)]
     + [{"ms": "patterns", "orders": n} for n in (2, 3)]
     + [{"ms": "directions", "downsampling": d, "directions": n, "orders": k}
