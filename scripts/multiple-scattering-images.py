@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Side-by-side images of multiple scattering in the SVS mapper (issue 14).
 
-For each scene: the SVS mapper with single scattering only (k_multi 0, 256 slices),
-the same with the mapper's default multiple scattering (discrete directions), and the
+For each scene: the SVS mapper with single scattering only (k_multi 0, 256 slices, single
+scattering in the air too: paper 000), the same with the mapper's default multiple
+scattering (discrete directions, and the air's), and the
 path-traced reference from the harness's cache (full multiple scattering), each
 tone-mapped like the harness's PNGs, with the RMSE and PSNR against the reference
 (noise-corrected) under each panel.
@@ -54,7 +55,8 @@ def main(argv):
         renderer = harness.SvsRenderer(scene_path)
         panels = []
         try:
-            for title, settings in (("SVS, single scattering", {"k_multi": 0.0}),
+            for title, settings in (("SVS, single scattering (000)",
+                                     {"k_multi": 0.0, "air_ms": False}),
                                     ("SVS + multiple scattering", {"ms": "directions"})):
                 image = renderer.render(dict(settings, slices=256))
                 metrics = harness.error_metrics(image, reference, reference_error)
