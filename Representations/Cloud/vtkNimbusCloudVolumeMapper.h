@@ -19,6 +19,10 @@
  *    atmosphere, the background attenuated by g_view.
  *  - A ground plane lit by the attenuated sun and shadowed through the shadow
  *    surface, and shafts of light in the atmosphere beyond the cloud box.
+ *  - Multiple scattering in the air (AirMultipleScattering, default on): the
+ *    isotropic orders >= 2 of a sky model of the same air (Hillaire 2020 §5.5) in
+ *    the air's source and the sky's light on the ground, neither shadowed by the
+ *    cloud (rows 4 and 5 of the atmosphere texture, AtmosphereTable.h).
  *
  * Frame and units: world z is up; MetresPerUnit metres per world unit (1 by
  * default); extinction in 1/m per unit density; radiance relative to the sun
