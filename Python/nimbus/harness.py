@@ -594,9 +594,14 @@ def setting_label(settings):
     return ", ".join(f"{key}={value}" for key, value in settings.items())
 
 
-def measure(renderer, settings, repeats):
+def measure(renderer, settings, repeats, warm_up=False):
+    """The last image and the median time of `repeats` renders; with warm_up, after one
+    render that is not timed (the GPU renderers' one-time work: shader compilation,
+    uploads, the multiple-scattering solve, which the SVS rows report on their own)."""
     times = []
     image = None
+    if warm_up:
+        image = renderer.render(settings)
     for _ in range(repeats):
         start = time.perf_counter()
         image = renderer.render(settings)
@@ -829,7 +834,8 @@ def run(arguments):
                     name = reference_name(renderer_name, settings)
                     reference, reference_error, label = references.get(name)
                     used_references.add(name)
-                    image, seconds = measure(renderer, settings, args.repeats)
+                    image, seconds = measure(renderer, settings, args.repeats,
+                                             warm_up=renderer_name in ("vtk-gpu", "svs"))
                     row = {"scene": scene_name, "renderer": renderer_name,
                            "setting": setting_label(settings),
                            "settings_json": json.dumps(settings, sort_keys=True),

@@ -274,8 +274,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::string LastScatteringError;
   double LastPrecomputeSeconds = 0.0;
   double SolvedIlluminance = 0.0; // the sun's illuminance of the last solve
-  std::unique_ptr<nimbus::SkyModel> CloudSky;
-  std::vector<double> CloudSkyKey;
   std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
   std::vector<double> CloudSkyViewKey;
 
@@ -284,8 +282,11 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::vector<double> AtmosphereKey;
   nimbus::AtmosphereTable Table;
   // The air's multiple scattering (AirMultipleScattering): a sky model of the air.
-  std::unique_ptr<nimbus::SkyModel> AirSky;
-  std::vector<double> AirSkyKey;
+  // The sky model of the frame's air and ground (FrameSkyModel): the air's multiple
+  // scattering and the cloud's sky light share it; rebuilt (1.5 s) when they change.
+  std::unique_ptr<nimbus::SkyModel> FrameSky;
+  std::vector<double> FrameSkyKey;
+  int FrameSkyGeneration = 0;
 
   // Sampling-interval and Mie-phase texture (000 §4.4), keyed likewise.
   vtkNew<vtkTextureObject> IntervalPhase;
@@ -877,10 +878,7 @@ bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
   // The air's multiple scattering needs a sky model of the air (and of the ground
   // it reflects from), built only when it is on and those changed.
   const bool airMultiple = this->AirMultipleScattering && frame.Atmosphere;
-  const double groundAlbedo = frame.Ground ? settings.GroundAlbedo : 0.0;
-  const std::vector<double> skyKey = { air.RayleighScatteringPerMetre, air.MieScatteringPerMetre,
-    air.MieG, air.MieAlbedo, air.RayleighScaleHeightMetres, air.MieScaleHeightMetres,
-    air.EarthRadiusMetres, air.TopRadiusMetres, groundAlbedo, settings.Sun.TemperatureKelvin };
+  const std::vector<double> skyKey = FrameSkyKey(frame);
   std::vector<double> atmosphereKey = tableKey;
   atmosphereKey.push_back(airMultiple ? 1.0 : 0.0);
   if (airMultiple)
@@ -895,19 +893,11 @@ bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
   {
     const int wavelengths = 16;
     const nimbus::SunAndAir sunAndAir(settings.Sun, air, wavelengths);
-    if (airMultiple && (!in.AirSky || skyKey != in.AirSkyKey))
-    {
-      in.AirSky.reset();
-      nimbus::SkyParameters parameters;
-      parameters.Atmosphere = air;
-      parameters.GroundAlbedo = groundAlbedo;
-      parameters.SunTemperatureKelvin = settings.Sun.TemperatureKelvin;
-      parameters.Wavelengths = wavelengths;
-      in.AirSky = std::make_unique<nimbus::SkyModel>(parameters);
-      in.AirSkyKey = skyKey;
-    }
-    in.Table = nimbus::BuildAtmosphereTable(
-      sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024, airMultiple ? in.AirSky.get() : nullptr);
+    // The sky model shared with the cloud's sky light (FrameSkyModel), 16 wavelengths
+    // like the table.
+    const nimbus::SkyModel* skyModel = airMultiple ? &this->FrameSkyModel(frame) : nullptr;
+    in.Table =
+      nimbus::BuildAtmosphereTable(sunAndAir, std::min(zLow, zHigh - 1.0), zHigh, 1024, skyModel);
   }
   catch (const std::exception& error)
   {
@@ -1113,7 +1103,7 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
       return;
     }
     // The sky's radiance is relative to its own sun; the mapper's sun may be brighter.
-    const nimbus::SkyModel& model = *in.CloudSky;
+    const nimbus::SkyModel& model = *in.FrameSky;
     const auto skySun = model.GetSpectrum().ToLinearSrgb(model.GetSunIrradiance());
     nimbus::Rgb scale{ { 0, 0, 0 } };
     for (int c = 0; c < 3; ++c)
@@ -1202,36 +1192,24 @@ const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
   Internals& in = *this->Internal;
   const FrameSettings& settings = frame.Settings;
   const nimbus::SceneAtmosphere& air = settings.Air;
-  const double groundAlbedo = frame.Ground ? settings.GroundAlbedo : 0.0;
-  const std::vector<double> modelKey = { air.RayleighScatteringPerMetre, air.MieScatteringPerMetre,
-    air.MieG, air.MieAlbedo, air.RayleighScaleHeightMetres, air.MieScaleHeightMetres,
-    air.EarthRadiusMetres, air.TopRadiusMetres, groundAlbedo, settings.Sun.TemperatureKelvin };
   try
   {
-    if (!in.CloudSky || modelKey != in.CloudSkyKey)
-    {
-      nimbus::SkyParameters parameters;
-      parameters.Atmosphere = air;
-      parameters.GroundAlbedo = groundAlbedo;
-      parameters.SunTemperatureKelvin = settings.Sun.TemperatureKelvin;
-      in.CloudSkyView.reset();
-      in.CloudSky = std::make_unique<nimbus::SkyModel>(parameters);
-      in.CloudSkyKey = modelKey;
-    }
+    const nimbus::SkyModel& model = this->FrameSkyModel(frame);
     const double altitude = std::max(0.0, air.SceneAltitudeMetres + cloudAltitude);
-    const std::vector<double> viewKey = { settings.Sun.ElevationDegrees, altitude };
+    const std::vector<double> viewKey = { settings.Sun.ElevationDegrees, altitude,
+      static_cast<double>(in.FrameSkyGeneration) };
     if (!in.CloudSkyView || viewKey != in.CloudSkyViewKey)
     {
       // 64 x (32 + 16): the solver looks up a few dozen directions (the background's
       // 128 x (64 + 32) takes 0.36 s on 2 cores).
       in.CloudSkyView = std::make_unique<nimbus::SkyViewLut>(
-        *in.CloudSky, settings.Sun.ElevationDegrees, altitude, 64, 32, 16);
+        model, settings.Sun.ElevationDegrees, altitude, 64, 32, 16);
       in.CloudSkyViewKey = viewKey;
     }
   }
   catch (const std::exception& error)
   {
-    in.CloudSky.reset();
+    in.FrameSky.reset();
     in.CloudSkyView.reset();
     const std::string message = std::string("The sky light on the cloud is off: ") + error.what();
     if (message != in.LastScatteringError)
@@ -1242,6 +1220,37 @@ const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
     return nullptr;
   }
   return in.CloudSkyView.get();
+}
+
+std::vector<double> vtkNimbusCloudVolumeMapper::FrameSkyKey(const FrameState& frame)
+{
+  const FrameSettings& settings = frame.Settings;
+  const nimbus::SceneAtmosphere& air = settings.Air;
+  return { air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG, air.MieAlbedo,
+    air.RayleighScaleHeightMetres, air.MieScaleHeightMetres, air.EarthRadiusMetres,
+    air.TopRadiusMetres, frame.Ground ? settings.GroundAlbedo : 0.0,
+    settings.Sun.TemperatureKelvin };
+}
+
+// The sky model of the frame's air, ground albedo and sun temperature (throws for an
+// air the model refuses).
+const nimbus::SkyModel& vtkNimbusCloudVolumeMapper::FrameSkyModel(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const std::vector<double> key = FrameSkyKey(frame);
+  if (!in.FrameSky || key != in.FrameSkyKey)
+  {
+    in.FrameSky.reset();
+    nimbus::SkyParameters parameters;
+    parameters.Atmosphere = frame.Settings.Air;
+    parameters.GroundAlbedo = key[8];
+    parameters.SunTemperatureKelvin = frame.Settings.Sun.TemperatureKelvin;
+    parameters.Wavelengths = 16; // as the atmosphere table's SunAndAir
+    in.FrameSky = std::make_unique<nimbus::SkyModel>(parameters);
+    in.FrameSkyKey = key;
+    ++in.FrameSkyGeneration;
+  }
+  return *in.FrameSky;
 }
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfMultipleScatteringSolves() const

@@ -72,11 +72,13 @@
 
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
+#include <vector> // for std::vector
 
 class vtkImageData;
 class vtkMatrix4x4;
 namespace nimbus
 {
+class SkyModel;
 class SkyViewLut;
 }
 class vtkNimbusSky;
@@ -482,6 +484,8 @@ private:
   bool UpdateAtmosphereTable(FrameState& frame);
   void UpdateMultipleScattering(FrameState& frame);
   const nimbus::SkyViewLut* CloudSkyView(const FrameState& frame, double cloudAltitude);
+  const nimbus::SkyModel& FrameSkyModel(const FrameState& frame);
+  static std::vector<double> FrameSkyKey(const FrameState& frame);
   void BeginPasses(const FrameState& frame);
   void ClearShadowSurface(const FrameState& frame);
   void RenderIntervalPhase(const FrameState& frame);
