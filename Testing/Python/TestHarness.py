@@ -110,6 +110,27 @@ class HarnessTest(unittest.TestCase):
         self.assertEqual(rmse, sorted(rmse, reverse=True))
         self.assertLess(rmse[-1], 4e-4)
 
+    def test_svs_multiple_scattering_rows(self):
+        # The multiple-scattering settings are judged by the path tracer and report
+        # the solve's time and memory (octaves: the sky light's solve).
+        settings = os.path.join(self.output, "ms.json")
+        with open(settings, "w") as stream:
+            stream.write('[{"ms": "directions", "orders": 4, "directions": 6}, '
+                         '{"ms": "octaves", "octaves": 3}, {"slices": 32, "air_ms": false}]')
+        self.assertEqual(harness.run([SCENE, "--renderer", "svs", "--settings", settings,
+                                      "--repeats", "1", "--reference-seconds", "2",
+                                      "--output-dir", self.output]), 0)
+        with open(os.path.join(self.output, "trade.csv")) as stream:
+            rows = list(csv.DictReader(stream))
+        self.assertEqual(len(rows), 3)
+        for row in rows[:2]:
+            self.assertRegex(row["reference"], r"^path \(")
+            self.assertGreater(float(row["precompute_seconds"]), 0.0, row)
+            self.assertGreater(float(row["ms_mib"]), 0.0, row)
+            self.assertTrue(math.isfinite(float(row["rmse"])))
+        self.assertEqual(rows[2]["reference"], "single")
+        self.assertEqual(float(rows[2]["precompute_seconds"]), 0.0)
+
     def test_fast_renderers_refuse_version3_features(self):
         # Lights (scene format version 3) are the path tracer's: the GPU mappers say so by
         # name instead of rendering the scene without them.
