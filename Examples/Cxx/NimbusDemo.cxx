@@ -7,9 +7,9 @@
 // plane, lit by the sun whose colour comes from the atmosphere model
 // through the atmosphere, rendered with Nimbus's shadow-view-slice mapper
 // (vtkNimbusCloudVolumeMapper, paper 000): cloud and ground shadows, shafts of
-// light, in front of the Nimbus sky (vtkNimbusSkyBackground: Rayleigh + Mie
-// with multiple scattering) whose sun and air the cloud mapper shares.
-// With --no-sky the mapper draws its own single-scattering atmosphere instead.
+// light and multiple scattering in the cloud, in front of the Nimbus sky
+// (vtkNimbusSkyBackground: Rayleigh + Mie with multiple scattering) whose sun and air
+// the cloud mapper shares. With --no-sky the mapper draws its own atmosphere instead.
 // Units: metres; z up.
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
@@ -52,7 +52,7 @@ bool ParseNumber(const char* text, double& value)
 int main(int argc, char* argv[])
 {
   std::string output = "nimbus-demo.png";
-  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7, kMulti = 3.0,
+  double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7, kMulti = 0.0,
          exposure = 8.0;
   bool drawSky = true;
   for (int i = 1; i < argc; ++i)
@@ -123,8 +123,10 @@ int main(int argc, char* argv[])
   }
 
   // The cloud rendered with Nimbus's shadow-view-slice mapper (000): single
-  // scattering with the k_multi term, sun shadows (also on the ground), the
-  // atmosphere (sky colour, reddened sun, haze) and shafts of light.
+  // scattering, multiple scattering (the mapper's default: 003's discrete
+  // directions, the sky's and the ground's light; --k-multi adds 000's constant on
+  // top, 0 by default), sun shadows (also on the ground), the atmosphere (sky
+  // colour, reddened sun, haze) and shafts of light.
   vtkNew<vtkNimbusCloudVolumeMapper> cloudMapper;
   cloudMapper->SetInputConnection(cloud->GetOutputPort(0));
   cloudMapper->SetExtinctionPerDensity(0.02); // 1/m per unit density: a cumulus
