@@ -19,6 +19,11 @@
  *    atmosphere, the background attenuated by g_view.
  *  - A ground plane lit by the attenuated sun and shadowed through the shadow
  *    surface, and shafts of light in the atmosphere beyond the cloud box.
+ *  - Multiple scattering (issue 14; MultipleScatteringMethod, default discrete
+ *    directions): the light the cloud scatters more than once and the sky's and the
+ *    ground's light on it, solved on a downsampled grid (Physics/MultipleScattering.h)
+ *    only when the density, sun, air, ground, optics or knobs change, and added per
+ *    sample from three SH textures; docs/multiple-scattering.md.
  *  - Multiple scattering in the air (AirMultipleScattering, default on): the
  *    isotropic orders >= 2 of a sky model of the same air (Hillaire 2020 §5.5) in
  *    the air's source and the sky's light on the ground, neither shadowed by the
