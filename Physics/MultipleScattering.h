@@ -28,7 +28,8 @@
 //    tail beyond Orders is summed as a geometric series). The sky and the ground
 //    enter as radiance at the grid's boundary, so all their orders are included.
 //    The cloud's forward peak is treated with the delta-M scaling (Wiscombe 1977):
-//    a fraction f = g^2 of the scattering is kept in the direction of travel, which
+//    a fraction f = k_2 of the scattering (the phase function's second Legendre
+//    coefficient; g^2 for Henyey-Greenstein) is kept in the direction of travel, which
 //    makes a few dozen directions enough; the light the peak carries along the sun's
 //    direction is returned to the mapper as ForwardPeakFraction (see there).
 //
@@ -129,9 +130,11 @@ struct NIMBUSPHYSICS_EXPORT CloudLighting
 struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
 {
   MultipleScatteringMethod Method = MultipleScatteringMethod::DiscreteDirections;
-  /// The highest order computed explicitly (>= 2). DiscreteDirections stops earlier
-  /// when an order carries < 1e-5 of the total and adds the rest as a geometric series
-  /// when ExtrapolateHigherOrders; ReferencePatterns stops there (the paper: 3).
+  /// Orders computed explicitly (>= 2). DiscreteDirections: the radiance scattered
+  /// 1..Orders times (so J of orders 2..Orders + 1; the sky's and the ground's from
+  /// order 1), stopping earlier when an order carries < 1e-5 of the total, the rest a
+  /// geometric series when ExtrapolateHigherOrders. ReferencePatterns: J of orders
+  /// 2..Orders (the paper: 3).
   int Orders = 32;
   bool ExtrapolateHigherOrders = true;
   /// Directions of the discrete-direction system and of the sky-light look-ups
