@@ -44,8 +44,8 @@ bool FiniteRgb(const Rgb& c)
 // two axes, and is read bilinearly from that plane (points outside the grid give
 // the boundary's value). Along the segment of length t [m] between them:
 //   L = L_up exp(-tau) + S (1 - exp(-tau)),  tau = t (sigma_up + sigma) / 2,
-// S the mean of the source functions at both ends (sigma_s J / sigma_t). Each plane's
-// points are independent: the plane is split over threads.
+// S the extinction-weighted mean of the source functions at both ends (sigma_s J /
+// sigma_t). The optical-depth sweeps and the solver's transport share it.
 class DirectionSweep
 {
 public:
@@ -74,93 +74,84 @@ public:
     this->OffsetC = -e[this->C] * this->Step;
   }
 
-  // Runs body(plane, index-of-point, upstream) for every point in sweep order,
-  // plane after plane; `upstream` gives the bilinear weights of the upstream point
-  // in the previous plane (or none: outside).
-  struct Upstream
+  // One upstream corner of a point, in the previous plane: its index and bilinear
+  // weight (the weights are the same for every point of a direction).
+  struct Corner
   {
-    bool Inside = false; // false: every corner is outside (the boundary)
-    std::size_t Index[4] = { 0, 0, 0, 0 };
-    double Weight[4] = { 0, 0, 0, 0 }; // of the corners inside
-    double Outside = 1.0;              // weight of the boundary (corners outside)
+    std::ptrdiff_t Index;
+    float Weight;
   };
 
+  // Runs body(index, first, corners, count, outside) for every point, plane after
+  // plane in the order of travel: `first` on the first plane (its upstream lies
+  // outside the grid), corners[0 .. count) the upstream corners inside the grid,
+  // `outside` the weight of those outside (where the boundary's value holds). A
+  // plane's points are independent: `threads` split large planes by rows.
   template <class Body>
   void Run(int threads, const Body& body) const
   {
     const auto& n = this->Grid.Dimensions;
-    const int planes = n[this->Axis];
-    const std::size_t planeSize = static_cast<std::size_t>(n[this->B]) * n[this->C];
-    for (int p = 0; p < planes; ++p)
+    const std::ptrdiff_t stride[3] = { 1, n[0], static_cast<std::ptrdiff_t>(n[0]) * n[1] };
+    const std::ptrdiff_t sA = stride[this->Axis], sB = stride[this->B], sC = stride[this->C];
+    const int nA = n[this->Axis], nB = n[this->B], nC = n[this->C];
+    const int b0 = static_cast<int>(std::floor(this->OffsetB));
+    const int c0 = static_cast<int>(std::floor(this->OffsetC));
+    const float fb = static_cast<float>(this->OffsetB - b0);
+    const float fc = static_cast<float>(this->OffsetC - c0);
+    const float weight[4] = { (1 - fb) * (1 - fc), fb * (1 - fc), (1 - fb) * fc, fb * fc };
+    const int cornerB[4] = { 0, 1, 0, 1 }, cornerC[4] = { 0, 0, 1, 1 };
+    const std::ptrdiff_t previous = this->Forward ? -sA : sA;
+    for (int p = 0; p < nA; ++p)
     {
-      const int plane = this->Forward ? p : planes - 1 - p;
-      const int previous = this->Forward ? plane - 1 : plane + 1;
-      const bool hasPrevious = p > 0;
-      ParallelFor(planeSize, planeSize > 4096 ? 1024 : planeSize, threads,
-        [&](std::size_t begin, std::size_t end)
-        {
-          for (std::size_t q = begin; q < end; ++q)
-          {
-            const int ib = static_cast<int>(q % n[this->B]);
-            const int ic = static_cast<int>(q / n[this->B]);
-            int ijk[3];
-            ijk[this->Axis] = plane;
-            ijk[this->B] = ib;
-            ijk[this->C] = ic;
-            const std::size_t index = this->Grid.Index(ijk[0], ijk[1], ijk[2]);
-            Upstream up;
-            if (hasPrevious)
-            {
-              this->Locate(previous, ib + this->OffsetB, ic + this->OffsetC, up);
-            }
-            body(index, up);
-          }
-        });
-    }
-  }
-
-  double GetStep() const { return this->Step; }
-  int GetAxis() const { return this->Axis; }
-  int GetB() const { return this->B; }
-  int GetC() const { return this->C; }
-  bool GetForward() const { return this->Forward; }
-  double GetOffsetB() const { return this->OffsetB; }
-  double GetOffsetC() const { return this->OffsetC; }
-
-private:
-  void Locate(int plane, double b, double c, Upstream& up) const
-  {
-    const auto& n = this->Grid.Dimensions;
-    const int b0 = static_cast<int>(std::floor(b));
-    const int c0 = static_cast<int>(std::floor(c));
-    const double fb = b - b0;
-    const double fc = c - c0;
-    up.Outside = 0.0;
-    int corner = 0;
-    for (int dc = 0; dc < 2; ++dc)
-    {
-      for (int db = 0; db < 2; ++db, ++corner)
+      const int plane = this->Forward ? p : nA - 1 - p;
+      auto rows = [&](std::size_t begin, std::size_t end)
       {
-        const double w = (db ? fb : 1.0 - fb) * (dc ? fc : 1.0 - fc);
-        const int jb = b0 + db;
-        const int jc = c0 + dc;
-        if (jb < 0 || jb >= n[this->B] || jc < 0 || jc >= n[this->C])
+        for (int ic = static_cast<int>(begin); ic < static_cast<int>(end); ++ic)
         {
-          up.Weight[corner] = 0.0;
-          up.Outside += w;
-          continue;
+          for (int ib = 0; ib < nB; ++ib)
+          {
+            const std::ptrdiff_t index = plane * sA + ib * sB + ic * sC;
+            if (p == 0)
+            {
+              body(index, true, static_cast<const Corner*>(nullptr), 0, 1.0f);
+              continue;
+            }
+            Corner corners[4];
+            int count = 0;
+            float outside = 0.0f;
+            const bool interior =
+              ib + b0 >= 0 && ib + b0 + 1 < nB && ic + c0 >= 0 && ic + c0 + 1 < nC;
+            for (int q = 0; q < 4; ++q)
+            {
+              const int jb = ib + b0 + cornerB[q], jc = ic + c0 + cornerC[q];
+              if (!interior && (jb < 0 || jb >= nB || jc < 0 || jc >= nC))
+              {
+                outside += weight[q];
+                continue;
+              }
+              corners[count++] = {
+                index + previous + (b0 + cornerB[q]) * sB + (c0 + cornerC[q]) * sC, weight[q]
+              };
+            }
+            body(index, false, static_cast<const Corner*>(corners), count, outside);
+          }
         }
-        int ijk[3];
-        ijk[this->Axis] = plane;
-        ijk[this->B] = jb;
-        ijk[this->C] = jc;
-        up.Index[corner] = this->Grid.Index(ijk[0], ijk[1], ijk[2]);
-        up.Weight[corner] = w;
-        up.Inside = true;
+      };
+      const std::size_t rowCount = static_cast<std::size_t>(nC);
+      if (threads != 1 && rowCount * nB > 4096)
+      {
+        ParallelFor(rowCount, std::max<std::size_t>(1, 1024 / std::max(nB, 1)), threads, rows);
+      }
+      else
+      {
+        rows(0, rowCount);
       }
     }
   }
 
+  double GetStep() const { return this->Step; }
+
+private:
   const ExtinctionGrid& Grid;
   int Axis = 0, B = 1, C = 2;
   bool Forward = true;
@@ -177,21 +168,23 @@ std::vector<float> SweptOpticalDepth(const ExtinctionGrid& grid,
   const DirectionSweep sweep(grid, travelWorld);
   const double t = sweep.GetStep();
   sweep.Run(threads,
-    [&](std::size_t index, const DirectionSweep::Upstream& up)
+    [&](std::ptrdiff_t index, bool first, const DirectionSweep::Corner* corners, int count, float)
     {
-      double tauUp = 0.0, sigmaUp = 0.0;
-      for (int c = 0; c < 4; ++c)
+      // The first plane and points whose upstream lies wholly outside: the segment
+      // upstream is outside the grid, where the extinction is 0 (trilinear inside
+      // [0, n-1] only).
+      if (first || count == 0)
       {
-        if (up.Weight[c] > 0.0)
-        {
-          tauUp += up.Weight[c] * depth[up.Index[c]];
-          sigmaUp += up.Weight[c] * extinction[up.Index[c]];
-        }
+        depth[index] = 0.0f;
+        return;
       }
-      // The first plane: the segment upstream lies outside the grid, where the
-      // extinction is 0 (trilinear inside [0, n-1] only).
-      depth[index] =
-        up.Inside ? static_cast<float>(tauUp + 0.5 * t * (sigmaUp + extinction[index])) : 0.0f;
+      double tauUp = 0.0, sigmaUp = 0.0;
+      for (int q = 0; q < count; ++q)
+      {
+        tauUp += corners[q].Weight * static_cast<double>(depth[corners[q].Index]);
+        sigmaUp += corners[q].Weight * static_cast<double>(extinction[corners[q].Index]);
+      }
+      depth[index] = static_cast<float>(tauUp + 0.5 * t * (sigmaUp + extinction[index]));
     });
   return depth;
 }
@@ -637,92 +630,64 @@ private:
   }
 
   // out(x) for direction m: the boundary's radiance `boundary` carried in, plus
-  // the source function `source` (per point, RGB; nullptr: 0) along the way. The
-  // sweep of DirectionSweep written out for speed (the solver's inner loop): the
-  // upstream point's bilinear weights are the same for every point of a direction,
-  // only the corners outside the grid (the boundary's radiance, no extinction, no
-  // source) differ. Along the segment: L = L_up e^-tau + S (1 - e^-tau) with
-  // tau = t (sigma_up + sigma) / 2 and S the extinction-weighted mean source.
+  // the source function `source` (per point, RGB; nullptr: 0) along the way
+  // (DirectionSweep, sequential: the callers run the directions in parallel). Along
+  // the segment: L = L_up e^-tau + S (1 - e^-tau) with tau = t (sigma_up + sigma) / 2
+  // and S the extinction-weighted mean source; corners outside the grid bring the
+  // boundary's radiance, no extinction and no source.
   void Transport(const ExtinctionGrid& grid, std::size_t m, const Rgb& boundary,
     const float* source, float* out) const
   {
     const DirectionSweep sweep(grid, this->Directions[m]);
-    const auto& n = grid.Dimensions;
-    const int axis = sweep.GetAxis(), axisB = sweep.GetB(), axisC = sweep.GetC();
-    const std::ptrdiff_t stride[3] = { 1, n[0], static_cast<std::ptrdiff_t>(n[0]) * n[1] };
-    const std::ptrdiff_t sA = stride[axis], sB = stride[axisB], sC = stride[axisC];
-    const int nA = n[axis], nB = n[axisB], nC = n[axisC];
     const float t = static_cast<float>(sweep.GetStep());
-    const int b0 = static_cast<int>(std::floor(sweep.GetOffsetB()));
-    const int c0 = static_cast<int>(std::floor(sweep.GetOffsetC()));
-    const float fb = static_cast<float>(sweep.GetOffsetB() - b0);
-    const float fc = static_cast<float>(sweep.GetOffsetC() - c0);
-    const float weight[4] = { (1 - fb) * (1 - fc), fb * (1 - fc), (1 - fb) * fc, fb * fc };
-    const int cornerB[4] = { 0, 1, 0, 1 }, cornerC[4] = { 0, 0, 1, 1 };
     const float* sigma = grid.Extinction.data();
     const float edge[3] = { static_cast<float>(boundary[0]), static_cast<float>(boundary[1]),
       static_cast<float>(boundary[2]) };
-    for (int p = 0; p < nA; ++p)
-    {
-      const int plane = sweep.GetForward() ? p : nA - 1 - p;
-      const std::ptrdiff_t previous = sweep.GetForward() ? -sA : sA;
-      for (int ic = 0; ic < nC; ++ic)
+    sweep.Run(1,
+      [&](std::ptrdiff_t index, bool first, const DirectionSweep::Corner* corners, int count,
+        float outside)
       {
-        for (int ib = 0; ib < nB; ++ib)
+        float* o = out + 3 * index;
+        if (first)
         {
-          const std::ptrdiff_t index = plane * sA + ib * sB + ic * sC;
-          float* o = out + 3 * index;
-          if (p == 0)
+          // Upstream of the first plane lies outside the grid: no extinction.
+          o[0] = edge[0];
+          o[1] = edge[1];
+          o[2] = edge[2];
+          return;
+        }
+        float lUp[3] = { 0, 0, 0 }, emissionUp[3] = { 0, 0, 0 };
+        float sigmaUp = 0.0f;
+        for (int q = 0; q < count; ++q)
+        {
+          const std::ptrdiff_t j = corners[q].Index;
+          const float w = corners[q].Weight;
+          const float sj = sigma[j];
+          sigmaUp += w * sj;
+          const float* lj = out + 3 * j;
+          lUp[0] += w * lj[0];
+          lUp[1] += w * lj[1];
+          lUp[2] += w * lj[2];
+          if (source)
           {
-            // Upstream of the first plane lies outside the grid: no extinction.
-            o[0] = edge[0];
-            o[1] = edge[1];
-            o[2] = edge[2];
-            continue;
-          }
-          float lUp[3] = { 0, 0, 0 }, emissionUp[3] = { 0, 0, 0 };
-          float sigmaUp = 0.0f, outside = 0.0f;
-          const std::ptrdiff_t up = index + previous;
-          const bool interior =
-            ib + b0 >= 0 && ib + b0 + 1 < nB && ic + c0 >= 0 && ic + c0 + 1 < nC;
-          for (int q = 0; q < 4; ++q)
-          {
-            const int jb = ib + b0 + cornerB[q], jc = ic + c0 + cornerC[q];
-            if (!interior && (jb < 0 || jb >= nB || jc < 0 || jc >= nC))
-            {
-              outside += weight[q];
-              continue;
-            }
-            const std::ptrdiff_t j = up + (b0 + cornerB[q]) * sB + (c0 + cornerC[q]) * sC;
-            const float w = weight[q];
-            const float sj = sigma[j];
-            sigmaUp += w * sj;
-            const float* lj = out + 3 * j;
-            lUp[0] += w * lj[0];
-            lUp[1] += w * lj[1];
-            lUp[2] += w * lj[2];
-            if (source)
-            {
-              const float* sj3 = source + 3 * j;
-              emissionUp[0] += w * sj * sj3[0];
-              emissionUp[1] += w * sj * sj3[1];
-              emissionUp[2] += w * sj * sj3[2];
-            }
-          }
-          const float sigmaHere = sigma[index];
-          const float sigmaSum = sigmaUp + sigmaHere;
-          const float transmittance = std::exp(-0.5f * t * sigmaSum);
-          for (int c = 0; c < 3; ++c)
-          {
-            const float l = lUp[c] + outside * edge[c];
-            const float s = source && sigmaSum > 0.0f
-              ? (emissionUp[c] + sigmaHere * source[3 * index + c]) / sigmaSum
-              : 0.0f;
-            o[c] = l * transmittance + s * (1.0f - transmittance);
+            const float* sj3 = source + 3 * j;
+            emissionUp[0] += w * sj * sj3[0];
+            emissionUp[1] += w * sj * sj3[1];
+            emissionUp[2] += w * sj * sj3[2];
           }
         }
-      }
-    }
+        const float sigmaHere = sigma[index];
+        const float sigmaSum = sigmaUp + sigmaHere;
+        const float transmittance = std::exp(-0.5f * t * sigmaSum);
+        for (int c = 0; c < 3; ++c)
+        {
+          const float l = lUp[c] + outside * edge[c];
+          const float s = source && sigmaSum > 0.0f
+            ? (emissionUp[c] + sigmaHere * source[3 * index + c]) / sigmaSum
+            : 0.0f;
+          o[c] = l * transmittance + s * (1.0f - transmittance);
+        }
+      });
   }
 
   // coefficients += SH projection of radiance(x) arriving along s, weighted by the
