@@ -19,6 +19,23 @@ namespace nimbus
 MultipleScatteringTexture::MultipleScatteringTexture() = default;
 MultipleScatteringTexture::~MultipleScatteringTexture() = default;
 
+DensityResamplePlan MultipleScatteringTexture::PlanGrid(
+  vtkImageData* image, bool cellData, const Request& request)
+{
+  int pointDims[3];
+  image->GetDimensions(pointDims);
+  DensityResamplePlan plan;
+  for (int k = 0; k < 3; ++k)
+  {
+    const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    plan.InputDimensions[k] = samples;
+    plan.Factors[k] =
+      std::min(samples, std::max(1, request.Downsampling) * std::max(1, request.TextureFactors[k]));
+    plan.OutputDimensions[k] = (samples + plan.Factors[k] - 1) / plan.Factors[k];
+  }
+  return plan;
+}
+
 vtkTextureObject* MultipleScatteringTexture::GetTexture(int channel) const
 {
   return this->Textures[channel].GetPointer();
@@ -28,18 +45,8 @@ bool MultipleScatteringTexture::BuildGrid(vtkImageData* image, vtkDataArray* sca
   vtkMatrix4x4* dataToWorld, const Request& request, ExtinctionGrid& grid,
   std::array<int, 3>& factors, std::string& error)
 {
-  int pointDims[3];
-  image->GetDimensions(pointDims);
-  DensityResamplePlan plan;
-  for (int k = 0; k < 3; ++k)
-  {
-    const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
-    plan.InputDimensions[k] = samples;
-    factors[k] =
-      std::min(samples, std::max(1, request.Downsampling) * std::max(1, request.TextureFactors[k]));
-    plan.Factors[k] = factors[k];
-    plan.OutputDimensions[k] = (samples + factors[k] - 1) / factors[k];
-  }
+  const DensityResamplePlan plan = PlanGrid(image, cellData, request);
+  factors = plan.Factors;
   const ResampledDensity density = CloudDensityTexture::Resample(scalars, plan);
   grid.Dimensions = plan.OutputDimensions;
   grid.Extinction.resize(plan.OutputSize());
@@ -151,16 +158,8 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
   std::array<int, 3> factors{ { 1, 1, 1 } };
   // The estimate before any allocation: the grid's own floats plus the solver's.
   {
-    int pointDims[3];
-    image->GetDimensions(pointDims);
     ExtinctionGrid shape;
-    for (int k = 0; k < 3; ++k)
-    {
-      const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
-      const int f = std::min(
-        samples, std::max(1, request.Downsampling) * std::max(1, request.TextureFactors[k]));
-      shape.Dimensions[k] = (samples + f - 1) / f;
-    }
+    shape.Dimensions = PlanGrid(image, cellData, request).OutputDimensions;
     const double points =
       static_cast<double>(shape.Dimensions[0]) * shape.Dimensions[1] * shape.Dimensions[2];
     this->LastEstimatedBytes =

@@ -11,6 +11,7 @@
 #ifndef nimbus_MultipleScatteringTexture_h
 #define nimbus_MultipleScatteringTexture_h
 
+#include "DensityResample.h"
 #include "MultipleScattering.h"
 #include "NimbusRepresentationsModule.h"
 #include "vtkNew.h" // for vtkNew
@@ -53,6 +54,10 @@ public:
     /// last solve's); the density's identity is `densityVersion`.
     std::vector<double> Key;
   };
+
+  /// The blocks of the grid: input samples (cells for cell data), block factors,
+  /// grid points per axis.
+  static DensityResamplePlan PlanGrid(vtkImageData* image, bool cellData, const Request& request);
 
   /// The grid the solver will work on: the image's scalars (cell data when
   /// `cellData`) in blocks (see the file comment), placed in world metres through
