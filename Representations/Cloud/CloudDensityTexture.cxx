@@ -210,6 +210,7 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   }
   this->SetBox(image, cellData, plan);
   std::copy(texDims.begin(), texDims.end(), this->Dimensions);
+  std::copy(plan.Factors.begin(), plan.Factors.end(), this->Factors);
   this->UploadedArray = scalars;
   this->UploadedImage = image;
   this->UploadedMaximumSize = maximumSize;
@@ -283,6 +284,11 @@ void CloudDensityTexture::GetDataToBox(vtkMatrix4x4* matrix) const
 void CloudDensityTexture::GetDimensions(int dimensions[3]) const
 {
   std::copy(this->Dimensions, this->Dimensions + 3, dimensions);
+}
+
+void CloudDensityTexture::GetFactors(int factors[3]) const
+{
+  std::copy(this->Factors, this->Factors + 3, factors);
 }
 
 void CloudDensityTexture::Release(vtkWindow* window)

@@ -57,6 +57,8 @@ public:
   vtkTextureObject* GetTexture() const { return this->Texture; }
   /// Texels per axis of the last upload (0 before the first).
   void GetDimensions(int dimensions[3]) const;
+  /// Input samples per texel per axis of the last upload (the block factors).
+  void GetFactors(int factors[3]) const;
   /// Uploads so far (tests and benchmarks).
   int GetNumberOfUploads() const { return this->Uploads; }
 
@@ -92,6 +94,7 @@ private:
   bool HasDensity = false;
   int Uploads = 0;
   int Dimensions[3] = { 0, 0, 0 };
+  int Factors[3] = { 1, 1, 1 };
   double BoxToTexScale[3] = { 1, 1, 1 };
   double BoxToTexOffset[3] = { 0, 0, 0 };
   double BoxOrigin[3] = { 0, 0, 0 };

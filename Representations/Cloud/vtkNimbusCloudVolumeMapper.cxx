@@ -1055,14 +1055,12 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   request.Downsampling = this->MultipleScatteringDownsampling > 0
     ? this->MultipleScatteringDownsampling
     : (longest + kAutomaticScatteringGridSide - 1) / kAutomaticScatteringGridSide;
-  int pointDims[3];
-  frame.Image->GetDimensions(pointDims);
+  int textureFactors[3];
+  in.Density.GetFactors(textureFactors);
   for (int k = 0; k < 3; ++k)
   {
-    const int samples = frame.CellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
     request.TextureDimensions[k] = std::max(textureDims[k], 1);
-    request.TextureFactors[k] =
-      (samples + request.TextureDimensions[k] - 1) / request.TextureDimensions[k];
+    request.TextureFactors[k] = textureFactors[k];
   }
   request.MetresPerUnit = settings.MetresPerUnit;
   request.BudgetBytes = this->MultipleScatteringMemoryBudgetMiB > 0.0
