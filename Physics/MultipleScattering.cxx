@@ -42,10 +42,10 @@ bool FiniteRgb(const Rgb& c)
 // axis a where the direction of travel d advances fastest in grid indices; each
 // point's upstream point lies one plane back, at fractional offsets < 1 in the other
 // two axes, and is read bilinearly from that plane (points outside the grid give
-// the boundary's value). Along the segment of length t [m] between them:
-//   L = L_up exp(-tau) + S (1 - exp(-tau)),  tau = t (sigma_up + sigma) / 2,
-// S the extinction-weighted mean of the source functions at both ends (sigma_s J /
-// sigma_t). The optical-depth sweeps and the solver's transport share it.
+// the boundary's value). Along the segment of length t [m] between them the optical
+// depth is tau = t (sigma_up + sigma) / 2 and the source function (sigma_s J /
+// sigma_t) is linear in optical depth (Transport). The optical-depth sweeps and the
+// solver's transport share it.
 class DirectionSweep
 {
 public:
@@ -578,16 +578,19 @@ public:
       }
     }
     field.OrdersComputed = computed;
-    // The orders beyond: a geometric series with the ratio of the last two orders'
-    // energies, the spectral radius of the scattering operator once its dominant
-    // mode has taken over (Aitken's extrapolation).
+    // The orders beyond the last computed (at Orders, or where the criterion stopped
+    // it: in a thick conservative cloud each order carries almost as much as the one
+    // before, so 1e-5 of the total per order still leaves a remainder of about 2 %):
+    // a geometric series with the ratio of the last two orders' energies, the
+    // spectral radius of the scattering operator once its dominant mode has taken
+    // over (Aitken's extrapolation).
     for (int c = 0; c < 3; ++c)
     {
       const double ratio = previousEnergy[c] > 0.0 ? energy[c] / previousEnergy[c] : 0.0;
       field.LastOrderRatio[c] = ratio;
       field.TailShare[c] = 0.0;
     }
-    if (this->Options.ExtrapolateHigherOrders && computed == maximumOrder)
+    if (this->Options.ExtrapolateHigherOrders)
     {
       Rgb factor{ { 0, 0, 0 } };
       for (int c = 0; c < 3; ++c)
@@ -631,10 +634,15 @@ private:
 
   // out(x) for direction m: the boundary's radiance `boundary` carried in, plus
   // the source function `source` (per point, RGB; nullptr: 0) along the way
-  // (DirectionSweep, sequential: the callers run the directions in parallel). Along
-  // the segment: L = L_up e^-tau + S (1 - e^-tau) with tau = t (sigma_up + sigma) / 2
-  // and S the extinction-weighted mean source; corners outside the grid bring the
-  // boundary's radiance, no extinction and no source.
+  // (DirectionSweep, sequential: the callers run the directions in parallel), the
+  // source linear in optical depth along each segment (below); corners outside the
+  // grid bring the boundary's radiance, no extinction and no source.
+  //
+  // Why linear: in cells many mean free paths thick (a coarse grid of a dense cloud)
+  // the source must be the point's own; the mean of both ends (the step rule) moves
+  // light half a cell per order whatever the optical depth, a numerical diffusion
+  // that carried the sunlit side's light to the shadowed side (cumulonimbus: 26.4 dB
+  // against the path tracer with the mean, 31.3 dB linear; docs/multiple-scattering.md).
   void Transport(const ExtinctionGrid& grid, std::size_t m, const Rgb& boundary,
     const float* source, float* out) const
   {
@@ -676,16 +684,24 @@ private:
             emissionUp[2] += w * sj * sj3[2];
           }
         }
-        const float sigmaHere = sigma[index];
-        const float sigmaSum = sigmaUp + sigmaHere;
-        const float transmittance = std::exp(-0.5f * t * sigmaSum);
+        const float tau = 0.5f * t * (sigmaUp + sigma[index]);
+        const float transmittance = std::exp(-tau);
+        // The source function linear in optical depth along the segment (short
+        // characteristics with a linear source, Olson & Kunasz 1987):
+        //   L = L_up e^-tau + S (1 - (1 - e^-tau)/tau) + S_up ((1 - e^-tau)/tau - e^-tau),
+        // the trapezoid rule when thin, S alone when thick. S_up is the upstream
+        // corners' extinction-weighted source (points without medium emit nothing;
+        // none with medium: S).
+        const float escape = tau > 1e-4f ? -std::expm1(-tau) / tau : 1.0f - 0.5f * tau;
+        const float weightHere = 1.0f - escape;
+        const float weightUp = escape - transmittance;
         for (int c = 0; c < 3; ++c)
         {
           const float l = lUp[c] + outside * edge[c];
-          const float s = source && sigmaSum > 0.0f
-            ? (emissionUp[c] + sigmaHere * source[3 * index + c]) / sigmaSum
-            : 0.0f;
-          o[c] = l * transmittance + s * (1.0f - transmittance);
+          const float here = source ? source[3 * index + c] : 0.0f;
+          const float up = sigmaUp > 0.0f ? emissionUp[c] / sigmaUp : here;
+          const float s = weightHere * here + weightUp * up;
+          o[c] = l * transmittance + s;
         }
       });
   }
