@@ -1,5 +1,6 @@
 #include "vtkNimbusCloudRepresentation.h"
 
+#include "vtkCommand.h"
 #include "vtkDataObject.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
@@ -19,6 +20,13 @@ vtkNimbusCloudRepresentation::vtkNimbusCloudRepresentation()
   // the delivered data to VolumeMapper at each render request.
   this->CloudMapper = vtkNimbusCloudVolumeMapper::New();
   this->VolumeMapper.TakeReference(this->CloudMapper);
+  this->CloudMapper->AddObserver(
+    vtkCommand::ProgressEvent, this, &vtkNimbusCloudRepresentation::ForwardMapperProgress);
+}
+
+void vtkNimbusCloudRepresentation::ForwardMapperProgress(vtkObject*, unsigned long, void*)
+{
+  this->UpdateProgress(this->CloudMapper->GetProgress());
 }
 
 vtkNimbusCloudRepresentation::~vtkNimbusCloudRepresentation() = default;
@@ -126,6 +134,8 @@ NIMBUS_FORWARD(TextureMemoryBudgetMiB, double)
 NIMBUS_FORWARD(MetresPerUnit, double)
 NIMBUS_FORWARD(Exposure, double)
 NIMBUS_FORWARD(EncodeSrgb, bool)
+NIMBUS_FORWARD(FrameBudgetMilliseconds, double)
+NIMBUS_FORWARD(Quality, double)
 
 #undef NIMBUS_FORWARD
 

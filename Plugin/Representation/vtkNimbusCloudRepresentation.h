@@ -159,6 +159,16 @@ public:
   ///@}
 
   ///@{
+  /// Automatic quality (vtkNimbusCloudVolumeMapper::SetQuality): ParaView's
+  /// interactive renders (a camera drag) fit the cloud's passes into the frame
+  /// budget [ms; 0: no lowering], still renders draw at Quality (1: full).
+  void SetFrameBudgetMilliseconds(double value);
+  double GetFrameBudgetMilliseconds();
+  void SetQuality(double value);
+  double GetQuality();
+  ///@}
+
+  ///@{
   /// Metres per world unit; framebuffer = Exposure * radiance; sRGB encoding.
   void SetMetresPerUnit(double value);
   double GetMetresPerUnit();
@@ -180,6 +190,10 @@ protected:
   vtkNimbusCloudVolumeMapper* CloudMapper = nullptr;
 
 private:
+  /// The mapper's progress during a long still render, as this representation's
+  /// (ParaView's progress bar listens to the representation, not to its mapper).
+  void ForwardMapperProgress(vtkObject* caller, unsigned long event, void* data);
+
   vtkNimbusCloudRepresentation(const vtkNimbusCloudRepresentation&) = delete;
   void operator=(const vtkNimbusCloudRepresentation&) = delete;
 };

@@ -4,6 +4,7 @@
 #include "AtmosphereTable.h"
 #include "CloudDensityTexture.h"
 #include "FiniteSetters.h"
+#include "FrameQuality.h"
 #include "MemoryBudget.h"
 #include "MultipleScatteringTexture.h"
 #include "SliceGeometry.h"
@@ -46,6 +47,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <new>
 #include <sstream>
@@ -77,6 +80,14 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SliceAngleRatio);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MetresPerUnit);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Exposure);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, TextureMemoryBudgetMiB);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, FrameBudgetMilliseconds);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Quality);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, InteractiveUpdateRate);
+
+double vtkNimbusCloudVolumeMapper::GetQualityMinValue()
+{
+  return nimbus::kMinimumFrameQuality;
+}
 
 namespace
 {
@@ -225,6 +236,13 @@ struct vtkNimbusCloudVolumeMapper::FrameState
 
   // The renderer's viewport in the framebuffer.
   int Width = 0, Height = 0, X0 = 0, Y0 = 0;
+  // This frame's quality level (slices, shadow surface, the size of the image the
+  // passes render before the composite scales it to the viewport) and whether the
+  // render window asked for an interactive frame.
+  nimbus::FrameLevel Level;
+  bool Interactive = false;
+  // When the passes began (the frame's cost, for the cost model and the progress).
+  std::chrono::steady_clock::time_point PassesStart;
 
   // Slice geometry (world coordinates).
   nimbus::Vector3 ToSun{ { 0.0, 0.0, 1.0 } };
@@ -259,6 +277,9 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   double ForwardPeakFraction = 0.0;
   double ScatteringScale = 1.0; // this frame's illuminance / the solve's
   int Octaves = 1;
+
+  // A hash of the opaque scene's depth in the viewport (0 without one).
+  std::uint64_t SceneDepthHash = 0;
 };
 
 struct vtkNimbusCloudVolumeMapper::Internals
@@ -315,6 +336,19 @@ struct vtkNimbusCloudVolumeMapper::Internals
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
   int PassesLastRender = 0;
+
+  // Automatic quality: the passes' measured cost against the quality level, and
+  // the last frame's key (FrameReuseKey) while its cloud image (the accumulation
+  // targets) is still valid for a frame with the same key.
+  nimbus::FrameCostModel Cost;
+  std::vector<double> ReuseKey;
+  bool ReuseValid = false;
+  std::vector<float> DepthReadback;
+  nimbus::FrameLevel LastLevel;
+  bool LastInteractive = false;
+  bool LastReused = false;
+  bool LastAborted = false;
+  double LastFrameSeconds = 0.0;
   bool LastBackToFront = false;
   bool LastOverSky = false;
   double LastSunElevationDegrees = 0.0;
@@ -349,6 +383,8 @@ struct vtkNimbusCloudVolumeMapper::Internals
     }
     AtmosphereKey.clear();
     IntervalPhaseKey.clear();
+    ReuseKey.clear();
+    ReuseValid = false;
     Window = nullptr;
   }
 
@@ -495,6 +531,7 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
 bool vtkNimbusCloudVolumeMapper::RenderFrame(
   vtkRenderer* renderer, vtkVolume* volume, FrameState& frame)
 {
+  Internals& in = *this->Internal;
   if (!this->UpdateDensityTexture(renderer, frame) || !this->ComputeFrameSettings(frame) ||
     !this->ComputeFrameGeometry(renderer, volume, frame))
   {
@@ -509,18 +546,142 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     return false;
   }
   this->UpdateMultipleScattering(frame);
+  // Nothing the cloud depends on changed since the last complete frame: its image
+  // (the accumulation targets) is composited again without a pass.
+  std::vector<double> key = this->FrameReuseKey(frame);
+  const bool reuse = in.ReuseValid && key == in.ReuseKey;
+
+  in.ReuseValid = false;
+  in.LastLevel = frame.Level;
+  in.LastInteractive = frame.Interactive;
+  in.LastReused = reuse;
+  in.LastAborted = false;
+  in.LastFrameSeconds = 0.0;
   this->BeginPasses(frame);
-  this->ClearShadowSurface(frame);
-  this->RenderIntervalPhase(frame);
-  this->RenderRayEnds(frame);
-  this->ClearAccumulation(frame);
-  this->RenderOutsideRegion(frame, false);
-  this->RenderSlices(frame);
-  this->RenderOutsideRegion(frame, true);
-  this->CaptureRadianceImage(frame);
+  frame.PassesStart = std::chrono::steady_clock::now();
+  if (reuse)
+  {
+    in.RayEnds->Activate();
+  }
+  else
+  {
+    this->ClearShadowSurface(frame);
+    this->RenderIntervalPhase(frame);
+    this->RenderRayEnds(frame);
+    this->ClearAccumulation(frame);
+    this->RenderOutsideRegion(frame, false);
+    if (!this->RenderSlices(renderer, frame))
+    {
+      // Aborted: nothing is drawn over the scene this frame.
+      frame.State->PopFramebufferBindings();
+      frame.FramebuffersPushed = false;
+      this->EndPasses(frame);
+      in.LastAborted = true;
+      return true;
+    }
+    this->RenderOutsideRegion(frame, true);
+    this->CaptureRadianceImage(frame);
+  }
   this->RenderComposite(frame);
   this->EndPasses(frame);
+  if (!reuse)
+  {
+    // The passes' cost at this level (the work is done when glFinish returns).
+    glFinish();
+    in.LastFrameSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - frame.PassesStart).count();
+    in.Cost.AddSample(frame.Level.Quality, in.LastFrameSeconds);
+  }
+  in.ReuseKey = std::move(key);
+  in.ReuseValid = true;
   return true;
+}
+
+//------------------------------------------------------------------------------
+// The quality level of this frame: Quality for still frames, the level the cost
+// model fits into FrameBudgetMilliseconds for interactive ones.
+void vtkNimbusCloudVolumeMapper::ChooseFrameLevel(vtkRenderer* renderer, FrameState& frame)
+{
+  vtkRenderWindow* window = renderer->GetRenderWindow();
+  frame.Interactive = window && window->GetDesiredUpdateRate() >= this->InteractiveUpdateRate;
+  double quality = this->Quality;
+  if (frame.Interactive && this->FrameBudgetMilliseconds > 0.0)
+  {
+    // The passes get 80 % of the budget; the rest of the frame (the scene's other
+    // props, the copies, the swap) the rest.
+    quality = this->Internal->Cost.QualityFor(0.8e-3 * this->FrameBudgetMilliseconds, quality);
+  }
+  frame.Level = nimbus::ComputeFrameLevel(
+    quality, this->NumberOfSlices, this->ShadowSurfaceSize, frame.Width, frame.Height);
+}
+
+//------------------------------------------------------------------------------
+// Everything the cloud's image (the accumulation targets) depends on: the mapper's
+// settings (its modification time), the data, the volume's matrix (not its
+// modification time: ParaView touches the vtkVolume every render), the followed
+// sky, the camera, the viewport, the quality level, the solver's output and the
+// opaque scene's depth. The exposure and the background only enter the composite,
+// which runs every frame, but a change of them costs one frame at most.
+std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  std::vector<double> key;
+  key.reserve(96);
+  const auto time = [](vtkObject* o) { return o ? static_cast<double>(o->GetMTime()) : -1.0; };
+  vtkNimbusSky* sky = this->GetFollowedSky();
+  key.insert(key.end(),
+    { time(this), time(frame.Image), time(frame.Scalars), time(this->SkyBackground), time(sky),
+      static_cast<double>(in.Density.GetNumberOfUploads()),
+      static_cast<double>(in.Scattering.GetNumberOfSolves()), frame.ScatteringScale,
+      static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),
+      frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees,
+      frame.Settings.OverSky ? 1.0 : 0.0, static_cast<double>(frame.Width),
+      static_cast<double>(frame.Height), static_cast<double>(frame.X0),
+      static_cast<double>(frame.Y0), static_cast<double>(frame.Level.Width),
+      static_cast<double>(frame.Level.Height), static_cast<double>(frame.Level.Slices),
+      static_cast<double>(frame.Level.ShadowSurfaceSize),
+      static_cast<double>(frame.SceneDepthHash >> 32),
+      static_cast<double>(frame.SceneDepthHash & 0xffffffffu) });
+  key.insert(key.end(), frame.WorldToNdc->GetData(), frame.WorldToNdc->GetData() + 16);
+  key.insert(key.end(), frame.DataToWorld->GetData(), frame.DataToWorld->GetData() + 16);
+  key.insert(key.end(), frame.Camera->GetPosition(), frame.Camera->GetPosition() + 3);
+  key.insert(key.end(), frame.ClippingRange.begin(), frame.ClippingRange.end());
+  return key;
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastFrameQuality() const
+{
+  return this->Internal->LastLevel.Quality;
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastFrameImageScale() const
+{
+  return this->Internal->LastLevel.ImageScale;
+}
+
+int vtkNimbusCloudVolumeMapper::GetLastFrameSlices() const
+{
+  return this->Internal->LastLevel.Slices;
+}
+
+bool vtkNimbusCloudVolumeMapper::GetLastFrameInteractive() const
+{
+  return this->Internal->LastInteractive;
+}
+
+bool vtkNimbusCloudVolumeMapper::GetLastFrameReused() const
+{
+  return this->Internal->LastReused;
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastFrameSeconds() const
+{
+  return this->Internal->LastFrameSeconds;
+}
+
+bool vtkNimbusCloudVolumeMapper::GetLastFrameAborted() const
+{
+  return this->Internal->LastAborted;
 }
 
 //------------------------------------------------------------------------------
@@ -665,6 +826,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   {
     return false;
   }
+  this->ChooseFrameLevel(renderer, frame);
   frame.ToSun =
     nimbus::SunDirection(frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees);
   double projection[3];
@@ -707,7 +869,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   }
   const std::array<double, 2> range = nimbus::ProjectedRange(frame.Corners, frame.Axis.Normal);
   frame.Planes =
-    nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), this->NumberOfSlices);
+    nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), frame.Level.Slices);
   frame.Shadow = nimbus::ComputeShadowFrame(frame.Corners, frame.ToSun, 0.02);
   frame.SunStepMetres = frame.Planes.Spacing / frame.Axis.SunCosine * frame.Settings.MetresPerUnit;
 
@@ -832,6 +994,20 @@ void vtkNimbusCloudVolumeMapper::CopySceneColorAndDepth(FrameState& frame)
   {
     in.SceneColor->CopyFromFrameBuffer(frame.X0, frame.Y0, 0, 0, frame.Width, frame.Height);
     in.SceneDepth->CopyFromFrameBuffer(frame.X0, frame.Y0, 0, 0, frame.Width, frame.Height);
+    // The opaque scene's depth, hashed (FNV-1a over its bytes) for FrameReuseKey:
+    // geometry that moved in front of or behind the cloud changes the cloud's image.
+    in.DepthReadback.resize(static_cast<std::size_t>(frame.Width) * frame.Height);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(frame.X0, frame.Y0, frame.Width, frame.Height, GL_DEPTH_COMPONENT, GL_FLOAT,
+      in.DepthReadback.data());
+    std::uint64_t hash = 1469598103934665603ull;
+    for (const float depth : in.DepthReadback)
+    {
+      std::uint32_t bits;
+      std::memcpy(&bits, &depth, sizeof bits);
+      hash = (hash ^ bits) * 1099511628211ull;
+    }
+    frame.SceneDepthHash = hash;
     return;
   }
   in.SceneFramebuffer->SetContext(frame.Window);
@@ -1277,14 +1453,15 @@ void vtkNimbusCloudVolumeMapper::GetMultipleScatteringGridDimensions(int dims[3]
 void vtkNimbusCloudVolumeMapper::ClearShadowSurface(const FrameState& frame)
 {
   Internals& in = *this->Internal;
+  const int size = frame.Level.ShadowSurfaceSize;
   in.Shadow->SetContext(frame.Window);
-  if (static_cast<int>(in.Shadow->GetWidth()) != this->ShadowSurfaceSize || !in.Shadow->GetHandle())
+  if (static_cast<int>(in.Shadow->GetWidth()) != size || !in.Shadow->GetHandle())
   {
     ResetTexture(in.Shadow, frame.Window, true);
-    in.Shadow->Allocate2D(this->ShadowSurfaceSize, this->ShadowSurfaceSize, 1, VTK_FLOAT);
+    in.Shadow->Allocate2D(size, size, 1, VTK_FLOAT);
   }
   DrawInto(in.ShadowFramebuffer, in.Shadow, frame.Window);
-  frame.State->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+  frame.State->vtkglViewport(0, 0, size, size);
   frame.State->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
   frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
 }
@@ -1300,13 +1477,15 @@ void vtkNimbusCloudVolumeMapper::RenderIntervalPhase(const FrameState& frame)
   const double mieG = frame.Settings.Air.MieG;
   std::vector<double> key(frame.InverseViewProjection.begin(), frame.InverseViewProjection.end());
   key.insert(key.end(),
-    { static_cast<double>(frame.Width), static_cast<double>(frame.Height), toSun[0], toSun[1],
-      toSun[2], normal[0], normal[1], normal[2], this->CloudG, mieG, this->MultipleScattering });
+    { static_cast<double>(frame.Level.Width), static_cast<double>(frame.Level.Height), toSun[0],
+      toSun[1], toSun[2], normal[0], normal[1], normal[2], this->CloudG, mieG,
+      this->MultipleScattering });
   if (key != in.IntervalPhaseKey || !in.IntervalPhase->GetHandle())
   {
-    EnsureTexture2D(in.IntervalPhase, frame.Window, frame.Width, frame.Height, 4, false);
+    EnsureTexture2D(
+      in.IntervalPhase, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
     DrawInto(in.IntervalPhaseFramebuffer, in.IntervalPhase, frame.Window);
-    frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+    frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
     frame.State->vtkglDisable(GL_BLEND);
     vtkShaderProgram* program = in.Ready(in.IntervalPhasePass, svsIntervalPhaseFS);
     this->SetCommonUniforms(program, frame);
@@ -1327,9 +1506,9 @@ void vtkNimbusCloudVolumeMapper::RenderIntervalPhase(const FrameState& frame)
 void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  EnsureTexture2D(in.RayEnds, frame.Window, frame.Width, frame.Height, 4, false);
+  EnsureTexture2D(in.RayEnds, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
   DrawInto(in.RayEndsFramebuffer, in.RayEnds, frame.Window);
-  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglDisable(GL_BLEND);
   vtkShaderProgram* program = in.Ready(in.RayEndsPass, svsRayEndsFS);
   this->SetCommonUniforms(program, frame);
@@ -1344,16 +1523,23 @@ void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
 void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  EnsureTexture2D(in.Accumulation, frame.Window, frame.Width, frame.Height, 4, false);
+  // Linear: the composite scales a smaller image (a lower quality level) to the
+  // viewport; at full size it reads texel centres, where linear is nearest.
+  EnsureTexture2D(in.Accumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+  in.Accumulation->SetMinificationFilter(vtkTextureObject::Linear);
+  in.Accumulation->SetMagnificationFilter(vtkTextureObject::Linear);
   DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
   in.AccumulationFramebuffer->RemoveColorAttachment(1);
   if (frame.Settings.OverSky)
   {
-    EnsureTexture2D(in.ClearAccumulation, frame.Window, frame.Width, frame.Height, 4, false);
+    EnsureTexture2D(
+      in.ClearAccumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+    in.ClearAccumulation->SetMinificationFilter(vtkTextureObject::Linear);
+    in.ClearAccumulation->SetMagnificationFilter(vtkTextureObject::Linear);
     in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
     in.AccumulationFramebuffer->ActivateDrawBuffers(2);
   }
-  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
 }
@@ -1373,7 +1559,7 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
     beyondCloud ? frame.Planes.Offsets.back() + 0.5 * frame.Planes.Spacing : -1e30;
   const double end = beyondCloud ? 1e30 : frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing;
   in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   UseSliceBlend(frame.State, frame.Axis.BackToFront);
   vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
   this->SetCommonUniforms(program, frame);
@@ -1393,7 +1579,7 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
 // seen from the eye with the shadow so far, then added to the shadow surface. The
 // eye pass is scissored to the slice's pixels only when nothing outside the box is
 // drawn (no atmosphere, no ground).
-void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
+bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const FrameState& frame)
 {
   Internals& in = *this->Internal;
   vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
@@ -1433,8 +1619,33 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
     this->SetCommonUniforms(shadowProgram, frame);
     shadowProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
   }
+  // A still frame that has taken a second reports its progress every 16 slices
+  // (after glFinish: the slices done, not queued) and stops when the render window
+  // or the caller asks for an abort.
+  const std::size_t total = frame.Planes.Offsets.size();
+  bool reported = false;
+  std::size_t done = 0;
   for (const double offset : frame.Planes.Offsets)
   {
+    if (!frame.Interactive && done > 0 && done % 16 == 0)
+    {
+      glFinish();
+      const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - frame.PassesStart).count();
+      if (seconds > 1.0)
+      {
+        reported = true;
+        this->UpdateProgress(static_cast<double>(done) / total);
+        vtkRenderWindow* window = renderer->GetRenderWindow();
+        if ((window && window->CheckAbortStatus()) || this->GetAbortExecute())
+        {
+          this->SetAbortExecute(0);
+          this->UpdateProgress(1.0);
+          return false;
+        }
+      }
+    }
+    ++done;
     const std::vector<nimbus::Vector3> polygon =
       nimbus::SlicePolygon(frame.Corners, frame.Axis.Normal, offset);
     if (polygon.empty())
@@ -1444,16 +1655,21 @@ void vtkNimbusCloudVolumeMapper::RenderSlices(const FrameState& frame)
     int scissor[4];
     const bool scissored = !frame.OutsideRegions &&
       nimbus::ScreenRectangle(
-        polygon, frame.WorldToNdc->GetData(), frame.Width, frame.Height, scissor);
+        polygon, frame.WorldToNdc->GetData(), frame.Level.Width, frame.Level.Height, scissor);
     this->RenderSliceFromEye(
       frame, sliceProgram, static_cast<float>(offset), scissored ? scissor : nullptr);
     if (shadowProgram)
     {
       int texels[4];
-      nimbus::ShadowRectangle(polygon, frame.Shadow, this->ShadowSurfaceSize, texels);
+      nimbus::ShadowRectangle(polygon, frame.Shadow, frame.Level.ShadowSurfaceSize, texels);
       this->RenderSliceShadow(frame, shadowProgram, static_cast<float>(offset), texels);
     }
   }
+  if (reported)
+  {
+    this->UpdateProgress(1.0);
+  }
+  return true;
 }
 
 void vtkNimbusCloudVolumeMapper::RenderSliceFromEye(
@@ -1461,7 +1677,7 @@ void vtkNimbusCloudVolumeMapper::RenderSliceFromEye(
 {
   Internals& in = *this->Internal;
   in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-  frame.State->vtkglViewport(0, 0, frame.Width, frame.Height);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   if (scissor)
   {
     frame.State->vtkglEnable(GL_SCISSOR_TEST);
@@ -1483,7 +1699,7 @@ void vtkNimbusCloudVolumeMapper::RenderSliceShadow(
 {
   Internals& in = *this->Internal;
   in.ShadowFramebuffer->Bind(GL_FRAMEBUFFER);
-  frame.State->vtkglViewport(0, 0, this->ShadowSurfaceSize, this->ShadowSurfaceSize);
+  frame.State->vtkglViewport(0, 0, frame.Level.ShadowSurfaceSize, frame.Level.ShadowSurfaceSize);
   frame.State->vtkglEnable(GL_SCISSOR_TEST);
   frame.State->vtkglScissor(texels[0], texels[1], texels[2], texels[3]);
   frame.State->vtkglEnable(GL_BLEND);
@@ -1510,11 +1726,12 @@ void vtkNimbusCloudVolumeMapper::CaptureRadianceImage(const FrameState& frame)
   vtkNew<vtkFloatArray> values;
   values->SetName("radiance");
   values->SetNumberOfComponents(4);
-  values->SetNumberOfTuples(static_cast<vtkIdType>(frame.Width) * frame.Height);
+  const int width = frame.Level.Width, height = frame.Level.Height;
+  values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, frame.Width, frame.Height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
   in.Radiance->Initialize();
-  in.Radiance->SetDimensions(frame.Width, frame.Height, 1);
+  in.Radiance->SetDimensions(width, height, 1);
   in.Radiance->GetPointData()->SetScalars(values);
 }
 
@@ -1592,6 +1809,9 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfSlices: " << this->NumberOfSlices << "\n";
   os << indent << "SliceAngleRatio (a): " << this->SliceAngleRatio << "\n";
   os << indent << "ShadowSurfaceSize: " << this->ShadowSurfaceSize << "\n";
+  os << indent << "FrameBudgetMilliseconds: " << this->FrameBudgetMilliseconds << " ms\n";
+  os << indent << "Quality: " << this->Quality << "\n";
+  os << indent << "InteractiveUpdateRate: " << this->InteractiveUpdateRate << " frames/s\n";
   os << indent << "AtmosphereSteps: " << this->AtmosphereSteps << "\n";
   os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";

@@ -312,6 +312,47 @@ public:
   ///@}
 
   ///@{
+  /// Automatic quality (docs/svs-mapper.md, "Frame budget"). Quality in (0, 1] is
+  /// the fraction of a full frame's work that still frames do: 1 renders
+  /// NumberOfSlices slices into the whole viewport with a ShadowSurfaceSize shadow
+  /// surface; lower levels take fewer slices (down to a quarter), then a smaller
+  /// image (down to 1/16 per side, upscaled in the composite) and shadow surface
+  /// (nimbus::ComputeFrameLevel). While the render window asks for an interactive
+  /// frame (its DesiredUpdateRate >= InteractiveUpdateRate: ParaView's interactive
+  /// renders ask 5 frames/s, VTK's interactor 15, still renders less than 0.01) the
+  /// mapper picks the highest level at most Quality that its measured cost model
+  /// (nimbus::FrameCostModel: the passes' seconds of the frames before, against their
+  /// levels) predicts to take at most FrameBudgetMilliseconds; the next still frame
+  /// returns to Quality. FrameBudgetMilliseconds 0: interactive frames use Quality.
+  virtual void SetFrameBudgetMilliseconds(double value);
+  virtual double GetFrameBudgetMillisecondsMinValue() { return 0.0; }
+  virtual double GetFrameBudgetMillisecondsMaxValue() { return 1e7; }
+  vtkGetMacro(FrameBudgetMilliseconds, double);
+  virtual void SetQuality(double value);
+  virtual double GetQualityMinValue();
+  virtual double GetQualityMaxValue() { return 1.0; }
+  vtkGetMacro(Quality, double);
+  virtual void SetInteractiveUpdateRate(double value);
+  virtual double GetInteractiveUpdateRateMinValue() { return 1e-6; }
+  virtual double GetInteractiveUpdateRateMaxValue() { return 1e6; }
+  vtkGetMacro(InteractiveUpdateRate, double);
+  /// The last frame drawn: its quality level, image scale (rendered pixels per
+  /// viewport pixel, per side) and slices; whether it was interactive; whether it
+  /// reused the cloud image of the frame before (nothing the cloud depends on had
+  /// changed: the camera, the viewport, the data, the mapper's and the sky's
+  /// settings, the opaque geometry's depth); the seconds of its passes (0 when
+  /// reused); whether it was aborted (the render window's AbortRender, or
+  /// SetAbortExecute, seen between slices once the frame has taken a second).
+  double GetLastFrameQuality() const;
+  double GetLastFrameImageScale() const;
+  int GetLastFrameSlices() const;
+  bool GetLastFrameInteractive() const;
+  bool GetLastFrameReused() const;
+  double GetLastFrameSeconds() const;
+  bool GetLastFrameAborted() const;
+  ///@}
+
+  ///@{
   /// Metres per world unit (distances and heights are converted with it).
   virtual void SetMetresPerUnit(double value);
   virtual double GetMetresPerUnitMinValue() { return 1e-9; }
@@ -462,6 +503,9 @@ protected:
   bool CaptureRadiance = false;
   bool UseSceneSky = true;
   vtkNimbusSkyBackground* SkyBackground = nullptr;
+  double FrameBudgetMilliseconds = 200.0;
+  double Quality = 1.0;
+  double InteractiveUpdateRate = 1.0;
 
 private:
   vtkNimbusCloudVolumeMapper(const vtkNimbusCloudVolumeMapper&) = delete;
@@ -484,6 +528,8 @@ private:
   bool UpdateDensityTexture(vtkRenderer* renderer, FrameState& frame);
   bool ComputeFrameSettings(FrameState& frame);
   bool ComputeFrameGeometry(vtkRenderer* renderer, vtkVolume* volume, FrameState& frame);
+  void ChooseFrameLevel(vtkRenderer* renderer, FrameState& frame);
+  std::vector<double> FrameReuseKey(const FrameState& frame);
   bool ComputeDataToWorld(vtkVolume* volume, vtkMatrix4x4* dataToWorld);
   void CopySceneColorAndDepth(FrameState& frame);
   bool UpdateAtmosphereTable(FrameState& frame);
@@ -497,7 +543,7 @@ private:
   void RenderRayEnds(const FrameState& frame);
   void ClearAccumulation(const FrameState& frame);
   void RenderOutsideRegion(const FrameState& frame, bool beyondCloud);
-  void RenderSlices(const FrameState& frame);
+  bool RenderSlices(vtkRenderer* renderer, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
   void RenderComposite(const FrameState& frame);
   void EndPasses(const FrameState& frame);

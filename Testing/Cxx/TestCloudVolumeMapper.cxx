@@ -12,6 +12,7 @@
 #include "TestCumulus.h"
 
 #include "vtkActor.h"
+#include "vtkCallbackCommand.h"
 #include "vtkCamera.h"
 #include "vtkCellData.h"
 #include "vtkFloatArray.h"
@@ -93,6 +94,7 @@ struct Scene
     capture->SetInput(this->Window);
     capture->SetInputBufferTypeToRGB();
     capture->ReadFrontBufferOff();
+    capture->ShouldRerenderOff(); // the frame just drawn (the mapper's counters are its)
     capture->Update();
     if (!pngPath.empty())
     {
@@ -270,6 +272,134 @@ bool MultipleScatteringResolvesOnlyOnChange(const Context&)
   s.Mapper->SetMultipleScatteringMethodToNone();
   s.Render();
   ok &= Check(s.Mapper->GetNumberOfMultipleScatteringSolves() == 4, "method none: no solve");
+  return ok;
+}
+
+// Automatic quality (issue 15): still frames at Quality, interactive frames (the
+// window's DesiredUpdateRate >= InteractiveUpdateRate) at the level the cost model
+// fits into FrameBudgetMilliseconds; an unchanged frame reuses the cloud's image;
+// anything the cloud depends on (camera, a setting, opaque geometry) does not.
+bool FrameBudgetAndReuse(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Mapper->SetNumberOfSlices(96);
+  s.Mapper->SetFrameBudgetMilliseconds(1.0); // below any real frame: the lowest level
+  const auto still = s.Render();
+  bool ok = Check(!s.Mapper->GetLastFrameInteractive() && s.Mapper->GetLastFrameQuality() == 1.0 &&
+      s.Mapper->GetLastFrameSlices() == s.Mapper->GetNumberOfSlices() &&
+      !s.Mapper->GetLastFrameReused() && s.Mapper->GetLastFrameSeconds() > 0.0,
+    "still frame: full quality, measured");
+  s.Render();
+  ok &= Check(s.Mapper->GetLastFrameReused() && s.Mapper->GetLastFrameSeconds() == 0.0,
+    "nothing changed: the cloud image is reused");
+  const auto reused = s.Render();
+  ok &= Check(Rmse(still, reused) == 0.0, "the reused frame is the same image");
+  s.Window->SetDesiredUpdateRate(15.0); // what VTK's interactor asks while it interacts
+  s.LookFrom({ 300, -6000, 1500 }, { 0, 0, 1600 }, 35);
+  const auto interactive = s.Render();
+  ok &= Check(s.Mapper->GetLastFrameInteractive() && !s.Mapper->GetLastFrameReused() &&
+      s.Mapper->GetLastFrameQuality() < 0.05 && s.Mapper->GetLastFrameImageScale() < 0.5,
+    "interactive frame over budget: quality " + std::to_string(s.Mapper->GetLastFrameQuality()) +
+      ", image scale " + std::to_string(s.Mapper->GetLastFrameImageScale()));
+  // Still the same cloud: a coarse image of it, not a different picture (measured
+  // on this scene: mean brightness 0.3 % off the full frame's).
+  ok &= Check(std::abs(Mean(interactive) - Mean(still)) < 0.05 * Mean(still) + 1.0,
+    "interactive mean " + std::to_string(Mean(interactive)) + " vs still " +
+      std::to_string(Mean(still)));
+  s.Window->SetDesiredUpdateRate(0.0001); // still again (VTK's interactor: StillUpdateRate)
+  s.Render();
+  ok &= Check(!s.Mapper->GetLastFrameInteractive() && s.Mapper->GetLastFrameQuality() == 1.0 &&
+      !s.Mapper->GetLastFrameReused(),
+    "still after interaction: full quality again");
+  s.Mapper->SetFrameBudgetMilliseconds(0.0);
+  s.Window->SetDesiredUpdateRate(15.0);
+  s.Render();
+  ok &= Check(s.Mapper->GetLastFrameQuality() == 1.0, "budget 0: interactive at Quality");
+  s.Window->SetDesiredUpdateRate(0.0001);
+  s.Mapper->SetQuality(0.25);
+  s.Render();
+  ok &= Check(std::abs(s.Mapper->GetLastFrameQuality() - 0.25) < 0.01 &&
+      s.Mapper->GetLastFrameSlices() == s.Mapper->GetNumberOfSlices() / 2,
+    "Quality 0.25: half the slices, an image 0.71 per side");
+  s.Mapper->SetQuality(std::nan(""));
+  ok &= Check(s.Mapper->GetQuality() == 0.25, "NaN quality refused");
+  s.Mapper->SetQuality(1.0);
+  s.Render();
+  s.Render();
+  ok &= Check(s.Mapper->GetLastFrameReused(), "reused before the sphere");
+  // Opaque geometry in front of the cloud changes its image.
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(0, -2000, 1600);
+  sphere->SetRadius(300);
+  vtkNew<vtkPolyDataMapper> sphereMapper;
+  sphereMapper->SetInputConnection(sphere->GetOutputPort());
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(sphereMapper);
+  s.Renderer->AddActor(actor);
+  s.Render();
+  ok &= Check(!s.Mapper->GetLastFrameReused(), "an opaque sphere appeared: not reused");
+  actor->SetPosition(200, 0, 0);
+  s.Render();
+  ok &= Check(!s.Mapper->GetLastFrameReused(), "the sphere moved: not reused");
+  s.Render();
+  ok &= Check(s.Mapper->GetLastFrameReused(), "the sphere stays: reused");
+  s.Mapper->SetCloudG(0.8);
+  s.Render();
+  ok &= Check(!s.Mapper->GetLastFrameReused(), "a setting changed: not reused");
+  return ok;
+}
+
+// Progress and abort: a still frame that takes more than a second reports progress
+// every 16 slices and stops when asked (here by an observer of its progress).
+bool ProgressAndAbort(const Context&)
+{
+  Scene s(MakeCloud());
+  s.Window->SetSize(480, 360);
+  s.Mapper->SetNumberOfSlices(8192);
+  s.Mapper->SetShadowSurfaceSize(1024);
+  std::vector<double> progress;
+  vtkNew<vtkCallbackCommand> observer;
+  observer->SetClientData(&progress);
+  observer->SetCallback(
+    [](vtkObject* caller, unsigned long, void* data, void*)
+    {
+      // The frame's progress (the pipeline's own update of the mapper reports 0
+      // and 1 before it); abort at the second report.
+      auto* mapper = static_cast<vtkNimbusCloudVolumeMapper*>(caller);
+      auto* values = static_cast<std::vector<double>*>(data);
+      const double p = mapper->GetProgress();
+      if (p > 0.0 && (p < 1.0 || !values->empty()))
+      {
+        values->push_back(p);
+      }
+      if (values->size() == 2 && values->back() < 1.0)
+      {
+        mapper->SetAbortExecute(1);
+      }
+    });
+  s.Mapper->AddObserver(vtkCommand::ProgressEvent, observer);
+  s.Render();
+  bool ok = Check(
+    progress.size() >= 2 && progress[0] > 0.0 && progress[0] < 1.0 && progress[1] > progress[0],
+    "progress reported during a long frame (" + std::to_string(progress.size()) + " events: " +
+      [&progress]()
+      {
+        std::string list;
+        for (double p : progress)
+        {
+          list += std::to_string(p) + " ";
+        }
+        return list;
+      }() +
+      ")");
+  ok &= Check(s.Mapper->GetLastFrameAborted(), "the frame was aborted");
+  ok &= Check(!progress.empty() && progress.back() == 1.0, "progress ends at 1");
+  progress.clear();
+  s.Mapper->RemoveAllObservers();
+  s.Mapper->SetNumberOfSlices(64);
+  s.Render();
+  ok &= Check(!s.Mapper->GetLastFrameAborted() && !s.Mapper->GetLastFrameReused(),
+    "the next frame is drawn in full, not reused from the aborted one");
   return ok;
 }
 
@@ -678,7 +808,8 @@ int main(int argc, char* argv[])
     { "MultipleScatteringBacklit", MultipleScatteringBacklit },
     { "MultipleScatteringOctaves", MultipleScatteringOctaves },
     { "MultipleScatteringPatterns", MultipleScatteringPatterns },
-    { "MultipleScatteringResolvesOnlyOnChange", MultipleScatteringResolvesOnlyOnChange } };
+    { "MultipleScatteringResolvesOnlyOnChange", MultipleScatteringResolvesOnlyOnChange },
+    { "FrameBudgetAndReuse", FrameBudgetAndReuse }, { "ProgressAndAbort", ProgressAndAbort } };
   if (argc != 4 || !cases.count(argv[1]))
   {
     std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";
