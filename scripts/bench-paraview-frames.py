@@ -19,9 +19,8 @@ import statistics
 import sys
 import time
 
-from paraview.simple import (ColorBy, CreateRenderView, GetActiveCamera, GetScalarBar,
-                             GetColorTransferFunction, LoadPlugin, Render, SetActiveView,
-                             Show)
+from paraview.simple import (ColorBy, CreateRenderView, Delete, GetColorTransferFunction,
+                             GetScalarBar, LoadPlugin, SetActiveView, Show)
 
 
 def cloud_mapper(view):
@@ -91,6 +90,8 @@ def main():
         view.GetActiveCamera().Azimuth(1.0)
         view.InteractiveRender()
         rows["interactive_quality"] = mapper.GetLastFrameQuality()
+        rows["interactive_image_scale"] = mapper.GetLastFrameImageScale()
+        rows["interactive_cloud_passes"] = mapper.GetLastFrameSeconds()
         view.StillRender()
         rows["still_quality"] = mapper.GetLastFrameQuality()
     # A change that does not touch the cloud: the colour legend.
@@ -120,6 +121,11 @@ def main():
     if arguments.json:
         with open(arguments.json, "w") as stream:
             json.dump(rows, stream, indent=1)
+    # The view goes while its X display is still open (left to the interpreter's exit,
+    # ParaView 5.11 releases its FXAA filter's GL objects after the display is gone).
+    mapper = None
+    Delete(display)
+    Delete(view)
     return 0
 
 
