@@ -29,7 +29,7 @@ namespace
 // Automatic exposure: the share of the sky in view allowed above the white point,
 // and that white point (display luminance, linear; 1 = white).
 constexpr double MeteredFraction = 0.95;
-constexpr double WhitePoint = 0.85;
+constexpr double WhitePoint = 0.9;
 constexpr int MeterGrid = 16; // view directions per side of the frustum
 
 // The factor automatic exposure applies for a camera and a viewport aspect ratio

@@ -23,9 +23,11 @@
  * Automatic exposure (AutomaticExposure, on by default): before each render the
  * sky is metered in the view's camera (a grid of view directions through the
  * frustum, the sky's display luminance at the input's Exposure), and when more
- * than 5 % of the sky in view would be brighter than 85 % of display white, the
- * exposure is lowered until that 95th percentile sits at 85 % of white. It is
- * never raised, so views away from the sun keep the input's Exposure; looking
+ * than 5 % of the sky in view would be brighter than 90 % of display white, the
+ * exposure is lowered until that 95th percentile sits at 90 % of white. It is
+ * never raised, so views away from the sun keep the input's Exposure (a clear
+ * noon sky's brightest part, the band over the horizon, is at 0.80 to 0.87 of
+ * white at the default Exposure 10, below the threshold); looking
  * toward the sun the glow around it no longer fills the frame with white. The
  * sky's vtkNimbusSky then holds the exposure used, which a Cloud representation
  * over this sky takes too (vtkNimbusSky::GetDisplayScale).
