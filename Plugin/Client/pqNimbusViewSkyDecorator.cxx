@@ -12,6 +12,8 @@
 #include "vtkSMProxy.h"
 #include "vtkSMUncheckedPropertyHelper.h"
 
+#include <QTextDocument> // Qt::mightBeRichText
+
 #include <cstring>
 
 namespace
@@ -28,6 +30,24 @@ bool IsVisibleSkyBackground(pqRepresentation* representation)
   }
   const char* type = vtkSMPropertyHelper(proxy, "Representation").GetAsString();
   return type && std::strcmp(type, pqNimbusViewSkyDecorator::SkyBackgroundType()) == 0;
+}
+
+// The tooltip with the note in front, in bold; ParaView's tooltips are rich text
+// (<html><head/><body><p>documentation</p></body></html>).
+QString WithNote(const QString& toolTip, const QString& note)
+{
+  if (toolTip.isEmpty())
+  {
+    return note;
+  }
+  if (!Qt::mightBeRichText(toolTip))
+  {
+    return note + "\n\n" + toolTip;
+  }
+  const QString paragraph = "<p><b>" + note.toHtmlEscaped() + "</b></p>";
+  const int body = toolTip.indexOf("<body>");
+  QString result = toolTip;
+  return body >= 0 ? result.insert(body + 6, paragraph) : paragraph + toolTip;
 }
 }
 
@@ -121,8 +141,7 @@ void pqNimbusViewSkyDecorator::updateState()
     this->OriginalToolTip = widget->toolTip();
     const QString note = tr("Set by the Nimbus Sky shown in this view (Use the View's Sky is on): "
                             "change it on the Nimbus Sky, or turn Use the View's Sky off.");
-    widget->setToolTip(
-      this->OriginalToolTip.isEmpty() ? note : note + "\n\n" + this->OriginalToolTip);
+    widget->setToolTip(WithNote(this->OriginalToolTip, note));
   }
   else
   {
