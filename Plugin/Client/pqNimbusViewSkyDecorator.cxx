@@ -13,6 +13,7 @@
 #include "vtkSMUncheckedPropertyHelper.h"
 
 #include <QTextDocument> // Qt::mightBeRichText
+#include <QTimer>
 
 #include <cstring>
 
@@ -32,22 +33,44 @@ bool IsVisibleSkyBackground(pqRepresentation* representation)
   return type && std::strcmp(type, pqNimbusViewSkyDecorator::SkyBackgroundType()) == 0;
 }
 
-// The tooltip with the note in front, in bold; ParaView's tooltips are rich text
-// (<html><head/><body><p>documentation</p></body></html>).
-QString WithNote(const QString& toolTip, const QString& note)
+// The note in front of a greyed-out field's tooltip, in bold; ParaView's tooltips
+// are rich text (<html><head/><body><p>documentation</p></body></html>).
+QString Note()
 {
+  return QObject::tr("Set by the Nimbus Sky shown in this view (Use the View's Sky is on): "
+                     "change it on the Nimbus Sky, or turn Use the View's Sky off.");
+}
+
+QString NoteParagraph()
+{
+  return "<p><b>" + Note().toHtmlEscaped() + "</b></p>";
+}
+
+QString WithoutNote(QString toolTip)
+{
+  toolTip.remove(NoteParagraph());
+  toolTip.remove(Note() + "\n\n");
+  toolTip.remove(Note());
+  return toolTip;
+}
+
+QString WithNote(const QString& toolTip, bool note)
+{
+  if (!note)
+  {
+    return toolTip;
+  }
   if (toolTip.isEmpty())
   {
-    return note;
+    return Note();
   }
   if (!Qt::mightBeRichText(toolTip))
   {
-    return note + "\n\n" + toolTip;
+    return Note() + "\n\n" + toolTip;
   }
-  const QString paragraph = "<p><b>" + note.toHtmlEscaped() + "</b></p>";
   const int body = toolTip.indexOf("<body>");
   QString result = toolTip;
-  return body >= 0 ? result.insert(body + 6, paragraph) : paragraph + toolTip;
+  return body >= 0 ? result.insert(body + 6, NoteParagraph()) : NoteParagraph() + toolTip;
 }
 }
 
@@ -64,6 +87,8 @@ pqNimbusViewSkyDecorator::pqNimbusViewSkyDecorator(
       useSceneSky, vtkCommand::UncheckedPropertyModifiedEvent, this, SLOT(updateState()));
   }
   this->updateView();
+  // Once more after the panel has finished the widget (and set its tooltip).
+  QTimer::singleShot(0, this, SLOT(updateState()));
 }
 
 //------------------------------------------------------------------------------
@@ -129,25 +154,20 @@ void pqNimbusViewSkyDecorator::updateState()
     }
   }
   const bool skyInUse = this->computeSkyInUse();
-  if (skyInUse == this->SkyInUse)
-  {
-    return;
-  }
+  const bool changed = skyInUse != this->SkyInUse;
   this->SkyInUse = skyInUse;
+  // The panel sets the documentation as the tooltip after building the widget,
+  // and again when it rebuilds it: the note is (re)applied on every update.
   pqPropertyWidget* widget = this->parentWidget();
-  if (skyInUse)
+  const QString toolTip = WithNote(WithoutNote(widget->toolTip()), skyInUse);
+  if (toolTip != widget->toolTip())
   {
-    // The panel sets the documentation as the tooltip after building the widget.
-    this->OriginalToolTip = widget->toolTip();
-    const QString note = tr("Set by the Nimbus Sky shown in this view (Use the View's Sky is on): "
-                            "change it on the Nimbus Sky, or turn Use the View's Sky off.");
-    widget->setToolTip(WithNote(this->OriginalToolTip, note));
+    widget->setToolTip(toolTip);
   }
-  else
+  if (changed)
   {
-    widget->setToolTip(this->OriginalToolTip);
+    Q_EMIT this->enableStateChanged();
   }
-  Q_EMIT this->enableStateChanged();
 }
 
 //------------------------------------------------------------------------------

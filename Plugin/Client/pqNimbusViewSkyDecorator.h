@@ -24,7 +24,6 @@
 #include "pqPropertyWidgetDecorator.h"
 
 #include <QPointer>
-#include <QString>
 
 class pqView;
 
@@ -56,7 +55,6 @@ private:
   bool computeSkyInUse() const;
 
   QPointer<pqView> View;
-  QString OriginalToolTip;
   bool SkyInUse = false;
 };
 
