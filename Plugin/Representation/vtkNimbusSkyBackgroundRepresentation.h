@@ -19,6 +19,18 @@
  * geometry is not drawn and not moved: only its field data is delivered (through
  * vtkPVView::SetPiece / GetDeliveredPiece, like ParaView's own representations),
  * and the sky has no bounds, so camera resets ignore it.
+ *
+ * Automatic exposure (AutomaticExposure, on by default): before each render the
+ * sky is metered in the view's camera (a grid of view directions through the
+ * frustum, the sky's display luminance at the input's Exposure), and when more
+ * than 5 % of the sky in view would be brighter than 90 % of display white, the
+ * exposure is lowered until that 95th percentile sits at 90 % of white. It is
+ * never raised, so views away from the sun keep the input's Exposure (a clear
+ * noon sky's brightest part, the band over the horizon, is at 0.80 to 0.87 of
+ * white at the default Exposure 10, below the threshold); looking
+ * toward the sun the glow around it no longer fills the frame with white. The
+ * sky's vtkNimbusSky then holds the exposure used, which a Cloud representation
+ * over this sky takes too (vtkNimbusSky::GetDisplayScale).
  */
 #ifndef vtkNimbusSkyBackgroundRepresentation_h
 #define vtkNimbusSkyBackgroundRepresentation_h
@@ -62,6 +74,18 @@ public:
   /// data (tests).
   vtkGetMacro(NumberOfParameterUpdates, int);
 
+  ///@{
+  /// Lower the exposure when the sky in view is too bright (see the class
+  /// comment). On by default.
+  vtkSetMacro(AutomaticExposure, bool);
+  vtkGetMacro(AutomaticExposure, bool);
+  vtkBooleanMacro(AutomaticExposure, bool);
+  ///@}
+
+  /// The factor (in (0, 1]) that automatic exposure applied to the input's
+  /// Exposure at the last render; 1 when off or when the view was not too bright.
+  vtkGetMacro(LastExposureFactor, double);
+
 protected:
   vtkNimbusSkyBackgroundRepresentation();
   ~vtkNimbusSkyBackgroundRepresentation() override;
@@ -76,6 +100,9 @@ protected:
   /// What is delivered: an empty polydata with the input's field data.
   vtkSmartPointer<vtkPolyData> Parameters;
   int NumberOfParameterUpdates = 0;
+  bool AutomaticExposure = true;
+  double LastExposureFactor = 1.0;
+  double InputExposure = -1.0; // the input's Exposure (-1: none delivered yet)
 
 private:
   vtkNimbusSkyBackgroundRepresentation(const vtkNimbusSkyBackgroundRepresentation&) = delete;
