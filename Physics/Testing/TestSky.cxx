@@ -581,18 +581,37 @@ TEST(Sky, ValidationAgainstPreetham)
       std::printf("  %.0f %6.0f | %.3f%s %.2f %.2f | %.3f %.2f | %+.4f %+.4f%s | %+.4f %+.4f\n",
         turbidity, elevation, c.Shape, shapeOk ? " " : "*", c.Glow, c.MaxRatio, c.CieShape,
         c.CieGlow, c.Dx, c.Dy, colourOk ? " " : "*", c.ZenithDx, c.ZenithDy);
-      // Bounds (measured, see docs/sky.md): every case finite and inside the envelope
-      // measured when this test was written.
       EXPECT_TRUE(std::isfinite(c.Shape) && std::isfinite(c.Dx) && std::isfinite(c.Dy));
-      EXPECT_GT(c.Shape, 0.70) << turbidity << " " << elevation;
+      // The goal where it is met (measured): the chromaticity within 0.02 of Preetham's
+      // for the sun up to 10 deg at every turbidity (worst 0.0196, T = 5, sun 1 deg).
+      if (elevation <= 10.0)
+      {
+        EXPECT_LE(std::abs(c.Dx), 0.02) << "T " << turbidity << ", sun " << elevation;
+        EXPECT_LE(std::abs(c.Dy), 0.02) << "T " << turbidity << ", sun " << elevation;
+      }
+      // The glow around the sun (3..15 deg) against the CIE clear sky (measured skies),
+      // sun >= 20 deg: measured 0.78..1.16 (against Preetham's, which has no aureole:
+      // 1.30..2.06; the CIE clear sky's own circumsolar term is 1.5..1.7 times
+      // Preetham's there). Bound: within 25 %.
+      if (elevation >= 20.0)
+      {
+        EXPECT_GT(c.CieGlow, 0.75) << "T " << turbidity << ", sun " << elevation;
+        EXPECT_LT(c.CieGlow, 1.25) << "T " << turbidity << ", sun " << elevation;
+      }
+      // Elsewhere the measured envelope (the goal is missed there, see docs/sky.md):
+      // shape 0.757..1.409, chromaticity up to +0.040 (high sun: ours paler).
+      EXPECT_GT(c.Shape, 0.72) << turbidity << " " << elevation;
       EXPECT_LT(c.Shape, 1.45) << turbidity << " " << elevation;
-      EXPECT_LT(std::abs(c.Dx), 0.045) << turbidity << " " << elevation;
-      EXPECT_LT(std::abs(c.Dy), 0.045) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dx), 0.043) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dy), 0.043) << turbidity << " " << elevation;
     }
   }
   std::printf("  (* outside the goal) shape within 10 %%: %d of %d; chromaticity within 0.02: %d "
               "of %d\n",
     shapeWithin, cases, colourWithin, cases);
+  // Measured 23 and 17 of 40: no fewer.
+  EXPECT_GE(shapeWithin, 23);
+  EXPECT_GE(colourWithin, 17);
 }
 
 // The haze knob at the ends of its range and bad values: finite skies from the zenith
@@ -636,4 +655,29 @@ TEST(Sky, TurbidityRange)
   bad = SkyParameters();
   bad.Atmosphere.MieAngstromExponent = 9.0;
   EXPECT_THROW(SkyModel{ bad }, std::invalid_argument);
+}
+
+// Ozone keeps the twilight zenith blue (its Chappuis band absorbs orange-red light on
+// the long sunlit paths of twilight; Hulburt 1953): zenith B/R with and without ozone.
+TEST(Sky, OzoneKeepsTwilightBlue)
+{
+  const SkyModel& withOzone = nimbus::testing::FullSkyModel();
+  SkyParameters p;
+  p.Atmosphere.OzoneDobsonUnits = 0.0;
+  const SkyModel withoutOzone(p);
+  for (double elevation : { 10.0, 0.0, -4.0 })
+  {
+    const Vector3 s = Direction(elevation, 0.0);
+    const Rgb a = withOzone.Radiance(0.0, { { 0, 0, 1 } }, s);
+    const Rgb b = withoutOzone.Radiance(0.0, { { 0, 0, 1 } }, s);
+    std::printf("  sun %5.1f deg: zenith B/R with ozone %.2f, without %.2f\n", elevation,
+      a[2] / a[0], b[2] / b[0]);
+    EXPECT_GT(a[2] / a[0], b[2] / b[0]);
+    if (elevation <= -4.0)
+    {
+      // Measured 3.07 with 300 DU and 0.96 (grey) without.
+      EXPECT_GT(a[2] / a[0], 2.5);
+      EXPECT_LT(b[2] / b[0], 1.2);
+    }
+  }
 }
