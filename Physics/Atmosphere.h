@@ -53,7 +53,7 @@ struct NIMBUSPHYSICS_EXPORT AtmosphereParameters
 /// Preetham et al. fit T in [2, 10]; T = 1 is air without aerosol.
 constexpr double kMinTurbidity = 1.0;
 constexpr double kMaxTurbidity = 10.0;
-constexpr double kDefaultTurbidity = 2.5;
+constexpr double kDefaultTurbidity = 2.0;
 
 /// Preetham, Shirley & Smits 1999, Appendix A.1 (after its Eq. for the haze
 /// attenuation): the Angstrom turbidity coefficient beta (the aerosol optical depth

@@ -79,7 +79,7 @@ public:
   /// without aerosol). It sets the aerosol amount (Ångström beta = 0.04608 T - 0.04586,
   /// the aerosol optical depth at 550 nm is beta 0.55^-1.3: 0.10 at T = 2, 0.20 at 3,
   /// 0.70 at 8); the rest of the air is fixed (Ångström exponent 1.3, measured-aerosol
-  /// phase function, ozone 300 DU: nimbus::ClearSkyAtmosphere). Default 2.5 (AOD 0.15).
+  /// phase function, ozone 300 DU: nimbus::ClearSkyAtmosphere). Default 2 (AOD 0.10).
   /// Turbidity and MieScatteringPerMetre are two names of one setting: setting one
   /// sets the other.
   virtual void SetTurbidity(double value);
@@ -90,7 +90,7 @@ public:
   ///@{
   /// The same setting as the aerosol (Mie) scattering coefficient at sea level and
   /// 550 nm, 1/m, [0, 6.8e-4] (the mapper's and the scene format's name and unit):
-  /// 1.13e-4 at the default turbidity 2.5; 2e-5 (the default before turbidity) is
+  /// 7.56e-5 at the default turbidity 2; 2e-5 (the default before turbidity) is
   /// turbidity 1.26. Setting it sets Turbidity (below 1 for less than 3.6e-7).
   virtual void SetMieScatteringPerMetre(double value);
   virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
@@ -197,8 +197,8 @@ protected:
 
   double SunElevationDegrees = 45.0;
   double SunAzimuthDegrees = 135.0;
-  double Turbidity = 2.5;                 // nimbus::kDefaultTurbidity
-  double MieScatteringPerMetre = 1.13e-4; // of Turbidity (set in the constructor)
+  double Turbidity = 2.0;                 // nimbus::kDefaultTurbidity
+  double MieScatteringPerMetre = 7.56e-5; // of Turbidity (set in the constructor)
   double GroundAlbedo = 0.3;
   double Exposure = 10.0;
   double SceneAltitudeMetres = 0.0;

@@ -64,7 +64,7 @@ public:
   /// >= 0, which then sets the aerosol directly (vtkNimbusSky::SetMieScatteringPerMetre)
   /// whatever the order of the two calls (ParaView's property "MieScatteringPerMetre",
   /// -1 by default, keeps states saved before Turbidity existed as they were).
-  /// Defaults: Turbidity 2.5, MieScatteringPerMetre -1 (from Turbidity).
+  /// Defaults: Turbidity 2, MieScatteringPerMetre -1 (from Turbidity).
   void SetTurbidity(double v);
   vtkGetMacro(Turbidity, double);
   void SetMieScatteringPerMetre(double v);
@@ -127,7 +127,7 @@ protected:
   double Center[3] = { 0.0, 0.0, 0.0 };
   int ElevationResolution = 32;
   int AzimuthResolution = 64;
-  double Turbidity = 2.5;
+  double Turbidity = 2.0;
   double MieScatteringPerMetre = -1.0;
   void ApplyHaze();
 

@@ -125,8 +125,8 @@ TEST(SkyDomeParameters, MissingArraysMeanDefaults)
 TEST(SkyDomeParameters, TurbidityAndMieScattering)
 {
   vtkNew<vtkNimbusSky> sky;
-  EXPECT_EQ(sky->GetTurbidity(), 2.5);
-  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 1.132e-4, 1e-7);
+  EXPECT_EQ(sky->GetTurbidity(), 2.0);
+  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 7.555e-5, 1e-7);
   sky->SetTurbidity(5.0);
   EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 3.01e-4, 1e-6);
   sky->SetMieScatteringPerMetre(2.0e-5);
