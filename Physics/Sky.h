@@ -1,6 +1,12 @@
 // The sky: radiance of the clear sky in any direction for a given sun, from
 // Rayleigh (molecules) and Mie (aerosols) scattering over a spherical earth with
-// exponential densities (002 §2 Eqs. 1-2, 004 §3.5), spectral, then linear sRGB.
+// exponential densities (002 §2 Eqs. 1-2, 004 §3.5) and ozone absorption, spectral,
+// then linear sRGB. The air is by default ClearSkyAtmosphere(T) (Atmosphere.h): the
+// aerosol amount from the turbidity T (Preetham et al. 1999), Angstrom exponent 1.3,
+// the phase function fitted to the measured aerosol asymmetry, ozone 300 DU; the
+// extinction in every equation below is sigma_t = beta_R(lambda) rho_R +
+// beta_M,ext(lambda) rho_M + beta_O3(lambda) rho_O3 [1/m]. Validated against Preetham
+// et al. 1999 (PreethamSky.h) and the CIE clear sky in TestSky, docs/sky.md.
 // Single scattering as in 002 Eq. 1 plus multiple scattering from an iterated
 // precomputation in the manner of Bruneton & Neyret 2008 ("Precomputed
 // Atmospheric Scattering", EGSR 2008, §4: scattering density -> radiance ->
