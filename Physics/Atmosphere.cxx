@@ -158,9 +158,12 @@ bool BallInterval(const Ray& ray, double Rb, double& sIn, double& sOut)
   return true;
 }
 
-// integral_{s0}^{s1} density(h(s)) ds, split at the closest approach s* = -b.
+// integral_{s0}^{s1} density(h(s)) ds, split at the closest approach s* = -b and where
+// the ray crosses the altitudes `kinks` [m] (where the profile's slope jumps, so the
+// adaptive quadrature need not bisect down to them).
 template <class Density>
-double IntegrateProfile(const Ray& ray, double R, const Density& density, double s0, double s1)
+double IntegrateProfile(const Ray& ray, double R, const Density& density, double s0, double s1,
+  const std::vector<double>& kinks = {})
 {
   if (!(s1 > s0))
   {
@@ -172,6 +175,21 @@ double IntegrateProfile(const Ray& ray, double R, const Density& density, double
   {
     breaks.push_back(sStar);
   }
+  for (double h : kinks)
+  {
+    double sIn = 0.0, sOut = 0.0;
+    if (BallInterval(ray, R + h, sIn, sOut))
+    {
+      for (double sk : { sIn, sOut })
+      {
+        if (sk > s0 && sk < s1)
+        {
+          breaks.push_back(sk);
+        }
+      }
+    }
+  }
+  std::sort(breaks.begin() + 1, breaks.end());
   breaks.push_back(s1);
   const auto rho = [&](double s) { return density(AltitudeAlongRay(ray, R, s)); };
   return IntegrateAdaptive(rho, breaks);
@@ -198,8 +216,9 @@ constexpr double kOzoneCrossSectionTable[48] = { 1.18e-27, 2.182e-28, 2.818e-28,
   4.398e-25, 4.701e-25, 5.019e-25, 4.305e-25, 3.74e-25, 3.215e-25, 2.662e-25, 2.238e-25, 1.852e-25,
   1.473e-25, 1.209e-25, 9.423e-26, 7.455e-26, 6.566e-26, 5.105e-26, 4.15e-26, 4.228e-26, 3.237e-26,
   2.451e-26, 2.801e-26, 2.534e-26, 1.624e-26, 1.465e-26, 2.078e-26, 1.383e-26, 7.105e-27 };
-constexpr double kDobsonUnitPerSquareMetre = 2.687e20; // molecules per m^2 per DU
-constexpr double kOzoneProfileColumnMetres = 15000.0;  // integral of OzoneTent dh
+constexpr double kDobsonUnitPerSquareMetre = 2.687e20;              // molecules per m^2 per DU
+constexpr double kOzoneProfileColumnMetres = 15000.0;               // integral of OzoneTent dh
+const std::vector<double> kOzoneKinks{ 10000.0, 25000.0, 40000.0 }; // OzoneTent's corners [m]
 
 Ray MakeRay(const Vector3& o, const Vector3& direction)
 {
@@ -409,8 +428,8 @@ double Atmosphere::OzoneOpticalLength(const Vector3& p0, const Vector3& p1) cons
   {
     return 0.0;
   }
-  return IntegrateProfile(
-    ray, this->Parameters.EarthRadiusMetres, OzoneTent, std::max(0.0, sIn), std::min(length, sOut));
+  return IntegrateProfile(ray, this->Parameters.EarthRadiusMetres, OzoneTent, std::max(0.0, sIn),
+    std::min(length, sOut), kOzoneKinks);
 }
 
 OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& d) const
@@ -457,7 +476,7 @@ OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& 
     IntegrateDensity(ray, R, this->Parameters.MieScaleHeightMetres, sBegin, sEnd);
   if (this->Parameters.OzoneDobsonUnits > 0.0)
   {
-    result.OzoneLengthMetres = IntegrateProfile(ray, R, OzoneTent, sBegin, sEnd);
+    result.OzoneLengthMetres = IntegrateProfile(ray, R, OzoneTent, sBegin, sEnd, kOzoneKinks);
   }
   return result;
 }
