@@ -7,6 +7,7 @@
 #include <cmath>
 #include <queue>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace nimbus
@@ -157,8 +158,12 @@ bool BallInterval(const Ray& ray, double Rb, double& sIn, double& sOut)
   return true;
 }
 
-// integral_{s0}^{s1} exp(-max(h,0)/H) ds, split at the closest approach s* = -b.
-double IntegrateDensity(const Ray& ray, double R, double H, double s0, double s1)
+// integral_{s0}^{s1} density(h(s)) ds, split at the closest approach s* = -b and where
+// the ray crosses the altitudes `kinks` [m] (where the profile's slope jumps, so the
+// adaptive quadrature need not bisect down to them).
+template <class Density>
+double IntegrateProfile(const Ray& ray, double R, const Density& density, double s0, double s1,
+  const std::vector<double>& kinks = {})
 {
   if (!(s1 > s0))
   {
@@ -170,11 +175,50 @@ double IntegrateDensity(const Ray& ray, double R, double H, double s0, double s1
   {
     breaks.push_back(sStar);
   }
+  for (double h : kinks)
+  {
+    double sIn = 0.0, sOut = 0.0;
+    if (BallInterval(ray, R + h, sIn, sOut))
+    {
+      for (double sk : { sIn, sOut })
+      {
+        if (sk > s0 && sk < s1)
+        {
+          breaks.push_back(sk);
+        }
+      }
+    }
+  }
+  std::sort(breaks.begin() + 1, breaks.end());
   breaks.push_back(s1);
-  const auto rho = [&](double s)
-  { return std::exp(-std::max(0.0, AltitudeAlongRay(ray, R, s)) / H); };
+  const auto rho = [&](double s) { return density(AltitudeAlongRay(ray, R, s)); };
   return IntegrateAdaptive(rho, breaks);
 }
+
+// integral_{s0}^{s1} exp(-max(h,0)/H) ds.
+double IntegrateDensity(const Ray& ray, double R, double H, double s0, double s1)
+{
+  return IntegrateProfile(
+    ray, R, [H](double h) { return std::exp(-std::max(0.0, h) / H); }, s0, s1);
+}
+
+// Bruneton 2017's ozone layer: a tent from 10 km to 40 km, 1 at 25 km [relative].
+double OzoneTent(double h)
+{
+  return std::max(0.0, 1.0 - std::abs(h - 25000.0) / 15000.0);
+}
+
+// Serdyuchenko et al. 2014, 233 K, 10-nm bin means from 360 nm (bin [360, 370) at
+// index 0) to 830 nm, in m^2 per molecule, as tabulated by Bruneton 2017.
+constexpr double kOzoneCrossSectionTable[48] = { 1.18e-27, 2.182e-28, 2.818e-28, 6.636e-28,
+  1.527e-27, 2.763e-27, 5.52e-27, 8.451e-27, 1.582e-26, 2.316e-26, 3.669e-26, 4.924e-26, 7.752e-26,
+  9.016e-26, 1.48e-25, 1.602e-25, 2.139e-25, 2.755e-25, 3.091e-25, 3.5e-25, 4.266e-25, 4.672e-25,
+  4.398e-25, 4.701e-25, 5.019e-25, 4.305e-25, 3.74e-25, 3.215e-25, 2.662e-25, 2.238e-25, 1.852e-25,
+  1.473e-25, 1.209e-25, 9.423e-26, 7.455e-26, 6.566e-26, 5.105e-26, 4.15e-26, 4.228e-26, 3.237e-26,
+  2.451e-26, 2.801e-26, 2.534e-26, 1.624e-26, 1.465e-26, 2.078e-26, 1.383e-26, 7.105e-27 };
+constexpr double kDobsonUnitPerSquareMetre = 2.687e20;              // molecules per m^2 per DU
+constexpr double kOzoneProfileColumnMetres = 15000.0;               // integral of OzoneTent dh
+const std::vector<double> kOzoneKinks{ 10000.0, 25000.0, 40000.0 }; // OzoneTent's corners [m]
 
 Ray MakeRay(const Vector3& o, const Vector3& direction)
 {
@@ -201,6 +245,68 @@ void CheckPoint(const Vector3& p)
 } // namespace
 
 //------------------------------------------------------------------------------
+double AngstromBetaFromTurbidity(double turbidity)
+{
+  return 0.04608 * turbidity - 0.04586;
+}
+
+double MieScatteringFromTurbidity(double turbidity, const AtmosphereParameters& a)
+{
+  const double beta = AngstromBetaFromTurbidity(turbidity);
+  if (!std::isfinite(turbidity) || beta < 0.0)
+  {
+    throw std::invalid_argument("nimbus::MieScatteringFromTurbidity: turbidity must be finite "
+                                "and >= 0.995 (Angstrom beta >= 0)");
+  }
+  // tau(550) = beta 0.55^-alpha = beta_M,ext(550) H_M;  beta_M,s = albedo beta_M,ext.
+  return a.MieAlbedo * beta * std::pow(0.55, -a.MieAngstromExponent) / a.MieScaleHeightMetres;
+}
+
+double TurbidityFromMieScattering(double mie, const AtmosphereParameters& a)
+{
+  if (!std::isfinite(mie) || mie < 0.0)
+  {
+    throw std::invalid_argument(
+      "nimbus::TurbidityFromMieScattering: the scattering coefficient must be finite and >= 0");
+  }
+  const double beta =
+    mie * a.MieScaleHeightMetres / (a.MieAlbedo * std::pow(0.55, -a.MieAngstromExponent));
+  return (beta + 0.04586) / 0.04608;
+}
+
+AtmosphereParameters ClearSkyAtmosphere(double turbidity)
+{
+  if (!(std::isfinite(turbidity) && turbidity >= kMinTurbidity && turbidity <= kMaxTurbidity))
+  {
+    throw std::invalid_argument("nimbus::ClearSkyAtmosphere: turbidity must be in [" +
+      std::to_string(kMinTurbidity) + ", " + std::to_string(kMaxTurbidity) + "]");
+  }
+  AtmosphereParameters a;
+  a.MieAngstromExponent = 1.3;
+  // Cornette-Shanks g whose mean cosine is the measured 0.70 (bisection: the mean
+  // cosine grows monotonically with g).
+  double lo = 0.0, hi = 0.99;
+  for (int i = 0; i < 60; ++i)
+  {
+    const double mid = 0.5 * (lo + hi);
+    (CornetteShanksMeanCosine(mid) < 0.70 ? lo : hi) = mid;
+  }
+  a.MieG = 0.5 * (lo + hi);
+  a.OzoneDobsonUnits = 300.0;
+  a.MieScatteringPerMetre = MieScatteringFromTurbidity(turbidity, a);
+  return a;
+}
+
+double OzoneCrossSection(double lambdaNm)
+{
+  // Bin i covers [360 + 10 i, 370 + 10 i) nm: its value sits at the centre 365 + 10 i.
+  const double u = std::min(47.0, std::max(0.0, (lambdaNm - 365.0) / 10.0));
+  const int i = std::min(46, static_cast<int>(u));
+  const double f = u - i;
+  return (1.0 - f) * kOzoneCrossSectionTable[i] + f * kOzoneCrossSectionTable[i + 1];
+}
+
+//------------------------------------------------------------------------------
 Atmosphere::Atmosphere(const AtmosphereParameters& p)
   : Parameters(p)
 {
@@ -210,10 +316,15 @@ Atmosphere::Atmosphere(const AtmosphereParameters& p)
     std::isfinite(p.MieScaleHeightMetres) && p.MieScaleHeightMetres > 0.0 &&
     std::isfinite(p.RayleighScatteringPerMetre) && p.RayleighScatteringPerMetre >= 0.0 &&
     std::isfinite(p.MieScatteringPerMetre) && p.MieScatteringPerMetre >= 0.0 && p.MieAlbedo > 0.0 &&
-    p.MieAlbedo <= 1.0 && !std::isnan(p.MieG);
+    p.MieAlbedo <= 1.0 && !std::isnan(p.MieG) && std::isfinite(p.MieAngstromExponent) &&
+    std::abs(p.MieAngstromExponent) <= 4.0 && std::isfinite(p.OzoneDobsonUnits) &&
+    p.OzoneDobsonUnits >= 0.0 && p.OzoneDobsonUnits <= 2000.0;
   if (!ok)
   {
-    throw std::invalid_argument("nimbus::Atmosphere: invalid AtmosphereParameters");
+    throw std::invalid_argument("nimbus::Atmosphere: invalid AtmosphereParameters (radii, "
+                                "scale heights > 0, coefficients >= 0, albedo in (0, 1], "
+                                "|MieAngstromExponent| <= 4, "
+                                "OzoneDobsonUnits in [0, 2000])");
   }
 }
 
@@ -238,14 +349,27 @@ double Atmosphere::RayleighScattering(double lambdaNm) const
   return this->Parameters.RayleighScatteringPerMetre * (x * x) * (x * x);
 }
 
-double Atmosphere::MieScattering(double) const
+double Atmosphere::MieScattering(double lambdaNm) const
 {
-  return this->Parameters.MieScatteringPerMetre;
+  const double alpha = this->Parameters.MieAngstromExponent;
+  return alpha == 0.0 ? this->Parameters.MieScatteringPerMetre
+                      : this->Parameters.MieScatteringPerMetre * std::pow(550.0 / lambdaNm, alpha);
 }
 
 double Atmosphere::MieExtinction(double lambdaNm) const
 {
   return this->MieScattering(lambdaNm) / this->Parameters.MieAlbedo;
+}
+
+double Atmosphere::OzoneAbsorption(double lambdaNm) const
+{
+  return this->Parameters.OzoneDobsonUnits * kDobsonUnitPerSquareMetre / kOzoneProfileColumnMetres *
+    OzoneCrossSection(lambdaNm);
+}
+
+double Atmosphere::OzoneDensity(double altitude) const
+{
+  return this->Parameters.OzoneDobsonUnits > 0.0 ? OzoneTent(altitude) : 0.0;
 }
 
 double Atmosphere::RayleighPhase(double mu) const
@@ -282,6 +406,30 @@ double Atmosphere::OpticalLength(const Vector3& p0, const Vector3& p1, double H)
   // Clip the segment [0, length] to the atmosphere ball (density 0 above the top).
   return IntegrateDensity(
     ray, this->Parameters.EarthRadiusMetres, H, std::max(0.0, sIn), std::min(length, sOut));
+}
+
+double Atmosphere::OzoneOpticalLength(const Vector3& p0, const Vector3& p1) const
+{
+  CheckPoint(p0);
+  CheckPoint(p1);
+  if (!(this->Parameters.OzoneDobsonUnits > 0.0))
+  {
+    return 0.0;
+  }
+  const Vector3 delta = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+  const double length = std::sqrt(Dot(delta, delta));
+  if (!(length > 0.0))
+  {
+    return 0.0;
+  }
+  const Ray ray = MakeRay(p0, delta);
+  double sIn = 0.0, sOut = 0.0;
+  if (!BallInterval(ray, this->Parameters.TopRadiusMetres, sIn, sOut))
+  {
+    return 0.0;
+  }
+  return IntegrateProfile(ray, this->Parameters.EarthRadiusMetres, OzoneTent, std::max(0.0, sIn),
+    std::min(length, sOut), kOzoneKinks);
 }
 
 OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& d) const
@@ -326,13 +474,19 @@ OpticalLengths Atmosphere::OpticalLengthsToTop(const Vector3& p, const Vector3& 
     IntegrateDensity(ray, R, this->Parameters.RayleighScaleHeightMetres, sBegin, sEnd);
   result.MieLengthMetres =
     IntegrateDensity(ray, R, this->Parameters.MieScaleHeightMetres, sBegin, sEnd);
+  if (this->Parameters.OzoneDobsonUnits > 0.0)
+  {
+    result.OzoneLengthMetres = IntegrateProfile(ray, R, OzoneTent, sBegin, sEnd, kOzoneKinks);
+  }
   return result;
 }
 
 double Atmosphere::OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const
 {
   return this->RayleighScattering(lambdaNm) * lengths.RayleighLengthMetres +
-    this->MieExtinction(lambdaNm) * lengths.MieLengthMetres;
+    this->MieExtinction(lambdaNm) * lengths.MieLengthMetres +
+    (lengths.OzoneLengthMetres > 0.0 ? this->OzoneAbsorption(lambdaNm) * lengths.OzoneLengthMetres
+                                     : 0.0);
 }
 
 double Atmosphere::Transmittance(const OpticalLengths& lengths, double lambdaNm) const
@@ -355,6 +509,7 @@ double Atmosphere::TransmittanceBetween(const Vector3& p0, const Vector3& p1, do
   lengths.RayleighLengthMetres =
     this->OpticalLength(p0, p1, this->Parameters.RayleighScaleHeightMetres);
   lengths.MieLengthMetres = this->OpticalLength(p0, p1, this->Parameters.MieScaleHeightMetres);
+  lengths.OzoneLengthMetres = this->OzoneOpticalLength(p0, p1);
   return this->Transmittance(lengths, lambdaNm);
 }
 

@@ -37,7 +37,64 @@ struct NIMBUSPHYSICS_EXPORT AtmosphereParameters
   double MieScatteringPerMetre = 2.0e-5;       // beta_M,s at sea level, wavelength independent
   double MieAlbedo = 0.9;                      // beta_M,s / beta_M,ext of the aerosols
   double MieG = 0.76; // Cornette-Shanks asymmetry of the aerosol phase function
+  // Angstrom exponent alpha of the aerosols (Angstrom 1929): their scattering and
+  // extinction scale as (550 nm / lambda)^alpha around the 550 nm values above.
+  // 0 = grey (wavelength independent), the default of the scene format and the mapper;
+  // the sky uses 1.3 (ClearSkyAtmosphere).
+  double MieAngstromExponent = 0.0;
+  // Total ozone column [Dobson units, 1 DU = 2.687e20 molecules/m^2] in a layer from
+  // 10 to 40 km peaking at 25 km (OzoneDensity); ozone only absorbs (the Chappuis band,
+  // 500-700 nm). 0 = no ozone (the scene format's and the mapper's default); the sky
+  // uses 300 DU.
+  double OzoneDobsonUnits = 0.0;
 };
+
+/// The range of the turbidity T that the sky accepts, and its default (a clear day).
+/// Preetham et al. fit T in [2, 10]; T = 1 is air without aerosol.
+constexpr double kMinTurbidity = 1.0;
+constexpr double kMaxTurbidity = 10.0;
+constexpr double kDefaultTurbidity = 2.0;
+
+/// Preetham, Shirley & Smits 1999, Appendix A.1 (after its Eq. for the haze
+/// attenuation): the Angstrom turbidity coefficient beta (the aerosol optical depth
+/// at 1 um, dimensionless) of turbidity T,  beta = 0.04608 T - 0.04586 (0 at T = 0.995).
+NIMBUSPHYSICS_EXPORT double AngstromBetaFromTurbidity(double turbidity);
+
+/// Sea-level aerosol scattering coefficient beta_M,s(550 nm) [1/m] of turbidity T for
+/// the given atmosphere's aerosol scale height H_M, albedo and Angstrom exponent alpha:
+/// the vertical aerosol optical depth tau(lambda) = beta (lambda / 1 um)^-alpha
+/// (Angstrom 1929) equals the extinction column beta_M,ext(550) H_M of the exponential
+/// layer (its part above the top of the atmosphere, exp(-60 km / H_M), neglected), so
+///   beta_M,s(550) = albedo beta(T) 0.55^-alpha / H_M.
+/// Throws std::invalid_argument for a non-finite T or one below 0.995 (negative beta).
+NIMBUSPHYSICS_EXPORT double MieScatteringFromTurbidity(
+  double turbidity, const AtmosphereParameters& atmosphere);
+/// Its inverse: the turbidity T of a sea-level aerosol scattering coefficient [1/m] (>= 0).
+NIMBUSPHYSICS_EXPORT double TurbidityFromMieScattering(
+  double mieScatteringPerMetre, const AtmosphereParameters& atmosphere);
+
+/// The clear-sky atmosphere of turbidity T (Preetham et al. 1999's haze measure; 2 = very
+/// clear, 3 = clear, 5 = light haze, 10 = hazy) that the sky uses
+/// (SkyParameters default: T = kDefaultTurbidity):
+///  - the aerosol amount from T (MieScatteringFromTurbidity);
+///  - Angstrom exponent 1.3 (Angstrom 1929's continental mean, Preetham's Appendix A.1);
+///  - the aerosol phase function: Cornette-Shanks whose mean cosine (asymmetry factor)
+///    is 0.70, the mean of the AERONET sky-radiometer retrievals of continental and urban
+///    aerosol at 440-670 nm (Dubovik et al. 2002, "Variability of absorption and optical
+///    properties of key aerosol types observed in worldwide locations", J. Atmos. Sci. 59,
+///    Table 1: 0.59-0.75), i.e. g_CS = 0.637 (CornetteShanksMeanCosine); the earlier
+///    g = 0.76 has mean cosine 0.81, brighter than measured aerosol around the sun;
+///  - ozone 300 DU (the global mean column);
+///  - everything else as AtmosphereParameters' defaults.
+/// Throws std::invalid_argument for T non-finite or outside [kMinTurbidity, kMaxTurbidity].
+NIMBUSPHYSICS_EXPORT AtmosphereParameters ClearSkyAtmosphere(double turbidity);
+
+/// Absorption cross-section of ozone [m^2 per molecule] at lambda [nm]: Serdyuchenko et
+/// al. 2014 ("High spectral resolution ozone absorption cross-sections", Atmos. Meas.
+/// Tech. 7, 625; the IUP Bremen O3 spectra 2011, 233 K), averaged over 10-nm bins
+/// 360-830 nm as tabulated by Bruneton 2017 (precomputed_atmospheric_scattering), linear
+/// between the bin centres, clamped outside. Chappuis peak 5.0e-25 m^2 at 605 nm.
+NIMBUSPHYSICS_EXPORT double OzoneCrossSection(double lambdaNm);
 
 /// The air over a scene: the atmosphere, whether it is there at all, and where the
 /// scene sits in it. Scene point p (metres) maps to the earth-centred frame as
@@ -53,6 +110,7 @@ struct NIMBUSPHYSICS_EXPORT OpticalLengths
 {
   double RayleighLengthMetres = 0.0; // integral exp(-h/H_R) ds
   double MieLengthMetres = 0.0;      // integral exp(-h/H_M) ds
+  double OzoneLengthMetres = 0.0;    // integral OzoneDensity(h) ds (0 without ozone)
   bool HitsGround = false;           // the ray hits the earth; lengths are up to the hit point
 };
 
@@ -93,10 +151,17 @@ public:
 
   /// beta_R(lambda) = rayleighScattering550 * (550/lambda)^4 [1/m] (= extinction).
   double RayleighScattering(double lambdaNm) const;
-  /// beta_M,s [1/m] (wavelength independent).
+  /// beta_M,s(lambda) = beta_M,s(550) (550/lambda)^alpha [1/m] (Angstrom 1929;
+  /// wavelength independent for alpha = 0).
   double MieScattering(double lambdaNm) const;
   /// beta_M,ext = beta_M,s / albedo [1/m].
   double MieExtinction(double lambdaNm) const;
+  /// Ozone absorption at the layer's peak, n_max sigma_O3(lambda) [1/m], with
+  /// n_max = OzoneDobsonUnits 2.687e20 / 15000 m (the profile's column is 15 km x peak).
+  double OzoneAbsorption(double lambdaNm) const;
+  /// Relative ozone density at altitude h [m] (Bruneton 2017's profile): 0 below 10 km
+  /// and above 40 km, rising linearly to 1 at 25 km and falling linearly; 0 without ozone.
+  double OzoneDensity(double altitude) const;
   /// Rayleigh phase function [1/sr], mu = cos(scattering angle).
   double RayleighPhase(double mu) const;
   /// Cornette-Shanks with g = mieG [1/sr] (000 Eq. 3 / 004 Eq. 5, divided by 4 pi).
@@ -121,7 +186,12 @@ public:
   /// Throws std::invalid_argument for a zero or non-finite d or non-finite p.
   OpticalLengths OpticalLengthsToTop(const Vector3& p, const Vector3& d) const;
 
-  /// tau(lambda) = beta_R(lambda) L_R + beta_M,ext L_M (dimensionless; ignores hitsGround).
+  /// Ozone length integral OzoneDensity(h) ds [m] over the segment (as OpticalLength);
+  /// 0 without ozone.
+  double OzoneOpticalLength(const Vector3& p0, const Vector3& p1) const;
+
+  /// tau(lambda) = beta_R(lambda) L_R + beta_M,ext(lambda) L_M + OzoneAbsorption(lambda) L_O
+  /// (dimensionless; ignores hitsGround).
   double OpticalDepth(const OpticalLengths& lengths, double lambdaNm) const;
   /// exp(-tau(lambda)); exactly 0 when lengths.HitsGround.
   double Transmittance(const OpticalLengths& lengths, double lambdaNm) const;

@@ -75,12 +75,6 @@ void Locate(double x, int n, int& i0, double& f)
 } // namespace
 
 //------------------------------------------------------------------------------
-double PreethamZenithLuminance(double turbidity, double sunZenith)
-{
-  const double chi = (4.0 / 9.0 - turbidity / 120.0) * (kPi - 2.0 * sunZenith);
-  return (4.0453 * turbidity - 4.9710) * std::tan(chi) - 0.2155 * turbidity + 2.4192;
-}
-
 double LinearSrgbLuminance(const std::array<double, 3>& rgb)
 {
   return 0.2126729 * rgb[0] + 0.7151522 * rgb[1] + 0.0721750 * rgb[2];
@@ -121,8 +115,13 @@ SkyModel::SkyModel(const SkyParameters& p)
   {
     this->BetaRayleigh.push_back(this->Air->RayleighScattering(lambda));
   }
-  this->BetaMieScattering = this->Air->MieScattering(550.0);
-  this->BetaMieExtinction = this->Air->MieExtinction(550.0);
+  for (double lambda : this->Spectrum->GetWavelengths())
+  {
+    this->BetaMieScattering.push_back(this->Air->MieScattering(lambda));
+    this->BetaMieExtinction.push_back(this->Air->MieExtinction(lambda));
+    this->BetaOzone.push_back(
+      p.Atmosphere.OzoneDobsonUnits > 0.0 ? this->Air->OzoneAbsorption(lambda) : 0.0);
+  }
 
   this->BuildTransmittance();
   this->BuildMultipleScattering();
@@ -184,7 +183,7 @@ void SkyModel::BuildTransmittance()
   const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
   const double top = this->Parameters.Atmosphere.TopRadiusMetres;
   const double H = std::sqrt(top * top - R * R);
-  this->TransmittanceTable.assign(static_cast<std::size_t>(nmu) * nr * 2, 0.0f);
+  this->TransmittanceTable.assign(static_cast<std::size_t>(nmu) * nr * 3, 0.0f);
   ForEachIndex(nr, this->Parameters.Threads,
     [&](int j)
     {
@@ -196,15 +195,17 @@ void SkyModel::BuildTransmittance()
         const double d = dmin + (i / (nmu - 1.0)) * (dmax - dmin);
         const double mu =
           d <= 0.0 ? 1.0 : Clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
-        const std::array<double, 2> lengths = this->ExactOpticalLengths(r, mu);
-        float* out = &this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2];
-        out[0] = static_cast<float>(lengths[0]);
-        out[1] = static_cast<float>(lengths[1]);
+        const std::array<double, 3> lengths = this->ExactOpticalLengths(r, mu);
+        float* out = &this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 3];
+        for (int c = 0; c < 3; ++c)
+        {
+          out[c] = static_cast<float>(lengths[c]);
+        }
       }
     });
 }
 
-std::array<double, 2> SkyModel::ExactOpticalLengths(double r, double mu) const
+std::array<double, 3> SkyModel::ExactOpticalLengths(double r, double mu) const
 {
   mu = Clamp(mu, -1.0, 1.0);
   const Vector3 p{ { 0.0, 0.0, r } };
@@ -217,10 +218,10 @@ std::array<double, 2> SkyModel::ExactOpticalLengths(double r, double mu) const
     d = { { std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu } };
     lengths = this->Air->OpticalLengthsToTop(p, d);
   }
-  return { { lengths.RayleighLengthMetres, lengths.MieLengthMetres } };
+  return { { lengths.RayleighLengthMetres, lengths.MieLengthMetres, lengths.OzoneLengthMetres } };
 }
 
-std::array<double, 2> SkyModel::LookupOpticalLengths(double r, double mu) const
+std::array<double, 3> SkyModel::LookupOpticalLengths(double r, double mu) const
 {
   const int nmu = this->Parameters.TransmittanceMuSize, nr = this->Parameters.TransmittanceRSize;
   const double R = this->Parameters.Atmosphere.EarthRadiusMetres;
@@ -235,13 +236,13 @@ std::array<double, 2> SkyModel::LookupOpticalLengths(double r, double mu) const
   double fi, fj;
   Locate(xmu, nmu, i0, fi);
   Locate(rho / H, nr, j0, fj);
-  std::array<double, 2> result{ { 0.0, 0.0 } };
-  for (int c = 0; c < 2; ++c)
+  std::array<double, 3> result{ { 0.0, 0.0, 0.0 } };
+  for (int c = 0; c < 3; ++c)
   {
     auto at = [&](int j, int i)
     {
       return static_cast<double>(
-        this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 2 + c]);
+        this->TransmittanceTable[(static_cast<std::size_t>(j) * nmu + i) * 3 + c]);
     };
     result[c] = (1.0 - fj) * ((1.0 - fi) * at(j0, i0) + fi * at(j0, i0 + 1)) +
       fj * ((1.0 - fi) * at(j0 + 1, i0) + fi * at(j0 + 1, i0 + 1));
@@ -257,11 +258,11 @@ void SkyModel::SunTransmittance(double r, double muS, double* T) const
     std::fill(T, T + n, 0.0);
     return;
   }
-  const std::array<double, 2> lengths = this->LookupOpticalLengths(r, muS);
-  const double mie = this->BetaMieExtinction * lengths[1];
+  const std::array<double, 3> lengths = this->LookupOpticalLengths(r, muS);
   for (int i = 0; i < n; ++i)
   {
-    T[i] = std::exp(-(this->BetaRayleigh[i] * lengths[0] + mie));
+    T[i] = std::exp(-(this->BetaRayleigh[i] * lengths[0] + this->BetaMieExtinction[i] * lengths[1] +
+      this->BetaOzone[i] * lengths[2]));
   }
 }
 
@@ -499,6 +500,7 @@ SkySpectra SkyModel::March(
       const double h = rp - R;
       const double rhoR = this->Air->Density(h, a.RayleighScaleHeightMetres);
       const double rhoM = this->Air->Density(h, a.MieScaleHeightMetres);
+      const double rhoO = this->Air->OzoneDensity(h);
       const double muS = Clamp(Dot(p, s) / rp, -1.0, 1.0);
       if (o.Single)
       {
@@ -518,11 +520,12 @@ SkySpectra SkyModel::March(
       {
         this->LookupTable(*o.Source, rp, muS, source.data());
       }
-      const double mieS = this->BetaMieScattering * rhoM;
       for (int l = 0; l < n; ++l)
       {
         const double rayleigh = this->BetaRayleigh[l] * rhoR;
-        const double sigma = rayleigh + this->BetaMieExtinction * rhoM;
+        const double mieS = this->BetaMieScattering[l] * rhoM;
+        const double sigma =
+          rayleigh + this->BetaMieExtinction[l] * rhoM + this->BetaOzone[l] * rhoO;
         const double x = sigma * dt;
         const double e = std::exp(-x);
         const double weight =

@@ -1,6 +1,12 @@
 // The sky: radiance of the clear sky in any direction for a given sun, from
 // Rayleigh (molecules) and Mie (aerosols) scattering over a spherical earth with
-// exponential densities (002 §2 Eqs. 1-2, 004 §3.5), spectral, then linear sRGB.
+// exponential densities (002 §2 Eqs. 1-2, 004 §3.5) and ozone absorption, spectral,
+// then linear sRGB. The air is by default ClearSkyAtmosphere(T) (Atmosphere.h): the
+// aerosol amount from the turbidity T (Preetham et al. 1999), Angstrom exponent 1.3,
+// the phase function fitted to the measured aerosol asymmetry, ozone 300 DU; the
+// extinction in every equation below is sigma_t = beta_R(lambda) rho_R +
+// beta_M,ext(lambda) rho_M + beta_O3(lambda) rho_O3 [1/m]. Validated against Preetham
+// et al. 1999 (PreethamSky.h) and the CIE clear sky in TestSky, docs/sky.md.
 // Single scattering as in 002 Eq. 1 plus multiple scattering from an iterated
 // precomputation in the manner of Bruneton & Neyret 2008 ("Precomputed
 // Atmospheric Scattering", EGSR 2008, §4: scattering density -> radiance ->
@@ -38,7 +44,7 @@
 //   M_ms = sum_{k=1}^{K-1} M_k, E_sky = sum_{k=1}^{K-1} E_k.
 //
 // Look-up tables (all node-centred: node i of n sits at x = i/(n-1)):
-//  - transmittance: optical lengths L_R, L_M (m, wavelength independent, so any
+//  - transmittance: optical lengths L_R, L_M, L_O (m, wavelength independent, so any
 //    wavelength count shares it) to the top of the atmosphere by (x_mu, x_r),
 //    Bruneton 2017's horizon-aware parametrisation (x_r = rho/H,
 //    x_mu = (d - d_min)/(d_max - d_min)); valid for rays that do not hit the ground.
@@ -60,6 +66,7 @@
 #include "NimbusPhysicsExport.h" // for export macro
 
 #include "Atmosphere.h"
+#include "PreethamSky.h" // PreethamZenithLuminance (declared here before)
 #include "SpectralColor.h"
 #include "Sun.h"
 
@@ -72,7 +79,10 @@ namespace nimbus
 
 struct NIMBUSPHYSICS_EXPORT SkyParameters
 {
-  AtmosphereParameters Atmosphere;
+  /// The air: by default the clear sky of turbidity kDefaultTurbidity (Atmosphere.h,
+  /// ClearSkyAtmosphere: aerosol from the turbidity with Angstrom exponent 1.3, the
+  /// measured-aerosol phase function, ozone 300 DU).
+  AtmosphereParameters Atmosphere = ClearSkyAtmosphere(kDefaultTurbidity);
   double GroundAlbedo = 0.3;            // grey Lambertian albedo of the earth's surface, [0, 1]
   int ScatteringOrders = 4;             // K >= 1; 1 = single scattering only
   int Wavelengths = 16;                 // spectral samples (SpectralSamples; >= 8 uses the spline)
@@ -133,18 +143,18 @@ public:
   double HorizonMu(double r) const;
 
   // --- transmittance table
-  /// Optical lengths (L_R, L_M) in m to the top of the atmosphere from radius r
-  /// along a direction with zenith cosine mu, bilinear in the table (r clamped
-  /// to [R, R_top]; mu clamped to the horizon from above).
-  std::array<double, 2> LookupOpticalLengths(double r, double mu) const;
+  /// Optical lengths (L_R, L_M, L_O: Rayleigh, Mie, ozone) in m to the top of the
+  /// atmosphere from radius r along a direction with zenith cosine mu, bilinear in
+  /// the table (r clamped to [R, R_top]; mu clamped to the horizon from above).
+  std::array<double, 3> LookupOpticalLengths(double r, double mu) const;
   /// The same, exact (Atmosphere::OpticalLengthsToTop), for tests.
-  std::array<double, 2> ExactOpticalLengths(double r, double mu) const;
+  std::array<double, 3> ExactOpticalLengths(double r, double mu) const;
   /// Spectral transmittance toward the sun from radius r, sun zenith cosine mu_s
   /// (0 where the earth blocks it).
   void SunTransmittance(double r, double muS, double* transmittance) const;
   int GetTransmittanceMuSize() const { return this->Parameters.TransmittanceMuSize; }
   int GetTransmittanceRSize() const { return this->Parameters.TransmittanceRSize; }
-  /// [x_r][x_mu][2] (L_R, L_M in m), node-centred.
+  /// [x_r][x_mu][3] (L_R, L_M, L_O in m), node-centred.
   const std::vector<float>& GetTransmittanceTable() const { return this->TransmittanceTable; }
 
   // --- multiple-scattering table
@@ -230,7 +240,8 @@ private:
   std::unique_ptr<SpectralSamples> Spectrum;
   std::vector<double> SunIrradiance;
   std::vector<double> BetaRayleigh; // per wavelength, 1/m
-  double BetaMieScattering = 0.0, BetaMieExtinction = 0.0;
+  // Per wavelength, 1/m at sea level (Mie) or at the ozone layer's peak (ozone).
+  std::vector<double> BetaMieScattering, BetaMieExtinction, BetaOzone;
   std::vector<float> TransmittanceTable;
   std::vector<float> MultipleTable;            // M_ms
   std::vector<float> GroundSkyTable;           // E_sky by x_mus (r = R)
@@ -325,14 +336,6 @@ private:
   std::vector<float> Table;
   double BuildSeconds = 0.0;
 };
-
-/// Preetham, Shirley & Smits 1999 ("A Practical Analytic Model for Daylight",
-/// SIGGRAPH 99, Appendix A.2): absolute zenith luminance in kcd/m^2 for turbidity T
-/// and sun zenith angle thetaS (rad):
-///   chi = (4/9 - T/120)(pi - 2 thetaS),
-///   Y_z = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192.
-/// Implemented from the published formula (valid for the sun above the horizon).
-NIMBUSPHYSICS_EXPORT double PreethamZenithLuminance(double turbidity, double sunZenith);
 
 /// Relative luminance Y of linear sRGB (row 2 of the sRGB -> XYZ matrix).
 NIMBUSPHYSICS_EXPORT double LinearSrgbLuminance(const std::array<double, 3>& rgb);

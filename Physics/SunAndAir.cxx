@@ -127,6 +127,7 @@ void SunAndAir::AtmosphereTransmittanceBetween(
   OpticalLengths lengths;
   lengths.RayleighLengthMetres = this->Air->OpticalLength(q0, q1, a.RayleighScaleHeightMetres);
   lengths.MieLengthMetres = this->Air->OpticalLength(q0, q1, a.MieScaleHeightMetres);
+  lengths.OzoneLengthMetres = this->Air->OzoneOpticalLength(q0, q1);
   for (std::size_t i = 0; i < this->Wavelengths.size(); ++i)
   {
     transmittance[i] = this->Air->Transmittance(lengths, this->Wavelengths[i]);

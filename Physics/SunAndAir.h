@@ -62,6 +62,9 @@ public:
   double GetMieExtinctionSeaLevel() const { return this->BetaMieExtinction; }
   /// Per wavelength sample at scene point p (1/m): Rayleigh scattering (=
   /// extinction), Mie scattering, Mie extinction. Zero without atmosphere.
+  /// The Mie values are those at 550 nm and ozone is left out here (exact for the
+  /// scene format's air: MieAngstromExponent = 0, OzoneDobsonUnits = 0); the
+  /// transmittances below include both (Atmosphere::OpticalDepth).
   void AtmosphereCoefficients(const Vector3& p, std::vector<double>& rayleighScattering,
     double& mieScattering, double& mieExtinction) const;
   /// Transmittance of the atmosphere from p toward the sun, per wavelength sample

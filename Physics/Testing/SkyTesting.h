@@ -22,19 +22,23 @@ inline double Y(const Rgb& c)
   return LinearSrgbLuminance(c);
 }
 
-/// The default model (multiple scattering, ground albedo 0.3), built once.
+/// The default model (multiple scattering, ground albedo 0.3, the clear sky of the
+/// default turbidity: ClearSkyAtmosphere(kDefaultTurbidity)), built once.
 inline const SkyModel& FullSkyModel()
 {
   static const SkyModel model{ SkyParameters() };
   return model;
 }
 
-/// A single-scattering model (K = 1, ground albedo 0), built once.
+/// A single-scattering model (K = 1, ground albedo 0) of the reference renderer's air
+/// (AtmosphereParameters' defaults: grey aerosol, no ozone, which is what the scene
+/// format and nimbus::SunAndAir model), built once.
 inline const SkyModel& SingleScatteringSkyModel()
 {
   static const SkyModel model{ []
     {
       SkyParameters p;
+      p.Atmosphere = AtmosphereParameters();
       p.ScatteringOrders = 1;
       p.GroundAlbedo = 0.0;
       return p;

@@ -2,6 +2,7 @@
 // integrals, horizon / ground / top-of-atmosphere edge cases.
 #include "Atmosphere.h"
 #include "Math.h"
+#include "PhaseFunctions.h"
 
 #include <gtest/gtest.h>
 
@@ -349,4 +350,62 @@ TEST(Atmosphere, FlatLayerOpticalLengthAgainstSphericalEarth)
               "error %.3g (paths up to 30 km, elevations down to 2 deg)\n",
     worst);
   EXPECT_LT(worst, 0.05); // measured 3.0e-2, the longest path at the lowest elevation
+}
+
+// Angstrom exponent, ozone and turbidity (Atmosphere.h): the published relations.
+TEST(Atmosphere, AngstromOzoneAndTurbidity)
+{
+  nimbus::AtmosphereParameters p;
+  p.MieAngstromExponent = 1.3;
+  p.OzoneDobsonUnits = 300.0;
+  const nimbus::Atmosphere air(p);
+  // Angstrom 1929: beta_M(lambda) = beta_M(550) (550 / lambda)^alpha.
+  EXPECT_DOUBLE_EQ(air.MieScattering(550.0), p.MieScatteringPerMetre);
+  EXPECT_NEAR(air.MieScattering(440.0) / air.MieScattering(550.0), std::pow(1.25, 1.3), 1e-12);
+  EXPECT_NEAR(air.MieExtinction(700.0), air.MieScattering(700.0) / p.MieAlbedo, 1e-18);
+  // Ozone: Chappuis peak about 5e-25 m^2 near 600 nm, a thousand times less at 400 nm.
+  EXPECT_NEAR(nimbus::OzoneCrossSection(605.0), 5.019e-25, 1e-30);
+  EXPECT_LT(nimbus::OzoneCrossSection(400.0), 1e-26);
+  EXPECT_GT(nimbus::OzoneCrossSection(600.0), 4e-25);
+  // The vertical column is the Dobson amount: tau_O3 = DU 2.687e20 sigma (the
+  // profile's column is 15 km of the peak density).
+  const double R = p.EarthRadiusMetres;
+  const nimbus::OpticalLengths up =
+    air.OpticalLengthsToTop({ { 0.0, 0.0, R } }, { { 0.0, 0.0, 1.0 } });
+  EXPECT_NEAR(up.OzoneLengthMetres, 15000.0, 1e-6);
+  const double tauO3 = air.OzoneAbsorption(600.0) * up.OzoneLengthMetres;
+  EXPECT_NEAR(tauO3, 300.0 * 2.687e20 * nimbus::OzoneCrossSection(600.0), 1e-9);
+  std::printf("  ozone 300 DU: vertical optical depth %.4f at 600 nm, %.5f at 450 nm\n", tauO3,
+    air.OzoneAbsorption(450.0) * up.OzoneLengthMetres);
+  EXPECT_GT(tauO3, 0.03); // about 0.04 (Chappuis band)
+  EXPECT_LT(tauO3, 0.05);
+  // Transmittance includes the ozone.
+  nimbus::AtmosphereParameters noOzone = p;
+  noOzone.OzoneDobsonUnits = 0.0;
+  const nimbus::Atmosphere clean(noOzone);
+  EXPECT_NEAR(
+    air.Transmittance(up, 600.0) / clean.Transmittance(up, 600.0), std::exp(-tauO3), 1e-12);
+  EXPECT_EQ(clean.OzoneDensity(25000.0), 0.0);
+  EXPECT_DOUBLE_EQ(air.OzoneDensity(25000.0), 1.0);
+  EXPECT_DOUBLE_EQ(air.OzoneDensity(5000.0), 0.0);
+  // Preetham et al. 1999 Appendix A.1: beta = 0.04608 T - 0.04586; the vertical aerosol
+  // optical depth of the atmosphere at 550 nm is beta 0.55^-1.3.
+  for (double turbidity : { 1.0, 2.0, 2.5, 5.0, 10.0 })
+  {
+    const nimbus::AtmosphereParameters a = nimbus::ClearSkyAtmosphere(turbidity);
+    const double beta = 0.04608 * turbidity - 0.04586;
+    const nimbus::Atmosphere hazy(a);
+    const nimbus::OpticalLengths column =
+      hazy.OpticalLengthsToTop({ { 0.0, 0.0, R } }, { { 0.0, 0.0, 1.0 } });
+    const double aod = hazy.MieExtinction(550.0) * column.MieLengthMetres;
+    EXPECT_NEAR(aod, beta * std::pow(0.55, -1.3), 1e-9 + 1e-9 * aod) << turbidity;
+    EXPECT_NEAR(nimbus::TurbidityFromMieScattering(a.MieScatteringPerMetre, a), turbidity, 1e-9);
+    EXPECT_NEAR(nimbus::CornetteShanksMeanCosine(a.MieG), 0.70, 1e-9);
+  }
+  EXPECT_THROW(nimbus::ClearSkyAtmosphere(std::nan("")), std::invalid_argument);
+  EXPECT_THROW(nimbus::MieScatteringFromTurbidity(0.5, p), std::invalid_argument);
+  EXPECT_THROW(nimbus::TurbidityFromMieScattering(-1.0, p), std::invalid_argument);
+  nimbus::AtmosphereParameters bad = p;
+  bad.OzoneDobsonUnits = -1.0;
+  EXPECT_THROW(nimbus::Atmosphere{ bad }, std::invalid_argument);
 }

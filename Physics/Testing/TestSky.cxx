@@ -8,14 +8,17 @@
 // Every bound below is set from the measured value printed by the test (see
 // docs/sky.md for the table); units: radiance relative to the sun (Y = 1).
 #include "Math.h"
+#include "PreethamSky.h"
 #include "Sky.h"
 #include "SkyTesting.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -81,7 +84,7 @@ TEST(Sky, TransmittanceTableInterpolation)
   }
   std::printf("  transmittance table %dx%d: max |dT| = %.2e, max relative d(tau) = %.2e\n",
     model.GetTransmittanceMuSize(), model.GetTransmittanceRSize(), worstT, worstTau);
-  EXPECT_LT(worstT, 1e-3); // measured 5.8e-4 (grazing rays near the top)
+  EXPECT_LT(worstT, 1e-3); // measured 8.0e-4 (grazing rays near the top; 5.8e-4 without ozone)
 }
 
 // Multiple scattering: orders decrease geometrically; the sky is brighter than single
@@ -100,7 +103,15 @@ TEST(Sky, MultipleScatteringOrders)
     }
     std::printf("\n");
   }
-  const SkyModel& single = nimbus::testing::SingleScatteringSkyModel();
+  // Single scattering of the same air (the shared single-scattering model has the
+  // reference renderer's grey air).
+  const SkyModel single{ []
+    {
+      SkyParameters p;
+      p.ScatteringOrders = 1;
+      p.GroundAlbedo = 0.0;
+      return p;
+    }() };
   for (double elevation : { 60.0, 10.0, 0.0, -4.0, -8.0 })
   {
     const Vector3 s = Direction(elevation, 0.0);
@@ -151,7 +162,8 @@ TEST(Sky, ZenithLuminanceAgainstPreetham)
     {
       elevations.push_back(elevation);
       ours.push_back(y);
-      preetham.push_back(nimbus::PreethamZenithLuminance(2.5, (90.0 - elevation) * kDegree));
+      preetham.push_back(
+        nimbus::PreethamZenithLuminance(nimbus::kDefaultTurbidity, (90.0 - elevation) * kDegree));
     }
   }
   EXPECT_TRUE(monotone);
@@ -162,22 +174,26 @@ TEST(Sky, ZenithLuminanceAgainstPreetham)
   for (std::size_t i = 0; i < elevations.size(); ++i)
   {
     const double ratio = (ours[i] / ours[at40]) / (preetham[i] / preetham[at40]);
-    if (elevations[i] <= 70.0)
+    if (elevations[i] >= 20.0 && elevations[i] <= 50.0)
     {
       worst = std::max(worst, std::abs(std::log(ratio)));
     }
     if (static_cast<int>(elevations[i]) % 10 == 0 || elevations[i] < 10.0)
     {
-      std::printf(
-        "  sun %4.0f deg: zenith Y ours %.4e, Preetham T=2.5 %.3f kcd/m2, normalised ratio %.3f\n",
+      std::printf("  sun %4.0f deg: zenith Y ours %.4e, Preetham (same T) %.3f kcd/m2, normalised "
+                  "ratio %.3f\n",
         elevations[i], ours[i], preetham[i], ratio);
     }
   }
-  std::printf("  worst |ln(normalised ratio)| over 4..70 deg: %.3f\n", worst);
-  // Bound: measured 0.215 (normalised ratio 0.81 at 4 deg, 0.97..1.11 over 8..70 deg),
-  // rounded up. Above 70 deg the zenith enters the Mie aureole of this aerosol
-  // (g = 0.76), which Preetham's fit (a smooth function of the sun angle only) does
-  // not have: ratio 1.41 at 80 deg, printed only.
+  std::printf("  worst |ln(normalised ratio)| over 20..50 deg: %.3f\n", worst);
+  // Bound: measured 0.218 over 20..50 deg (ratio 0.80 at 20 deg, 1.14 at 50 deg),
+  // rounded up. At the default turbidity 2 (aerosol optical depth 0.10 at 550 nm,
+  // 3.8 times the grey aerosol of before) the zenith rises faster with the sun than
+  // Preetham's fit: below 20 deg the sunlight crosses the aerosol layer at grazing
+  // angles (ratio 0.63 at 10 deg, 0.38 at 4 deg) and above 50 deg the zenith is within
+  // 40 deg of the sun, in the aerosol's forward lobe, which Preetham's smooth function
+  // of the sun angle does not have (1.35 at 60 deg, 1.65 at 70 deg). Printed only; the
+  // whole sky is compared in ValidationAgainstPreetham.
   EXPECT_LT(worst, 0.25);
 }
 
@@ -191,7 +207,7 @@ TEST(Sky, PublishedBehaviour)
     const Rgb z = model.Radiance(0.0, { { 0, 0, 1 } }, Direction(60.0, 0.0));
     std::printf(
       "  sun 60 deg: zenith rgb %.3e %.3e %.3e, B/R %.2f\n", z[0], z[1], z[2], z[2] / z[0]);
-    EXPECT_GT(z[2] / z[0], 1.5); // measured 2.0
+    EXPECT_GT(z[2] / z[0], 1.5); // measured 1.70 (2.0 with the grey aerosol of before)
   }
   // Sunset: near the sun on the horizon red/orange (R > G > B, R/B large), while the
   // zenith stays blue (B > R).
@@ -380,8 +396,289 @@ TEST(Sky, AerialPerspectiveTable)
     std::printf("  sun %4.1f deg: aerial-perspective table vs march: max |dT| %.2e, max inscatter "
                 "error %.2e (relative, floor 1e-3)\n",
       elevation, worstT, worstL);
-    // Bounds: measured 1.3e-3 and 1.6e-2 (sun 45 and 3 deg), rounded up.
+    // Bounds: measured 1.7e-3 and 2.1e-2 (sun 45 deg; 1.3e-3 and 1.6e-2 with the
+    // thinner grey aerosol of before), rounded up.
     EXPECT_LT(worstT, 2e-3);
-    EXPECT_LT(worstL, 2e-2);
+    EXPECT_LT(worstL, 2.5e-2);
+  }
+}
+
+namespace
+{
+/// CIE 1931 XYZ of linear sRGB (IEC 61966-2-1, D65; the inverse of XyzToLinearSrgb).
+std::array<double, 3> LinearSrgbToXyz(const Rgb& c)
+{
+  return { { 0.4124564 * c[0] + 0.3575761 * c[1] + 0.1804375 * c[2],
+    0.2126729 * c[0] + 0.7151522 * c[1] + 0.0721750 * c[2],
+    0.0193339 * c[0] + 0.1191920 * c[1] + 0.9503041 * c[2] } };
+}
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+/// CIE Standard General Sky (ISO 15469:2004 / CIE S 011/E:2003, from measured skies):
+/// relative luminance L / L_zenith for view zenith Z, angle chi from the sun, sun zenith
+/// Zs (rad): f(chi) phi(Z) / (f(Zs) phi(0)) with the gradation phi(Z) = 1 + a exp(b / cos Z)
+/// and the indicatrix f(chi) = 1 + c (exp(d chi) - exp(d pi/2)) + e cos^2 chi. Clear-sky
+/// types: 12 "clear, low luminance turbidity" (a, b, c, d, e) = (-1, -0.32, 10, -3, 0.45),
+/// 13 "clear, polluted atmosphere" (-1, -0.32, 16, -3, 0.30).
+double CieClearSky(int type, double Z, double chi, double Zs)
+{
+  const double a = -1.0, b = -0.32, d = -3.0;
+  const double c = type == 13 ? 16.0 : 10.0, e = type == 13 ? 0.30 : 0.45;
+  const auto f = [&](double x)
+  { return 1.0 + c * (std::exp(d * x) - std::exp(d * kPi / 2.0)) + e * std::cos(x) * std::cos(x); };
+  const auto phi = [&](double z) { return 1.0 + a * std::exp(b / std::max(std::cos(z), 1e-4)); };
+  return f(chi) * phi(Z) / (f(Zs) * phi(0.0));
+}
+
+/// One sky (turbidity T, sun elevation) against Preetham et al. 1999 and the CIE clear sky.
+struct SkyComparison
+{
+  double Shape = 0.0;    // median over the dome of the normalised luminance ratio ours / Preetham
+  double Glow = 0.0;     // the same over directions 3..15 deg from the sun
+  double MaxRatio = 0.0; // largest ratio on the dome (the brightest excess: the aureole)
+  double CieShape = 0.0; // median ratio ours / CIE clear sky (type 12 for T < 3.5, else 13)
+  double CieGlow = 0.0;  // the same 3..15 deg from the sun
+  double Dx = 0.0;       // median over the dome of x_ours - x_Preetham
+  double Dy = 0.0;       // median over the dome of y_ours - y_Preetham
+  double ZenithDx = 0.0; // at the zenith
+  double ZenithDy = 0.0;
+};
+
+/// The dome: view elevations 2.5, 7.5, ..., 87.5 deg by azimuths 0, 10, ..., 180 deg from
+/// the sun (the sky is symmetric about the sun's vertical), each weighted by its solid
+/// angle (cos elevation; the two border azimuths by half). Each sky is normalised by
+/// its solid-angle mean over the directions more than 20 deg from the sun (so that the
+/// aureole, which Preetham's smooth fit does not have, does not set the scale), then
+/// the ratio ours / theirs is taken per direction and its median reported. The glow is
+/// the median ratio on rings 3, 5, 8, 12, 15 deg around the sun (12 directions each,
+/// those above 2 deg elevation).
+SkyComparison CompareSky(const SkyModel& model, double turbidity, double sunElevation)
+{
+  const SkyViewLut lut(model, sunElevation, 0.0);
+  const double sunZenith = (90.0 - sunElevation) * kDegree;
+  const nimbus::PreethamSky preetham(turbidity, sunZenith);
+  const int cieType = turbidity < 3.5 ? 12 : 13;
+  const Vector3 s = Direction(sunElevation, 0.0);
+  const auto angleToSun = [&](const Vector3& w)
+  { return std::acos(std::max(-1.0, std::min(1.0, nimbus::Dot(w, s)))); };
+
+  struct Sample
+  {
+    double Weight, Gamma, Ours, Preetham, Cie;
+    std::array<double, 2> OursXy, PreethamXy;
+  };
+  const auto sample = [&](const Vector3& w, double weight)
+  {
+    const double zenith = std::acos(std::max(-1.0, std::min(1.0, w[2])));
+    const double gamma = angleToSun(w);
+    const std::array<double, 3> xyz = LinearSrgbToXyz(lut.Radiance(w, 0.0));
+    const double sum = xyz[0] + xyz[1] + xyz[2];
+    Sample x{ weight, gamma, xyz[1], preetham.Luminance(zenith, gamma),
+      CieClearSky(cieType, zenith, gamma, sunZenith), { { xyz[0] / sum, xyz[1] / sum } },
+      preetham.Chromaticity(zenith, gamma) };
+    return x;
+  };
+  std::vector<Sample> dome;
+  for (double e = 2.5; e < 90.0; e += 5.0)
+  {
+    for (double az = 0.0; az <= 180.0; az += 10.0)
+    {
+      const double border = (az == 0.0 || az == 180.0) ? 0.5 : 1.0;
+      dome.push_back(sample(Direction(e, az), border * std::cos(e * kDegree)));
+    }
+  }
+  double ours = 0.0, theirs = 0.0, cie = 0.0;
+  for (const Sample& x : dome)
+  {
+    if (x.Gamma > 20.0 * kDegree)
+    {
+      ours += x.Weight * x.Ours;
+      theirs += x.Weight * x.Preetham;
+      cie += x.Weight * x.Cie;
+    }
+  }
+  SkyComparison result;
+  std::vector<double> shape, cieShape, dx, dy;
+  for (const Sample& x : dome)
+  {
+    const double ratio = (x.Ours / ours) / (x.Preetham / theirs);
+    shape.push_back(ratio);
+    cieShape.push_back((x.Ours / ours) / (x.Cie / cie));
+    result.MaxRatio = std::max(result.MaxRatio, ratio);
+    dx.push_back(x.OursXy[0] - x.PreethamXy[0]);
+    dy.push_back(x.OursXy[1] - x.PreethamXy[1]);
+  }
+  // Rings around the sun: directions at angle g from s.
+  const Vector3 east{ { 1.0, 0.0, 0.0 } };
+  Vector3 u = nimbus::Cross(s, east);
+  u = nimbus::Normalized(u);
+  const Vector3 v = nimbus::Cross(s, u);
+  std::vector<double> glow, cieGlow;
+  for (double g : { 3.0, 5.0, 8.0, 12.0, 15.0 })
+  {
+    for (double psi = 0.0; psi < 360.0; psi += 30.0)
+    {
+      const double cg = std::cos(g * kDegree), sg = std::sin(g * kDegree);
+      const double cp = std::cos(psi * kDegree), sp = std::sin(psi * kDegree);
+      Vector3 w;
+      for (int i = 0; i < 3; ++i)
+      {
+        w[i] = cg * s[i] + sg * (cp * u[i] + sp * v[i]);
+      }
+      if (w[2] < std::sin(2.0 * kDegree))
+      {
+        continue;
+      }
+      const Sample x = sample(w, 0.0);
+      glow.push_back((x.Ours / ours) / (x.Preetham / theirs));
+      cieGlow.push_back((x.Ours / ours) / (x.Cie / cie));
+    }
+  }
+  result.Shape = Median(shape);
+  result.Glow = Median(glow);
+  result.CieShape = Median(cieShape);
+  result.CieGlow = Median(cieGlow);
+  result.Dx = Median(dx);
+  result.Dy = Median(dy);
+  const Sample z = sample({ { 0.0, 0.0, 1.0 } }, 0.0);
+  result.ZenithDx = z.OursXy[0] - z.PreethamXy[0];
+  result.ZenithDy = z.OursXy[1] - z.PreethamXy[1];
+  return result;
+}
+} // namespace
+
+// Validation of the sky's shape and colour against an independent published clear-sky
+// model, Preetham, Shirley & Smits 1999 (PreethamSky.h), at the same turbidity (the
+// aerosol amount of Preetham's own relation beta = 0.04608 T - 0.04586: Atmosphere.h),
+// over sun elevations 1..90 deg and turbidities 2..5; the luminance shape also against
+// the CIE Standard General Sky's clear types (measured skies). Goal: medians of the
+// normalised luminance ratio within 10 %, of the chromaticity differences within 0.02.
+// Bounds: measured values rounded (docs/sky.md has the table and the discussion).
+TEST(Sky, ValidationAgainstPreetham)
+{
+  const double elevations[] = { 1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0 };
+  int shapeWithin = 0, colourWithin = 0, cases = 0;
+  std::printf(
+    "  T    sun | shape  glow3-15 max | CIE shape glow | median dx     dy | zenith dx  dy\n");
+  for (double turbidity : { 2.0, 3.0, 4.0, 5.0 })
+  {
+    SkyParameters p;
+    p.Atmosphere = nimbus::ClearSkyAtmosphere(turbidity);
+    const SkyModel model(p);
+    for (double elevation : elevations)
+    {
+      const SkyComparison c = CompareSky(model, turbidity, elevation);
+      const bool shapeOk = std::abs(c.Shape - 1.0) <= 0.10;
+      const bool colourOk = std::abs(c.Dx) <= 0.02 && std::abs(c.Dy) <= 0.02;
+      shapeWithin += shapeOk ? 1 : 0;
+      colourWithin += colourOk ? 1 : 0;
+      ++cases;
+      std::printf("  %.0f %6.0f | %.3f%s %.2f %.2f | %.3f %.2f | %+.4f %+.4f%s | %+.4f %+.4f\n",
+        turbidity, elevation, c.Shape, shapeOk ? " " : "*", c.Glow, c.MaxRatio, c.CieShape,
+        c.CieGlow, c.Dx, c.Dy, colourOk ? " " : "*", c.ZenithDx, c.ZenithDy);
+      EXPECT_TRUE(std::isfinite(c.Shape) && std::isfinite(c.Dx) && std::isfinite(c.Dy));
+      // The goal where it is met (measured): the chromaticity within 0.02 of Preetham's
+      // for the sun up to 10 deg at every turbidity (worst 0.0196, T = 5, sun 1 deg).
+      if (elevation <= 10.0)
+      {
+        EXPECT_LE(std::abs(c.Dx), 0.02) << "T " << turbidity << ", sun " << elevation;
+        EXPECT_LE(std::abs(c.Dy), 0.02) << "T " << turbidity << ", sun " << elevation;
+      }
+      // The glow around the sun (3..15 deg) against the CIE clear sky (measured skies),
+      // sun >= 20 deg: measured 0.78..1.16 (against Preetham's, which has no aureole:
+      // 1.30..2.06; the CIE clear sky's own circumsolar term is 1.5..1.7 times
+      // Preetham's there). Bound: within 25 %.
+      if (elevation >= 20.0)
+      {
+        EXPECT_GT(c.CieGlow, 0.75) << "T " << turbidity << ", sun " << elevation;
+        EXPECT_LT(c.CieGlow, 1.25) << "T " << turbidity << ", sun " << elevation;
+      }
+      // Elsewhere the measured envelope (the goal is missed there, see docs/sky.md):
+      // shape 0.757..1.409, chromaticity up to +0.040 (high sun: ours paler).
+      EXPECT_GT(c.Shape, 0.72) << turbidity << " " << elevation;
+      EXPECT_LT(c.Shape, 1.45) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dx), 0.043) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dy), 0.043) << turbidity << " " << elevation;
+    }
+  }
+  std::printf("  (* outside the goal) shape within 10 %%: %d of %d; chromaticity within 0.02: %d "
+              "of %d\n",
+    shapeWithin, cases, colourWithin, cases);
+  // Measured 23 and 17 of 40: no fewer.
+  EXPECT_GE(shapeWithin, 23);
+  EXPECT_GE(colourWithin, 17);
+}
+
+// The haze knob at the ends of its range and bad values: finite skies from the zenith
+// sun to below the horizon, clear errors for NaN and out-of-range turbidities.
+TEST(Sky, TurbidityRange)
+{
+  for (double turbidity : { nimbus::kMinTurbidity, nimbus::kMaxTurbidity })
+  {
+    SkyParameters p;
+    p.Atmosphere = nimbus::ClearSkyAtmosphere(turbidity);
+    p.TransmittanceMuSize = 64; // coarse tables: stability, not accuracy
+    p.TransmittanceRSize = 16;
+    p.ScatteringMuSSize = 16;
+    p.ScatteringRSize = 8;
+    const SkyModel model(p);
+    for (double elevation : { 90.0, 45.0, 1.0, 0.0, -1.0, -10.0 })
+    {
+      const Vector3 s = Direction(elevation, 0.0);
+      const SkyViewLut lut(model, elevation, 0.0, 32, 16, 8);
+      for (const Vector3& w : { Vector3{ { 0, 0, 1 } }, Direction(0.0, 0.0), Direction(0.5, 0.0),
+             Direction(-0.5, 90.0), Direction(elevation, 0.0), Vector3{ { 0, 0, -1 } } })
+      {
+        const Rgb direct = model.Radiance(0.0, w, s);
+        const Rgb table = lut.Radiance(w, 0.0);
+        EXPECT_TRUE(Finite(direct) && Finite(table)) << turbidity << " " << elevation;
+        EXPECT_GE(Y(direct), 0.0);
+        EXPECT_GE(Y(table), 0.0);
+      }
+    }
+  }
+  const double nan = std::nan("");
+  for (double bad : { nan, 0.5, 10.5, -3.0, std::numeric_limits<double>::infinity() })
+  {
+    EXPECT_THROW(nimbus::ClearSkyAtmosphere(bad), std::invalid_argument) << bad;
+  }
+  EXPECT_THROW(nimbus::PreethamSky(nan, 0.5), std::invalid_argument);
+  EXPECT_THROW(nimbus::PreethamSky(3.0, 2.0), std::invalid_argument);
+  SkyParameters bad;
+  bad.Atmosphere.OzoneDobsonUnits = nan;
+  EXPECT_THROW(SkyModel{ bad }, std::invalid_argument);
+  bad = SkyParameters();
+  bad.Atmosphere.MieAngstromExponent = 9.0;
+  EXPECT_THROW(SkyModel{ bad }, std::invalid_argument);
+}
+
+// Ozone keeps the twilight zenith blue (its Chappuis band absorbs orange-red light on
+// the long sunlit paths of twilight; Hulburt 1953): zenith B/R with and without ozone.
+TEST(Sky, OzoneKeepsTwilightBlue)
+{
+  const SkyModel& withOzone = nimbus::testing::FullSkyModel();
+  SkyParameters p;
+  p.Atmosphere.OzoneDobsonUnits = 0.0;
+  const SkyModel withoutOzone(p);
+  for (double elevation : { 10.0, 0.0, -4.0 })
+  {
+    const Vector3 s = Direction(elevation, 0.0);
+    const Rgb a = withOzone.Radiance(0.0, { { 0, 0, 1 } }, s);
+    const Rgb b = withoutOzone.Radiance(0.0, { { 0, 0, 1 } }, s);
+    std::printf("  sun %5.1f deg: zenith B/R with ozone %.2f, without %.2f\n", elevation,
+      a[2] / a[0], b[2] / b[0]);
+    EXPECT_GT(a[2] / a[0], b[2] / b[0]);
+    if (elevation <= -4.0)
+    {
+      // Measured 3.11 with 300 DU and 0.98 without.
+      EXPECT_GT(a[2] / a[0], 2.5);
+      EXPECT_LT(b[2] / b[0], 1.2);
+    }
   }
 }

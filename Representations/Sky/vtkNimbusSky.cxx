@@ -6,6 +6,7 @@
 #include "vtkMath.h"
 #include "vtkObjectFactory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -15,7 +16,6 @@ vtkStandardNewMacro(vtkNimbusSky);
 // (FiniteSetters.h).
 nimbusDefineFiniteSetter(vtkNimbusSky, SunElevationDegrees);
 nimbusDefineFiniteSetter(vtkNimbusSky, SunAzimuthDegrees);
-nimbusDefineFiniteSetter(vtkNimbusSky, MieScatteringPerMetre);
 nimbusDefineFiniteSetter(vtkNimbusSky, GroundAlbedo);
 nimbusDefineFiniteSetter(vtkNimbusSky, Exposure);
 nimbusDefineFiniteSetter(vtkNimbusSky, SceneAltitudeMetres);
@@ -46,6 +46,52 @@ struct vtkNimbusSky::Internals
 vtkNimbusSky::vtkNimbusSky()
   : Internal(new Internals)
 {
+  this->Turbidity = nimbus::kDefaultTurbidity;
+  this->MieScatteringPerMetre = nimbus::MieScatteringFromTurbidity(
+    this->Turbidity, nimbus::ClearSkyAtmosphere(this->Turbidity));
+}
+
+// Turbidity and MieScatteringPerMetre are one setting (nimbus::MieScatteringFromTurbidity
+// and its inverse for the sky's atmosphere: scale height, albedo and Ångström exponent
+// do not depend on the turbidity).
+void vtkNimbusSky::SetTurbidity(double value)
+{
+  if (!std::isfinite(value))
+  {
+    vtkErrorMacro(
+      "SetTurbidity(" << value << "): not a finite number; Turbidity stays " << this->Turbidity);
+    return;
+  }
+  const double clamped =
+    std::clamp(value, this->GetTurbidityMinValue(), this->GetTurbidityMaxValue());
+  if (clamped != this->Turbidity)
+  {
+    this->Turbidity = clamped;
+    this->MieScatteringPerMetre =
+      nimbus::MieScatteringFromTurbidity(clamped, nimbus::ClearSkyAtmosphere(clamped));
+    this->Modified();
+  }
+}
+
+void vtkNimbusSky::SetMieScatteringPerMetre(double value)
+{
+  if (!std::isfinite(value))
+  {
+    vtkErrorMacro("SetMieScatteringPerMetre(" << value
+                                              << "): not a finite number; MieScatteringPerMetre "
+                                                 "stays "
+                                              << this->MieScatteringPerMetre);
+    return;
+  }
+  const double clamped = std::clamp(
+    value, this->GetMieScatteringPerMetreMinValue(), this->GetMieScatteringPerMetreMaxValue());
+  if (clamped != this->MieScatteringPerMetre)
+  {
+    this->MieScatteringPerMetre = clamped;
+    this->Turbidity = nimbus::TurbidityFromMieScattering(
+      clamped, nimbus::ClearSkyAtmosphere(nimbus::kDefaultTurbidity));
+    this->Modified();
+  }
 }
 
 vtkNimbusSky::~vtkNimbusSky() = default;
@@ -92,6 +138,8 @@ const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
     in.ModelAlbedo != this->GroundAlbedo || in.ModelOrders != this->ScatteringOrders)
   {
     nimbus::SkyParameters p;
+    // The clear sky (Ångström exponent, phase function, ozone) with this aerosol amount.
+    p.Atmosphere = nimbus::ClearSkyAtmosphere(nimbus::kDefaultTurbidity);
     p.Atmosphere.MieScatteringPerMetre = this->MieScatteringPerMetre;
     p.GroundAlbedo = this->GroundAlbedo;
     p.ScatteringOrders = this->ScatteringOrders;
@@ -265,6 +313,7 @@ void vtkNimbusSky::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
   os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
+  os << indent << "Turbidity: " << this->Turbidity << "\n";
   os << indent << "MieScatteringPerMetre: " << this->MieScatteringPerMetre << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";

@@ -7,7 +7,8 @@
  * share, so that sky, haze and clouds agree. It is thin glue around
  * Physics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
  * and rebuilds each only when what it depends on changed (cache keys):
- *  - SkyModel (transmittance + multiple scattering): MieScatteringPerMetre, GroundAlbedo;
+ *  - SkyModel (transmittance + multiple scattering): Turbidity (= MieScatteringPerMetre),
+ *    GroundAlbedo, ScatteringOrders;
  *  - sky-view table: the model, SunElevationDegrees, SceneAltitudeMetres;
  *  - aerial-perspective table: the model, SunElevationDegrees, the camera altitude,
  *    MaxAerialDistanceMetres.
@@ -73,12 +74,27 @@ public:
   vtkGetMacro(SunAzimuthDegrees, double);
   ///@}
   ///@{
-  /// Aerosol (Mie) scattering coefficient at sea level, 1/m, [0, 4e-4]: how hazy
-  /// the air is. Default 2e-5 (a clear atmosphere; the mapper and the scene format
-  /// use the same name and unit).
+  /// How hazy the air is: the turbidity T of Preetham, Shirley & Smits 1999
+  /// (dimensionless, [1, 10]; 2 very clear, 3 clear, 5 light haze, 10 hazy; 1 is air
+  /// without aerosol). It sets the aerosol amount (Ångström beta = 0.04608 T - 0.04586,
+  /// the aerosol optical depth at 550 nm is beta 0.55^-1.3: 0.10 at T = 2, 0.20 at 3,
+  /// 0.70 at 8); the rest of the air is fixed (Ångström exponent 1.3, measured-aerosol
+  /// phase function, ozone 300 DU: nimbus::ClearSkyAtmosphere). Default 2 (AOD 0.10).
+  /// Turbidity and MieScatteringPerMetre are two names of one setting: setting one
+  /// sets the other.
+  virtual void SetTurbidity(double value);
+  virtual double GetTurbidityMinValue() { return 1.0; }
+  virtual double GetTurbidityMaxValue() { return 10.0; }
+  vtkGetMacro(Turbidity, double);
+  ///@}
+  ///@{
+  /// The same setting as the aerosol (Mie) scattering coefficient at sea level and
+  /// 550 nm, 1/m, [0, 6.8e-4] (the mapper's and the scene format's name and unit):
+  /// 7.56e-5 at the default turbidity 2; 2e-5 (the default before turbidity) is
+  /// turbidity 1.26. Setting it sets Turbidity (below 1 for less than 3.6e-7).
   virtual void SetMieScatteringPerMetre(double value);
   virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
-  virtual double GetMieScatteringPerMetreMaxValue() { return 4.0e-4; }
+  virtual double GetMieScatteringPerMetreMaxValue() { return 6.8e-4; }
   vtkGetMacro(MieScatteringPerMetre, double);
   ///@}
   ///@{
@@ -181,7 +197,8 @@ protected:
 
   double SunElevationDegrees = 45.0;
   double SunAzimuthDegrees = 135.0;
-  double MieScatteringPerMetre = 2.0e-5;
+  double Turbidity = 2.0;                 // nimbus::kDefaultTurbidity
+  double MieScatteringPerMetre = 7.56e-5; // of Turbidity (set in the constructor)
   double GroundAlbedo = 0.3;
   double Exposure = 10.0;
   double SceneAltitudeMetres = 0.0;

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 vtkStandardNewMacro(vtkNimbusSkyDomeSource);
 vtkCxxSetObjectMacro(vtkNimbusSkyDomeSource, Sky, vtkNimbusSky);
@@ -70,12 +71,57 @@ vtkNimbusSkyDomeSource::vtkNimbusSkyDomeSource()
   }
 NIMBUS_FORWARD(SunElevationDegrees)
 NIMBUS_FORWARD(SunAzimuthDegrees)
-NIMBUS_FORWARD(MieScatteringPerMetre)
 NIMBUS_FORWARD(GroundAlbedo)
 NIMBUS_FORWARD(Exposure)
 NIMBUS_FORWARD(SceneAltitudeMetres)
 NIMBUS_FORWARD(MetresPerUnit)
 #undef NIMBUS_FORWARD
+
+void vtkNimbusSkyDomeSource::SetTurbidity(double v)
+{
+  if (!std::isfinite(v))
+  {
+    vtkErrorMacro("SetTurbidity(" << v << "): not a finite number; ignored");
+    return;
+  }
+  if (this->Turbidity != v)
+  {
+    this->Turbidity = v;
+    this->Modified();
+  }
+  this->ApplyHaze();
+}
+
+void vtkNimbusSkyDomeSource::SetMieScatteringPerMetre(double v)
+{
+  if (!std::isfinite(v))
+  {
+    vtkErrorMacro("SetMieScatteringPerMetre(" << v << "): not a finite number; ignored");
+    return;
+  }
+  if (this->MieScatteringPerMetre != v)
+  {
+    this->MieScatteringPerMetre = v;
+    this->Modified();
+  }
+  this->ApplyHaze();
+}
+
+void vtkNimbusSkyDomeSource::ApplyHaze()
+{
+  if (!this->Sky)
+  {
+    return;
+  }
+  if (this->MieScatteringPerMetre >= 0.0)
+  {
+    this->Sky->SetMieScatteringPerMetre(this->MieScatteringPerMetre);
+  }
+  else
+  {
+    this->Sky->SetTurbidity(this->Turbidity);
+  }
+}
 
 void vtkNimbusSkyDomeSource::SetScatteringOrders(int v)
 {
@@ -120,6 +166,7 @@ struct SkyParameter
 const SkyParameter SkyParameters[] = {
   NIMBUS_PARAMETER(SunElevationDegrees, double),
   NIMBUS_PARAMETER(SunAzimuthDegrees, double),
+  NIMBUS_PARAMETER(Turbidity, double),
   NIMBUS_PARAMETER(MieScatteringPerMetre, double),
   NIMBUS_PARAMETER(GroundAlbedo, double),
   NIMBUS_PARAMETER(Exposure, double),
@@ -157,13 +204,20 @@ int vtkNimbusSkyDomeSource::ApplySkyParameters(vtkFieldData* fieldData, vtkNimbu
   }
   vtkNew<vtkNimbusSky> defaults;
   int found = 0;
+  bool turbidityFound = false;
   for (const SkyParameter& parameter : SkyParameters)
   {
     vtkDataArray* array = fieldData ? fieldData->GetArray(parameter.Name) : nullptr;
+    const bool isTurbidity = std::string(parameter.Name) == "Turbidity";
     if (array && array->GetNumberOfTuples() > 0 && array->GetNumberOfComponents() > 0)
     {
       parameter.Set(sky, array->GetComponent(0, 0));
+      turbidityFound = turbidityFound || isTurbidity;
       ++found;
+    }
+    else if (turbidityFound && std::string(parameter.Name) == "MieScatteringPerMetre")
+    {
+      // The same setting as Turbidity, already set: no default over it.
     }
     else
     {
@@ -296,4 +350,6 @@ void vtkNimbusSkyDomeSource::PrintSelf(ostream& os, vtkIndent indent)
      << "\n";
   os << indent << "ElevationResolution: " << this->ElevationResolution << "\n";
   os << indent << "AzimuthResolution: " << this->AzimuthResolution << "\n";
+  os << indent << "Turbidity: " << this->Turbidity << "\n";
+  os << indent << "MieScatteringPerMetre: " << this->MieScatteringPerMetre << "\n";
 }

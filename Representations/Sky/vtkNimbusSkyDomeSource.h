@@ -16,7 +16,8 @@
  * colours were computed (after the Preset), one one-tuple vtkDoubleArray each,
  * named as the vtkNimbusSky parameter (units as there):
  *  - "SunElevationDegrees" (deg above the horizon), "SunAzimuthDegrees" (deg from +y toward +x),
- *  - "MieScatteringPerMetre" (1/m at sea level), "GroundAlbedo",
+ *  - "Turbidity", "MieScatteringPerMetre" (1/m at sea level and 550 nm; the same
+ *    setting, both written; read in this order, so the second wins), "GroundAlbedo",
  *  - "Exposure", "WhiteBalance" (0/1), "SunDisc" (0/1),
  *  - "SceneAltitudeMetres" (m), "MetresPerUnit", "MaxAerialDistanceMetres" (m),
  *  - "ScatteringOrders" (1 = single scattering).
@@ -57,7 +58,19 @@ public:
   /// Forwarded to the sky (one place for ParaView's properties).
   void SetSunElevationDegrees(double v);
   void SetSunAzimuthDegrees(double v);
+  ///@}
+  ///@{
+  /// The haze: Turbidity (vtkNimbusSky::SetTurbidity) unless MieScatteringPerMetre is
+  /// >= 0, which then sets the aerosol directly (vtkNimbusSky::SetMieScatteringPerMetre)
+  /// whatever the order of the two calls (ParaView's property "MieScatteringPerMetre",
+  /// -1 by default, keeps states saved before Turbidity existed as they were).
+  /// Defaults: Turbidity 2, MieScatteringPerMetre -1 (from Turbidity).
+  void SetTurbidity(double v);
+  vtkGetMacro(Turbidity, double);
   void SetMieScatteringPerMetre(double v);
+  vtkGetMacro(MieScatteringPerMetre, double);
+  ///@}
+  ///@{
   void SetGroundAlbedo(double v);
   void SetExposure(double v);
   void SetSceneAltitudeMetres(double v);
@@ -114,6 +127,9 @@ protected:
   double Center[3] = { 0.0, 0.0, 0.0 };
   int ElevationResolution = 32;
   int AzimuthResolution = 64;
+  double Turbidity = 2.0;
+  double MieScatteringPerMetre = -1.0;
+  void ApplyHaze();
 
 private:
   vtkNimbusSkyDomeSource(const vtkNimbusSkyDomeSource&) = delete;

@@ -267,7 +267,7 @@ int main(int argc, char* argv[])
     return EXIT_FAILURE;
   }
   Scene scene;
-  scene.Sky->GetSky()->SetMieScatteringPerMetre(2.0 * 2.0e-5); // twice the default haze
+  scene.Sky->GetSky()->SetTurbidity(3.0); // a little hazier than the default (optical depth 0.20)
   // Far to near (volumes are composited in the order they were added).
   scene.AddCloud(-9000.0, 28000.0);
   scene.AddCloud(2500.0, 10000.0);

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace
 {
 void ExpectSameSky(vtkNimbusSky* a, vtkNimbusSky* b)
@@ -20,6 +22,7 @@ void ExpectSameSky(vtkNimbusSky* a, vtkNimbusSky* b)
   EXPECT_EQ(a->GetSunElevationDegrees(), b->GetSunElevationDegrees());
   EXPECT_EQ(a->GetSunAzimuthDegrees(), b->GetSunAzimuthDegrees());
   EXPECT_EQ(a->GetMieScatteringPerMetre(), b->GetMieScatteringPerMetre());
+  EXPECT_DOUBLE_EQ(a->GetTurbidity(), b->GetTurbidity());
   EXPECT_EQ(a->GetGroundAlbedo(), b->GetGroundAlbedo());
   EXPECT_EQ(a->GetExposure(), b->GetExposure());
   EXPECT_EQ(a->GetWhiteBalance(), b->GetWhiteBalance());
@@ -48,9 +51,9 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
   dome->SetSunDisc(false);
   dome->Update();
   vtkFieldData* fields = dome->GetOutput()->GetFieldData();
-  const char* names[] = { "SunElevationDegrees", "SunAzimuthDegrees", "MieScatteringPerMetre",
-    "GroundAlbedo", "Exposure", "WhiteBalance", "SunDisc", "SceneAltitudeMetres", "MetresPerUnit",
-    "MaxAerialDistanceMetres", "ScatteringOrders" };
+  const char* names[] = { "SunElevationDegrees", "SunAzimuthDegrees", "Turbidity",
+    "MieScatteringPerMetre", "GroundAlbedo", "Exposure", "WhiteBalance", "SunDisc",
+    "SceneAltitudeMetres", "MetresPerUnit", "MaxAerialDistanceMetres", "ScatteringOrders" };
   for (const char* name : names)
   {
     vtkDataArray* array = fields->GetArray(name);
@@ -59,7 +62,7 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
     EXPECT_EQ(array->GetNumberOfComponents(), 1) << name;
     EXPECT_TRUE(vtkDoubleArray::SafeDownCast(array)) << name;
   }
-  EXPECT_EQ(fields->GetNumberOfArrays(), 11);
+  EXPECT_EQ(fields->GetNumberOfArrays(), 12);
   EXPECT_EQ(fields->GetArray("SunElevationDegrees")->GetComponent(0, 0), 2.0);
   EXPECT_EQ(fields->GetArray("SunAzimuthDegrees")->GetComponent(0, 0), 270.0);
   EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 25.0);
@@ -69,14 +72,14 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
 
   // Read back into another sky: the same parameters.
   vtkNew<vtkNimbusSky> copy;
-  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(fields, copy), 11);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(fields, copy), 12);
   ExpectSameSky(dome->GetSky(), copy);
 
   // A second update replaces the arrays instead of adding more.
   dome->SetExposure(5.0);
   dome->Update();
   fields = dome->GetOutput()->GetFieldData();
-  EXPECT_EQ(fields->GetNumberOfArrays(), 11);
+  EXPECT_EQ(fields->GetNumberOfArrays(), 12);
   EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 5.0);
 }
 
@@ -113,4 +116,49 @@ TEST(SkyDomeParameters, MissingArraysMeanDefaults)
   EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(nullptr, sky), 0);
   ExpectSameSky(sky, defaults);
   EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(one, nullptr), 0);
+}
+
+// Turbidity and MieScatteringPerMetre are one setting on the sky; on the dome source
+// (ParaView's properties) a MieScatteringPerMetre >= 0 overrides Turbidity whatever the
+// order of the calls, and field data written before Turbidity existed (only
+// MieScatteringPerMetre) gives that aerosol back.
+TEST(SkyDomeParameters, TurbidityAndMieScattering)
+{
+  vtkNew<vtkNimbusSky> sky;
+  EXPECT_EQ(sky->GetTurbidity(), 2.0);
+  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 7.555e-5, 1e-7);
+  sky->SetTurbidity(5.0);
+  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 3.01e-4, 1e-6);
+  sky->SetMieScatteringPerMetre(2.0e-5);
+  EXPECT_NEAR(sky->GetTurbidity(), 1.26, 0.005);
+  sky->SetTurbidity(100.0); // clamped
+  EXPECT_EQ(sky->GetTurbidity(), 10.0);
+  sky->SetTurbidity(std::nan("")); // refused (an error), value kept
+  EXPECT_EQ(sky->GetTurbidity(), 10.0);
+
+  vtkNew<vtkNimbusSkyDomeSource> dome;
+  dome->SetMieScatteringPerMetre(6.0e-5);
+  dome->SetTurbidity(4.0);
+  EXPECT_EQ(dome->GetSky()->GetMieScatteringPerMetre(), 6.0e-5);
+  dome->SetMieScatteringPerMetre(-1.0); // back to Turbidity
+  EXPECT_EQ(dome->GetSky()->GetTurbidity(), 4.0);
+  dome->SetTurbidity(3.0);
+  EXPECT_EQ(dome->GetSky()->GetTurbidity(), 3.0);
+
+  vtkNew<vtkFieldData> old;
+  vtkNew<vtkDoubleArray> mie;
+  mie->SetName("MieScatteringPerMetre");
+  mie->InsertNextValue(2.0e-5);
+  old->AddArray(mie);
+  vtkNew<vtkNimbusSky> restored;
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(old, restored), 1);
+  EXPECT_EQ(restored->GetMieScatteringPerMetre(), 2.0e-5);
+
+  vtkNew<vtkFieldData> onlyTurbidity;
+  vtkNew<vtkDoubleArray> turbidity;
+  turbidity->SetName("Turbidity");
+  turbidity->InsertNextValue(4.0);
+  onlyTurbidity->AddArray(turbidity);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(onlyTurbidity, restored), 1);
+  EXPECT_EQ(restored->GetTurbidity(), 4.0);
 }

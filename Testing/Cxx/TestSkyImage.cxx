@@ -75,7 +75,7 @@ int main(int argc, char* argv[])
     sky->SetPreset(vtkNimbusSky::Afternoon);
     sky->SetSunAzimuthDegrees(150.0);
     sky->SetExposure(12.0);
-    sky->SetMieScatteringPerMetre(2.0 * 2.0e-5); // twice the default haze
+    sky->SetTurbidity(3.0); // clear, a little hazier than the default (aerosol optical depth 0.20)
     vtkNew<vtkPlaneSource> ground;
     ground->SetOrigin(-2.0e5, -2.0e5, 0.0);
     ground->SetPoint1(2.0e5, -2.0e5, 0.0);

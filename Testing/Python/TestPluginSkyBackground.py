@@ -153,12 +153,27 @@ def main():
     print("field data:", parameters)
     view = CreateRenderView()
     check = Checker(view, args.output_dir)
-    for name in ("SunElevationDegrees", "SunAzimuthDegrees", "MieScatteringPerMetre", "GroundAlbedo", "Exposure",
+    for name in ("SunElevationDegrees", "SunAzimuthDegrees", "Turbidity", "MieScatteringPerMetre", "GroundAlbedo",
+                 "Exposure",
                  "SceneAltitudeMetres", "MetresPerUnit", "ScatteringOrders", "WhiteBalance",
                  "SunDisc"):
         check.expect(name in parameters, "field data lacks %s" % name)
     check.expect(parameters.get("SunElevationDegrees") == 60.0 and parameters.get("SunAzimuthDegrees") == 180.0,
                  "Noon preset not in the field data: %s" % parameters)
+    # The haze: Turbidity (default 2); MieScatteringPerMetre >= 0 (a state saved before
+    # Turbidity existed) overrides it, -1 (its default) gives it back.
+    check.expect(abs(parameters.get("Turbidity", 0.0) - 2.0) < 1e-9, "default Turbidity: %s" % parameters)
+    sky.Turbidity = 5.0
+    hazy = field_parameters(sky)
+    check.expect(abs(hazy.get("Turbidity", 0.0) - 5.0) < 1e-9
+                 and hazy.get("MieScatteringPerMetre", 0.0) > 2.0 * parameters.get("MieScatteringPerMetre", 1.0),
+                 "Turbidity 5 did not reach the field data: %s" % hazy)
+    sky.MieScatteringPerMetre = 2e-5
+    old = field_parameters(sky)
+    check.expect(old.get("MieScatteringPerMetre") == 2e-5, "MieScatteringPerMetre 2e-5 not applied: %s" % old)
+    sky.MieScatteringPerMetre = -1.0
+    sky.Turbidity = 2.0
+    check.expect(abs(field_parameters(sky).get("Turbidity", 0.0) - 2.0) < 1e-9, "Turbidity 2 not back")
 
     view.ViewSize = SIZE
     view.OrientationAxesVisibility = 0
