@@ -2,6 +2,8 @@
 
 #include "pqApplicationCore.h"
 #include "pqDataRepresentation.h"
+#include "pqOutputPort.h"
+#include "pqPipelineFilter.h"
 #include "pqPipelineSource.h"
 #include "pqRenderView.h"
 #include "pqServerManagerModel.h"
@@ -18,7 +20,7 @@
 
 namespace
 {
-// Sources and filters whose output is a cloud density (proxy XML names).
+// Sources and filters of clouds and the sky (proxy XML names).
 bool IsNimbusCloudProducer(pqPipelineSource* source)
 {
   const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
@@ -26,8 +28,9 @@ bool IsNimbusCloudProducer(pqPipelineSource* source)
   {
     return false;
   }
-  for (const char* cloud : { "NimbusMetaballCloud", "NimbusCloudAutomaton",
-         "NimbusCloudAutomatonWithMaps", "NimbusImageCloud", "NimbusOpenVDBReader" })
+  for (const char* cloud :
+    { "NimbusMetaballCloud", "NimbusCloudAutomaton", "NimbusCloudAutomatonWithMaps",
+      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome" })
   {
     if (std::strcmp(name, cloud) == 0)
     {
@@ -120,10 +123,20 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
   {
     return;
   }
+  // The filter's inputs do not count: Apply hides them (an image under the image cloud).
+  QList<pqPipelineSource*> inputs;
+  if (auto* filter = qobject_cast<pqPipelineFilter*>(data->getInput()))
+  {
+    for (pqOutputPort* port : filter->getAllInputs())
+    {
+      inputs.push_back(port->getSource());
+    }
+  }
   for (pqRepresentation* other : view->getRepresentations())
   {
-    if (other != representation && other->isVisible() && !IsSkyBackground(other) &&
-      qobject_cast<pqDataRepresentation*>(other))
+    auto* otherData = qobject_cast<pqDataRepresentation*>(other);
+    if (other != representation && other->isVisible() && !IsSkyBackground(other) && otherData &&
+      !inputs.contains(otherData->getInput()))
     {
       return;
     }
@@ -139,6 +152,18 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
   vtkSMPropertyHelper(viewProxy, "CameraPosition").Set(position, 3);
   vtkSMPropertyHelper(viewProxy, "CameraViewUp").Set(up, 3);
   viewProxy->UpdateVTKObjects();
+  // Fit the data once Apply is done (Apply resets the camera itself only when this is the
+  // one visible representation, i.e. not while a filter's input is still shown).
+  QPointer<pqRenderView> guarded(view);
+  QTimer::singleShot(0, this,
+    [guarded]()
+    {
+      if (guarded)
+      {
+        guarded->resetCamera();
+        guarded->render();
+      }
+    });
 }
 
 void pqNimbusFirstApplyBehavior::hideLegends(pqView* view)

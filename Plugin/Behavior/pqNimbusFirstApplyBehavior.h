@@ -3,9 +3,10 @@
  * @brief   The ParaView GUI's first look at Nimbus data: a side view, no legends.
  *
  * Started with the plugin (an auto-start interface). In every render view it
- * - turns the camera, when the first data shown in the view comes from a Nimbus cloud source
- *   or filter (Nimbus Metaball Cloud, Cloud Automaton (With Maps), Image Cloud, OpenVDB
- *   reader), to look from the south (+y), 11 degrees down, z up: the ground at the bottom,
+ * - turns the camera, when the first data shown in the view comes from a Nimbus source or
+ *   filter (Nimbus Metaball Cloud, Cloud Automaton (With Maps), Image Cloud, OpenVDB reader,
+ *   Sky; a filter's input, hidden by Apply, and a sky background do not count), to look from
+ *   the south (+y), 11 degrees down, z up: the ground at the bottom,
  *   where ParaView would look down -z at the clouds' tops;
  * - keeps the "Cloud" and "Sky Background" representations without a colour legend: their
  *   picture does not use the colour map, so a legend (ParaView shows one whenever a

@@ -19,11 +19,12 @@ Prints what it checks; exit 0 on success.
 import argparse
 import os
 import sys
+import tempfile
 
 import numpy as np
 
 from paraview import servermanager
-from paraview.simple import (CreateRenderView, LoadPlugin, OpenDataFile, Render,
+from paraview.simple import (CreateRenderView, LoadPlugin, OpenDataFile, Render, SaveData,
                              SaveScreenshot, Show)
 from paraview.vtk.util.numpy_support import vtk_to_numpy
 
@@ -125,6 +126,20 @@ def main():
     ok &= good
     if args.output_dir:
         render(view, display, os.path.join(args.output_dir, "first-apply-metaball.png"))
+
+    # --- a .vdb file (when the plugin has OpenVDB) ------------------------------------------
+    vdb = os.path.join(tempfile.mkdtemp(), "metaball.vdb")
+    try:
+        SaveData(vdb, proxy=metaballs)
+    except Exception as error:  # no OpenVDB in this build
+        print("skip  .vdb (%s)" % error)
+    else:
+        reader = OpenDataFile(vdb)
+        reader.UpdatePipeline()
+        view = CreateRenderView()
+        display = Show(reader, view)
+        ok &= check(display.Representation == "Cloud",
+                    ".vdb file (%s): shown as %s" % (reader.GetXMLName(), display.Representation))
 
     # --- the image cloud from ParaView's default PNG reader -------------------------------
     reader = OpenDataFile(args.image)
