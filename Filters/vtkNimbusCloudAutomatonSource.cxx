@@ -123,15 +123,23 @@ vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
   const double bounds[6] = { -6400.0, 6400.0, -6400.0, 6400.0, 1000.0, 2600.0 };
   std::copy(bounds, bounds + 6, this->Bounds);
   this->Seed = 1;
-  this->ExtinctionProbability = 0.05;
-  this->HumidityProbability = 0.002;
-  this->ActivationProbability = 0.0002;
-  this->InitialHumidity = 0.3;
-  this->InitialActivation = 0.001;
-  this->Wind[0] = this->Wind[1] = 0.0;
-  this->Shear[0] = this->Shear[1] = 0.0;
-  this->PeriodicBoundary = true;
-  this->StepDuration = 1.0;
+  // Defaults that give separate cumulus drifting downwind at time 0 (formation regions, a
+  // spin-up, wind and shear), after Dobashi et al. 2000.
+  this->ExtinctionProbability = 0.06;
+  this->HumidityProbability = 0.1;
+  this->ActivationProbability = 0.005;
+  this->InitialHumidity = 0.0;
+  this->InitialActivation = 0.0;
+  this->Wind[0] = 4.0;
+  this->Wind[1] = 0.0;
+  this->Shear[0] = 0.002;
+  this->Shear[1] = 0.0;
+  this->NumberOfFormationRegions = 10;
+  this->FormationRegionRadiusRange[0] = 400.0;
+  this->FormationRegionRadiusRange[1] = 700.0;
+  this->SpinUpSteps = 40;
+  this->PeriodicBoundary = false;
+  this->StepDuration = 10.0;
   this->NumberOfTimeSteps = 100;
   this->SmoothingRadius = 2.5;
   this->InterpolateInTime = true;
@@ -303,6 +311,17 @@ bool vtkNimbusCloudAutomatonSource::CheckParameters()
                   << ".");
     return false;
   }
+  if (this->NumberOfFormationRegions > 0 &&
+    !(AllFinite(this->FormationRegionRadiusRange, 2) && this->FormationRegionRadiusRange[0] > 0.0 &&
+      this->FormationRegionRadiusRange[1] > 0.0 &&
+      this->FormationRegionRadiusRange[0] <= MaximumLength &&
+      this->FormationRegionRadiusRange[1] <= MaximumLength))
+  {
+    vtkErrorMacro(<< "FormationRegionRadiusRange must be two finite lengths in (0, "
+                  << MaximumLength << "] m, got (" << this->FormationRegionRadiusRange[0] << ", "
+                  << this->FormationRegionRadiusRange[1] << ").");
+    return false;
+  }
   if (!AllFinite(this->Wind, 2) || !AllFinite(this->Shear, 2))
   {
     vtkErrorMacro(<< "Wind and Shear must be finite.");
@@ -385,12 +404,15 @@ int vtkNimbusCloudAutomatonSource::Generate(
   const double cellCount = static_cast<double>(cells);
   // One state: three bit fields, rows padded to 64-bit words.
   const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * d[2];
+  const double lastStep =
+    static_cast<double>(this->NumberOfTimeSteps) + static_cast<double>(this->SpinUpSteps);
   const double checkpoints = std::min(static_cast<double>(this->MaximumNumberOfCheckpoints),
-    std::floor(static_cast<double>(this->NumberOfTimeSteps) / this->CheckpointInterval));
+    std::floor(lastStep / this->CheckpointInterval));
   // Floats per cell: the cached densities (up to 2 more while a request runs), the
   // smoothing's two buffers and the output array; 8 bytes per cell per input map.
   const double bytes = stateBytes * (2.0 + checkpoints) +
-    4.0 * cellCount * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0);
+    4.0 * cellCount * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0) +
+    (this->NumberOfFormationRegions > 0 ? 12.0 * cellCount : 0.0);
   std::ostringstream what;
   what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
        << checkpoints << " checkpoints)";
@@ -429,6 +451,35 @@ int vtkNimbusCloudAutomatonSource::Generate(
     p.Boundary =
       this->PeriodicBoundary ? nimbus::CloudBoundary::Periodic : nimbus::CloudBoundary::Open;
     p.NumberOfThreads = this->NumberOfThreads;
+    if (this->NumberOfFormationRegions > 0)
+    {
+      // Regions in cells: the radii (metres) over the horizontal spacing, vertical semi-axes
+      // half the horizontal ones, centres at 30 % of the height.
+      const double sx = AxisSpacing(d[0], this->Bounds[0], this->Bounds[1]);
+      const double sy = AxisSpacing(d[1], this->Bounds[2], this->Bounds[3]);
+      const double radius[2] = { this->FormationRegionRadiusRange[0],
+        this->FormationRegionRadiusRange[1] };
+      const double cellRadius[2] = { radius[0] / sx, radius[1] / sx };
+      std::vector<nimbus::FormationRegion> regions =
+        nimbus::RandomFormationRegions(d, this->NumberOfFormationRegions, cellRadius, 1.0,
+          0.3 * (d[2] - 1), p.Seed, p.Boundary == nimbus::CloudBoundary::Open);
+      for (nimbus::FormationRegion& region : regions)
+      {
+        const double metres = region.Radius[0] * sx;
+        region.Radius[1] = metres / sy;
+        region.Radius[2] = 0.5 * metres / dz;
+      }
+      const std::vector<float> weights =
+        nimbus::FormationRegionWeights(d, regions, p.Boundary == nimbus::CloudBoundary::Periodic);
+      std::vector<float> hum(weights.size()), act(weights.size());
+      for (std::size_t i = 0; i < weights.size(); ++i)
+      {
+        hum[i] = static_cast<float>(this->HumidityProbability * weights[i]);
+        act[i] = static_cast<float>(this->ActivationProbability * weights[i]);
+      }
+      p.HumiditySupply = nimbus::ProbabilityField::Volume(std::move(hum));
+      p.ActivationSupply = nimbus::ProbabilityField::Volume(std::move(act));
+    }
 
     if (input)
     {
@@ -529,8 +580,9 @@ int vtkNimbusCloudAutomatonSource::Generate(
   {
     time = 0.0;
   }
-  const double lastStep = static_cast<double>(this->NumberOfTimeSteps);
-  const double stepPosition = std::clamp(time / this->StepDuration, 0.0, lastStep);
+  const double lastTimeStep = static_cast<double>(this->NumberOfTimeSteps);
+  const double stepPosition = std::clamp(time / this->StepDuration, 0.0, lastTimeStep) +
+    static_cast<double>(this->SpinUpSteps);
   std::int64_t step = static_cast<std::int64_t>(std::floor(stepPosition));
   double fraction = stepPosition - static_cast<double>(step);
   // Times that are meant to be step k but land a rounding error below it.
@@ -714,6 +766,10 @@ void vtkNimbusCloudAutomatonSource::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "InitialActivation: " << this->InitialActivation << "\n";
   os << indent << "Wind: " << this->Wind[0] << " " << this->Wind[1] << "\n";
   os << indent << "Shear: " << this->Shear[0] << " " << this->Shear[1] << "\n";
+  os << indent << "NumberOfFormationRegions: " << this->NumberOfFormationRegions << "\n";
+  os << indent << "FormationRegionRadiusRange: " << this->FormationRegionRadiusRange[0] << " "
+     << this->FormationRegionRadiusRange[1] << "\n";
+  os << indent << "SpinUpSteps: " << this->SpinUpSteps << "\n";
   os << indent << "PeriodicBoundary: " << (this->PeriodicBoundary ? "On" : "Off") << "\n";
   os << indent << "StepDuration: " << this->StepDuration << "\n";
   os << indent << "NumberOfTimeSteps: " << this->NumberOfTimeSteps << "\n";

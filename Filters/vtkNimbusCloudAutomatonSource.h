@@ -17,9 +17,23 @@
  * for a given time depends only on the parameters, the input and Seed -- never on the
  * order times were requested.
  *
+ * Formation regions (on by default): vapour and activation are supplied in
+ * NumberOfFormationRegions Gaussian ellipsoids, as Dobashi et al. (2000) shape their supply
+ * probabilities so that separate clouds form (Filters/Core/CloudAutomaton.h,
+ * RandomFormationRegions): p_hum = HumidityProbability w and p_act = ActivationProbability w,
+ * w = exp(-r^2/2) in [0, 1] (0 beyond r = 3), r the distance from the nearest region's centre
+ * in semi-axes. The regions are drawn from Seed: centres uniform over x and y at 30 % of the
+ * grid's height, horizontal semi-axes in FormationRegionRadiusRange (metres), vertical ones
+ * half as long. NumberOfFormationRegions 0 gives the uniform probabilities everywhere.
+ * Extinction stays uniform, so clouds that the wind carries out of a region decay.
+ *
+ * Spin-up: time 0 shows automaton step SpinUpSteps (default 40), so that the first frame
+ * already has grown clouds; time t shows step SpinUpSteps + t / StepDuration.
+ *
  * Optional input (port 0): vtkImageData whose point arrays "p_ext", "p_hum", "p_act"
  * (one component, values in [0, 1]) replace the scalar ExtinctionProbability,
- * HumidityProbability, ActivationProbability per cell. The input must have the source's
+ * HumidityProbability, ActivationProbability per cell (arrays given replace the formation
+ * regions' fields too). The input must have the source's
  * Dimensions (a 3-D field) or Dimensions[0] x Dimensions[1] x 1 (a 2-D map used at every
  * height). Its geometry is ignored; cell (i, j, k) of the automaton is point (i, j, k).
  *
@@ -73,7 +87,9 @@ public:
 
   ///@{
   /// Per-step probabilities used where the input has no array: cloud extinction p_ext,
-  /// vapour supply p_hum, activation supply p_act (002 §3). Defaults 0.05, 0.002, 0.0002.
+  /// vapour supply p_hum, activation supply p_act (002 §3); with formation regions, p_hum and
+  /// p_act at a region's centre (scaled by the region's weight elsewhere). Defaults 0.06,
+  /// 0.1, 0.005.
   /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
   virtual void SetExtinctionProbability(double value);
   double GetExtinctionProbabilityMinValue() { return 0.0; }
@@ -92,8 +108,8 @@ public:
   ///@}
 
   ///@{
-  /// Probabilities of hum and act in each cell at time 0 (cld starts empty).
-  /// Defaults 0.3 and 0.001.
+  /// Probabilities of hum and act in each cell at step 0 (cld starts empty).
+  /// Defaults 0 and 0 (the formation regions supply both).
   /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
   virtual void SetInitialHumidity(double value);
   double GetInitialHumidityMinValue() { return 0.0; }
@@ -109,7 +125,7 @@ public:
   ///@{
   /// Wind (m/s, x and y) at the bottom of the grid, and its increase per metre of height
   /// ((m/s)/m). The fields move by whole cells; fractional motion accumulates exactly.
-  /// Defaults (0, 0) and (0, 0).
+  /// Defaults (4, 0) and (0.002, 0): a light breeze along +x, 7 m/s at the default top.
   vtkSetVector2Macro(Wind, double);
   vtkGetVector2Macro(Wind, double);
   vtkSetVector2Macro(Shear, double);
@@ -117,8 +133,27 @@ public:
   ///@}
 
   ///@{
+  /// Formation regions (see the class description): how many (0: uniform probabilities;
+  /// clamped to [0, 10000]; default 10) and the range of their horizontal semi-axes, metres
+  /// (both > 0 and finite, else RequestData refuses them; default (400, 700)). With open
+  /// boundaries the centres keep three semi-axes from the x and y faces.
+  vtkSetClampMacro(NumberOfFormationRegions, int, 0, 10000);
+  vtkGetMacro(NumberOfFormationRegions, int);
+  vtkSetVector2Macro(FormationRegionRadiusRange, double);
+  vtkGetVector2Macro(FormationRegionRadiusRange, double);
+  ///@}
+
+  ///@{
+  /// Automaton steps run before time 0 (clamped to [0, 1e6]; default 40), so that the first
+  /// frame shows grown clouds.
+  vtkSetClampMacro(SpinUpSteps, int, 0, 1000000);
+  vtkGetMacro(SpinUpSteps, int);
+  ///@}
+
+  ///@{
   /// On: the grid wraps around in x and y (clouds blown out come back in). Off: open
-  /// faces, clear air blows in. z is always open. Default on.
+  /// faces, clear air blows in. z is always open. Default off (open: clouds leave downwind
+  /// instead of coming back cut by the faces).
   vtkSetMacro(PeriodicBoundary, bool);
   vtkGetMacro(PeriodicBoundary, bool);
   vtkBooleanMacro(PeriodicBoundary, bool);
@@ -126,7 +161,7 @@ public:
 
   ///@{
   /// Seconds per automaton step (in [1e-6, 1e9]) and number of steps advertised as
-  /// TIME_STEPS (clamped to [0, 1e6]). Defaults 1 and 100.
+  /// TIME_STEPS (clamped to [0, 1e6]). Defaults 10 and 100.
   vtkSetMacro(StepDuration, double);
   vtkGetMacro(StepDuration, double);
   vtkSetClampMacro(NumberOfTimeSteps, int, 0, 1000000);
@@ -205,6 +240,9 @@ protected:
   double InitialActivation;
   double Wind[2];
   double Shear[2];
+  int NumberOfFormationRegions;
+  double FormationRegionRadiusRange[2];
+  int SpinUpSteps;
   bool PeriodicBoundary;
   double StepDuration;
   int NumberOfTimeSteps;

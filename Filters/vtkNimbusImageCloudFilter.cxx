@@ -53,9 +53,12 @@ vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
     0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   this->IntensityRange[0] = 0.0;
   this->IntensityRange[1] = 255.0;
-  this->MappingType = LINEAR;
+  // Defaults that look right on a satellite picture: clear sea and land are dark but not
+  // black (the sample's reach 0.2 of the range), clouds bright; bright pixels read as the
+  // reflectance of a non-absorbing cloud (TwoStream), not as a fraction of the thickest.
+  this->MappingType = TWO_STREAM;
   const nimbus::OpticalDepthMapping mapping;
-  this->ClearIntensity = mapping.ClearIntensity;
+  this->ClearIntensity = 0.25;
   this->WhiteIntensity = mapping.WhiteIntensity;
   this->Gamma = mapping.Gamma;
   this->MaximumOpticalDepth = mapping.MaximumOpticalDepth;
@@ -299,36 +302,42 @@ int vtkNimbusImageCloudFilter::Generate(
     : nullptr;
   const bool named = arrayName && *arrayName;
   vtkPointData* pointData = input->GetPointData();
+  vtkCellData* cellData = input->GetCellData();
   if (!intensity && !named)
   {
     // No array chosen (an empty name, as ParaView may send before its domain is filled):
-    // the active scalars, else the first numeric point array (named or not).
-    intensity = pointData->GetScalars();
-    for (int i = 0; !intensity && i < pointData->GetNumberOfArrays(); ++i)
+    // the active point scalars, else the first numeric point array (named or not), else the
+    // same among the cell arrays (ParaView's default reader for PNG, TIFF and JPEG files,
+    // GDAL's, gives the pixels as cell data).
+    for (vtkDataSetAttributes* attributes : { static_cast<vtkDataSetAttributes*>(pointData),
+           static_cast<vtkDataSetAttributes*>(cellData) })
     {
-      intensity = pointData->GetArray(i);
+      intensity = intensity ? intensity : attributes->GetScalars();
+      for (int i = 0; !intensity && i < attributes->GetNumberOfArrays(); ++i)
+      {
+        intensity = attributes->GetArray(i);
+      }
     }
   }
   if (!intensity)
   {
-    if (pointData->GetNumberOfArrays() == 0)
+    if (pointData->GetNumberOfArrays() == 0 && cellData->GetNumberOfArrays() == 0)
     {
-      vtkErrorMacro(<< "The input image has no point arrays to read intensities from"
-                    << (input->GetCellData()->GetNumberOfArrays() > 0
-                           ? " (it has cell arrays; convert them with Cell Data to Point Data)."
-                           : "."));
+      vtkErrorMacro(<< "The input image has no point or cell arrays to read intensities from.");
     }
     else if (named)
     {
-      vtkErrorMacro(<< "The input image has no numeric point array \"" << arrayName
+      vtkErrorMacro(<< "The input image has no numeric array \"" << arrayName
                     << "\"; its point arrays are " << DescribeArrays(pointData)
+                    << " and its cell arrays " << DescribeArrays(cellData)
                     << " (choose one with SetInputArrayToProcess).");
     }
     else
     {
-      vtkErrorMacro(<< "The input image has no numeric point array to read intensities from; "
+      vtkErrorMacro(<< "The input image has no numeric array to read intensities from; "
                        "its point arrays are "
-                    << DescribeArrays(pointData) << ".");
+                    << DescribeArrays(pointData) << " and its cell arrays "
+                    << DescribeArrays(cellData) << ".");
     }
     return 1;
   }
@@ -336,11 +345,22 @@ int vtkNimbusImageCloudFilter::Generate(
   const std::string intensityName = intensity->GetName() && *intensity->GetName()
     ? std::string("\"") + intensity->GetName() + "\""
     : std::string("(unnamed)");
-  if (intensity->GetNumberOfTuples() != pixels)
+  // Pixels as cells (GDAL's reader: nx x ny pixels on (nx + 1) x (ny + 1) points): each
+  // point takes the mean of the cells around it, as ParaView's Cell Data to Point Data does.
+  const vtkIdType cellPixels =
+    static_cast<vtkIdType>(std::max(dims[0] - 1, 1)) * std::max(dims[1] - 1, 1);
+  bool inCellData = false;
+  for (int i = 0; i < cellData->GetNumberOfArrays(); ++i)
+  {
+    inCellData = inCellData || cellData->GetAbstractArray(i) == intensity;
+  }
+  const bool cellArray = inCellData && intensity->GetNumberOfTuples() != pixels &&
+    intensity->GetNumberOfTuples() == cellPixels;
+  if (intensity->GetNumberOfTuples() != pixels && !cellArray)
   {
     vtkErrorMacro(<< "The intensity array " << intensityName << " has "
                   << intensity->GetNumberOfTuples() << " values for " << dims[0] << " x " << dims[1]
-                  << " = " << pixels << " pixels.");
+                  << " = " << pixels << " points (or " << cellPixels << " cells).");
     return 1;
   }
   if (!(this->IntensityRange[1] > this->IntensityRange[0]) ||
@@ -434,13 +454,39 @@ int vtkNimbusImageCloudFilter::Generate(
   std::vector<double> tau(static_cast<std::size_t>(pixels));
   const double scale = 1.0 / (this->IntensityRange[1] - this->IntensityRange[0]);
   nimbus::ValueCensus census;
-  for (vtkIdType i = 0; i < pixels; ++i)
+  auto luminance = [intensity, components](vtkIdType t)
   {
-    double value = intensity->GetComponent(i, 0);
+    double value = intensity->GetComponent(t, 0);
     if (components >= 3)
     {
-      value = 0.2126 * value + 0.7152 * intensity->GetComponent(i, 1) +
-        0.0722 * intensity->GetComponent(i, 2); // Rec. 709 luminance
+      value = 0.2126 * value + 0.7152 * intensity->GetComponent(t, 1) +
+        0.0722 * intensity->GetComponent(t, 2); // Rec. 709 luminance
+    }
+    return value;
+  };
+  const int cellsX = std::max(dims[0] - 1, 1);
+  const int cellsY = std::max(dims[1] - 1, 1);
+  for (vtkIdType i = 0; i < pixels; ++i)
+  {
+    double value = 0.0;
+    if (cellArray)
+    {
+      const int x = static_cast<int>(i % dims[0]);
+      const int y = static_cast<int>(i / dims[0]);
+      int count = 0;
+      for (int cy = std::max(y - 1, 0); cy <= std::min(y, cellsY - 1); ++cy)
+      {
+        for (int cx = std::max(x - 1, 0); cx <= std::min(x, cellsX - 1); ++cx)
+        {
+          value += luminance(static_cast<vtkIdType>(cx) + static_cast<vtkIdType>(cellsX) * cy);
+          ++count;
+        }
+      }
+      value /= count;
+    }
+    else
+    {
+      value = luminance(i);
     }
     census.NaN += std::isnan(value) ? 1 : 0;
     census.Infinite += std::isinf(value) ? 1 : 0;

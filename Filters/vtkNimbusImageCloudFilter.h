@@ -3,7 +3,11 @@
  * @brief   3-D cloud density from a 2-D image, e.g. a satellite picture (002 §3).
  *
  * Input: a 2-D vtkImageData (one slice, nx x ny x 1), its active point scalars (or the
- * array chosen with SetInputArrayToProcess) read as intensity; RGB(A) images use the
+ * array chosen with SetInputArrayToProcess; without one, the first point array, else the
+ * active or first cell array) read as intensity. A cell array of (nx - 1) x (ny - 1) values
+ * (pixels as cells, as ParaView's default image reader, GDAL's, gives PNG, JPEG and TIFF
+ * files) is averaged onto the points (each point the mean of the cells around it, as Cell
+ * Data to Point Data does); the output then has nx x ny columns. RGB(A) images use the
  * luminance 0.2126 R + 0.7152 G + 0.0722 B. Intensities are normalised with IntensityRange
  * (default 0..255, for 8-bit images), then mapped to optical depth tau
  * (Filters/Core/ImageClouds.h, OpticalDepthMapping):
@@ -61,9 +65,9 @@ public:
   ///@}
 
   ///@{
-  /// Intensity -> optical depth mapping (see the class description). Defaults: Linear,
-  /// ClearIntensity 0.1, WhiteIntensity 1, Gamma 1, MaximumOpticalDepth 30,
-  /// AsymmetryParameter 0.85.
+  /// Intensity -> optical depth mapping (see the class description). Defaults: TwoStream,
+  /// ClearIntensity 0.25 (dark sea and land stay clear), WhiteIntensity 1, Gamma 1,
+  /// MaximumOpticalDepth 30, AsymmetryParameter 0.85.
   vtkSetClampMacro(MappingType, int, LINEAR, TWO_STREAM);
   vtkGetMacro(MappingType, int);
   void SetMappingTypeToLinear() { this->SetMappingType(LINEAR); }

@@ -63,6 +63,8 @@ def make_source():
     source.SetWind(4.0, 0.0)  # m/s: 0.4 cells per step at the bottom
     source.SetShear(0.002, 0.0)  # faster aloft
     source.SetPeriodicBoundary(False)
+    source.SetNumberOfFormationRegions(0)  # the four ellipsoids above are the regions
+    source.SetSpinUpSteps(0)  # frames from the start, 150 s apart
     source.SetSmoothingRadius(3.0)
     return source
 

@@ -2,6 +2,7 @@
 
 #include "Metaballs.h" // WyvillFalloff
 #include "ParallelFor.h"
+#include "Random.h"
 
 #include <algorithm>
 #include <cmath>
@@ -818,6 +819,109 @@ void InterpolateDensity(
   {
     out[i] = a[i] + s * (b[i] - a[i]);
   }
+}
+
+std::vector<float> FormationRegionWeights(
+  const int dimensions[3], const std::vector<FormationRegion>& regions, bool periodic)
+{
+  const int nx = dimensions[0], ny = dimensions[1], nz = dimensions[2];
+  std::vector<float> weights(static_cast<std::size_t>(nx) * ny * nz, 0.0f);
+  constexpr double cutoff = 3.0; // semi-axes
+  for (const FormationRegion& region : regions)
+  {
+    // The box of cells within the cutoff (unwrapped indices; wrapped below when periodic).
+    int low[3], high[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const double reach = cutoff * std::max(region.Radius[a], 1e-9);
+      low[a] = static_cast<int>(std::floor(region.Center[a] - reach));
+      high[a] = static_cast<int>(std::ceil(region.Center[a] + reach));
+      const bool wraps = periodic && a < 2;
+      const int n = dimensions[a];
+      if (wraps && high[a] - low[a] + 1 > n)
+      {
+        // Wider than the grid: every cell once, at its nearest image.
+        low[a] = static_cast<int>(std::floor(region.Center[a] - 0.5 * n));
+        high[a] = low[a] + n - 1;
+      }
+      else if (!wraps)
+      {
+        low[a] = std::max(low[a], 0);
+        high[a] = std::min(high[a], n - 1);
+      }
+    }
+    for (int k = low[2]; k <= high[2]; ++k)
+    {
+      const double dz = (k - region.Center[2]) / region.Radius[2];
+      for (int j = low[1]; j <= high[1]; ++j)
+      {
+        const double dy = (j - region.Center[1]) / region.Radius[1];
+        const int y = ((j % ny) + ny) % ny;
+        for (int i = low[0]; i <= high[0]; ++i)
+        {
+          const double dx = (i - region.Center[0]) / region.Radius[0];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          if (r2 > cutoff * cutoff)
+          {
+            continue;
+          }
+          const int x = ((i % nx) + nx) % nx;
+          float& w =
+            weights[x + static_cast<std::size_t>(nx) * (y + static_cast<std::size_t>(ny) * k)];
+          w = std::max(w, static_cast<float>(std::exp(-0.5 * r2)));
+        }
+      }
+    }
+  }
+  return weights;
+}
+
+std::vector<FormationRegion> RandomFormationRegions(const int dimensions[3], int count,
+  const double horizontalRadius[2], double aspect, double centerHeight, std::uint64_t seed,
+  bool inside)
+{
+  Random random(seed ^ 0x9E3779B97F4A7C15ull);
+  std::vector<FormationRegion> regions;
+  const double low = std::min(horizontalRadius[0], horizontalRadius[1]);
+  const double high = std::max(horizontalRadius[0], horizontalRadius[1]);
+  for (int r = 0; r < count; ++r)
+  {
+    FormationRegion region;
+    const double radius = random.Uniform(low, high);
+    region.Radius[0] = region.Radius[1] = radius;
+    region.Radius[2] = aspect * radius;
+    region.Center[2] = centerHeight;
+    // Kept apart while there are few regions (beyond 256 the test would cost too much and
+    // there is no room anyway).
+    const int attempts = regions.size() < 256 ? 64 : 1;
+    for (int attempt = 0; attempt < attempts; ++attempt)
+    {
+      for (int a = 0; a < 2; ++a)
+      {
+        const double margin = inside && dimensions[a] > 6.0 * radius ? 3.0 * radius : 0.0;
+        region.Center[a] = random.Uniform(margin, dimensions[a] - margin);
+      }
+      bool apart = true;
+      for (const FormationRegion& other : regions)
+      {
+        double d2 = 0.0;
+        for (int a = 0; a < 2; ++a)
+        {
+          double d = std::abs(region.Center[a] - other.Center[a]);
+          d = std::min(d, dimensions[a] - d); // nearest image
+          d2 += d * d;
+        }
+        const double apartDistance = 1.5 * (radius + other.Radius[0]);
+        apart = apart && d2 >= apartDistance * apartDistance;
+      }
+      if (apart)
+      {
+        break;
+      }
+    }
+    regions.push_back(region);
+  }
+  return regions;
 }
 
 } // namespace nimbus

@@ -155,6 +155,32 @@ private:
   CloudAutomatonState Scratch;
 };
 
+/// A formation region: where vapour and activation are supplied, so that separate clouds
+/// form there (Dobashi et al. 2000 give the supply probabilities the shape of ellipsoids).
+/// A Gaussian ellipsoid: centre and semi-axes (its standard deviations), in cells.
+struct FormationRegion
+{
+  double Center[3] = { 0.0, 0.0, 0.0 };
+  double Radius[3] = { 1.0, 1.0, 1.0 };
+};
+
+/// Per-cell weight in [0, 1] on the grid `dimensions` (x fastest): the largest
+/// exp(-r^2 / 2) over the regions, r the distance from a region's centre in units of its
+/// semi-axes, 0 where r > 3. With `periodic`, regions wrap around in x and y (nearest image).
+NIMBUSFILTERS_EXPORT std::vector<float> FormationRegionWeights(
+  const int dimensions[3], const std::vector<FormationRegion>& regions, bool periodic);
+
+/// `count` regions drawn from `seed` (the same on every platform): centres uniform over x
+/// and y at height `centerHeight`, horizontal semi-axes uniform in `horizontalRadius` (low,
+/// high) and the same ratio vertical/horizontal `aspect` for all; a centre is redrawn (up to
+/// 64 times, for the first 256 regions) while it lies within 1.5 times the sum of the horizontal
+/// semi-axes of an earlier one, so that the clouds stay apart where there is room. Units: cells.
+/// With `inside`, centres keep three horizontal semi-axes from the x and y faces (where the
+/// grid is wide enough), so that open faces do not cut the clouds.
+NIMBUSFILTERS_EXPORT std::vector<FormationRegion> RandomFormationRegions(const int dimensions[3],
+  int count, const double horizontalRadius[2], double aspect, double centerHeight,
+  std::uint64_t seed, bool inside = false);
+
 /// Options of the smoothing of cld into a continuous density.
 struct CloudSmoothingParameters
 {

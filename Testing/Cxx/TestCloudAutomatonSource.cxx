@@ -18,8 +18,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,16 @@ void Configure(vtkNimbusCloudAutomatonSource* source)
   source->SetWind(30.0, -10.0); // 0.6 and -0.2 cells per step
   source->SetShear(0.05, 0.0);  // +0.1 cell/step per layer
   source->SetCheckpointInterval(8);
+  // The mechanics below are checked against the core with uniform probabilities and no
+  // spin-up (the defaults' formation regions and spin-up have their own tests).
+  source->SetNumberOfFormationRegions(0);
+  source->SetSpinUpSteps(0);
+  source->SetPeriodicBoundary(true);
+  source->SetExtinctionProbability(0.05);
+  source->SetHumidityProbability(0.002);
+  source->SetActivationProbability(0.0002);
+  source->SetInitialHumidity(0.3);
+  source->SetInitialActivation(0.001);
 }
 
 std::vector<float> DensityAt(vtkNimbusCloudAutomatonSource* source, double time)
@@ -378,6 +390,8 @@ TEST(CloudAutomatonSource, AMillionStepsAreRefusedWithAnEstimate)
   // The default 128 x 128 x 32 grid at step 1e6 ran for many minutes before.
   vtkNew<vtkNimbusCloudAutomatonSource> source;
   source->SetNumberOfTimeSteps(1000000);
+  source->SetStepDuration(1.0);
+  source->SetSpinUpSteps(0);
   MessageCatcher catcher(source);
   const auto start = std::chrono::steady_clock::now();
   EXPECT_TRUE(DensityAt(source, 1.0e6).empty());
@@ -410,4 +424,130 @@ TEST(CloudAutomatonSource, BadInputMapValuesAreCounted)
   ASSERT_EQ(catcher.Errors.size(), 1u);
   EXPECT_NE(catcher.Errors[0].find("1 NaN, 1 infinite and 1 negative"), std::string::npos)
     << catcher.Errors[0];
+}
+
+TEST(CloudAutomatonSource, FormationRegionWeightsAreGaussianEllipsoids)
+{
+  const int dims[3] = { 40, 30, 10 };
+  nimbus::FormationRegion region;
+  region.Center[0] = 2.0; // near the x = 0 face: wraps when periodic
+  region.Center[1] = 15.0;
+  region.Center[2] = 4.0;
+  region.Radius[0] = 3.0;
+  region.Radius[1] = 2.0;
+  region.Radius[2] = 1.0;
+  auto at = [&](const std::vector<float>& w, int x, int y, int z)
+  { return w[x + dims[0] * (y + dims[1] * z)]; };
+  const std::vector<float> open = nimbus::FormationRegionWeights(dims, { region }, false);
+  const std::vector<float> periodic = nimbus::FormationRegionWeights(dims, { region }, true);
+  EXPECT_FLOAT_EQ(at(open, 2, 15, 4), 1.0f);
+  EXPECT_NEAR(at(open, 5, 15, 4), std::exp(-0.5), 1e-6);                   // one semi-axis along x
+  EXPECT_NEAR(at(open, 2, 17, 4), std::exp(-0.5), 1e-6);                   // along y
+  EXPECT_NEAR(at(open, 2, 15, 5), std::exp(-0.5), 1e-6);                   // along z
+  EXPECT_EQ(at(open, 2, 15, 8), 0.0f);                                     // beyond 3 semi-axes
+  EXPECT_EQ(at(open, 38, 15, 4), 0.0f);                                    // open: no wrap
+  EXPECT_NEAR(at(periodic, 38, 15, 4), std::exp(-0.5 * 16.0 / 9.0), 1e-6); // 4 cells away
+  // Random regions: deterministic per seed, inside the grid, radii in range.
+  const double range[2] = { 3.0, 5.0 };
+  const auto a = nimbus::RandomFormationRegions(dims, 4, range, 0.5, 3.0, 7);
+  const auto b = nimbus::RandomFormationRegions(dims, 4, range, 0.5, 3.0, 7);
+  const auto c = nimbus::RandomFormationRegions(dims, 4, range, 0.5, 3.0, 8);
+  ASSERT_EQ(a.size(), 4u);
+  for (std::size_t r = 0; r < a.size(); ++r)
+  {
+    EXPECT_EQ(a[r].Center[0], b[r].Center[0]);
+    EXPECT_EQ(a[r].Center[1], b[r].Center[1]);
+    EXPECT_GE(a[r].Center[0], 0.0);
+    EXPECT_LT(a[r].Center[0], 40.0);
+    EXPECT_GE(a[r].Radius[0], 3.0);
+    EXPECT_LE(a[r].Radius[0], 5.0);
+    EXPECT_DOUBLE_EQ(a[r].Radius[2], 0.5 * a[r].Radius[0]);
+    EXPECT_DOUBLE_EQ(a[r].Center[2], 3.0);
+  }
+  EXPECT_NE(a[0].Center[0], c[0].Center[0]);
+}
+
+namespace
+{
+// Cloudy columns (vertical sum of density above `threshold` cells' worth) and their
+// 4-connected groups on the periodic x-y grid.
+struct Cover
+{
+  double Fraction = 0.0;
+  int Groups = 0;
+};
+
+Cover MeasureCover(const std::vector<float>& density, int nx, int ny, int nz, double threshold)
+{
+  std::vector<int> cloudy(static_cast<std::size_t>(nx) * ny, 0);
+  Cover cover;
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x)
+    {
+      double column = 0.0;
+      for (int z = 0; z < nz; ++z)
+        column += density[x + nx * (y + static_cast<std::size_t>(ny) * z)];
+      if (column > threshold)
+      {
+        cloudy[x + nx * y] = 1;
+        cover.Fraction += 1.0;
+      }
+    }
+  cover.Fraction /= static_cast<double>(nx) * ny;
+  std::vector<int> stack;
+  for (int start = 0; start < nx * ny; ++start)
+  {
+    if (cloudy[start] != 1)
+      continue;
+    ++cover.Groups;
+    stack.push_back(start);
+    cloudy[start] = 2;
+    while (!stack.empty())
+    {
+      const int i = stack.back();
+      stack.pop_back();
+      const int x = i % nx, y = i / nx;
+      const int next[4] = { (x + 1) % nx + nx * y, (x + nx - 1) % nx + nx * y,
+        x + nx * ((y + 1) % ny), x + nx * ((y + ny - 1) % ny) };
+      for (const int j : next)
+        if (cloudy[j] == 1)
+        {
+          cloudy[j] = 2;
+          stack.push_back(j);
+        }
+    }
+  }
+  return cover;
+}
+}
+
+TEST(CloudAutomatonSource, DefaultsGiveSeparateCumulusThatDrift)
+{
+  // The first Apply in ParaView: time 0 of the defaults. Before issue 15 the defaults (uniform
+  // vapour 0.3, no regions, no wind) filled the whole box: every column cloudy, one group.
+  vtkNew<vtkNimbusCloudAutomatonSource> source;
+  const std::vector<float> first = DensityAt(source, 0.0);
+  ASSERT_EQ(first.size(), 128u * 128u * 32u);
+  EXPECT_DOUBLE_EQ(
+    source->GetOutput()->GetFieldData()->GetArray("AutomatonStep")->GetComponent(0, 0), 40.0);
+  const Cover cover = MeasureCover(first, 128, 128, 32, 1.0);
+  std::cout << "defaults at t = 0: cloudy columns " << 100.0 * cover.Fraction << " %, "
+            << cover.Groups << " separate clouds\n";
+  EXPECT_GT(cover.Fraction, 0.03);
+  EXPECT_LT(cover.Fraction, 0.35);
+  EXPECT_GE(cover.Groups, 4);
+  // Nothing touches the top of the box (no slab with a lid).
+  double top = 0.0;
+  for (int i = 0; i < 128 * 128; ++i)
+    top = std::max(top, static_cast<double>(first[i + 128 * 128 * 31]));
+  EXPECT_LT(top, 0.05);
+  vtkNew<vtkNimbusCloudAutomatonSource> again;
+  const std::vector<float> repeat = DensityAt(again, 0.0);
+  EXPECT_EQ(repeat, first); // same seed, same clouds
+  again->SetSeed(2);
+  EXPECT_NE(DensityAt(again, 0.0), first);
+  // Spin-up: time 0 with 40 spin-up steps is step 40 of the run without.
+  vtkNew<vtkNimbusCloudAutomatonSource> noSpinUp;
+  noSpinUp->SetSpinUpSteps(0);
+  EXPECT_EQ(DensityAt(noSpinUp, 400.0), first);
 }

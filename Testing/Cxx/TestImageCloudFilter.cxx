@@ -3,6 +3,7 @@
 // arrays), RGB input uses luminance, the shipped sample image runs, bad input is refused.
 #include "vtkNimbusImageCloudFilter.h"
 
+#include "vtkCellData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
@@ -55,13 +56,15 @@ vtkNew<vtkImageData> DiscImage(int nx, int ny, const std::vector<Disc>& discs, i
 
 TEST(ImageCloudFilter, DiscsGetTheirOpticalDepths)
 {
-  // Linear mapping, defaults: u = (gray/255 - 0.1) / 0.9, tau = 30 u.
+  // Linear mapping: u = (gray/255 - 0.1) / 0.9, tau = 30 u.
   const std::vector<Disc> discs = { { 24, 24, 18, 80 }, { 70, 30, 20, 160 }, { 45, 62, 16, 255 } };
   for (const int components : { 1, 3 })
   {
     auto image = DiscImage(96, 84, discs, components);
     vtkNew<vtkNimbusImageCloudFilter> filter;
     filter->SetInputData(image);
+    filter->SetMappingTypeToLinear();
+    filter->SetClearIntensity(0.1);
     filter->Update();
     vtkImageData* density = filter->GetOutput();
     vtkImageData* map = filter->GetOpticalDepthMap();
@@ -168,13 +171,14 @@ TEST(ImageCloudFilter, ArrayMessagesNameWhatTheInputHas)
     << catcher.Errors[0];
   EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);
 
-  // No point arrays at all.
+  // No arrays at all.
   vtkNew<vtkImageData> bare;
   bare->SetDimensions(16, 16, 1);
   filter->SetInputData(bare);
   filter->Update();
   ASSERT_EQ(catcher.Errors.size(), 2u);
-  EXPECT_NE(catcher.Errors[1].find("no point arrays"), std::string::npos) << catcher.Errors[1];
+  EXPECT_NE(catcher.Errors[1].find("no point or cell arrays"), std::string::npos)
+    << catcher.Errors[1];
 }
 
 TEST(ImageCloudFilter, NonFiniteAndNegativeIntensitiesAreCountedInAWarning)
@@ -236,4 +240,106 @@ TEST(ImageCloudFilter, SizeAndBudgetMessagesNameTheRealCause)
   EXPECT_NE(catcher.Errors[2].find("MaximumOpticalDepth"), std::string::npos) << catcher.Errors[2];
   filter->SetMaximumOpticalDepth(1e308); // finite: clamped to 1000, as the setter documents
   EXPECT_EQ(filter->GetMaximumOpticalDepth(), 1000.0);
+}
+
+TEST(ImageCloudFilter, DefaultsKeepTheDarkSeaClear)
+{
+  // The first Apply: the sample image with the defaults (TwoStream, ClearIntensity 0.25).
+  // Before issue 15 the defaults (Linear, 0.1) made the sea (25 to 50 of 255) a cloud of
+  // optical depth up to 3: a solid square.
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(NIMBUS_SAMPLE_IMAGE);
+  reader->Update();
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  filter->SetInputConnection(reader->GetOutputPort());
+  filter->Update();
+  vtkDataArray* gray = reader->GetOutput()->GetPointData()->GetScalars();
+  auto* target = filter->GetOpticalDepthMap()->GetPointData()->GetArray("optical_depth");
+  ASSERT_TRUE(gray && target);
+  ASSERT_EQ(target->GetNumberOfTuples(), gray->GetNumberOfTuples());
+  vtkIdType sea = 0, clearSea = 0, bright = 0, thickBright = 0;
+  for (vtkIdType i = 0; i < gray->GetNumberOfTuples(); ++i)
+  {
+    const double g = gray->GetComponent(i, 0);
+    const double tau = target->GetComponent(i, 0);
+    if (g <= 55)
+    {
+      ++sea;
+      clearSea += tau == 0.0 ? 1 : 0;
+    }
+    if (g >= 200)
+    {
+      ++bright;
+      thickBright += tau >= 5.0 ? 1 : 0;
+    }
+  }
+  std::cout << "sample image, defaults: " << clearSea << " of " << sea << " sea pixels clear, "
+            << thickBright << " of " << bright << " bright pixels at tau >= 5\n";
+  EXPECT_GT(sea, 8000);
+  EXPECT_EQ(clearSea, sea);
+  EXPECT_GT(bright, 1000);
+  EXPECT_EQ(thickBright, bright);
+}
+
+TEST(ImageCloudFilter, PixelsAsCellsLikeParaViewsGdalReader)
+{
+  // ParaView opens a PNG with its GDAL reader: nx x ny pixels as a cell array on
+  // (nx + 1) x (ny + 1) points. The filter takes it (no point arrays at all) and gives each
+  // point the mean of the cells around it.
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(NIMBUS_SAMPLE_IMAGE);
+  reader->Update();
+  vtkImageData* png = reader->GetOutput();
+  vtkNew<vtkImageData> gdal;
+  gdal->SetDimensions(129, 129, 1);
+  vtkNew<vtkUnsignedCharArray> elevation;
+  elevation->SetName("Elevation");
+  elevation->SetNumberOfTuples(128 * 128);
+  for (vtkIdType i = 0; i < 128 * 128; ++i)
+  {
+    elevation->SetValue(
+      i, static_cast<unsigned char>(png->GetPointData()->GetScalars()->GetComponent(i, 0)));
+  }
+  gdal->GetCellData()->SetScalars(elevation);
+  vtkNew<vtkNimbusImageCloudFilter> filter;
+  filter->SetInputData(gdal);
+  MessageCatcher catcher(filter);
+  filter->Update();
+  EXPECT_TRUE(catcher.Errors.empty()) << catcher.AllErrors();
+  int dims[3];
+  filter->GetOutput()->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 129);
+  EXPECT_EQ(dims[1], 129);
+  auto* target = filter->GetOpticalDepthMap()->GetPointData()->GetArray("optical_depth");
+  ASSERT_NE(target, nullptr);
+  // Point (x, y) from cells (x-1..x, y-1..y): a corner takes its one cell, an inner point four.
+  vtkNew<vtkNimbusImageCloudFilter> reference;
+  vtkNew<vtkImageData> averaged;
+  averaged->SetDimensions(129, 129, 1);
+  vtkNew<vtkFloatArray> mean;
+  mean->SetNumberOfTuples(129 * 129);
+  for (int y = 0; y < 129; ++y)
+    for (int x = 0; x < 129; ++x)
+    {
+      double sum = 0.0;
+      int count = 0;
+      for (int cy = std::max(y - 1, 0); cy <= std::min(y, 127); ++cy)
+        for (int cx = std::max(x - 1, 0); cx <= std::min(x, 127); ++cx)
+        {
+          sum += elevation->GetValue(cx + 128 * cy);
+          ++count;
+        }
+      mean->SetValue(x + 129 * y, static_cast<float>(sum / count));
+    }
+  averaged->GetPointData()->SetScalars(mean);
+  reference->SetInputData(averaged);
+  reference->Update();
+  auto* expected = reference->GetOpticalDepthMap()->GetPointData()->GetArray("optical_depth");
+  ASSERT_NE(expected, nullptr);
+  double worst = 0.0, range[2];
+  target->GetRange(range, 0);
+  for (vtkIdType i = 0; i < 129 * 129; ++i)
+    worst = std::max(worst, std::abs(target->GetComponent(i, 0) - expected->GetComponent(i, 0)));
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_GT(range[1], 5.0);
 }

@@ -521,6 +521,23 @@ std::vector<Property<AutomatonSetup>> AutomatonProperties()
     [](A* s, double v) { s->SetMaximumNumberOfCheckpoints(ToInt(v)); }, 16);
   scalar(
     "MemoryBudgetMiB", false, true, [](A* s, double v) { s->SetMemoryBudgetMiB(v); }, 2048);
+  scalar(
+    "NumberOfFormationRegions", true, true,
+    [](A* s, double v) { s->SetNumberOfFormationRegions(ToInt(v)); }, 6);
+  for (int a = 0; a < 2; ++a)
+  {
+    properties.push_back({ "FormationRegionRadiusRange[" + std::to_string(a) + "]", false, true,
+      [a](S& s, double v)
+      {
+        double r[2];
+        s.Source->GetFormationRegionRadiusRange(r);
+        r[a] = v;
+        s.Source->SetFormationRegionRadiusRange(r);
+      },
+      a == 0 ? 500.0 : 900.0 });
+  }
+  scalar(
+    "SpinUpSteps", true, true, [](A* s, double v) { s->SetSpinUpSteps(ToInt(v)); }, 40);
   // The requested time: NaN reads as time 0, infinities are clamped to the time range.
   properties.push_back({ "UpdateTimeStep", false, false, [](S& s, double v) { s.Time = v; }, 3.5 });
   // One cell of an input p_hum map: values outside [0, 1] are refused.
@@ -934,6 +951,7 @@ TEST(ExtremeParameters, ReportedCases)
     {
       s.Source->SetDimensions(128, 128, 32);
       s.Source->SetNumberOfTimeSteps(1000000);
+      s.Source->SetStepDuration(1.0); // a million steps, as before the defaults changed
       s.Time = 1.0e6;
     },
     "cell updates");

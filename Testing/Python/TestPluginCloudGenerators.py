@@ -76,7 +76,7 @@ def main():
     # --- clouds from the sample image --------------------------------------------------------
     reader = PNGSeriesReader(FileNames=[args.image])
     cloud = NimbusImageCloud(Input=reader, MappingType="TwoStream",  # noqa: F821
-                             MaximumOpticalDepth=40.0)
+                             MaximumOpticalDepth=40.0, ClearIntensity=0.1)
     cloud_data, cloud_density = fetch_density(cloud, 0.0)
     dims = cloud_data.GetDimensions()
     ok &= check(dims[0] == 128 and dims[1] == 128 and dims[2] > 10,

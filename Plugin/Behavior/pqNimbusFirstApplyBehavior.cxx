@@ -1,0 +1,192 @@
+#include "pqNimbusFirstApplyBehavior.h"
+
+#include "pqApplicationCore.h"
+#include "pqDataRepresentation.h"
+#include "pqOutputPort.h"
+#include "pqPipelineFilter.h"
+#include "pqPipelineSource.h"
+#include "pqRenderView.h"
+#include "pqServerManagerModel.h"
+#include "vtkSMPVRepresentationProxy.h"
+#include "vtkSMPropertyHelper.h"
+#include "vtkSMProxy.h"
+#include "vtkSMViewProxy.h"
+
+#include <QPointer>
+#include <QTimer>
+
+#include <cmath>
+#include <cstring>
+
+namespace
+{
+// Sources and filters of clouds and the sky (proxy XML names).
+bool IsNimbusCloudProducer(pqPipelineSource* source)
+{
+  const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
+  if (!name)
+  {
+    return false;
+  }
+  for (const char* cloud :
+    { "NimbusMetaballCloud", "NimbusCloudAutomaton", "NimbusCloudAutomatonWithMaps",
+      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome" })
+  {
+    if (std::strcmp(name, cloud) == 0)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* RepresentationType(pqRepresentation* representation)
+{
+  vtkSMProxy* proxy = representation ? representation->getProxy() : nullptr;
+  if (!proxy || !proxy->GetProperty("Representation"))
+  {
+    return nullptr;
+  }
+  return vtkSMPropertyHelper(proxy, "Representation", /*quiet=*/true).GetAsString();
+}
+
+// The types whose picture does not use the colour map.
+bool DrawsWithoutColorMap(pqRepresentation* representation)
+{
+  const char* type = RepresentationType(representation);
+  return type && (std::strcmp(type, "Cloud") == 0 || std::strcmp(type, "Sky Background") == 0);
+}
+
+bool IsSkyBackground(pqRepresentation* representation)
+{
+  const char* type = RepresentationType(representation);
+  return type && std::strcmp(type, "Sky Background") == 0;
+}
+}
+
+pqNimbusFirstApplyBehavior::pqNimbusFirstApplyBehavior(QObject* parent)
+  : QObject(parent)
+{
+}
+
+pqNimbusFirstApplyBehavior::~pqNimbusFirstApplyBehavior() = default;
+
+void pqNimbusFirstApplyBehavior::startup()
+{
+  pqServerManagerModel* model = pqApplicationCore::instance()->getServerManagerModel();
+  QObject::connect(
+    model, &pqServerManagerModel::viewAdded, this, &pqNimbusFirstApplyBehavior::onViewAdded);
+  for (pqView* view : model->findItems<pqView*>())
+  {
+    this->onViewAdded(view);
+  }
+}
+
+void pqNimbusFirstApplyBehavior::shutdown()
+{
+  QObject::disconnect(this);
+}
+
+void pqNimbusFirstApplyBehavior::onViewAdded(pqView* view)
+{
+  if (qobject_cast<pqRenderView*>(view))
+  {
+    QObject::connect(view, &pqView::representationAdded, this,
+      &pqNimbusFirstApplyBehavior::onRepresentationAdded, Qt::UniqueConnection);
+    // The GUI shows a legend right after a change of colouring or representation type, then
+    // renders: look after each render (a check of a few properties; at most one more render).
+    QPointer<pqView> guarded(view);
+    QObject::connect(view, &pqView::endRender, this,
+      [this, guarded]()
+      { QTimer::singleShot(0, this, [this, guarded]() { this->hideLegends(guarded); }); });
+  }
+}
+
+void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* representation)
+{
+  auto* data = qobject_cast<pqDataRepresentation*>(representation);
+  auto* view = qobject_cast<pqRenderView*>(representation ? representation->getView() : nullptr);
+  if (!data || !view)
+  {
+    return;
+  }
+  if (IsSkyBackground(representation) &&
+    vtkSMPVRepresentationProxy::GetUsingScalarColoring(representation->getProxy()))
+  {
+    // Solid Color: the sky background does not use the colour map.
+    vtkSMPVRepresentationProxy::SetScalarColoring(representation->getProxy(), nullptr, 0);
+    representation->getProxy()->UpdateVTKObjects();
+  }
+
+  // The camera: only for the first data in the view (a sky background does not count).
+  if (!IsNimbusCloudProducer(data->getInput()))
+  {
+    return;
+  }
+  // The filter's inputs do not count: Apply hides them (an image under the image cloud).
+  QList<pqPipelineSource*> inputs;
+  if (auto* filter = qobject_cast<pqPipelineFilter*>(data->getInput()))
+  {
+    for (pqOutputPort* port : filter->getAllInputs())
+    {
+      inputs.push_back(port->getSource());
+    }
+  }
+  for (pqRepresentation* other : view->getRepresentations())
+  {
+    auto* otherData = qobject_cast<pqDataRepresentation*>(other);
+    if (other != representation && other->isVisible() && !IsSkyBackground(other) && otherData &&
+      !inputs.contains(otherData->getInput()))
+    {
+      return;
+    }
+  }
+  // Looking north (+y), 11 degrees down, z up. ParaView resets the camera to the data's
+  // bounds right after (Apply), keeping this direction.
+  vtkSMProxy* viewProxy = view->getProxy();
+  double focal[3] = { 0.0, 0.0, 0.0 };
+  vtkSMPropertyHelper(viewProxy, "CameraFocalPoint").Get(focal, 3);
+  const double look[3] = { 0.0, std::cos(11.0 * M_PI / 180.0), -std::sin(11.0 * M_PI / 180.0) };
+  const double position[3] = { focal[0] - look[0], focal[1] - look[1], focal[2] - look[2] };
+  const double up[3] = { 0.0, 0.0, 1.0 };
+  vtkSMPropertyHelper(viewProxy, "CameraPosition").Set(position, 3);
+  vtkSMPropertyHelper(viewProxy, "CameraViewUp").Set(up, 3);
+  viewProxy->UpdateVTKObjects();
+  // Fit the data once Apply is done (Apply resets the camera itself only when this is the
+  // one visible representation, i.e. not while a filter's input is still shown).
+  QPointer<pqRenderView> guarded(view);
+  QTimer::singleShot(0, this,
+    [guarded]()
+    {
+      if (guarded)
+      {
+        guarded->resetCamera();
+        guarded->render();
+      }
+    });
+}
+
+void pqNimbusFirstApplyBehavior::hideLegends(pqView* view)
+{
+  if (!view)
+  {
+    return;
+  }
+  vtkSMProxy* viewProxy = view->getProxy();
+  bool hidden = false;
+  for (pqRepresentation* representation : view->getRepresentations())
+  {
+    vtkSMProxy* proxy = representation->getProxy();
+    if (DrawsWithoutColorMap(representation) &&
+      vtkSMPVRepresentationProxy::GetUsingScalarColoring(proxy) &&
+      vtkSMPVRepresentationProxy::IsScalarBarVisible(proxy, viewProxy))
+    {
+      vtkSMPVRepresentationProxy::SetScalarBarVisibility(proxy, viewProxy, false);
+      hidden = true;
+    }
+  }
+  if (hidden)
+  {
+    view->render();
+  }
+}
