@@ -176,10 +176,14 @@ int main(int argc, char* argv[])
     }
     double Frame()
     {
+      // A small camera turn: the mapper reuses its last image when nothing changed.
+      this->Renderer->GetActiveCamera()->Azimuth((this->Frames++ % 2) ? 0.01 : -0.01);
       const auto start = Clock::now();
       this->Window->Render();
+      this->Window->WaitForCompletion();
       return Seconds(start);
     }
+    int Frames = 0;
   };
   View single(cloud, 0);
   single.Frame();
