@@ -541,6 +541,9 @@ class SvsRenderer:
         self.mapper.SetPatternRadius(int(settings.get("pattern_radius", 6)))
         self.mapper.SetPatternSelection(float(settings.get("pattern_selection", 0.25)))
         solves = self.mapper.GetNumberOfMultipleScatteringSolves()
+        # Every timed frame is drawn in full: the mapper reuses its last image when
+        # nothing it depends on changed (a repeat of the same settings).
+        self.mapper.Modified()
         self.window.Render()
         if self.mapper.GetNumberOfMultipleScatteringSolves() != solves:
             self.extra = {"precompute_seconds": self.mapper.GetLastMultipleScatteringSeconds(),
