@@ -84,6 +84,11 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, FrameBudgetMilliseconds);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Quality);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, InteractiveUpdateRate);
 
+void vtkNimbusCloudVolumeMapper::SetScalarMode(int mode)
+{
+  this->ScalarMode = mode;
+}
+
 double vtkNimbusCloudVolumeMapper::GetQualityMinValue()
 {
   return nimbus::kMinimumFrameQuality;
@@ -630,7 +635,9 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
   const auto time = [](vtkObject* o) { return o ? static_cast<double>(o->GetMTime()) : -1.0; };
   vtkNimbusSky* sky = this->GetFollowedSky();
   key.insert(key.end(),
-    { time(this), time(frame.Image), time(frame.Scalars), time(this->SkyBackground), time(sky),
+    { time(this), time(frame.Image), time(frame.Scalars),
+      static_cast<double>(reinterpret_cast<std::uintptr_t>(frame.Scalars)),
+      frame.CellData ? 1.0 : 0.0, time(this->SkyBackground), time(sky),
       static_cast<double>(in.Density.GetNumberOfUploads()),
       static_cast<double>(in.Scattering.GetNumberOfSolves()), frame.ScatteringScale,
       static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),

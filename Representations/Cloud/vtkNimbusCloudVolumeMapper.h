@@ -451,6 +451,13 @@ public:
   /// Dimensions of the density texture last uploaded.
   void GetTextureDimensions(int dims[3]) const;
 
+  /// The scalar mode, without Modified(): the array it selects is resolved every
+  /// frame and is part of the frame's reuse key, and ParaView's Cloud representation
+  /// sets it twice per render with Solid Color (its superclass the point field data
+  /// mode, then the representation the default mode that finds the active scalars);
+  /// a Modified() each time would keep any frame from being reused.
+  void SetScalarMode(int mode) override;
+
   void Render(vtkRenderer* renderer, vtkVolume* volume) override;
   void ReleaseGraphicsResources(vtkWindow* window) override;
 

@@ -343,6 +343,12 @@ bool FrameBudgetAndReuse(const Context&)
   ok &= Check(!s.Mapper->GetLastFrameReused(), "the sphere moved: not reused");
   s.Render();
   ok &= Check(s.Mapper->GetLastFrameReused(), "the sphere stays: reused");
+  // ParaView's Cloud representation with Solid Color sets the scalar mode twice per
+  // render (point field data, then the default): the same array, still reused.
+  s.Mapper->SetScalarModeToUsePointFieldData();
+  s.Mapper->SetScalarModeToDefault();
+  s.Render();
+  ok &= Check(s.Mapper->GetLastFrameReused(), "scalar mode set back and forth: reused");
   s.Mapper->SetCloudG(0.8);
   s.Render();
   ok &= Check(!s.Mapper->GetLastFrameReused(), "a setting changed: not reused");
