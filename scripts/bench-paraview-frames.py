@@ -25,18 +25,10 @@ from paraview.simple import (ColorBy, CreateRenderView, Delete, GetColorTransfer
 
 def cloud_mapper(view):
     try:
-        import nimbus  # noqa: F401 (registers the mapper's Python class)
+        import nimbus
     except ImportError:
         return None
-    volumes = view.SMProxy.GetRenderer().GetVolumes()
-    volumes.InitTraversal()
-    for _ in range(volumes.GetNumberOfItems()):
-        volume = volumes.GetNextVolume()
-        mapper = volume.GetMapper()
-        if volume.GetVisibility() and mapper is not None and \
-                mapper.IsA("vtkNimbusCloudVolumeMapper"):
-            return mapper
-    return None
+    return nimbus.find_cloud_mapper(view.SMProxy.GetRenderer())
 
 
 def timed(view, interactive, repeats, turn=True):

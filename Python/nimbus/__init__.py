@@ -15,3 +15,17 @@ except ModuleNotFoundError:
     pass
 
 __version__ = "0.1.0"
+
+
+def find_cloud_mapper(renderer):
+    """The first visible vtkNimbusCloudVolumeMapper among `renderer`'s volumes, or None
+    (e.g. ParaView's Cloud representation: view.SMProxy.GetRenderer())."""
+    volumes = renderer.GetVolumes()
+    volumes.InitTraversal()
+    for _ in range(volumes.GetNumberOfItems()):
+        volume = volumes.GetNextVolume()
+        mapper = volume.GetMapper()
+        if volume.GetVisibility() and mapper is not None and \
+                mapper.IsA("vtkNimbusCloudVolumeMapper"):
+            return mapper
+    return None

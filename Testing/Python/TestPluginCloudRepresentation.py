@@ -46,18 +46,10 @@ def read_png(path):
 def cloud_mapper(view):
     """The visible vtkNimbusCloudVolumeMapper in the view (None without `import nimbus`)."""
     try:
-        import nimbus  # noqa: F401 (registers the mapper's Python class)
+        import nimbus
     except ImportError:
         return None
-    volumes = view.SMProxy.GetRenderer().GetVolumes()
-    volumes.InitTraversal()
-    for _ in range(volumes.GetNumberOfItems()):
-        volume = volumes.GetNextVolume()
-        mapper = volume.GetMapper()
-        if volume.GetVisibility() and mapper is not None and \
-                mapper.IsA("vtkNimbusCloudVolumeMapper"):
-            return mapper
-    return None
+    return nimbus.find_cloud_mapper(view.SMProxy.GetRenderer())
 
 
 # The "Multiple Scattering" group: property -> (the mapper's default, a test value).

@@ -138,17 +138,10 @@ def check_words(failures):
 def cloud_mapper(view):
     """The visible vtkNimbusCloudVolumeMapper (None without `import nimbus`)."""
     try:
-        import nimbus  # noqa: F401
+        import nimbus
     except ImportError:
         return None
-    volumes = view.SMProxy.GetRenderer().GetVolumes()
-    volumes.InitTraversal()
-    for _ in range(volumes.GetNumberOfItems()):
-        volume = volumes.GetNextVolume()
-        if volume.GetVisibility() and volume.GetMapper() is not None and \
-                volume.GetMapper().IsA("vtkNimbusCloudVolumeMapper"):
-            return volume.GetMapper()
-    return None
+    return nimbus.find_cloud_mapper(view.SMProxy.GetRenderer())
 
 
 def main():
