@@ -574,7 +574,6 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     this->RenderIntervalPhase(frame);
     this->RenderRayEnds(frame);
     this->ClearAccumulation(frame);
-    this->RenderOutsideRegion(frame, false);
     if (!this->RenderSlices(renderer, frame))
     {
       // Aborted: nothing is drawn over the scene this frame.
@@ -584,7 +583,9 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
       in.LastAborted = true;
       return true;
     }
+    // Behind the box first: its blend reads the cloud transmittance the slices left.
     this->RenderOutsideRegion(frame, true);
+    this->RenderOutsideRegion(frame, false);
     this->CaptureRadianceImage(frame);
   }
   this->RenderComposite(frame);
@@ -1117,6 +1118,12 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(frame.WorldToBox.data()));
   program->SetUniform3f("sunDirection", frame.ToSun.data());
   program->SetUniform3f("sliceNormal", frame.Axis.Normal.data());
+  double middleOffset = 0.0; // dot(centre, n): the mean over the box's corners
+  for (const nimbus::Vector3& corner : frame.Corners)
+  {
+    middleOffset += nimbus::Dot(corner, frame.Axis.Normal) / frame.Corners.size();
+  }
+  program->SetUniformf("boxMiddleOffset", static_cast<float>(middleOffset));
   program->SetUniformf("metresPerUnit", static_cast<float>(frame.Settings.MetresPerUnit));
   program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
   program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
@@ -1530,19 +1537,24 @@ void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
 void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  // Linear: the composite scales a smaller image (a lower quality level) to the
-  // viewport; at full size it reads texel centres, where linear is nearest.
+  // Linear where the composite scales a smaller image (a lower quality level) to
+  // the viewport; nearest at full size, where the composite's texture coordinates,
+  // interpolated across a viewport at an offset, can miss texel centres by a
+  // rounding error that linear filtering would turn into a neighbour's share.
+  const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
+    ? vtkTextureObject::Nearest
+    : vtkTextureObject::Linear;
   EnsureTexture2D(in.Accumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
-  in.Accumulation->SetMinificationFilter(vtkTextureObject::Linear);
-  in.Accumulation->SetMagnificationFilter(vtkTextureObject::Linear);
+  in.Accumulation->SetMinificationFilter(filter);
+  in.Accumulation->SetMagnificationFilter(filter);
   DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
   in.AccumulationFramebuffer->RemoveColorAttachment(1);
   if (frame.Settings.OverSky)
   {
     EnsureTexture2D(
       in.ClearAccumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
-    in.ClearAccumulation->SetMinificationFilter(vtkTextureObject::Linear);
-    in.ClearAccumulation->SetMagnificationFilter(vtkTextureObject::Linear);
+    in.ClearAccumulation->SetMinificationFilter(filter);
+    in.ClearAccumulation->SetMagnificationFilter(filter);
     in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
     in.AccumulationFramebuffer->ActivateDrawBuffers(2);
   }
@@ -1552,29 +1564,29 @@ void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 }
 
 //------------------------------------------------------------------------------
-// The atmosphere and the ground outside the slices (only when either is drawn):
-// sunward of the cloud, unshadowed, or beyond it, through the finished shadow
-// surface (shafts).
-void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bool beyondCloud)
+// The atmosphere and the ground outside the cloud box (only when either is drawn),
+// after the slices, through the finished shadow surface (the shafts): the part of
+// each ray in front of the box added as it is, the part behind it (behindBox)
+// multiplied by the cloud transmittance the slices left in the alpha, whatever
+// their order. The ground, where a ray ends on it, zeroes that alpha (not over a
+// sky).
+void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bool behindBox)
 {
   if (!frame.OutsideRegions)
   {
     return;
   }
   Internals& in = *this->Internal;
-  const double start =
-    beyondCloud ? frame.Planes.Offsets.back() + 0.5 * frame.Planes.Spacing : -1e30;
-  const double end = beyondCloud ? 1e30 : frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing;
   in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
-  UseSliceBlend(frame.State, frame.Axis.BackToFront);
+  frame.State->vtkglEnable(GL_BLEND);
+  frame.State->vtkglBlendFuncSeparate(
+    behindBox ? GL_DST_ALPHA : GL_ONE, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
   vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
   this->SetCommonUniforms(program, frame);
   program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
   program->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
-  program->SetUniformf("regionStart", static_cast<float>(start));
-  program->SetUniformf("regionEnd", static_cast<float>(end));
-  program->SetUniformi("useShadow", beyondCloud ? 1 : 0);
+  program->SetUniformi("segment", behindBox ? 1 : 0);
   program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   program->SetUniformi("steps", this->AtmosphereSteps);
   in.MarchPass->Render();
@@ -1584,8 +1596,8 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
 //------------------------------------------------------------------------------
 // The slices (000 §4.2-4.3), in order of increasing distance from the sun: each
 // seen from the eye with the shadow so far, then added to the shadow surface. The
-// eye pass is scissored to the slice's pixels only when nothing outside the box is
-// drawn (no atmosphere, no ground).
+// eye pass is scissored to the slice's pixels (only the box's part of the slice is
+// drawn; the air and ground outside the box are RenderOutsideRegion's).
 bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const FrameState& frame)
 {
   Internals& in = *this->Internal;
@@ -1660,8 +1672,7 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
       continue;
     }
     int scissor[4];
-    const bool scissored = !frame.OutsideRegions &&
-      nimbus::ScreenRectangle(
+    const bool scissored = nimbus::ScreenRectangle(
         polygon, frame.WorldToNdc->GetData(), frame.Level.Width, frame.Level.Height, scissor);
     this->RenderSliceFromEye(
       frame, sliceProgram, static_cast<float>(offset), scissored ? scissor : nullptr);

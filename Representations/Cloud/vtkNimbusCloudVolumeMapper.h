@@ -549,7 +549,7 @@ private:
   void RenderIntervalPhase(const FrameState& frame);
   void RenderRayEnds(const FrameState& frame);
   void ClearAccumulation(const FrameState& frame);
-  void RenderOutsideRegion(const FrameState& frame, bool beyondCloud);
+  void RenderOutsideRegion(const FrameState& frame, bool behindBox);
   bool RenderSlices(vtkRenderer* renderer, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
   void RenderComposite(const FrameState& frame);

@@ -17,6 +17,7 @@ uniform float metresPerUnit;        // metres per world unit
 uniform sampler3D density;          // cloud density volume
 uniform mat4 worldToTexture;        // world -> density texture coordinates
 uniform mat4 worldToBox;            // world -> [0,1]^3 over the density's box
+uniform float boxMiddleOffset;      // dot(x, n) of the box's centre
 uniform float extinctionPerDensity; // k_cl [1/m per density unit]
 uniform float cloudAlbedo;          // sigma_s / sigma_t
 
@@ -185,10 +186,43 @@ vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
   return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
 }
 
-float CloudDensity(vec3 p)
+// The interval [tIn, tOut] of the ray origin + t direction inside the cloud box
+// (t may be negative); false when the ray's line misses the box.
+bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
+{
+  vec3 o = (worldToBox * vec4(origin, 1.0)).xyz;
+  vec3 d = (worldToBox * vec4(direction, 0.0)).xyz;
+  tIn = -kInfinity;
+  tOut = kInfinity;
+  for (int i = 0; i < 3; ++i)
+  {
+    if (abs(d[i]) < 1e-30)
+    {
+      if (o[i] < 0.0 || o[i] > 1.0)
+      {
+        return false;
+      }
+    }
+    else
+    {
+      float a = -o[i] / d[i];
+      float b = (1.0 - o[i]) / d[i];
+      tIn = max(tIn, min(a, b));
+      tOut = min(tOut, max(a, b));
+    }
+  }
+  return tIn <= tOut;
+}
+
+bool InsideBox(vec3 p)
 {
   vec3 box = (worldToBox * vec4(p, 1.0)).xyz;
-  if (any(lessThan(box, vec3(0.0))) || any(greaterThan(box, vec3(1.0))))
+  return all(greaterThanEqual(box, vec3(0.0))) && all(lessThanEqual(box, vec3(1.0)));
+}
+
+float CloudDensity(vec3 p)
+{
+  if (!InsideBox(p))
   {
     return 0.0;
   }
@@ -205,6 +239,15 @@ float ShadowDepth(vec3 p)
     return 0.0;
   }
   return texture(shadowSurface, st).r;
+}
+
+// Cloud optical depth toward the sun of a point outside the box, once the shadow
+// surface is complete (see svsMarchFS.glsl): the whole sun line's when the line
+// toward the sun meets the box, else 0.
+float CloudDepthOutsideBox(vec3 p)
+{
+  float tIn, tOut;
+  return BoxInterval(p, sunDirection, tIn, tOut) && tOut >= 0.0 ? ShadowDepth(p) : 0.0;
 }
 
 // Radiance of the Lambertian ground at g, toward the eye, before view attenuation.

@@ -1,22 +1,66 @@
-// The atmosphere (and ground) before the first and after the last cloud slice.
-// There the shadow surface no longer changes (no cloud), so the slices that
-// continue the slicing beyond the cloud box — which carry the shafts of light
-// (000 §5, Fig. 6c) — are drawn in one pass: each pixel steps through
-// `steps` samples of its ray inside the region and looks the shadow surface up at
-// each, which is what drawing them one by one would compute, without a blend per
-// slice. Before the cloud (pre) the sun is unshadowed; after it (post) the
-// shadow surface holds the whole cloud. Output as for a slice: rgb = radiance
-// toward the eye, a = 1, or 0 where the ground closes the ray in the region
-// (not over a sky, see overSky);
-// second output: the same without the cloud's shadow (see svsSliceFS.glsl).
+// The atmosphere and the ground outside the cloud box, after the slices (which
+// draw only inside the box). Each pixel marches its ray outside the box in one
+// pass: `segment` 0, the part in front of the box (the whole ray where it misses
+// the box), added as it is; `segment` 1, the part behind it, which the mapper's
+// blend multiplies by the cloud transmittance the slices left in the alpha.
+// Shadows: the shadow surface is complete now and holds, per sun line, the cloud's
+// whole optical depth along it. A point outside the (convex) box lies either
+// sunward of all of the box's part of its sun line or beyond all of it, so its
+// cloud depth toward the sun is that whole value when the line toward the sun
+// meets the box, else 0: exact, where drawing the slices on past the box (000 §5,
+// Fig. 6c, the shafts) would give the same up to the slicing. The ground point
+// inside the box (a box that reaches below the ground) takes the whole line too.
+// Output: rgb = radiance toward the eye, a = 1, or 0 where the ground closes the
+// ray (not over a sky, see overSky); second output: the same without the cloud's
+// shadow (see svsSliceFS.glsl).
 in vec2 texCoord;
 uniform sampler2D intervalPhase;
 uniform sampler2D rayEnds;  // (t_end, t_ground) per pixel, this frame
-uniform float regionStart;  // d range of the region (dot(x, n)); +-1e30 for open ends
-uniform float regionEnd;
-uniform int useShadow;      // 1 after the cloud
+uniform int segment;        // 0: in front of the box (or the whole ray), 1: behind it
 uniform int shaftsOn;
-uniform int steps;
+uniform int steps;          // samples per interval (a missing ray has two intervals)
+
+vec3 color = vec3(0.0);
+vec3 clearColor = vec3(0.0); // without the cloud's shadow
+
+// Air of [t0, t1] by `steps` samples in quadratic spacing, dense toward the box
+// (at t0 when denseAtStart, else at t1); viewTransmittance comes in at t0 and
+// leaves at t1 (altitude over the spherical earth, accumulated step by step:
+// the interval can reach the top of the atmosphere along rays near the horizon).
+void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, bool denseAtStart,
+  inout vec3 viewTransmittance)
+{
+  float span = t1 - t0;
+  if (span <= 0.0)
+  {
+    return;
+  }
+  for (int k = 0; k < steps; ++k)
+  {
+    float u = (float(k) + 0.5) / float(steps);
+    float t = denseAtStart ? t0 + span * u * u : t1 - span * (1.0 - u) * (1.0 - u);
+    float dt = span * 2.0 * (denseAtStart ? u : 1.0 - u) / float(steps) * metresPerUnit;
+    vec3 p = origin + t * direction;
+    float altitude = Altitude(p);
+    vec3 clearAir = AirSource(altitude, phase);
+    vec3 air = clearAir;
+    if (shaftsOn != 0)
+    {
+      air *= exp(-CloudDepthOutsideBox(p));
+    }
+    vec3 multiple = AirMultipleSource(altitude);
+    air += multiple;
+    clearAir += multiple;
+    vec3 extinction = AtmosphereRow(3, altitude);
+    vec3 stepTransmittance = exp(-extinction * dt);
+    // Exact for constant coefficients over the step: (1 - T_step) / k_atm.
+    vec3 weight = mix(vec3(dt), (1.0 - stepTransmittance) / max(extinction, vec3(1e-30)),
+      step(vec3(1e-4), extinction * dt));
+    color += air * viewTransmittance * weight;
+    clearColor += clearAir * viewTransmittance * weight;
+    viewTransmittance *= stepTransmittance;
+  }
+}
 
 void main()
 {
@@ -27,69 +71,62 @@ void main()
   float tEnd = ends.x;
   float tGround = ends.y;
   float tEndMarch = min(tEnd, 1e9);
-  // The part of [0, tEnd] where regionStart <= dot(x, n) < regionEnd.
-  float d0 = dot(origin, sliceNormal);
-  float vn = dot(direction, sliceNormal);
-  float t0 = 0.0, t1 = tEndMarch;
-  if (abs(vn) > 1e-7)
-  {
-    float ta = (regionStart - d0) / vn, tb = (regionEnd - d0) / vn;
-    t0 = max(t0, min(ta, tb));
-    t1 = min(t1, max(ta, tb));
-  }
-  else if (d0 < regionStart || d0 >= regionEnd)
+  float tIn, tOut;
+  bool hitsBox = BoxInterval(origin, direction, tIn, tOut) && tOut > 0.0 && tIn < tEnd;
+  tIn = max(tIn, 0.0);
+  if (segment == 1 && !hitsBox)
   {
     discard;
   }
-  vec3 color = vec3(0.0);
-  vec3 clearColor = vec3(0.0); // without the cloud's shadow
-  float alpha = 1.0;
-  // View transmittance: closed form (flat layers) up to the region's start, then
-  // accumulated step by step with the altitude over the spherical earth, because
-  // the region can reach the top of the atmosphere along rays near the horizon.
-  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
-  if (t1 > t0 && atmosphereOn != 0)
+  // The interval(s) of this segment; where the ray misses the box, split at its
+  // crossing of the box's middle slice plane (dense samples on both sides of it,
+  // where the ray passes the cloud and its shadow).
+  float t0 = 0.0, t1 = tEndMarch, tSplit = -1.0;
+  bool missDenseAtStart = true;
+  if (hitsBox)
   {
-    // Quadratic spacing: dense at the region's start, sparse toward its far end.
-    float span = t1 - t0;
-    for (int k = 0; k < steps; ++k)
+    t0 = segment == 0 ? 0.0 : min(tOut, tEndMarch);
+    t1 = segment == 0 ? min(tIn, tEndMarch) : tEndMarch;
+  }
+  else
+  {
+    float vn = dot(direction, sliceNormal);
+    float tMiddle = abs(vn) > 1e-7 ? (boxMiddleOffset - dot(origin, sliceNormal)) / vn : -1.0;
+    tSplit = tMiddle > 0.0 && tMiddle < tEndMarch ? tMiddle : -1.0;
+    missDenseAtStart = tMiddle <= 0.0;
+  }
+  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
+  if (atmosphereOn != 0)
+  {
+    if (segment == 1)
     {
-      float u = (float(k) + 0.5) / float(steps);
-      float t = t0 + span * u * u;
-      float dt = span * 2.0 * u / float(steps) * metresPerUnit;
-      vec3 p = origin + t * direction;
-      float altitude = Altitude(p);
-      vec3 clearAir = AirSource(altitude, intervalAndPhase.zw);
-      vec3 air = clearAir;
-      if (useShadow != 0 && shaftsOn != 0)
-      {
-        air *= exp(-ShadowDepth(p));
-      }
-      vec3 multiple = AirMultipleSource(altitude);
-      air += multiple;
-      clearAir += multiple;
-      vec3 stepTransmittance = exp(-AtmosphereRow(3, altitude) * dt);
-      // Exact for constant coefficients over the step: (1 - T_step) / k_atm.
-      vec3 extinction = AtmosphereRow(3, altitude);
-      vec3 weight = mix(vec3(dt), (1.0 - stepTransmittance) / max(extinction, vec3(1e-30)),
-        step(vec3(1e-4), extinction * dt));
-      color += air * viewTransmittance * weight;
-      clearColor += clearAir * viewTransmittance * weight;
-      viewTransmittance *= stepTransmittance;
+      MarchAir(origin, direction, intervalAndPhase.zw, t0, t1, true, viewTransmittance);
+    }
+    else if (tSplit > 0.0)
+    {
+      MarchAir(origin, direction, intervalAndPhase.zw, t0, tSplit, false, viewTransmittance);
+      MarchAir(origin, direction, intervalAndPhase.zw, tSplit, t1, true, viewTransmittance);
+    }
+    else
+    {
+      MarchAir(origin, direction, intervalAndPhase.zw, t0, t1, !hitsBox && missDenseAtStart,
+        viewTransmittance);
     }
   }
-  if (tGround < kInfinity && tGround <= tEnd)
+  float alpha = 1.0;
+  // The ground where the ray ends on it in this segment: in front of the box, or
+  // behind (or inside) it.
+  bool groundHere = tGround < kInfinity && tGround <= tEnd &&
+    (segment == 0 ? (!hitsBox || tGround < tIn) : tGround >= tIn);
+  if (groundHere)
   {
-    float dGround = dot(origin + tGround * direction, sliceNormal);
-    if (dGround >= regionStart && dGround < regionEnd)
-    {
-      vec3 g = origin + tGround * direction;
-      vec3 groundTransmittance = (t1 > t0 && atmosphereOn != 0)
-        ? viewTransmittance : AtmosphereViewTransmittance(origin, direction, tGround);
-      color += GroundRadiance(g, useShadow != 0 ? ShadowDepth(g) : 0.0) * groundTransmittance;
-      clearColor += GroundRadiance(g, 0.0) * groundTransmittance;
-      alpha = overSky != 0 ? 1.0 : 0.0;
-    }
+    vec3 g = origin + tGround * direction;
+    // The march ended at the ground (t1 = t_end = t_ground), unless it is beyond 1e9.
+    vec3 groundTransmittance = atmosphereOn != 0 && tGround < 1e9
+      ? viewTransmittance : AtmosphereViewTransmittance(origin, direction, tGround);
+    color += GroundRadiance(g, CloudDepthOutsideBox(g)) * groundTransmittance;
+    clearColor += GroundRadiance(g, 0.0) * groundTransmittance;
+    alpha = overSky != 0 ? 1.0 : 0.0;
   }
   gl_FragData[0] = vec4(color, alpha);
   gl_FragData[1] = vec4(clearColor, 1.0);

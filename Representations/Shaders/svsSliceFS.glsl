@@ -2,15 +2,15 @@
 // the fixed-function blend set by the mapper). Output: rgb = C_i, the radiance the
 // slab around slice i sends toward the eye (already multiplied by the atmosphere's
 // view transmittance in front of it), a = alpha_i, the slab's cloud transmittance
-// Delta g_view_cl. Opaque things in the slab (the ground) give alpha 0 (not over
-// a sky, see overSky).
+// Delta g_view_cl. Only the slice's part inside the cloud box is drawn: the air
+// and the ground outside it are the march passes' (svsMarchFS.glsl).
 // Second output (only bound when the mapper draws over a Nimbus sky): the same
-// slab's radiance without the cloud — unshadowed air and ground — with alpha 1,
+// slab's radiance without the cloud — unshadowed air — with alpha 1,
 // which the same blend sums; the composite subtracts what the cloud hides and
 // shadows of it from the sky (see svsCompositeFS.glsl).
 in vec2 texCoord;
-uniform sampler2D intervalPhase;
-uniform sampler2D rayEnds;        // (t_end, t_ground) per pixel, this frame  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
+uniform sampler2D intervalPhase;  // (1/|v.n|, beta_cl + k_multi/4pi, beta_R, beta_M) per pixel (000 §4.4)
+uniform sampler2D rayEnds;        // (t_end, t_ground) per pixel, this frame
 uniform float sliceOffset;        // d_i: the slice plane is dot(x, n) = d_i
 uniform float sliceSpacing;       // Delta d (world)
 uniform float sunStepMetres;      // Delta s = Delta d / dot(n, -L) [m] (000 Eq. 10)
@@ -72,80 +72,62 @@ void main()
 {
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
-  vec4 intervalAndPhase = texture(intervalPhase, texCoord);
   float vn = dot(direction, sliceNormal);
-  vec2 ends = texture(rayEnds, texCoord).rg;
-  float tEnd = ends.x;
+  float tEnd = texture(rayEnds, texCoord).r;
   float t = abs(vn) > 1e-7 ? (sliceOffset - dot(origin, sliceNormal)) / vn : -1.0;
-  bool medium = t >= 0.0 && t < tEnd;
-
-  // The ground closes the ray inside this slab?
-  float tGround = ends.y;
-  bool ground = false;
-  if (unlit == 0 && tGround < kInfinity && tGround <= tEnd)
-  {
-    float dGround = dot(origin + tGround * direction, sliceNormal);
-    ground = abs(dGround - sliceOffset) <= 0.5 * sliceSpacing;
-  }
-  if (!medium && !ground)
+  // Only the slice's part inside the box: the air and the ground outside it are
+  // the march passes' (svsMarchFS.glsl), and so is the ground where a ray ends on
+  // it (these slices stop at t_end).
+  if (t < 0.0 || t >= tEnd)
   {
     discard;
   }
-
-  vec3 color = vec3(0.0);
+  vec3 p = origin + t * direction;
+  if (!InsideBox(p))
+  {
+    discard;
+  }
+  // k_cl rho_cl [1/m] (p is inside the box)
+  float sigma = extinctionPerDensity * max(texture(density, (worldToTexture * vec4(p, 1.0)).xyz).r, 0.0);
+  if (sigma <= 0.0 && atmosphereOn == 0)
+  {
+    discard; // empty space without air: nothing to add, nothing to attenuate
+  }
+  vec4 intervalAndPhase = texture(intervalPhase, texCoord);
+  float stepMetres = sliceSpacing * intervalAndPhase.x * metresPerUnit; // Delta t(p) [m]
+  float alpha = exp(-sigma * stepMetres);                              // 000 Eq. 9 (cloud part)
+  // Exact integral of a constant source over the slab: (1 - alpha) / sigma.
+  float slabLength = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
+  vec3 source;
   vec3 clearColor = vec3(0.0); // the slab without the cloud
-  float alpha = 1.0;
-  if (medium)
+  if (unlit != 0)
   {
-    vec3 p = origin + t * direction;
-    float stepMetres = sliceSpacing * intervalAndPhase.x * metresPerUnit; // Delta t(p) [m]
-    float sigma = extinctionPerDensity * CloudDensity(p);              // k_cl rho_cl [1/m]
-    if (sigma <= 0.0 && atmosphereOn == 0 && !ground)
-    {
-      discard; // empty space without air: nothing to add, nothing to attenuate
-    }
-    alpha = exp(-sigma * stepMetres);                                  // 000 Eq. 9 (cloud part)
-    // Exact integral of a constant source over the slab: (1 - alpha) / sigma.
-    float slabLength = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
-    vec3 source;
-    if (unlit != 0)
-    {
-      source = vec3(sigma);
-    }
-    else
-    {
-      float altitude = Altitude(p);
-      // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
-      float sunDepth = ShadowDepth(p) + 0.5 * sigma * sunStepMetres;
-      float sunTransmittance = exp(-sunDepth);
-      float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
-      source = cloudAlbedo * sigma *
-        (intervalAndPhase.y * sunTransmittance + SunMultipleScattering(mu, sunDepth)) *
-        SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
-      if (scatteringTextureOn != 0 && sigma > 0.0)
-      {
-        source += cloudAlbedo * sigma * InScattering(p, -direction);
-      }
-      if (atmosphereOn != 0)
-      {
-        vec3 air = AirSource(altitude, intervalAndPhase.zw);            // 000 Eq. 8, atmosphere
-        vec3 multiple = AirMultipleSource(altitude);
-        source += air * (shaftsOn != 0 ? sunTransmittance : 1.0) + multiple;
-        clearColor =
-          (air + multiple) * AtmosphereViewTransmittance(origin, direction, t) * stepMetres;
-      }
-      source *= AtmosphereViewTransmittance(origin, direction, t);
-    }
-    color = source * slabLength;
+    source = vec3(sigma);
   }
-  if (ground && (!medium || t < tGround))
+  else
   {
-    vec3 g = origin + tGround * direction;
-    vec3 groundTransmittance = AtmosphereViewTransmittance(origin, direction, tGround);
-    color += alpha * GroundRadiance(g, ShadowDepth(g)) * groundTransmittance;
-    clearColor += GroundRadiance(g, 0.0) * groundTransmittance;
-    alpha = overSky != 0 ? alpha : 0.0;
+    float altitude = Altitude(p);
+    // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
+    float sunDepth = ShadowDepth(p) + 0.5 * sigma * sunStepMetres;
+    float sunTransmittance = exp(-sunDepth);
+    float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+    source = cloudAlbedo * sigma *
+      (intervalAndPhase.y * sunTransmittance + SunMultipleScattering(mu, sunDepth)) *
+      SunIrradiance(altitude);                                         // 000 Eq. 8, cloud
+    if (scatteringTextureOn != 0 && sigma > 0.0)
+    {
+      source += cloudAlbedo * sigma * InScattering(p, -direction);
+    }
+    vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);
+    if (atmosphereOn != 0)
+    {
+      vec3 air = AirSource(altitude, intervalAndPhase.zw);              // 000 Eq. 8, atmosphere
+      vec3 multiple = AirMultipleSource(altitude);
+      source += air * (shaftsOn != 0 ? sunTransmittance : 1.0) + multiple;
+      clearColor = (air + multiple) * viewTransmittance * stepMetres;
+    }
+    source *= viewTransmittance;
   }
-  gl_FragData[0] = vec4(color, alpha);
+  gl_FragData[0] = vec4(source * slabLength, alpha);
   gl_FragData[1] = vec4(clearColor, 1.0);
 }
