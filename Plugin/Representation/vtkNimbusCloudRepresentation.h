@@ -152,6 +152,8 @@ public:
   int GetShadowSurfaceSize();
   void SetAtmosphereSteps(int value);
   int GetAtmosphereSteps();
+  void SetSliceJitter(bool value);
+  bool GetSliceJitter();
   void SetMaximumTextureSize(int value);
   int GetMaximumTextureSize();
   void SetTextureMemoryBudgetMiB(double value);

@@ -467,7 +467,8 @@ class SvsRenderer:
     mapper (CaptureRadiance); "constant" is that radiance in the 8-bit
     framebuffer (radiance x VTK_SCALE, quantisation <= 6.5e-4).
     Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
-    atmosphere_steps, unlit (the unlit compositing floor, for timing only), k_multi
+    atmosphere_steps, jitter (SliceJitter, default on), unlit (the unlit
+    compositing floor, for timing only), k_multi
     (000 Eq. 1's multiple-scattering constant; default the scene's), and the
     multiple-scattering term (issue 14): ms (none, the default here, octaves,
     patterns or directions), orders, downsampling (0: the mapper's automatic
@@ -525,7 +526,8 @@ class SvsRenderer:
         self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
         self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
         self.mapper.SetShadowSurfaceSize(int(settings.get("shadow", 512)))
-        self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 64)))
+        self.mapper.SetAtmosphereSteps(int(settings.get("atmosphere_steps", 16)))
+        self.mapper.SetSliceJitter(bool(settings.get("jitter", True)))
         self.mapper.SetUnlit(bool(settings.get("unlit", False)))
         self.mapper.SetMultipleScattering(float(settings.get("k_multi", self.k_multi)))
         self.mapper.SetMultipleScatteringMethod(SVS_METHODS[settings.get("ms", "none")])

@@ -1118,12 +1118,6 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(frame.WorldToBox.data()));
   program->SetUniform3f("sunDirection", frame.ToSun.data());
   program->SetUniform3f("sliceNormal", frame.Axis.Normal.data());
-  double middleOffset = 0.0; // dot(centre, n): the mean over the box's corners
-  for (const nimbus::Vector3& corner : frame.Corners)
-  {
-    middleOffset += nimbus::Dot(corner, frame.Axis.Normal) / frame.Corners.size();
-  }
-  program->SetUniformf("boxMiddleOffset", static_cast<float>(middleOffset));
   program->SetUniformf("metresPerUnit", static_cast<float>(frame.Settings.MetresPerUnit));
   program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
   program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
@@ -1157,6 +1151,7 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformf("groundAlbedo", static_cast<float>(frame.Settings.GroundAlbedo));
   program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
   program->SetUniformi("overSky", frame.Settings.OverSky ? 1 : 0);
+  program->SetUniformi("sliceJitter", this->SliceJitter ? 1 : 0);
 }
 
 //------------------------------------------------------------------------------
@@ -1589,7 +1584,25 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
   program->SetUniformi("segment", behindBox ? 1 : 0);
   program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   program->SetUniformi("steps", this->AtmosphereSteps);
+  program->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
+  program->SetUniformf("firstSliceOffset",
+    static_cast<float>(frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing));
+  program->SetUniformi("maxShadowSteps", std::min(frame.Level.Slices, 4 * this->AtmosphereSteps));
+  // Only rays through the box have a part behind it: the box's pixels.
+  int scissor[4];
+  const bool scissored = behindBox &&
+    nimbus::ScreenRectangle(
+      frame.Corners, frame.WorldToNdc->GetData(), frame.Level.Width, frame.Level.Height, scissor);
+  if (scissored)
+  {
+    frame.State->vtkglEnable(GL_SCISSOR_TEST);
+    frame.State->vtkglScissor(scissor[0], scissor[1], scissor[2], scissor[3]);
+  }
   in.MarchPass->Render();
+  if (scissored)
+  {
+    frame.State->vtkglDisable(GL_SCISSOR_TEST);
+  }
   ++in.PassesLastRender;
 }
 
@@ -1637,6 +1650,7 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
     shadowProgram = in.Ready(in.ShadowPass, svsShadowFS);
     this->SetCommonUniforms(shadowProgram, frame);
     shadowProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
+    shadowProgram->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
   }
   // A still frame that has taken a second reports its progress every 16 slices
   // (after glFinish: the slices done, not queued) and stops when the render window
@@ -1831,6 +1845,7 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Quality: " << this->Quality << "\n";
   os << indent << "InteractiveUpdateRate: " << this->InteractiveUpdateRate << " frames/s\n";
   os << indent << "AtmosphereSteps: " << this->AtmosphereSteps << "\n";
+  os << indent << "SliceJitter: " << this->SliceJitter << "\n";
   os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "EncodeSrgb: " << this->EncodeSrgb << "\n";

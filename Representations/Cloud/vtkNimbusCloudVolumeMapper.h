@@ -298,7 +298,10 @@ public:
   /// Quality knobs. NumberOfSlices: shadow-view slices over the cloud box (the
   /// main knob); SliceAngleRatio: a of theta_e : theta_s = 1 : a (000 §4.2);
   /// ShadowSurfaceSize: texels per side of the shadow surface; AtmosphereSteps:
-  /// samples per pixel of the atmosphere outside the cloud slices.
+  /// samples of the air per ray outside the cloud box, in front of it and again
+  /// behind it; where a ray can be in the cloud's shadow (the shafts), one more
+  /// per slice plane it crosses there, from AtmosphereSteps / 2 to
+  /// min(4 AtmosphereSteps, slices).
   vtkSetClampMacro(NumberOfSlices, int, 1, 8192);
   vtkGetMacro(NumberOfSlices, int);
   virtual void SetSliceAngleRatio(double value);
@@ -309,6 +312,18 @@ public:
   vtkGetMacro(ShadowSurfaceSize, int);
   vtkSetClampMacro(AtmosphereSteps, int, 1, 4096);
   vtkGetMacro(AtmosphereSteps, int);
+  ///@}
+
+  ///@{
+  /// Jittered slices (default on): each pixel's slice planes, and each shadow
+  /// texel's, are shifted by a fixed fraction of the slice spacing in
+  /// [-1/2, 1/2) (interleaved gradient noise of the pixel), so the planes do not
+  /// meet a cloud's edges at the same depth in neighbouring pixels: the
+  /// diagonal hatching on sharp-edged clouds and the streaks in their shadows
+  /// become a fine, static grain. Off: the paper's planes (000 §4.2).
+  vtkSetMacro(SliceJitter, bool);
+  vtkGetMacro(SliceJitter, bool);
+  vtkBooleanMacro(SliceJitter, bool);
   ///@}
 
   ///@{
@@ -500,7 +515,8 @@ protected:
   int NumberOfSlices = 256;
   double SliceAngleRatio = 1.0;
   int ShadowSurfaceSize = 512;
-  int AtmosphereSteps = 64;
+  int AtmosphereSteps = 16;
+  bool SliceJitter = true;
   double MetresPerUnit = 1.0;
   double Exposure = 1.0;
   bool EncodeSrgb = false;

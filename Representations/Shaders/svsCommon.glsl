@@ -17,7 +17,6 @@ uniform float metresPerUnit;        // metres per world unit
 uniform sampler3D density;          // cloud density volume
 uniform mat4 worldToTexture;        // world -> density texture coordinates
 uniform mat4 worldToBox;            // world -> [0,1]^3 over the density's box
-uniform float boxMiddleOffset;      // dot(x, n) of the box's centre
 uniform float extinctionPerDensity; // k_cl [1/m per density unit]
 uniform float cloudAlbedo;          // sigma_s / sigma_t
 
@@ -50,8 +49,22 @@ uniform sampler2D sceneDepth;       // depth of the opaque geometry already draw
 // accumulation's alpha, which is then the cloud's transmittance alone (nothing
 // is accumulated behind the ground either way: rays end there).
 uniform int overSky;
+uniform int sliceJitter;            // 1: slice planes shifted per pixel (SliceJitter)
 
 const float kInfinity = 1e30;
+
+// The shift of this pixel's (or shadow texel's) slice planes in units of the slice
+// spacing, in [-1/2, 1/2): interleaved gradient noise (Jimenez 2014, "Next
+// generation post processing in Call of Duty: Advanced Warfare"), whose
+// neighbouring values are spread over the interval; 0 without SliceJitter.
+float SliceJitterFraction(vec2 pixel)
+{
+  if (sliceJitter == 0)
+  {
+    return 0.0;
+  }
+  return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715)))) - 0.5;
+}
 
 void ViewRay(vec2 uv, out vec3 origin, out vec3 direction)
 {
@@ -151,6 +164,15 @@ vec3 AirMultipleSource(float altitude)
 vec3 SunIrradiance(float altitude)
 {
   return atmosphereOn != 0 ? max(AtmosphereRow(0, altitude), vec3(0.0)) : sunIrradianceTop;
+}
+
+// Extinction of the air at altitude h [1/m] (the table's row 3 in closed form,
+// the coefficients of AtmosphereViewTransmittance; 000 Eq. 6).
+vec3 AirExtinction(float altitude)
+{
+  float h = max(altitude, 0.0);
+  return rayleighExtinction0 * exp(-h / rayleighScaleHeightMetres) +
+    mieExtinction0 * exp(-h / mieScaleHeightMetres);
 }
 
 // Atmospheric transmittance g_view_atm between the ray origin and distance t (000 Eq. 6).

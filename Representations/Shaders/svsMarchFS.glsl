@@ -18,28 +18,38 @@ uniform sampler2D intervalPhase;
 uniform sampler2D rayEnds;  // (t_end, t_ground) per pixel, this frame
 uniform int segment;        // 0: in front of the box (or the whole ray), 1: behind it
 uniform int shaftsOn;
-uniform int steps;          // samples per interval (a missing ray has two intervals)
+uniform int steps;          // samples per segment outside the cloud's shadow
+uniform float sliceSpacing; // Delta d of the slices (world)
+uniform float firstSliceOffset; // d where the slicing starts: sunward of it, no shadow
+uniform int maxShadowSteps; // cap of the samples in the shadow (the number of slices)
+
+const int kDenseAtStart = 0;
+const int kDenseAtEnd = 1;
+const int kUniform = 2;
 
 vec3 color = vec3(0.0);
 vec3 clearColor = vec3(0.0); // without the cloud's shadow
 
-// Air of [t0, t1] by `steps` samples in quadratic spacing, dense toward the box
-// (at t0 when denseAtStart, else at t1); viewTransmittance comes in at t0 and
-// leaves at t1 (altitude over the spherical earth, accumulated step by step:
-// the interval can reach the top of the atmosphere along rays near the horizon).
-void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, bool denseAtStart,
-  inout vec3 viewTransmittance)
+// Air of [t0, t1] by `count` samples, spaced uniformly or quadratically (dense
+// at one end); viewTransmittance comes in at t0 and leaves at t1 (altitude over
+// the spherical earth, accumulated step by step: the interval can reach the top
+// of the atmosphere along rays near the horizon).
+void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, int spacing,
+  int count, inout vec3 viewTransmittance)
 {
   float span = t1 - t0;
   if (span <= 0.0)
   {
     return;
   }
-  for (int k = 0; k < steps; ++k)
+  for (int k = 0; k < count; ++k)
   {
-    float u = (float(k) + 0.5) / float(steps);
-    float t = denseAtStart ? t0 + span * u * u : t1 - span * (1.0 - u) * (1.0 - u);
-    float dt = span * 2.0 * (denseAtStart ? u : 1.0 - u) / float(steps) * metresPerUnit;
+    float u = (float(k) + 0.5) / float(count);
+    float t = spacing == kUniform ? t0 + span * u
+      : spacing == kDenseAtStart  ? t0 + span * u * u
+                                  : t1 - span * (1.0 - u) * (1.0 - u);
+    float density = spacing == kUniform ? 1.0 : 2.0 * (spacing == kDenseAtStart ? u : 1.0 - u);
+    float dt = span * density / float(count) * metresPerUnit;
     vec3 p = origin + t * direction;
     float altitude = Altitude(p);
     vec3 clearAir = AirSource(altitude, phase);
@@ -51,7 +61,7 @@ void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, bool 
     vec3 multiple = AirMultipleSource(altitude);
     air += multiple;
     clearAir += multiple;
-    vec3 extinction = AtmosphereRow(3, altitude);
+    vec3 extinction = AirExtinction(altitude);
     vec3 stepTransmittance = exp(-extinction * dt);
     // Exact for constant coefficients over the step: (1 - T_step) / k_atm.
     vec3 weight = mix(vec3(dt), (1.0 - stepTransmittance) / max(extinction, vec3(1e-30)),
@@ -60,6 +70,51 @@ void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, bool 
     clearColor += clearAir * viewTransmittance * weight;
     viewTransmittance *= stepTransmittance;
   }
+}
+
+// The part [a, b] of [t0, t1] where the ray can be in the cloud's shadow: its sun
+// line crosses the shadow surface's rectangle, and it is past the first slice
+// plane (sunward of that plane the line toward the sun never meets the box).
+bool ShadowInterval(vec3 origin, vec3 direction, float t0, float t1, out float a, out float b)
+{
+  a = t0;
+  b = t1;
+  vec3 q = origin - shadowOrigin;
+  vec2 s0 = vec2(dot(q, shadowU), dot(q, shadowW)) / shadowExtent;
+  vec2 ds = vec2(dot(direction, shadowU), dot(direction, shadowW)) / shadowExtent;
+  for (int i = 0; i < 2; ++i)
+  {
+    if (abs(ds[i]) < 1e-30)
+    {
+      if (s0[i] < 0.0 || s0[i] > 1.0)
+      {
+        return false;
+      }
+    }
+    else
+    {
+      float ta = -s0[i] / ds[i];
+      float tb = (1.0 - s0[i]) / ds[i];
+      a = max(a, min(ta, tb));
+      b = min(b, max(ta, tb));
+    }
+  }
+  float vn = dot(direction, sliceNormal);
+  float d0 = dot(origin, sliceNormal);
+  if (abs(vn) < 1e-30)
+  {
+    return d0 >= firstSliceOffset && a < b;
+  }
+  float tPlane = (firstSliceOffset - d0) / vn;
+  if (vn > 0.0)
+  {
+    a = max(a, tPlane);
+  }
+  else
+  {
+    b = min(b, tPlane);
+  }
+  return a < b;
 }
 
 void main()
@@ -78,40 +133,36 @@ void main()
   {
     discard;
   }
-  // The interval(s) of this segment; where the ray misses the box, split at its
-  // crossing of the box's middle slice plane (dense samples on both sides of it,
-  // where the ray passes the cloud and its shadow).
-  float t0 = 0.0, t1 = tEndMarch, tSplit = -1.0;
-  bool missDenseAtStart = true;
+  // This segment's part of the ray.
+  float t0 = 0.0, t1 = tEndMarch;
   if (hitsBox)
   {
     t0 = segment == 0 ? 0.0 : min(tOut, tEndMarch);
     t1 = segment == 0 ? min(tIn, tEndMarch) : tEndMarch;
   }
+  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
+  float a, b;
+  if (atmosphereOn == 0 || t1 <= t0)
+  {
+  }
+  else if (shaftsOn != 0 && ShadowInterval(origin, direction, t0, t1, a, b))
+  {
+    // In the shadow (the shafts): one sample per slice plane crossed, as drawing
+    // the slices on would take (at least steps / 2, at most maxShadowSteps);
+    // around it, steps / 2 each, dense toward it.
+    int around = max(steps / 2, 1);
+    float crossings = (b - a) * abs(dot(direction, sliceNormal)) / sliceSpacing;
+    int inside = int(clamp(ceil(crossings), float(around), float(max(maxShadowSteps, 1))));
+    vec2 phase = intervalAndPhase.zw;
+    MarchAir(origin, direction, phase, t0, a, kDenseAtEnd, around, viewTransmittance);
+    MarchAir(origin, direction, phase, a, b, kUniform, inside, viewTransmittance);
+    MarchAir(origin, direction, phase, b, t1, kDenseAtStart, around, viewTransmittance);
+  }
   else
   {
-    float vn = dot(direction, sliceNormal);
-    float tMiddle = abs(vn) > 1e-7 ? (boxMiddleOffset - dot(origin, sliceNormal)) / vn : -1.0;
-    tSplit = tMiddle > 0.0 && tMiddle < tEndMarch ? tMiddle : -1.0;
-    missDenseAtStart = tMiddle <= 0.0;
-  }
-  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
-  if (atmosphereOn != 0)
-  {
-    if (segment == 1)
-    {
-      MarchAir(origin, direction, intervalAndPhase.zw, t0, t1, true, viewTransmittance);
-    }
-    else if (tSplit > 0.0)
-    {
-      MarchAir(origin, direction, intervalAndPhase.zw, t0, tSplit, false, viewTransmittance);
-      MarchAir(origin, direction, intervalAndPhase.zw, tSplit, t1, true, viewTransmittance);
-    }
-    else
-    {
-      MarchAir(origin, direction, intervalAndPhase.zw, t0, t1, !hitsBox && missDenseAtStart,
-        viewTransmittance);
-    }
+    // Smooth air: dense toward the box (in front: its end), else near the eye.
+    MarchAir(origin, direction, intervalAndPhase.zw, t0, t1,
+      hitsBox && segment == 0 ? kDenseAtEnd : kDenseAtStart, steps, viewTransmittance);
   }
   float alpha = 1.0;
   // The ground where the ray ends on it in this segment: in front of the box, or

@@ -5,13 +5,16 @@
 in vec2 texCoord;
 uniform float sliceOffset;
 uniform float sunStepMetres;
+uniform float sliceSpacing; // Delta d (world)
 
 void main()
 {
   // Point of this texel's sun ray on the slice plane dot(x, n) = d_i.
   vec3 base = shadowOrigin + texCoord.x * shadowExtent.x * shadowU +
     texCoord.y * shadowExtent.y * shadowW;
-  float lambda = (sliceOffset - dot(base, sliceNormal)) / dot(-sunDirection, sliceNormal);
+  // This texel's plane of slice i (SliceJitter; a pattern other than the eye's).
+  float planeOffset = sliceOffset + SliceJitterFraction(gl_FragCoord.yx) * sliceSpacing;
+  float lambda = (planeOffset - dot(base, sliceNormal)) / dot(-sunDirection, sliceNormal);
   vec3 p = base - lambda * sunDirection;
   gl_FragData[0] = vec4(extinctionPerDensity * CloudDensity(p) * sunStepMetres, 0.0, 0.0, 0.0);
 }

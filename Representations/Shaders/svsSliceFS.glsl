@@ -74,7 +74,9 @@ void main()
   ViewRay(texCoord, origin, direction);
   float vn = dot(direction, sliceNormal);
   float tEnd = texture(rayEnds, texCoord).r;
-  float t = abs(vn) > 1e-7 ? (sliceOffset - dot(origin, sliceNormal)) / vn : -1.0;
+  // This pixel's plane of slice i (SliceJitter): stratified along the ray.
+  float planeOffset = sliceOffset + SliceJitterFraction(gl_FragCoord.xy) * sliceSpacing;
+  float t = abs(vn) > 1e-7 ? (planeOffset - dot(origin, sliceNormal)) / vn : -1.0;
   // Only the slice's part inside the box: the air and the ground outside it are
   // the march passes' (svsMarchFS.glsl), and so is the ground where a ray ends on
   // it (these slices stop at t_end).

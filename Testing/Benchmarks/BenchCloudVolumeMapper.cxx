@@ -216,8 +216,8 @@ int main(int argc, char* argv[])
       { "no ground", [](vtkNimbusCloudVolumeMapper* m) { m->SetGround(false); } },
       { "no atmosphere", [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphere(false); } },
       { "no atmosphere, no ground", cloudOnly },
-      { "atmosphere steps 16 (default 64)",
-        [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphereSteps(16); } },
+      { "atmosphere steps 64 (default 16)",
+        [](vtkNimbusCloudVolumeMapper* m) { m->SetAtmosphereSteps(64); } },
       { "shadow surface 256 (default 512)",
         [](vtkNimbusCloudVolumeMapper* m) { m->SetShadowSurfaceSize(256); } },
     };
