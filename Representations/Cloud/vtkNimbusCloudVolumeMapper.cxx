@@ -1687,7 +1687,7 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
     }
     int scissor[4];
     const bool scissored = nimbus::ScreenRectangle(
-        polygon, frame.WorldToNdc->GetData(), frame.Level.Width, frame.Level.Height, scissor);
+      polygon, frame.WorldToNdc->GetData(), frame.Level.Width, frame.Level.Height, scissor);
     this->RenderSliceFromEye(
       frame, sliceProgram, static_cast<float>(offset), scissored ? scissor : nullptr);
     if (shadowProgram)
