@@ -1587,7 +1587,7 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
   program->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
   program->SetUniformf("firstSliceOffset",
     static_cast<float>(frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing));
-  program->SetUniformi("maxShadowSteps", std::min(frame.Level.Slices, 4 * this->AtmosphereSteps));
+  program->SetUniformi("maxShadowSteps", std::min(frame.Level.Slices, 2 * this->AtmosphereSteps));
   // Only rays through the box have a part behind it: the box's pixels.
   int scissor[4];
   const bool scissored = behindBox &&

@@ -301,7 +301,7 @@ public:
   /// samples of the air per ray outside the cloud box, in front of it and again
   /// behind it; where a ray can be in the cloud's shadow (the shafts), one more
   /// per slice plane it crosses there, from AtmosphereSteps / 2 to
-  /// min(4 AtmosphereSteps, slices).
+  /// min(2 AtmosphereSteps, slices).
   vtkSetClampMacro(NumberOfSlices, int, 1, 8192);
   vtkGetMacro(NumberOfSlices, int);
   virtual void SetSliceAngleRatio(double value);

@@ -35,7 +35,7 @@ vec3 clearColor = vec3(0.0); // without the cloud's shadow
 // the spherical earth, accumulated step by step: the interval can reach the top
 // of the atmosphere along rays near the horizon).
 void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, int spacing,
-  int count, inout vec3 viewTransmittance)
+  int count, bool shadowed, inout vec3 viewTransmittance)
 {
   float span = t1 - t0;
   if (span <= 0.0)
@@ -54,7 +54,7 @@ void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, int s
     float altitude = Altitude(p);
     vec3 clearAir = AirSource(altitude, phase);
     vec3 air = clearAir;
-    if (shaftsOn != 0)
+    if (shadowed) // (only inside ShadowInterval: elsewhere the cloud depth is 0)
     {
       air *= exp(-CloudDepthOutsideBox(p));
     }
@@ -154,15 +154,15 @@ void main()
     float crossings = (b - a) * abs(dot(direction, sliceNormal)) / sliceSpacing;
     int inside = int(clamp(ceil(crossings), float(around), float(max(maxShadowSteps, 1))));
     vec2 phase = intervalAndPhase.zw;
-    MarchAir(origin, direction, phase, t0, a, kDenseAtEnd, around, viewTransmittance);
-    MarchAir(origin, direction, phase, a, b, kUniform, inside, viewTransmittance);
-    MarchAir(origin, direction, phase, b, t1, kDenseAtStart, around, viewTransmittance);
+    MarchAir(origin, direction, phase, t0, a, kDenseAtEnd, around, false, viewTransmittance);
+    MarchAir(origin, direction, phase, a, b, kUniform, inside, true, viewTransmittance);
+    MarchAir(origin, direction, phase, b, t1, kDenseAtStart, around, false, viewTransmittance);
   }
   else
   {
     // Smooth air: dense toward the box (in front: its end), else near the eye.
     MarchAir(origin, direction, intervalAndPhase.zw, t0, t1,
-      hitsBox && segment == 0 ? kDenseAtEnd : kDenseAtStart, steps, viewTransmittance);
+      hitsBox && segment == 0 ? kDenseAtEnd : kDenseAtStart, steps, false, viewTransmittance);
   }
   float alpha = 1.0;
   // The ground where the ray ends on it in this segment: in front of the box, or

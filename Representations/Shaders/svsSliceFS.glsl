@@ -112,13 +112,17 @@ void main()
     // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
     float sunDepth = ShadowDepth(p) + 0.5 * sigma * sunStepMetres;
     float sunTransmittance = exp(-sunDepth);
-    float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
-    source = cloudAlbedo * sigma *
-      (intervalAndPhase.y * sunTransmittance + SunMultipleScattering(mu, sunDepth)) *
-      SunIrradiance(altitude);                                         // 000 Eq. 8, cloud
-    if (scatteringTextureOn != 0 && sigma > 0.0)
+    source = vec3(0.0);
+    if (sigma > 0.0) // (empty parts of the box: the air alone, and no cloud terms to pay)
     {
-      source += cloudAlbedo * sigma * InScattering(p, -direction);
+      float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+      source = cloudAlbedo * sigma *
+        (intervalAndPhase.y * sunTransmittance + SunMultipleScattering(mu, sunDepth)) *
+        SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
+      if (scatteringTextureOn != 0)
+      {
+        source += cloudAlbedo * sigma * InScattering(p, -direction);
+      }
     }
     vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);
     if (atmosphereOn != 0)
