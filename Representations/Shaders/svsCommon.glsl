@@ -208,6 +208,21 @@ vec3 AtmosphereViewTransmittance(vec3 origin, vec3 direction, float t)
   return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
 }
 
+// Narrows [tIn, tOut] to the t where 0 <= o + t d <= 1 (one slab of a unit box);
+// false when a line parallel to the slab lies outside it.
+bool ClipToUnitSlab(float o, float d, inout float tIn, inout float tOut)
+{
+  if (abs(d) < 1e-30)
+  {
+    return o >= 0.0 && o <= 1.0;
+  }
+  float a = -o / d;
+  float b = (1.0 - o) / d;
+  tIn = max(tIn, min(a, b));
+  tOut = min(tOut, max(a, b));
+  return true;
+}
+
 // The interval [tIn, tOut] of the ray origin + t direction inside the cloud box
 // (t may be negative); false when the ray's line misses the box.
 bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
@@ -216,24 +231,8 @@ bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
   vec3 d = (worldToBox * vec4(direction, 0.0)).xyz;
   tIn = -kInfinity;
   tOut = kInfinity;
-  for (int i = 0; i < 3; ++i)
-  {
-    if (abs(d[i]) < 1e-30)
-    {
-      if (o[i] < 0.0 || o[i] > 1.0)
-      {
-        return false;
-      }
-    }
-    else
-    {
-      float a = -o[i] / d[i];
-      float b = (1.0 - o[i]) / d[i];
-      tIn = max(tIn, min(a, b));
-      tOut = min(tOut, max(a, b));
-    }
-  }
-  return tIn <= tOut;
+  return ClipToUnitSlab(o.x, d.x, tIn, tOut) && ClipToUnitSlab(o.y, d.y, tIn, tOut) &&
+    ClipToUnitSlab(o.z, d.z, tIn, tOut) && tIn <= tOut;
 }
 
 bool InsideBox(vec3 p)

@@ -82,22 +82,9 @@ bool ShadowInterval(vec3 origin, vec3 direction, float t0, float t1, out float a
   vec3 q = origin - shadowOrigin;
   vec2 s0 = vec2(dot(q, shadowU), dot(q, shadowW)) / shadowExtent;
   vec2 ds = vec2(dot(direction, shadowU), dot(direction, shadowW)) / shadowExtent;
-  for (int i = 0; i < 2; ++i)
+  if (!ClipToUnitSlab(s0.x, ds.x, a, b) || !ClipToUnitSlab(s0.y, ds.y, a, b))
   {
-    if (abs(ds[i]) < 1e-30)
-    {
-      if (s0[i] < 0.0 || s0[i] > 1.0)
-      {
-        return false;
-      }
-    }
-    else
-    {
-      float ta = -s0[i] / ds[i];
-      float tb = (1.0 - s0[i]) / ds[i];
-      a = max(a, min(ta, tb));
-      b = min(b, max(ta, tb));
-    }
+    return false;
   }
   float vn = dot(direction, sliceNormal);
   float d0 = dot(origin, sliceNormal);
