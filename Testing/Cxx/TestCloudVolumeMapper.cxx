@@ -715,12 +715,15 @@ bool DataLayouts(const Context&)
   Scene cellScene(cells);
   const double cellRmse = Rmse(expected, cellScene.Render());
   // The cell box is half a voxel larger on every side, where the point data's
-  // box clips the cloud; the cloud's rim has density ~0 there.
-  // Measured 0.026 (quantisation to 1/1000) and 0.054 (the rim).
+  // box clips the cloud; the cloud's rim has density ~0 there. Measured 0.026
+  // (quantisation to 1/1000) and 0.054 (the rim) with the slices over the whole
+  // screen; 0.106 (0.096 without SliceJitter) since the air outside the box is
+  // marched and inside it sliced (issue 15): the larger box moves that border,
+  // and the slices' planes and jitter with it (a few pixels off by 1 of 255).
   return Check(typedRmse < 0.1,
            "unsigned short x1000 vs float: RMSE " + std::to_string(typedRmse) + " < 0.1") &&
-    Check(cellRmse < 0.1,
-      "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < 0.1");
+    Check(cellRmse < 0.2,
+      "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < 0.2");
 }
 
 // Two viewports side by side each show what a window of their size shows (with and
