@@ -104,6 +104,22 @@ std::vector<Vector3> SlicePolygon(const std::vector<Vector3>& corners, const Vec
   return points;
 }
 
+std::vector<Vector3> SlabPoints(
+  const std::vector<Vector3>& corners, const Vector3& n, double d, double halfWidth)
+{
+  std::vector<Vector3> points = SlicePolygon(corners, n, d - halfWidth);
+  const std::vector<Vector3> far = SlicePolygon(corners, n, d + halfWidth);
+  points.insert(points.end(), far.begin(), far.end());
+  for (const Vector3& corner : corners)
+  {
+    if (std::abs(Dot(corner, n) - d) <= halfWidth)
+    {
+      points.push_back(corner);
+    }
+  }
+  return points;
+}
+
 ShadowFrame ComputeShadowFrame(
   const std::vector<Vector3>& corners, const Vector3& toSun, double margin)
 {

@@ -64,6 +64,13 @@ NIMBUSREPRESENTATIONS_EXPORT SlicePlanes MakeSlicePlanes(double dMin, double dMa
 NIMBUSREPRESENTATIONS_EXPORT std::vector<Vector3> SlicePolygon(
   const std::vector<Vector3>& corners, const Vector3& n, double d);
 
+/// Vertices of the box's part between the planes dot(x, n) = d - halfWidth and
+/// d + halfWidth: both planes' polygons and the corners between them. Their convex
+/// hull holds every polygon of a plane in that range (a jittered slice's, see
+/// vtkNimbusCloudVolumeMapper::SetSliceJitter). Empty when the slab misses the box.
+NIMBUSREPRESENTATIONS_EXPORT std::vector<Vector3> SlabPoints(
+  const std::vector<Vector3>& corners, const Vector3& n, double d, double halfWidth);
+
 /// Orthographic frame of the shadow surface: it faces the sun (normal -L) and
 /// covers the projection of the box corners. A point x maps to texture
 /// coordinates ((dot(x - Origin, U)) / Width, (dot(x - Origin, W)) / Height).

@@ -1679,8 +1679,11 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
       }
     }
     ++done;
-    const std::vector<nimbus::Vector3> polygon =
-      nimbus::SlicePolygon(frame.Corners, frame.Axis.Normal, offset);
+    // The pixels (texels) the slice can touch: with SliceJitter its planes move by up
+    // to half a spacing either way.
+    const std::vector<nimbus::Vector3> polygon = this->SliceJitter
+      ? nimbus::SlabPoints(frame.Corners, frame.Axis.Normal, offset, 0.5 * frame.Planes.Spacing)
+      : nimbus::SlicePolygon(frame.Corners, frame.Axis.Normal, offset);
     if (polygon.empty())
     {
       continue;

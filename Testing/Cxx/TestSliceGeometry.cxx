@@ -392,6 +392,49 @@ TEST(SliceGeometry, SlicePolygonCutsTheBox)
     nimbus::SlicePolygon({ { { 0, 0, 0 } } }, { { 0, 0, 1 } }, 0.0), std::invalid_argument);
 }
 
+// The slab's points bound every plane's polygon between its two planes (the
+// jittered slices' scissor), over random tilted planes through a cube.
+TEST(SliceGeometry, SlabPointsBoundTheJitteredPolygons)
+{
+  std::vector<Vector3> cube;
+  for (int c = 0; c < 8; ++c)
+  {
+    cube.push_back({ { (c & 1) ? 1.0 : 0.0, (c & 2) ? 1.0 : 0.0, (c & 4) ? 1.0 : 0.0 } });
+  }
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const Vector3 n = nimbus::Normalized({ { unit(random), unit(random), unit(random) } });
+    const double d = nimbus::Dot(n, { { 0.5, 0.5, 0.5 } }) + 0.9 * unit(random);
+    const double half = 0.1 * (1.0 + unit(random));
+    const auto slab = nimbus::SlabPoints(cube, n, d, half);
+    for (int k = 0; k <= 10; ++k)
+    {
+      const auto polygon = nimbus::SlicePolygon(cube, n, d - half + 0.2 * half * k);
+      for (const Vector3& p : polygon)
+      {
+        ASSERT_FALSE(slab.empty());
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          double lo = 1e30, hi = -1e30;
+          for (const Vector3& q : slab)
+          {
+            lo = std::min(lo, q[axis]);
+            hi = std::max(hi, q[axis]);
+          }
+          EXPECT_GE(p[axis], lo - 1e-12);
+          EXPECT_LE(p[axis], hi + 1e-12);
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_TRUE(nimbus::SlabPoints(cube, { { 0, 0, 1 } }, 3.0, 0.5).empty());
+}
+
 // The scissor rectangles cover the projected polygon with one pixel (texel) of
 // margin, stay inside the target, and refuse a polygon behind the eye.
 TEST(SliceGeometry, ScissorRectanglesCoverTheSlice)
