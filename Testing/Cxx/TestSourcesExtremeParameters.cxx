@@ -32,6 +32,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -45,6 +46,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace
@@ -316,61 +318,39 @@ struct ImageSetup
   double PixelValue = 200;
 };
 
-template <typename Setup, typename Vector>
-std::function<void(Setup&, double)> Component(
-  Vector get, int component, std::function<void(Setup&, const double*)> set, int size)
+// One property per element of a vector setting of N values of type T: element a
+// set to the value (rounded for integers), the others kept as they are.
+template <typename T, int N, typename Setup, typename Get, typename SetAll>
+void AddElements(std::vector<Property<Setup>>& properties, const std::string& name, Get get,
+  SetAll set, const std::array<double, N>& typical)
 {
-  return [get, component, set, size](Setup& setup, double value)
+  for (int a = 0; a < N; ++a)
   {
-    double v[6];
-    get(setup, v);
-    (void)size;
-    v[component] = value;
-    set(setup, v);
-  };
+    properties.push_back({ name + "[" + std::to_string(a) + "]", std::is_integral<T>::value, true,
+      [get, set, a](Setup& s, double v)
+      {
+        T values[N];
+        get(s, values);
+        values[a] = std::is_integral<T>::value ? static_cast<T>(ToInt(v)) : static_cast<T>(v);
+        set(s, values);
+      },
+      typical[a] });
+  }
 }
 
 std::vector<Property<MetaballSetup>> MetaballProperties()
 {
   using S = MetaballSetup;
   std::vector<Property<S>> properties;
-  for (int a = 0; a < 3; ++a)
-  {
-    properties.push_back({ "Dimensions[" + std::to_string(a) + "]", true, true,
-      [a](S& s, double v)
-      {
-        int d[3];
-        s.Source->GetDimensions(d);
-        d[a] = ToInt(v);
-        s.Source->SetDimensions(d);
-      },
-      40 });
-  }
-  for (int a = 0; a < 6; ++a)
-  {
-    const double typical[6] = { -1500, 1500, -1500, 1500, 800, 2800 };
-    properties.push_back({ "Bounds[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double b[6];
-        s.Source->GetBounds(b);
-        b[a] = v;
-        s.Source->SetBounds(b);
-      },
-      typical[a] });
-  }
-  for (int a = 0; a < 2; ++a)
-  {
-    properties.push_back({ "BaseBallRadiusRange[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double r[2];
-        s.Source->GetBaseBallRadiusRange(r);
-        r[a] = v;
-        s.Source->SetBaseBallRadiusRange(r);
-      },
-      a == 0 ? 350.0 : 600.0 });
-  }
+  AddElements<int, 3>(
+    properties, "Dimensions", [](S& s, int* v) { s.Source->GetDimensions(v); },
+    [](S& s, int* v) { s.Source->SetDimensions(v); }, { { 40, 40, 40 } });
+  AddElements<double, 6>(
+    properties, "Bounds", [](S& s, double* v) { s.Source->GetBounds(v); },
+    [](S& s, double* v) { s.Source->SetBounds(v); }, { { -1500, 1500, -1500, 1500, 800, 2800 } });
+  AddElements<double, 2>(
+    properties, "BaseBallRadiusRange", [](S& s, double* v) { s.Source->GetBaseBallRadiusRange(v); },
+    [](S& s, double* v) { s.Source->SetBaseBallRadiusRange(v); }, { { 350.0, 600.0 } });
   auto scalar = [&properties](const std::string& name, bool integer,
                   std::function<void(vtkNimbusMetaballCloudSource*, double)> set, double typical)
   {
@@ -434,52 +414,18 @@ std::vector<Property<AutomatonSetup>> AutomatonProperties()
 {
   using S = AutomatonSetup;
   std::vector<Property<S>> properties;
-  for (int a = 0; a < 3; ++a)
-  {
-    properties.push_back({ "Dimensions[" + std::to_string(a) + "]", true, true,
-      [a](S& s, double v)
-      {
-        int d[3];
-        s.Source->GetDimensions(d);
-        d[a] = ToInt(v);
-        s.Source->SetDimensions(d);
-      },
-      48 });
-  }
-  for (int a = 0; a < 6; ++a)
-  {
-    const double typical[6] = { -6400, 6400, -6400, 6400, 1000, 2600 };
-    properties.push_back({ "Bounds[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double b[6];
-        s.Source->GetBounds(b);
-        b[a] = v;
-        s.Source->SetBounds(b);
-      },
-      typical[a] });
-  }
-  for (int a = 0; a < 2; ++a)
-  {
-    properties.push_back({ "Wind[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double w[2];
-        s.Source->GetWind(w);
-        w[a] = v;
-        s.Source->SetWind(w);
-      },
-      12.0 });
-    properties.push_back({ "Shear[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double w[2];
-        s.Source->GetShear(w);
-        w[a] = v;
-        s.Source->SetShear(w);
-      },
-      0.01 });
-  }
+  AddElements<int, 3>(
+    properties, "Dimensions", [](S& s, int* v) { s.Source->GetDimensions(v); },
+    [](S& s, int* v) { s.Source->SetDimensions(v); }, { { 48, 48, 48 } });
+  AddElements<double, 6>(
+    properties, "Bounds", [](S& s, double* v) { s.Source->GetBounds(v); },
+    [](S& s, double* v) { s.Source->SetBounds(v); }, { { -6400, 6400, -6400, 6400, 1000, 2600 } });
+  AddElements<double, 2>(
+    properties, "Wind", [](S& s, double* v) { s.Source->GetWind(v); },
+    [](S& s, double* v) { s.Source->SetWind(v); }, { { 12.0, 12.0 } });
+  AddElements<double, 2>(
+    properties, "Shear", [](S& s, double* v) { s.Source->GetShear(v); },
+    [](S& s, double* v) { s.Source->SetShear(v); }, { { 0.01, 0.01 } });
   auto scalar = [&properties](const std::string& name, bool integer, bool refuseNonFinite,
                   std::function<void(vtkNimbusCloudAutomatonSource*, double)> set, double typical)
   {
@@ -524,18 +470,10 @@ std::vector<Property<AutomatonSetup>> AutomatonProperties()
   scalar(
     "NumberOfFormationRegions", true, true,
     [](A* s, double v) { s->SetNumberOfFormationRegions(ToInt(v)); }, 6);
-  for (int a = 0; a < 2; ++a)
-  {
-    properties.push_back({ "FormationRegionRadiusRange[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double r[2];
-        s.Source->GetFormationRegionRadiusRange(r);
-        r[a] = v;
-        s.Source->SetFormationRegionRadiusRange(r);
-      },
-      a == 0 ? 500.0 : 900.0 });
-  }
+  AddElements<double, 2>(
+    properties, "FormationRegionRadiusRange",
+    [](S& s, double* v) { s.Source->GetFormationRegionRadiusRange(v); },
+    [](S& s, double* v) { s.Source->SetFormationRegionRadiusRange(v); }, { { 500.0, 900.0 } });
   scalar(
     "SpinUpSteps", true, true, [](A* s, double v) { s->SetSpinUpSteps(ToInt(v)); }, 40);
   // The requested time: NaN reads as time 0, infinities are clamped to the time range.
@@ -556,18 +494,9 @@ std::vector<Property<ImageSetup>> ImageProperties()
   using S = ImageSetup;
   using F = vtkNimbusImageCloudFilter;
   std::vector<Property<S>> properties;
-  for (int a = 0; a < 2; ++a)
-  {
-    properties.push_back({ "IntensityRange[" + std::to_string(a) + "]", false, true,
-      [a](S& s, double v)
-      {
-        double r[2];
-        s.Filter->GetIntensityRange(r);
-        r[a] = v;
-        s.Filter->SetIntensityRange(r);
-      },
-      a == 0 ? 0.0 : 255.0 });
-  }
+  AddElements<double, 2>(
+    properties, "IntensityRange", [](S& s, double* v) { s.Filter->GetIntensityRange(v); },
+    [](S& s, double* v) { s.Filter->SetIntensityRange(v); }, { { 0.0, 255.0 } });
   properties.push_back({ "image nx", true, true, [](S& s, double v) { s.Nx = v; }, 24 });
   properties.push_back({ "image ny", true, true, [](S& s, double v) { s.Ny = v; }, 20 });
   // Intensities may be anything: NaN reads as clear sky, infinities clamp (with a warning).
