@@ -245,21 +245,20 @@ void CheckPoint(const Vector3& p)
 } // namespace
 
 //------------------------------------------------------------------------------
-double AngstromBetaFromTurbidity(double turbidity)
+double AerosolOpticalDepthFromTurbidity(double turbidity)
 {
-  return 0.04608 * turbidity - 0.04586;
+  return kAerosolOpticalDepthPerTurbidity * (turbidity - 1.0);
 }
 
 double MieScatteringFromTurbidity(double turbidity, const AtmosphereParameters& a)
 {
-  const double beta = AngstromBetaFromTurbidity(turbidity);
-  if (!std::isfinite(turbidity) || beta < 0.0)
+  if (!std::isfinite(turbidity) || turbidity < 1.0)
   {
-    throw std::invalid_argument("nimbus::MieScatteringFromTurbidity: turbidity must be finite "
-                                "and >= 0.995 (Angstrom beta >= 0)");
+    throw std::invalid_argument(
+      "nimbus::MieScatteringFromTurbidity: turbidity must be finite and >= 1 (1 = no aerosol)");
   }
-  // tau(550) = beta 0.55^-alpha = beta_M,ext(550) H_M;  beta_M,s = albedo beta_M,ext.
-  return a.MieAlbedo * beta * std::pow(0.55, -a.MieAngstromExponent) / a.MieScaleHeightMetres;
+  // tau_A(550) = beta_M,ext(550) H_M;  beta_M,s = albedo beta_M,ext.
+  return a.MieAlbedo * AerosolOpticalDepthFromTurbidity(turbidity) / a.MieScaleHeightMetres;
 }
 
 double TurbidityFromMieScattering(double mie, const AtmosphereParameters& a)
@@ -269,9 +268,8 @@ double TurbidityFromMieScattering(double mie, const AtmosphereParameters& a)
     throw std::invalid_argument(
       "nimbus::TurbidityFromMieScattering: the scattering coefficient must be finite and >= 0");
   }
-  const double beta =
-    mie * a.MieScaleHeightMetres / (a.MieAlbedo * std::pow(0.55, -a.MieAngstromExponent));
-  return (beta + 0.04586) / 0.04608;
+  const double opticalDepth = mie * a.MieScaleHeightMetres / a.MieAlbedo;
+  return 1.0 + opticalDepth / kAerosolOpticalDepthPerTurbidity;
 }
 
 AtmosphereParameters ClearSkyAtmosphere(double turbidity)

@@ -50,23 +50,35 @@ struct NIMBUSPHYSICS_EXPORT AtmosphereParameters
 };
 
 /// The range of the turbidity T that the sky accepts, and its default (a clear day).
-/// Preetham et al. fit T in [2, 10]; T = 1 is air without aerosol.
+/// Preetham et al. and Hosek & Wilkie fit T in [2, 10] (Hosek-Wilkie from 1); T = 1 is
+/// air without aerosol.
 constexpr double kMinTurbidity = 1.0;
 constexpr double kMaxTurbidity = 10.0;
 constexpr double kDefaultTurbidity = 2.0;
 
-/// Preetham, Shirley & Smits 1999, Appendix A.1 (after its Eq. for the haze
-/// attenuation): the Angstrom turbidity coefficient beta (the aerosol optical depth
-/// at 1 um, dimensionless) of turbidity T,  beta = 0.04608 T - 0.04586 (0 at T = 0.995).
-NIMBUSPHYSICS_EXPORT double AngstromBetaFromTurbidity(double turbidity);
+/// How much aerosol a turbidity T means: the vertical aerosol optical depth at 550 nm
+///   tau_A(550) = kAerosolOpticalDepthPerTurbidity (T - 1),
+/// T = 1 air without aerosol. The slope is calibrated (one number) so that the sky of T
+/// is the clear sky that Hosek & Wilkie 2012 (and Preetham et al. 1999) call T: against
+/// Hosek-Wilkie over sun elevations 1..90 deg and T = 2..5 (TestSky
+/// ValidationAgainstHosekWilkie, docs/sky.md) slopes 0.015..0.025 keep every luminance
+/// shape within 10 % and every chromaticity within 0.02; 0.03 already misses 3 of 40 and
+/// Preetham's own relation (Appendix A.1, beta = 0.04608 T - 0.04586 at 1 um, i.e. about
+/// 0.1 (T - 1) at 550 nm) gives a sky 0.03..0.04 paler in chromaticity than both models
+/// at high sun. Measured skies agree with a small slope: Bruneton 2016 ("A Qualitative
+/// and Quantitative Evaluation of 8 Clear Sky Models", IEEE TVCG 23(12)) fits the sky
+/// measured by Kider et al. 2014 with Preetham and Hosek-Wilkie at T = 2.53 and with
+/// libRadtran at the aerosol optical depth 0.064 (Angstrom alpha 0.8, beta 0.04):
+/// slope 0.042.
+constexpr double kAerosolOpticalDepthPerTurbidity = 0.025;
+NIMBUSPHYSICS_EXPORT double AerosolOpticalDepthFromTurbidity(double turbidity);
 
 /// Sea-level aerosol scattering coefficient beta_M,s(550 nm) [1/m] of turbidity T for
-/// the given atmosphere's aerosol scale height H_M, albedo and Angstrom exponent alpha:
-/// the vertical aerosol optical depth tau(lambda) = beta (lambda / 1 um)^-alpha
-/// (Angstrom 1929) equals the extinction column beta_M,ext(550) H_M of the exponential
+/// the given atmosphere's aerosol scale height H_M and albedo: the vertical optical
+/// depth tau_A(550) equals the extinction column beta_M,ext(550) H_M of the exponential
 /// layer (its part above the top of the atmosphere, exp(-60 km / H_M), neglected), so
-///   beta_M,s(550) = albedo beta(T) 0.55^-alpha / H_M.
-/// Throws std::invalid_argument for a non-finite T or one below 0.995 (negative beta).
+///   beta_M,s(550) = albedo tau_A(550) / H_M   (the Angstrom exponent scales the other
+/// wavelengths around 550 nm). Throws std::invalid_argument for a non-finite T or T < 1.
 NIMBUSPHYSICS_EXPORT double MieScatteringFromTurbidity(
   double turbidity, const AtmosphereParameters& atmosphere);
 /// Its inverse: the turbidity T of a sea-level aerosol scattering coefficient [1/m] (>= 0).
@@ -76,7 +88,7 @@ NIMBUSPHYSICS_EXPORT double TurbidityFromMieScattering(
 /// The clear-sky atmosphere of turbidity T (Preetham et al. 1999's haze measure; 2 = very
 /// clear, 3 = clear, 5 = light haze, 10 = hazy) that the sky uses
 /// (SkyParameters default: T = kDefaultTurbidity):
-///  - the aerosol amount from T (MieScatteringFromTurbidity);
+///  - the aerosol amount from T (AerosolOpticalDepthFromTurbidity);
 ///  - Angstrom exponent 1.3 (Angstrom 1929's continental mean, Preetham's Appendix A.1);
 ///  - the aerosol phase function: Cornette-Shanks whose mean cosine (asymmetry factor)
 ///    is 0.70, the mean of the AERONET sky-radiometer retrievals of continental and urban

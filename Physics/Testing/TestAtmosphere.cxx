@@ -388,17 +388,16 @@ TEST(Atmosphere, AngstromOzoneAndTurbidity)
   EXPECT_EQ(clean.OzoneDensity(25000.0), 0.0);
   EXPECT_DOUBLE_EQ(air.OzoneDensity(25000.0), 1.0);
   EXPECT_DOUBLE_EQ(air.OzoneDensity(5000.0), 0.0);
-  // Preetham et al. 1999 Appendix A.1: beta = 0.04608 T - 0.04586; the vertical aerosol
-  // optical depth of the atmosphere at 550 nm is beta 0.55^-1.3.
+  // The vertical aerosol optical depth of the atmosphere at 550 nm is
+  // kAerosolOpticalDepthPerTurbidity (T - 1) (0.025 (T - 1): Atmosphere.h).
   for (double turbidity : { 1.0, 2.0, 2.5, 5.0, 10.0 })
   {
     const nimbus::AtmosphereParameters a = nimbus::ClearSkyAtmosphere(turbidity);
-    const double beta = 0.04608 * turbidity - 0.04586;
     const nimbus::Atmosphere hazy(a);
     const nimbus::OpticalLengths column =
       hazy.OpticalLengthsToTop({ { 0.0, 0.0, R } }, { { 0.0, 0.0, 1.0 } });
     const double aod = hazy.MieExtinction(550.0) * column.MieLengthMetres;
-    EXPECT_NEAR(aod, beta * std::pow(0.55, -1.3), 1e-9 + 1e-9 * aod) << turbidity;
+    EXPECT_NEAR(aod, 0.025 * (turbidity - 1.0), 1e-9 + 1e-9 * aod) << turbidity;
     EXPECT_NEAR(nimbus::TurbidityFromMieScattering(a.MieScatteringPerMetre, a), turbidity, 1e-9);
     EXPECT_NEAR(nimbus::CornetteShanksMeanCosine(a.MieG), 0.70, 1e-9);
   }

@@ -18,9 +18,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace
@@ -436,90 +440,38 @@ double CieClearSky(int type, double Z, double chi, double Zs)
   return f(chi) * phi(Z) / (f(Zs) * phi(0.0));
 }
 
-/// One sky (turbidity T, sun elevation) against Preetham et al. 1999 and the CIE clear sky.
-struct SkyComparison
+/// One direction of a published sky: view elevation and azimuth from the sun (deg), the
+/// sky's luminance there (any unit: every comparison normalises) and CIE 1931 (x, y).
+struct ReferenceSample
 {
-  double Shape = 0.0;    // median over the dome of the normalised luminance ratio ours / Preetham
-  double Glow = 0.0;     // the same over directions 3..15 deg from the sun
-  double MaxRatio = 0.0; // largest ratio on the dome (the brightest excess: the aureole)
-  double CieShape = 0.0; // median ratio ours / CIE clear sky (type 12 for T < 3.5, else 13)
-  double CieGlow = 0.0;  // the same 3..15 deg from the sun
-  double Dx = 0.0;       // median over the dome of x_ours - x_Preetham
-  double Dy = 0.0;       // median over the dome of y_ours - y_Preetham
-  double ZenithDx = 0.0; // at the zenith
-  double ZenithDy = 0.0;
+  enum Kind
+  {
+    Dome,   // the grid over the dome
+    Ring,   // 3..15 deg from the sun
+    Zenith, // straight up
+  } Where;
+  double Elevation, Azimuth, Luminance;
+  std::array<double, 2> Xy;
 };
 
-/// The dome: view elevations 2.5, 7.5, ..., 87.5 deg by azimuths 0, 10, ..., 180 deg from
-/// the sun (the sky is symmetric about the sun's vertical), each weighted by its solid
-/// angle (cos elevation; the two border azimuths by half). Each sky is normalised by
-/// its solid-angle mean over the directions more than 20 deg from the sun (so that the
-/// aureole, which Preetham's smooth fit does not have, does not set the scale), then
-/// the ratio ours / theirs is taken per direction and its median reported. The glow is
-/// the median ratio on rings 3, 5, 8, 12, 15 deg around the sun (12 directions each,
-/// those above 2 deg elevation).
-SkyComparison CompareSky(const SkyModel& model, double turbidity, double sunElevation)
+/// The directions of a comparison: the dome, view elevations 2.5, 7.5, ..., 87.5 deg by
+/// azimuths 0, 10, ..., 180 deg from the sun (the sky is symmetric about the sun's
+/// vertical); rings 3, 5, 8, 12, 15 deg around the sun (12 directions each, those above
+/// 2 deg elevation); the zenith. scripts/hosek-wilkie-reference.py samples the same.
+std::vector<ReferenceSample> ComparisonDirections(double sunElevation)
 {
-  const SkyViewLut lut(model, sunElevation, 0.0);
-  const double sunZenith = (90.0 - sunElevation) * kDegree;
-  const nimbus::PreethamSky preetham(turbidity, sunZenith);
-  const int cieType = turbidity < 3.5 ? 12 : 13;
-  const Vector3 s = Direction(sunElevation, 0.0);
-  const auto angleToSun = [&](const Vector3& w)
-  { return std::acos(std::max(-1.0, std::min(1.0, nimbus::Dot(w, s)))); };
-
-  struct Sample
-  {
-    double Weight, Gamma, Ours, Preetham, Cie;
-    std::array<double, 2> OursXy, PreethamXy;
-  };
-  const auto sample = [&](const Vector3& w, double weight)
-  {
-    const double zenith = std::acos(std::max(-1.0, std::min(1.0, w[2])));
-    const double gamma = angleToSun(w);
-    const std::array<double, 3> xyz = LinearSrgbToXyz(lut.Radiance(w, 0.0));
-    const double sum = xyz[0] + xyz[1] + xyz[2];
-    Sample x{ weight, gamma, xyz[1], preetham.Luminance(zenith, gamma),
-      CieClearSky(cieType, zenith, gamma, sunZenith), { { xyz[0] / sum, xyz[1] / sum } },
-      preetham.Chromaticity(zenith, gamma) };
-    return x;
-  };
-  std::vector<Sample> dome;
+  std::vector<ReferenceSample> out;
   for (double e = 2.5; e < 90.0; e += 5.0)
   {
     for (double az = 0.0; az <= 180.0; az += 10.0)
     {
-      const double border = (az == 0.0 || az == 180.0) ? 0.5 : 1.0;
-      dome.push_back(sample(Direction(e, az), border * std::cos(e * kDegree)));
+      out.push_back({ ReferenceSample::Dome, e, az, 0.0, {} });
     }
   }
-  double ours = 0.0, theirs = 0.0, cie = 0.0;
-  for (const Sample& x : dome)
-  {
-    if (x.Gamma > 20.0 * kDegree)
-    {
-      ours += x.Weight * x.Ours;
-      theirs += x.Weight * x.Preetham;
-      cie += x.Weight * x.Cie;
-    }
-  }
-  SkyComparison result;
-  std::vector<double> shape, cieShape, dx, dy;
-  for (const Sample& x : dome)
-  {
-    const double ratio = (x.Ours / ours) / (x.Preetham / theirs);
-    shape.push_back(ratio);
-    cieShape.push_back((x.Ours / ours) / (x.Cie / cie));
-    result.MaxRatio = std::max(result.MaxRatio, ratio);
-    dx.push_back(x.OursXy[0] - x.PreethamXy[0]);
-    dy.push_back(x.OursXy[1] - x.PreethamXy[1]);
-  }
-  // Rings around the sun: directions at angle g from s.
+  const Vector3 s = Direction(sunElevation, 0.0);
   const Vector3 east{ { 1.0, 0.0, 0.0 } };
-  Vector3 u = nimbus::Cross(s, east);
-  u = nimbus::Normalized(u);
+  const Vector3 u = nimbus::Normalized(nimbus::Cross(s, east));
   const Vector3 v = nimbus::Cross(s, u);
-  std::vector<double> glow, cieGlow;
   for (double g : { 3.0, 5.0, 8.0, 12.0, 15.0 })
   {
     for (double psi = 0.0; psi < 360.0; psi += 30.0)
@@ -535,9 +487,111 @@ SkyComparison CompareSky(const SkyModel& model, double turbidity, double sunElev
       {
         continue;
       }
-      const Sample x = sample(w, 0.0);
-      glow.push_back((x.Ours / ours) / (x.Preetham / theirs));
-      cieGlow.push_back((x.Ours / ours) / (x.Cie / cie));
+      out.push_back({ ReferenceSample::Ring, std::asin(std::min(1.0, w[2])) / kDegree,
+        std::atan2(w[0], w[1]) / kDegree, 0.0, {} });
+    }
+  }
+  out.push_back({ ReferenceSample::Zenith, 90.0, 0.0, 0.0, {} });
+  return out;
+}
+
+/// Preetham et al. 1999 at turbidity T and the sun's elevation, in those directions.
+std::vector<ReferenceSample> PreethamReference(double turbidity, double sunElevation)
+{
+  const nimbus::PreethamSky preetham(turbidity, (90.0 - sunElevation) * kDegree);
+  const Vector3 s = Direction(sunElevation, 0.0);
+  std::vector<ReferenceSample> out = ComparisonDirections(sunElevation);
+  for (ReferenceSample& x : out)
+  {
+    const Vector3 w = Direction(x.Elevation, x.Azimuth);
+    const double zenith = std::acos(std::max(-1.0, std::min(1.0, w[2])));
+    const double gamma = std::acos(std::max(-1.0, std::min(1.0, nimbus::Dot(w, s))));
+    x.Luminance = preetham.Luminance(zenith, gamma);
+    x.Xy = preetham.Chromaticity(zenith, gamma);
+  }
+  return out;
+}
+
+/// One sky (turbidity T, sun elevation) against a published sky and the CIE clear sky.
+struct SkyComparison
+{
+  double Shape = 0.0;    // median over the dome of the normalised luminance ratio ours / theirs
+  double Glow = 0.0;     // the same over directions 3..15 deg from the sun
+  double MaxRatio = 0.0; // largest ratio on the dome (the brightest excess: the aureole)
+  double CieShape = 0.0; // median ratio ours / CIE clear sky (type 12 for T < 3.5, else 13)
+  double CieGlow = 0.0;  // the same 3..15 deg from the sun
+  double Dx = 0.0;       // median over the dome of x_ours - x_theirs
+  double Dy = 0.0;       // median over the dome of y_ours - y_theirs
+  double ZenithDx = 0.0; // at the zenith
+  double ZenithDy = 0.0;
+};
+
+/// Our sky against a reference sampled in ComparisonDirections. Each dome direction is
+/// weighted by its solid angle (cos elevation; the two border azimuths by half); each
+/// sky is normalised by its solid-angle mean over the dome's directions more than 20 deg
+/// from the sun (so that the aureole, which Preetham's smooth fit does not have, does
+/// not set the scale); then the ratio ours / theirs is taken per direction and its
+/// median reported (shape over the dome, glow over the rings).
+SkyComparison CompareSky(const SkyModel& model, double turbidity, double sunElevation,
+  const std::vector<ReferenceSample>& reference)
+{
+  const SkyViewLut lut(model, sunElevation, 0.0);
+  const double sunZenith = (90.0 - sunElevation) * kDegree;
+  const int cieType = turbidity < 3.5 ? 12 : 13;
+  const Vector3 s = Direction(sunElevation, 0.0);
+
+  struct Sample
+  {
+    ReferenceSample::Kind Where;
+    double Weight, Gamma, Ours, Theirs, Cie;
+    std::array<double, 2> OursXy, TheirXy;
+  };
+  std::vector<Sample> samples;
+  for (const ReferenceSample& r : reference)
+  {
+    const Vector3 w = Direction(r.Elevation, r.Azimuth);
+    const double zenith = std::acos(std::max(-1.0, std::min(1.0, w[2])));
+    const double gamma = std::acos(std::max(-1.0, std::min(1.0, nimbus::Dot(w, s))));
+    const std::array<double, 3> xyz = LinearSrgbToXyz(lut.Radiance(w, 0.0));
+    const double sum = xyz[0] + xyz[1] + xyz[2];
+    const bool border = r.Azimuth == 0.0 || r.Azimuth == 180.0;
+    samples.push_back(
+      { r.Where, (border ? 0.5 : 1.0) * std::cos(r.Elevation * kDegree), gamma, xyz[1], r.Luminance,
+        CieClearSky(cieType, zenith, gamma, sunZenith), { { xyz[0] / sum, xyz[1] / sum } }, r.Xy });
+  }
+  double ours = 0.0, theirs = 0.0, cie = 0.0;
+  for (const Sample& x : samples)
+  {
+    if (x.Where == ReferenceSample::Dome && x.Gamma > 20.0 * kDegree)
+    {
+      ours += x.Weight * x.Ours;
+      theirs += x.Weight * x.Theirs;
+      cie += x.Weight * x.Cie;
+    }
+  }
+  SkyComparison result;
+  std::vector<double> shape, cieShape, dx, dy, glow, cieGlow;
+  for (const Sample& x : samples)
+  {
+    const double ratio = (x.Ours / ours) / (x.Theirs / theirs);
+    const double cieRatio = (x.Ours / ours) / (x.Cie / cie);
+    if (x.Where == ReferenceSample::Dome)
+    {
+      shape.push_back(ratio);
+      cieShape.push_back(cieRatio);
+      result.MaxRatio = std::max(result.MaxRatio, ratio);
+      dx.push_back(x.OursXy[0] - x.TheirXy[0]);
+      dy.push_back(x.OursXy[1] - x.TheirXy[1]);
+    }
+    else if (x.Where == ReferenceSample::Ring)
+    {
+      glow.push_back(ratio);
+      cieGlow.push_back(cieRatio);
+    }
+    else
+    {
+      result.ZenithDx = x.OursXy[0] - x.TheirXy[0];
+      result.ZenithDy = x.OursXy[1] - x.TheirXy[1];
     }
   }
   result.Shape = Median(shape);
@@ -546,20 +600,89 @@ SkyComparison CompareSky(const SkyModel& model, double turbidity, double sunElev
   result.CieGlow = Median(cieGlow);
   result.Dx = Median(dx);
   result.Dy = Median(dy);
-  const Sample z = sample({ { 0.0, 0.0, 1.0 } }, 0.0);
-  result.ZenithDx = z.OursXy[0] - z.PreethamXy[0];
-  result.ZenithDy = z.OursXy[1] - z.PreethamXy[1];
   return result;
+}
+
+/// Preetham's sky against another published one (the same normalisation as CompareSky):
+/// the median over the dome of the normalised luminance ratio Preetham / reference.
+double PublishedShapeRatio(
+  double turbidity, double sunElevation, const std::vector<ReferenceSample>& reference)
+{
+  const std::vector<ReferenceSample> preetham = PreethamReference(turbidity, sunElevation);
+  const Vector3 s = Direction(sunElevation, 0.0);
+  std::vector<std::array<double, 2>> dome; // (Preetham, reference)
+  double sumPreetham = 0.0, sumReference = 0.0;
+  for (const ReferenceSample& r : reference)
+  {
+    if (r.Where != ReferenceSample::Dome)
+    {
+      continue;
+    }
+    const auto same = std::find_if(preetham.begin(), preetham.end(),
+      [&](const ReferenceSample& p)
+      {
+        return p.Where == ReferenceSample::Dome && p.Elevation == r.Elevation &&
+          p.Azimuth == r.Azimuth;
+      });
+    EXPECT_NE(same, preetham.end());
+    if (same == preetham.end())
+    {
+      return 0.0;
+    }
+    const double weight =
+      ((r.Azimuth == 0.0 || r.Azimuth == 180.0) ? 0.5 : 1.0) * std::cos(r.Elevation * kDegree);
+    if (nimbus::Dot(Direction(r.Elevation, r.Azimuth), s) < std::cos(20.0 * kDegree))
+    {
+      sumPreetham += weight * same->Luminance;
+      sumReference += weight * r.Luminance;
+    }
+    dome.push_back({ { same->Luminance, r.Luminance } });
+  }
+  std::vector<double> ratios;
+  for (const auto& x : dome)
+  {
+    ratios.push_back((x[0] / sumPreetham) / (x[1] / sumReference));
+  }
+  return Median(ratios);
+}
+
+/// Hosek & Wilkie 2012 in ComparisonDirections, keyed by (turbidity, sun elevation):
+/// read from Data/hosek-wilkie-reference.csv (scripts/hosek-wilkie-reference.py).
+std::map<std::pair<int, int>, std::vector<ReferenceSample>> ReadHosekWilkieReference()
+{
+  std::map<std::pair<int, int>, std::vector<ReferenceSample>> out;
+  std::ifstream file(NIMBUS_PHYSICS_TEST_DATA "/hosek-wilkie-reference.csv");
+  std::string line;
+  while (std::getline(file, line))
+  {
+    if (line.empty() || line[0] == '#' || line[0] == 't')
+    {
+      continue;
+    }
+    std::istringstream in(line);
+    std::string field[8];
+    for (std::string& f : field)
+    {
+      std::getline(in, f, ',');
+    }
+    const double x = std::stod(field[5]), y = std::stod(field[6]), z = std::stod(field[7]);
+    const ReferenceSample::Kind where = field[2] == "dome"
+      ? ReferenceSample::Dome
+      : (field[2] == "ring" ? ReferenceSample::Ring : ReferenceSample::Zenith);
+    out[{ std::stoi(field[0]), std::stoi(field[1]) }].push_back({ where, std::stod(field[3]),
+      std::stod(field[4]), y, { { x / (x + y + z), y / (x + y + z) } } });
+  }
+  return out;
 }
 } // namespace
 
-// Validation of the sky's shape and colour against an independent published clear-sky
-// model, Preetham, Shirley & Smits 1999 (PreethamSky.h), at the same turbidity (the
-// aerosol amount of Preetham's own relation beta = 0.04608 T - 0.04586: Atmosphere.h),
-// over sun elevations 1..90 deg and turbidities 2..5; the luminance shape also against
-// the CIE Standard General Sky's clear types (measured skies). Goal: medians of the
-// normalised luminance ratio within 10 %, of the chromaticity differences within 0.02.
-// Bounds: measured values rounded (docs/sky.md has the table and the discussion).
+// The sky's shape and colour against a second published clear-sky model, Preetham, Shirley
+// & Smits 1999 (PreethamSky.h), at the same turbidity, over sun elevations 1..90 deg and
+// turbidities 2..5; the luminance shape also against the CIE Standard General Sky's clear
+// types (measured skies). The validation proper is against Hosek & Wilkie 2012 (below):
+// Preetham's and Hosek-Wilkie's shapes differ from each other by up to 70 % at T = 3..5
+// (ValidationAgainstHosekWilkie prints it), so no sky can be within 10 % of both; their
+// colours agree within 0.02. Bounds: measured values rounded (docs/sky.md).
 TEST(Sky, ValidationAgainstPreetham)
 {
   const double elevations[] = { 1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0 };
@@ -573,7 +696,8 @@ TEST(Sky, ValidationAgainstPreetham)
     const SkyModel model(p);
     for (double elevation : elevations)
     {
-      const SkyComparison c = CompareSky(model, turbidity, elevation);
+      const SkyComparison c =
+        CompareSky(model, turbidity, elevation, PreethamReference(turbidity, elevation));
       const bool shapeOk = std::abs(c.Shape - 1.0) <= 0.10;
       const bool colourOk = std::abs(c.Dx) <= 0.02 && std::abs(c.Dy) <= 0.02;
       shapeWithin += shapeOk ? 1 : 0;
@@ -583,36 +707,97 @@ TEST(Sky, ValidationAgainstPreetham)
         turbidity, elevation, c.Shape, shapeOk ? " " : "*", c.Glow, c.MaxRatio, c.CieShape,
         c.CieGlow, c.Dx, c.Dy, colourOk ? " " : "*", c.ZenithDx, c.ZenithDy);
       EXPECT_TRUE(std::isfinite(c.Shape) && std::isfinite(c.Dx) && std::isfinite(c.Dy));
-      // The goal where it is met (measured): the chromaticity within 0.02 of Preetham's
-      // for the sun up to 10 deg at every turbidity (worst 0.0196, T = 5, sun 1 deg).
-      if (elevation <= 10.0)
+      // The chromaticity within 0.02 of Preetham's for the sun at 20 deg and above
+      // (measured: at most 0.0176); below, ours is up to 0.032 bluer (ozone).
+      if (elevation >= 20.0)
       {
         EXPECT_LE(std::abs(c.Dx), 0.02) << "T " << turbidity << ", sun " << elevation;
         EXPECT_LE(std::abs(c.Dy), 0.02) << "T " << turbidity << ", sun " << elevation;
       }
-      // The glow around the sun (3..15 deg) against the CIE clear sky (measured skies),
-      // sun >= 20 deg: measured 0.78..1.16 (against Preetham's, which has no aureole:
-      // 1.30..2.06; the CIE clear sky's own circumsolar term is 1.5..1.7 times
-      // Preetham's there). Bound: within 25 %.
-      if (elevation >= 20.0)
-      {
-        EXPECT_GT(c.CieGlow, 0.75) << "T " << turbidity << ", sun " << elevation;
-        EXPECT_LT(c.CieGlow, 1.25) << "T " << turbidity << ", sun " << elevation;
-      }
-      // Elsewhere the measured envelope (the goal is missed there, see docs/sky.md):
-      // shape 0.757..1.409, chromaticity up to +0.040 (high sun: ours paler).
-      EXPECT_GT(c.Shape, 0.72) << turbidity << " " << elevation;
-      EXPECT_LT(c.Shape, 1.45) << turbidity << " " << elevation;
-      EXPECT_LT(std::abs(c.Dx), 0.043) << turbidity << " " << elevation;
-      EXPECT_LT(std::abs(c.Dy), 0.043) << turbidity << " " << elevation;
+      // The measured envelope elsewhere: shape 0.596..1.192 (Preetham's sky is flatter
+      // than Hosek-Wilkie's and ours at T = 3..5), chromaticity up to 0.032, the glow
+      // 3..15 deg from the sun 0.38..0.75 of the CIE clear sky's (whose circumsolar term,
+      // from measured skies, is brighter than Hosek-Wilkie's and Preetham's).
+      EXPECT_GT(c.Shape, 0.56) << turbidity << " " << elevation;
+      EXPECT_LT(c.Shape, 1.25) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dx), 0.035) << turbidity << " " << elevation;
+      EXPECT_LT(std::abs(c.Dy), 0.035) << turbidity << " " << elevation;
+      EXPECT_GT(c.CieGlow, 0.34) << turbidity << " " << elevation;
+      EXPECT_LT(c.CieGlow, 0.8) << turbidity << " " << elevation;
     }
   }
   std::printf("  (* outside the goal) shape within 10 %%: %d of %d; chromaticity within 0.02: %d "
               "of %d\n",
     shapeWithin, cases, colourWithin, cases);
-  // Measured 23 and 17 of 40: no fewer.
-  EXPECT_GE(shapeWithin, 23);
-  EXPECT_GE(colourWithin, 17);
+  // Measured 6 and 31 of 40: no fewer.
+  EXPECT_GE(shapeWithin, 6);
+  EXPECT_GE(colourWithin, 31);
+}
+
+// Validation against Hosek & Wilkie 2012 ("An Analytic Model for Full Spectral Sky-Dome
+// Radiance", ACM TOG 31(4): fitted to path-traced spectral skies, with Preetham's
+// turbidity and a ground albedo), evaluated by Blender's Cycles (the authors' CIE XYZ
+// data set; scripts/hosek-wilkie-reference.py wrote the table), ground albedo 0.3 as
+// ours, over sun elevations 1..90 deg and turbidities 2..5. Goal: medians of the
+// normalised luminance ratio within 10 %, of the chromaticity differences within 0.02.
+// Compared twice: with the same physics as Hosek-Wilkie (no ozone: their sky does not
+// absorb in the Chappuis band; with ozone, ours is bluer at sunrise, as measured
+// twilight skies are: OzoneKeepsTwilightBlue), and as the sky is built (300 DU).
+TEST(Sky, ValidationAgainstHosekWilkie)
+{
+  const auto reference = ReadHosekWilkieReference();
+  ASSERT_EQ(reference.size(), 40u) << "Data/hosek-wilkie-reference.csv";
+  for (const double ozone : { 0.0, 300.0 })
+  {
+    int shapeWithin = 0, colourWithin = 0, cases = 0;
+    std::printf("  ozone %.0f DU\n  T    sun | shape  glow3-15 max | median dx     dy | zenith "
+                "dx  dy | Preetham/H-W shape\n",
+      ozone);
+    for (int turbidity : { 2, 3, 4, 5 })
+    {
+      SkyParameters p;
+      p.Atmosphere = nimbus::ClearSkyAtmosphere(turbidity);
+      p.Atmosphere.OzoneDobsonUnits = ozone;
+      const SkyModel model(p);
+      for (int elevation : { 1, 2, 5, 10, 20, 30, 45, 60, 75, 90 })
+      {
+        const auto found = reference.find({ turbidity, elevation });
+        ASSERT_NE(found, reference.end()) << turbidity << " " << elevation;
+        const SkyComparison c = CompareSky(model, turbidity, elevation, found->second);
+        const double published = PublishedShapeRatio(turbidity, elevation, found->second);
+        const bool shapeOk = std::abs(c.Shape - 1.0) <= 0.10;
+        const bool colourOk = std::abs(c.Dx) <= 0.02 && std::abs(c.Dy) <= 0.02;
+        shapeWithin += shapeOk ? 1 : 0;
+        colourWithin += colourOk ? 1 : 0;
+        ++cases;
+        std::printf("  %d %6d | %.3f%s %.2f %.2f | %+.4f %+.4f%s | %+.4f %+.4f | %.3f\n", turbidity,
+          elevation, c.Shape, shapeOk ? " " : "*", c.Glow, c.MaxRatio, c.Dx, c.Dy,
+          colourOk ? " " : "*", c.ZenithDx, c.ZenithDy, published);
+        // The two published models' shapes (measured 0.886..1.695).
+        EXPECT_GT(published, 0.85);
+        EXPECT_LT(published, 1.75);
+        // The goal, in every case.
+        EXPECT_TRUE(shapeOk) << "ozone " << ozone << ", T " << turbidity << ", sun " << elevation;
+        if (ozone == 0.0 || elevation >= 5)
+        {
+          EXPECT_TRUE(colourOk) << "ozone " << ozone << ", T " << turbidity << ", sun "
+                                << elevation;
+        }
+        else
+        {
+          // Ozone's blue at sunrise: ours bluer (y lower), measured -0.024..-0.040.
+          EXPECT_LT(c.Dy, -0.02) << "T " << turbidity << ", sun " << elevation;
+          EXPECT_GT(c.Dy, -0.045) << "T " << turbidity << ", sun " << elevation;
+        }
+        // The glow 3..15 deg from the sun, median ratio: measured 0.72..1.28.
+        EXPECT_GT(c.Glow, 0.65) << turbidity << " " << elevation;
+        EXPECT_LT(c.Glow, 1.4) << turbidity << " " << elevation;
+      }
+    }
+    std::printf("  (* outside the goal) shape within 10 %%: %d of %d; chromaticity within 0.02: "
+                "%d of %d\n",
+      shapeWithin, cases, colourWithin, cases);
+  }
 }
 
 // The haze knob at the ends of its range and bad values: finite skies from the zenith
