@@ -90,8 +90,9 @@ public:
   ///@{
   /// The same setting as the aerosol (Mie) scattering coefficient at sea level and
   /// 550 nm, 1/m, [0, 6.8e-4] (the mapper's and the scene format's name and unit):
-  /// 7.56e-5 at the default turbidity 2; 2e-5 (the default before turbidity) is
-  /// turbidity 1.26. Setting it sets Turbidity (below 1 for less than 3.6e-7).
+  /// 1.875e-5 at the default turbidity 2 (nimbus::MieScatteringFromTurbidity); 2e-5
+  /// (the default before turbidity) is turbidity 2.07. Setting it sets Turbidity
+  /// (1 + 53.3 per 1e-3 /m: 10 at 1.69e-4, 37 at the top of the range).
   virtual void SetMieScatteringPerMetre(double value);
   virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
   virtual double GetMieScatteringPerMetreMaxValue() { return 6.8e-4; }
@@ -198,7 +199,7 @@ protected:
   double SunElevationDegrees = 45.0;
   double SunAzimuthDegrees = 135.0;
   double Turbidity = 2.0;                 // nimbus::kDefaultTurbidity
-  double MieScatteringPerMetre = 7.56e-5; // of Turbidity (set in the constructor)
+  double MieScatteringPerMetre = 1.875e-5; // of Turbidity (set in the constructor)
   double GroundAlbedo = 0.3;
   double Exposure = 10.0;
   double SceneAltitudeMetres = 0.0;

@@ -126,11 +126,12 @@ TEST(SkyDomeParameters, TurbidityAndMieScattering)
 {
   vtkNew<vtkNimbusSky> sky;
   EXPECT_EQ(sky->GetTurbidity(), 2.0);
-  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 7.555e-5, 1e-7);
+  // 0.9 * 0.025 (T - 1) / 1200 m (Atmosphere.h: MieScatteringFromTurbidity)
+  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 1.875e-5, 1e-9);
   sky->SetTurbidity(5.0);
-  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 3.01e-4, 1e-6);
+  EXPECT_NEAR(sky->GetMieScatteringPerMetre(), 7.5e-5, 1e-9);
   sky->SetMieScatteringPerMetre(2.0e-5);
-  EXPECT_NEAR(sky->GetTurbidity(), 1.26, 0.005);
+  EXPECT_NEAR(sky->GetTurbidity(), 2.0667, 0.0005);
   sky->SetTurbidity(100.0); // clamped
   EXPECT_EQ(sky->GetTurbidity(), 10.0);
   sky->SetTurbidity(std::nan("")); // refused (an error), value kept
