@@ -198,7 +198,7 @@ protected:
 
   double SunElevationDegrees = 45.0;
   double SunAzimuthDegrees = 135.0;
-  double Turbidity = 2.0;                 // nimbus::kDefaultTurbidity
+  double Turbidity = 2.0;                  // nimbus::kDefaultTurbidity
   double MieScatteringPerMetre = 1.875e-5; // of Turbidity (set in the constructor)
   double GroundAlbedo = 0.3;
   double Exposure = 10.0;
