@@ -12,6 +12,8 @@
 #include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
+#include <cmath>
+
 vtkStandardNewMacro(vtkNimbusCloudRepresentation);
 
 vtkNimbusCloudRepresentation::vtkNimbusCloudRepresentation()
@@ -22,6 +24,49 @@ vtkNimbusCloudRepresentation::vtkNimbusCloudRepresentation()
   this->VolumeMapper.TakeReference(this->CloudMapper);
   this->CloudMapper->AddObserver(
     vtkCommand::ProgressEvent, this, &vtkNimbusCloudRepresentation::ForwardMapperProgress);
+  this->ApplyHaze();
+}
+
+void vtkNimbusCloudRepresentation::SetTurbidity(double value)
+{
+  if (!std::isfinite(value))
+  {
+    vtkErrorMacro("SetTurbidity(" << value << "): not a finite number; ignored");
+    return;
+  }
+  if (value != this->Turbidity)
+  {
+    this->Turbidity = value;
+    this->ApplyHaze();
+    this->Modified();
+  }
+}
+
+void vtkNimbusCloudRepresentation::SetMieScatteringPerMetre(double value)
+{
+  if (!std::isfinite(value))
+  {
+    vtkErrorMacro("SetMieScatteringPerMetre(" << value << "): not a finite number; ignored");
+    return;
+  }
+  if (value != this->MieScatteringOverride)
+  {
+    this->MieScatteringOverride = value;
+    this->ApplyHaze();
+    this->Modified();
+  }
+}
+
+void vtkNimbusCloudRepresentation::ApplyHaze()
+{
+  if (this->MieScatteringOverride >= 0.0)
+  {
+    this->CloudMapper->SetMieScatteringPerMetre(this->MieScatteringOverride);
+  }
+  else
+  {
+    this->CloudMapper->SetTurbidity(this->Turbidity);
+  }
 }
 
 void vtkNimbusCloudRepresentation::ForwardMapperProgress(vtkObject*, unsigned long, void*)
@@ -115,7 +160,6 @@ NIMBUS_FORWARD(SunElevationDegrees, double)
 NIMBUS_FORWARD(SunIlluminance, double)
 NIMBUS_FORWARD(SunTemperatureKelvin, double)
 NIMBUS_FORWARD(Atmosphere, bool)
-NIMBUS_FORWARD(MieScatteringPerMetre, double)
 NIMBUS_FORWARD(MieG, double)
 NIMBUS_FORWARD(RayleighScatteringPerMetre, double)
 NIMBUS_FORWARD(SceneAltitudeMetres, double)
@@ -143,6 +187,10 @@ NIMBUS_FORWARD(Quality, double)
 void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "Turbidity: " << this->Turbidity << "\n";
+  os << indent
+     << "MieScatteringPerMetre (override, -1 = from Turbidity): " << this->MieScatteringOverride
+     << "\n";
   os << indent << "CloudMapper:\n";
   this->CloudMapper->PrintSelf(os, indent.GetNextIndent());
 }

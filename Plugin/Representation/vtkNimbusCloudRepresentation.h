@@ -104,12 +104,18 @@ public:
   ///@}
 
   ///@{
-  /// Atmosphere: on/off, haze (Mie) scattering at sea level [1/m], haze g,
-  /// Rayleigh scattering at sea level [1/m], altitude of z = 0 [m].
+  /// Atmosphere: on/off, haze, haze g, Rayleigh scattering at sea level [1/m],
+  /// altitude of z = 0 [m]. The haze is Turbidity (default 2; the mapper's
+  /// SetTurbidity) unless MieScatteringPerMetre (the aerosol scattering at sea level,
+  /// 1/m) is >= 0, which then sets it directly whatever the order of the two calls
+  /// (ParaView's "Mie Scattering (Per Metre)", advanced; -1 = from Turbidity), as
+  /// vtkNimbusSkyDomeSource does.
   void SetAtmosphere(bool value);
   bool GetAtmosphere();
+  void SetTurbidity(double value);
+  double GetTurbidity() { return this->Turbidity; }
   void SetMieScatteringPerMetre(double value);
-  double GetMieScatteringPerMetre();
+  double GetMieScatteringPerMetre() { return this->MieScatteringOverride; }
   void SetMieG(double value);
   double GetMieG();
   void SetRayleighScatteringPerMetre(double value);
@@ -190,6 +196,11 @@ protected:
 
   /// Owned through the superclass's VolumeMapper.
   vtkNimbusCloudVolumeMapper* CloudMapper = nullptr;
+
+  /// The haze's two settings and the mapper's value from them.
+  void ApplyHaze();
+  double Turbidity = 2.0;
+  double MieScatteringOverride = -1.0;
 
 private:
   /// The mapper's progress during a long still render, as this representation's

@@ -1,6 +1,7 @@
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "Math.h"
 
+#include "Atmosphere.h"
 #include "AtmosphereTable.h"
 #include "CloudDensityTexture.h"
 #include "FiniteSetters.h"
@@ -72,6 +73,25 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunIlluminance);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunTemperatureKelvin);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieScatteringPerMetre);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieG);
+
+void vtkNimbusCloudVolumeMapper::SetTurbidity(double turbidity)
+{
+  if (!std::isfinite(turbidity))
+  {
+    vtkErrorMacro("SetTurbidity(" << turbidity << "): not a finite number; MieScatteringPerMetre "
+                                  << "stays " << this->MieScatteringPerMetre);
+    return;
+  }
+  const double clamped = std::clamp(turbidity, nimbus::kMinTurbidity, nimbus::kMaxTurbidity);
+  this->SetMieScatteringPerMetre(
+    nimbus::MieScatteringFromTurbidity(clamped, nimbus::AtmosphereParameters()));
+}
+
+double vtkNimbusCloudVolumeMapper::GetTurbidity()
+{
+  return nimbus::TurbidityFromMieScattering(
+    this->MieScatteringPerMetre, nimbus::AtmosphereParameters());
+}
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, RayleighScatteringPerMetre);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SceneAltitudeMetres);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, GroundHeight);

@@ -243,6 +243,14 @@ public:
   virtual double GetMieScatteringPerMetreMinValue() { return 0.0; }
   virtual double GetMieScatteringPerMetreMaxValue() { return 1.0; }
   vtkGetMacro(MieScatteringPerMetre, double);
+  /// The haze in the sky's words: turbidity T in [1, 10] (1: no aerosol, 2 very clear,
+  /// 3 clear, 5 light haze, 10 hazy; vtkNimbusSky::SetTurbidity) sets
+  /// MieScatteringPerMetre to nimbus::MieScatteringFromTurbidity(T) for this air (aerosol
+  /// optical depth 0.025 (T - 1) at 550 nm, albedo 0.9, scale height 1.2 km: 1.875e-5 /m
+  /// at T = 2); GetTurbidity is the inverse of the current MieScatteringPerMetre (2.07
+  /// for the default 2e-5). Out-of-range values are clamped, NaN refused with an error.
+  virtual void SetTurbidity(double turbidity);
+  virtual double GetTurbidity();
   virtual void SetMieG(double value);
   virtual double GetMieGMinValue() { return -0.999; }
   virtual double GetMieGMaxValue() { return 0.999; }

@@ -101,6 +101,35 @@ def check_multiple_scattering_defaults(display, failures):
             failures.append("%s: the mapper's default is %g, the XML's %g" % (name, own, default))
 
 
+def check_haze_defaults(display, failures):
+    """The haze's XML defaults: Turbidity 2, no Mie override (-1)."""
+    turbidity = scalar(display, "Turbidity")
+    mie = scalar(display, "MieScatteringPerMetre")
+    if abs(turbidity - 2.0) > 1e-12 or abs(mie + 1.0) > 1e-12:
+        failures.append("haze XML defaults: Turbidity %g, MieScatteringPerMetre %g" % (
+            turbidity, mie))
+
+
+def check_haze(display, mapper, failures):
+    """Turbidity is the haze unless MieScatteringPerMetre >= 0 overrides it (either order);
+    -1 goes back to Turbidity. The mapper's value: 0.9 * 0.025 (T - 1) / 1200 m."""
+    if mapper is None:
+        return
+    kept = display.MieScatteringPerMetre
+    steps = [("MieScatteringPerMetre", -1.0, 1.875e-5), ("Turbidity", 5.0, 7.5e-5), ("MieScatteringPerMetre", 3e-5, 3e-5),
+             ("Turbidity", 3.0, 3e-5), ("MieScatteringPerMetre", -1.0, 3.75e-5)]
+    for name, value, expected in steps:
+        setattr(display, name, value)
+        display.UpdateVTKObjects()
+        got = mapper.GetMieScatteringPerMetre()
+        print("haze: %s = %g -> the mapper's MieScatteringPerMetre %g" % (name, value, got))
+        if abs(got - expected) > 1e-12:
+            failures.append("haze: %s = %g gave %g, expected %g" % (name, value, got, expected))
+    display.Turbidity = 2.0
+    display.MieScatteringPerMetre = kept
+    display.UpdateVTKObjects()
+
+
 def check_multiple_scattering(display, view, output_dir, failures):
     """Sets each multiple-scattering property through the proxy and renders every method."""
     expected_methods = list(display.GetProperty("MultipleScatteringMethod").Available)
@@ -200,6 +229,7 @@ def main():
     display.SetRepresentationType("Cloud")
     ColorBy(display, ("POINTS", "density"))
     check_multiple_scattering_defaults(display, failures)
+    check_haze_defaults(display, failures)
     # A few properties set through the proxy (the others keep the XML defaults).
     # The baseline predates the multiple-scattering solver: these checks keep the
     # k_multi-only cloud it shows (check_multiple_scattering covers the methods).
@@ -212,6 +242,8 @@ def main():
     # Nimbus Sky's: 10 and 0.3).
     display.Exposure = 8.0
     display.GroundAlbedo = 0.2
+    # The haze of the baseline's time (the default is now Turbidity 2: 1.875e-5 /m).
+    display.MieScatteringPerMetre = 2e-5
     display.NumberOfSlices = 192
     print("defaults: k_multi %g, Exposure %g, CloudG %g, MieG %g, slices %d" % (
         display.MultipleScattering, display.Exposure, display.CloudG, display.MieG,
@@ -223,6 +255,7 @@ def main():
         failures.append("the noon image differs from the baseline")
 
     mapper = cloud_mapper(view)
+    check_haze(display, mapper, failures)
     uploads = mapper.GetNumberOfVolumeUploads() if mapper else None
     print("volume uploads after the first render:", uploads)
     if mapper is not None and uploads != 1:

@@ -38,7 +38,7 @@ PAPER_WORDS = re.compile(r"\b00\d\b|\bEq\.|§|\bsection \d|k_multi|theta_|\bClou
                          r"\bRatio a\b|Basic-shape")
 # The Cloud representation's fields that a visible Nimbus Sky replaces.
 SKY_SET = ["SunElevationDegrees", "SunAzimuthDegrees", "SunIlluminance", "SunTemperatureKelvin",
-           "Exposure", "EncodeSrgb", "MieScatteringPerMetre", "MieG",
+           "Exposure", "EncodeSrgb", "Turbidity", "MieScatteringPerMetre", "MieG",
            "RayleighScatteringPerMetre", "SceneAltitudeMetres", "GroundHeight", "GroundAlbedo",
            "MetresPerUnit"]
 SHARED_DEFAULTS = ["SunElevationDegrees", "SunAzimuthDegrees", "GroundAlbedo", "Exposure"]
