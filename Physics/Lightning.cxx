@@ -72,6 +72,7 @@ struct Channel
   Vector3 Start, Heading, Overall;
   double Length, Intensity;
   int Depth;
+  double PathStart;
 };
 } // namespace
 
@@ -159,7 +160,7 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
   const Vector3 overall = Normalized(p.Direction);
   std::vector<LightningSegment> segments;
   std::deque<Channel> channels;
-  channels.push_back({ p.Start, overall, overall, p.Length, p.Intensity, 0 });
+  channels.push_back({ p.Start, overall, overall, p.Length, p.Intensity, 0, 0.0 });
   const double k = p.Straightness;
   while (!channels.empty())
   {
@@ -168,6 +169,7 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
     Vector3 position = channel.Start;
     Vector3 heading = channel.Heading;
     double remaining = channel.Length;
+    double path = channel.PathStart;
     if (position[2] < p.StopBelowHeight)
     {
       continue;
@@ -200,8 +202,9 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
         end[2] = p.StopBelowHeight;
         grounded = true;
       }
-      segments.push_back({ position, end, channel.Intensity, channel.Depth });
+      segments.push_back({ position, end, channel.Intensity, channel.Depth, path });
       remaining -= length;
+      path += Length({ { end[0] - position[0], end[1] - position[1], end[2] - position[2] } });
       if (grounded)
       {
         break;
@@ -217,13 +220,91 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
         if (branchLength >= 0.5 * p.SegmentLength)
         {
           channels.push_back({ end, branchHeading, branchHeading, branchLength,
-            channel.Intensity * p.BranchIntensityFactor, channel.Depth + 1 });
+            channel.Intensity * p.BranchIntensityFactor, channel.Depth + 1, path });
         }
       }
       position = end;
     }
   }
   return segments;
+}
+
+std::string CheckLightningFlashTimeline(const LightningFlashTimeline& t)
+{
+  std::ostringstream why;
+  if (!(Finite(t.LeaderDuration) && t.LeaderDuration >= 0.0 && t.LeaderDuration <= 1e3))
+  {
+    why << "LeaderDuration must be in [0, 1000] seconds, got " << t.LeaderDuration;
+  }
+  else if (!(Finite(t.LeaderBrightness) && t.LeaderBrightness >= 0.0 && t.LeaderBrightness <= 1.0))
+  {
+    why << "LeaderBrightness must be in [0, 1], got " << t.LeaderBrightness;
+  }
+  else if (t.NumberOfStrokes < 1 || t.NumberOfStrokes > 100)
+  {
+    why << "NumberOfStrokes must be in [1, 100], got " << t.NumberOfStrokes;
+  }
+  else if (!(Finite(t.InterstrokeInterval) && t.InterstrokeInterval > 0.0 &&
+             t.InterstrokeInterval <= 1e3))
+  {
+    why << "InterstrokeInterval must be in (0, 1000] seconds, got " << t.InterstrokeInterval;
+  }
+  else if (!(Finite(t.SubsequentStrokeFactor) && t.SubsequentStrokeFactor > 0.0 &&
+             t.SubsequentStrokeFactor <= 1.0))
+  {
+    why << "SubsequentStrokeFactor must be in (0, 1], got " << t.SubsequentStrokeFactor;
+  }
+  else if (!(Finite(t.StrokeDecaySeconds) && t.StrokeDecaySeconds > 0.0 &&
+             t.StrokeDecaySeconds <= 1e3))
+  {
+    why << "StrokeDecaySeconds must be in (0, 1000] seconds, got " << t.StrokeDecaySeconds;
+  }
+  return why.str();
+}
+
+double LightningFlashBrightness(const LightningFlashTimeline& timeline,
+  const LightningSegment& segment, double farthestPath, double seconds)
+{
+  const std::string why = CheckLightningFlashTimeline(timeline);
+  if (!why.empty())
+  {
+    throw std::invalid_argument("nimbus::LightningFlashBrightness: " + why);
+  }
+  if (!(seconds >= 0.0) || !std::isfinite(seconds))
+  {
+    return 0.0; // before the flash (or no time at all)
+  }
+  double brightness = 0.0;
+  // The leader reaches the segment's start at this time.
+  const double reach = farthestPath > 0.0 && std::isfinite(farthestPath)
+    ? timeline.LeaderDuration * std::clamp(segment.PathStart / farthestPath, 0.0, 1.0)
+    : 0.0;
+  if (seconds >= reach && seconds < timeline.LeaderDuration)
+  {
+    brightness += timeline.LeaderBrightness;
+  }
+  double strength = 1.0;
+  for (int k = 0; k < timeline.NumberOfStrokes; ++k)
+  {
+    const double start = timeline.LeaderDuration + k * timeline.InterstrokeInterval;
+    if (seconds >= start && (k == 0 || segment.Depth == 0))
+    {
+      brightness += strength * std::exp(-(seconds - start) / timeline.StrokeDecaySeconds);
+    }
+    strength *= timeline.SubsequentStrokeFactor;
+  }
+  return brightness;
+}
+
+double LightningFlashDuration(const LightningFlashTimeline& timeline)
+{
+  const std::string why = CheckLightningFlashTimeline(timeline);
+  if (!why.empty())
+  {
+    throw std::invalid_argument("nimbus::LightningFlashDuration: " + why);
+  }
+  return timeline.LeaderDuration + (timeline.NumberOfStrokes - 1) * timeline.InterstrokeInterval +
+    timeline.StrokeDecaySeconds * std::log(100.0);
 }
 
 std::vector<PointLight> LightningPointSources(

@@ -79,6 +79,7 @@ struct NIMBUSPHYSICS_EXPORT LightningSegment
   Vector3 A, B;           // from A to B (metres)
   double Intensity = 0.0; // radiant intensity per metre of channel
   int Depth = 0;          // 0 main channel, 1 its branches, ...
+  double PathStart = 0.0; // distance from the seed along the channels to A, metres
 };
 
 /// The first message describing what is wrong with the parameters, or "" (NaN or
@@ -91,6 +92,38 @@ NIMBUSPHYSICS_EXPORT std::string CheckLightningParameters(const LightningParamet
 /// Throws std::invalid_argument with CheckLightningParameters's message, or when the
 /// stroke with its branches would pass a million segments.
 NIMBUSPHYSICS_EXPORT std::vector<LightningSegment> GenerateLightning(const LightningParameters& p);
+
+/// One flash over time (seconds from its start), after the measured sequence of a
+/// cloud-to-ground flash (Rakov & Uman 2003, "Lightning: Physics and Effects", ch. 4):
+/// a stepped leader grows from the seed along the channels at constant speed, faint,
+/// reaching the farthest point at LeaderDuration; then the return stroke lights every
+/// channel; NumberOfStrokes - 1 subsequent strokes follow every InterstrokeInterval
+/// along the main channel only (dart leaders retrace the first channel), each
+/// SubsequentStrokeFactor times the one before. Every stroke decays as exp(-dt /
+/// StrokeDecaySeconds) (its continuing current). Measured medians: 3-5 strokes per flash,
+/// 60 ms between strokes, leaders of tens of milliseconds.
+struct NIMBUSPHYSICS_EXPORT LightningFlashTimeline
+{
+  double LeaderDuration = 0.03;        // seconds
+  double LeaderBrightness = 0.02;      // of the return stroke's
+  int NumberOfStrokes = 4;             // >= 1
+  double InterstrokeInterval = 0.06;   // seconds
+  double SubsequentStrokeFactor = 0.6; // (0, 1]
+  double StrokeDecaySeconds = 0.015;   // > 0
+};
+
+/// "" or what is wrong (non-finite or out-of-range fields).
+NIMBUSPHYSICS_EXPORT std::string CheckLightningFlashTimeline(const LightningFlashTimeline& t);
+
+/// The factor on a segment's intensity at time `seconds` (0 before the flash): the
+/// leader's faint glow once the leader has reached the segment (at PathStart /
+/// farthestPath of LeaderDuration), then the strokes. Deterministic, >= 0. Throws
+/// std::invalid_argument with CheckLightningFlashTimeline's message.
+NIMBUSPHYSICS_EXPORT double LightningFlashBrightness(const LightningFlashTimeline& timeline,
+  const LightningSegment& segment, double farthestPath, double seconds);
+
+/// The time the whole flash takes until its last stroke has decayed to 1 % (seconds).
+NIMBUSPHYSICS_EXPORT double LightningFlashDuration(const LightningFlashTimeline& timeline);
 
 /// Point sources along the segments (003 Eq. 3), at most `spacing` metres apart, with
 /// intensity = segment intensity x piece length, one colour for all (grey: rgb equal).

@@ -548,3 +548,53 @@ TEST(HaarWavelet, BadInputRefused)
   EXPECT_NEAR(none.DroppedNorm, std::sqrt(8.0), 1e-12);
   EXPECT_NEAR(none.AmbientPerPoint(), 1.0, 1e-12); // the constant 1 back as the ambient
 }
+
+// The flash over time: nothing before it, the leader's glow reaching the far end at
+// LeaderDuration, the return stroke on every channel, the subsequent strokes on the
+// main channel only, each weaker, all decayed by the flash's duration.
+TEST(Lightning, FlashTimeline)
+{
+  LightningParameters p;
+  p.BranchProbability = 0.15;
+  p.Seed = 5;
+  const auto segments = nimbus::GenerateLightning(p);
+  double farthest = 0.0;
+  const LightningSegment* branch = nullptr;
+  for (const LightningSegment& s : segments)
+  {
+    farthest = std::max(farthest, s.PathStart);
+    if (s.Depth > 0 && !branch)
+    {
+      branch = &s;
+    }
+  }
+  ASSERT_NE(branch, nullptr);
+  // Path lengths: the main channel's grow by each segment's length from 0.
+  EXPECT_EQ(segments[0].PathStart, 0.0);
+  EXPECT_NEAR(segments[1].PathStart, Distance(segments[0].A, segments[0].B), 1e-9);
+  const nimbus::LightningFlashTimeline t;
+  const LightningSegment& first = segments.front();
+  const LightningSegment& last = *std::max_element(segments.begin(), segments.end(),
+    [](const LightningSegment& a, const LightningSegment& b) { return a.PathStart < b.PathStart; });
+  EXPECT_EQ(nimbus::LightningFlashBrightness(t, first, farthest, -0.01), 0.0);
+  EXPECT_DOUBLE_EQ(nimbus::LightningFlashBrightness(t, first, farthest, 0.001), t.LeaderBrightness);
+  EXPECT_EQ(nimbus::LightningFlashBrightness(t, last, farthest, 0.5 * t.LeaderDuration), 0.0);
+  const double stroke = t.LeaderDuration;
+  EXPECT_DOUBLE_EQ(nimbus::LightningFlashBrightness(t, first, farthest, stroke), 1.0);
+  EXPECT_DOUBLE_EQ(nimbus::LightningFlashBrightness(t, *branch, farthest, stroke), 1.0);
+  const double second = stroke + t.InterstrokeInterval;
+  const double decayed = std::exp(-t.InterstrokeInterval / t.StrokeDecaySeconds);
+  EXPECT_NEAR(nimbus::LightningFlashBrightness(t, first, farthest, second),
+    decayed + t.SubsequentStrokeFactor, 1e-12);
+  EXPECT_NEAR(nimbus::LightningFlashBrightness(t, *branch, farthest, second), decayed, 1e-12);
+  const double end = nimbus::LightningFlashDuration(t);
+  const double lastStrength = std::pow(t.SubsequentStrokeFactor, t.NumberOfStrokes - 1);
+  EXPECT_LE(
+    nimbus::LightningFlashBrightness(t, first, farthest, end), 0.0101 * lastStrength + 1e-3);
+  nimbus::LightningFlashTimeline bad;
+  bad.NumberOfStrokes = 0;
+  EXPECT_THROW(nimbus::LightningFlashBrightness(bad, first, farthest, 0.1), std::invalid_argument);
+  bad = nimbus::LightningFlashTimeline();
+  bad.StrokeDecaySeconds = std::nan("");
+  EXPECT_NE(nimbus::CheckLightningFlashTimeline(bad).find("StrokeDecaySeconds"), std::string::npos);
+}
