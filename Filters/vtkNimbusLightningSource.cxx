@@ -1,0 +1,244 @@
+#include "vtkNimbusLightningSource.h"
+
+#include "Lightning.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkFloatArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkNimbusLightningSource);
+
+namespace
+{
+constexpr double kMaxPointSources = 1e7;
+}
+
+vtkNimbusLightningSource::vtkNimbusLightningSource()
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetNumberOfOutputPorts(2);
+}
+
+namespace
+{
+nimbus::LightningFlashTimeline Timeline(const vtkNimbusLightningSource* s)
+{
+  nimbus::LightningFlashTimeline t;
+  auto* self = const_cast<vtkNimbusLightningSource*>(s);
+  t.LeaderDuration = self->GetLeaderDuration();
+  t.NumberOfStrokes = self->GetNumberOfStrokes();
+  t.InterstrokeInterval = self->GetInterstrokeInterval();
+  t.SubsequentStrokeFactor = self->GetSubsequentStrokeFactor();
+  t.StrokeDecaySeconds = self->GetStrokeDecaySeconds();
+  return t;
+}
+}
+
+int vtkNimbusLightningSource::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  const nimbus::LightningFlashTimeline timeline = Timeline(this);
+  const bool valid = nimbus::CheckLightningFlashTimeline(timeline).empty() &&
+    std::isfinite(this->FlashStartTime) && this->FlashStartTime >= 0.0 &&
+    this->FlashStartTime <= 1e6;
+  for (int port = 0; port < 2; ++port)
+  {
+    vtkInformation* outInfo = outputVector->GetInformationObject(port);
+    outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    if (!valid)
+    {
+      continue; // RequestData names the problem
+    }
+    const double end = this->FlashStartTime + nimbus::LightningFlashDuration(timeline);
+    std::vector<double> times(this->NumberOfTimeSteps + 1);
+    for (int i = 0; i <= this->NumberOfTimeSteps; ++i)
+    {
+      times[i] = end * i / this->NumberOfTimeSteps;
+    }
+    outInfo->Set(
+      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+    const double range[2] = { 0.0, end };
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  }
+  return 1;
+}
+
+int vtkNimbusLightningSource::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkPolyData* strokes = vtkPolyData::GetData(outputVector, 0);
+  vtkPolyData* sources = vtkPolyData::GetData(outputVector, 1);
+  strokes->Initialize();
+  sources->Initialize();
+
+  nimbus::LightningParameters p;
+  p.Start = { { this->StartPoint[0], this->StartPoint[1], this->StartPoint[2] } };
+  p.Direction = { { this->Direction[0], this->Direction[1], this->Direction[2] } };
+  p.Length = this->Length;
+  p.SegmentLength = this->SegmentLength;
+  p.MeanAngleDegrees = this->MeanAngleDegrees;
+  p.Straightness = this->Straightness;
+  p.BranchProbability = this->BranchProbability;
+  p.BranchLengthFactor = this->BranchLengthFactor;
+  p.BranchIntensityFactor = this->BranchIntensityFactor;
+  p.MaxBranchDepth = this->MaxBranchDepth;
+  p.Intensity = this->Intensity;
+  p.StopBelowHeight = this->GroundHeight;
+  p.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
+  const nimbus::LightningFlashTimeline timeline = Timeline(this);
+  std::string why = nimbus::CheckLightningParameters(p);
+  if (why.empty())
+  {
+    why = nimbus::CheckLightningFlashTimeline(timeline);
+  }
+  if (why.empty() &&
+    !(std::isfinite(this->FlashStartTime) && this->FlashStartTime >= 0.0 &&
+      this->FlashStartTime <= 1e6))
+  {
+    why = "FlashStartTime must be in [0, 1e6] seconds";
+  }
+  if (why.empty() && !(std::isfinite(this->PointSourceSpacing) && this->PointSourceSpacing > 0.0))
+  {
+    why = "PointSourceSpacing must be > 0 (metres)";
+  }
+  if (why.empty() && std::isnan(this->GroundHeight))
+  {
+    why = "GroundHeight is NaN";
+  }
+  if (!why.empty())
+  {
+    vtkErrorMacro("Lightning: " << why << "; no output.");
+    return 1;
+  }
+  std::vector<nimbus::LightningSegment> segments;
+  try
+  {
+    segments = nimbus::GenerateLightning(p);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    vtkErrorMacro("Lightning: " << e.what() << "; no output.");
+    return 1;
+  }
+  this->UpdateProgress(0.5);
+
+  // The requested time (a request without one: the return stroke's peak).
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  double time = this->FlashStartTime + this->LeaderDuration;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+  }
+  double farthest = 0.0, sourceCount = 0.0;
+  for (const nimbus::LightningSegment& s : segments)
+  {
+    farthest = std::max(farthest, s.PathStart);
+    const double length = nimbus::Length({ { s.B[0] - s.A[0], s.B[1] - s.A[1], s.B[2] - s.A[2] } });
+    sourceCount += std::ceil(length / this->PointSourceSpacing);
+  }
+  if (sourceCount > kMaxPointSources)
+  {
+    vtkErrorMacro("Lightning: PointSourceSpacing " << this->PointSourceSpacing << " m makes "
+                                                   << sourceCount
+                                                   << " point sources (at most 1e7); no output.");
+    return 1;
+  }
+
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  vtkNew<vtkFloatArray> intensity, peak, path;
+  vtkNew<vtkIntArray> depth;
+  intensity->SetName("intensity");
+  peak->SetName("peak_intensity");
+  depth->SetName("depth");
+  path->SetName("path_length");
+  std::vector<nimbus::LightningSegment> lit = segments;
+  for (std::size_t i = 0; i < segments.size(); ++i)
+  {
+    const nimbus::LightningSegment& s = segments[i];
+    const double brightness =
+      nimbus::LightningFlashBrightness(timeline, s, farthest, time - this->FlashStartTime);
+    lit[i].Intensity = s.Intensity * brightness;
+    const vtkIdType a = points->InsertNextPoint(s.A.data());
+    const vtkIdType b = points->InsertNextPoint(s.B.data());
+    const vtkIdType ids[2] = { a, b };
+    lines->InsertNextCell(2, ids);
+    intensity->InsertNextValue(static_cast<float>(lit[i].Intensity));
+    peak->InsertNextValue(static_cast<float>(s.Intensity));
+    depth->InsertNextValue(s.Depth);
+    const double length = nimbus::Length({ { s.B[0] - s.A[0], s.B[1] - s.A[1], s.B[2] - s.A[2] } });
+    path->InsertNextValue(static_cast<float>(s.PathStart));
+    path->InsertNextValue(static_cast<float>(s.PathStart + length));
+  }
+  strokes->SetPoints(points);
+  strokes->SetLines(lines);
+  strokes->GetCellData()->AddArray(intensity);
+  strokes->GetCellData()->AddArray(peak);
+  strokes->GetCellData()->AddArray(depth);
+  strokes->GetCellData()->SetActiveScalars("intensity");
+  strokes->GetPointData()->AddArray(path);
+
+  const std::vector<nimbus::PointLight> lights =
+    nimbus::LightningPointSources(lit, this->PointSourceSpacing);
+  vtkNew<vtkPoints> sourcePoints;
+  sourcePoints->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> vertices;
+  vtkNew<vtkDoubleArray> sourceIntensity;
+  sourceIntensity->SetName("intensity");
+  for (const nimbus::PointLight& light : lights)
+  {
+    const vtkIdType id = sourcePoints->InsertNextPoint(light.Position.data());
+    vertices->InsertNextCell(1, &id);
+    sourceIntensity->InsertNextValue(light.Intensity[0]);
+  }
+  sources->SetPoints(sourcePoints);
+  sources->SetVerts(vertices);
+  sources->GetPointData()->AddArray(sourceIntensity);
+  sources->GetPointData()->SetActiveScalars("intensity");
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkNimbusLightningSource::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "StartPoint: " << this->StartPoint[0] << " " << this->StartPoint[1] << " "
+     << this->StartPoint[2] << "\n";
+  os << indent << "Direction: " << this->Direction[0] << " " << this->Direction[1] << " "
+     << this->Direction[2] << "\n";
+  os << indent << "Length: " << this->Length << "\n";
+  os << indent << "SegmentLength: " << this->SegmentLength << "\n";
+  os << indent << "BranchProbability: " << this->BranchProbability << "\n";
+  os << indent << "MaxBranchDepth: " << this->MaxBranchDepth << "\n";
+  os << indent << "BranchIntensityFactor: " << this->BranchIntensityFactor << "\n";
+  os << indent << "BranchLengthFactor: " << this->BranchLengthFactor << "\n";
+  os << indent << "MeanAngleDegrees: " << this->MeanAngleDegrees << "\n";
+  os << indent << "Straightness: " << this->Straightness << "\n";
+  os << indent << "Intensity: " << this->Intensity << "\n";
+  os << indent << "GroundHeight: " << this->GroundHeight << "\n";
+  os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "PointSourceSpacing: " << this->PointSourceSpacing << "\n";
+  os << indent << "FlashStartTime: " << this->FlashStartTime << "\n";
+  os << indent << "LeaderDuration: " << this->LeaderDuration << "\n";
+  os << indent << "NumberOfStrokes: " << this->NumberOfStrokes << "\n";
+  os << indent << "InterstrokeInterval: " << this->InterstrokeInterval << "\n";
+  os << indent << "SubsequentStrokeFactor: " << this->SubsequentStrokeFactor << "\n";
+  os << indent << "StrokeDecaySeconds: " << this->StrokeDecaySeconds << "\n";
+  os << indent << "NumberOfTimeSteps: " << this->NumberOfTimeSteps << "\n";
+}
