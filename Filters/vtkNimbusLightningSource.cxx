@@ -15,6 +15,7 @@
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -70,6 +71,14 @@ int vtkNimbusLightningSource::RequestInformation(
     {
       times[i] = end * i / this->NumberOfTimeSteps;
     }
+    // Every stroke's peak is a frame of its own (the flicker is not missed).
+    for (int k = 0; k < timeline.NumberOfStrokes; ++k)
+    {
+      times.push_back(
+        this->FlashStartTime + timeline.LeaderDuration + k * timeline.InterstrokeInterval);
+    }
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end()), times.end());
     outInfo->Set(
       vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
     const double range[2] = { 0.0, end };

@@ -24,9 +24,9 @@
  * leader of LeaderDuration seconds, the return stroke, NumberOfStrokes - 1 subsequent
  * strokes InterstrokeInterval apart along the main channel, each decaying with
  * StrokeDecaySeconds) starting at FlashStartTime. The source advertises NumberOfTimeSteps
- * + 1 TIME_STEPS evenly spread over [0, FlashStartTime + the flash's duration], so
- * ParaView's animation plays the flash; a request without a time gives the return
- * stroke's peak.
+ * + 1 TIME_STEPS evenly spread over [0, FlashStartTime + the flash's duration] and the
+ * peak of every stroke, so ParaView's animation plays the flash; a request without a
+ * time gives the return stroke's peak.
  *
  * Default: a 3 km channel down from (0, 0, 2000) m to the ground at z = 0, intensity
  * 100 per metre (at 500 m from a long channel, an irradiance of about 0.6 of the

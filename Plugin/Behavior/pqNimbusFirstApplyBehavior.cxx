@@ -1,20 +1,27 @@
 #include "pqNimbusFirstApplyBehavior.h"
 
+#include "pqAnimationManager.h"
+#include "pqAnimationScene.h"
 #include "pqApplicationCore.h"
 #include "pqDataRepresentation.h"
 #include "pqOutputPort.h"
+#include "pqPVApplicationCore.h"
 #include "pqPipelineFilter.h"
 #include "pqPipelineSource.h"
 #include "pqRenderView.h"
 #include "pqServerManagerModel.h"
+#include "vtkDataObject.h"
 #include "vtkSMPVRepresentationProxy.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
+#include "vtkSMTransferFunctionManager.h"
+#include "vtkSMTransferFunctionProxy.h"
 #include "vtkSMViewProxy.h"
 
 #include <QPointer>
 #include <QTimer>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -30,7 +37,7 @@ bool IsNimbusCloudProducer(pqPipelineSource* source)
   }
   for (const char* cloud :
     { "NimbusMetaballCloud", "NimbusCloudAutomaton", "NimbusCloudAutomatonWithMaps",
-      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome" })
+      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome", "NimbusLightning" })
   {
     if (std::strcmp(name, cloud) == 0)
     {
@@ -55,6 +62,68 @@ bool DrawsWithoutColorMap(pqRepresentation* representation)
 {
   const char* type = RepresentationType(representation);
   return type && (std::strcmp(type, "Cloud") == 0 || std::strcmp(type, "Sky Background") == 0);
+}
+
+bool IsLightning(pqPipelineSource* source)
+{
+  const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
+  return name && std::strcmp(name, "NimbusLightning") == 0;
+}
+
+// The strokes as lines whose grey level is their brightness on a log scale: black (a
+// thousandth of the return stroke's peak and less) to white (the peak), the range fixed
+// so that the flash fades over time and dimmer branches stay visible.
+void StyleLightning(pqDataRepresentation* representation)
+{
+  vtkSMProxy* proxy = representation->getProxy();
+  vtkSMProxy* source = representation->getInput()->getProxy();
+  if (!proxy->GetProperty("LineWidth") || !source->GetProperty("Brightness"))
+  {
+    return;
+  }
+  vtkSMPVRepresentationProxy::SetScalarColoring(proxy, "intensity", vtkDataObject::CELL);
+  vtkSMProxy* lut = vtkSMPropertyHelper(proxy, "LookupTable", /*quiet=*/true).GetAsProxy();
+  if (lut)
+  {
+    const double peak = std::max(vtkSMPropertyHelper(source, "Brightness").GetAsDouble(), 1e-12);
+    vtkSMTransferFunctionProxy::ApplyPreset(lut, "Grayscale", /*rescale=*/false);
+    vtkSMPropertyHelper(lut, "AutomaticRescaleRangeMode").Set(vtkSMTransferFunctionManager::NEVER);
+    vtkSMTransferFunctionProxy::RescaleTransferFunction(lut, 1e-3 * peak, peak);
+    vtkSMPropertyHelper(lut, "UseLogScale").Set(1);
+    lut->UpdateVTKObjects();
+  }
+  vtkSMPropertyHelper(proxy, "LineWidth").Set(2.0);
+  proxy->UpdateVTKObjects();
+}
+
+// The animation at the return stroke's peak (the first time step at or after it) when it
+// stands before it: the flash starts dark at time 0 (Play shows the leader and strokes).
+void ShowLightningPeak(pqDataRepresentation* representation)
+{
+  vtkSMProxy* source = representation->getInput()->getProxy();
+  auto* core = pqPVApplicationCore::instance();
+  pqAnimationScene* scene =
+    core && core->animationManager() ? core->animationManager()->getActiveScene() : nullptr;
+  if (!scene || !source->GetProperty("TimestepValues") || !source->GetProperty("FlashStartSeconds"))
+  {
+    return;
+  }
+  source->UpdatePropertyInformation();
+  const double peak = vtkSMPropertyHelper(source, "FlashStartSeconds").GetAsDouble() +
+    vtkSMPropertyHelper(source, "LeaderDurationSeconds").GetAsDouble();
+  if (scene->getAnimationTime() >= peak)
+  {
+    return;
+  }
+  vtkSMPropertyHelper steps(source, "TimestepValues");
+  for (unsigned int i = 0; i < steps.GetNumberOfElements(); ++i)
+  {
+    if (steps.GetAsDouble(i) >= peak - 1e-12)
+    {
+      scene->setAnimationTime(steps.GetAsDouble(i));
+      return;
+    }
+  }
 }
 
 bool IsSkyBackground(pqRepresentation* representation)
@@ -116,6 +185,25 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
     // Solid Color: the sky background does not use the colour map.
     vtkSMPVRepresentationProxy::SetScalarColoring(representation->getProxy(), nullptr, 0);
     representation->getProxy()->UpdateVTKObjects();
+  }
+
+  if (IsLightning(data->getInput()))
+  {
+    // After ParaView's own Apply has picked its colouring.
+    QPointer<pqDataRepresentation> guarded(data);
+    QTimer::singleShot(0, this,
+      [guarded]()
+      {
+        if (guarded)
+        {
+          StyleLightning(guarded);
+          ShowLightningPeak(guarded);
+          if (guarded->getView())
+          {
+            guarded->getView()->render();
+          }
+        }
+      });
   }
 
   // The camera: only for the first data in the view (a sky background does not count).

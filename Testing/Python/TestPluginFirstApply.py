@@ -24,7 +24,7 @@ import tempfile
 import numpy as np
 
 from paraview import servermanager
-from paraview.simple import (CreateRenderView, LoadPlugin, OpenDataFile, Render, SaveData,
+from paraview.simple import (CreateRenderView, Delete, LoadPlugin, OpenDataFile, Render, SaveData,
                              SaveScreenshot, Show)
 from paraview.vtk.util.numpy_support import vtk_to_numpy
 
@@ -161,6 +161,30 @@ def main():
     ok &= good
     if args.output_dir:
         render(view, display, os.path.join(args.output_dir, "first-apply-image-cloud.png"))
+    # --- the lightning: strokes shown as lines, point sources hidden, a flash over time ---
+    bolt = NimbusLightning()  # noqa: F821
+    controller = servermanager.vtkSMParaViewPipelineControllerWithRendering()
+    view = CreateRenderView()
+    strokes = Show(bolt, view)
+    ok &= check(strokes.Representation == "Surface",
+                "Nimbus Lightning: strokes shown as %s" % strokes.Representation)
+    ok &= check(controller.ShowInPreferredView(bolt.SMProxy, 1, view.SMProxy) is None,
+                "Nimbus Lightning: the point sources are not shown on Apply")
+    times = list(bolt.TimestepValues)
+    peak = bolt.FlashStartSeconds + bolt.LeaderDurationSeconds
+    ok &= check(len(times) > 10 and peak in times,
+                "Nimbus Lightning: %d time steps, the return stroke's peak %.3f s among them"
+                % (len(times), peak))
+    emission = []
+    for t in (0.0, peak, peak + 0.5 * bolt.StrokeIntervalSeconds):
+        bolt.UpdatePipeline(t)
+        cells = servermanager.Fetch(bolt, None, 0)
+        values = cells.GetCellData().GetArray("intensity")
+        emission.append(sum(values.GetValue(i) for i in range(values.GetNumberOfTuples())))
+    ok &= check(emission[0] == 0.0 and emission[1] > 0.0 and emission[2] < 0.5 * emission[1],
+                "Nimbus Lightning: dark before the flash, lit at the stroke, fading after "
+                "(sum of intensities %s)" % ["%.3g" % e for e in emission])
+    Delete(view)
     return 0 if ok else 1
 
 

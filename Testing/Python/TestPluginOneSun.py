@@ -94,7 +94,8 @@ def check_words(failures):
     pxm = servermanager.ProxyManager().SMProxyManager
     definitions = [("sources", "NimbusMetaballCloud"), ("sources", "NimbusCloudAutomaton"),
                    ("sources", "NimbusSkyDome"), ("filters", "NimbusCloudAutomatonWithMaps"),
-                   ("filters", "NimbusImageCloud"), ("representations", "CloudRepresentation"),
+                   ("filters", "NimbusImageCloud"), ("sources", "NimbusLightning"),
+                   ("representations", "CloudRepresentation"),
                    ("representations", "NimbusSkyBackgroundRepresentation")]
     checked = 0
     for group, name in definitions:
