@@ -613,6 +613,10 @@ public:
       this->Project(std::vector<float>(total.begin() + m * 3 * n, total.begin() + (m + 1) * 3 * n),
         this->Directions[m], 1.0, k1, coefficients);
     }
+    if (this->Options.PointLightFirstScattering)
+    {
+      this->AddPointLightFirstScattering(k1, coefficients);
+    }
     return phase.F;
   }
 
@@ -708,6 +712,52 @@ private:
 
   // coefficients += SH projection of radiance(x) arriving along s, weighted by the
   // direction's solid angle, with degree l scaled by k_l (k_0, k_1).
+  // The point lights' first scattering (003 Eq. 1's first term): at every point with
+  // extinction, J1(x, w) = p(w . d) E(x), E = I exp(-tau) / r^2 the unscattered irradiance
+  // through the full (not delta-M scaled) extinction, d the direction of travel from the
+  // light; in degree-1 SH (Funk-Hecke): c_00 += E Y_00, c_1m += E k_1 Y_1m(d).
+  void AddPointLightFirstScattering(double k1, std::vector<float>& coefficients) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nx = this->Grid.Dimensions[0], ny = this->Grid.Dimensions[1];
+    const double minimum =
+      0.5 * std::min({ this->Grid.Spacing[0], this->Grid.Spacing[1], this->Grid.Spacing[2] });
+    for (const PointLight& light : this->Lighting.PointLights)
+    {
+      const Vector3 lightIndex = GridCoordinates(this->Grid, light.Position);
+      ParallelFor(n, 256, this->Options.Threads,
+        [&](std::size_t begin, std::size_t end)
+        {
+          for (std::size_t i = begin; i < end; ++i)
+          {
+            if (this->Grid.Extinction[i] <= 0.0f)
+            {
+              continue;
+            }
+            const Vector3 idx{ { static_cast<double>(i % nx), static_cast<double>((i / nx) % ny),
+              static_cast<double>(i / (nx * ny)) } };
+            const Vector3 p = this->Grid.Position(idx[0], idx[1], idx[2]);
+            const Vector3 d{ { p[0] - light.Position[0], p[1] - light.Position[1],
+              p[2] - light.Position[2] } };
+            const double length = Length(d);
+            const double r = std::max(length, minimum);
+            const Vector3 w = length > 0.0 ? Normalized(d) : Vector3{ { 0, 0, 1 } };
+            const double t = std::exp(-OpticalDepthBetween(this->Grid, lightIndex, idx));
+            const auto y = ShBasis(w);
+            const double k[4] = { 1.0, k1, k1, k1 };
+            for (int c = 0; c < 3; ++c)
+            {
+              const double e = light.Intensity[c] * t / (r * r);
+              for (int b = 0; b < 4; ++b)
+              {
+                coefficients[i * kCoefficients + 4 * c + b] += static_cast<float>(k[b] * y[b] * e);
+              }
+            }
+          }
+        });
+    }
+  }
+
   void Project(const std::vector<float>& radiance, const Vector3& s, double k0, double k1,
     std::vector<float>& coefficients) const
   {

@@ -157,6 +157,10 @@ struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
   double PatternContribution = 0.8;
   double PatternSelection = 0.25;
   std::uint64_t Seed = 1;
+  /// Add the point lights' first scattering to J (their single scattering, which no
+  /// renderer computes otherwise; DiscreteDirections only). Default off: J holds the
+  /// orders the mapper does not compute (for the sun, orders >= 2).
+  bool PointLightFirstScattering = false;
   /// Threads (0: hardware concurrency). Results do not depend on it.
   int Threads = 0;
 };
