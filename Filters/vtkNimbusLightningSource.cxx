@@ -36,15 +36,14 @@ vtkNimbusLightningSource::vtkNimbusLightningSource()
 
 namespace
 {
-nimbus::LightningFlashTimeline Timeline(const vtkNimbusLightningSource* s)
+nimbus::LightningFlashTimeline Timeline(vtkNimbusLightningSource* s)
 {
   nimbus::LightningFlashTimeline t;
-  auto* self = const_cast<vtkNimbusLightningSource*>(s);
-  t.LeaderDuration = self->GetLeaderDuration();
-  t.NumberOfStrokes = self->GetNumberOfStrokes();
-  t.InterstrokeInterval = self->GetInterstrokeInterval();
-  t.SubsequentStrokeFactor = self->GetSubsequentStrokeFactor();
-  t.StrokeDecaySeconds = self->GetStrokeDecaySeconds();
+  t.LeaderDuration = s->GetLeaderDuration();
+  t.NumberOfStrokes = s->GetNumberOfStrokes();
+  t.InterstrokeInterval = s->GetInterstrokeInterval();
+  t.SubsequentStrokeFactor = s->GetSubsequentStrokeFactor();
+  t.StrokeDecaySeconds = s->GetStrokeDecaySeconds();
   return t;
 }
 }
@@ -157,8 +156,7 @@ int vtkNimbusLightningSource::RequestData(
   for (const nimbus::LightningSegment& s : segments)
   {
     farthest = std::max(farthest, s.PathStart);
-    const double length = nimbus::Length({ { s.B[0] - s.A[0], s.B[1] - s.A[1], s.B[2] - s.A[2] } });
-    sourceCount += std::ceil(length / this->PointSourceSpacing);
+    sourceCount += std::ceil(s.Length() / this->PointSourceSpacing);
   }
   if (sourceCount > kMaxPointSources)
   {
@@ -191,9 +189,8 @@ int vtkNimbusLightningSource::RequestData(
     intensity->InsertNextValue(static_cast<float>(lit[i].Intensity));
     peak->InsertNextValue(static_cast<float>(s.Intensity));
     depth->InsertNextValue(s.Depth);
-    const double length = nimbus::Length({ { s.B[0] - s.A[0], s.B[1] - s.A[1], s.B[2] - s.A[2] } });
     path->InsertNextValue(static_cast<float>(s.PathStart));
-    path->InsertNextValue(static_cast<float>(s.PathStart + length));
+    path->InsertNextValue(static_cast<float>(s.PathStart + s.Length()));
   }
   strokes->SetPoints(points);
   strokes->SetLines(lines);

@@ -196,6 +196,34 @@ SparseHaarField CompressHaar(
   return field;
 }
 
+void DropHaarCoefficients(SparseHaarField& field, double threshold)
+{
+  if (!(threshold >= 0.0) || !std::isfinite(threshold))
+  {
+    throw std::invalid_argument(
+      "nimbus::DropHaarCoefficients: the threshold must be finite and >= 0");
+  }
+  double dropped = field.DroppedNorm * field.DroppedNorm;
+  std::size_t kept = 0;
+  for (std::size_t n = 0; n < field.Index.size(); ++n)
+  {
+    const double v = field.Value[n];
+    if (std::abs(v) > threshold)
+    {
+      field.Index[kept] = field.Index[n];
+      field.Value[kept] = field.Value[n];
+      ++kept;
+    }
+    else
+    {
+      dropped += v * v;
+    }
+  }
+  field.Index.resize(kept);
+  field.Value.resize(kept);
+  field.DroppedNorm = std::sqrt(dropped);
+}
+
 void AccumulateHaar(const SparseHaarField& field, double weight, std::vector<double>& coefficients)
 {
   if (coefficients.empty())

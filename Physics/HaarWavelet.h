@@ -63,6 +63,11 @@ struct NIMBUSPHYSICS_EXPORT SparseHaarField
 NIMBUSPHYSICS_EXPORT SparseHaarField CompressHaar(
   const std::vector<float>& values, const std::array<int, 3>& dimensions, double threshold);
 
+/// Drops the kept coefficients with |B| <= threshold from `field`, adding their squares
+/// to DroppedNorm (the same field CompressHaar gives at that threshold, without a second
+/// transform). Throws std::invalid_argument for a negative or NaN threshold.
+NIMBUSPHYSICS_EXPORT void DropHaarCoefficients(SparseHaarField& field, double threshold);
+
 /// H += weight B (003 Eq. 9) into a dense padded coefficient array (resized and zeroed
 /// when empty).
 NIMBUSPHYSICS_EXPORT void AccumulateHaar(

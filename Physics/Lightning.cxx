@@ -67,6 +67,29 @@ bool Finite(double x)
   return std::isfinite(x);
 }
 
+/// A parameter that must lie in [Low, High] ((Low, High] when OpenLow), finite.
+struct RangeCheck
+{
+  const char* Name;
+  double Value, Low, High;
+  bool OpenLow = false;
+  const char* Unit = "";
+
+  bool Holds() const
+  {
+    return Finite(this->Value) &&
+      (this->OpenLow ? this->Value > this->Low : this->Value >= this->Low) &&
+      this->Value <= this->High;
+  }
+  std::string Message() const
+  {
+    std::ostringstream why;
+    why << this->Name << " must be in " << (this->OpenLow ? "(" : "[") << this->Low << ", "
+        << this->High << "]" << this->Unit << ", got " << this->Value;
+    return why.str();
+  }
+};
+
 struct Channel
 {
   Vector3 Start, Heading, Overall;
@@ -78,75 +101,50 @@ struct Channel
 
 std::string CheckLightningParameters(const LightningParameters& p)
 {
-  std::ostringstream why;
   if (!IsFinite(p.Start))
   {
-    why << "Start is not finite";
+    return "Start is not finite";
   }
-  else if (!IsFinite(p.Direction) || Length(p.Direction) == 0.0)
+  if (!IsFinite(p.Direction) || Length(p.Direction) == 0.0)
   {
-    why << "Direction must be finite and non-zero";
+    return "Direction must be finite and non-zero";
   }
-  else if (!(Finite(p.Length) && p.Length > 0.0))
+  if (!(Finite(p.Length) && p.Length > 0.0))
   {
-    why << "Length must be > 0 (metres), got " << p.Length;
+    return "Length must be > 0 (metres), got " + std::to_string(p.Length);
   }
-  else if (!(Finite(p.SegmentLength) && p.SegmentLength > 0.0))
+  if (!(Finite(p.SegmentLength) && p.SegmentLength > 0.0))
   {
-    why << "SegmentLength must be > 0 (metres), got " << p.SegmentLength;
+    return "SegmentLength must be > 0 (metres), got " + std::to_string(p.SegmentLength);
   }
-  else if (p.Length / p.SegmentLength > kMaxSegments)
+  if (p.Length / p.SegmentLength > kMaxSegments)
   {
-    why << "Length / SegmentLength = " << p.Length / p.SegmentLength << " segments; at most "
-        << kMaxSegments;
+    return "Length / SegmentLength = " + std::to_string(p.Length / p.SegmentLength) +
+      " segments; at most " + std::to_string(kMaxSegments);
   }
-  else if (!(Finite(p.MeanAngleDegrees) && p.MeanAngleDegrees >= 0.0 &&
-             p.MeanAngleDegrees <= 180.0))
+  for (const RangeCheck& c : { RangeCheck{ "MeanAngleDegrees", p.MeanAngleDegrees, 0.0, 180.0 },
+         RangeCheck{ "AngleSpreadDegrees", p.AngleSpreadDegrees, 0.0, 180.0 },
+         RangeCheck{ "Straightness", p.Straightness, 0.0, 1.0 },
+         RangeCheck{ "BranchProbability", p.BranchProbability, 0.0, 1.0 },
+         RangeCheck{ "BranchAngleDegrees", p.BranchAngleDegrees, 0.0, 180.0 },
+         RangeCheck{ "BranchLengthFactor", p.BranchLengthFactor, 0.0, 1.0, true },
+         RangeCheck{ "BranchIntensityFactor", p.BranchIntensityFactor, 0.0, 1.0, true },
+         RangeCheck{ "MaxBranchDepth", static_cast<double>(p.MaxBranchDepth), 0.0, 16.0 } })
   {
-    why << "MeanAngleDegrees must be in [0, 180], got " << p.MeanAngleDegrees;
+    if (!c.Holds())
+    {
+      return c.Message();
+    }
   }
-  else if (!(Finite(p.AngleSpreadDegrees) && p.AngleSpreadDegrees >= 0.0 &&
-             p.AngleSpreadDegrees <= 180.0))
+  if (!(Finite(p.Intensity) && p.Intensity >= 0.0))
   {
-    why << "AngleSpreadDegrees must be in [0, 180], got " << p.AngleSpreadDegrees;
+    return "Intensity must be finite and >= 0, got " + std::to_string(p.Intensity);
   }
-  else if (!(Finite(p.Straightness) && p.Straightness >= 0.0 && p.Straightness <= 1.0))
+  if (std::isnan(p.StopBelowHeight))
   {
-    why << "Straightness must be in [0, 1], got " << p.Straightness;
+    return "StopBelowHeight is NaN";
   }
-  else if (!(Finite(p.BranchProbability) && p.BranchProbability >= 0.0 &&
-             p.BranchProbability <= 1.0))
-  {
-    why << "BranchProbability must be in [0, 1], got " << p.BranchProbability;
-  }
-  else if (!(Finite(p.BranchAngleDegrees) && p.BranchAngleDegrees >= 0.0 &&
-             p.BranchAngleDegrees <= 180.0))
-  {
-    why << "BranchAngleDegrees must be in [0, 180], got " << p.BranchAngleDegrees;
-  }
-  else if (!(Finite(p.BranchLengthFactor) && p.BranchLengthFactor > 0.0 &&
-             p.BranchLengthFactor <= 1.0))
-  {
-    why << "BranchLengthFactor must be in (0, 1], got " << p.BranchLengthFactor;
-  }
-  else if (!(Finite(p.BranchIntensityFactor) && p.BranchIntensityFactor > 0.0 &&
-             p.BranchIntensityFactor <= 1.0))
-  {
-    why << "BranchIntensityFactor must be in (0, 1], got " << p.BranchIntensityFactor;
-  }
-  else if (p.MaxBranchDepth < 0 || p.MaxBranchDepth > 16)
-  {
-    why << "MaxBranchDepth must be in [0, 16], got " << p.MaxBranchDepth;
-  }
-  else if (!(Finite(p.Intensity) && p.Intensity >= 0.0))
-  {
-    why << "Intensity must be finite and >= 0, got " << p.Intensity;
-  }
-  else if (std::isnan(p.StopBelowHeight))
-  {
-    why << "StopBelowHeight is NaN";
-  }
-  return why.str();
+  return "";
 }
 
 std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
@@ -204,7 +202,7 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
       }
       segments.push_back({ position, end, channel.Intensity, channel.Depth, path });
       remaining -= length;
-      path += Length({ { end[0] - position[0], end[1] - position[1], end[2] - position[2] } });
+      path += segments.back().Length();
       if (grounded)
       {
         break;
@@ -231,35 +229,21 @@ std::vector<LightningSegment> GenerateLightning(const LightningParameters& p)
 
 std::string CheckLightningFlashTimeline(const LightningFlashTimeline& t)
 {
-  std::ostringstream why;
-  if (!(Finite(t.LeaderDuration) && t.LeaderDuration >= 0.0 && t.LeaderDuration <= 1e3))
+  // No strings unless something is wrong: LightningFlashBrightness checks on every call.
+  for (const RangeCheck& c :
+    { RangeCheck{ "LeaderDuration", t.LeaderDuration, 0.0, 1e3, false, " seconds" },
+      RangeCheck{ "LeaderBrightness", t.LeaderBrightness, 0.0, 1.0 },
+      RangeCheck{ "NumberOfStrokes", static_cast<double>(t.NumberOfStrokes), 1.0, 100.0 },
+      RangeCheck{ "InterstrokeInterval", t.InterstrokeInterval, 0.0, 1e3, true, " seconds" },
+      RangeCheck{ "SubsequentStrokeFactor", t.SubsequentStrokeFactor, 0.0, 1.0, true },
+      RangeCheck{ "StrokeDecaySeconds", t.StrokeDecaySeconds, 0.0, 1e3, true, " seconds" } })
   {
-    why << "LeaderDuration must be in [0, 1000] seconds, got " << t.LeaderDuration;
+    if (!c.Holds())
+    {
+      return c.Message();
+    }
   }
-  else if (!(Finite(t.LeaderBrightness) && t.LeaderBrightness >= 0.0 && t.LeaderBrightness <= 1.0))
-  {
-    why << "LeaderBrightness must be in [0, 1], got " << t.LeaderBrightness;
-  }
-  else if (t.NumberOfStrokes < 1 || t.NumberOfStrokes > 100)
-  {
-    why << "NumberOfStrokes must be in [1, 100], got " << t.NumberOfStrokes;
-  }
-  else if (!(Finite(t.InterstrokeInterval) && t.InterstrokeInterval > 0.0 &&
-             t.InterstrokeInterval <= 1e3))
-  {
-    why << "InterstrokeInterval must be in (0, 1000] seconds, got " << t.InterstrokeInterval;
-  }
-  else if (!(Finite(t.SubsequentStrokeFactor) && t.SubsequentStrokeFactor > 0.0 &&
-             t.SubsequentStrokeFactor <= 1.0))
-  {
-    why << "SubsequentStrokeFactor must be in (0, 1], got " << t.SubsequentStrokeFactor;
-  }
-  else if (!(Finite(t.StrokeDecaySeconds) && t.StrokeDecaySeconds > 0.0 &&
-             t.StrokeDecaySeconds <= 1e3))
-  {
-    why << "StrokeDecaySeconds must be in (0, 1000] seconds, got " << t.StrokeDecaySeconds;
-  }
-  return why.str();
+  return "";
 }
 
 double LightningFlashBrightness(const LightningFlashTimeline& timeline,

@@ -80,6 +80,13 @@ struct NIMBUSPHYSICS_EXPORT LightningSegment
   double Intensity = 0.0; // radiant intensity per metre of channel
   int Depth = 0;          // 0 main channel, 1 its branches, ...
   double PathStart = 0.0; // distance from the seed along the channels to A, metres
+
+  /// |B - A|, metres.
+  double Length() const
+  {
+    return nimbus::Length(
+      { { this->B[0] - this->A[0], this->B[1] - this->A[1], this->B[2] - this->A[2] } });
+  }
 };
 
 /// The first message describing what is wrong with the parameters, or "" (NaN or

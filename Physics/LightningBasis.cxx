@@ -133,14 +133,16 @@ LightningBasis PrecomputeLightningBasis(const ExtinctionGrid& cloud, const Cloud
               values[i] = field.Coefficients[i * kCoefficients + b]; // red = grey
             }
             // The threshold relative to this field's largest Haar coefficient.
-            SparseHaarField all = CompressHaar(values, cloud.Dimensions, 0.0);
-            for (float v : all.Value)
+            SparseHaarField field = CompressHaar(values, cloud.Dimensions, 0.0);
+            for (float v : field.Value)
             {
               largest = std::max(largest, static_cast<double>(std::abs(v)));
             }
-            basis.Fields[kShPerChannel * l + b] = options.Threshold > 0.0
-              ? CompressHaar(values, cloud.Dimensions, options.Threshold * largest)
-              : std::move(all);
+            if (options.Threshold > 0.0)
+            {
+              DropHaarCoefficients(field, options.Threshold * largest);
+            }
+            basis.Fields[kShPerChannel * l + b] = std::move(field);
           }
         }
       });
