@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -36,7 +40,252 @@ int ThreadCount(int requested)
   }
   return std::max(1u, std::thread::hardware_concurrency());
 }
+// FNV-1a over bytes, 64 bits; two different offset bases make the 128-bit fingerprint.
+class Fnv1a
+{
+public:
+  explicit Fnv1a(std::uint64_t basis)
+    : Hash(basis)
+  {
+  }
+  void Bytes(const void* data, std::size_t size)
+  {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < size; ++i)
+    {
+      this->Hash = (this->Hash ^ p[i]) * 1099511628211ull;
+    }
+  }
+  template <typename T>
+  void Value(const T& value)
+  {
+    this->Bytes(&value, sizeof(T));
+  }
+  std::uint64_t Hash;
+};
+
+constexpr char kMagic[8] = { 'N', 'I', 'M', 'B', 'L', 'B', 'A', 'S' };
+constexpr std::uint32_t kFormatVersion = 1;
+
+template <typename T>
+void Put(std::ostream& out, const T& value)
+{
+  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+template <typename T>
+bool Get(std::istream& in, T& value)
+{
+  return static_cast<bool>(in.read(reinterpret_cast<char*>(&value), sizeof(T)));
+}
 } // namespace
+
+std::string LightningBasisFingerprint(const ExtinctionGrid& cloud, const CloudOptics& optics,
+  const VirtualLightGrid& lights, const LightningBasisOptions& options)
+{
+  std::uint64_t hashes[2] = { 0, 0 };
+  const std::uint64_t bases[2] = { 14695981039346656037ull, 0x84222325cbf29ce4ull };
+  for (int h = 0; h < 2; ++h)
+  {
+    Fnv1a f(bases[h]);
+    f.Value(kFormatVersion);
+    f.Value(cloud.Dimensions);
+    f.Value(cloud.Origin);
+    f.Value(cloud.Spacing);
+    f.Value(cloud.Axes);
+    f.Bytes(cloud.Extinction.data(), cloud.Extinction.size() * sizeof(float));
+    f.Value(optics.Albedo);
+    f.Value(static_cast<int>(optics.Phase));
+    f.Value(optics.G);
+    for (const std::vector<double>& axis : lights.Nodes)
+    {
+      f.Value(axis.size());
+      f.Bytes(axis.data(), axis.size() * sizeof(double));
+    }
+    f.Value(options.NumberOfDirections);
+    f.Value(options.Orders);
+    f.Value(options.Threshold);
+    f.Value(options.IncludeFirstScattering);
+    hashes[h] = f.Hash;
+  }
+  char text[33];
+  std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(hashes[0]),
+    static_cast<unsigned long long>(hashes[1]));
+  return text;
+}
+
+void WriteLightningBasis(
+  const LightningBasis& basis, const std::string& fingerprint, const std::string& path)
+{
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    if (!out)
+    {
+      throw std::runtime_error("nimbus::WriteLightningBasis: cannot write " + partial);
+    }
+    out.write(kMagic, sizeof(kMagic));
+    Put(out, kFormatVersion);
+    const std::uint32_t length = static_cast<std::uint32_t>(fingerprint.size());
+    Put(out, length);
+    out.write(fingerprint.data(), length);
+    Put(out, basis.Dimensions);
+    Put(out, basis.Seconds);
+    for (const std::vector<double>& axis : basis.Lights.Nodes)
+    {
+      Put(out, static_cast<std::uint64_t>(axis.size()));
+      out.write(reinterpret_cast<const char*>(axis.data()),
+        static_cast<std::streamsize>(axis.size() * sizeof(double)));
+    }
+    Put(out, static_cast<std::uint64_t>(basis.Fields.size()));
+    for (const SparseHaarField& field : basis.Fields)
+    {
+      Put(out, field.Dimensions);
+      Put(out, field.Padded);
+      Put(out, field.DroppedNorm);
+      Put(out, static_cast<std::uint64_t>(field.Index.size()));
+      out.write(reinterpret_cast<const char*>(field.Index.data()),
+        static_cast<std::streamsize>(field.Index.size() * sizeof(std::uint32_t)));
+      out.write(reinterpret_cast<const char*>(field.Value.data()),
+        static_cast<std::streamsize>(field.Value.size() * sizeof(float)));
+    }
+    out.flush();
+    if (!out)
+    {
+      out.close();
+      std::remove(partial.c_str());
+      throw std::runtime_error("nimbus::WriteLightningBasis: writing " + partial + " failed");
+    }
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0)
+  {
+    std::remove(partial.c_str());
+    throw std::runtime_error("nimbus::WriteLightningBasis: cannot rename " + partial + " to " + path);
+  }
+}
+
+bool ReadLightningBasis(const std::string& path, const std::string& fingerprint,
+  LightningBasis& basis, std::string& why)
+{
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in)
+  {
+    why = "no file " + path;
+    return false;
+  }
+  // Sizes read from the file are checked against what is left of it before anything
+  // is allocated, so a damaged count cannot ask for gigabytes.
+  const std::streamoff fileSize = in.tellg();
+  in.seekg(0);
+  const auto left = [&]() { return static_cast<std::uint64_t>(fileSize - in.tellg()); };
+  char magic[sizeof(kMagic)];
+  std::uint32_t version = 0, length = 0;
+  if (!in.read(magic, sizeof(magic)) || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0 ||
+    !Get(in, version) || !Get(in, length) || length > 256)
+  {
+    why = path + " is not a Nimbus lightning basis";
+    return false;
+  }
+  if (version != kFormatVersion)
+  {
+    why = path + " has format version " + std::to_string(version) + ", not " +
+      std::to_string(kFormatVersion);
+    return false;
+  }
+  std::string stored(length, '\0');
+  if (!in.read(&stored[0], length) || stored != fingerprint)
+  {
+    why = path + " holds another basis (fingerprint " + stored + ")";
+    return false;
+  }
+  const auto damaged = [&](const char* what)
+  {
+    why = path + " is damaged: " + what;
+    return false;
+  };
+  LightningBasis read;
+  if (!Get(in, read.Dimensions) || !Get(in, read.Seconds))
+  {
+    return damaged("truncated header");
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    if (read.Dimensions[k] < 1 || read.Dimensions[k] > (1 << 20))
+    {
+      return damaged("bad grid dimensions");
+    }
+  }
+  std::array<int, 3> padded;
+  try
+  {
+    padded = HaarPaddedDimensions(read.Dimensions);
+  }
+  catch (const std::exception&)
+  {
+    return damaged("bad grid dimensions");
+  }
+  const std::uint64_t paddedSize = static_cast<std::uint64_t>(padded[0]) * padded[1] * padded[2];
+  for (std::vector<double>& axis : read.Lights.Nodes)
+  {
+    std::uint64_t count = 0;
+    if (!Get(in, count) || count < 1 || count > left() / sizeof(double))
+    {
+      return damaged("bad light grid");
+    }
+    axis.resize(count);
+    if (!in.read(reinterpret_cast<char*>(axis.data()),
+          static_cast<std::streamsize>(count * sizeof(double))))
+    {
+      return damaged("truncated light grid");
+    }
+  }
+  std::uint64_t fields = 0;
+  if (!Get(in, fields) || fields > left() ||
+    fields != kShPerChannel * read.Lights.NumberOfNodes())
+  {
+    return damaged("the number of fields does not match the lights");
+  }
+  read.Fields.resize(fields);
+  for (SparseHaarField& field : read.Fields)
+  {
+    std::uint64_t kept = 0;
+    if (!Get(in, field.Dimensions) || !Get(in, field.Padded) || !Get(in, field.DroppedNorm) ||
+      !Get(in, kept))
+    {
+      return damaged("truncated field");
+    }
+    if (field.Dimensions != read.Dimensions || field.Padded != padded || kept > paddedSize ||
+      kept > left() / (sizeof(std::uint32_t) + sizeof(float)) ||
+      !(field.DroppedNorm >= 0.0) || !std::isfinite(field.DroppedNorm))
+    {
+      return damaged("a field's header does not match the grid");
+    }
+    field.Index.resize(kept);
+    field.Value.resize(kept);
+    if (!in.read(reinterpret_cast<char*>(field.Index.data()),
+          static_cast<std::streamsize>(kept * sizeof(std::uint32_t))) ||
+      !in.read(reinterpret_cast<char*>(field.Value.data()),
+        static_cast<std::streamsize>(kept * sizeof(float))))
+    {
+      return damaged("truncated field");
+    }
+    for (std::size_t i = 0; i < kept; ++i)
+    {
+      if (field.Index[i] >= paddedSize || (i > 0 && field.Index[i] <= field.Index[i - 1]) ||
+        !std::isfinite(field.Value[i]))
+      {
+        return damaged("a field's coefficients are out of range");
+      }
+    }
+  }
+  char extra;
+  if (in.read(&extra, 1))
+  {
+    return damaged("bytes after the last field");
+  }
+  basis = std::move(read);
+  return true;
+}
 
 double LightningBasis::CompressedBytes() const
 {

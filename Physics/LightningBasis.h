@@ -32,6 +32,7 @@
 #include "MultipleScattering.h"
 
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace nimbus
@@ -91,6 +92,26 @@ NIMBUSPHYSICS_EXPORT LightningBasis PrecomputeLightningBasis(const ExtinctionGri
 /// std::invalid_argument when e does not have one entry per node or is not finite.
 NIMBUSPHYSICS_EXPORT MultipleScatteringField RelightLightning(
   const LightningBasis& basis, const std::vector<Rgb>& e);
+
+/// A fingerprint (32 hex digits: two 64-bit FNV-1a hashes) of everything the basis
+/// depends on: the cloud's extinction values and placement, the optics, the virtual
+/// lights' nodes and the options that change the result (directions, orders,
+/// threshold, first scattering; not threads or budget). The disk cache's key.
+NIMBUSPHYSICS_EXPORT std::string LightningBasisFingerprint(const ExtinctionGrid& cloud,
+  const CloudOptics& optics, const VirtualLightGrid& lights, const LightningBasisOptions& options);
+
+/// Writes the basis with its fingerprint to `path` (binary, little-endian as the machine
+/// writes it; written to `path`.partial and renamed, so a reader never sees half a
+/// file). Throws std::runtime_error naming the path when it cannot be written.
+NIMBUSPHYSICS_EXPORT void WriteLightningBasis(
+  const LightningBasis& basis, const std::string& fingerprint, const std::string& path);
+
+/// Reads a basis written by WriteLightningBasis. False, with the reason in `why`, when
+/// the file is missing, holds another fingerprint or format version, or is damaged
+/// (sizes that do not add up, indices out of range, non-finite values); `basis` is then
+/// unchanged.
+NIMBUSPHYSICS_EXPORT bool ReadLightningBasis(const std::string& path,
+  const std::string& fingerprint, LightningBasis& basis, std::string& why);
 
 } // namespace nimbus
 
