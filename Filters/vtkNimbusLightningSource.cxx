@@ -5,6 +5,7 @@
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
 #include "vtkFloatArray.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -87,7 +88,7 @@ int vtkNimbusLightningSource::RequestInformation(
 }
 
 int vtkNimbusLightningSource::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+  vtkInformation* request, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkPolyData* strokes = vtkPolyData::GetData(outputVector, 0);
   vtkPolyData* sources = vtkPolyData::GetData(outputVector, 1);
@@ -145,12 +146,20 @@ int vtkNimbusLightningSource::RequestData(
   }
   this->UpdateProgress(0.5);
 
-  // The requested time (a request without one: the return stroke's peak).
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  // The requested time, from the port that asked (a downstream filter may want only the
+  // point sources); a request without one: the return stroke's peak.
+  int port = request->Has(vtkExecutive::FROM_OUTPUT_PORT())
+    ? request->Get(vtkExecutive::FROM_OUTPUT_PORT())
+    : 0;
+  port = port == 1 ? 1 : 0;
+  vtkInformation* outInfo = outputVector->GetInformationObject(port);
   double time = this->FlashStartTime + this->LeaderDuration;
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
   {
     time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    // Both outputs hold this time (whichever port asked).
+    strokes->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
+    sources->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), time);
   }
   double farthest = 0.0, sourceCount = 0.0;
   for (const nimbus::LightningSegment& s : segments)

@@ -63,11 +63,28 @@ ResampledDensity CloudDensityTexture::Resample(
   return std::move(worker.Result);
 }
 
+namespace
+{
+std::array<double, 12> GeometryOf(vtkImageData* image)
+{
+  std::array<double, 12> g{};
+  int extent[6];
+  image->GetExtent(extent);
+  for (int k = 0; k < 6; ++k)
+  {
+    g[k] = extent[k];
+  }
+  image->GetOrigin(g.data() + 6);
+  image->GetSpacing(g.data() + 9);
+  return g;
+}
+} // namespace
+
 bool CloudDensityTexture::NeedsUpload(
   vtkImageData* image, vtkDataArray* scalars, int maximumSize, double budgetBytes) const
 {
   return !this->HasDensity || this->UploadedArray != scalars || this->UploadedImage != image ||
-    scalars->GetMTime() > this->UploadTime || image->GetMTime() > this->UploadTime ||
+    scalars->GetMTime() > this->UploadTime || GeometryOf(image) != this->UploadedGeometry ||
     this->UploadedMaximumSize != maximumSize || this->UploadedBudgetBytes != budgetBytes;
 }
 
@@ -213,6 +230,7 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
   std::copy(plan.Factors.begin(), plan.Factors.end(), this->Factors);
   this->UploadedArray = scalars;
   this->UploadedImage = image;
+  this->UploadedGeometry = GeometryOf(image);
   this->UploadedMaximumSize = maximumSize;
   this->UploadedBudgetBytes = budgetBytes;
   this->UploadTime.Modified();

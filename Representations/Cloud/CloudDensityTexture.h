@@ -16,6 +16,7 @@
 #include "vtkNew.h"       // for vtkNew
 #include "vtkTimeStamp.h" // for vtkTimeStamp
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,9 @@ private:
   vtkTimeStamp UploadTime;
   vtkDataArray* UploadedArray = nullptr; // identity only, never dereferenced
   vtkImageData* UploadedImage = nullptr;
+  // The uploaded image's extent, origin and spacing: a new version of the image object
+  // that only changed its field data (a lightning time step) keeps the texture.
+  std::array<double, 12> UploadedGeometry{};
   int UploadedMaximumSize = -1;
   double UploadedBudgetBytes = -1.0;
   // The array whose values were last reported (NaN, infinite, negative): reported

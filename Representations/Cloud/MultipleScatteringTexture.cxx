@@ -16,6 +16,47 @@
 
 namespace nimbus
 {
+bool UploadShCoefficients(vtkOpenGLRenderWindow* window, vtkTextureObject* const textures[3],
+  const std::array<int, 3>& dimensions, const float* coefficients)
+{
+  const std::size_t points =
+    static_cast<std::size_t>(dimensions[0]) * dimensions[1] * dimensions[2];
+  std::vector<float> channel(4 * points);
+  for (int c = 0; c < 3; ++c)
+  {
+    for (std::size_t i = 0; i < points; ++i)
+    {
+      for (int b = 0; b < 4; ++b)
+      {
+        channel[4 * i + b] = coefficients[12 * i + 4 * c + b];
+      }
+    }
+    vtkTextureObject* texture = textures[c];
+    texture->SetContext(window);
+    texture->ReleaseGraphicsResources(window);
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetWrapR(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Linear);
+    texture->SetMagnificationFilter(vtkTextureObject::Linear);
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
+    {
+      // errors of earlier GL calls are not this upload's
+    }
+    if (!texture->Create3DFromRaw(dimensions[0], dimensions[1], dimensions[2], 4, VTK_FLOAT,
+          channel.data()) ||
+      glGetError() == GL_OUT_OF_MEMORY)
+    {
+      for (int t = 0; t < 3; ++t)
+      {
+        textures[t]->ReleaseGraphicsResources(window);
+      }
+      return false;
+    }
+  }
+  return true;
+}
+
 MultipleScatteringTexture::MultipleScatteringTexture() = default;
 MultipleScatteringTexture::~MultipleScatteringTexture() = default;
 
@@ -206,41 +247,13 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
   }
   if (any)
   {
-    const std::size_t points = grid.NumberOfPoints();
-    std::vector<float> channel(4 * points);
-    for (int c = 0; c < 3; ++c)
+    vtkTextureObject* textures[3] = { this->Textures[0], this->Textures[1], this->Textures[2] };
+    if (!UploadShCoefficients(window, textures, grid.Dimensions, this->Field.Coefficients.data()))
     {
-      for (std::size_t i = 0; i < points; ++i)
-      {
-        for (int b = 0; b < 4; ++b)
-        {
-          channel[4 * i + b] = this->Field.Coefficients[12 * i + 4 * c + b];
-        }
-      }
-      vtkTextureObject* texture = this->Textures[c];
-      texture->SetContext(window);
-      texture->ReleaseGraphicsResources(window);
-      texture->SetWrapS(vtkTextureObject::ClampToEdge);
-      texture->SetWrapT(vtkTextureObject::ClampToEdge);
-      texture->SetWrapR(vtkTextureObject::ClampToEdge);
-      texture->SetMinificationFilter(vtkTextureObject::Linear);
-      texture->SetMagnificationFilter(vtkTextureObject::Linear);
-      for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
-      {
-        // errors of earlier GL calls are not this upload's
-      }
-      if (!texture->Create3DFromRaw(grid.Dimensions[0], grid.Dimensions[1], grid.Dimensions[2], 4,
-            VTK_FLOAT, channel.data()) ||
-        glGetError() == GL_OUT_OF_MEMORY)
-      {
-        for (auto& t : this->Textures)
-        {
-          t->ReleaseGraphicsResources(window);
-        }
-        error = "Could not upload the multiple-scattering texture (" + FormatBytes(48.0 * points) +
-          "; GL out of memory?); the cloud is drawn without it.";
-        return false;
-      }
+      error = "Could not upload the multiple-scattering texture (" +
+        FormatBytes(48.0 * grid.NumberOfPoints()) +
+        "; GL out of memory?); the cloud is drawn without it.";
+      return false;
     }
     this->Textured = true;
   }

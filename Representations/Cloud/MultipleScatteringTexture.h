@@ -30,6 +30,13 @@ class vtkWindow;
 
 namespace nimbus
 {
+/// Uploads 12 floats per point (SH c_00, c_1-1, c_10, c_11 of R, G, B; x fastest) as
+/// three RGBA float 3-D textures, linear filtering, clamped at the edges. False (the
+/// textures released) when GL refuses them.
+NIMBUSREPRESENTATIONS_EXPORT bool UploadShCoefficients(vtkOpenGLRenderWindow* window,
+  vtkTextureObject* const textures[3], const std::array<int, 3>& dimensions,
+  const float* coefficients);
+
 class NIMBUSREPRESENTATIONS_EXPORT MultipleScatteringTexture
 {
 public:

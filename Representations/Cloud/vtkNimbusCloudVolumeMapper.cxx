@@ -7,6 +7,7 @@
 #include "FiniteSetters.h"
 #include "FrameQuality.h"
 #include "MemoryBudget.h"
+#include "LightningTexture.h"
 #include "MultipleScatteringTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
@@ -303,6 +304,10 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   double ScatteringScale = 1.0; // this frame's illuminance / the solve's
   int Octaves = 1;
 
+  // Lightning (issue 16): the in-scattered radiance vtkNimbusLightningIllumination left
+  // in the image's field data, uploaded.
+  bool LightningTexture = false;
+
   // A hash of the opaque scene's depth in the viewport (0 without one).
   std::uint64_t SceneDepthHash = 0;
 };
@@ -318,6 +323,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // (a sky model of the mapper's own air, built only when the sky light needs it).
   nimbus::MultipleScatteringTexture Scattering;
   std::string LastScatteringError;
+  // Lightning (issue 16; LightningTexture.h).
+  nimbus::LightningTexture Lightning;
+  std::string LastLightningError;
   double LastPrecomputeSeconds = 0.0;
   double SolvedIlluminance = 0.0; // the sun's illuminance of the last solve
   std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
@@ -385,6 +393,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   {
     this->Density.Release(window);
     this->Scattering.Release(window);
+    this->Lightning.Release(window);
     for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
            Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
            SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
@@ -571,6 +580,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     return false;
   }
   this->UpdateMultipleScattering(frame);
+  this->UpdateLightning(frame);
   // Nothing the cloud depends on changed since the last complete frame: its image
   // (the accumulation targets) is composited again without a pass.
   std::vector<double> key = this->FrameReuseKey(frame);
@@ -661,6 +671,7 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
       frame.CellData ? 1.0 : 0.0, time(this->SkyBackground), time(sky),
       static_cast<double>(in.Density.GetNumberOfUploads()),
       static_cast<double>(in.Scattering.GetNumberOfSolves()), frame.ScatteringScale,
+      static_cast<double>(in.Lightning.GetNumberOfUploads()), frame.LightningTexture ? 1.0 : 0.0,
       static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),
       frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees,
       frame.Settings.OverSky ? 1.0 : 0.0, static_cast<double>(frame.Width),
@@ -1193,6 +1204,13 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
       in.Scattering.GetTexture(c)->Activate();
     }
   }
+  if (frame.LightningTexture)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      in.Lightning.GetTexture(c)->Activate();
+    }
+  }
   frame.State->vtkglDisable(GL_DEPTH_TEST);
   frame.State->vtkglDepthMask(GL_FALSE);
 }
@@ -1219,6 +1237,13 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
     for (int c = 0; c < 3; ++c)
     {
       in.Scattering.GetTexture(c)->Deactivate();
+    }
+  }
+  if (frame.LightningTexture)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      in.Lightning.GetTexture(c)->Deactivate();
     }
   }
 }
@@ -1383,6 +1408,66 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   frame.ScatteringScale =
     in.SolvedIlluminance > 0.0 ? settings.Sun.Illuminance / in.SolvedIlluminance : 1.0;
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
+}
+
+//------------------------------------------------------------------------------
+// Lightning (issue 16): the field vtkNimbusLightningIllumination computed, uploaded
+// when it changes (every time step of a flash).
+void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  frame.LightningTexture = false;
+  if (this->Unlit)
+  {
+    return;
+  }
+  int textureDims[3], textureFactors[3];
+  in.Density.GetDimensions(textureDims);
+  in.Density.GetFactors(textureFactors);
+  std::string error;
+  if (!in.Lightning.Update(frame.Window, frame.Image, frame.CellData,
+        { { std::max(textureDims[0], 1), std::max(textureDims[1], 1),
+          std::max(textureDims[2], 1) } },
+        { { textureFactors[0], textureFactors[1], textureFactors[2] } }, error))
+  {
+    if (error != in.LastLightningError)
+    {
+      vtkErrorMacro(<< error);
+      in.LastLightningError = error;
+    }
+    return;
+  }
+  frame.LightningTexture = in.Lightning.HasTexture();
+  if (!frame.LightningTexture)
+  {
+    return;
+  }
+  // The lightning was solved with the filter's optics; say so once when they are not
+  // the mapper's (the picture mixes two clouds).
+  const auto& optics = in.Lightning.GetOptics();
+  const double mine[4] = { this->ExtinctionPerDensity, this->Albedo, this->CloudG,
+    frame.Settings.MetresPerUnit };
+  std::string mismatch;
+  const char* names[4] = { "ExtinctionPerDensity", "Albedo", "CloudG", "MetresPerUnit" };
+  for (int k = 0; k < 4; ++k)
+  {
+    if (std::isfinite(optics[k]) && std::abs(optics[k] - mine[k]) > 1e-9 * std::abs(mine[k]))
+    {
+      mismatch += std::string(mismatch.empty() ? "" : ", ") + names[k];
+    }
+  }
+  const std::string warning = mismatch.empty()
+    ? std::string()
+    : "The lightning was computed with another " + mismatch +
+      " than this cloud is drawn with; set the same on the Lightning Illumination filter.";
+  if (warning != in.LastLightningError)
+  {
+    if (!warning.empty())
+    {
+      vtkWarningMacro(<< warning);
+    }
+    in.LastLightningError = warning;
+  }
 }
 
 // The sky seen from the cloud at altitude `cloudAltitude` above the scene [m]: a
@@ -1658,6 +1743,19 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
   const float scatteringScale[3] = { static_cast<float>(scale[0]), static_cast<float>(scale[1]),
     static_cast<float>(scale[2]) };
   sliceProgram->SetUniform3f("scatteringTextureScale", scatteringScale);
+  // Lightning (issue 16), the same way.
+  sliceProgram->SetUniformi("lightningTextureOn", frame.LightningTexture ? 1 : 0);
+  const char* lightningSamplers[3] = { "lightningRed", "lightningGreen", "lightningBlue" };
+  for (int c = 0; c < 3; ++c)
+  {
+    sliceProgram->SetUniformi(lightningSamplers[c],
+      (frame.LightningTexture ? in.Lightning.GetTexture(c) : in.Density.GetTexture())
+        ->GetTextureUnit());
+  }
+  const auto& lightningScale = in.Lightning.GetTextureScale();
+  const float lightningTextureScale[3] = { static_cast<float>(lightningScale[0]),
+    static_cast<float>(lightningScale[1]), static_cast<float>(lightningScale[2]) };
+  sliceProgram->SetUniform3f("lightningTextureScale", lightningTextureScale);
   sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
   sliceProgram->SetUniformi("octaves", frame.Octaves);
   const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),

@@ -565,6 +565,7 @@ private:
   void CopySceneColorAndDepth(FrameState& frame);
   bool UpdateAtmosphereTable(FrameState& frame);
   void UpdateMultipleScattering(FrameState& frame);
+  void UpdateLightning(FrameState& frame);
   const nimbus::SkyViewLut* CloudSkyView(const FrameState& frame, double cloudAltitude);
   const nimbus::SkyModel& FrameSkyModel(const FrameState& frame);
   static std::vector<double> FrameSkyKey(const FrameState& frame);

@@ -27,6 +27,13 @@ uniform float scatteringScale;        // the sun's illuminance now / at the solv
 uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
 uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
 uniform vec3 octaveScales;            // a (extinction), b (scattering), c (asymmetry)
+// Lightning (issue 16; vtkNimbusLightningIllumination, 003 Eqs. 8-10): J of the strokes'
+// light, all orders, in the same layout and units.
+uniform int lightningTextureOn;
+uniform sampler3D lightningRed;
+uniform sampler3D lightningGreen;
+uniform sampler3D lightningBlue;
+uniform vec3 lightningTextureScale;   // density texture coordinates -> these textures'
 
 // J(p, w) of the solver: the radiance the cloud's particles at p scatter toward w
 // (w the direction of travel) per unit scattering coefficient, beyond the sun's
@@ -38,6 +45,15 @@ vec3 InScattering(vec3 p, vec3 w)
   return scatteringScale * max(vec3(dot(texture(scatteringRed, tc), y),
                                  dot(texture(scatteringGreen, tc), y),
                                  dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+}
+
+// J(p, w) of the lightning (the same form as InScattering, without the sun's scale).
+vec3 LightningInScattering(vec3 p, vec3 w)
+{
+  vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * lightningTextureScale;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return max(vec3(dot(texture(lightningRed, tc), y), dot(texture(lightningGreen, tc), y),
+               dot(texture(lightningBlue, tc), y)), vec3(0.0));
 }
 
 // The sun's light scattered more than once that the mapper evaluates per sample,
@@ -122,6 +138,10 @@ void main()
       if (scatteringTextureOn != 0)
       {
         source += cloudAlbedo * sigma * InScattering(p, -direction);
+      }
+      if (lightningTextureOn != 0)
+      {
+        source += cloudAlbedo * sigma * LightningInScattering(p, -direction);
       }
     }
     vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);

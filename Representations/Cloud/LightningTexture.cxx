@@ -1,0 +1,135 @@
+#include "LightningTexture.h"
+
+#include "MultipleScatteringTexture.h"
+
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkIntArray.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkTextureObject.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace nimbus
+{
+LightningTexture::LightningTexture() = default;
+LightningTexture::~LightningTexture() = default;
+
+vtkTextureObject* LightningTexture::GetTexture(int channel) const
+{
+  return this->Textures[channel].GetPointer();
+}
+
+bool LightningTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image, bool cellData,
+  const std::array<int, 3>& textureDimensions, const std::array<int, 3>& textureFactors,
+  std::string& error)
+{
+  vtkFieldData* fields = image->GetFieldData();
+  vtkFloatArray* values = fields
+    ? vtkFloatArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_in_scattering"))
+    : nullptr;
+  vtkIntArray* layout =
+    fields ? vtkIntArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_grid")) : nullptr;
+  const std::array<int, 6> noLayout{};
+  if (!values || !layout)
+  {
+    this->Textured = false;
+    this->UploadedArray = nullptr;
+    return true;
+  }
+  std::array<int, 6> grid{};
+  const bool layoutShape = layout->GetNumberOfValues() == 7;
+  for (int k = 0; layoutShape && k < 6; ++k)
+  {
+    grid[k] = layout->GetValue(k);
+  }
+  const unsigned long time = values->GetMTime();
+  if (values == this->UploadedArray && time == this->UploadedTime && grid == this->UploadedLayout)
+  {
+    return true;
+  }
+  this->Textured = false;
+  this->UploadedArray = values;
+  this->UploadedTime = time;
+  this->UploadedLayout = noLayout;
+
+  // The layout must fit this image: blocks of D input samples, ceil(n / D) points.
+  int pointDims[3];
+  image->GetDimensions(pointDims);
+  bool fits = layoutShape && values->GetNumberOfComponents() == 12 &&
+    (layout->GetValue(6) != 0) == cellData;
+  std::size_t points = 1;
+  for (int k = 0; fits && k < 3; ++k)
+  {
+    const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    fits = grid[k] >= 1 && grid[3 + k] >= 1 && (samples + grid[3 + k] - 1) / grid[3 + k] == grid[k];
+    points *= static_cast<std::size_t>(std::max(grid[k], 0));
+  }
+  if (!fits || static_cast<std::size_t>(values->GetNumberOfTuples()) != points)
+  {
+    error = "The lightning arrays in the image's field data do not fit this image (another "
+            "density array, point and cell data mixed, or a changed grid); the cloud is drawn "
+            "without lightning. Re-run the Lightning Illumination filter on this cloud.";
+    return false;
+  }
+  const float* data = values->GetPointer(0);
+  bool any = false;
+  for (std::size_t i = 0; i < 12 * points; ++i)
+  {
+    if (!std::isfinite(data[i]))
+    {
+      error = "The lightning field holds NaN or infinite values; the cloud is drawn without "
+              "lightning.";
+      return false;
+    }
+    any = any || data[i] != 0.0f;
+  }
+  vtkDoubleArray* optics =
+    vtkDoubleArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_optics"));
+  for (int k = 0; k < 4; ++k)
+  {
+    this->Optics[k] = optics && optics->GetNumberOfValues() == 4
+      ? optics->GetValue(k)
+      : std::numeric_limits<double>::quiet_NaN();
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    // As for the multiple-scattering texture: density texture coordinate u = (s + 0.5) /
+    // (n_tex f) for input sample position s; this texture's v = (s + 0.5) / (n' D).
+    this->TextureScale[k] = static_cast<double>(textureDimensions[k]) * textureFactors[k] /
+      (static_cast<double>(grid[k]) * grid[3 + k]);
+  }
+  this->UploadedLayout = grid;
+  if (!any)
+  {
+    return true; // dark: nothing to draw
+  }
+  vtkTextureObject* textures[3] = { this->Textures[0], this->Textures[1], this->Textures[2] };
+  if (!UploadShCoefficients(window, textures, { { grid[0], grid[1], grid[2] } }, data))
+  {
+    std::ostringstream message;
+    message << "Could not upload the lightning texture (" << 48.0 * points / 1048576.0
+            << " MiB; GL out of memory?); the cloud is drawn without lightning.";
+    error = message.str();
+    return false;
+  }
+  this->Textured = true;
+  ++this->Uploads;
+  return true;
+}
+
+void LightningTexture::Release(vtkWindow* window)
+{
+  for (auto& t : this->Textures)
+  {
+    t->ReleaseGraphicsResources(window);
+  }
+  this->Textured = false;
+  this->UploadedArray = nullptr;
+}
+} // namespace nimbus
