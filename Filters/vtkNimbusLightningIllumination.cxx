@@ -46,6 +46,7 @@ struct vtkNimbusLightningIllumination::vtkInternals
   double PrecomputeSeconds = 0.0;
   bool FromDisk = false;
   double RelightSeconds = 0.0;
+  int SourcesOutside = 0;
 };
 
 vtkNimbusLightningIllumination::vtkNimbusLightningIllumination()
@@ -517,6 +518,41 @@ int vtkNimbusLightningIllumination::RequestData(
     in.PrecomputeSeconds = 0.0; // from memory
   }
 
+  // Sources outside the virtual lights' box would be moved onto it (Eq. 6's cells end
+  // there), closer to the cloud than they are: their intensity is dimmed by the inverse
+  // square of the distances to the cloud's centre, where they are and where they land.
+  const nimbus::VirtualLightGrid& box = in.Basis.Lights;
+  nimbus::Vector3 centre;
+  for (int k = 0; k < 3; ++k)
+  {
+    centre[k] = 0.5 * (low[k] + high[k]);
+  }
+  int outside = 0;
+  for (nimbus::PointLight& s : sources)
+  {
+    nimbus::Vector3 landed = s.Position;
+    for (int k = 0; k < 3; ++k)
+    {
+      landed[k] = std::clamp(landed[k], box.Nodes[k].front(), box.Nodes[k].back());
+    }
+    if (landed != s.Position)
+    {
+      ++outside;
+      double far = 0.0, near = 0.0;
+      for (int k = 0; k < 3; ++k)
+      {
+        far += (s.Position[k] - centre[k]) * (s.Position[k] - centre[k]);
+        near += (landed[k] - centre[k]) * (landed[k] - centre[k]);
+      }
+      const double dim = far > 0.0 ? std::min(1.0, near / far) : 1.0;
+      for (int k = 0; k < 3; ++k)
+      {
+        s.Intensity[k] *= dim;
+      }
+    }
+  }
+  in.SourcesOutside = outside;
+
   // The relight (003 Eqs. 6-10).
   const auto start = std::chrono::steady_clock::now();
   nimbus::MultipleScatteringField field;
@@ -598,6 +634,11 @@ double vtkNimbusLightningIllumination::GetUncompressedBasisBytes() const
 double vtkNimbusLightningIllumination::GetLastRelightSeconds() const
 {
   return this->Internals->RelightSeconds;
+}
+
+int vtkNimbusLightningIllumination::GetNumberOfSourcesOutside() const
+{
+  return this->Internals->SourcesOutside;
 }
 
 std::string vtkNimbusLightningIllumination::GetCacheFile() const

@@ -37,6 +37,11 @@
  * the sources to the virtual lights with trilinear weights (Eq. 6), weighted sums in the
  * wavelet domain and one inverse transform (Eqs. 8-10), milliseconds.
  *
+ * Sources outside the virtual lights' box (a stroke beside the cloud, branches far out)
+ * are moved onto the box, as Eq. 6 needs, and dimmed by (d_landed / d)^2, the distances
+ * from the cloud's centre to where they land and where they are: their light reaches the
+ * cloud from about the right distance rather than from the box's face.
+ *
  * Time: the output has the lightning input's time steps; the cloud is taken as steady.
  *
  * Refusals (an error naming the problem; the cloud passes through without lightning):
@@ -140,6 +145,9 @@ public:
   double GetBasisBytes() const;
   double GetUncompressedBasisBytes() const;
   double GetLastRelightSeconds() const;
+  /// Point sources of the last relight outside the virtual lights' box (moved onto it and
+  /// dimmed, see the class comment).
+  int GetNumberOfSourcesOutside() const;
   /// The file of the basis in the disk cache ("" before the first precompute).
   std::string GetCacheFile() const;
   ///@}
