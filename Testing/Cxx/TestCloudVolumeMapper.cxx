@@ -6,9 +6,12 @@
 // <baseline dir>/TestCloudVolumeMapper_<case>.png (criteria: ImageComparison.h).
 // Stability cases check finite, sensible images at the extremes.
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusLightningIllumination.h"
+#include "vtkNimbusLightningSource.h"
 #include "vtkNimbusMetaballCloudSource.h"
 
 #include "ImageComparison.h"
+#include "MessageCatcher.h"
 #include "TestCumulus.h"
 
 #include "vtkActor.h"
@@ -357,6 +360,101 @@ bool FrameBudgetAndReuse(const Context&)
 
 // Progress and abort: a still frame that takes more than a second reports progress
 // every 16 slices and stops when asked (here by an observer of its progress).
+// --- lightning (issue 16) --------------------------------------------------------------
+// The cumulus at night lit by a flash from inside (vtkNimbusLightningIllumination, cheap
+// settings: 14 directions, lights 750 m apart), the filter driven to time `seconds`.
+struct LightningScene
+{
+  vtkNew<vtkNimbusLightningSource> Lightning;
+  vtkNew<vtkNimbusLightningIllumination> Illumination;
+  LightningScene()
+  {
+    this->Lightning->SetStartPoint(200.0, 0.0, 2000.0);
+    this->Lightning->SetDirection(0.15, 0.0, -1.0);
+    this->Lightning->SetLength(3000.0);
+    this->Lightning->SetSeed(11);
+    this->Illumination->SetInputData(0, MakeCloud());
+    this->Illumination->SetInputConnection(1, this->Lightning->GetOutputPort(1));
+    this->Illumination->SetNumberOfDirections(14);
+    this->Illumination->SetLightSpacingMetres(750.0);
+    this->Illumination->SetNumberOfThreads(2);
+    this->Illumination->UseDiskCacheOff();
+  }
+  double Peak() const
+  {
+    return this->Lightning->GetFlashStartTime() + this->Lightning->GetLeaderDuration();
+  }
+  void At(double seconds)
+  {
+    this->Illumination->UpdateTimeStep(seconds);
+    this->Lightning->UpdateTimeStep(seconds);
+  }
+};
+
+void NightMapper(Scene& s)
+{
+  s.Mapper->SetSunAzimuthDegrees(250);
+  s.Mapper->SetSunElevationDegrees(-15.0); // night: the earth hides the sun
+  s.Mapper->SetExposure(1.0);
+  s.LookFrom({ 0, -6000, 600 }, { 0, 0, 1500 }, 40);
+}
+
+bool LightningAtNight(const Context& c)
+{
+  LightningScene lightning;
+  lightning.At(lightning.Peak());
+  Scene s(lightning.Illumination->GetOutput());
+  NightMapper(s);
+  // The channels, white lines, as an application would draw them.
+  vtkNew<vtkPolyDataMapper> strokes;
+  strokes->SetInputData(lightning.Lightning->GetOutput(0));
+  strokes->ScalarVisibilityOff();
+  vtkNew<vtkActor> channel;
+  channel->SetMapper(strokes);
+  channel->GetProperty()->SetColor(0.85, 0.9, 1.0);
+  channel->GetProperty()->SetLineWidth(2.0);
+  channel->GetProperty()->LightingOff();
+  s.Renderer->AddActor(channel);
+  s.Render(c.Png());
+  return c.CompareWithBaseline();
+}
+
+bool LightningFollowsTime(const Context&)
+{
+  LightningScene lightning;
+  lightning.At(0.0); // before the flash: no light at all
+  Scene s(lightning.Illumination->GetOutput());
+  NightMapper(s);
+  const auto before = s.Render();
+  const int uploads = s.Mapper->GetNumberOfVolumeUploads();
+  lightning.At(lightning.Peak());
+  const auto peak = s.Render();
+  lightning.At(lightning.Peak() + lightning.Lightning->GetInterstrokeInterval());
+  const auto second = s.Render();
+  lightning.At(lightning.Peak() + 0.5);
+  const auto after = s.Render();
+  bool ok = Check(Mean(before) < 0.05, "before the flash the night is black (mean " +
+      std::to_string(Mean(before)) + ")");
+  ok &= Check(Mean(peak) > 2.0,
+    "the return stroke lights the cloud (mean " + std::to_string(Mean(peak)) + ")");
+  ok &= Check(Mean(second) < Mean(peak) && Mean(second) > 0.2 * Mean(peak),
+    "the second stroke dimmer (mean " + std::to_string(Mean(second)) + ")");
+  ok &= Check(Mean(after) < 0.05 * Mean(peak),
+    "half a second later dark again (mean " + std::to_string(Mean(after)) + ")");
+  ok &= Check(s.Mapper->GetNumberOfVolumeUploads() == uploads,
+    "the density is not uploaded again for a new lightning time step");
+  // The filter's optics differ from the mapper's: said once, as a warning.
+  nimbus::testing::MessageCatcher messages(s.Mapper);
+  lightning.Illumination->SetCloudG(0.5);
+  lightning.At(lightning.Peak());
+  s.Render();
+  s.Render();
+  ok &= Check(messages.Warnings.size() == 1 &&
+      messages.Warnings[0].find("CloudG") != std::string::npos,
+    "optics that differ from the mapper's are named once (" + messages.AllWarnings() + ")");
+  return ok;
+}
+
 bool ProgressAndAbort(const Context&)
 {
   Scene s(MakeCloud());
@@ -818,7 +916,8 @@ int main(int argc, char* argv[])
     { "MultipleScatteringOctaves", MultipleScatteringOctaves },
     { "MultipleScatteringPatterns", MultipleScatteringPatterns },
     { "MultipleScatteringResolvesOnlyOnChange", MultipleScatteringResolvesOnlyOnChange },
-    { "FrameBudgetAndReuse", FrameBudgetAndReuse }, { "ProgressAndAbort", ProgressAndAbort } };
+    { "FrameBudgetAndReuse", FrameBudgetAndReuse }, { "ProgressAndAbort", ProgressAndAbort },
+    { "LightningAtNight", LightningAtNight }, { "LightningFollowsTime", LightningFollowsTime } };
   if (argc != 4 || !cases.count(argv[1]))
   {
     std::cerr << "usage: TestCloudVolumeMapper <case> <baseline dir> <output dir>; cases:";
