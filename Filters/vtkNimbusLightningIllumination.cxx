@@ -450,6 +450,57 @@ int vtkNimbusLightningIllumination::RequestData(
     nimbus::LightningBasisFingerprint(grid, optics, lights, options);
 
   vtkInternals& in = *this->Internals;
+  if (this->Method == DirectSolve)
+  {
+    // The reference: the solver with the actual point sources, every time step.
+    const auto start = std::chrono::steady_clock::now();
+    nimbus::MultipleScatteringField field;
+    try
+    {
+      nimbus::CloudLighting lighting;
+      lighting.HasSun = false;
+      lighting.PointLights = sources;
+      nimbus::MultipleScatteringOptions solver;
+      solver.NumberOfDirections = this->NumberOfDirections;
+      solver.Orders = this->Orders;
+      solver.SkyLight = false;
+      solver.PointLightFirstScattering = true;
+      solver.Threads = this->NumberOfThreads;
+      if (sources.empty())
+      {
+        field.Dimensions = grid.Dimensions;
+        field.Coefficients.assign(12 * grid.NumberOfPoints(), 0.0f);
+      }
+      else
+      {
+        field = nimbus::SolveMultipleScattering(grid, optics, lighting, solver,
+          [this](double fraction)
+          {
+            this->UpdateProgress(0.95 * fraction);
+            if (this->CheckAbort())
+            {
+              throw Aborted();
+            }
+          });
+      }
+    }
+    catch (const Aborted&)
+    {
+      return 1;
+    }
+    catch (const std::exception& problem)
+    {
+      vtkErrorMacro("Lightning illumination: the direct solve refused: "
+        << problem.what() << ". The cloud passes through unlit.");
+      return 1;
+    }
+    in.RelightSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    in.Factors = factors;
+    this->AddLightningArrays(fieldData, field, cellData);
+    this->UpdateProgress(1.0);
+    return 1;
+  }
   if (fingerprint != in.Fingerprint)
   {
     in.Fingerprint.clear();
@@ -571,6 +622,13 @@ int vtkNimbusLightningIllumination::RequestData(
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   this->UpdateProgress(1.0);
 
+  this->AddLightningArrays(fieldData, field, cellData);
+  return 1;
+}
+
+void vtkNimbusLightningIllumination::AddLightningArrays(
+  vtkFieldData* fieldData, const nimbus::MultipleScatteringField& field, bool cellData)
+{
   vtkNew<vtkFloatArray> inScattering;
   inScattering->SetName("nimbus_lightning_in_scattering");
   inScattering->SetNumberOfComponents(12);
@@ -582,7 +640,7 @@ int vtkNimbusLightningIllumination::RequestData(
   for (int k = 0; k < 3; ++k)
   {
     gridArray->SetValue(k, field.Dimensions[k]);
-    gridArray->SetValue(3 + k, in.Factors[k]);
+    gridArray->SetValue(3 + k, this->Internals->Factors[k]);
   }
   gridArray->SetValue(6, cellData ? 1 : 0);
   vtkNew<vtkDoubleArray> opticsArray;
@@ -595,7 +653,6 @@ int vtkNimbusLightningIllumination::RequestData(
   fieldData->AddArray(inScattering);
   fieldData->AddArray(gridArray);
   fieldData->AddArray(opticsArray);
-  return 1;
 }
 
 double vtkNimbusLightningIllumination::GetLastPrecomputeSeconds() const
@@ -649,6 +706,7 @@ std::string vtkNimbusLightningIllumination::GetCacheFile() const
 void vtkNimbusLightningIllumination::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "Method: " << (this->Method == DirectSolve ? "DirectSolve" : "Basis") << "\n";
   os << indent << "ExtinctionPerDensity: " << this->ExtinctionPerDensity << " /m per unit\n";
   os << indent << "Albedo: " << this->Albedo << "\n";
   os << indent << "CloudG: " << this->CloudG << "\n";

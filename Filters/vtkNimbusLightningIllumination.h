@@ -29,7 +29,7 @@
  * and below it down to SimulationBottomMetres with Eq. 4's widening steps. One
  * multiple-scattering solve per virtual light (NumberOfDirections discrete directions,
  * the first scattering included) gives the basis, Haar-compressed at Threshold (xi,
- * relative to each field's largest coefficient). That precompute runs once per cloud and
+ * relative to the basis's largest coefficient). That precompute runs once per cloud and
  * setting (progress reported, abortable) and is kept in memory and, when UseDiskCache,
  * on disk under CacheDirectory (default $NIMBUS_CACHE_DIR, else $XDG_CACHE_HOME/nimbus,
  * else ~/.cache/nimbus), named by a fingerprint of everything it depends on, so a new
@@ -58,12 +58,33 @@
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
 
+class vtkFieldData;
+namespace nimbus
+{
+struct MultipleScatteringField;
+}
+
 class NIMBUSFILTERS_EXPORT vtkNimbusLightningIllumination : public vtkImageAlgorithm
 {
 public:
   static vtkNimbusLightningIllumination* New();
   vtkTypeMacro(vtkNimbusLightningIllumination, vtkImageAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// How the field is made. Basis (default): 003's precompute and relight (the sources
+  /// spread to virtual lights: fast per time step, approximate near the sources).
+  /// DirectSolve: the multiple-scattering solve with the actual point sources at every
+  /// time step (no precompute; the reference the basis is measured against; about a
+  /// second per step on the default grid).
+  enum Methods
+  {
+    Basis = 0,
+    DirectSolve = 1
+  };
+  vtkSetClampMacro(Method, int, 0, 1);
+  vtkGetMacro(Method, int);
+  void SetMethodToBasis() { this->SetMethod(Basis); }
+  void SetMethodToDirectSolve() { this->SetMethod(DirectSolve); }
 
   /// The lightning (input port 1).
   void SetLightningConnection(vtkAlgorithmOutput* output) { this->SetInputConnection(1, output); }
@@ -97,7 +118,7 @@ public:
   ///@}
 
   ///@{
-  /// The solve and the compression: n_dir (26), scattering orders (32), xi (1e-3),
+  /// The solve and the compression: n_dir (26), scattering orders (16, then a geometric tail), xi (1e-3),
   /// threads (0: all cores; the result does not depend on it).
   vtkSetClampMacro(NumberOfDirections, int, 6, 1024);
   vtkGetMacro(NumberOfDirections, int);
@@ -137,7 +158,8 @@ public:
   ///@{
   /// What the last update did: seconds of the precompute (0 when it came from memory or
   /// disk), whether it was read from the disk cache, the basis's virtual lights, grid
-  /// and bytes (compressed, uncompressed), and the seconds of the last relight.
+  /// and bytes (compressed, uncompressed), and the seconds of the last relight (or of
+  /// the last direct solve).
   double GetLastPrecomputeSeconds() const;
   bool GetLastBasisFromDisk() const;
   int GetNumberOfVirtualLights() const;
@@ -164,6 +186,7 @@ protected:
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
+  int Method = Basis;
   double ExtinctionPerDensity = 0.02;
   double Albedo = 0.99;
   double CloudG = 0.85;
@@ -172,7 +195,7 @@ protected:
   double LightSpacingMetres = 0.0;
   double SimulationBottomMetres = 0.0;
   int NumberOfDirections = 26;
-  int Orders = 32;
+  int Orders = 16;
   double Threshold = 1e-3;
   int NumberOfThreads = 0;
   double MemoryBudgetMiB = 2048.0;
@@ -184,6 +207,9 @@ protected:
 private:
   vtkNimbusLightningIllumination(const vtkNimbusLightningIllumination&) = delete;
   void operator=(const vtkNimbusLightningIllumination&) = delete;
+
+  void AddLightningArrays(
+    vtkFieldData* fieldData, const nimbus::MultipleScatteringField& field, bool cellData);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

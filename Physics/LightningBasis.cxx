@@ -353,52 +353,78 @@ LightningBasis PrecomputeLightningBasis(const ExtinctionGrid& cloud, const Cloud
   basis.Fields.resize(kShPerChannel * count);
   const std::size_t n = cloud.NumberOfPoints();
   const std::size_t nx = lights.Nodes[0].size(), ny = lights.Nodes[1].size();
-  // The lights over threads, one solve each (results independent of the split), in
-  // batches so that progress is reported (and a stop honoured) on this thread.
+  // Three lights per solve: the solver carries red, green and blue through the same
+  // sweeps independently (the cloud's optics are grey), so light 3t + c goes in channel
+  // c of solve t, and one solve gives three basis fields for the cost of one. The
+  // solves over threads (results independent of the split), in batches so that
+  // progress is reported (and a stop honoured) on this thread.
+  const std::size_t solves = (count + 2) / 3;
   const int threads = ThreadCount(options.Threads);
   const std::size_t batch = static_cast<std::size_t>(4 * threads);
-  for (std::size_t first = 0; first < count; first += batch)
+  for (std::size_t first = 0; first < solves; first += batch)
   {
-    const std::size_t last = std::min(count, first + batch);
+    const std::size_t last = std::min(solves, first + batch);
     ParallelFor(last - first, 1, threads,
       [&](std::size_t begin, std::size_t end)
       {
         begin += first;
         end += first;
         std::vector<float> values(n);
-        for (std::size_t l = begin; l < end; ++l)
+        for (std::size_t t = begin; t < end; ++t)
         {
           CloudLighting lighting;
           lighting.HasSun = false;
-          lighting.PointLights = { PointLight{
-            lights.Position(l % nx, (l / nx) % ny, l / (nx * ny)), { { 1.0, 1.0, 1.0 } } } };
-          const MultipleScatteringField field =
-            SolveMultipleScattering(cloud, optics, lighting, solver);
-          for (int b = 0; b < kShPerChannel; ++b)
+          for (std::size_t c = 0; c < 3 && 3 * t + c < count; ++c)
           {
-            double largest = 0.0;
-            for (std::size_t i = 0; i < n; ++i)
+            const std::size_t l = 3 * t + c;
+            Rgb unit{ { 0.0, 0.0, 0.0 } };
+            unit[c] = 1.0;
+            lighting.PointLights.push_back(
+              PointLight{ lights.Position(l % nx, (l / nx) % ny, l / (nx * ny)), unit });
+          }
+          const MultipleScatteringField solved =
+            SolveMultipleScattering(cloud, optics, lighting, solver);
+          for (std::size_t c = 0; c < lighting.PointLights.size(); ++c)
+          {
+            const std::size_t l = 3 * t + c;
+            for (int b = 0; b < kShPerChannel; ++b)
             {
-              values[i] = field.Coefficients[i * kCoefficients + b]; // red = grey
+              for (std::size_t i = 0; i < n; ++i)
+              {
+                values[i] = solved.Coefficients[i * kCoefficients + kShPerChannel * c + b];
+              }
+              basis.Fields[kShPerChannel * l + b] = CompressHaar(values, cloud.Dimensions, 0.0);
             }
-            // The threshold relative to this field's largest Haar coefficient.
-            SparseHaarField field = CompressHaar(values, cloud.Dimensions, 0.0);
-            for (float v : field.Value)
-            {
-              largest = std::max(largest, static_cast<double>(std::abs(v)));
-            }
-            if (options.Threshold > 0.0)
-            {
-              DropHaarCoefficients(field, options.Threshold * largest);
-            }
-            basis.Fields[kShPerChannel * l + b] = std::move(field);
           }
         }
       });
     if (progress)
     {
-      progress(static_cast<double>(last) / count);
+      progress(static_cast<double>(last) / solves);
     }
+  }
+  // 003 Eq. 5: the coefficients of magnitude <= xi dropped, xi relative to the largest
+  // coefficient of the whole basis (one absolute threshold for every light: what a
+  // light far from the cloud contributes is small in every coefficient, and the
+  // relight's error is the weighted sum of what was dropped).
+  if (options.Threshold > 0.0)
+  {
+    double largest = 0.0;
+    for (const SparseHaarField& field : basis.Fields)
+    {
+      for (float v : field.Value)
+      {
+        largest = std::max(largest, static_cast<double>(std::abs(v)));
+      }
+    }
+    ParallelFor(basis.Fields.size(), 16, threads,
+      [&](std::size_t begin, std::size_t end)
+      {
+        for (std::size_t f = begin; f < end; ++f)
+        {
+          DropHaarCoefficients(basis.Fields[f], options.Threshold * largest);
+        }
+      });
   }
   basis.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return basis;

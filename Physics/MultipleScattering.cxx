@@ -501,42 +501,67 @@ public:
         {
           for (std::size_t m = begin; m < end; ++m)
           {
-            this->Transport(scaledGrid, m, sky[m], nullptr, &order[m * 3 * n]);
+            this->Transport(scaledGrid, m, sky[m], nullptr, &order[m * 3 * n], nullptr);
           }
         });
       total = order;
     }
+    // Every order sweeps the same segments: their optical depths and the linear-source
+    // weights (Transport) once per direction, not once per order and direction.
+    std::vector<float> factors(nd * 4 * n);
+    ParallelFor(nd, 1, this->Options.Threads,
+      [&](std::size_t begin, std::size_t end)
+      {
+        for (std::size_t m = begin; m < end; ++m)
+        {
+          this->TransportFactors(scaledGrid, m, &factors[m * 4 * n]);
+        }
+      });
     const int maximumOrder = std::max(2, this->Options.Orders);
     Rgb previousEnergy{ { 0, 0, 0 } }, energy{ { 0, 0, 0 } }, sumEnergy{ { 0, 0, 0 } };
     int computed = 0;
     for (int k = 1; k <= maximumOrder; ++k)
     {
       // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1):
-      // per direction m a sum of whole fields (contiguous, vectorised), the
-      // directions over threads; then each direction's sweep, the directions over
-      // threads (each sweep is sequential plane by plane).
+      // per direction m a sum of fields (contiguous, vectorised), in tiles of the fields
+      // small enough that every direction's tile stays in the cache while all the
+      // directions' sums are made (the tiles over threads; each value's sum in the
+      // same order whatever the split); then each direction's sweep, the directions
+      // over threads (each sweep is sequential plane by plane).
       const std::size_t fieldSize = 3 * n;
-      ParallelFor(nd, 1, this->Options.Threads,
+      constexpr std::size_t kTile = 1536;
+      const std::size_t tiles = (fieldSize + kTile - 1) / kTile;
+      std::vector<float> weights(nd * nd);
+      for (std::size_t q = 0; q < nd * nd; ++q)
+      {
+        weights[q] = static_cast<float>(albedoScaled * matrix[q]);
+      }
+      ParallelFor(tiles, 1, this->Options.Threads,
         [&](std::size_t begin, std::size_t end)
         {
-          for (std::size_t m = begin; m < end; ++m)
+          for (std::size_t tile = begin; tile < end; ++tile)
           {
-            float* out = &source[m * fieldSize];
-            if (k == 1)
+            const std::size_t j0 = tile * kTile, j1 = std::min(fieldSize, j0 + kTile);
+            for (std::size_t m = 0; m < nd; ++m)
             {
-              std::copy(&firstSource[m * fieldSize], &firstSource[m * fieldSize] + fieldSize, out);
-            }
-            else
-            {
-              std::fill(out, out + fieldSize, 0.0f);
-            }
-            for (std::size_t q = 0; q < nd; ++q)
-            {
-              const float w = static_cast<float>(albedoScaled * matrix[m * nd + q]);
-              const float* in = &order[q * fieldSize];
-              for (std::size_t j = 0; j < fieldSize; ++j)
+              float* __restrict out = &source[m * fieldSize];
+              if (k == 1)
               {
-                out[j] += w * in[j];
+                std::copy(&firstSource[m * fieldSize + j0], &firstSource[m * fieldSize + j1],
+                  out + j0);
+              }
+              else
+              {
+                std::fill(out + j0, out + j1, 0.0f);
+              }
+              for (std::size_t q = 0; q < nd; ++q)
+              {
+                const float w = weights[m * nd + q];
+                const float* __restrict in = &order[q * fieldSize];
+                for (std::size_t j = j0; j < j1; ++j)
+                {
+                  out[j] += w * in[j];
+                }
               }
             }
           }
@@ -546,8 +571,8 @@ public:
         {
           for (std::size_t m = begin; m < end; ++m)
           {
-            this->Transport(
-              scaledGrid, m, Rgb{ { 0, 0, 0 } }, &source[m * fieldSize], &order[m * fieldSize]);
+            this->Transport(scaledGrid, m, Rgb{ { 0, 0, 0 } }, &source[m * fieldSize],
+              &order[m * fieldSize], &factors[m * 4 * n]);
           }
         });
       previousEnergy = energy;
@@ -647,8 +672,9 @@ private:
   // light half a cell per order whatever the optical depth, a numerical diffusion
   // that carried the sunlit side's light to the shadowed side (cumulonimbus: 26.4 dB
   // against the path tracer with the mean, 31.3 dB linear; docs/multiple-scattering.md).
+  // `factors`: the segments' TransportFactors of this direction (nullptr: computed here).
   void Transport(const ExtinctionGrid& grid, std::size_t m, const Rgb& boundary,
-    const float* source, float* out) const
+    const float* source, float* out, const float* factors) const
   {
     const DirectionSweep sweep(grid, this->Directions[m]);
     const float t = static_cast<float>(sweep.GetStep());
@@ -688,17 +714,18 @@ private:
             emissionUp[2] += w * sj * sj3[2];
           }
         }
-        const float tau = 0.5f * t * (sigmaUp + sigma[index]);
-        const float transmittance = std::exp(-tau);
-        // The source function linear in optical depth along the segment (short
-        // characteristics with a linear source, Olson & Kunasz 1987):
-        //   L = L_up e^-tau + S (1 - (1 - e^-tau)/tau) + S_up ((1 - e^-tau)/tau - e^-tau),
-        // the trapezoid rule when thin, S alone when thick. S_up is the upstream
-        // corners' extinction-weighted source (points without medium emit nothing;
-        // none with medium: S).
-        const float escape = tau > 1e-4f ? -std::expm1(-tau) / tau : 1.0f - 0.5f * tau;
-        const float weightHere = 1.0f - escape;
-        const float weightUp = escape - transmittance;
+        float f[3];
+        if (factors)
+        {
+          f[0] = factors[4 * index];
+          f[1] = factors[4 * index + 1];
+          f[2] = factors[4 * index + 2];
+        }
+        else
+        {
+          SegmentFactors(0.5f * t * (sigmaUp + sigma[index]), f);
+        }
+        const float transmittance = f[0], weightHere = f[1], weightUp = f[2];
         for (int c = 0; c < 3; ++c)
         {
           const float l = lUp[c] + outside * edge[c];
@@ -707,6 +734,48 @@ private:
           const float s = weightHere * here + weightUp * up;
           o[c] = l * transmittance + s;
         }
+      });
+  }
+
+  // The factors of one segment of optical depth tau: transmittance e^-tau and the
+  // weights of the source here and upstream. The source function is linear in optical
+  // depth along the segment (short characteristics with a linear source, Olson &
+  // Kunasz 1987):
+  //   L = L_up e^-tau + S (1 - (1 - e^-tau)/tau) + S_up ((1 - e^-tau)/tau - e^-tau),
+  // the trapezoid rule when thin, S alone when thick. S_up is the upstream corners'
+  // extinction-weighted source (points without medium emit nothing; none with medium: S).
+  static void SegmentFactors(float tau, float f[3])
+  {
+    const float transmittance = std::exp(-tau);
+    const float escape = tau > 1e-4f ? -std::expm1(-tau) / tau : 1.0f - 0.5f * tau;
+    f[0] = transmittance;
+    f[1] = 1.0f - escape;
+    f[2] = escape - transmittance;
+  }
+
+  // Transport's factors for direction m, 4 floats per point (the fourth unused).
+  void TransportFactors(const ExtinctionGrid& grid, std::size_t m, float* factors) const
+  {
+    const DirectionSweep sweep(grid, this->Directions[m]);
+    const float t = static_cast<float>(sweep.GetStep());
+    const float* sigma = grid.Extinction.data();
+    sweep.Run(1,
+      [&](std::ptrdiff_t index, bool first, const DirectionSweep::Corner* corners, int count,
+        float)
+      {
+        float* f = factors + 4 * index;
+        f[3] = 0.0f;
+        if (first)
+        {
+          f[0] = f[1] = f[2] = 0.0f;
+          return;
+        }
+        float sigmaUp = 0.0f;
+        for (int q = 0; q < count; ++q)
+        {
+          sigmaUp += corners[q].Weight * sigma[corners[q].Index];
+        }
+        SegmentFactors(0.5f * t * (sigmaUp + sigma[index]), f);
       });
   }
 
@@ -881,8 +950,16 @@ double PhaseLegendreCoefficient(const CloudOptics& optics, int l)
   // 2 pi integral p(mu) P_l(mu) dmu by Gauss-Legendre on [-1, 1], split at 0.9 and
   // 0.99 where a forward peak lives (512 nodes per piece: k_1 to 1e-9 at g = 0.99).
   static const double kBreaks[4] = { -1.0, 0.9, 0.99, 1.0 };
-  std::vector<double> x, w;
-  GaussLegendre(512, x, w);
+  // The nodes once per process (every solve asks for k_1 and k_2; computing 512 nodes
+  // took an eighth of a small solve).
+  struct Nodes
+  {
+    std::vector<double> X, W;
+    Nodes() { GaussLegendre(512, this->X, this->W); }
+  };
+  static const Nodes nodes;
+  const std::vector<double>& x = nodes.X;
+  const std::vector<double>& w = nodes.W;
   double sum = 0.0;
   for (int piece = 0; piece < 3; ++piece)
   {
@@ -923,8 +1000,10 @@ double EstimateMultipleScatteringBytes(
   switch (options.Method)
   {
     case MultipleScatteringMethod::DiscreteDirections:
-      // the lights' first scattering, this order, the sum and the source: 4 x nd x RGB
-      bytes += 4.0 * nd * 3.0 * n * sizeof(float) + n * sizeof(float);
+      // the lights' first scattering, this order, the sum and the source: 4 x nd x RGB;
+      // the segments' transport factors: nd x 4
+      bytes += 4.0 * nd * 3.0 * n * sizeof(float) + 4.0 * nd * n * sizeof(float) +
+        n * sizeof(float);
       break;
     case MultipleScatteringMethod::ReferencePatterns:
       // two orders' fields, the radiance of one direction, a mask, the sky's depths

@@ -172,7 +172,9 @@ TEST(LightningBasis, StrokeAgainstDirectSolve)
       previous = error;
       if (xi <= 1e-3)
       {
-        EXPECT_LT(error, 0.01) << xi; // measured 0.0043 (with the first scattering) at 1e-3
+        // Measured at 1e-3 (xi relative to the basis's largest coefficient): 0.0086 with
+        // the first scattering (1.3x less memory), 0.0148 for orders >= 2 (2.7x).
+        EXPECT_LT(error, first ? 0.012 : 0.02) << xi;
       }
     }
   }

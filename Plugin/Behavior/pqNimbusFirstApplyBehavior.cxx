@@ -27,6 +27,10 @@
 
 namespace
 {
+// The sun of a cloud lit by lightning on first Apply: below the horizon (nautical
+// twilight, a dark sky), so the flash is what lights it.
+constexpr double kNightSunElevationDegrees = -12.0;
+
 // Sources and filters of clouds and the sky (proxy XML names).
 bool IsNimbusCloudProducer(pqPipelineSource* source)
 {
@@ -37,7 +41,8 @@ bool IsNimbusCloudProducer(pqPipelineSource* source)
   }
   for (const char* cloud :
     { "NimbusMetaballCloud", "NimbusCloudAutomaton", "NimbusCloudAutomatonWithMaps",
-      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome", "NimbusLightning" })
+      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome", "NimbusLightning",
+      "NimbusLightningIllumination" })
   {
     if (std::strcmp(name, cloud) == 0)
     {
@@ -70,6 +75,30 @@ bool IsLightning(pqPipelineSource* source)
   return name && std::strcmp(name, "NimbusLightning") == 0;
 }
 
+bool IsLightningIllumination(pqPipelineSource* source)
+{
+  const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
+  return name && std::strcmp(name, "NimbusLightningIllumination") == 0;
+}
+
+// The Nimbus Lightning feeding a Lightning Illumination filter, or nullptr.
+vtkSMProxy* LightningOf(pqPipelineSource* illumination)
+{
+  auto* filter = qobject_cast<pqPipelineFilter*>(illumination);
+  if (!filter)
+  {
+    return nullptr;
+  }
+  for (pqOutputPort* port : filter->getInputs("Lightning"))
+  {
+    if (IsLightning(port->getSource()))
+    {
+      return port->getSource()->getProxy();
+    }
+  }
+  return nullptr;
+}
+
 // The strokes as lines whose grey level is their brightness on a log scale: black (a
 // thousandth of the return stroke's peak and less) to white (the peak), the range fixed
 // so that the flash fades over time and dimmer branches stay visible.
@@ -100,7 +129,13 @@ void StyleLightning(pqDataRepresentation* representation)
 // stands before it: the flash starts dark at time 0 (Play shows the leader and strokes).
 void ShowLightningPeak(pqDataRepresentation* representation)
 {
-  vtkSMProxy* source = representation->getInput()->getProxy();
+  vtkSMProxy* source = IsLightningIllumination(representation->getInput())
+    ? LightningOf(representation->getInput())
+    : representation->getInput()->getProxy();
+  if (!source)
+  {
+    return;
+  }
   auto* core = pqPVApplicationCore::instance();
   pqAnimationScene* scene =
     core && core->animationManager() ? core->animationManager()->getActiveScene() : nullptr;
@@ -202,6 +237,32 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
           {
             guarded->getView()->render();
           }
+        }
+      });
+  }
+
+  if (IsLightningIllumination(data->getInput()))
+  {
+    // A flash is seen at night: the cloud's own sun below the horizon (a Nimbus Sky in
+    // the view still sets the sun for both), and the frame at the return stroke.
+    QPointer<pqDataRepresentation> guarded(data);
+    QTimer::singleShot(0, this,
+      [guarded]()
+      {
+        if (!guarded)
+        {
+          return;
+        }
+        vtkSMProxy* proxy = guarded->getProxy();
+        if (proxy->GetProperty("SunElevationDegrees"))
+        {
+          vtkSMPropertyHelper(proxy, "SunElevationDegrees").Set(kNightSunElevationDegrees);
+          proxy->UpdateVTKObjects();
+        }
+        ShowLightningPeak(guarded);
+        if (guarded->getView())
+        {
+          guarded->getView()->render();
         }
       });
   }
