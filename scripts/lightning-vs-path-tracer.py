@@ -1,0 +1,173 @@
+#!/usr/bin/env python3
+"""Lightning inside a cloud: Nimbus against the path tracer (issue 16).
+
+    PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
+        scripts/lightning-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
+
+The scene: the metaball cumulus (seed 3, 3 km wide, base 1000 m) at night (no sun, no
+air, no ground, to isolate the cloud), lit by a Nimbus Lightning flash at its return
+stroke's peak (a 3.5 km channel from 2 km high inside the cloud down to the ground, its
+branches). The reference is the path tracer (vtkNimbusReferenceRenderer) on a version-3
+scene file whose lights are the flash's segments as polyline lights of their intensity
+per metre (grey, 6500 K); it is cached in the output directory. Nimbus renders the
+same view with vtkNimbusCloudVolumeMapper over vtkNimbusLightningIllumination, once with
+the precomputed basis and once with its direct solve, and the script prints their error
+against the reference (RMSE corrected for the reference's Monte Carlo noise, and relative
+to the mean radiance of the cloud's pixels) with the times, and writes
+reference | basis | direct as lightning-vs-path-tracer.png.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+import nimbus
+from nimbus import harness
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkRenderingCore import vtkRenderWindow, vtkRenderer, vtkVolume
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--output-dir", default="lightning-vs-path-tracer")
+parser.add_argument("--time-limit", type=float, default=300.0,
+                    help="seconds of path tracing for the reference (default 300)")
+parser.add_argument("--size", type=int, nargs=2, default=(200, 150))
+parser.add_argument("--downsampling", type=int, default=3,
+                    help="the illumination grid's blocks of density samples (default 3)")
+args = parser.parse_args()
+os.makedirs(args.output_dir, exist_ok=True)
+
+CLOUD = {"Dimensions": [96, 96, 64], "Bounds": [-1500, 1500, -1500, 1500, 800, 2800],
+         "Seed": 3}
+CAMERA = {"position": [0, -5000, 300], "focal_point": [0, 0, 1300], "view_up": [0, 0, 1],
+          "view_angle": 50, "width": args.size[0], "height": args.size[1]}
+
+lightning = nimbus.vtkNimbusLightningSource()
+lightning.SetStartPoint(200, 0, 2000)
+lightning.SetDirection(0.15, 0, -1)
+lightning.SetLength(3500)
+lightning.SetSeed(11)
+lightning.Update()  # no time: the return stroke's peak
+strokes = lightning.GetOutput(0)
+intensity = strokes.GetCellData().GetArray("intensity")
+lights = []
+for cell in range(strokes.GetNumberOfCells()):
+    ids = strokes.GetCell(cell).GetPointIds()
+    a, b = strokes.GetPoint(ids.GetId(0)), strokes.GetPoint(ids.GetId(1))
+    if a != b and intensity.GetValue(cell) > 0:
+        lights.append({"type": "polyline", "vertices": [list(a), list(b)],
+                       "intensity_per_metre": intensity.GetValue(cell),
+                       "temperature_kelvin": 6500})
+if len(lights) > 1024:
+    sys.exit(f"{len(lights)} segments: more than the scene format's 1024 lights")
+
+scene = {
+    "nimbus_scene": 3, "name": "lightning_in_cumulus",
+    "description": "The seed-3 metaball cumulus lit from inside by a lightning flash at its "
+                   "return stroke (scripts/lightning-vs-path-tracer.py); no sun, air or ground.",
+    "camera": CAMERA,
+    "medium": {"density": {"type": "metaball_cloud", "parameters": CLOUD},
+               "extinction_per_density": 0.02, "single_scattering_albedo": 0.99,
+               "phase": [{"type": "cornette_shanks", "g": 0.85, "weight": 1}]},
+    "sun": {"azimuth_degrees": 0, "elevation_degrees": 45, "illuminance": 0,
+            "temperature_kelvin": 5778},
+    "atmosphere": {"enabled": False}, "ground": {"enabled": False},
+    "background": {"type": "constant", "radiance": 0},
+    "lights": lights,
+}
+scene_path = os.path.join(args.output_dir, "lightning_in_cumulus.json")
+with open(scene_path, "w") as stream:
+    json.dump(scene, stream, indent=1)
+
+settings = {"mode": "path", "min_spp": 16, "max_spp": 1 << 20, "time_limit": args.time_limit,
+            "seed": 1}
+key = "reference-" + harness.scene_hash(scene_path, settings)
+
+
+def path_trace():
+    start = time.perf_counter()
+    image, output = harness.render_reference_mode(scene_path, settings)
+    print(f"path tracer: {time.perf_counter() - start:.0f} s", file=sys.stderr)
+    return image, harness.standard_error_of(output)
+
+
+reference, reference_error, cached = harness.cached_image(args.output_dir, key, path_trace)
+print(f"reference: {'cached' if cached else 'rendered'}, {len(lights)} polyline lights; "
+      f"noise (RMS standard error) {np.sqrt(np.mean(reference_error ** 2)):.3g}, "
+      f"mean {reference.mean():.3g}")
+
+cloud = nimbus.vtkNimbusMetaballCloudSource()
+cloud.SetDimensions(*CLOUD["Dimensions"])
+cloud.SetBounds(*CLOUD["Bounds"])
+cloud.SetSeed(CLOUD["Seed"])
+
+
+def render(method):
+    illumination = nimbus.vtkNimbusLightningIllumination()
+    illumination.SetInputConnection(0, cloud.GetOutputPort(0))
+    illumination.SetInputConnection(1, lightning.GetOutputPort(0))  # the strokes
+    illumination.SetMethod(method)
+    illumination.SetDownsampling(args.downsampling)
+    illumination.SetLightningColor(1, 1, 1)  # grey, as the reference's 6500 K
+    illumination.SetAlbedo(0.99)
+    start = time.perf_counter()
+    illumination.Update()
+    update = time.perf_counter() - start
+    mapper = nimbus.vtkNimbusCloudVolumeMapper()
+    mapper.SetInputData(illumination.GetOutput())
+    mapper.SetAlbedo(0.99)
+    mapper.SetMultipleScatteringMethodToNone()
+    mapper.SetSunIlluminance(0.0)
+    mapper.SetAtmosphere(False)
+    mapper.SetGround(False)
+    mapper.SetNumberOfSlices(512)
+    mapper.SetExposure(harness.VTK_SCALE)
+    mapper.SetCaptureRadiance(True)
+    volume = vtkVolume()
+    volume.SetMapper(mapper)
+    renderer = vtkRenderer()
+    renderer.AddVolume(volume)
+    renderer.SetBackground(0, 0, 0)
+    camera = renderer.GetActiveCamera()
+    camera.SetPosition(*CAMERA["position"])
+    camera.SetFocalPoint(*CAMERA["focal_point"])
+    camera.SetViewUp(*CAMERA["view_up"])
+    camera.SetViewAngle(CAMERA["view_angle"])
+    camera.SetClippingRange(1.0, 1e6)
+    window = vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetMultiSamples(0)
+    window.SetSize(*args.size)
+    window.AddRenderer(renderer)
+    window.Render()
+    radiance = mapper.GetRadianceImage()
+    width, height, _ = radiance.GetDimensions()
+    image = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
+    grid = [0, 0, 0]
+    illumination.GetGridDimensions(grid)
+    window.Finalize()
+    return image[..., :3].astype(np.float32).copy(), update, illumination
+
+
+cloud_pixels = reference.mean(axis=2) > 0.01 * reference.mean(axis=2).max()
+mean_cloud = float(reference[cloud_pixels].mean())
+images = [reference]
+print(f"{'method':<22} {'update s':>9} {'per frame ms':>13} {'RMSE':>10} {'rel. RMSE (cloud)':>18} "
+      f"{'mean ratio':>11}")
+for method, name in ((0, "precomputed basis"), (1, "direct solve")):
+    image, update, illumination = render(method)
+    metrics = harness.error_metrics(image, reference, reference_error)
+    cloud_metrics = harness.error_metrics(image[cloud_pixels], reference[cloud_pixels],
+                                          reference_error[cloud_pixels])
+    print(f"{name:<22} {update:9.1f} {1000 * illumination.GetLastRelightSeconds():13.1f} "
+          f"{metrics['rmse']:10.4g} {cloud_metrics['rmse'] / mean_cloud:18.3f} "
+          f"{image[cloud_pixels].mean() / mean_cloud:11.3f}")
+    images.append(image)
+strip = np.concatenate(images, axis=1)
+scale = 0.5 / max(float(np.percentile(reference[cloud_pixels], 99)), 1e-30)
+path = os.path.join(args.output_dir, "lightning-vs-path-tracer.png")
+harness.write_png(strip * scale / harness.DISPLAY_EXPOSURE, path)
+print(path)
