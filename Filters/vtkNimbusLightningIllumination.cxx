@@ -266,6 +266,11 @@ int vtkNimbusLightningIllumination::RequestData(
   }
   if (!scalars)
   {
+    scalars = cloud->GetCellData()->GetScalars();
+    association = vtkDataObject::FIELD_ASSOCIATION_CELLS;
+  }
+  if (!scalars)
+  {
     vtkErrorMacro("Lightning illumination: the cloud has no density array (point or cell "
                   "scalars); the cloud passes through unlit.");
     return 1;

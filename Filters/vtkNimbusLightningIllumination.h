@@ -3,7 +3,8 @@
  * @brief   A cloud lit from inside by lightning (003 §4-§7): precomputed basis, relit per time.
  *
  * Input port 0: the cloud, vtkImageData with a density array (the array to process,
- * by default the active point scalars; point or cell data). Input port 1: the lightning,
+ * SetInputArrayToProcess(0, ...); when it is not there, the active point scalars, else
+ * the active cell scalars). Input port 1: the lightning,
  * vtkPolyData: the point sources of vtkNimbusLightningSource's port 1 (vertices with
  * point data "intensity") or its strokes (port 0: lines with cell data "intensity",
  * radiant intensity per metre, split here into sources PointSourceSpacing metres apart,

@@ -24,8 +24,8 @@ import tempfile
 import numpy as np
 
 from paraview import servermanager
-from paraview.simple import (CreateRenderView, Delete, LoadPlugin, OpenDataFile, Render, SaveData,
-                             SaveScreenshot, Show)
+from paraview.simple import (CreateRenderView, Delete, LoadPlugin, OpenDataFile, OutputPort,
+                             Render, SaveData, SaveScreenshot, Show)
 from paraview.vtk.util.numpy_support import vtk_to_numpy
 
 
@@ -184,6 +184,27 @@ def main():
     ok &= check(emission[0] == 0.0 and emission[1] > 0.0 and emission[2] < 0.5 * emission[1],
                 "Nimbus Lightning: dark before the flash, lit at the stroke, fading after "
                 "(sum of intensities %s)" % ["%.3g" % e for e in emission])
+    # --- the cloud lit by the flash: shown as a Cloud, the lightning's time steps, lit at
+    # the stroke and dark before it (cheap settings: a small grid, 14 directions) ---
+    cloud = NimbusMetaballCloud(Dimensions=[48, 48, 32])  # noqa: F821
+    lit = NimbusLightningIllumination(  # noqa: F821
+        Input=cloud, Lightning=OutputPort(bolt, 1), NumberOfDirections=14,
+        LightSpacingMetres=750.0, UseDiskCache=0)
+    lit_display = Show(lit, view)
+    ok &= check(lit_display.Representation == "Cloud",
+                "Nimbus Lightning Illumination: shown as %s" % lit_display.Representation)
+    ok &= check(list(lit.TimestepValues) == times,
+                "Nimbus Lightning Illumination: the lightning's %d time steps"
+                % len(lit.TimestepValues))
+    light = []
+    for t in (0.0, peak):
+        lit.UpdatePipeline(t)
+        field = servermanager.Fetch(lit).GetFieldData().GetArray(
+            "nimbus_lightning_in_scattering")
+        light.append(max(abs(field.GetRange(c)[1]) for c in range(12)) if field else -1.0)
+    ok &= check(light[0] == 0.0 and light[1] > 0.0,
+                "Nimbus Lightning Illumination: no light before the flash, light at the "
+                "return stroke (largest coefficient %s)" % ["%.3g" % v for v in light])
     Delete(view)
     return 0 if ok else 1
 
