@@ -455,4 +455,13 @@ std::vector<Rgb> DistributeToVirtualLights(
   return e;
 }
 
+double LightningGlowRadiance(double sigmaS, double intensity, double b)
+{
+  if (!(b > 0.0) || !std::isfinite(b) || !std::isfinite(sigmaS) || !std::isfinite(intensity))
+  {
+    return 0.0;
+  }
+  return sigmaS * intensity / (4.0 * b); // integral of 1/(b^2 + s^2) over s: pi / b
+}
+
 } // namespace nimbus

@@ -138,6 +138,15 @@ NIMBUSPHYSICS_EXPORT double LightningFlashDuration(const LightningFlashTimeline&
 NIMBUSPHYSICS_EXPORT std::vector<PointLight> LightningPointSources(
   const std::vector<LightningSegment>& segments, double spacing);
 
+/// The glow of the air around a point source (003 §8, after its [2]): the radiance that a
+/// ray passing at distance b [m] from a point source of radiant intensity I sees
+/// scattered once by air of scattering coefficient sigma_s [1/m], isotropic scattering,
+/// extinction along the way neglected: L = integral over the ray of sigma_s / (4 pi) x
+/// I / (b^2 + s^2) ds = sigma_s I / (4 b). Along a straight channel of I' per metre the
+/// sources sum to (sigma_s I' / 2) acosh(R / d) at distance d < R when each glow is cut
+/// at radius R (about ln(2R / d): a line source's log profile). 0 for b <= 0 or non-finite input.
+NIMBUSPHYSICS_EXPORT double LightningGlowRadiance(double sigmaS, double intensity, double b);
+
 /// The grid of virtual point lights (003 §5): node coordinates per axis, ascending,
 /// metres. x and y uniform, z per Eq. 4 below the cloud bottom.
 struct NIMBUSPHYSICS_EXPORT VirtualLightGrid

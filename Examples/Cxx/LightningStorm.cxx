@@ -7,9 +7,11 @@
 // their point sources over time) feed vtkNimbusLightningIllumination, which precomputes
 // the cloud's answer to virtual point lights once (kept on disk, see its class comment)
 // and relights it per time step; vtkNimbusCloudVolumeMapper draws it under a night sky
-// (sun 12 degrees below the horizon), the strokes as lines in their brightness. Without
-// --time: the return stroke's peak.
+// (sun 12 degrees below the horizon), the strokes as lines in their brightness with the
+// glow of the rainy air around them (vtkNimbusLightningGlowMapper). Without --time: the
+// return stroke's peak.
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusLightningGlowMapper.h"
 #include "vtkNimbusLightningIllumination.h"
 #include "vtkNimbusLightningSource.h"
 #include "vtkNimbusMetaballCloudSource.h"
@@ -162,9 +164,18 @@ int main(int argc, char* argv[])
   channel->GetProperty()->SetLineWidth(2.0);
   channel->GetProperty()->LightingOff();
 
+  // The glow of the rainy air around the channels (003 §8): emissive splats at the point
+  // sources with the single-scattering profile of a point source in air.
+  vtkNew<vtkNimbusLightningGlowMapper> glowMapper;
+  glowMapper->SetInputData(vtkPolyData::SafeDownCast(lightning->GetOutputDataObject(1)));
+  glowMapper->SetExposure(2.0);
+  vtkNew<vtkActor> glow;
+  glow->SetMapper(glowMapper);
+
   vtkNew<vtkRenderer> renderer;
   renderer->AddViewProp(sky);
   renderer->AddActor(channel);
+  renderer->AddActor(glow);
   renderer->AddVolume(volume);
   renderer->SetBackground(0.0, 0.0, 0.0);
   vtkCamera* camera = renderer->GetActiveCamera();

@@ -8,8 +8,9 @@ strokes and their point sources over time) into vtkNimbusLightningIllumination, 
 precomputes the cloud's response to virtual point lights once (003 §4-7; cached on disk,
 see its class comment) and relights it for every time step in milliseconds;
 vtkNimbusCloudVolumeMapper draws the result under a night sky (sun 12 degrees below
-the horizon), the strokes themselves as bright lines. Without --time the frame is the
-return stroke's peak.
+the horizon), the strokes themselves as bright lines with the glow of the rainy air
+around them (vtkNimbusLightningGlowMapper). Without --time the frame is the return
+stroke's peak.
 """
 import argparse
 import sys
@@ -93,9 +94,18 @@ channel.SetMapper(strokes)
 channel.GetProperty().SetLineWidth(2.0)
 channel.GetProperty().LightingOff()
 
+# The glow of the rainy air around the channels (003 §8): emissive splats at the point
+# sources with the single-scattering profile of a point source in air.
+glow_mapper = nimbus.vtkNimbusLightningGlowMapper()
+glow_mapper.SetInputData(lightning.GetOutputDataObject(1))
+glow_mapper.SetExposure(2.0)
+glow = vtkActor()
+glow.SetMapper(glow_mapper)
+
 renderer = vtkRenderer()
 renderer.AddViewProp(sky)
 renderer.AddActor(channel)
+renderer.AddActor(glow)
 renderer.AddVolume(volume)
 renderer.SetBackground(0, 0, 0)
 camera = renderer.GetActiveCamera()

@@ -598,3 +598,48 @@ TEST(Lightning, FlashTimeline)
   bad.StrokeDecaySeconds = std::nan("");
   EXPECT_NE(nimbus::CheckLightningFlashTimeline(bad).find("StrokeDecaySeconds"), std::string::npos);
 }
+
+// The glow (003 §8): a point source's single-scattered radiance against the integral
+// along the ray, and a straight channel of point sources against the line source's
+// closed form (sigma_s I' / 2) acosh(R / d) with every glow cut at radius R.
+TEST(Lightning, GlowOfPointAndLine)
+{
+  const double sigma = 1e-3, intensity = 50.0;
+  for (double b : { 1.0, 10.0, 100.0 })
+  {
+    // sigma / (4 pi) I / (b^2 + s^2) over s in [-1e7 b, 1e7 b], midpoint rule in atan.
+    double sum = 0.0;
+    const int n = 20000;
+    const double limit = std::atan(1e7);
+    for (int i = 0; i < n; ++i)
+    {
+      const double theta = -limit + (i + 0.5) * 2.0 * limit / n; // s = b tan(theta)
+      const double s = b * std::tan(theta);
+      const double ds = b / (std::cos(theta) * std::cos(theta)) * 2.0 * limit / n;
+      sum += sigma / (4.0 * M_PI) * intensity / (b * b + s * s) * ds;
+    }
+    EXPECT_NEAR(nimbus::LightningGlowRadiance(sigma, intensity, b), sum, 1e-6 * sum) << b;
+  }
+  EXPECT_EQ(nimbus::LightningGlowRadiance(sigma, intensity, 0.0), 0.0);
+  EXPECT_EQ(nimbus::LightningGlowRadiance(sigma, intensity, std::nan("")), 0.0);
+  EXPECT_EQ(nimbus::LightningGlowRadiance(std::nan(""), intensity, 1.0), 0.0);
+
+  // A channel along x of I' = 100 per metre as sources 0.5 m apart, each glow cut at
+  // R = 300 m, seen by a ray passing at distance d (the ray along y through (0, d, 0)
+  // reaches each source at b = sqrt(x^2 + d^2)).
+  const double perMetre = 100.0, spacing = 0.5, radius = 300.0;
+  for (double d : { 5.0, 30.0, 150.0 })
+  {
+    double glow = 0.0;
+    for (double x = -radius; x <= radius; x += spacing)
+    {
+      const double b = std::hypot(x, d);
+      if (b <= radius)
+      {
+        glow += nimbus::LightningGlowRadiance(sigma, perMetre * spacing, b);
+      }
+    }
+    const double line = 0.5 * sigma * perMetre * std::acosh(radius / d);
+    EXPECT_NEAR(glow, line, 0.01 * line) << d; // the sum's rule: < 1 % at these spacings
+  }
+}

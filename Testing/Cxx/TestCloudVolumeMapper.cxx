@@ -6,6 +6,7 @@
 // <baseline dir>/TestCloudVolumeMapper_<case>.png (criteria: ImageComparison.h).
 // Stability cases check finite, sensible images at the extremes.
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusLightningGlowMapper.h"
 #include "vtkNimbusLightningIllumination.h"
 #include "vtkNimbusLightningSource.h"
 #include "vtkNimbusMetaballCloudSource.h"
@@ -23,6 +24,7 @@
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
@@ -415,6 +417,14 @@ bool LightningAtNight(const Context& c)
   channel->GetProperty()->SetLineWidth(2.0);
   channel->GetProperty()->LightingOff();
   s.Renderer->AddActor(channel);
+  // The glow of the air around the channel (heavy rain: 3e-3 /m, so that it shows on
+  // this small, dim image).
+  vtkNew<vtkNimbusLightningGlowMapper> glowMapper;
+  glowMapper->SetAirScatteringPerMetre(3e-3);
+  glowMapper->SetInputData(vtkPolyData::SafeDownCast(lightning.Lightning->GetOutputDataObject(1)));
+  vtkNew<vtkActor> glow;
+  glow->SetMapper(glowMapper);
+  s.Renderer->AddActor(glow);
   s.Render(c.Png());
   return c.CompareWithBaseline();
 }

@@ -1,0 +1,91 @@
+/**
+ * @class   vtkNimbusLightningGlowMapper
+ * @brief   The glow of the air around lightning strokes (003 §8): emissive splats facing
+ *          the camera at the strokes' point sources, each with the single-scattering profile
+ *          of a point source in air.
+ *
+ * Input: vtkNimbusLightningSource's point sources (port 1: vertices with point data
+ * "intensity", radiant intensity in units where the sun's irradiance is 1). Every source
+ * of intensity I lights the air around it; a view ray passing it at distance b sees the
+ * single-scattered radiance L(b) = sigma_s I / (4 b) (Physics/Lightning.h,
+ * LightningGlowRadiance: isotropic scattering, the air's extinction over the glow
+ * neglected). The mapper draws one camera-facing quad of radius GlowRadiusMetres per
+ * source, the profile L(b) x Exposure x Color in its fragments, cut off smoothly at the
+ * radius (x (1 - (b/R)^2)^2) and held at the channel's radius near the centre, added to
+ * the frame (emissive blending). Along a channel the quads sum to the glow of a line
+ * source, about (sigma_s I' / 2) ln(2R / d) at distance d for I' per metre (tested), the
+ * paper's texture-mapped quads along the strokes with the texture computed per fragment.
+ *
+ * AirScatteringPerMetre defaults to 1e-3 /m: air in rain and haze (a visibility of about
+ * 4 km), as under a thunderstorm; clear air (about 3e-5 /m) makes a glow 30 times fainter,
+ * invisible at night beside the channel. The frame's 8-bit colour rounds each splat's
+ * addition, so the faintest part of the tail (below about 1/500 of white per splat) is
+ * lost.
+ */
+#ifndef vtkNimbusLightningGlowMapper_h
+#define vtkNimbusLightningGlowMapper_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkNew.h"                      // for vtkNew
+#include "vtkOpenGLPointGaussianMapper.h"
+
+#include <string> // for std::string
+
+class vtkLookupTable;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusLightningGlowMapper
+  : public vtkOpenGLPointGaussianMapper
+{
+public:
+  static vtkNimbusLightningGlowMapper* New();
+  vtkTypeMacro(vtkNimbusLightningGlowMapper, vtkOpenGLPointGaussianMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// sigma_s of the air (1/m; default 1e-3: rain and haze).
+  vtkSetClampMacro(AirScatteringPerMetre, double, 0.0, 1.0);
+  vtkGetMacro(AirScatteringPerMetre, double);
+  ///@}
+
+  ///@{
+  /// The radius of each source's glow (metres, default 300) and the channel's radius,
+  /// inside which the profile stays at its value there (metres, default 2).
+  vtkSetClampMacro(GlowRadiusMetres, double, 1e-3, 1e6);
+  vtkGetMacro(GlowRadiusMetres, double);
+  vtkSetClampMacro(ChannelRadiusMetres, double, 1e-3, 1e3);
+  vtkGetMacro(ChannelRadiusMetres, double);
+  ///@}
+
+  ///@{
+  /// Exposure (as the cloud mapper's: multiplies the radiance; default 1), the light's
+  /// colour (default 0.85, 0.9, 1) and metres per world unit (default 1).
+  vtkSetClampMacro(Exposure, double, 0.0, 1e6);
+  vtkGetMacro(Exposure, double);
+  vtkSetVector3Macro(Color, double);
+  vtkGetVector3Macro(Color, double);
+  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  vtkGetMacro(MetresPerUnit, double);
+  ///@}
+
+  void Render(vtkRenderer* renderer, vtkActor* actor) override;
+
+protected:
+  vtkNimbusLightningGlowMapper();
+  ~vtkNimbusLightningGlowMapper() override;
+
+  double AirScatteringPerMetre = 1e-3;
+  double GlowRadiusMetres = 300.0;
+  double ChannelRadiusMetres = 2.0;
+  double Exposure = 1.0;
+  double Color[3] = { 0.85, 0.9, 1.0 };
+  double MetresPerUnit = 1.0;
+
+private:
+  vtkNimbusLightningGlowMapper(const vtkNimbusLightningGlowMapper&) = delete;
+  void operator=(const vtkNimbusLightningGlowMapper&) = delete;
+
+  vtkNew<vtkLookupTable> Colors;
+  std::string LastShaderCode;
+};
+
+#endif
