@@ -86,9 +86,8 @@ int vtkNimbusLightningIllumination::RequestInformation(
   if (lightningInfo)
   {
     // The time is the lightning's; the cloud is taken as steady.
-    for (vtkInformationDoubleVectorKey* key :
-      { vtkStreamingDemandDrivenPipeline::TIME_STEPS(),
-        vtkStreamingDemandDrivenPipeline::TIME_RANGE() })
+    for (vtkInformationDoubleVectorKey* key : { vtkStreamingDemandDrivenPipeline::TIME_STEPS(),
+           vtkStreamingDemandDrivenPipeline::TIME_RANGE() })
     {
       if (lightningInfo->Has(key))
       {
@@ -114,8 +113,8 @@ namespace
 // The density in blocks of `factors` input samples (each block's mean), sigma_t =
 // extinctionPerDensity x density; the grid placed in metres. "" or what is wrong.
 std::string BuildCloudGrid(vtkImageData* image, vtkDataArray* scalars, bool cellData,
-  int downsampling, double extinctionPerDensity, double metresPerUnit,
-  nimbus::ExtinctionGrid& grid, std::array<int, 3>& factors)
+  int downsampling, double extinctionPerDensity, double metresPerUnit, nimbus::ExtinctionGrid& grid,
+  std::array<int, 3>& factors)
 {
   int pointDims[3];
   image->GetDimensions(pointDims);
@@ -133,8 +132,7 @@ std::string BuildCloudGrid(vtkImageData* image, vtkDataArray* scalars, bool cell
     factors[k] = std::min(samples[k], std::max(1, d));
     grid.Dimensions[k] = (samples[k] + factors[k] - 1) / factors[k];
   }
-  if (scalars->GetNumberOfTuples() !=
-    static_cast<vtkIdType>(samples[0]) * samples[1] * samples[2])
+  if (scalars->GetNumberOfTuples() != static_cast<vtkIdType>(samples[0]) * samples[1] * samples[2])
   {
     return "the density array does not have one value per sample";
   }
@@ -337,8 +335,8 @@ int vtkNimbusLightningIllumination::RequestData(
     }
     catch (const std::exception& problem)
     {
-      vtkErrorMacro("Lightning illumination: " << problem.what()
-                                               << "; the cloud passes through unlit.");
+      vtkErrorMacro(
+        "Lightning illumination: " << problem.what() << "; the cloud passes through unlit.");
       return 1;
     }
   }
@@ -451,8 +449,7 @@ int vtkNimbusLightningIllumination::RequestData(
   options.Threshold = this->Threshold;
   options.Threads = this->NumberOfThreads;
   options.MemoryBudgetBytes = this->MemoryBudgetMiB * 1048576.0;
-  const std::string fingerprint =
-    nimbus::LightningBasisFingerprint(grid, optics, lights, options);
+  const std::string fingerprint = nimbus::LightningBasisFingerprint(grid, optics, lights, options);
 
   vtkInternals& in = *this->Internals;
   if (this->Method == DirectSolve)
@@ -513,8 +510,8 @@ int vtkNimbusLightningIllumination::RequestData(
     in.PrecomputeSeconds = 0.0;
     in.FromDisk = false;
     in.CacheFile.clear();
-    const std::string directory = ExpandUser(
-      this->CacheDirectory.empty() ? DefaultCacheDirectory() : this->CacheDirectory);
+    const std::string directory =
+      ExpandUser(this->CacheDirectory.empty() ? DefaultCacheDirectory() : this->CacheDirectory);
     if (this->UseDiskCache && !directory.empty())
     {
       in.CacheFile = directory + "/lightning-basis-" + fingerprint + ".bin";
@@ -619,8 +616,8 @@ int vtkNimbusLightningIllumination::RequestData(
   }
   catch (const std::exception& problem)
   {
-    vtkErrorMacro("Lightning illumination: " << problem.what()
-                                             << "; the cloud passes through unlit.");
+    vtkErrorMacro(
+      "Lightning illumination: " << problem.what() << "; the cloud passes through unlit.");
     return 1;
   }
   in.RelightSeconds =

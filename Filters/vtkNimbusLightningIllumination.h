@@ -119,8 +119,8 @@ public:
   ///@}
 
   ///@{
-  /// The solve and the compression: n_dir (26), scattering orders (16, then a geometric tail), xi (1e-3),
-  /// threads (0: all cores; the result does not depend on it).
+  /// The solve and the compression: n_dir (26), scattering orders (16, then a geometric tail), xi
+  /// (1e-3), threads (0: all cores; the result does not depend on it).
   vtkSetClampMacro(NumberOfDirections, int, 6, 1024);
   vtkGetMacro(NumberOfDirections, int);
   vtkSetClampMacro(Orders, int, 1, 1000);

@@ -160,12 +160,13 @@ void WriteLightningBasis(
   if (std::rename(partial.c_str(), path.c_str()) != 0)
   {
     std::remove(partial.c_str());
-    throw std::runtime_error("nimbus::WriteLightningBasis: cannot rename " + partial + " to " + path);
+    throw std::runtime_error(
+      "nimbus::WriteLightningBasis: cannot rename " + partial + " to " + path);
   }
 }
 
-bool ReadLightningBasis(const std::string& path, const std::string& fingerprint,
-  LightningBasis& basis, std::string& why)
+bool ReadLightningBasis(
+  const std::string& path, const std::string& fingerprint, LightningBasis& basis, std::string& why)
 {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in)
@@ -240,8 +241,7 @@ bool ReadLightningBasis(const std::string& path, const std::string& fingerprint,
     }
   }
   std::uint64_t fields = 0;
-  if (!Get(in, fields) || fields > left() ||
-    fields != kShPerChannel * read.Lights.NumberOfNodes())
+  if (!Get(in, fields) || fields > left() || fields != kShPerChannel * read.Lights.NumberOfNodes())
   {
     return damaged("the number of fields does not match the lights");
   }
@@ -255,8 +255,8 @@ bool ReadLightningBasis(const std::string& path, const std::string& fingerprint,
       return damaged("truncated field");
     }
     if (field.Dimensions != read.Dimensions || field.Padded != padded || kept > paddedSize ||
-      kept > left() / (sizeof(std::uint32_t) + sizeof(float)) ||
-      !(field.DroppedNorm >= 0.0) || !std::isfinite(field.DroppedNorm))
+      kept > left() / (sizeof(std::uint32_t) + sizeof(float)) || !(field.DroppedNorm >= 0.0) ||
+      !std::isfinite(field.DroppedNorm))
     {
       return damaged("a field's header does not match the grid");
     }

@@ -46,7 +46,7 @@ namespace nimbus
 
 struct NIMBUSPHYSICS_EXPORT LightningBasisOptions
 {
-  int NumberOfDirections = 26;    // n_dir of 003 (its default)
+  int NumberOfDirections = 26; // n_dir of 003 (its default)
   /// Scattering orders before the geometric tail. 16: 1e-4 of a 64-order solve for a
   /// light below and one inside the seed's cloud (measured), at about half the time of 32.
   int Orders = 16;
@@ -118,8 +118,8 @@ NIMBUSPHYSICS_EXPORT void WriteLightningBasis(
 /// the file is missing, holds another fingerprint or format version, or is damaged
 /// (sizes that do not add up, indices out of range, non-finite values); `basis` is then
 /// unchanged.
-NIMBUSPHYSICS_EXPORT bool ReadLightningBasis(const std::string& path,
-  const std::string& fingerprint, LightningBasis& basis, std::string& why);
+NIMBUSPHYSICS_EXPORT bool ReadLightningBasis(
+  const std::string& path, const std::string& fingerprint, LightningBasis& basis, std::string& why);
 
 } // namespace nimbus
 

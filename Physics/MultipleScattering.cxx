@@ -547,8 +547,8 @@ public:
               float* __restrict out = &source[m * fieldSize];
               if (k == 1)
               {
-                std::copy(&firstSource[m * fieldSize + j0], &firstSource[m * fieldSize + j1],
-                  out + j0);
+                std::copy(
+                  &firstSource[m * fieldSize + j0], &firstSource[m * fieldSize + j1], out + j0);
               }
               else
               {
@@ -760,8 +760,7 @@ private:
     const float t = static_cast<float>(sweep.GetStep());
     const float* sigma = grid.Extinction.data();
     sweep.Run(1,
-      [&](std::ptrdiff_t index, bool first, const DirectionSweep::Corner* corners, int count,
-        float)
+      [&](std::ptrdiff_t index, bool first, const DirectionSweep::Corner* corners, int count, float)
       {
         float* f = factors + 4 * index;
         f[3] = 0.0f;
@@ -1002,8 +1001,8 @@ double EstimateMultipleScatteringBytes(
     case MultipleScatteringMethod::DiscreteDirections:
       // the lights' first scattering, this order, the sum and the source: 4 x nd x RGB;
       // the segments' transport factors: nd x 4
-      bytes += 4.0 * nd * 3.0 * n * sizeof(float) + 4.0 * nd * n * sizeof(float) +
-        n * sizeof(float);
+      bytes +=
+        4.0 * nd * 3.0 * n * sizeof(float) + 4.0 * nd * n * sizeof(float) + n * sizeof(float);
       break;
     case MultipleScatteringMethod::ReferencePatterns:
       // two orders' fields, the radiance of one direction, a mask, the sky's depths

@@ -11,9 +11,9 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
-#include <string>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace

@@ -39,10 +39,9 @@ bool IsNimbusCloudProducer(pqPipelineSource* source)
   {
     return false;
   }
-  for (const char* cloud :
-    { "NimbusMetaballCloud", "NimbusCloudAutomaton", "NimbusCloudAutomatonWithMaps",
-      "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome", "NimbusLightning",
-      "NimbusLightningIllumination" })
+  for (const char* cloud : { "NimbusMetaballCloud", "NimbusCloudAutomaton",
+         "NimbusCloudAutomatonWithMaps", "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome",
+         "NimbusLightning", "NimbusLightningIllumination" })
   {
     if (std::strcmp(name, cloud) == 0)
     {

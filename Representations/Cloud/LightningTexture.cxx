@@ -61,8 +61,8 @@ bool LightningTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image
   // The layout must fit this image: blocks of D input samples, ceil(n / D) points.
   int pointDims[3];
   image->GetDimensions(pointDims);
-  bool fits = layoutShape && values->GetNumberOfComponents() == 12 &&
-    (layout->GetValue(6) != 0) == cellData;
+  bool fits =
+    layoutShape && values->GetNumberOfComponents() == 12 && (layout->GetValue(6) != 0) == cellData;
   std::size_t points = 1;
   for (int k = 0; fits && k < 3; ++k)
   {

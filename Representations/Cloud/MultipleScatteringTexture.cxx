@@ -43,8 +43,8 @@ bool UploadShCoefficients(vtkOpenGLRenderWindow* window, vtkTextureObject* const
     {
       // errors of earlier GL calls are not this upload's
     }
-    if (!texture->Create3DFromRaw(dimensions[0], dimensions[1], dimensions[2], 4, VTK_FLOAT,
-          channel.data()) ||
+    if (!texture->Create3DFromRaw(
+          dimensions[0], dimensions[1], dimensions[2], 4, VTK_FLOAT, channel.data()) ||
       glGetError() == GL_OUT_OF_MEMORY)
     {
       for (int t = 0; t < 3; ++t)

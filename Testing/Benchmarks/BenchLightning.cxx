@@ -72,8 +72,8 @@ struct Errors
   double All = 0.0, Brightest = 0.0;
 };
 
-Errors RelativeRms(const nimbus::ExtinctionGrid& cloud, const std::vector<float>& a,
-  const std::vector<float>& b)
+Errors RelativeRms(
+  const nimbus::ExtinctionGrid& cloud, const std::vector<float>& a, const std::vector<float>& b)
 {
   std::vector<double> reference;
   for (std::size_t i = 0; i < cloud.NumberOfPoints(); ++i)
@@ -142,16 +142,15 @@ int main(int argc, char** argv)
   const nimbus::VirtualLightGrid lights = nimbus::MakeVirtualLightGrid(p);
   std::printf("cloud grid 32x32x4 (200 m), virtual lights %zux%zux%zu = %zu, n_dir 26, %d "
               "threads\n",
-    lights.Nodes[0].size(), lights.Nodes[1].size(), lights.Nodes[2].size(),
-    lights.NumberOfNodes(), threads);
+    lights.Nodes[0].size(), lights.Nodes[1].size(), lights.Nodes[2].size(), lights.NumberOfNodes(),
+    threads);
   nimbus::LightningBasisOptions o;
   o.Threads = threads;
   o.Threshold = 0.0;
   const nimbus::LightningBasis exact =
     nimbus::PrecomputeLightningBasis(cloud, nimbus::CloudOptics(), lights, o);
-  std::printf("precompute (xi = 0, %d orders): %.1f s (%.1f ms per light per thread)\n",
-    o.Orders, exact.Seconds,
-    1000.0 * exact.Seconds * threads / lights.NumberOfNodes());
+  std::printf("precompute (xi = 0, %d orders): %.1f s (%.1f ms per light per thread)\n", o.Orders,
+    exact.Seconds, 1000.0 * exact.Seconds * threads / lights.NumberOfNodes());
 
   // A stroke from inside the cloud to the ground.
   nimbus::LightningParameters stroke;
@@ -160,8 +159,7 @@ int main(int argc, char** argv)
   stroke.StopBelowHeight = 0.0;
   stroke.Intensity = 100.0;
   stroke.Seed = 5;
-  const auto sources =
-    nimbus::LightningPointSources(nimbus::GenerateLightning(stroke), 10.0);
+  const auto sources = nimbus::LightningPointSources(nimbus::GenerateLightning(stroke), 10.0);
   const std::vector<nimbus::Rgb> e = nimbus::DistributeToVirtualLights(lights, sources);
   std::vector<double> directTimes, directTimesOne;
   nimbus::MultipleScatteringField direct;
@@ -189,9 +187,8 @@ int main(int argc, char** argv)
   for (const bool global : { false, true })
   {
     std::printf("\nthreshold relative to %s\n%-7s %10s %8s %11s %11s %14s %10s %12s\n",
-      global ? "the whole basis's largest coefficient" : "each field's largest coefficient",
-      "xi", "basis MB", "ratio", "relight ms", "x direct", "RMS vs direct", "brightest",
-      "RMS vs xi 0");
+      global ? "the whole basis's largest coefficient" : "each field's largest coefficient", "xi",
+      "basis MB", "ratio", "relight ms", "x direct", "RMS vs direct", "brightest", "RMS vs xi 0");
     for (const double xi : { 0.0, 1e-4, 1e-3, 1e-2, 3e-2, 1e-1 })
     {
       if (global && xi == 0.0)
@@ -237,7 +234,8 @@ int main(int argc, char** argv)
   // 2. Cost per virtual light against the cloud grid and n_dir: one solve of three
   // lights (the basis's packing: one per colour channel), one thread, divided by 3.
   std::printf("\ncost per virtual light (ms, one thread; precompute = lights x this / "
-              "threads)\n%-14s", "cloud grid");
+              "threads)\n%-14s",
+    "cloud grid");
   const int directionCounts[] = { 14, 26, 50, 98 };
   for (int nd : directionCounts)
   {

@@ -443,8 +443,8 @@ bool LightningFollowsTime(const Context&)
   const auto second = s.Render();
   lightning.At(lightning.Peak() + 0.5);
   const auto after = s.Render();
-  bool ok = Check(Mean(before) < 0.05, "before the flash the night is black (mean " +
-      std::to_string(Mean(before)) + ")");
+  bool ok = Check(Mean(before) < 0.05,
+    "before the flash the night is black (mean " + std::to_string(Mean(before)) + ")");
   ok &= Check(Mean(peak) > 2.0,
     "the return stroke lights the cloud (mean " + std::to_string(Mean(peak)) + ")");
   ok &= Check(Mean(second) < Mean(peak) && Mean(second) > 0.2 * Mean(peak),
@@ -453,15 +453,25 @@ bool LightningFollowsTime(const Context&)
     "half a second later dark again (mean " + std::to_string(Mean(after)) + ")");
   ok &= Check(s.Mapper->GetNumberOfVolumeUploads() == uploads,
     "the density is not uploaded again for a new lightning time step");
+  // By day the flash adds to the sunlit cloud.
+  s.Mapper->SetSunElevationDegrees(45.0);
+  lightning.At(0.0);
+  const auto day = s.Render();
+  lightning.At(lightning.Peak());
+  const auto dayFlash = s.Render();
+  ok &= Check(Mean(dayFlash) > Mean(day) + 0.5,
+    "by day the flash brightens the sunlit image (mean " + std::to_string(Mean(day)) + " -> " +
+      std::to_string(Mean(dayFlash)) + ")");
+  s.Mapper->SetSunElevationDegrees(-15.0);
   // The filter's optics differ from the mapper's: said once, as a warning.
   nimbus::testing::MessageCatcher messages(s.Mapper);
   lightning.Illumination->SetCloudG(0.5);
   lightning.At(lightning.Peak());
   s.Render();
   s.Render();
-  ok &= Check(messages.Warnings.size() == 1 &&
-      messages.Warnings[0].find("CloudG") != std::string::npos,
-    "optics that differ from the mapper's are named once (" + messages.AllWarnings() + ")");
+  ok &=
+    Check(messages.Warnings.size() == 1 && messages.Warnings[0].find("CloudG") != std::string::npos,
+      "optics that differ from the mapper's are named once (" + messages.AllWarnings() + ")");
   return ok;
 }
 
