@@ -335,3 +335,57 @@ TEST(LightningBasis, FileRoundTripAndDamage)
   std::remove(path.c_str());
   std::remove(damagedPath.c_str());
 }
+
+// Sources of one colour take the one-sum path (e_l = s_l k); sources of two colours the
+// per-channel path; both agree with relighting each colour alone and adding.
+TEST(LightningBasis, OneColourAndMixedColours)
+{
+  const ExtinctionGrid cloud = Cloud(8, 8, 2);
+  nimbus::LightningBasisOptions o;
+  o.NumberOfDirections = 6;
+  o.Orders = 4;
+  o.Threads = 2;
+  nimbus::VirtualLightGridParameters p;
+  p.Low = { { -400.0, -400.0, 600.0 } };
+  p.High = { { 400.0, 400.0, 1200.0 } };
+  p.CloudBottom = 1000.0;
+  p.BaseInterval = 400.0;
+  const nimbus::VirtualLightGrid lights = nimbus::MakeVirtualLightGrid(p);
+  const nimbus::LightningBasis basis =
+    nimbus::PrecomputeLightningBasis(cloud, CloudOptics(), lights, o);
+  const std::size_t count = lights.NumberOfNodes();
+  std::vector<Rgb> blue(count), red(count), both(count);
+  for (std::size_t l = 0; l < count; ++l)
+  {
+    const double s = 1.0 + 0.37 * static_cast<double>(l % 5);
+    blue[l] = { { 0.85 * s, 0.9 * s, 1.0 * s } };
+    red[l] = { { l % 2 ? 2.0 : 0.0, 0.0, 0.0 } };
+    both[l] = { { blue[l][0] + red[l][0], blue[l][1], blue[l][2] } };
+  }
+  const auto b = nimbus::RelightLightning(basis, blue).Coefficients;
+  const auto r = nimbus::RelightLightning(basis, red).Coefficients;
+  const auto m = nimbus::RelightLightning(basis, both).Coefficients;
+  double worst = 0.0, peak = 0.0;
+  for (std::size_t i = 0; i < m.size(); ++i)
+  {
+    worst = std::max(worst, static_cast<double>(std::abs(m[i] - (b[i] + r[i]))));
+    peak = std::max(peak, static_cast<double>(std::abs(m[i])));
+  }
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(worst, 1e-5 * peak);
+  // The one-colour field is the grey relight scaled per channel.
+  std::vector<Rgb> grey(count);
+  for (std::size_t l = 0; l < count; ++l)
+  {
+    grey[l] = { { blue[l][2], blue[l][2], blue[l][2] } };
+  }
+  const auto g = nimbus::RelightLightning(basis, grey).Coefficients;
+  for (std::size_t i = 0; i < g.size(); i += 12)
+  {
+    for (int k = 0; k < 4; ++k)
+    {
+      EXPECT_NEAR(b[i + k], 0.85 * g[i + 8 + k], 1e-6 * peak);
+      EXPECT_NEAR(b[i + 4 + k], 0.9 * g[i + 8 + k], 1e-6 * peak);
+    }
+  }
+}
