@@ -27,9 +27,9 @@
  * sigma_t = ExtinctionPerDensity x density. The virtual lights (003 §5 Eq. 4) fill the
  * cloud's box horizontally, LightSpacingMetres apart (0: a tenth of the box's longest
  * horizontal side: 300 m for a 3 km cloud, where the relit picture is within 1.3 % of the
- * direct solve's brightest pixel; docs/lightning.md), from the cloud bottom (the lowest layer holding density) to its top,
- * and below it down to SimulationBottomMetres with Eq. 4's widening steps. One
- * multiple-scattering solve per three virtual lights (NumberOfDirections discrete
+ * direct solve's brightest pixel; docs/lightning.md), from the cloud bottom (the lowest layer
+ * holding density) to its top, and below it down to SimulationBottomMetres with Eq. 4's widening
+ * steps. One multiple-scattering solve per three virtual lights (NumberOfDirections discrete
  * directions, the first scattering included) gives the basis, Haar-compressed at Threshold (xi,
  * relative to the basis's largest coefficient). That precompute runs once per cloud and
  * setting (progress reported, abortable) and is kept in memory and, when UseDiskCache,
