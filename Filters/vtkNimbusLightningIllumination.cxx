@@ -412,7 +412,7 @@ int vtkNimbusLightningIllumination::RequestData(
   const double side = std::max(high[0] - low[0], high[1] - low[1]);
   lightParameters.BaseInterval = this->LightSpacingMetres > 0.0
     ? this->LightSpacingMetres
-    : std::max(side / 10.0, std::max(grid.Spacing[0], grid.Spacing[1]));
+    : std::max(side / 12.0, std::max(grid.Spacing[0], grid.Spacing[1]));
   const double bottom = std::isfinite(this->SimulationBottomMetres)
     ? std::min(this->SimulationBottomMetres, cloudBottom)
     : cloudBottom;
