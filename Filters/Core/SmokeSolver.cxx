@@ -916,6 +916,25 @@ double SmokeSolver::TotalSmoke() const
   return sum * h * h * h;
 }
 
+std::vector<double> SmokeSolver::GetPressureGuess() const
+{
+  const Eigen::VectorXd& phi = this->PressureSolver->Phi;
+  return std::vector<double>(phi.data(), phi.data() + phi.size());
+}
+
+void SmokeSolver::SetPressureGuess(const std::vector<double>& guess)
+{
+  Eigen::VectorXd& phi = this->PressureSolver->Phi;
+  if (guess.size() != static_cast<std::size_t>(phi.size()))
+  {
+    throw std::invalid_argument("nimbus::SmokeSolver::SetPressureGuess: size does not match");
+  }
+  for (std::size_t i = 0; i < guess.size(); ++i)
+  {
+    phi[static_cast<Eigen::Index>(i)] = guess[i];
+  }
+}
+
 void SmokeSolver::SetState(double time, const std::vector<float>& density,
   const std::vector<float>& temperature, const std::vector<float>& u, const std::vector<float>& v,
   const std::vector<float>& w)

@@ -135,6 +135,11 @@ public:
   /// Total density times cell volume [m^3].
   double TotalSmoke() const;
 
+  /// The pressure solve's last solution, its next first guess (part of the state: a
+  /// checkpoint keeps it so a restored run repeats the same iterations).
+  std::vector<double> GetPressureGuess() const;
+  void SetPressureGuess(const std::vector<double>& guess);
+
   /// Replaces the state (for checkpoints): sizes must match; throws otherwise.
   void SetState(double time, const std::vector<float>& density,
     const std::vector<float>& temperature, const std::vector<float>& u, const std::vector<float>& v,

@@ -1,0 +1,196 @@
+// vtkNimbusSmokeSource (issue 17): the arrays and time steps, the same frame whatever the
+// order of the requests (checkpoints), obstacles from an input image, bad input refused
+// with a message and an empty output.
+#include "vtkNimbusSmokeSource.h"
+
+#include "MessageCatcher.h"
+
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace
+{
+vtkNew<vtkNimbusSmokeSource> SmallSmoke()
+{
+  vtkNew<vtkNimbusSmokeSource> s;
+  s->SetDimensions(12, 12, 20);
+  s->SetCellSizeMetres(0.4);
+  s->SetOrigin(-2.4, -2.4, 0.0);
+  s->SetEmitterCentre(0.0, 0.0, 0.8);
+  s->SetEmitterRadiusMetres(0.8);
+  s->SetNumberOfFrames(24);
+  s->SetCheckpointInterval(4);
+  s->SetNumberOfThreads(2);
+  return s;
+}
+
+std::vector<float> DensityAt(vtkNimbusSmokeSource* s, double time)
+{
+  s->UpdateInformation();
+  s->UpdateTimeStep(time);
+  vtkDataArray* d = s->GetOutput()->GetPointData()->GetArray("density");
+  std::vector<float> out;
+  for (vtkIdType i = 0; d && i < d->GetNumberOfTuples(); ++i)
+  {
+    out.push_back(static_cast<float>(d->GetComponent(i, 0)));
+  }
+  return out;
+}
+} // namespace
+
+TEST(SmokeSource, ArraysAndTimeSteps)
+{
+  auto s = SmallSmoke();
+  s->UpdateInformation();
+  vtkInformation* info = s->GetOutputInformation(0);
+  ASSERT_TRUE(info->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS()));
+  EXPECT_EQ(info->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()), 25);
+  s->UpdateTimeStep(0.5);
+  vtkImageData* out = s->GetOutput();
+  int dims[3];
+  out->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 12);
+  EXPECT_EQ(dims[2], 20);
+  double spacing[3], origin[3];
+  out->GetSpacing(spacing);
+  out->GetOrigin(origin);
+  EXPECT_DOUBLE_EQ(spacing[0], 0.4);
+  EXPECT_NEAR(origin[0], -2.2, 1e-12); // cell centres
+  ASSERT_NE(out->GetPointData()->GetScalars(), nullptr);
+  EXPECT_STREQ(out->GetPointData()->GetScalars()->GetName(), "density");
+  ASSERT_NE(out->GetPointData()->GetArray("temperature"), nullptr);
+  ASSERT_NE(out->GetPointData()->GetArray("velocity"), nullptr);
+  EXPECT_EQ(out->GetPointData()->GetArray("velocity")->GetNumberOfComponents(), 3);
+  EXPECT_EQ(s->GetLastFrame(), 12);
+  double range[2];
+  out->GetPointData()->GetArray("density")->GetRange(range);
+  EXPECT_GT(range[1], 0.1);
+  out->GetPointData()->GetArray("temperature")->GetRange(range);
+  EXPECT_GT(range[1], 300.0);
+}
+
+// Forward, back, forward again, a fresh source and one on one thread: the same densities.
+TEST(SmokeSource, SameFrameWhateverTheOrder)
+{
+  auto a = SmallSmoke();
+  const std::vector<float> late = DensityAt(a, 0.9);
+  const std::vector<float> early = DensityAt(a, 0.3);
+  const std::vector<float> lateAgain = DensityAt(a, 0.9);
+  auto b = SmallSmoke();
+  const std::vector<float> earlyFresh = DensityAt(b, 0.3);
+  EXPECT_EQ(late, lateAgain);
+  EXPECT_EQ(early, earlyFresh);
+  EXPECT_NE(early, late);
+  auto c = SmallSmoke();
+  c->SetNumberOfThreads(1);
+  EXPECT_EQ(DensityAt(c, 0.9), late) << "threads change nothing";
+}
+
+// A solid block above the emitter: no smoke inside it; a mask of the wrong size refused.
+TEST(SmokeSource, ObstaclesFromAnImage)
+{
+  auto s = SmallSmoke();
+  vtkNew<vtkImageData> mask;
+  mask->SetDimensions(12, 12, 20);
+  vtkNew<vtkFloatArray> obstacle;
+  obstacle->SetName("obstacle");
+  obstacle->SetNumberOfValues(12 * 12 * 20);
+  for (int k = 0; k < 20; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 12; ++i)
+      {
+        obstacle->SetValue((k * 12 + j) * 12 + i,
+          (k >= 6 && k < 8 && i >= 4 && i < 8 && j >= 4 && j < 8) ? 1.0f : 0.0f);
+      }
+  mask->GetPointData()->AddArray(obstacle);
+  s->SetInputData(mask);
+  const std::vector<float> d = DensityAt(s, 0.8);
+  ASSERT_EQ(d.size(), obstacle->GetNumberOfValues());
+  double inside = 0.0;
+  for (std::size_t c = 0; c < d.size(); ++c)
+  {
+    inside += obstacle->GetValue(static_cast<vtkIdType>(c)) != 0.0f ? d[c] : 0.0;
+  }
+  EXPECT_EQ(inside, 0.0);
+
+  vtkNew<vtkImageData> wrong;
+  wrong->SetDimensions(5, 5, 5);
+  vtkNew<vtkFloatArray> small;
+  small->SetName("obstacle");
+  small->SetNumberOfValues(125);
+  small->Fill(0.0);
+  wrong->GetPointData()->AddArray(small);
+  s->SetInputData(wrong);
+  nimbus::testing::MessageCatcher messages(s);
+  s->Update();
+  EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0);
+  EXPECT_NE(messages.AllErrors().find("one value per simulation cell"), std::string::npos)
+    << messages.AllErrors();
+}
+
+// Bad parameters: an error naming them and an empty output, never an exception.
+TEST(SmokeSource, BadInputRefused)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto expectRefused = [](vtkNimbusSmokeSource* s, const char* words)
+  {
+    nimbus::testing::MessageCatcher messages(s);
+    s->Update();
+    EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0) << words;
+    EXPECT_NE(messages.AllErrors().find(words), std::string::npos) << messages.AllErrors();
+  };
+  {
+    auto s = SmallSmoke();
+    s->SetDimensions(0, 12, 12);
+    expectRefused(s, "cells per axis");
+  }
+  {
+    auto s = SmallSmoke();
+    s->SetCellSizeMetres(nan);
+    expectRefused(s, "cell size");
+  }
+  {
+    auto s = SmallSmoke();
+    s->SetEmitterCentre(nan, 0, 0);
+    expectRefused(s, "emitter 0");
+  }
+  {
+    auto s = SmallSmoke();
+    s->SetEmitterTemperatureKelvin(-1.0);
+    expectRefused(s, "emitter 0");
+  }
+  {
+    auto s = SmallSmoke();
+    s->SetFrameDurationSeconds(0.0);
+    expectRefused(s, "FrameDurationSeconds");
+  }
+  {
+    auto s = SmallSmoke();
+    s->SetWind(nan, 0, 0);
+    expectRefused(s, "wind");
+  }
+  {
+    auto s = SmallSmoke();
+    vtkNew<vtkImageData> all;
+    all->SetDimensions(12, 12, 20);
+    vtkNew<vtkFloatArray> solid;
+    solid->SetName("obstacle");
+    solid->SetNumberOfValues(12 * 12 * 20);
+    solid->Fill(1.0);
+    all->GetPointData()->AddArray(solid);
+    s->SetInputData(all);
+    expectRefused(s, "every cell");
+  }
+}
