@@ -95,7 +95,7 @@ def check_words(failures):
     definitions = [("sources", "NimbusMetaballCloud"), ("sources", "NimbusCloudAutomaton"),
                    ("sources", "NimbusSkyDome"), ("filters", "NimbusCloudAutomatonWithMaps"),
                    ("filters", "NimbusImageCloud"), ("sources", "NimbusLightning"),
-                   ("filters", "NimbusLightningIllumination"),
+                   ("filters", "NimbusLightningIllumination"), ("sources", "NimbusSmoke"),
                    ("representations", "CloudRepresentation"),
                    ("representations", "NimbusSkyBackgroundRepresentation")]
     checked = 0
