@@ -191,7 +191,7 @@ struct SmokeSolver::Pressure
   std::vector<int> Unknown; // per cell: its row, or -1 (solid)
   Eigen::SparseMatrix<double> A;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-    Eigen::IncompleteCholesky<double>>
+    Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>>>
     Cg;
   Eigen::VectorXd Phi; // the last solution (the next solve's first guess)
 };
