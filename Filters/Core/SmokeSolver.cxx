@@ -265,8 +265,8 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
             entries.emplace_back(row, neighbour, -1.0);
           }
         }
-        // A cell with no open neighbour at all (enclosed by obstacles) keeps a tiny
-        // diagonal so the matrix stays definite; its pressure is then 0.
+        // A cell with no open neighbour at all (enclosed by obstacles) gets a diagonal
+        // of 1 so the matrix stays definite; its right-hand side is 0, so its pressure.
         entries.emplace_back(row, row, diagonal > 0.0 ? diagonal : 1.0);
       }
   ps.A.resize(rows, rows);
