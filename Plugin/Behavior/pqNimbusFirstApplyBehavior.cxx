@@ -41,7 +41,7 @@ bool IsNimbusCloudProducer(pqPipelineSource* source)
   }
   for (const char* cloud : { "NimbusMetaballCloud", "NimbusCloudAutomaton",
          "NimbusCloudAutomatonWithMaps", "NimbusImageCloud", "NimbusOpenVDBReader", "NimbusSkyDome",
-         "NimbusLightning", "NimbusLightningIllumination" })
+         "NimbusLightning", "NimbusLightningIllumination", "NimbusSmoke" })
   {
     if (std::strcmp(name, cloud) == 0)
     {
@@ -79,6 +79,20 @@ bool IsLightningIllumination(pqPipelineSource* source)
   const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
   return name && std::strcmp(name, "NimbusLightningIllumination") == 0;
 }
+
+bool IsSmoke(pqPipelineSource* source)
+{
+  const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
+  return name && std::strcmp(name, "NimbusSmoke") == 0;
+}
+
+// Smoke's optics on the Cloud representation: the smoke's density is about 1 near the
+// source over metres, not a cloud's over kilometres, and soot absorbs. Extinction 1.5 /m
+// per unit density (an optical depth of a few across the plume), albedo 0.6 (grey
+// smoke), forward scattering 0.3.
+constexpr double kSmokeExtinctionPerDensity = 1.5;
+constexpr double kSmokeAlbedo = 0.6;
+constexpr double kSmokeG = 0.3;
 
 // The Nimbus Lightning feeding a Lightning Illumination filter, or nullptr.
 vtkSMProxy* LightningOf(pqPipelineSource* illumination)
@@ -236,6 +250,34 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
           {
             guarded->getView()->render();
           }
+        }
+      });
+  }
+
+  if (IsSmoke(data->getInput()))
+  {
+    QPointer<pqDataRepresentation> guarded(data);
+    QTimer::singleShot(0, this,
+      [guarded]()
+      {
+        if (!guarded)
+        {
+          return;
+        }
+        vtkSMProxy* proxy = guarded->getProxy();
+        const char* names[3] = { "ExtinctionPerDensity", "Albedo", "CloudG" };
+        const double values[3] = { kSmokeExtinctionPerDensity, kSmokeAlbedo, kSmokeG };
+        for (int k = 0; k < 3; ++k)
+        {
+          if (proxy->GetProperty(names[k]))
+          {
+            vtkSMPropertyHelper(proxy, names[k]).Set(values[k]);
+          }
+        }
+        proxy->UpdateVTKObjects();
+        if (guarded->getView())
+        {
+          guarded->getView()->render();
         }
       });
   }
