@@ -90,6 +90,26 @@ double RelativeRms(
   }
   return std::sqrt(difference / reference);
 }
+/// 3 x 3 x 2 virtual lights 400 m apart around the 8 x 8 x 2 cloud (file and colour cases).
+nimbus::VirtualLightGrid FewLights()
+{
+  nimbus::VirtualLightGridParameters p;
+  p.Low = { { -400.0, -400.0, 600.0 } };
+  p.High = { { 400.0, 400.0, 1200.0 } };
+  p.CloudBottom = 1000.0;
+  p.BaseInterval = 400.0;
+  return nimbus::MakeVirtualLightGrid(p);
+}
+
+/// A cheap solve: 6 directions, 4 orders, 2 threads.
+nimbus::LightningBasisOptions QuickOptions()
+{
+  nimbus::LightningBasisOptions o;
+  o.NumberOfDirections = 6;
+  o.Orders = 4;
+  o.Threads = 2;
+  return o;
+}
 } // namespace
 
 // A source on a virtual light, xi = 0: the relight is the direct solve (linearity of
@@ -247,17 +267,9 @@ TEST(LightningBasis, BadInputRefused)
 TEST(LightningBasis, FileRoundTripAndDamage)
 {
   const ExtinctionGrid cloud = Cloud(8, 8, 2);
-  nimbus::LightningBasisOptions o;
-  o.NumberOfDirections = 6;
-  o.Orders = 4;
-  o.Threads = 2;
+  nimbus::LightningBasisOptions o = QuickOptions();
   o.Threshold = 1e-2;
-  nimbus::VirtualLightGridParameters p;
-  p.Low = { { -400.0, -400.0, 600.0 } };
-  p.High = { { 400.0, 400.0, 1200.0 } };
-  p.CloudBottom = 1000.0;
-  p.BaseInterval = 400.0;
-  const nimbus::VirtualLightGrid lights = nimbus::MakeVirtualLightGrid(p);
+  const nimbus::VirtualLightGrid lights = FewLights();
   const nimbus::LightningBasis basis =
     nimbus::PrecomputeLightningBasis(cloud, CloudOptics(), lights, o);
   const std::string key = nimbus::LightningBasisFingerprint(cloud, CloudOptics(), lights, o);
@@ -341,16 +353,8 @@ TEST(LightningBasis, FileRoundTripAndDamage)
 TEST(LightningBasis, OneColourAndMixedColours)
 {
   const ExtinctionGrid cloud = Cloud(8, 8, 2);
-  nimbus::LightningBasisOptions o;
-  o.NumberOfDirections = 6;
-  o.Orders = 4;
-  o.Threads = 2;
-  nimbus::VirtualLightGridParameters p;
-  p.Low = { { -400.0, -400.0, 600.0 } };
-  p.High = { { 400.0, 400.0, 1200.0 } };
-  p.CloudBottom = 1000.0;
-  p.BaseInterval = 400.0;
-  const nimbus::VirtualLightGrid lights = nimbus::MakeVirtualLightGrid(p);
+  const nimbus::LightningBasisOptions o = QuickOptions();
+  const nimbus::VirtualLightGrid lights = FewLights();
   const nimbus::LightningBasis basis =
     nimbus::PrecomputeLightningBasis(cloud, CloudOptics(), lights, o);
   const std::size_t count = lights.NumberOfNodes();

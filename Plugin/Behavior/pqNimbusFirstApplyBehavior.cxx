@@ -174,6 +174,27 @@ void ShowLightningPeak(pqDataRepresentation* representation)
   }
 }
 
+// Runs `style` on the representation after ParaView's own Apply has finished with it
+// (its colouring picked), then renders; nothing if the representation is gone by then.
+template <typename Style>
+void AfterApply(QObject* context, pqDataRepresentation* representation, Style style)
+{
+  QPointer<pqDataRepresentation> guarded(representation);
+  QTimer::singleShot(0, context,
+    [guarded, style]()
+    {
+      if (!guarded)
+      {
+        return;
+      }
+      style(guarded.data());
+      if (guarded->getView())
+      {
+        guarded->getView()->render();
+      }
+    });
+}
+
 bool IsSkyBackground(pqRepresentation* representation)
 {
   const char* type = RepresentationType(representation);
@@ -237,34 +258,20 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
 
   if (IsLightning(data->getInput()))
   {
-    // After ParaView's own Apply has picked its colouring.
-    QPointer<pqDataRepresentation> guarded(data);
-    QTimer::singleShot(0, this,
-      [guarded]()
+    AfterApply(this, data,
+      [](pqDataRepresentation* lightning)
       {
-        if (guarded)
-        {
-          StyleLightning(guarded);
-          ShowLightningPeak(guarded);
-          if (guarded->getView())
-          {
-            guarded->getView()->render();
-          }
-        }
+        StyleLightning(lightning);
+        ShowLightningPeak(lightning);
       });
   }
 
   if (IsSmoke(data->getInput()))
   {
-    QPointer<pqDataRepresentation> guarded(data);
-    QTimer::singleShot(0, this,
-      [guarded]()
+    AfterApply(this, data,
+      [](pqDataRepresentation* smoke)
       {
-        if (!guarded)
-        {
-          return;
-        }
-        vtkSMProxy* proxy = guarded->getProxy();
+        vtkSMProxy* proxy = smoke->getProxy();
         const char* names[3] = { "ExtinctionPerDensity", "Albedo", "CloudG" };
         const double values[3] = { kSmokeExtinctionPerDensity, kSmokeAlbedo, kSmokeG };
         for (int k = 0; k < 3; ++k)
@@ -275,10 +282,6 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
           }
         }
         proxy->UpdateVTKObjects();
-        if (guarded->getView())
-        {
-          guarded->getView()->render();
-        }
       });
   }
 
@@ -286,25 +289,16 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
   {
     // A flash is seen at night: the cloud's own sun below the horizon (a Nimbus Sky in
     // the view still sets the sun for both), and the frame at the return stroke.
-    QPointer<pqDataRepresentation> guarded(data);
-    QTimer::singleShot(0, this,
-      [guarded]()
+    AfterApply(this, data,
+      [](pqDataRepresentation* lit)
       {
-        if (!guarded)
-        {
-          return;
-        }
-        vtkSMProxy* proxy = guarded->getProxy();
+        vtkSMProxy* proxy = lit->getProxy();
         if (proxy->GetProperty("SunElevationDegrees"))
         {
           vtkSMPropertyHelper(proxy, "SunElevationDegrees").Set(kNightSunElevationDegrees);
           proxy->UpdateVTKObjects();
         }
-        ShowLightningPeak(guarded);
-        if (guarded->getView())
-        {
-          guarded->getView()->render();
-        }
+        ShowLightningPeak(lit);
       });
   }
 
