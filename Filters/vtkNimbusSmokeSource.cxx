@@ -1,8 +1,11 @@
 #include "vtkNimbusSmokeSource.h"
 
 #include "SmokeSolver.h"
+#include "Voxelize.h"
 
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
+#include "vtkCleanPolyData.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -10,7 +13,10 @@
 #include "vtkInformationVector.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkTriangleFilter.h"
+#include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
 #include <cmath>
@@ -59,7 +65,9 @@ vtkNimbusSmokeSource::~vtkNimbusSmokeSource() = default;
 
 int vtkNimbusSmokeSource::FillInputPortInformation(int, vtkInformation* info)
 {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Remove(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE());
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
   info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   return 1;
 }
@@ -155,8 +163,10 @@ int vtkNimbusSmokeSource::RequestData(
   }
 
   // The obstacles: one value per cell, as point data on the cells' grid or cell data on
-  // the grid one larger.
+  // the grid one larger; or a closed surface, voxelised (a cell is solid when its centre
+  // is inside).
   vtkImageData* obstacleImage = vtkImageData::GetData(inputVector[0], 0);
+  vtkPolyData* obstacleSurface = vtkPolyData::GetData(inputVector[0], 0);
   vtkMTimeType obstacleTime = 0;
   if (obstacleImage)
   {
@@ -191,6 +201,52 @@ int vtkNimbusSmokeSource::RequestData(
     }
     obstacleTime = std::max(mask->GetMTime(), obstacleImage->GetMTime());
   }
+  else if (obstacleSurface)
+  {
+    // Coincident points merged (closedness is read from shared points), polygons and
+    // strips as triangles; lines and vertices bound no volume.
+    vtkNew<vtkCleanPolyData> merged;
+    merged->SetInputData(obstacleSurface);
+    merged->PointMergingOn();
+    merged->ConvertLinesToPointsOff();
+    merged->ConvertPolysToLinesOff();
+    merged->ConvertStripsToPolysOff();
+    vtkNew<vtkTriangleFilter> triangles;
+    triangles->SetInputConnection(merged->GetOutputPort());
+    triangles->PassVertsOff();
+    triangles->PassLinesOff();
+    triangles->Update();
+    vtkPolyData* surface = triangles->GetOutput();
+    std::vector<nimbus::Vector3> points(static_cast<std::size_t>(surface->GetNumberOfPoints()));
+    for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+    {
+      surface->GetPoint(i, points[static_cast<std::size_t>(i)].data());
+    }
+    std::vector<std::array<std::int64_t, 3>> faces;
+    faces.reserve(static_cast<std::size_t>(surface->GetNumberOfPolys()));
+    vtkCellArray* polys = surface->GetPolys();
+    vtkIdType count = 0;
+    const vtkIdType* ids = nullptr;
+    for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
+    {
+      if (count == 3)
+      {
+        faces.push_back({ { ids[0], ids[1], ids[2] } });
+      }
+    }
+    std::string problem;
+    if (faces.empty() ||
+      !nimbus::VoxelizeClosedSurface(
+        points, faces, p.Dimensions, p.Origin, this->CellSizeMetres, p.Obstacles, problem))
+    {
+      vtkErrorMacro("Smoke: the obstacle surface can not be voxelised: "
+        << (faces.empty() ? std::string("it has no polygons") : problem)
+        << " (it must be a closed surface, in metres); no output.");
+      in.Reset();
+      return 1;
+    }
+    obstacleTime = obstacleSurface->GetMTime();
+  }
   const std::string why = nimbus::CheckSmokeParameters(p);
   if (!why.empty())
   {
@@ -208,8 +264,8 @@ int vtkNimbusSmokeSource::RequestData(
     emitter.Centre[0], emitter.Centre[1], emitter.Centre[2], emitter.Velocity[0],
     emitter.Velocity[1], emitter.Velocity[2], emitter.RadiusMetres, emitter.DensityPerSecond,
     emitter.TemperatureKelvin, this->FrameDurationSeconds,
-    static_cast<double>(this->CheckpointInterval), obstacleImage ? 1.0 : 0.0,
-    static_cast<double>(obstacleTime) };
+    static_cast<double>(this->CheckpointInterval),
+    obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0), static_cast<double>(obstacleTime) };
   if (key != in.Key)
   {
     in.Reset();
@@ -323,6 +379,15 @@ int vtkNimbusSmokeSource::RequestData(
   output->GetPointData()->SetScalars(density);
   output->GetPointData()->AddArray(temperature);
   output->GetPointData()->AddArray(velocity);
+  if (!p.Obstacles.empty())
+  {
+    // Where the solid cells are (1), to show them (a contour at 0.5, or a threshold).
+    vtkNew<vtkUnsignedCharArray> obstacle;
+    obstacle->SetName("obstacle");
+    obstacle->SetNumberOfTuples(cells);
+    std::copy(p.Obstacles.begin(), p.Obstacles.end(), obstacle->GetPointer(0));
+    output->GetPointData()->AddArray(obstacle);
+  }
   output->GetInformation()->Set(
     vtkDataObject::DATA_TIME_STEP(), frame * this->FrameDurationSeconds);
   return 1;

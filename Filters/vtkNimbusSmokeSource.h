@@ -11,13 +11,16 @@
  * EmitterVelocity (m/s; 0 leaves the air alone). The top of the box is open, its sides
  * and bottom are walls.
  *
- * Optional input (port 0): vtkImageData with a point or cell array "obstacle" (non-zero:
- * solid), one value per simulation cell (Dimensions points, or Dimensions + 1 points with
- * cell data): the smoke flows around it.
+ * Optional input (port 0), the obstacles the smoke flows around: either vtkImageData with
+ * a point or cell array "obstacle" (non-zero: solid), one value per simulation cell
+ * (Dimensions points, or Dimensions + 1 points with cell data); or vtkPolyData, a closed
+ * surface in metres (polygons and strips; a cell is solid when its centre is inside:
+ * nimbus::VoxelizeClosedSurface, Filters/Core/Voxelize.h). An open surface is an error.
  *
  * Output: vtkImageData with a point per cell centre (origin Origin + h/2, spacing h),
  * point data "density" (dimensionless, the active scalars: what the Cloud representation
- * multiplies by its extinction per density), "temperature" (K) and "velocity" (m/s).
+ * multiplies by its extinction per density), "temperature" (K), "velocity" (m/s) and, with
+ * obstacles, "obstacle" (1 in solid cells).
  *
  * Time: frame f is the state after f x FrameDurationSeconds of simulation; the source
  * advertises TIME_STEPS for frames 0..NumberOfFrames so ParaView's animation plays it. A

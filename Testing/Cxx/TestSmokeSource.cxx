@@ -1,17 +1,22 @@
 // vtkNimbusSmokeSource (issue 17): the arrays and time steps, the same frame whatever the
-// order of the requests (checkpoints), obstacles from an input image, bad input refused
+// order of the requests (checkpoints), obstacles from an input image or a closed surface,
+// bad input refused
 // with a message and an empty output.
 #include "vtkNimbusSmokeSource.h"
 
 #include "MessageCatcher.h"
 
+#include "vtkCellArray.h"
 #include "vtkCellData.h"
+#include "vtkCubeSource.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkSphereSource.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <gtest/gtest.h>
@@ -138,6 +143,95 @@ TEST(SmokeSource, ObstaclesFromAnImage)
   EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0);
   EXPECT_NE(messages.AllErrors().find("one value per simulation cell"), std::string::npos)
     << messages.AllErrors();
+}
+
+// A closed surface (a sphere above the emitter, as polydata in metres) is voxelised: the
+// output's "obstacle" array marks the cells whose centres are inside, no smoke enters
+// them, and the plume goes round. An open surface and one without polygons are refused.
+TEST(SmokeSource, ObstaclesFromASurface)
+{
+  auto s = SmallSmoke();
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(0.1, -0.1, 3.0);
+  sphere->SetRadius(1.0);
+  sphere->SetThetaResolution(32);
+  sphere->SetPhiResolution(32);
+  s->SetInputConnection(sphere->GetOutputPort());
+  s->UpdateInformation();
+  s->UpdateTimeStep(1.0);
+  vtkImageData* out = s->GetOutput();
+  vtkDataArray* obstacle = out->GetPointData()->GetArray("obstacle");
+  vtkDataArray* density = out->GetPointData()->GetArray("density");
+  ASSERT_NE(obstacle, nullptr);
+  ASSERT_NE(density, nullptr);
+  int solid = 0;
+  int expected = 0;
+  double inside = 0.0;
+  double total = 0.0;
+  for (vtkIdType c = 0; c < out->GetNumberOfPoints(); ++c)
+  {
+    double x[3];
+    out->GetPoint(c, x);
+    const double r2 =
+      (x[0] - 0.1) * (x[0] - 0.1) + (x[1] + 0.1) * (x[1] + 0.1) + (x[2] - 3.0) * (x[2] - 3.0);
+    // The 32-gon sphere is inscribed: cells well inside the radius or outside it agree.
+    if (r2 < 0.95 * 0.95 || r2 > 1.0)
+    {
+      EXPECT_EQ(obstacle->GetComponent(c, 0) != 0.0, r2 < 1.0) << "cell " << c;
+    }
+    expected += r2 < 1.0 ? 1 : 0;
+    solid += obstacle->GetComponent(c, 0) != 0.0 ? 1 : 0;
+    inside += obstacle->GetComponent(c, 0) != 0.0 ? density->GetComponent(c, 0) : 0.0;
+    total += density->GetComponent(c, 0);
+  }
+  EXPECT_GT(solid, 0);
+  EXPECT_NEAR(solid, expected, 0.1 * expected);
+  EXPECT_EQ(inside, 0.0);
+  EXPECT_GT(total, 0.0);
+
+  // A cube without its top face is open.
+  vtkNew<vtkCubeSource> cube;
+  cube->SetBounds(-1, 1, -1, 1, 2, 4);
+  cube->Update();
+  vtkNew<vtkPolyData> open;
+  open->DeepCopy(cube->GetOutput());
+  open->GetPolys()->Initialize();
+  vtkCellArray* faces = cube->GetOutput()->GetPolys();
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  int face = 0;
+  for (faces->InitTraversal(); faces->GetNextCell(count, ids); ++face)
+  {
+    if (face != 5)
+    {
+      open->GetPolys()->InsertNextCell(count, ids);
+    }
+  }
+  s->SetInputData(open);
+  {
+    nimbus::testing::MessageCatcher messages(s);
+    s->Update();
+    EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0);
+    EXPECT_NE(messages.AllErrors().find("not closed"), std::string::npos) << messages.AllErrors();
+  }
+  vtkNew<vtkPolyData> empty;
+  s->SetInputData(empty);
+  {
+    nimbus::testing::MessageCatcher messages(s);
+    s->Update();
+    EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0);
+    EXPECT_NE(messages.AllErrors().find("no polygons"), std::string::npos) << messages.AllErrors();
+  }
+  // The whole box inside a surface: every cell solid, refused by the solver's check.
+  vtkNew<vtkCubeSource> all;
+  all->SetBounds(-10, 10, -10, 10, -10, 20);
+  s->SetInputConnection(all->GetOutputPort());
+  {
+    nimbus::testing::MessageCatcher messages(s);
+    s->Update();
+    EXPECT_EQ(s->GetOutput()->GetNumberOfPoints(), 0);
+    EXPECT_NE(messages.AllErrors().find("every cell"), std::string::npos) << messages.AllErrors();
+  }
 }
 
 // Bad parameters: an error naming them and an empty output, never an exception.
