@@ -861,6 +861,26 @@ void SmokeSolver::Decay(double dt)
   }
 }
 
+Vector3 SmokeSolver::VelocityAt(const Vector3& positionMetres) const
+{
+  const SmokeParameters& p = this->Parameters;
+  const auto& n = p.Dimensions;
+  std::array<double, 3> x;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (std::isnan(positionMetres[a]))
+    {
+      throw std::invalid_argument("nimbus::SmokeSolver::VelocityAt: the position is NaN");
+    }
+    x[a] = (positionMetres[a] - p.Origin[a]) / p.CellSizeMetres; // cell coordinates
+  }
+  // The same views of the faces as Advect's.
+  const FieldView uView{ this->U.data(), { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } } };
+  const FieldView vView{ this->V.data(), { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } } };
+  const FieldView wView{ this->W.data(), { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } } };
+  return { { uView.Sample(x), vView.Sample(x), wView.Sample(x) } };
+}
+
 std::vector<float> SmokeSolver::CellVelocities() const
 {
   const auto& n = this->Parameters.Dimensions;

@@ -130,6 +130,10 @@ public:
   const std::vector<float>& GetU() const { return this->U; }
   const std::vector<float>& GetV() const { return this->V; }
   const std::vector<float>& GetW() const { return this->W; }
+  /// The velocity [m/s] at a point [m]: each component trilinear between its faces (the
+  /// samples the advection uses), the point clamped to each component's box of faces.
+  /// Throws std::invalid_argument for a NaN coordinate.
+  Vector3 VelocityAt(const Vector3& positionMetres) const;
   /// The velocity at cell centres (the mean of the two faces per axis), 3 per cell.
   std::vector<float> CellVelocities() const;
   /// Per fluid cell, the divergence [1/s] of the face velocities (0 in solid cells).
