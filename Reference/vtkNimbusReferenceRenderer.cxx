@@ -253,7 +253,8 @@ nimbus::SceneFields SceneFieldsOf(
       throw std::invalid_argument(key + ": array '" + array + "': " + error.what());
     }
   };
-  if (scene.Medium.Emission.Enabled && scene.Medium.Emission.Source == "array")
+  if (scene.Medium.Emission.Enabled &&
+    (scene.Medium.Emission.Source == "array" || scene.Medium.Emission.Source == "blackbody"))
   {
     fields.Emission = grid(
       scene.Medium.Density.Path, scene.Medium.Emission.ArrayName, "scene.medium.emission.array");
@@ -289,7 +290,7 @@ nimbus::SceneFields SceneFieldsOf(
       }
     }
     fields.MediaEmissions.emplace_back();
-    if (m.Emission.Enabled && m.Emission.Source == "array")
+    if (m.Emission.Enabled && (m.Emission.Source == "array" || m.Emission.Source == "blackbody"))
     {
       fields.MediaEmissions.back() =
         grid(m.Density.Path, m.Emission.ArrayName, key + ".emission.array");

@@ -1248,6 +1248,16 @@ void Integrator::AddEmission(const Vector3& p, double cloudMajorant, PathState& 
     {
       continue;
     }
+    if (!m.BlackbodyEmission.empty())
+    {
+      // "blackbody": a spectrum per voxel, trilinear per wavelength.
+      for (int i = 0; i < this->Wavelengths; ++i)
+      {
+        const double eta = m.EmissionScale * m.BlackbodyEmission[i].Sample(p) / cloudMajorant;
+        state.Radiance[i] += state.Weight[i] * eta;
+      }
+      continue;
+    }
     const double eta = m.EmissionScale * m.EmissionField->Sample(p) / cloudMajorant;
     if (eta > 0.0)
     {

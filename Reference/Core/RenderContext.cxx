@@ -1,8 +1,10 @@
 #include "RenderContext.h"
+#include "BlackbodyEmission.h"
 #include "Math.h"
 
 #include "Sun.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -169,6 +171,39 @@ void RenderContext::SetUpVersion3(const SceneDescription& scene)
         "names a field the renderer was not given ('" + e.ArrayName + "')");
       requireGeometry(*array, field + ".array");
       m.EmissionField = array;
+    }
+    else if (e.Source == "blackbody")
+    {
+      Require(array && !array->IsEmpty(), field + ".array",
+        "names a temperature field the renderer was not given ('" + e.ArrayName + "')");
+      requireGeometry(*array, field + ".array");
+      Require(e.TemperatureKelvin >= 500.0 && e.TemperatureKelvin <= 50000.0,
+        field + ".temperature_kelvin", "must be in [500, 50000] K for \"blackbody\"");
+      // Per voxel and wavelength, density_i B(lambda, T_i) / Y[B(T_ref)]
+      // (Physics/BlackbodyEmission.h).
+      const BlackbodyEmission blackbody(spectrum, e.TemperatureKelvin);
+      const std::vector<float>& rho = m.Density->GetValues();
+      const std::vector<float>& kelvin = array->GetValues();
+      const std::size_t n = spectrum.GetNumberOfSamples();
+      std::vector<std::vector<float>> channels(n, std::vector<float>(rho.size(), 0.0f));
+      for (std::size_t v = 0; v < rho.size(); ++v)
+      {
+        if (rho[v] > 0.0f)
+        {
+          const std::vector<double> b = blackbody.RelativeSpectrum(kelvin[v]);
+          for (std::size_t i = 0; i < n; ++i)
+          {
+            channels[i][v] = static_cast<float>(std::min(rho[v] * b[i], 1e30));
+          }
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        m.BlackbodyEmission.emplace_back(m.Density->GetDimensions(), m.Density->GetOrigin(),
+          m.Density->GetSpacing(), std::move(channels[i]));
+      }
+      m.EmissionField = m.Density;
+      m.EmissionSpectrum.assign(n, 1.0);
     }
     else
     {

@@ -36,7 +36,8 @@ struct NIMBUSREFERENCE_EXPORT SceneFields
 {
   /// scene.Media[i]'s density, one per additional medium.
   std::vector<DensityGrid> MediaDensities;
-  /// scene.Medium.Emission's field when its source is "array" (else empty).
+  /// scene.Medium.Emission's field when its source is "array" or "blackbody" (the
+  /// temperature, K) (else empty).
   DensityGrid Emission;
   /// scene.Media[i].Emission's field when its source is "array" (else empty or absent).
   std::vector<DensityGrid> MediaEmissions;
@@ -53,9 +54,12 @@ struct NIMBUSREFERENCE_EXPORT MediumComponent
   double Albedo = 0.0;
   PhaseFunctionMixture Phase;
   bool Emits = false;
-  const DensityGrid* EmissionField = nullptr; // Density for "from_density"
+  const DensityGrid* EmissionField = nullptr; // Density for "from_density" and "blackbody"
   double EmissionScale = 0.0;
   std::vector<double> EmissionSpectrum;
+  /// "blackbody": per wavelength, the voxels' density_i B(lambda, T_i) / Y[B(T_ref)]
+  /// (sampled trilinearly; eta = EmissionScale times it). Empty otherwise.
+  std::vector<DensityGrid> BlackbodyEmission;
 };
 
 /// A light of the scene broken into elements for next-event estimation: a point or one

@@ -57,13 +57,18 @@ struct DensitySourceDescription
 /// blackbody spectrum of TemperatureKelvin normalised to luminance 1 (as the sun's).
 /// The field is the medium's density ("from_density") or another point-data array
 /// of the medium's .vti ("array"; only for "file" densities), on the density's grid.
+/// "blackbody" (issue 17, hot smoke and fire; Physics/BlackbodyEmission.h): the array is
+/// a temperature T [K] and each voxel emits eta_i(lambda) = RadiancePerMetre density_i
+/// B(lambda, T_i) / Y[B(TemperatureKelvin)] (hotter: brighter and bluer), trilinear
+/// between voxels as the density is; TemperatureKelvin is then the reference temperature
+/// at which a unit density emits RadiancePerMetre of luminance per metre.
 struct EmissionDescription
 {
   bool Enabled = false;
-  std::string Source = "from_density"; // "from_density" or "array"
-  std::string ArrayName;               // "array": the point-data array of the density's file
-  double RadiancePerMetre = 0.0;       // Y / (sr m) per unit field value
-  double TemperatureKelvin = 1500.0;   // K, blackbody spectrum
+  std::string Source = "from_density"; // "from_density", "array" or "blackbody"
+  std::string ArrayName;         // "array", "blackbody": the point-data array of the density's file
+  double RadiancePerMetre = 0.0; // Y / (sr m) per unit field value
+  double TemperatureKelvin = 1500.0; // K, blackbody spectrum
 };
 
 struct MediumDescription

@@ -735,7 +735,7 @@ std::vector<PhaseComponentDescription> ReadPhase(const Json& phase, const std::s
   return components;
 }
 
-const std::vector<std::string> kEmissionSources = { "from_density", "array" };
+const std::vector<std::string> kEmissionSources = { "from_density", "array", "blackbody" };
 
 /// Version 3: medium.emission and media[i].emission.
 EmissionDescription ReadEmission(
@@ -745,20 +745,22 @@ EmissionDescription ReadEmission(
   EmissionDescription e;
   e.Enabled = true;
   e.Source = ReadEnum(r.Require("source"), r.Key("source"), kEmissionSources);
-  if (e.Source == "array")
+  if (e.Source == "array" || e.Source == "blackbody")
   {
     if (density.Type != "file")
     {
       Fail(r.Key("source"),
-        "\"array\" reads another point-data array of the density's .vti, so it needs a "
-        "\"file\" density (this density is \"" +
+        "\"" + e.Source +
+          "\" reads another point-data array of the density's .vti, so it needs a "
+          "\"file\" density (this density is \"" +
           density.Type + "\"; use \"from_density\")");
     }
     e.ArrayName = ReadString(r.Require("array"), r.Key("array"), false);
   }
   else if (r.Has("array"))
   {
-    Fail(r.Key("array"), "only used by source \"array\" (this emission is \"from_density\")");
+    Fail(r.Key("array"),
+      "only used by sources \"array\" and \"blackbody\" (this emission is \"from_density\")");
   }
   r.RequiredNumber("radiance_per_metre", e.RadiancePerMetre, Closed(0.0, kMaxEmissionPerMetre));
   r.Number("temperature_kelvin", e.TemperatureKelvin,
@@ -1227,7 +1229,7 @@ Json EmissionJson(const EmissionDescription& e)
 {
   Json emission;
   emission["source"] = e.Source;
-  if (e.Source == "array")
+  if (e.Source == "array" || e.Source == "blackbody")
   {
     emission["array"] = e.ArrayName;
   }

@@ -4,6 +4,7 @@
 #include "Atmosphere.h"
 #include "AtmosphereTable.h"
 #include "CloudDensityTexture.h"
+#include "EmissionTexture.h"
 #include "FiniteSetters.h"
 #include "FrameQuality.h"
 #include "LightningTexture.h"
@@ -67,6 +68,8 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, ExtinctionPerDensity);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Albedo);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, CloudG);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScattering);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, EmissionRadiancePerMetre);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, EmissionReferenceTemperatureKelvin);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScatteringMemoryBudgetMiB);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunAzimuthDegrees);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunElevationDegrees);
@@ -308,6 +311,9 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   // in the image's field data, uploaded.
   bool LightningTexture = false;
 
+  // Temperature emission (issue 17; EmissionTexture.h): uploaded and glowing.
+  bool EmissionTexture = false;
+
   // A hash of the opaque scene's depth in the viewport (0 without one).
   std::uint64_t SceneDepthHash = 0;
 };
@@ -326,6 +332,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // Lightning (issue 16; LightningTexture.h).
   nimbus::LightningTexture Lightning;
   std::string LastLightningError;
+  // Temperature emission (issue 17; EmissionTexture.h).
+  nimbus::EmissionTexture Emission;
+  std::string LastEmissionError;
   double LastPrecomputeSeconds = 0.0;
   double SolvedIlluminance = 0.0; // the sun's illuminance of the last solve
   std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
@@ -394,6 +403,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
     this->Density.Release(window);
     this->Scattering.Release(window);
     this->Lightning.Release(window);
+    this->Emission.Release(window);
     for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
            Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
            SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
@@ -581,6 +591,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
   }
   this->UpdateMultipleScattering(frame);
   this->UpdateLightning(frame);
+  this->UpdateEmission(frame);
   // Nothing the cloud depends on changed since the last complete frame: its image
   // (the accumulation targets) is composited again without a pass.
   std::vector<double> key = this->FrameReuseKey(frame);
@@ -672,6 +683,7 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
       static_cast<double>(in.Density.GetNumberOfUploads()),
       static_cast<double>(in.Scattering.GetNumberOfSolves()), frame.ScatteringScale,
       static_cast<double>(in.Lightning.GetNumberOfUploads()), frame.LightningTexture ? 1.0 : 0.0,
+      static_cast<double>(in.Emission.GetNumberOfUploads()), frame.EmissionTexture ? 1.0 : 0.0,
       static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),
       frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees,
       frame.Settings.OverSky ? 1.0 : 0.0, static_cast<double>(frame.Width),
@@ -1211,6 +1223,10 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
       in.Lightning.GetTexture(c)->Activate();
     }
   }
+  if (frame.EmissionTexture)
+  {
+    in.Emission.GetTexture()->Activate();
+  }
   frame.State->vtkglDisable(GL_DEPTH_TEST);
   frame.State->vtkglDepthMask(GL_FALSE);
 }
@@ -1245,6 +1261,10 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
     {
       in.Lightning.GetTexture(c)->Deactivate();
     }
+  }
+  if (frame.EmissionTexture)
+  {
+    in.Emission.GetTexture()->Deactivate();
   }
 }
 
@@ -1468,6 +1488,40 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
     }
     in.LastLightningError = warning;
   }
+}
+
+//------------------------------------------------------------------------------
+// Temperature emission (issue 17): rho B(T) / Y[B(T_ref)] per texel, uploaded when the
+// density, the temperature or the reference temperature change.
+void vtkNimbusCloudVolumeMapper::UpdateEmission(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  frame.EmissionTexture = false;
+  if (this->Unlit || !this->TemperatureEmission || this->EmissionRadiancePerMetre <= 0.0)
+  {
+    return;
+  }
+  int textureDims[3], textureFactors[3];
+  in.Density.GetDimensions(textureDims);
+  in.Density.GetFactors(textureFactors);
+  std::string error;
+  if (!in.Emission.Update(frame.Window, frame.Image, frame.Scalars, frame.CellData,
+        this->EmissionTemperatureArray, this->EmissionReferenceTemperatureKelvin,
+        { { std::max(textureDims[0], 1), std::max(textureDims[1], 1),
+          std::max(textureDims[2], 1) } },
+        { { std::max(textureFactors[0], 1), std::max(textureFactors[1], 1),
+          std::max(textureFactors[2], 1) } },
+        error))
+  {
+    if (error != in.LastEmissionError)
+    {
+      vtkErrorMacro(<< error);
+      in.LastEmissionError = error;
+    }
+    return;
+  }
+  in.LastEmissionError.clear();
+  frame.EmissionTexture = in.Emission.HasTexture();
 }
 
 // The sky seen from the cloud at altitude `cloudAltitude` above the scene [m]: a
@@ -1756,6 +1810,13 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
   const float lightningTextureScale[3] = { static_cast<float>(lightningScale[0]),
     static_cast<float>(lightningScale[1]), static_cast<float>(lightningScale[2]) };
   sliceProgram->SetUniform3f("lightningTextureScale", lightningTextureScale);
+  // Temperature emission (issue 17): the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
+  // E [Y/(sr m)] scales them.
+  sliceProgram->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);
+  sliceProgram->SetUniformi("emissionRgb",
+    (frame.EmissionTexture ? in.Emission.GetTexture() : in.Density.GetTexture())->GetTextureUnit());
+  sliceProgram->SetUniformf("emissionScale",
+    static_cast<float>(frame.EmissionTexture ? this->EmissionRadiancePerMetre : 0.0));
   sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
   sliceProgram->SetUniformi("octaves", frame.Octaves);
   const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
@@ -1928,6 +1989,9 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "ExtinctionPerDensity: " << this->ExtinctionPerDensity << " 1/m\n";
   os << indent << "Albedo: " << this->Albedo << "\n";
+  os << indent << "TemperatureEmission: " << (this->TemperatureEmission ? "on" : "off")
+     << " (array \"" << this->EmissionTemperatureArray << "\", " << this->EmissionRadiancePerMetre
+     << " Y/(sr m) per density at " << this->EmissionReferenceTemperatureKelvin << " K)\n";
   os << indent << "CloudG: " << this->CloudG << "\n";
   os << indent << "MultipleScattering (k_multi): " << this->MultipleScattering << "\n";
   static const char* methods[4] = { "None", "Octaves", "ReferencePatterns", "DiscreteDirections" };

@@ -34,6 +34,11 @@ uniform sampler3D lightningRed;
 uniform sampler3D lightningGreen;
 uniform sampler3D lightningBlue;
 uniform vec3 lightningTextureScale;   // density texture coordinates -> these textures'
+// Temperature emission (issue 17; Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
+// [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
+uniform int emissionOn;
+uniform sampler3D emissionRgb;
+uniform float emissionScale; // E [Y/(sr m) per unit density at T_ref]
 
 // J(p, w) of the solver: the radiance the cloud's particles at p scatter toward w
 // (w the direction of travel) per unit scattering coefficient, beyond the sun's
@@ -142,6 +147,11 @@ void main()
       if (lightningTextureOn != 0)
       {
         source += cloudAlbedo * sigma * LightningInScattering(p, -direction);
+      }
+      if (emissionOn != 0)
+      {
+        // The source term of the RTE, eta ds: attenuated in the slab like the scattering.
+        source += emissionScale * max(texture(emissionRgb, (worldToTexture * vec4(p, 1.0)).xyz).rgb, vec3(0.0));
       }
     }
     vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);

@@ -5,6 +5,7 @@
 // printed. Scenes are a single pixel (or a few) seen along the pixel centre, with no
 // sun, no atmosphere, a black background, so that only the feature under test lights
 // the pixel.
+#include "BlackbodyEmission.h"
 #include "Math.h"
 #include "MonteCarloAgreement.h"
 #include "PathTracer.h"
@@ -370,6 +371,44 @@ TEST(LightsPathTracer, EmittingAbsorbingBox)
     ExpectPixel(r, 0, 0, Rgb(context, context.GetMedia()[0].EmissionSpectrum, 0.02 * 3.0 * 200.0),
       "emitting field without extinction");
   }
+}
+
+//------------------------------------------------------------------------------
+// "blackbody" emission (issue 17, hot smoke): the same absorbing box with a temperature
+// field T; eta(lambda) = s rho B(lambda, T) / Y[B(T_ref)] (Physics/BlackbodyEmission.h),
+// so L = (eta / sigma_a)(1 - exp(-sigma_a D)) with the spectrum of B(T) scaled by its
+// luminance ratio: at T = T_ref the luminance is that of "from_density" at T_ref, at
+// 2000 K 60 times more (BlackbodyEmission's figure), bluer.
+TEST(LightsPathTracer, BlackbodyEmittingBox)
+{
+  const V camera{ { 0.0, -300.0, 50.0 } }, focus{ { 0.0, 0.0, 50.0 } };
+  const V lo{ { -100.0, -100.0, 0.0 } }, hi{ { 100.0, 100.0, 100.0 } };
+  SceneDescription scene = DarkScene(camera, focus);
+  scene.Medium.Density.Type = "file";
+  scene.Medium.ExtinctionPerDensity = 0.005;
+  scene.Medium.SingleScatteringAlbedo = 0.0;
+  const float rho = 1.5f;
+  const double sigmaA = 0.005 * rho;
+  const double path = (1.0 - std::exp(-sigmaA * 200.0)) / sigmaA;
+  for (const double kelvin : { 1500.0, 2000.0 })
+  {
+    scene.Medium.Emission = { true, "blackbody", "temperature", 0.02, 1500.0 };
+    nimbus::SceneFields fields;
+    fields.Emission = DensityGrid::Constant(lo, hi, static_cast<float>(kelvin));
+    const RenderContext context(scene, DensityGrid::Constant(lo, hi, rho), std::move(fields));
+    const PathTracingResult r = nimbus::RenderPathTraced(context, Samples(100000, 23, 0));
+    const nimbus::BlackbodyEmission blackbody(context.GetSpectrum(), 1500.0);
+    ExpectPixel(r, 0, 0, Rgb(context, blackbody.RelativeSpectrum(kelvin), 0.02 * rho * path),
+      kelvin == 1500.0 ? "blackbody box at T_ref" : "blackbody box at 2000 K");
+  }
+  // A temperature field the renderer was not given, and a reference out of range: errors.
+  scene.Medium.Emission = { true, "blackbody", "temperature", 0.02, 1500.0 };
+  EXPECT_THROW(RenderContext(scene, DensityGrid::Constant(lo, hi, rho)), std::invalid_argument);
+  scene.Medium.Emission = { true, "blackbody", "temperature", 0.02, 100000.0 };
+  nimbus::SceneFields fields;
+  fields.Emission = DensityGrid::Constant(lo, hi, 1500.0f);
+  EXPECT_THROW(RenderContext(scene, DensityGrid::Constant(lo, hi, rho), std::move(fields)),
+    std::invalid_argument);
 }
 
 //------------------------------------------------------------------------------

@@ -1209,7 +1209,8 @@ TEST(SceneJson, Version3Errors)
   ExpectError(
     V3Without("/medium/emission/source"), "scene.medium.emission: missing required key \"source\"");
   ExpectError(V3With("/medium/emission/source", "temperature"),
-    "scene.medium.emission.source: unknown value \"temperature\" (known: from_density, array)");
+    "scene.medium.emission.source: unknown value \"temperature\" (known: from_density, array, "
+    "blackbody)");
   ExpectError(
     V3Without("/medium/emission/array"), "scene.medium.emission: missing required key \"array\"");
   ExpectError(V3With("/medium/emission/array", ""),
@@ -1226,7 +1227,7 @@ TEST(SceneJson, Version3Errors)
     "scene.medium.emission.glow: unknown key (known: source, array, radiance_per_metre, "
     "temperature_kelvin)");
   ExpectError(V3With("/media/0/emission/array", "heat"),
-    "scene.media[0].emission.array: only used by source \"array\"");
+    "scene.media[0].emission.array: only used by sources \"array\" and \"blackbody\"");
   {
     Json j = Version3Json();
     j["medium"]["density"] = Json::parse(R"({"type": "metaball_cloud"})");

@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""Smoke and fire: the Cloud representation against the path tracer (issue 17).
+
+    PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
+        scripts/smoke-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
+
+Two media from vtkNimbusSmokeSource (the default 8 x 8 x 12 m box of 32 x 32 x 48
+cells), written as .vti files beside their version-3 scene files:
+
+  smoke  the default plume (600 K at the source) after 3 s, by day: sun 30 degrees
+         high, smoke's optics (1.5 /m per unit density, albedo 0.6, Cornette-Shanks
+         g 0.3); no air, no ground, black background, to isolate the medium;
+  fire   a hot plume (1500 K at the source, cooling 1.5 /s) after 2 s at night: no sun,
+         the smoke's own blackbody glow (the representation's Temperature Emission,
+         E = 1 Y/(sr m) per unit density at 1500 K; the scene's "blackbody" emission).
+
+The reference is the path tracer (vtkNimbusReferenceRenderer, all orders of scattering,
+cached in the output directory); Nimbus renders the same view with
+vtkNimbusCloudVolumeMapper (its default multiple scattering: the discrete-direction
+solve; 512 slices). The script prints, per scene, the mean over the medium's pixels
+(image / reference, with the reference's standard error) and the RMSE of 8x8-pixel block
+means over the medium corrected for the reference's noise, relative to the mean, with
+the times; it writes reference | Nimbus strips as smoke-vs-path-tracer-<scene>.png.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+import nimbus
+from nimbus import harness
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+from vtkmodules.vtkRenderingCore import vtkRenderWindow, vtkRenderer, vtkVolume
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--output-dir", default="smoke-vs-path-tracer")
+parser.add_argument("--time-limit", type=float, default=180.0,
+                    help="seconds of path tracing per reference (default 180)")
+parser.add_argument("--size", type=int, nargs=2, default=(160, 200))
+parser.add_argument("--scenes", nargs="+", default=["smoke", "fire"])
+parser.add_argument("--albedo", type=float, default=0.6,
+                    help="the smoke's single-scattering albedo (default 0.6; 0 isolates "
+                         "the emission from its scattering)")
+args = parser.parse_args()
+os.makedirs(args.output_dir, exist_ok=True)
+
+CAMERA = {"position": [0, -24, 5.5], "focal_point": [0, 0, 5.5], "view_up": [0, 0, 1],
+          "view_angle": 35, "width": args.size[0], "height": args.size[1]}
+SCENES = {
+    "smoke": {"source": {"EmitterTemperatureKelvin": 600.0, "CoolingPerSecond": 0.2},
+              "seconds": 3.0, "sun": 1.0, "emission": False},
+    "fire": {"source": {"EmitterTemperatureKelvin": 1500.0, "CoolingPerSecond": 1.5},
+             "seconds": 2.0, "sun": 0.0, "emission": True},
+}
+OPTICS = {"extinction": 1.5, "albedo": args.albedo, "g": 0.3}
+EMISSION = {"radiance_per_metre": 1.0, "reference_kelvin": 1500.0}
+BLOCK = 8
+
+
+def simulate(name):
+    config = SCENES[name]
+    smoke = nimbus.vtkNimbusSmokeSource()
+    for key, value in config["source"].items():
+        getattr(smoke, "Set" + key)(value)
+    smoke.SetNumberOfFrames(int(round(config["seconds"] * 24)))
+    start = time.perf_counter()
+    smoke.UpdateInformation()
+    smoke.UpdateTimeStep(config["seconds"])
+    print(f"{name}: simulated {config['seconds']} s in {time.perf_counter() - start:.1f} s",
+          file=sys.stderr)
+    path = os.path.join(args.output_dir, name + ".vti")
+    writer = vtkXMLImageDataWriter()
+    writer.SetInputData(smoke.GetOutput())
+    writer.SetFileName(path)
+    writer.Write()
+    return smoke.GetOutput(), path
+
+
+def scene_for(name, vti):
+    config = SCENES[name]
+    medium = {"density": {"type": "file", "path": os.path.basename(vti), "array": "density"},
+              "extinction_per_density": OPTICS["extinction"],
+              "single_scattering_albedo": OPTICS["albedo"],
+              "phase": [{"type": "cornette_shanks", "g": OPTICS["g"], "weight": 1}]}
+    if config["emission"]:
+        medium["emission"] = {"source": "blackbody", "array": "temperature",
+                              "radiance_per_metre": EMISSION["radiance_per_metre"],
+                              "temperature_kelvin": EMISSION["reference_kelvin"]}
+    scene = {"nimbus_scene": 3, "name": "smoke_" + name,
+             "description": f"vtkNimbusSmokeSource's {name} (scripts/smoke-vs-path-tracer.py)",
+             "camera": CAMERA, "medium": medium,
+             "sun": {"azimuth_degrees": 200, "elevation_degrees": 30,
+                     "illuminance": config["sun"], "temperature_kelvin": 5778},
+             "atmosphere": {"enabled": False}, "ground": {"enabled": False},
+             "background": {"type": "constant", "radiance": 0}}
+    path = os.path.join(args.output_dir, name + ".json")
+    with open(path, "w") as stream:
+        json.dump(scene, stream, indent=1)
+    return path
+
+
+def render_nimbus(name, image_data):
+    config = SCENES[name]
+    mapper = nimbus.vtkNimbusCloudVolumeMapper()
+    mapper.SetInputData(image_data)
+    mapper.SetExtinctionPerDensity(OPTICS["extinction"])
+    mapper.SetAlbedo(OPTICS["albedo"])
+    mapper.SetCloudG(OPTICS["g"])
+    mapper.SetSunElevationDegrees(30)
+    mapper.SetSunAzimuthDegrees(200)
+    mapper.SetSunIlluminance(config["sun"])
+    mapper.SetAtmosphere(False)
+    mapper.SetGround(False)
+    mapper.SetTemperatureEmission(config["emission"])
+    mapper.SetEmissionRadiancePerMetre(EMISSION["radiance_per_metre"])
+    mapper.SetEmissionReferenceTemperatureKelvin(EMISSION["reference_kelvin"])
+    mapper.SetNumberOfSlices(512)
+    mapper.SetExposure(harness.VTK_SCALE)
+    mapper.SetCaptureRadiance(True)
+    volume = vtkVolume()
+    volume.SetMapper(mapper)
+    renderer = vtkRenderer()
+    renderer.AddVolume(volume)
+    renderer.SetBackground(0, 0, 0)
+    camera = renderer.GetActiveCamera()
+    camera.SetPosition(*CAMERA["position"])
+    camera.SetFocalPoint(*CAMERA["focal_point"])
+    camera.SetViewUp(*CAMERA["view_up"])
+    camera.SetViewAngle(CAMERA["view_angle"])
+    camera.SetClippingRange(0.1, 1e4)
+    window = vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetMultiSamples(0)
+    window.SetSize(*args.size)
+    window.AddRenderer(renderer)
+    start = time.perf_counter()
+    window.Render()
+    seconds = time.perf_counter() - start
+    radiance = mapper.GetRadianceImage()
+    width, height, _ = radiance.GetDimensions()
+    image = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
+    window.Finalize()
+    return image[..., :3].astype(np.float32).copy(), seconds
+
+
+def blocks(image):
+    h, w = (image.shape[0] // BLOCK) * BLOCK, (image.shape[1] // BLOCK) * BLOCK
+    return image[:h, :w].reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK, 3).mean(axis=(1, 3))
+
+
+def block_errors(error):
+    h, w = (error.shape[0] // BLOCK) * BLOCK, (error.shape[1] // BLOCK) * BLOCK
+    return np.sqrt((error[:h, :w] ** 2).reshape(
+        h // BLOCK, BLOCK, w // BLOCK, BLOCK, 3).sum(axis=(1, 3))) / BLOCK ** 2
+
+
+print(f"{'scene':<6} {'Nimbus s':>9} {'mean / reference':>20} {'block RMSE / mean':>18} "
+      f"{'reference':>10}")
+for name in args.scenes:
+    image_data, vti = simulate(name)
+    scene_path = scene_for(name, vti)
+    settings = {"mode": "path", "min_spp": 16, "max_spp": 1 << 20,
+                "time_limit": args.time_limit, "seed": 1}
+    key = "reference-" + harness.scene_hash(scene_path, settings)
+
+    def path_trace():
+        start = time.perf_counter()
+        image, output = harness.render_reference_mode(scene_path, settings)
+        print(f"{name}: path tracer {time.perf_counter() - start:.0f} s", file=sys.stderr)
+        return image, harness.standard_error_of(output)
+
+    reference, reference_error, cached = harness.cached_image(args.output_dir, key, path_trace)
+    image, seconds = render_nimbus(name, image_data)
+    luminance = reference.mean(axis=2)
+    medium = luminance > 0.01 * luminance.max()
+    count = int(medium.sum())
+    mean_reference = float(reference[medium].mean())
+    mean_error = float(np.sqrt((reference_error[medium] ** 2).sum() / 3.0)) / count
+    ratio = float(image[medium].mean()) / mean_reference
+    medium_blocks = blocks(np.repeat(medium[..., None], 3, axis=2).astype(np.float64)) > 0.5
+    metrics = harness.error_metrics(blocks(image)[medium_blocks],
+                                    blocks(reference)[medium_blocks],
+                                    block_errors(reference_error)[medium_blocks])
+    print(f"{name:<6} {seconds:9.2f} {ratio:12.3f} +- {ratio * mean_error / mean_reference:.3f} "
+          f"{metrics['rmse'] / float(blocks(reference)[medium_blocks].mean()):18.3f} "
+          f"{'cached' if cached else 'rendered':>10}")
+    scale = 0.5 / max(float(np.percentile(reference[medium], 99)), 1e-30)
+    strip = np.concatenate([reference, image], axis=1) * scale / harness.DISPLAY_EXPOSURE
+    harness.write_png(strip, os.path.join(args.output_dir, f"smoke-vs-path-tracer-{name}.png"))
