@@ -5,6 +5,9 @@
 // vtkArrayDispatch, and the path that borrows the array instead of copying it.
 #include "CloudDensityTexture.h"
 #include "DensityResample.h"
+#include "EmissionTexture.h"
+
+#include "BlackbodyEmission.h"
 
 #include "vtkAOSDataArrayTemplate.h"
 #include "vtkBitArray.h"
@@ -405,4 +408,29 @@ TEST(DensityResample, CensusAndTooLargeValues)
     nimbus::ResampleDensity(large.data(), 1, PlanDensityResample({ 2, 1, 1 }, 16));
   EXPECT_TRUE(clamped.IsCopy());
   EXPECT_FLOAT_EQ(clamped.Data()[1], static_cast<float>(nimbus::kMaximumDensity));
+}
+
+// The emission texels (issue 17): per texel the mean over its block of rho B(T) / Y[B(T_ref)],
+// blocks at the upper edges partial; NaN or negative densities and NaN temperatures emit
+// nothing.
+TEST(EmissionTexels, BlockMeansOfDensityTimesBlackbody)
+{
+  const nimbus::SpectralSamples spectrum;
+  const nimbus::BlackbodyEmission blackbody(spectrum, 1500.0);
+  const std::array<int, 3> dims{ { 3, 2, 1 } };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> rho = { 1.0f, 2.0f, 4.0f, nan, -1.0f, 0.5f };
+  const std::vector<float> kelvin = { 1500.0f, 2000.0f, 1800.0f, 1500.0f, 1500.0f, nan };
+  const std::vector<float> texels = nimbus::ComputeEmissionTexels(
+    rho.data(), kelvin.data(), dims, { { 2, 2, 1 } }, { { 2, 1, 1 } }, blackbody);
+  ASSERT_EQ(texels.size(), 6u);
+  for (int c = 0; c < 3; ++c)
+  {
+    // Texel 0: samples 0, 1, 3, 4 (two of them emit nothing); texel 1: samples 2 and 5.
+    const double first =
+      (1.0 * blackbody.RelativeRgb(1500.0)[c] + 2.0 * blackbody.RelativeRgb(2000.0)[c]) / 4.0;
+    const double second = 4.0 * blackbody.RelativeRgb(1800.0)[c] / 2.0;
+    EXPECT_NEAR(texels[c], first, 1e-6 * std::abs(first)) << c;
+    EXPECT_NEAR(texels[3 + c], second, 1e-6 * std::abs(second)) << c;
+  }
 }
