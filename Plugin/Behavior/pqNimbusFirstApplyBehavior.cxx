@@ -1,5 +1,7 @@
 #include "pqNimbusFirstApplyBehavior.h"
 
+#include "NimbusMediumPresets.h"
+
 #include "pqAnimationManager.h"
 #include "pqAnimationScene.h"
 #include "pqApplicationCore.h"
@@ -85,14 +87,6 @@ bool IsSmoke(pqPipelineSource* source)
   const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
   return name && std::strcmp(name, "NimbusSmoke") == 0;
 }
-
-// Smoke's optics on the Cloud representation: the smoke's density is about 1 near the
-// source over metres, not a cloud's over kilometres, and soot absorbs. Extinction 1.5 /m
-// per unit density (an optical depth of a few across the plume), albedo 0.6 (grey
-// smoke), forward scattering 0.3.
-constexpr double kSmokeExtinctionPerDensity = 1.5;
-constexpr double kSmokeAlbedo = 0.6;
-constexpr double kSmokeG = 0.3;
 
 // The Nimbus Lightning feeding a Lightning Illumination filter, or nullptr.
 vtkSMProxy* LightningOf(pqPipelineSource* illumination)
@@ -271,9 +265,11 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
     AfterApply(this, data,
       [](pqDataRepresentation* smoke)
       {
+        // Smoke's optics (NimbusMediumPresets.h): not a cloud's over kilometres.
         vtkSMProxy* proxy = smoke->getProxy();
+        const nimbus::MediumPreset& preset = nimbus::kMediumPresets[nimbus::kSmokePreset];
         const char* names[3] = { "ExtinctionPerDensity", "Albedo", "CloudG" };
-        const double values[3] = { kSmokeExtinctionPerDensity, kSmokeAlbedo, kSmokeG };
+        const double values[3] = { preset.ExtinctionPerDensity, preset.Albedo, preset.CloudG };
         for (int k = 0; k < 3; ++k)
         {
           if (proxy->GetProperty(names[k]))

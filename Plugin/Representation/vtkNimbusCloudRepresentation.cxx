@@ -141,6 +141,9 @@ void vtkNimbusCloudRepresentation::UpdateMapperParameters()
 NIMBUS_FORWARD(ExtinctionPerDensity, double)
 NIMBUS_FORWARD(Albedo, double)
 NIMBUS_FORWARD(CloudG, double)
+NIMBUS_FORWARD(TemperatureEmission, bool)
+NIMBUS_FORWARD(EmissionRadiancePerMetre, double)
+NIMBUS_FORWARD(EmissionReferenceTemperatureKelvin, double)
 NIMBUS_FORWARD(MultipleScattering, double)
 NIMBUS_FORWARD(MultipleScatteringMethod, int)
 NIMBUS_FORWARD(MultipleScatteringOrders, int)
@@ -183,6 +186,16 @@ NIMBUS_FORWARD(FrameBudgetMilliseconds, double)
 NIMBUS_FORWARD(Quality, double)
 
 #undef NIMBUS_FORWARD
+
+void vtkNimbusCloudRepresentation::SetEmissionTemperatureArray(const char* name)
+{
+  this->CloudMapper->SetEmissionTemperatureArray(name);
+}
+
+const char* vtkNimbusCloudRepresentation::GetEmissionTemperatureArray()
+{
+  return this->CloudMapper->GetEmissionTemperatureArray();
+}
 
 void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {

@@ -56,6 +56,20 @@ public:
   ///@}
 
   ///@{
+  /// Temperature emission (vtkNimbusCloudVolumeMapper): on/off, the temperature array
+  /// (K), the luminance per metre of a unit density at the reference temperature, and
+  /// that temperature (K).
+  void SetTemperatureEmission(bool value);
+  bool GetTemperatureEmission();
+  void SetEmissionTemperatureArray(const char* name);
+  const char* GetEmissionTemperatureArray();
+  void SetEmissionRadiancePerMetre(double value);
+  double GetEmissionRadiancePerMetre();
+  void SetEmissionReferenceTemperatureKelvin(double value);
+  double GetEmissionReferenceTemperatureKelvin();
+  ///@}
+
+  ///@{
   /// Multiple scattering (vtkNimbusCloudVolumeMapper::MultipleScatteringMethods):
   /// the method (0 None, 1 Octaves, 2 Reference patterns, 3 Discrete directions),
   /// explicit orders, solver grid downsampling [texels per cell], directions, sky
