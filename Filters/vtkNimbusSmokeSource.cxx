@@ -1,5 +1,6 @@
 #include "vtkNimbusSmokeSource.h"
 
+#include "SmokePuffs.h"
 #include "SmokeSolver.h"
 #include "Voxelize.h"
 
@@ -19,7 +20,9 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -34,7 +37,38 @@ struct SmokeState
   double Time = 0.0;
   std::vector<float> Density, Temperature, U, V, W;
   std::vector<double> Pressure; // the pressure solve's first guess
+  nimbus::PuffState Puffs;      // with puffs on
 };
+
+// Trilinear interpolation of a cell-centred field (n cells per axis, x fastest) at a point
+// given in cell coordinates (cell c's centre at c + 1/2), clamped to the centres.
+float SampleCells(
+  const std::vector<float>& field, const std::array<int, 3>& n, double x, double y, double z)
+{
+  const double at[3] = { x - 0.5, y - 0.5, z - 0.5 };
+  int i0[3];
+  double f[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double c = std::clamp(at[a], 0.0, static_cast<double>(n[a] - 1));
+    i0[a] = std::min(static_cast<int>(c), std::max(n[a] - 2, 0));
+    f[a] = n[a] > 1 ? c - i0[a] : 0.0;
+  }
+  double value = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    int idx[3];
+    double w = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const int step = (corner >> a) & 1;
+      idx[a] = std::min(i0[a] + step, n[a] - 1);
+      w *= step ? f[a] : 1.0 - f[a];
+    }
+    value += w * field[(static_cast<std::size_t>(idx[2]) * n[1] + idx[1]) * n[0] + idx[0]];
+  }
+  return static_cast<float>(value);
+}
 } // namespace
 
 struct vtkNimbusSmokeSource::vtkInternals
@@ -42,7 +76,8 @@ struct vtkNimbusSmokeSource::vtkInternals
   std::vector<double> Key; // what the states depend on
   std::map<int, SmokeState> Checkpoints;
   std::unique_ptr<nimbus::SmokeSolver> Solver;
-  int SolverFrame = -1; // the frame the solver holds
+  std::unique_ptr<nimbus::SmokePuffs> Puffs; // with puffs on
+  int SolverFrame = -1;                      // the frame the solver holds
   int LastFrame = -1;
   int LastSubsteps = 0;
 
@@ -50,6 +85,7 @@ struct vtkNimbusSmokeSource::vtkInternals
   {
     this->Checkpoints.clear();
     this->Solver.reset();
+    this->Puffs.reset();
     this->SolverFrame = -1;
   }
 };
@@ -76,12 +112,16 @@ int vtkNimbusSmokeSource::RequestInformation(
   vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  const int n[3] = { std::clamp(this->Dimensions[0], 1, 1024),
-    std::clamp(this->Dimensions[1], 1, 1024), std::clamp(this->Dimensions[2], 1, 1024) };
+  // With puffs, PuffResolution points per cell and axis.
+  const int r = this->Puffs ? this->PuffResolution : 1;
+  const int n[3] = { r * std::clamp(this->Dimensions[0], 1, 1024),
+    r * std::clamp(this->Dimensions[1], 1, 1024), r * std::clamp(this->Dimensions[2], 1, 1024) };
   const int extent[6] = { 0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1 };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   const double h =
-    std::isfinite(this->CellSizeMetres) && this->CellSizeMetres > 0.0 ? this->CellSizeMetres : 1.0;
+    (std::isfinite(this->CellSizeMetres) && this->CellSizeMetres > 0.0 ? this->CellSizeMetres
+                                                                       : 1.0) /
+    r;
   const double spacing[3] = { h, h, h };
   const double origin[3] = { this->Origin[0] + 0.5 * h, this->Origin[1] + 0.5 * h,
     this->Origin[2] + 0.5 * h };
@@ -254,6 +294,31 @@ int vtkNimbusSmokeSource::RequestData(
     in.Reset();
     return 1;
   }
+  // Puffs: each carries the smoke of 1 / PuffsPerSecond seconds of the emitter's,
+  // DensityPerSecond V_emitter / PuffsPerSecond [density m^3], as a metaball of
+  // WyvillFalloffIntegral(R0) per unit peak density.
+  nimbus::PuffParameters pp;
+  pp.PuffsPerSecond = this->PuffsPerSecond;
+  pp.RadiusMetres = this->PuffRadiusMetres;
+  pp.GrowthPerSecond = this->PuffGrowthPerSecond;
+  pp.LifetimeSeconds = this->PuffLifetimeSeconds;
+  pp.Threads = this->NumberOfThreads;
+  if (this->Puffs)
+  {
+    const double emitterVolume = 4.0 / 3.0 * M_PI * std::pow(this->EmitterRadiusMetres, 3.0); // m^3
+    pp.DensityPerPuff = this->PuffsPerSecond > 0.0 && this->PuffRadiusMetres > 0.0
+      ? this->EmitterDensityPerSecond * emitterVolume /
+        (this->PuffsPerSecond * nimbus::WyvillFalloffIntegral(this->PuffRadiusMetres))
+      : 0.0;
+    const std::string puffWhy = nimbus::CheckPuffParameters(pp);
+    if (!puffWhy.empty() || !std::isfinite(pp.DensityPerPuff))
+    {
+      vtkErrorMacro("Smoke: puffs: "
+        << (puffWhy.empty() ? "the density per puff is not finite" : puffWhy) << "; no output.");
+      in.Reset();
+      return 1;
+    }
+  }
 
   // The states depend on everything above but the threads and the number of frames.
   std::vector<double> key = { static_cast<double>(p.Dimensions[0]),
@@ -265,7 +330,9 @@ int vtkNimbusSmokeSource::RequestData(
     emitter.Velocity[1], emitter.Velocity[2], emitter.RadiusMetres, emitter.DensityPerSecond,
     emitter.TemperatureKelvin, this->FrameDurationSeconds,
     static_cast<double>(this->CheckpointInterval),
-    obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0), static_cast<double>(obstacleTime) };
+    obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0), static_cast<double>(obstacleTime),
+    this->Puffs ? 1.0 : 0.0, pp.PuffsPerSecond, pp.RadiusMetres, pp.GrowthPerSecond,
+    pp.LifetimeSeconds };
   if (key != in.Key)
   {
     in.Reset();
@@ -284,10 +351,25 @@ int vtkNimbusSmokeSource::RequestData(
 
   try
   {
-    if (!in.Solver)
+    const auto restart = [&]()
     {
       in.Solver.reset(new nimbus::SmokeSolver(p));
+      in.Puffs.reset(this->Puffs ? new nimbus::SmokePuffs(pp) : nullptr);
       in.SolverFrame = 0;
+    };
+    const auto restore = [&](int checkpointFrame, const SmokeState& s)
+    {
+      in.Solver->SetState(s.Time, s.Density, s.Temperature, s.U, s.V, s.W);
+      in.Solver->SetPressureGuess(s.Pressure);
+      if (in.Puffs)
+      {
+        in.Puffs->SetState(s.Puffs);
+      }
+      in.SolverFrame = checkpointFrame;
+    };
+    if (!in.Solver)
+    {
+      restart();
     }
     if (in.SolverFrame > frame)
     {
@@ -296,15 +378,11 @@ int vtkNimbusSmokeSource::RequestData(
       if (checkpoint != in.Checkpoints.begin())
       {
         --checkpoint;
-        const SmokeState& s = checkpoint->second;
-        in.Solver->SetState(s.Time, s.Density, s.Temperature, s.U, s.V, s.W);
-        in.Solver->SetPressureGuess(s.Pressure);
-        in.SolverFrame = checkpoint->first;
+        restore(checkpoint->first, checkpoint->second);
       }
       else
       {
-        in.Solver.reset(new nimbus::SmokeSolver(p));
-        in.SolverFrame = 0;
+        restart();
       }
     }
     else
@@ -316,10 +394,7 @@ int vtkNimbusSmokeSource::RequestData(
         --checkpoint;
         if (checkpoint->first > in.SolverFrame)
         {
-          const SmokeState& s = checkpoint->second;
-          in.Solver->SetState(s.Time, s.Density, s.Temperature, s.U, s.V, s.W);
-          in.Solver->SetPressureGuess(s.Pressure);
-          in.SolverFrame = checkpoint->first;
+          restore(checkpoint->first, checkpoint->second);
         }
       }
     }
@@ -329,6 +404,10 @@ int vtkNimbusSmokeSource::RequestData(
     {
       const nimbus::SmokeStepReport report = in.Solver->Step(this->FrameDurationSeconds);
       in.LastSubsteps += report.Substeps;
+      if (in.Puffs)
+      {
+        in.Puffs->Step(this->FrameDurationSeconds, *in.Solver);
+      }
       ++in.SolverFrame;
       if (in.SolverFrame % this->CheckpointInterval == 0)
       {
@@ -340,6 +419,10 @@ int vtkNimbusSmokeSource::RequestData(
         s.V = in.Solver->GetV();
         s.W = in.Solver->GetW();
         s.Pressure = in.Solver->GetPressureGuess();
+        if (in.Puffs)
+        {
+          s.Puffs = in.Puffs->GetState();
+        }
       }
       this->UpdateProgress(static_cast<double>(in.SolverFrame - first) / (frame - first));
       if (this->CheckAbort())
@@ -358,34 +441,78 @@ int vtkNimbusSmokeSource::RequestData(
   in.LastFrame = frame;
 
   const nimbus::SmokeSolver& solver = *in.Solver;
-  const double h = p.CellSizeMetres;
-  output->SetExtent(0, p.Dimensions[0] - 1, 0, p.Dimensions[1] - 1, 0, p.Dimensions[2] - 1);
+  // Output points: the cells' centres, or with puffs PuffResolution per cell and axis.
+  const int r = in.Puffs ? this->PuffResolution : 1;
+  const double h = p.CellSizeMetres / r;
+  const std::array<int, 3> dims{ { r * p.Dimensions[0], r * p.Dimensions[1],
+    r * p.Dimensions[2] } };
+  output->SetExtent(0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1);
   output->SetSpacing(h, h, h);
-  output->SetOrigin(p.Origin[0] + 0.5 * h, p.Origin[1] + 0.5 * h, p.Origin[2] + 0.5 * h);
-  const vtkIdType cells = static_cast<vtkIdType>(solver.NumberOfCells());
+  const nimbus::Vector3 first{ { p.Origin[0] + 0.5 * h, p.Origin[1] + 0.5 * h,
+    p.Origin[2] + 0.5 * h } };
+  output->SetOrigin(first.data());
+  const vtkIdType points = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
   vtkNew<vtkFloatArray> density, temperature, velocity;
   density->SetName("density");
   temperature->SetName("temperature");
   velocity->SetName("velocity");
   velocity->SetNumberOfComponents(3);
-  density->SetNumberOfTuples(cells);
-  temperature->SetNumberOfTuples(cells);
-  velocity->SetNumberOfTuples(cells);
-  std::copy(solver.GetDensity().begin(), solver.GetDensity().end(), density->GetPointer(0));
-  std::copy(
-    solver.GetTemperature().begin(), solver.GetTemperature().end(), temperature->GetPointer(0));
-  const std::vector<float> v = solver.CellVelocities();
-  std::copy(v.begin(), v.end(), velocity->GetPointer(0));
+  density->SetNumberOfTuples(points);
+  temperature->SetNumberOfTuples(points);
+  velocity->SetNumberOfTuples(points);
+  std::vector<std::uint8_t> obstacles = p.Obstacles;
+  if (r == 1)
+  {
+    std::copy(solver.GetDensity().begin(), solver.GetDensity().end(), density->GetPointer(0));
+    std::copy(
+      solver.GetTemperature().begin(), solver.GetTemperature().end(), temperature->GetPointer(0));
+    const std::vector<float> v = solver.CellVelocities();
+    std::copy(v.begin(), v.end(), velocity->GetPointer(0));
+  }
+  else
+  {
+    // The simulation's fields at the finer points (trilinear); its own density as
+    // "grid_density" beside the puffs'.
+    vtkNew<vtkFloatArray> gridDensity;
+    gridDensity->SetName("grid_density");
+    gridDensity->SetNumberOfTuples(points);
+    std::vector<std::uint8_t> fine(obstacles.empty() ? 0 : static_cast<std::size_t>(points));
+    for (int k = 0; k < dims[2]; ++k)
+      for (int j = 0; j < dims[1]; ++j)
+        for (int i = 0; i < dims[0]; ++i)
+        {
+          const vtkIdType id = (static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i;
+          // In the simulation's cell coordinates (cell c spans [c, c + 1]).
+          const double x = (i + 0.5) / r, y = (j + 0.5) / r, z = (k + 0.5) / r;
+          temperature->SetValue(id, SampleCells(solver.GetTemperature(), p.Dimensions, x, y, z));
+          gridDensity->SetValue(id, SampleCells(solver.GetDensity(), p.Dimensions, x, y, z));
+          const nimbus::Vector3 at{ { p.Origin[0] + x * p.CellSizeMetres,
+            p.Origin[1] + y * p.CellSizeMetres, p.Origin[2] + z * p.CellSizeMetres } };
+          const nimbus::Vector3 v = solver.VelocityAt(at);
+          velocity->SetTuple3(id, v[0], v[1], v[2]);
+          if (!fine.empty())
+          {
+            fine[static_cast<std::size_t>(id)] = obstacles[solver.CellIndex(i / r, j / r, k / r)];
+          }
+        }
+    output->GetPointData()->AddArray(gridDensity);
+    obstacles.swap(fine);
+  }
+  if (in.Puffs)
+  {
+    const std::vector<float> splat = in.Puffs->Splat(dims, first, h, this->NumberOfThreads);
+    std::copy(splat.begin(), splat.end(), density->GetPointer(0));
+  }
   output->GetPointData()->SetScalars(density);
   output->GetPointData()->AddArray(temperature);
   output->GetPointData()->AddArray(velocity);
-  if (!p.Obstacles.empty())
+  if (!obstacles.empty())
   {
     // Where the solid cells are (1), to show them (a contour at 0.5, or a threshold).
     vtkNew<vtkUnsignedCharArray> obstacle;
     obstacle->SetName("obstacle");
-    obstacle->SetNumberOfTuples(cells);
-    std::copy(p.Obstacles.begin(), p.Obstacles.end(), obstacle->GetPointer(0));
+    obstacle->SetNumberOfTuples(points);
+    std::copy(obstacles.begin(), obstacles.end(), obstacle->GetPointer(0));
     output->GetPointData()->AddArray(obstacle);
   }
   output->GetInformation()->Set(
@@ -428,4 +555,8 @@ void vtkNimbusSmokeSource::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfFrames: " << this->NumberOfFrames << "\n";
   os << indent << "CheckpointInterval: " << this->CheckpointInterval << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Puffs: " << (this->Puffs ? "on" : "off") << " (" << this->PuffsPerSecond
+     << " /s, radius " << this->PuffRadiusMetres << " m growing " << this->PuffGrowthPerSecond
+     << " /s, lifetime " << this->PuffLifetimeSeconds << " s, resolution " << this->PuffResolution
+     << ")\n";
 }

@@ -30,6 +30,9 @@
  * the parameters, never on the order times were asked for. Progress is reported per frame
  * and AbortExecute stops between sub-steps (the output is then empty).
  *
+ * With Puffs on, the output grid is PuffResolution times finer and its density is the
+ * puffs' (see Puffs below).
+ *
  * Bad input (an error naming it, empty output): the solver's refusals
  * (CheckSmokeParameters: non-finite or out-of-range numbers, grid sizes, obstacles
  * covering every cell), an obstacle input of the wrong size, a frame that needs more than
@@ -100,6 +103,32 @@ public:
   ///@}
 
   ///@{
+  /// Puffs (002 §4; Filters/Core/SmokePuffs.h), off by default: metaball particles born
+  /// in the emitter (PuffsPerSecond, radius PuffRadiusMetres, growing by
+  /// PuffGrowthPerSecond of it per second, removed after PuffLifetimeSeconds), carried by
+  /// the simulated air. When on, the output's "density" is the puffs splatted on a grid
+  /// PuffResolution times finer per axis than the simulation's (1 to 4), so detail
+  /// finer than the simulation's cells survives; each puff carries the smoke of
+  /// EmitterDensityPerSecond / PuffsPerSecond seconds of emission (the same amount as the
+  /// grid's smoke), and "temperature" and "velocity" are the simulation's, interpolated
+  /// (trilinear) to the finer points. "grid_density" is then the simulation's own density
+  /// at those points.
+  vtkSetMacro(Puffs, bool);
+  vtkGetMacro(Puffs, bool);
+  vtkBooleanMacro(Puffs, bool);
+  vtkSetMacro(PuffsPerSecond, double);
+  vtkGetMacro(PuffsPerSecond, double);
+  vtkSetMacro(PuffRadiusMetres, double);
+  vtkGetMacro(PuffRadiusMetres, double);
+  vtkSetMacro(PuffGrowthPerSecond, double);
+  vtkGetMacro(PuffGrowthPerSecond, double);
+  vtkSetMacro(PuffLifetimeSeconds, double);
+  vtkGetMacro(PuffLifetimeSeconds, double);
+  vtkSetClampMacro(PuffResolution, int, 1, 4);
+  vtkGetMacro(PuffResolution, int);
+  ///@}
+
+  ///@{
   /// Time: seconds per frame (1/24), frames (96), checkpoints every this many frames
   /// (8), threads (0: all cores; results do not depend on it).
   vtkSetMacro(FrameDurationSeconds, double);
@@ -145,6 +174,12 @@ protected:
   int NumberOfFrames = 96;
   int CheckpointInterval = 8;
   int NumberOfThreads = 0;
+  bool Puffs = false;
+  double PuffsPerSecond = 400.0;
+  double PuffRadiusMetres = 0.4;
+  double PuffGrowthPerSecond = 0.3;
+  double PuffLifetimeSeconds = 20.0;
+  int PuffResolution = 2;
 
 private:
   vtkNimbusSmokeSource(const vtkNimbusSmokeSource&) = delete;
