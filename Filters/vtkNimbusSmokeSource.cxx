@@ -80,6 +80,7 @@ struct vtkNimbusSmokeSource::vtkInternals
   int SolverFrame = -1;                      // the frame the solver holds
   int LastFrame = -1;
   int LastSubsteps = 0;
+  bool WarnedSubsteps = false; // said once per set of parameters
 
   void Reset()
   {
@@ -337,6 +338,7 @@ int vtkNimbusSmokeSource::RequestData(
   {
     in.Reset();
     in.Key = key;
+    in.WarnedSubsteps = false;
   }
 
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
@@ -404,6 +406,17 @@ int vtkNimbusSmokeSource::RequestData(
     {
       const nimbus::SmokeStepReport report = in.Solver->Step(this->FrameDurationSeconds);
       in.LastSubsteps += report.Substeps;
+      if (report.Substeps > 1 && !in.WarnedSubsteps)
+      {
+        // Said once per set of parameters: the frames stay stable, but cost more.
+        in.WarnedSubsteps = true;
+        vtkWarningMacro("Smoke: frame " << in.SolverFrame + 1 << " took " << report.Substeps
+                                        << " sub-steps: the air moved more than " << p.MaxCfl
+                                        << " cells in one frame (up to " << report.MaxSpeed
+                                        << " m/s), so each frame is split "
+                                           "to stay stable and costs that many times more. "
+                                           "Shorter frames or larger cells avoid it.");
+      }
       if (in.Puffs)
       {
         in.Puffs->Step(this->FrameDurationSeconds, *in.Solver);

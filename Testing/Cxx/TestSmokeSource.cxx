@@ -300,6 +300,28 @@ TEST(SmokeSource, PuffsSplattedFiner)
   }
 }
 
+// Frames too long for the flow are split into sub-steps (CFL), with one warning per set
+// of parameters, and stay finite.
+TEST(SmokeSource, LongFramesSubsteppedWithAWarning)
+{
+  auto s = SmallSmoke();
+  s->SetFrameDurationSeconds(0.5);
+  s->SetNumberOfFrames(6);
+  s->SetEmitterVelocity(0.0, 0.0, 4.0); // 2 m per frame: 5 cells of 0.4 m
+  nimbus::testing::MessageCatcher messages(s);
+  const std::vector<float> d = DensityAt(s, 1.0);
+  DensityAt(s, 3.0);
+  EXPECT_GT(s->GetLastSubsteps(), 4);
+  ASSERT_FALSE(d.empty());
+  for (const float v : d)
+  {
+    ASSERT_TRUE(std::isfinite(v));
+  }
+  EXPECT_EQ(messages.Warnings.size(), 1u) << messages.AllWarnings();
+  EXPECT_NE(messages.AllWarnings().find("sub-steps"), std::string::npos) << messages.AllWarnings();
+  EXPECT_TRUE(messages.Errors.empty()) << messages.AllErrors();
+}
+
 // Bad parameters: an error naming them and an empty output, never an exception.
 TEST(SmokeSource, BadInputRefused)
 {
