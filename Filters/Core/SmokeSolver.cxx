@@ -1,6 +1,7 @@
 #include "SmokeSolver.h"
 
 #include "ParallelFor.h"
+#include "SmokePressure.h"
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
@@ -21,6 +22,25 @@ int ThreadCount(int requested)
 {
   return requested > 0 ? requested
                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// Runs body(k) for k in [first, last) (the layers of a grid), one layer per chunk;
+// the body must write only the values of its own layer.
+template <typename Body>
+void ForLayers(int first, int last, int threads, const Body& body)
+{
+  if (last <= first)
+  {
+    return;
+  }
+  ParallelFor(static_cast<std::size_t>(last - first), 1, threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      for (std::size_t k = begin; k < end; ++k)
+      {
+        body(first + static_cast<int>(k));
+      }
+    });
 }
 
 bool Finite(const Vector3& v)
@@ -155,6 +175,11 @@ std::string CheckSmokeParameters(const SmokeParameters& p)
   {
     return "the pressure tolerance must be in (0, 1) and the iterations >= 1";
   }
+  if (p.PressureSolver != SmokePressureSolver::Multigrid &&
+    p.PressureSolver != SmokePressureSolver::IncompleteCholesky)
+  {
+    return "PressureSolver must be Multigrid or IncompleteCholesky";
+  }
   for (std::size_t e = 0; e < p.Emitters.size(); ++e)
   {
     const SmokeEmitter& m = p.Emitters[e];
@@ -184,16 +209,19 @@ std::string CheckSmokeParameters(const SmokeParameters& p)
   return "";
 }
 
-// The pressure equation on the fluid cells (see the file comment) and its solver,
-// factored once.
+// The pressure equation on the fluid cells (see the file comment) and its solver, set
+// up once: the multigrid hierarchy, or the matrix and its incomplete Cholesky factor.
 struct SmokeSolver::Pressure
 {
   std::vector<int> Unknown; // per cell: its row, or -1 (solid)
+  int Rows = 0;
+  std::unique_ptr<SmokePressure> Multigrid;
   Eigen::SparseMatrix<double> A;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
     Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>>>
     Cg;
-  Eigen::VectorXd Phi; // the last solution (the next solve's first guess)
+  std::vector<double> Phi; // per cell (0 in solids): the last solution, the next guess
+  std::vector<double> B;   // per cell: the right-hand side (scratch)
 };
 
 SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
@@ -230,6 +258,15 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
     {
       ps.Unknown[c] = rows++;
     }
+  }
+  ps.Rows = rows;
+  ps.Phi.assign(cells, 0.0);
+  ps.B.assign(cells, 0.0);
+  if (this->Parameters.PressureSolver == SmokePressureSolver::Multigrid)
+  {
+    ps.Multigrid.reset(new SmokePressure(n, this->Solid, ThreadCount(this->Parameters.Threads)));
+    this->EnforceSolidFaces();
+    return;
   }
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(static_cast<std::size_t>(rows) * 7);
@@ -274,7 +311,6 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
   ps.Cg.setTolerance(this->Parameters.PressureTolerance);
   ps.Cg.setMaxIterations(this->Parameters.PressureMaxIterations);
   ps.Cg.compute(ps.A);
-  ps.Phi = Eigen::VectorXd::Zero(rows);
   this->EnforceSolidFaces();
 }
 
@@ -286,45 +322,48 @@ std::size_t SmokeSolver::NumberOfCells() const
   return static_cast<std::size_t>(n[0]) * n[1] * n[2];
 }
 
-std::size_t SmokeSolver::CellIndex(int i, int j, int k) const
-{
-  const auto& n = this->Parameters.Dimensions;
-  return (static_cast<std::size_t>(k) * n[1] + j) * n[0] + i;
-}
-
 void SmokeSolver::EnforceSolidFaces()
 {
   const auto& n = this->Parameters.Dimensions;
   const auto solid = [&](int i, int j, int k)
   { return this->Solid[this->CellIndex(i, j, k)] != 0; };
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i <= n[0]; ++i)
-      {
-        if (i == 0 || i == n[0] || solid(i - 1, j, k) || solid(i, j, k))
+  ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+    [&](int k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i <= n[0]; ++i)
         {
-          this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] = 0.0f;
+          if (i == 0 || i == n[0] || solid(i - 1, j, k) || solid(i, j, k))
+          {
+            this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] = 0.0f;
+          }
         }
-      }
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j <= n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        if (j == 0 || j == n[1] || solid(i, j - 1, k) || solid(i, j, k))
+    });
+  ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+    [&](int k)
+    {
+      for (int j = 0; j <= n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i)
         {
-          this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] = 0.0f;
+          if (j == 0 || j == n[1] || solid(i, j - 1, k) || solid(i, j, k))
+          {
+            this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] = 0.0f;
+          }
         }
-      }
-  for (int k = 0; k <= n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        // The bottom is a wall; the top is open (only a solid cell below closes it).
-        if (k == 0 || (k < n[2] && solid(i, j, k)) || solid(i, j, k - 1))
+    });
+  ForLayers(0, n[2] + 1, ThreadCount(this->Parameters.Threads),
+    [&](int k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i)
         {
-          this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] = 0.0f;
+          // The bottom is a wall; the top is open (only a solid cell below closes it).
+          if (k == 0 || (k < n[2] && solid(i, j, k)) || solid(i, j, k - 1))
+          {
+            this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] = 0.0f;
+          }
         }
-      }
+    });
 }
 
 double SmokeSolver::MaxSpeed() const
@@ -478,18 +517,22 @@ void SmokeSolver::AddForces(double dt)
   const double h = p.CellSizeMetres;
   // Buoyancy (Boussinesq) on the interior and top w faces: the mean of the cells on
   // either side (the top face: its cell alone).
-  for (int k = 1; k <= n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const std::size_t below = this->CellIndex(i, j, k - 1);
-        const std::size_t above = k < n[2] ? this->CellIndex(i, j, k) : below;
-        const double t = 0.5 * (this->Temperature[below] + this->Temperature[above]);
-        const double rho = 0.5 * (this->Density[below] + this->Density[above]);
-        const double a = p.Gravity *
-          ((t - p.AmbientTemperatureKelvin) / p.AmbientTemperatureKelvin - p.DensityWeight * rho);
-        this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] += static_cast<float>(a * dt);
-      }
+  ForLayers(1, n[2] + 1, ThreadCount(this->Parameters.Threads),
+    [&](int k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i)
+        {
+          const std::size_t below = this->CellIndex(i, j, k - 1);
+          const std::size_t above = k < n[2] ? this->CellIndex(i, j, k) : below;
+          const double t = 0.5 * (this->Temperature[below] + this->Temperature[above]);
+          const double rho = 0.5 * (this->Density[below] + this->Density[above]);
+          const double a = p.Gravity *
+            ((t - p.AmbientTemperatureKelvin) / p.AmbientTemperatureKelvin - p.DensityWeight * rho);
+          this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] +=
+            static_cast<float>(a * dt);
+        }
+    });
   // Wind: a drag toward the wind's velocity.
   if (p.WindCoupling > 0.0)
   {
@@ -517,78 +560,93 @@ void SmokeSolver::AddForces(double dt)
       k = std::clamp(k, 0, n[2] - 1);
       return static_cast<double>(velocity[3 * this->CellIndex(i, j, k) + a]);
     };
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-        {
-          const std::size_t c = this->CellIndex(i, j, k);
-          const double dwdy = (vel(i, j + 1, k, 2) - vel(i, j - 1, k, 2)) / (2 * h);
-          const double dvdz = (vel(i, j, k + 1, 1) - vel(i, j, k - 1, 1)) / (2 * h);
-          const double dudz = (vel(i, j, k + 1, 0) - vel(i, j, k - 1, 0)) / (2 * h);
-          const double dwdx = (vel(i + 1, j, k, 2) - vel(i - 1, j, k, 2)) / (2 * h);
-          const double dvdx = (vel(i + 1, j, k, 1) - vel(i - 1, j, k, 1)) / (2 * h);
-          const double dudy = (vel(i, j + 1, k, 0) - vel(i, j - 1, k, 0)) / (2 * h);
-          omega[3 * c] = dwdy - dvdz;
-          omega[3 * c + 1] = dudz - dwdx;
-          omega[3 * c + 2] = dvdx - dudy;
-          magnitude[c] = std::sqrt(omega[3 * c] * omega[3 * c] +
-            omega[3 * c + 1] * omega[3 * c + 1] + omega[3 * c + 2] * omega[3 * c + 2]);
-        }
+    ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
+          {
+            const std::size_t c = this->CellIndex(i, j, k);
+            const double dwdy = (vel(i, j + 1, k, 2) - vel(i, j - 1, k, 2)) / (2 * h);
+            const double dvdz = (vel(i, j, k + 1, 1) - vel(i, j, k - 1, 1)) / (2 * h);
+            const double dudz = (vel(i, j, k + 1, 0) - vel(i, j, k - 1, 0)) / (2 * h);
+            const double dwdx = (vel(i + 1, j, k, 2) - vel(i - 1, j, k, 2)) / (2 * h);
+            const double dvdx = (vel(i + 1, j, k, 1) - vel(i - 1, j, k, 1)) / (2 * h);
+            const double dudy = (vel(i, j + 1, k, 0) - vel(i, j - 1, k, 0)) / (2 * h);
+            omega[3 * c] = dwdy - dvdz;
+            omega[3 * c + 1] = dudz - dwdx;
+            omega[3 * c + 2] = dvdx - dudy;
+            magnitude[c] = std::sqrt(omega[3 * c] * omega[3 * c] +
+              omega[3 * c + 1] * omega[3 * c + 1] + omega[3 * c + 2] * omega[3 * c + 2]);
+          }
+      });
     std::vector<double> force(3 * cells, 0.0);
     const auto mag = [&](int i, int j, int k)
     {
       return magnitude[this->CellIndex(
         std::clamp(i, 0, n[0] - 1), std::clamp(j, 0, n[1] - 1), std::clamp(k, 0, n[2] - 1))];
     };
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-        {
-          const std::size_t c = this->CellIndex(i, j, k);
-          double g[3] = { (mag(i + 1, j, k) - mag(i - 1, j, k)) / (2 * h),
-            (mag(i, j + 1, k) - mag(i, j - 1, k)) / (2 * h),
-            (mag(i, j, k + 1) - mag(i, j, k - 1)) / (2 * h) };
-          const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-          if (!(length > 1e-20))
+    ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
           {
-            continue;
+            const std::size_t c = this->CellIndex(i, j, k);
+            double g[3] = { (mag(i + 1, j, k) - mag(i - 1, j, k)) / (2 * h),
+              (mag(i, j + 1, k) - mag(i, j - 1, k)) / (2 * h),
+              (mag(i, j, k + 1) - mag(i, j, k - 1)) / (2 * h) };
+            const double length = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+            if (!(length > 1e-20))
+            {
+              continue;
+            }
+            for (double& x : g)
+            {
+              x /= length;
+            }
+            const double* w = &omega[3 * c];
+            const double scale = p.VorticityConfinement * h;
+            force[3 * c] = scale * (g[1] * w[2] - g[2] * w[1]);
+            force[3 * c + 1] = scale * (g[2] * w[0] - g[0] * w[2]);
+            force[3 * c + 2] = scale * (g[0] * w[1] - g[1] * w[0]);
           }
-          for (double& x : g)
+      });
+    ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 1; i < n[0]; ++i)
           {
-            x /= length;
+            this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] +=
+              static_cast<float>(0.5 * dt *
+                (force[3 * this->CellIndex(i - 1, j, k)] + force[3 * this->CellIndex(i, j, k)]));
           }
-          const double* w = &omega[3 * c];
-          const double scale = p.VorticityConfinement * h;
-          force[3 * c] = scale * (g[1] * w[2] - g[2] * w[1]);
-          force[3 * c + 1] = scale * (g[2] * w[0] - g[0] * w[2]);
-          force[3 * c + 2] = scale * (g[0] * w[1] - g[1] * w[0]);
-        }
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 1; i < n[0]; ++i)
-        {
-          this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] +=
-            static_cast<float>(0.5 * dt *
-              (force[3 * this->CellIndex(i - 1, j, k)] + force[3 * this->CellIndex(i, j, k)]));
-        }
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 1; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-        {
-          this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] +=
-            static_cast<float>(0.5 * dt *
-              (force[3 * this->CellIndex(i, j - 1, k) + 1] +
-                force[3 * this->CellIndex(i, j, k) + 1]));
-        }
-    for (int k = 1; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-        {
-          this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] +=
-            static_cast<float>(0.5 * dt *
-              (force[3 * this->CellIndex(i, j, k - 1) + 2] +
-                force[3 * this->CellIndex(i, j, k) + 2]));
-        }
+      });
+    ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 1; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
+          {
+            this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] +=
+              static_cast<float>(0.5 * dt *
+                (force[3 * this->CellIndex(i, j - 1, k) + 1] +
+                  force[3 * this->CellIndex(i, j, k) + 1]));
+          }
+      });
+    ForLayers(1, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
+          {
+            this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] +=
+              static_cast<float>(0.5 * dt *
+                (force[3 * this->CellIndex(i, j, k - 1) + 2] +
+                  force[3 * this->CellIndex(i, j, k) + 2]));
+          }
+      });
   }
   this->EnforceSolidFaces();
 }
@@ -616,26 +674,29 @@ void SmokeSolver::Diffuse(double dt)
         a]);
     };
     const double cs = p.SmagorinskyConstant * h;
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-        {
-          double grad[3][3];
-          for (int a = 0; a < 3; ++a)
+    ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+      [&](int k)
+      {
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
           {
-            grad[a][0] = (vel(i + 1, j, k, a) - vel(i - 1, j, k, a)) / (2 * h);
-            grad[a][1] = (vel(i, j + 1, k, a) - vel(i, j - 1, k, a)) / (2 * h);
-            grad[a][2] = (vel(i, j, k + 1, a) - vel(i, j, k - 1, a)) / (2 * h);
-          }
-          double s2 = 0.0;
-          for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
+            double grad[3][3];
+            for (int a = 0; a < 3; ++a)
             {
-              const double s = 0.5 * (grad[a][b] + grad[b][a]);
-              s2 += s * s;
+              grad[a][0] = (vel(i + 1, j, k, a) - vel(i - 1, j, k, a)) / (2 * h);
+              grad[a][1] = (vel(i, j + 1, k, a) - vel(i, j - 1, k, a)) / (2 * h);
+              grad[a][2] = (vel(i, j, k + 1, a) - vel(i, j, k - 1, a)) / (2 * h);
             }
-          nu[this->CellIndex(i, j, k)] = cs * cs * std::sqrt(2.0 * s2);
-        }
+            double s2 = 0.0;
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b)
+              {
+                const double s = 0.5 * (grad[a][b] + grad[b][a]);
+                s2 += s * s;
+              }
+            nu[this->CellIndex(i, j, k)] = cs * cs * std::sqrt(2.0 * s2);
+          }
+      });
   }
   const double largest = *std::max_element(nu.begin(), nu.end());
   if (!(largest > 0.0))
@@ -665,21 +726,24 @@ void SmokeSolver::Diffuse(double dt)
             d[0] +
           std::clamp(i, 0, d[0] - 1)];
       };
-      for (int k = 0; k < d[2]; ++k)
-        for (int j = 0; j < d[1]; ++j)
-          for (int i = 0; i < d[0]; ++i)
-          {
-            // nu at the face: the nearest cell's.
-            const int ci = std::min(i, n[0] - 1), cj = std::min(j, n[1] - 1),
-                      ck = std::min(k, n[2] - 1);
-            const double viscosity = nu[this->CellIndex(ci, cj, ck)];
-            const double laplacian =
-              (at(i + 1, j, k) + at(i - 1, j, k) + at(i, j + 1, k) + at(i, j - 1, k) +
-                at(i, j, k + 1) + at(i, j, k - 1) - 6.0 * at(i, j, k)) /
-              (h * h);
-            (*faces[a].Field)[(static_cast<std::size_t>(k) * d[1] + j) * d[0] + i] =
-              static_cast<float>(at(i, j, k) + tau * viscosity * laplacian);
-          }
+      ForLayers(0, d[2], ThreadCount(this->Parameters.Threads),
+        [&](int k)
+        {
+          for (int j = 0; j < d[1]; ++j)
+            for (int i = 0; i < d[0]; ++i)
+            {
+              // nu at the face: the nearest cell's.
+              const int ci = std::min(i, n[0] - 1), cj = std::min(j, n[1] - 1),
+                        ck = std::min(k, n[2] - 1);
+              const double viscosity = nu[this->CellIndex(ci, cj, ck)];
+              const double laplacian =
+                (at(i + 1, j, k) + at(i - 1, j, k) + at(i, j + 1, k) + at(i, j - 1, k) +
+                  at(i, j, k + 1) + at(i, j, k - 1) - 6.0 * at(i, j, k)) /
+                (h * h);
+              (*faces[a].Field)[(static_cast<std::size_t>(k) * d[1] + j) * d[0] + i] =
+                static_cast<float>(at(i, j, k) + tau * viscosity * laplacian);
+            }
+        });
     }
     this->EnforceSolidFaces();
   }
@@ -689,61 +753,99 @@ void SmokeSolver::Project(double, SmokeStepReport& report)
 {
   const auto& n = this->Parameters.Dimensions;
   const double h = this->Parameters.CellSizeMetres;
+  const int threads = ThreadCount(this->Parameters.Threads);
   Pressure& ps = *this->PressureSolver;
   const std::vector<double> divergence = this->Divergence();
-  Eigen::VectorXd b(ps.A.rows());
   double before = 0.0;
   int fluid = 0;
   for (std::size_t c = 0; c < divergence.size(); ++c)
   {
+    ps.B[c] = -h * h * divergence[c]; // 0 in solid cells
     if (ps.Unknown[c] >= 0)
     {
-      b[ps.Unknown[c]] = -h * h * divergence[c];
       before += divergence[c] * divergence[c];
       ++fluid;
     }
   }
   report.DivergenceBefore = std::sqrt(before / std::max(fluid, 1));
-  if (before > 0.0)
+  if (before > 0.0 && ps.Multigrid)
   {
-    ps.Phi = ps.Cg.solveWithGuess(b, ps.Phi);
+    const SmokePressure::Result result = ps.Multigrid->Solve(
+      ps.B, ps.Phi, this->Parameters.PressureTolerance, this->Parameters.PressureMaxIterations);
+    report.PressureIterations = result.Iterations;
+    report.PressureResidual = result.Residual;
+  }
+  else if (before > 0.0)
+  {
+    Eigen::VectorXd b(ps.Rows), guess(ps.Rows);
+    for (std::size_t c = 0; c < divergence.size(); ++c)
+    {
+      if (ps.Unknown[c] >= 0)
+      {
+        b[ps.Unknown[c]] = ps.B[c];
+        guess[ps.Unknown[c]] = ps.Phi[c];
+      }
+    }
+    const Eigen::VectorXd phi = ps.Cg.solveWithGuess(b, guess);
+    for (std::size_t c = 0; c < divergence.size(); ++c)
+    {
+      ps.Phi[c] = ps.Unknown[c] >= 0 ? phi[ps.Unknown[c]] : 0.0;
+    }
     report.PressureIterations = static_cast<int>(ps.Cg.iterations());
     report.PressureResidual = ps.Cg.error();
   }
   else
   {
-    ps.Phi.setZero();
+    std::fill(ps.Phi.begin(), ps.Phi.end(), 0.0);
     report.PressureIterations = 0;
     report.PressureResidual = 0.0;
   }
-  const auto phi = [&](int i, int j, int k) -> double
-  {
-    const int row = ps.Unknown[this->CellIndex(i, j, k)];
-    return row >= 0 ? ps.Phi[row] : 0.0;
-  };
-  // u -= grad phi on the faces between two fluid cells, and on the open top.
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 1; i < n[0]; ++i)
+  const double* phi = ps.Phi.data(); // 0 in solid cells
+  const std::size_t nxy = static_cast<std::size_t>(n[0]) * n[1];
+  // u -= grad phi on the faces between two fluid cells, and on the open top (faces next
+  // to a solid are zeroed below); each layer of faces written by one thread.
+  ParallelFor(static_cast<std::size_t>(n[2]) + 1, 1, threads,
+    [&](std::size_t begin, std::size_t end)
+    {
+      for (std::size_t kk = begin; kk < end; ++kk)
       {
-        this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] -=
-          static_cast<float>((phi(i, j, k) - phi(i - 1, j, k)) / h);
+        const int k = static_cast<int>(kk);
+        for (int j = 0; j < n[1] && k < n[2]; ++j)
+        {
+          const std::size_t c0 =
+            static_cast<std::size_t>(k) * nxy + static_cast<std::size_t>(j) * n[0];
+          float* u = &this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1)];
+          for (int i = 1; i < n[0]; ++i)
+          {
+            u[i] -= static_cast<float>((phi[c0 + i] - phi[c0 + i - 1]) / h);
+          }
+        }
+        for (int j = 1; j < n[1] && k < n[2]; ++j)
+        {
+          const std::size_t c0 =
+            static_cast<std::size_t>(k) * nxy + static_cast<std::size_t>(j) * n[0];
+          float* v = &this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0]];
+          for (int i = 0; i < n[0]; ++i)
+          {
+            v[i] -= static_cast<float>((phi[c0 + i] - phi[c0 + i - n[0]]) / h);
+          }
+        }
+        if (k >= 1)
+        {
+          for (int j = 0; j < n[1]; ++j)
+          {
+            const std::size_t c0 =
+              static_cast<std::size_t>(k - 1) * nxy + static_cast<std::size_t>(j) * n[0];
+            float* w = &this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0]];
+            for (int i = 0; i < n[0]; ++i)
+            {
+              const double above = k < n[2] ? phi[c0 + nxy + i] : 0.0;
+              w[i] -= static_cast<float>((above - phi[c0 + i]) / h);
+            }
+          }
+        }
       }
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 1; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] -=
-          static_cast<float>((phi(i, j, k) - phi(i, j - 1, k)) / h);
-      }
-  for (int k = 1; k <= n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const double above = k < n[2] ? phi(i, j, k) : 0.0;
-        this->W[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] -=
-          static_cast<float>((above - phi(i, j, k - 1)) / h);
-      }
+    });
   this->EnforceSolidFaces();
   const std::vector<double> after = this->Divergence();
   double sum = 0.0;
@@ -780,14 +882,25 @@ void SmokeSolver::Advect(double dt)
       x[2] - step * v1[2] } };
   };
   const int threads = ThreadCount(p.Threads);
-  const auto advect = [&](std::vector<float>& field, const std::array<int, 3>& dims,
-                        const std::array<double, 3>& offset)
+  // Advects the fields that share one layout of samples (dims, offset) together: each
+  // backtrace is computed once for all of them, and MacCormack's clamp reuses the
+  // first pass's (the same numbers as tracing each field on its own).
+  const auto advect = [&](const std::vector<std::vector<float>*>& fields,
+                        const std::array<int, 3>& dims, const std::array<double, 3>& offset)
   {
-    const std::vector<float> old = field;
-    const FieldView oldView{ old.data(), dims, offset };
+    const std::size_t count = fields.size();
+    std::vector<std::vector<float>> old(count), forward(count);
+    for (std::size_t f = 0; f < count; ++f)
+    {
+      old[f] = *fields[f];
+      forward[f].resize(old[f].size());
+    }
+    const FieldView layout{ nullptr, dims, offset };
     const std::size_t rows = static_cast<std::size_t>(dims[1]) * dims[2];
+    const bool mac = p.Advection == SmokeAdvection::MacCormack;
+    // Where each sample came from (MacCormack's clamp needs it again).
+    std::vector<std::array<double, 3>> from(mac ? old[0].size() : 0);
     // Semi-Lagrangian pass.
-    std::vector<float> forward(old.size());
     ParallelFor(rows, 4, threads,
       [&](std::size_t begin, std::size_t end)
       {
@@ -797,18 +910,30 @@ void SmokeSolver::Advect(double dt)
           for (int i = 0; i < dims[0]; ++i)
           {
             const std::array<double, 3> x{ { i + offset[0], j + offset[1], k + offset[2] } };
-            forward[oldView.Index(i, j, k)] = static_cast<float>(oldView.Sample(backtrace(x, dt)));
+            const std::array<double, 3> y = backtrace(x, dt);
+            const std::size_t index = layout.Index(i, j, k);
+            for (std::size_t f = 0; f < count; ++f)
+            {
+              const FieldView oldView{ old[f].data(), dims, offset };
+              forward[f][index] = static_cast<float>(oldView.Sample(y));
+            }
+            if (mac)
+            {
+              from[index] = y;
+            }
           }
         }
       });
-    if (p.Advection == SmokeAdvection::SemiLagrangian)
+    if (!mac)
     {
-      field = forward;
+      for (std::size_t f = 0; f < count; ++f)
+      {
+        fields[f]->swap(forward[f]);
+      }
       return;
     }
     // MacCormack: back again, half the error corrected, clamped to the neighbourhood of
     // the backtraced point (else the semi-Lagrangian value).
-    const FieldView forwardView{ forward.data(), dims, offset };
     ParallelFor(rows, 4, threads,
       [&](std::size_t begin, std::size_t end)
       {
@@ -818,25 +943,30 @@ void SmokeSolver::Advect(double dt)
           for (int i = 0; i < dims[0]; ++i)
           {
             const std::array<double, 3> x{ { i + offset[0], j + offset[1], k + offset[2] } };
-            const std::size_t index = oldView.Index(i, j, k);
-            const double back = forwardView.Sample(backtrace(x, -dt));
-            double value = forward[index] + 0.5 * (old[index] - back);
-            double low, high;
-            oldView.Range(backtrace(x, dt), low, high);
-            if (value < low || value > high)
+            const std::size_t index = layout.Index(i, j, k);
+            const std::array<double, 3> y = backtrace(x, -dt);
+            for (std::size_t f = 0; f < count; ++f)
             {
-              value = forward[index];
+              const FieldView oldView{ old[f].data(), dims, offset };
+              const FieldView forwardView{ forward[f].data(), dims, offset };
+              const double back = forwardView.Sample(y);
+              double value = forward[f][index] + 0.5 * (old[f][index] - back);
+              double low, high;
+              oldView.Range(from[index], low, high);
+              if (value < low || value > high)
+              {
+                value = forward[f][index];
+              }
+              (*fields[f])[index] = static_cast<float>(value);
             }
-            field[index] = static_cast<float>(value);
           }
         }
       });
   };
-  advect(this->U, { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } });
-  advect(this->V, { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } });
-  advect(this->W, { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } });
-  advect(this->Density, { { n[0], n[1], n[2] } }, { { 0.5, 0.5, 0.5 } });
-  advect(this->Temperature, { { n[0], n[1], n[2] } }, { { 0.5, 0.5, 0.5 } });
+  advect({ &this->U }, { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } });
+  advect({ &this->V }, { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } });
+  advect({ &this->W }, { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } });
+  advect({ &this->Density, &this->Temperature }, { { n[0], n[1], n[2] } }, { { 0.5, 0.5, 0.5 } });
   for (std::size_t c = 0; c < this->Solid.size(); ++c)
   {
     if (this->Solid[c])
@@ -885,18 +1015,22 @@ std::vector<float> SmokeSolver::CellVelocities() const
 {
   const auto& n = this->Parameters.Dimensions;
   std::vector<float> out(3 * this->NumberOfCells());
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const std::size_t c = this->CellIndex(i, j, k);
-        const std::size_t u0 = (static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i;
-        const std::size_t v0 = (static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i;
-        const std::size_t w0 = (static_cast<std::size_t>(k) * n[1] + j) * n[0] + i;
-        out[3 * c] = 0.5f * (this->U[u0] + this->U[u0 + 1]);
-        out[3 * c + 1] = 0.5f * (this->V[v0] + this->V[v0 + n[0]]);
-        out[3 * c + 2] = 0.5f * (this->W[w0] + this->W[w0 + static_cast<std::size_t>(n[0]) * n[1]]);
-      }
+  ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
+    [&](int k)
+    {
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i)
+        {
+          const std::size_t c = this->CellIndex(i, j, k);
+          const std::size_t u0 = (static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i;
+          const std::size_t v0 = (static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i;
+          const std::size_t w0 = (static_cast<std::size_t>(k) * n[1] + j) * n[0] + i;
+          out[3 * c] = 0.5f * (this->U[u0] + this->U[u0 + 1]);
+          out[3 * c + 1] = 0.5f * (this->V[v0] + this->V[v0 + n[0]]);
+          out[3 * c + 2] =
+            0.5f * (this->W[w0] + this->W[w0 + static_cast<std::size_t>(n[0]) * n[1]]);
+        }
+    });
   return out;
 }
 
@@ -905,23 +1039,27 @@ std::vector<double> SmokeSolver::Divergence() const
   const auto& n = this->Parameters.Dimensions;
   const double h = this->Parameters.CellSizeMetres;
   std::vector<double> out(this->NumberOfCells(), 0.0);
-  for (int k = 0; k < n[2]; ++k)
-    for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const std::size_t c = this->CellIndex(i, j, k);
-        if (this->Solid[c])
-        {
-          continue;
-        }
-        const std::size_t u0 = (static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i;
-        const std::size_t v0 = (static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i;
-        const std::size_t w0 = (static_cast<std::size_t>(k) * n[1] + j) * n[0] + i;
-        out[c] =
-          (static_cast<double>(this->U[u0 + 1]) - this->U[u0] + this->V[v0 + n[0]] - this->V[v0] +
-            this->W[w0 + static_cast<std::size_t>(n[0]) * n[1]] - this->W[w0]) /
-          h;
-      }
+  ParallelFor(static_cast<std::size_t>(n[2]), 1, ThreadCount(this->Parameters.Threads),
+    [&](std::size_t begin, std::size_t end)
+    {
+      for (int k = static_cast<int>(begin); k < static_cast<int>(end); ++k)
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i)
+          {
+            const std::size_t c = this->CellIndex(i, j, k);
+            if (this->Solid[c])
+            {
+              continue;
+            }
+            const std::size_t u0 = (static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i;
+            const std::size_t v0 = (static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i;
+            const std::size_t w0 = (static_cast<std::size_t>(k) * n[1] + j) * n[0] + i;
+            out[c] =
+              (static_cast<double>(this->U[u0 + 1]) - this->U[u0] + this->V[v0 + n[0]] -
+                this->V[v0] + this->W[w0 + static_cast<std::size_t>(n[0]) * n[1]] - this->W[w0]) /
+              h;
+          }
+    });
   return out;
 }
 
@@ -938,20 +1076,29 @@ double SmokeSolver::TotalSmoke() const
 
 std::vector<double> SmokeSolver::GetPressureGuess() const
 {
-  const Eigen::VectorXd& phi = this->PressureSolver->Phi;
-  return std::vector<double>(phi.data(), phi.data() + phi.size());
+  // One value per fluid cell, in cell order (the rows of the pressure equation).
+  const Pressure& ps = *this->PressureSolver;
+  std::vector<double> guess(static_cast<std::size_t>(ps.Rows));
+  for (std::size_t c = 0; c < ps.Unknown.size(); ++c)
+  {
+    if (ps.Unknown[c] >= 0)
+    {
+      guess[static_cast<std::size_t>(ps.Unknown[c])] = ps.Phi[c];
+    }
+  }
+  return guess;
 }
 
 void SmokeSolver::SetPressureGuess(const std::vector<double>& guess)
 {
-  Eigen::VectorXd& phi = this->PressureSolver->Phi;
-  if (guess.size() != static_cast<std::size_t>(phi.size()))
+  Pressure& ps = *this->PressureSolver;
+  if (guess.size() != static_cast<std::size_t>(ps.Rows))
   {
     throw std::invalid_argument("nimbus::SmokeSolver::SetPressureGuess: size does not match");
   }
-  for (std::size_t i = 0; i < guess.size(); ++i)
+  for (std::size_t c = 0; c < ps.Unknown.size(); ++c)
   {
-    phi[static_cast<Eigen::Index>(i)] = guess[i];
+    ps.Phi[c] = ps.Unknown[c] >= 0 ? guess[static_cast<std::size_t>(ps.Unknown[c])] : 0.0;
   }
 }
 

@@ -24,17 +24,20 @@
 //     nu_t dt / h^2 <= 1/6);
 //  4. projection: the pressure that makes the velocity divergence-free, Poisson's
 //     equation on the fluid cells (obstacles and the side and bottom walls: no flow
-//     through them; the top: open, pressure 0) solved by conjugate gradients with an
-//     incomplete-Cholesky preconditioner (Eigen), the matrix factored once per obstacle
-//     layout (natural order: for a grid Laplacian it preconditions better than
-//     minimum degree, 41 % fewer iterations measured), each solve started from the last
+//     through them; the top: open, pressure 0) solved by conjugate gradients
+//     preconditioned with a geometric multigrid V-cycle (MGPCG, McAdams et al. 2010:
+//     SmokePressure.h; multithreaded, its iterations about constant as the grid grows)
+//     or, as an option, with an incomplete Cholesky factorisation (Eigen, natural
+//     order, factored once per obstacle layout), each solve started from the last
 //     pressure;
 //  5. advection of velocity, density and temperature along the projected velocity:
 //     semi-Lagrangian (a second-order backtrace, trilinear samples) or MacCormack
 //     (Selle et al. 2008, clamped to the neighbourhood of the backtraced point);
 //  6. decay: the temperature relaxes to ambient at CoolingPerSecond, the density fades
 //     at DissipationPerSecond.
-// Deterministic: every value is written by one thread, in no order that matters.
+// Deterministic: every value is written by one thread, in no order that matters; the
+// pressure solve's sums are taken per z-layer and added in layer order (the same for
+// any thread count).
 #ifndef nimbus_SmokeSolver_h
 #define nimbus_SmokeSolver_h
 
@@ -64,6 +67,12 @@ enum class SmokeAdvection
   MacCormack = 1
 };
 
+enum class SmokePressureSolver
+{
+  Multigrid = 0,         // MGPCG (SmokePressure.h): multithreaded, cost linear in the cells
+  IncompleteCholesky = 1 // Eigen's IC-CG: one thread, iterations grow with the grid
+};
+
 struct SmokeParameters
 {
   std::array<int, 3> Dimensions{ { 32, 32, 48 } }; // cells, each >= 2
@@ -84,6 +93,7 @@ struct SmokeParameters
   int MaxSubsteps = 64;            // per Step; more than that is an error
   double PressureTolerance = 1e-7; // relative residual of the pressure solve
   int PressureMaxIterations = 2000;
+  SmokePressureSolver PressureSolver = SmokePressureSolver::Multigrid;
   int Threads = 0; // 0: hardware concurrency
   std::vector<SmokeEmitter> Emitters;
   /// Solid cells (1) where nothing flows: empty, or one byte per cell (x fastest).
@@ -122,7 +132,12 @@ public:
   const SmokeParameters& GetParameters() const { return this->Parameters; }
   double GetTime() const { return this->Time; }
   std::size_t NumberOfCells() const;
-  std::size_t CellIndex(int i, int j, int k) const;
+  std::size_t CellIndex(int i, int j, int k) const
+  {
+    return (static_cast<std::size_t>(k) * this->Parameters.Dimensions[1] + j) *
+      this->Parameters.Dimensions[0] +
+      i;
+  }
 
   const std::vector<float>& GetDensity() const { return this->Density; }
   const std::vector<float>& GetTemperature() const { return this->Temperature; }

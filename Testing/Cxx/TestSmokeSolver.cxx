@@ -3,6 +3,7 @@
 // spreads, the advection's mass change is stated and bounded, a large time step is
 // sub-stepped (and too large a one refused), threads do not change the result, and bad
 // parameters of every kind are refused with a message. Bounds: from the values printed.
+#include "SmokePressure.h"
 #include "SmokeSolver.h"
 #include "Voxelize.h"
 
@@ -10,10 +11,12 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -327,6 +330,8 @@ TEST(SmokeSolver, BadParametersRefused)
   add("emitter 0", [](SmokeParameters& p) { p.Emitters[0].TemperatureKelvin = -5.0; });
   add("obstacle mask", [](SmokeParameters& p) { p.Obstacles.assign(10, 1); });
   add("every cell", [](SmokeParameters& p) { p.Obstacles.assign(16 * 16 * 24, 1); });
+  add("PressureSolver",
+    [](SmokeParameters& p) { p.PressureSolver = static_cast<nimbus::SmokePressureSolver>(7); });
   for (const auto& c : cases)
   {
     try
@@ -339,6 +344,270 @@ TEST(SmokeSolver, BadParametersRefused)
       EXPECT_NE(std::string(e.what()).find(c.first), std::string::npos) << e.what();
     }
   }
+}
+
+// ---- The pressure solve (SmokePressure.h: MGPCG) ----
+
+namespace
+{
+// Uniform in [-1, 1).
+struct Lcg
+{
+  std::uint64_t State;
+  double operator()()
+  {
+    this->State = this->State * 6364136223846793005ull + 1442695040888963407ull;
+    return (this->State >> 11) * (1.0 / (1ull << 53)) * 2.0 - 1.0;
+  }
+};
+
+// About `fraction` of the cells solid at random, plus a closed box of solid shell
+// holding a cavity of fluid shut in on every side when the grid has room for one.
+std::vector<std::uint8_t> RandomObstacles(
+  const std::array<int, 3>& n, double fraction, std::uint64_t seed, bool cavity)
+{
+  Lcg random{ seed };
+  std::vector<std::uint8_t> solid(static_cast<std::size_t>(n[0]) * n[1] * n[2], 0);
+  for (auto& s : solid)
+  {
+    s = 0.5 * (random() + 1.0) < fraction ? 1 : 0;
+  }
+  if (cavity && n[0] >= 6 && n[1] >= 6 && n[2] >= 8)
+  {
+    for (int k = 1; k < 6; ++k)
+      for (int j = 1; j < 6; ++j)
+        for (int i = 1; i < 6; ++i)
+        {
+          const bool shell = i == 1 || i == 5 || j == 1 || j == 5 || k == 1 || k == 5;
+          solid[(static_cast<std::size_t>(k) * n[1] + j) * n[0] + i] = shell ? 1 : 0;
+        }
+  }
+  return solid;
+}
+
+double Dot(const std::vector<double>& a, const std::vector<double>& b)
+{
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+  {
+    sum += a[i] * b[i];
+  }
+  return sum;
+}
+
+// Random face velocities (the solver zeroes those next to solids).
+void RandomVelocity(SmokeSolver& s, std::uint64_t seed)
+{
+  Lcg random{ seed };
+  std::vector<float> u(s.GetU().size()), v(s.GetV().size()), w(s.GetW().size());
+  for (auto* f : { &u, &v, &w })
+  {
+    for (float& x : *f)
+    {
+      x = static_cast<float>(random());
+    }
+  }
+  s.SetState(0.0, s.GetDensity(), s.GetTemperature(), u, v, w);
+}
+} // namespace
+
+// The multigrid V-cycle is symmetric positive definite (what CG needs), with obstacles, a
+// shut-in cavity and odd dimensions.
+TEST(SmokePressure, VCycleSymmetricPositiveDefinite)
+{
+  for (const auto& n : { std::array<int, 3>{ { 13, 11, 17 } }, std::array<int, 3>{ { 8, 8, 8 } },
+         std::array<int, 3>{ { 33, 20, 9 } }, std::array<int, 3>{ { 2, 2, 2 } } })
+  {
+    const std::vector<std::uint8_t> solid = RandomObstacles(n, 0.15, 5, true);
+    nimbus::SmokePressure mg(n, solid, 2);
+    Lcg random{ 11 };
+    std::vector<double> a(solid.size()), b(solid.size()), ma, mb;
+    for (std::size_t c = 0; c < solid.size(); ++c)
+    {
+      a[c] = solid[c] ? 0.0 : random();
+      b[c] = solid[c] ? 0.0 : random();
+    }
+    mg.Precondition(a, ma);
+    mg.Precondition(b, mb);
+    const double ab = Dot(ma, b), ba = Dot(a, mb);
+    std::printf("  %d x %d x %d: %zu levels, <Ma, b> %.15g, <a, Mb> %.15g, <Ma, a> %.4g\n", n[0],
+      n[1], n[2], mg.NumberOfLevels(), ab, ba, Dot(ma, a));
+    EXPECT_NEAR(ab, ba, 1e-12 * (std::abs(ab) + std::abs(ba)) + 1e-300);
+    EXPECT_GT(Dot(ma, a), 0.0);
+    EXPECT_GT(Dot(mb, b), 0.0);
+  }
+}
+
+// MGPCG's iterations stay about constant as the grid grows (IC-CG's grow with it), and
+// the residual it reports is the true one.
+TEST(SmokePressure, IterationsAboutConstantWithTheGrid)
+{
+  std::vector<int> iterations;
+  for (int size : { 16, 24, 32, 48, 64 })
+  {
+    const std::array<int, 3> n{ { size, size, size } };
+    // A block in the middle (an obstacle), the open top, random right-hand side.
+    std::vector<std::uint8_t> solid(static_cast<std::size_t>(size) * size * size, 0);
+    for (int k = size / 4; k < size / 2; ++k)
+      for (int j = size / 4; j < 3 * size / 4; ++j)
+        for (int i = size / 3; i < 2 * size / 3; ++i)
+        {
+          solid[(static_cast<std::size_t>(k) * size + j) * size + i] = 1;
+        }
+    nimbus::SmokePressure mg(n, solid, 2);
+    Lcg random{ 3 };
+    std::vector<double> b(solid.size()), x(solid.size(), 0.0), ax;
+    for (std::size_t c = 0; c < b.size(); ++c)
+    {
+      b[c] = solid[c] ? 0.0 : random();
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const nimbus::SmokePressure::Result r = mg.Solve(b, x, 1e-7, 500);
+    const double ms =
+      1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    mg.Apply(x, ax);
+    double rr = 0.0, bb = 0.0;
+    for (std::size_t c = 0; c < b.size(); ++c)
+    {
+      rr += (b[c] - ax[c]) * (b[c] - ax[c]);
+      bb += b[c] * b[c];
+    }
+    std::printf("  %d^3: %zu levels, %d MGPCG iterations, residual %.3g (true %.3g), %.1f ms\n",
+      size, mg.NumberOfLevels(), r.Iterations, r.Residual, std::sqrt(rr / bb), ms);
+    EXPECT_LT(r.Residual, 1e-7);
+    EXPECT_NEAR(std::sqrt(rr / bb), r.Residual, 1e-9);
+    iterations.push_back(r.Iterations);
+  }
+  // Measured (a random right-hand side, from 0, tolerance 1e-7): 7, 7, 8, 8, 9 iterations
+  // at 16^3, 24^3, 32^3, 48^3, 64^3 (IC-CG in the solver: 58 at 32^3, 115 at 64^3).
+  const int least = *std::min_element(iterations.begin(), iterations.end());
+  const int most = *std::max_element(iterations.begin(), iterations.end());
+  EXPECT_LE(most, least + 6);
+  EXPECT_LE(most, 25);
+}
+
+// Multigrid and incomplete Cholesky project a random field the same way (within the
+// tolerance), with obstacles and odd dimensions; both leave it divergence-free.
+TEST(SmokePressure, MultigridMatchesIncompleteCholesky)
+{
+  SmokeParameters p = Small(13, 11, 17);
+  p.Emitters.clear();
+  p.Obstacles = RandomObstacles(p.Dimensions, 0.12, 21, false);
+  p.PressureTolerance = 1e-10;
+  SmokeSolver mg(p);
+  p.PressureSolver = nimbus::SmokePressureSolver::IncompleteCholesky;
+  SmokeSolver ic(p);
+  RandomVelocity(mg, 8);
+  RandomVelocity(ic, 8);
+  const nimbus::SmokeStepReport a = mg.Step(1e-4), b = ic.Step(1e-4);
+  std::printf("  multigrid: %d iterations, divergence %.3g -> %.3g; incomplete Cholesky: %d "
+              "iterations, %.3g -> %.3g\n",
+    a.PressureIterations, a.DivergenceBefore, a.DivergenceAfter, b.PressureIterations,
+    b.DivergenceBefore, b.DivergenceAfter);
+  EXPECT_EQ(a.DivergenceBefore, b.DivergenceBefore);
+  EXPECT_LT(a.DivergenceAfter, 1e-7 * a.DivergenceBefore);
+  EXPECT_LT(b.DivergenceAfter, 1e-7 * b.DivergenceBefore);
+  const std::vector<double> pa = mg.GetPressureGuess(), pb = ic.GetPressureGuess();
+  ASSERT_EQ(pa.size(), pb.size());
+  double diff = 0.0, size = 0.0;
+  for (std::size_t i = 0; i < pa.size(); ++i)
+  {
+    diff = std::max(diff, std::abs(pa[i] - pb[i]));
+    size = std::max(size, std::abs(pb[i]));
+  }
+  double velocity = 0.0;
+  for (const auto& f : { std::make_pair(&mg.GetU(), &ic.GetU()),
+         std::make_pair(&mg.GetV(), &ic.GetV()), std::make_pair(&mg.GetW(), &ic.GetW()) })
+  {
+    for (std::size_t i = 0; i < f.first->size(); ++i)
+    {
+      velocity = std::max(velocity, static_cast<double>(std::abs((*f.first)[i] - (*f.second)[i])));
+    }
+  }
+  std::printf(
+    "  largest pressure difference %.3g (of %.3g), velocity %.3g m/s\n", diff, size, velocity);
+  EXPECT_LT(diff, 1e-6 * size);
+  EXPECT_LT(velocity, 1e-5); // the random field's faces are up to 1 m/s (float: 6e-8)
+
+  // At the default tolerance too, with a shut-in cavity: divergence-free either way.
+  p.PressureTolerance = 1e-7;
+  p.Obstacles = RandomObstacles(p.Dimensions, 0.12, 22, true);
+  p.PressureSolver = nimbus::SmokePressureSolver::Multigrid;
+  SmokeSolver cavity(p);
+  RandomVelocity(cavity, 9);
+  const nimbus::SmokeStepReport c = cavity.Step(1e-4);
+  std::printf("  with a cavity: %d iterations, divergence %.3g -> %.3g\n", c.PressureIterations,
+    c.DivergenceBefore, c.DivergenceAfter);
+  EXPECT_LT(c.DivergenceAfter, 1e-5 * c.DivergenceBefore);
+}
+
+// Threads 1, 2 and 3 give bit-identical flows with obstacles on a grid large enough for
+// the multigrid's fine levels to run in parallel (odd dimensions).
+TEST(SmokePressure, IndependentOfThreadsWithObstacles)
+{
+  SmokeParameters p = Small(41, 37, 45); // 68265 cells: level 0 runs in parallel
+  p.VorticityConfinement = 0.3;
+  p.Obstacles = RandomObstacles(p.Dimensions, 0.05, 31, true);
+  std::vector<std::unique_ptr<SmokeSolver>> solvers;
+  std::vector<nimbus::SmokeStepReport> last(3);
+  for (int threads : { 1, 2, 3 })
+  {
+    p.Threads = threads;
+    solvers.emplace_back(new SmokeSolver(p));
+  }
+  for (int step = 0; step < 4; ++step)
+  {
+    for (int t = 0; t < 3; ++t)
+    {
+      last[t] = solvers[t]->Step(0.05);
+    }
+  }
+  std::printf(
+    "  %d iterations, residual %.3g\n", last[0].PressureIterations, last[0].PressureResidual);
+  for (int t = 1; t < 3; ++t)
+  {
+    EXPECT_EQ(last[t].PressureIterations, last[0].PressureIterations);
+    EXPECT_EQ(last[t].PressureResidual, last[0].PressureResidual);
+    EXPECT_EQ(solvers[t]->GetDensity(), solvers[0]->GetDensity());
+    EXPECT_EQ(solvers[t]->GetU(), solvers[0]->GetU());
+    EXPECT_EQ(solvers[t]->GetV(), solvers[0]->GetV());
+    EXPECT_EQ(solvers[t]->GetW(), solvers[0]->GetW());
+    EXPECT_EQ(solvers[t]->GetPressureGuess(), solvers[0]->GetPressureGuess());
+  }
+}
+
+// A run restored from a checkpoint (state and pressure guess) repeats the same
+// iterations and the same flow, bit for bit.
+TEST(SmokePressure, RestoredRunRepeatsItself)
+{
+  SmokeParameters p = Small(12, 12, 20);
+  p.Obstacles = RandomObstacles(p.Dimensions, 0.05, 41, false);
+  SmokeSolver s(p);
+  for (int step = 0; step < 3; ++step)
+  {
+    s.Step(0.05);
+  }
+  const std::vector<float> density = s.GetDensity(), temperature = s.GetTemperature(), u = s.GetU(),
+                           v = s.GetV(), w = s.GetW();
+  const std::vector<double> guess = s.GetPressureGuess();
+  const double time = s.GetTime();
+  std::vector<int> first;
+  for (int step = 0; step < 2; ++step)
+  {
+    first.push_back(s.Step(0.05).PressureIterations);
+  }
+  SmokeSolver restored(p);
+  restored.SetState(time, density, temperature, u, v, w);
+  restored.SetPressureGuess(guess);
+  for (int step = 0; step < 2; ++step)
+  {
+    EXPECT_EQ(restored.Step(0.05).PressureIterations, first[static_cast<std::size_t>(step)]);
+  }
+  EXPECT_EQ(restored.GetU(), s.GetU());
+  EXPECT_EQ(restored.GetW(), s.GetW());
+  EXPECT_EQ(restored.GetDensity(), s.GetDensity());
+  EXPECT_EQ(restored.GetPressureGuess(), s.GetPressureGuess());
+  EXPECT_THROW(restored.SetPressureGuess(std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
 // ---- Obstacles from a closed surface (Voxelize.h) ----
