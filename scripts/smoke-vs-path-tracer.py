@@ -149,14 +149,11 @@ def render_nimbus(name, image_data):
 
 
 def blocks(image):
-    h, w = (image.shape[0] // BLOCK) * BLOCK, (image.shape[1] // BLOCK) * BLOCK
-    return image[:h, :w].reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK, 3).mean(axis=(1, 3))
+    return harness.block_means(image, BLOCK)
 
 
 def block_errors(error):
-    h, w = (error.shape[0] // BLOCK) * BLOCK, (error.shape[1] // BLOCK) * BLOCK
-    return np.sqrt((error[:h, :w] ** 2).reshape(
-        h // BLOCK, BLOCK, w // BLOCK, BLOCK, 3).sum(axis=(1, 3))) / BLOCK ** 2
+    return harness.block_standard_errors(error, BLOCK)
 
 
 print(f"{'scene':<6} {'Nimbus s':>9} {'mean / reference':>20} {'block RMSE / mean':>18} "

@@ -230,6 +230,19 @@ def zero_density(scene_path):
 
 # --- error metrics ----------------------------------------------------------------------------
 
+def block_means(image, block):
+    """Means of block x block pixel tiles of an H x W x 3 image (partial tiles dropped)."""
+    h, w = (image.shape[0] // block) * block, (image.shape[1] // block) * block
+    return image[:h, :w].reshape(h // block, block, w // block, block, 3).mean(axis=(1, 3))
+
+
+def block_standard_errors(error, block):
+    """The standard errors of block_means for independent per-pixel standard errors."""
+    h, w = (error.shape[0] // block) * block, (error.shape[1] // block) * block
+    return np.sqrt((error[:h, :w] ** 2).reshape(
+        h // block, block, w // block, block, 3).sum(axis=(1, 3))) / block ** 2
+
+
 def error_metrics(image, reference, reference_error=None, image_error=None):
     """RMSE, relative L1, max abs and PSNR of image against reference.
 
