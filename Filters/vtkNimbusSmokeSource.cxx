@@ -184,6 +184,9 @@ int vtkNimbusSmokeSource::RequestData(
   p.SmagorinskyConstant = this->SmagorinskyConstant;
   p.Advection = this->Advection == 0 ? nimbus::SmokeAdvection::SemiLagrangian
                                      : nimbus::SmokeAdvection::MacCormack;
+  p.SideBoundaries = this->SideBoundaries == 1 ? nimbus::SmokeSideBoundaries::Walls
+    : this->SideBoundaries == 2                ? nimbus::SmokeSideBoundaries::Open
+                                               : nimbus::SmokeSideBoundaries::Automatic;
   p.Threads = this->NumberOfThreads;
   nimbus::SmokeEmitter emitter;
   for (int k = 0; k < 3; ++k)
@@ -327,9 +330,9 @@ int vtkNimbusSmokeSource::RequestData(
     p.Origin[0], p.Origin[1], p.Origin[2], p.Wind[0], p.Wind[1], p.Wind[2],
     p.AmbientTemperatureKelvin, p.WindCoupling, p.CoolingPerSecond, p.DissipationPerSecond,
     p.VorticityConfinement, p.SmagorinskyConstant, static_cast<double>(this->Advection),
-    emitter.Centre[0], emitter.Centre[1], emitter.Centre[2], emitter.Velocity[0],
-    emitter.Velocity[1], emitter.Velocity[2], emitter.RadiusMetres, emitter.DensityPerSecond,
-    emitter.TemperatureKelvin, this->FrameDurationSeconds,
+    static_cast<double>(p.SideBoundaries), emitter.Centre[0], emitter.Centre[1], emitter.Centre[2],
+    emitter.Velocity[0], emitter.Velocity[1], emitter.Velocity[2], emitter.RadiusMetres,
+    emitter.DensityPerSecond, emitter.TemperatureKelvin, this->FrameDurationSeconds,
     static_cast<double>(this->CheckpointInterval),
     obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0), static_cast<double>(obstacleTime),
     this->Puffs ? 1.0 : 0.0, pp.PuffsPerSecond, pp.RadiusMetres, pp.GrowthPerSecond,
@@ -564,6 +567,11 @@ void vtkNimbusSmokeSource::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "VorticityConfinement: " << this->VorticityConfinement << "\n";
   os << indent << "SmagorinskyConstant: " << this->SmagorinskyConstant << "\n";
   os << indent << "Advection: " << (this->Advection ? "MacCormack" : "semi-Lagrangian") << "\n";
+  os << indent << "SideBoundaries: "
+     << (this->SideBoundaries == 1      ? "walls"
+            : this->SideBoundaries == 2 ? "open"
+                                        : "automatic (open with wind)")
+     << "\n";
   os << indent << "FrameDurationSeconds: " << this->FrameDurationSeconds << "\n";
   os << indent << "NumberOfFrames: " << this->NumberOfFrames << "\n";
   os << indent << "CheckpointInterval: " << this->CheckpointInterval << "\n";

@@ -8,8 +8,9 @@
  * projection by conjugate gradients) on Dimensions cells of CellSizeMetres from Origin
  * (z up), with one emitter: a sphere at EmitterCentre of EmitterRadiusMetres adding
  * EmitterDensityPerSecond of density per second at EmitterTemperatureKelvin, blowing at
- * EmitterVelocity (m/s; 0 leaves the air alone). The top of the box is open, its sides
- * and bottom are walls.
+ * EmitterVelocity (m/s; 0 leaves the air alone). The top of the box is open and its
+ * bottom a wall; its four sides are walls, or open so that the wind blows through the box
+ * (SideBoundaries: by default open when there is wind, walls when there is none).
  *
  * Optional input (port 0), the obstacles the smoke flows around: either vtkImageData with
  * a point or cell array "obstacle" (non-zero: solid), one value per simulation cell
@@ -83,7 +84,11 @@ public:
   /// The air: ambient temperature (K, 293.15), wind (m/s, 0) and how fast the air takes
   /// its speed (1/s, 0.5), cooling of the smoke (1/s, 0.2), fading of its density (1/s,
   /// 0), vorticity confinement (0.3), the Smagorinsky constant of the eddy viscosity
-  /// (0.15), the advection scheme (0 semi-Lagrangian, 1 MacCormack: default).
+  /// (0.15), the advection scheme (0 semi-Lagrangian, 1 MacCormack: default), the box's
+  /// sides (SideBoundaries: 0 automatic, the default: open when the wind and its coupling
+  /// are not 0, walls otherwise; 1 walls; 2 open: air and smoke pass through them, what
+  /// flows in is the wind, without smoke, at the ambient temperature, so the wind blows
+  /// through the box; with walls a steady wind hardly moves the air inside).
   vtkSetMacro(AmbientTemperatureKelvin, double);
   vtkGetMacro(AmbientTemperatureKelvin, double);
   vtkSetVector3Macro(Wind, double);
@@ -100,6 +105,8 @@ public:
   vtkGetMacro(SmagorinskyConstant, double);
   vtkSetClampMacro(Advection, int, 0, 1);
   vtkGetMacro(Advection, int);
+  vtkSetClampMacro(SideBoundaries, int, 0, 2);
+  vtkGetMacro(SideBoundaries, int);
   ///@}
 
   ///@{
@@ -170,6 +177,7 @@ protected:
   double VorticityConfinement = 0.3;
   double SmagorinskyConstant = 0.15;
   int Advection = 1;
+  int SideBoundaries = 0;
   double FrameDurationSeconds = 1.0 / 24.0;
   int NumberOfFrames = 96;
   int CheckpointInterval = 8;

@@ -54,7 +54,7 @@ double SumInOrder(const std::vector<double>& partial, int layers)
 } // namespace
 
 SmokePressure::SmokePressure(const std::array<int, 3>& dims, const std::vector<std::uint8_t>& solid,
-  int threads, int smoothingSweeps)
+  int threads, int smoothingSweeps, bool openSides)
   : SmoothingSweeps(std::max(1, smoothingSweeps))
 {
   for (int a = 0; a < 3; ++a)
@@ -71,8 +71,8 @@ SmokePressure::SmokePressure(const std::array<int, 3>& dims, const std::vector<s
   }
   const int resolved = ResolveThreadCount(threads);
 
-  // Level 0: couplings 1 between fluid neighbours, the open top 1.
-  std::vector<double> open; // per cell of the current level: the open top's coupling
+  // Level 0: couplings 1 between fluid neighbours, the open top 1, each open side 1.
+  std::vector<double> open; // per cell of the current level: the open faces' coupling
   std::vector<std::uint8_t> fluidMask(cells, 1); // per cell of the current level
   for (std::size_t c = 0; c < cells && !solid.empty(); ++c)
   {
@@ -116,6 +116,12 @@ SmokePressure::SmokePressure(const std::array<int, 3>& dims, const std::vector<s
           {
             open[c] = 1.0;
           }
+          if (openSides)
+          {
+            // Pressure 0 beyond the first and last columns in x and y.
+            open[c] += (i == 0 ? 1.0 : 0.0) + (i + 1 == nx ? 1.0 : 0.0) + (j == 0 ? 1.0 : 0.0) +
+              (j + 1 == ny ? 1.0 : 0.0);
+          }
         }
     this->Levels.push_back(std::move(l));
   }
@@ -125,7 +131,7 @@ SmokePressure::SmokePressure(const std::array<int, 3>& dims, const std::vector<s
     Level& l = this->Levels.back();
     const int nx = l.Dims[0], ny = l.Dims[1], nz = l.Dims[2];
     const std::size_t nxy = static_cast<std::size_t>(nx) * ny;
-    // The diagonal: the sum of the couplings and the open top (1 when none: a cell shut
+    // The diagonal: the sum of the couplings and the open faces (1 when none: a cell shut
     // in on every side; 0 for a solid cell, whose couplings are all 0 too); a coarse
     // cell is solid when all its children are.
     l.Diagonal.assign(l.Cells, 0.0);

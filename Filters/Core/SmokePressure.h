@@ -5,16 +5,21 @@
 // no VTK, no Eigen.
 //
 // The matrix (level 0): per fluid cell, the number of non-solid neighbours (fluid, or
-// the open top beyond the last layer: pressure 0 there) on the diagonal, -1 per fluid
-// neighbour; the side and bottom walls and solid cells close their faces (Neumann). A
-// fluid cell with no open neighbour at all gets a diagonal of 1.
+// the open top beyond the last layer: pressure 0 there; with open sides, also the air
+// beyond the first and last x and y columns: pressure 0 there too) on the diagonal, -1
+// per fluid neighbour; the bottom wall, the side walls (when the sides are not open) and
+// solid cells close their faces (Neumann). A fluid cell with no open neighbour at all
+// gets a diagonal of 1. (An open face adds 1 to the diagonal and no coupling, so level
+// 0's codes hold it as they hold the open top: a diagonal of at most 6.)
 //
 // The hierarchy: each coarse cell aggregates the 2 x 2 x 2 cells below it (fewer on the
 // last layer of an odd axis); it is fluid when any of them is. The coarse matrix is
 // half the Galerkin product P^T A P of the piecewise-constant prolongation P: the
 // coupling of two coarse cells is half the sum of the fine couplings across their
-// interface, the open top's likewise (so obstacles and the open top carry to every
-// level exactly; the half is the scale of a Laplacian on cells twice as large). The
+// interface, the open faces' (top and open sides) likewise: a coarse cell's open
+// coupling is half the sum of its children's (so obstacles, the open top and the open
+// sides carry to every level exactly; the half is the scale of a Laplacian on cells
+// twice as large). The
 // V-cycle: red-black Gauss-Seidel (red then black) before the restriction (R = P^T),
 // black then red after the prolongation, the same number of sweeps each side, and the
 // coarsest level (at most ~100 cells) smoothed to convergence by a symmetric sequence of
@@ -42,8 +47,10 @@ class SmokePressure
 public:
   /// dims: cells per axis (each >= 1), x fastest; solid: one byte per cell (non-zero:
   /// solid) or empty (all fluid). threads: as ParallelFor's (0: hardware concurrency).
+  /// openSides: the x and y faces of the box are open (pressure 0 beyond them) instead
+  /// of walls; the top is always open, the bottom always a wall.
   SmokePressure(const std::array<int, 3>& dims, const std::vector<std::uint8_t>& solid,
-    int threads = 0, int smoothingSweeps = 2);
+    int threads = 0, int smoothingSweeps = 2, bool openSides = false);
 
   struct Result
   {

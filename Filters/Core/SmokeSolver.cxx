@@ -50,20 +50,30 @@ bool Finite(const Vector3& v)
 
 // A field on the grid's samples: dims per axis and where sample (0, 0, 0) sits in cell
 // coordinates (cell i's centre at i + 0.5): cell centres (0.5, 0.5, 0.5), u faces
-// (0, 0.5, 0.5), v (0.5, 0, 0.5), w (0.5, 0.5, 0).
+// (0, 0.5, 0.5), v (0.5, 0, 0.5), w (0.5, 0.5, 0). With Open (the box's sides open), a
+// layer of ghost samples holding Outside lies one sample beyond each end in x and y (the
+// air outside: the wind's velocity component, no smoke, the ambient temperature), points
+// farther out clamped to it; z is clamped to the samples as without.
 struct FieldView
 {
   const float* Data;
   std::array<int, 3> Dims;
   std::array<double, 3> Offset;
+  bool Open = false;
+  double Outside = 0.0;
 
   std::size_t Index(int a, int b, int c) const
   {
     return (static_cast<std::size_t>(c) * this->Dims[1] + b) * this->Dims[0] + a;
   }
-  // Trilinear at position x (cell coordinates), clamped to the samples' box.
+  // Trilinear at position x (cell coordinates), clamped to the samples' box (with Open:
+  // to the ghosts' in x and y).
   double Sample(const std::array<double, 3>& x) const
   {
+    if (this->Open)
+    {
+      return this->SampleOpen(x);
+    }
     int i0[3];
     double f[3];
     for (int k = 0; k < 3; ++k)
@@ -96,6 +106,11 @@ struct FieldView
   // The smallest and largest of the 8 samples around x (MacCormack's clamp).
   void Range(const std::array<double, 3>& x, double& low, double& high) const
   {
+    if (this->Open)
+    {
+      this->RangeOpen(x, low, high);
+      return;
+    }
     int i0[3];
     for (int k = 0; k < 3; ++k)
     {
@@ -111,6 +126,62 @@ struct FieldView
         {
           const double v = this->Data[this->Index(std::min(i0[0] + a, this->Dims[0] - 1),
             std::min(i0[1] + b, this->Dims[1] - 1), std::min(i0[2] + c, this->Dims[2] - 1))];
+          low = std::min(low, v);
+          high = std::max(high, v);
+        }
+  }
+
+  // With Open: sample (a, b, c), Outside beyond the ends in x and y.
+  double At(int a, int b, int c) const
+  {
+    if (a < 0 || a >= this->Dims[0] || b < 0 || b >= this->Dims[1])
+    {
+      return this->Outside;
+    }
+    return this->Data[this->Index(a, b, std::min(c, this->Dims[2] - 1))];
+  }
+  // With Open: the lower corner of the samples around x (x and y from -1, the ghosts,
+  // to Dims - 1) and the weights of the upper ones.
+  void LocateOpen(const std::array<double, 3>& x, int i0[3], double f[3]) const
+  {
+    for (int k = 0; k < 2; ++k)
+    {
+      const double g = std::clamp(x[k] - this->Offset[k], -1.0, static_cast<double>(this->Dims[k]));
+      i0[k] = std::min(static_cast<int>(std::floor(g)), this->Dims[k] - 1);
+      f[k] = g - i0[k];
+    }
+    const double g =
+      std::clamp(x[2] - this->Offset[2], 0.0, static_cast<double>(this->Dims[2] - 1));
+    i0[2] = std::min(static_cast<int>(g), std::max(this->Dims[2] - 2, 0));
+    f[2] = this->Dims[2] == 1 ? 0.0 : g - i0[2];
+  }
+  double SampleOpen(const std::array<double, 3>& x) const
+  {
+    int i0[3];
+    double f[3];
+    this->LocateOpen(x, i0, f);
+    const int i1 = i0[0] + 1, j1 = i0[1] + 1, k1 = i0[2] + 1;
+    const double c00 =
+      (1 - f[0]) * this->At(i0[0], i0[1], i0[2]) + f[0] * this->At(i1, i0[1], i0[2]);
+    const double c10 = (1 - f[0]) * this->At(i0[0], j1, i0[2]) + f[0] * this->At(i1, j1, i0[2]);
+    const double c01 = (1 - f[0]) * this->At(i0[0], i0[1], k1) + f[0] * this->At(i1, i0[1], k1);
+    const double c11 = (1 - f[0]) * this->At(i0[0], j1, k1) + f[0] * this->At(i1, j1, k1);
+    const double c0 = (1 - f[1]) * c00 + f[1] * c10;
+    const double c1 = (1 - f[1]) * c01 + f[1] * c11;
+    return (1 - f[2]) * c0 + f[2] * c1;
+  }
+  void RangeOpen(const std::array<double, 3>& x, double& low, double& high) const
+  {
+    int i0[3];
+    double f[3];
+    this->LocateOpen(x, i0, f);
+    low = 1e300;
+    high = -1e300;
+    for (int c = 0; c < 2; ++c)
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a)
+        {
+          const double v = this->At(i0[0] + a, i0[1] + b, i0[2] + c);
           low = std::min(low, v);
           high = std::max(high, v);
         }
@@ -180,6 +251,11 @@ std::string CheckSmokeParameters(const SmokeParameters& p)
   {
     return "PressureSolver must be Multigrid or IncompleteCholesky";
   }
+  if (p.SideBoundaries != SmokeSideBoundaries::Automatic &&
+    p.SideBoundaries != SmokeSideBoundaries::Walls && p.SideBoundaries != SmokeSideBoundaries::Open)
+  {
+    return "SideBoundaries must be Automatic, Walls or Open";
+  }
   for (std::size_t e = 0; e < p.Emitters.size(); ++e)
   {
     const SmokeEmitter& m = p.Emitters[e];
@@ -209,6 +285,19 @@ std::string CheckSmokeParameters(const SmokeParameters& p)
   return "";
 }
 
+bool SmokeSidesOpen(const SmokeParameters& p)
+{
+  switch (p.SideBoundaries)
+  {
+    case SmokeSideBoundaries::Walls:
+      return false;
+    case SmokeSideBoundaries::Open:
+      return true;
+    default:
+      return p.WindCoupling > 0.0 && Length(p.Wind) > 0.0;
+  }
+}
+
 // The pressure equation on the fluid cells (see the file comment) and its solver, set
 // up once: the multigrid hierarchy, or the matrix and its incomplete Cholesky factor.
 struct SmokeSolver::Pressure
@@ -232,6 +321,7 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
   {
     throw std::invalid_argument("nimbus::SmokeSolver: " + why);
   }
+  this->SidesOpen = SmokeSidesOpen(this->Parameters);
   const auto& n = this->Parameters.Dimensions;
   const std::size_t cells = this->NumberOfCells();
   this->Density.assign(cells, 0.0f);
@@ -246,8 +336,8 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
     s = s ? 1 : 0;
   }
 
-  // The pressure matrix: per fluid cell, the number of non-solid neighbours (fluid, or
-  // the open top) on the diagonal, -1 per fluid neighbour.
+  // The pressure matrix: per fluid cell, the number of non-solid neighbours (fluid, the
+  // open top, open sides) on the diagonal, -1 per fluid neighbour.
   this->PressureSolver.reset(new Pressure);
   Pressure& ps = *this->PressureSolver;
   ps.Unknown.assign(cells, -1);
@@ -264,7 +354,8 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
   ps.B.assign(cells, 0.0);
   if (this->Parameters.PressureSolver == SmokePressureSolver::Multigrid)
   {
-    ps.Multigrid.reset(new SmokePressure(n, this->Solid, ThreadCount(this->Parameters.Threads)));
+    ps.Multigrid.reset(
+      new SmokePressure(n, this->Solid, ThreadCount(this->Parameters.Threads), 2, this->SidesOpen));
     this->EnforceSolidFaces();
     return;
   }
@@ -293,7 +384,11 @@ SmokeSolver::SmokeSolver(const SmokeParameters& parameters)
           }
           if (a < 0 || a >= n[0] || b < 0 || b >= n[1] || d < 0)
           {
-            continue; // a wall
+            if (this->SidesOpen && d >= 0)
+            {
+              diagonal += 1.0; // an open side: pressure 0 beyond it
+            }
+            continue; // else a wall
           }
           const int neighbour = ps.Unknown[this->CellIndex(a, b, d)];
           if (neighbour >= 0)
@@ -327,13 +422,18 @@ void SmokeSolver::EnforceSolidFaces()
   const auto& n = this->Parameters.Dimensions;
   const auto solid = [&](int i, int j, int k)
   { return this->Solid[this->CellIndex(i, j, k)] != 0; };
+  // The side faces: walls (zeroed), or open (free unless their cell is solid).
+  const bool walls = !this->SidesOpen;
   ForLayers(0, n[2], ThreadCount(this->Parameters.Threads),
     [&](int k)
     {
       for (int j = 0; j < n[1]; ++j)
         for (int i = 0; i <= n[0]; ++i)
         {
-          if (i == 0 || i == n[0] || solid(i - 1, j, k) || solid(i, j, k))
+          const bool closed = i == 0 ? walls || solid(0, j, k)
+            : i == n[0]              ? walls || solid(n[0] - 1, j, k)
+                                     : solid(i - 1, j, k) || solid(i, j, k);
+          if (closed)
           {
             this->U[(static_cast<std::size_t>(k) * n[1] + j) * (n[0] + 1) + i] = 0.0f;
           }
@@ -345,7 +445,10 @@ void SmokeSolver::EnforceSolidFaces()
       for (int j = 0; j <= n[1]; ++j)
         for (int i = 0; i < n[0]; ++i)
         {
-          if (j == 0 || j == n[1] || solid(i, j - 1, k) || solid(i, j, k))
+          const bool closed = j == 0 ? walls || solid(i, 0, k)
+            : j == n[1]              ? walls || solid(i, n[1] - 1, k)
+                                     : solid(i, j - 1, k) || solid(i, j, k);
+          if (closed)
           {
             this->V[(static_cast<std::size_t>(k) * (n[1] + 1) + j) * n[0] + i] = 0.0f;
           }
@@ -802,8 +905,10 @@ void SmokeSolver::Project(double, SmokeStepReport& report)
   }
   const double* phi = ps.Phi.data(); // 0 in solid cells
   const std::size_t nxy = static_cast<std::size_t>(n[0]) * n[1];
-  // u -= grad phi on the faces between two fluid cells, and on the open top (faces next
-  // to a solid are zeroed below); each layer of faces written by one thread.
+  // u -= grad phi on the faces between two fluid cells, on the open top and on open
+  // sides (pressure 0 beyond them; faces next to a solid are zeroed below); each layer of
+  // faces written by one thread.
+  const bool open = this->SidesOpen;
   ParallelFor(static_cast<std::size_t>(n[2]) + 1, 1, threads,
     [&](std::size_t begin, std::size_t end)
     {
@@ -819,6 +924,11 @@ void SmokeSolver::Project(double, SmokeStepReport& report)
           {
             u[i] -= static_cast<float>((phi[c0 + i] - phi[c0 + i - 1]) / h);
           }
+          if (open)
+          {
+            u[0] -= static_cast<float>(phi[c0] / h);
+            u[n[0]] += static_cast<float>(phi[c0 + n[0] - 1] / h);
+          }
         }
         for (int j = 1; j < n[1] && k < n[2]; ++j)
         {
@@ -828,6 +938,19 @@ void SmokeSolver::Project(double, SmokeStepReport& report)
           for (int i = 0; i < n[0]; ++i)
           {
             v[i] -= static_cast<float>((phi[c0 + i] - phi[c0 + i - n[0]]) / h);
+          }
+        }
+        if (open && k < n[2])
+        {
+          // The first and last rows of v faces: pressure 0 beyond them.
+          const std::size_t first = static_cast<std::size_t>(k) * nxy;
+          const std::size_t last = first + static_cast<std::size_t>(n[1] - 1) * n[0];
+          float* v0 = &this->V[static_cast<std::size_t>(k) * (n[1] + 1) * n[0]];
+          float* v1 = v0 + static_cast<std::size_t>(n[1]) * n[0];
+          for (int i = 0; i < n[0]; ++i)
+          {
+            v0[i] -= static_cast<float>(phi[first + i] / h);
+            v1[i] += static_cast<float>(phi[last + i] / h);
           }
         }
         if (k >= 1)
@@ -861,11 +984,16 @@ void SmokeSolver::Advect(double dt)
   const SmokeParameters& p = this->Parameters;
   const auto& n = p.Dimensions;
   const double h = p.CellSizeMetres;
-  // The velocity the samples move with: this (projected) one, in cells per second.
+  // The velocity the samples move with: this (projected) one, in cells per second; with
+  // open sides, beyond them the wind's.
+  const bool open = this->SidesOpen;
   const std::vector<float> u = this->U, v = this->V, w = this->W;
-  const FieldView uView{ u.data(), { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } } };
-  const FieldView vView{ v.data(), { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } } };
-  const FieldView wView{ w.data(), { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } } };
+  const FieldView uView{ u.data(), { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } }, open,
+    p.Wind[0] };
+  const FieldView vView{ v.data(), { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } }, open,
+    p.Wind[1] };
+  const FieldView wView{ w.data(), { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } }, open,
+    p.Wind[2] };
   const auto velocity = [&](const std::array<double, 3>& x)
   {
     return std::array<double, 3>{ { uView.Sample(x) / h, vView.Sample(x) / h,
@@ -884,9 +1012,11 @@ void SmokeSolver::Advect(double dt)
   const int threads = ThreadCount(p.Threads);
   // Advects the fields that share one layout of samples (dims, offset) together: each
   // backtrace is computed once for all of them, and MacCormack's clamp reuses the
-  // first pass's (the same numbers as tracing each field on its own).
+  // first pass's (the same numbers as tracing each field on its own). outside: per
+  // field, its value in the air beyond open sides (the inflow).
   const auto advect = [&](const std::vector<std::vector<float>*>& fields,
-                        const std::array<int, 3>& dims, const std::array<double, 3>& offset)
+                        const std::array<int, 3>& dims, const std::array<double, 3>& offset,
+                        const std::vector<double>& outside)
   {
     const std::size_t count = fields.size();
     std::vector<std::vector<float>> old(count), forward(count);
@@ -895,7 +1025,7 @@ void SmokeSolver::Advect(double dt)
       old[f] = *fields[f];
       forward[f].resize(old[f].size());
     }
-    const FieldView layout{ nullptr, dims, offset };
+    const FieldView layout{ nullptr, dims, offset, false, 0.0 };
     const std::size_t rows = static_cast<std::size_t>(dims[1]) * dims[2];
     const bool mac = p.Advection == SmokeAdvection::MacCormack;
     // Where each sample came from (MacCormack's clamp needs it again).
@@ -914,7 +1044,7 @@ void SmokeSolver::Advect(double dt)
             const std::size_t index = layout.Index(i, j, k);
             for (std::size_t f = 0; f < count; ++f)
             {
-              const FieldView oldView{ old[f].data(), dims, offset };
+              const FieldView oldView{ old[f].data(), dims, offset, open, outside[f] };
               forward[f][index] = static_cast<float>(oldView.Sample(y));
             }
             if (mac)
@@ -947,8 +1077,8 @@ void SmokeSolver::Advect(double dt)
             const std::array<double, 3> y = backtrace(x, -dt);
             for (std::size_t f = 0; f < count; ++f)
             {
-              const FieldView oldView{ old[f].data(), dims, offset };
-              const FieldView forwardView{ forward[f].data(), dims, offset };
+              const FieldView oldView{ old[f].data(), dims, offset, open, outside[f] };
+              const FieldView forwardView{ forward[f].data(), dims, offset, open, outside[f] };
               const double back = forwardView.Sample(y);
               double value = forward[f][index] + 0.5 * (old[f][index] - back);
               double low, high;
@@ -963,10 +1093,12 @@ void SmokeSolver::Advect(double dt)
         }
       });
   };
-  advect({ &this->U }, { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } });
-  advect({ &this->V }, { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } });
-  advect({ &this->W }, { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } });
-  advect({ &this->Density, &this->Temperature }, { { n[0], n[1], n[2] } }, { { 0.5, 0.5, 0.5 } });
+  advect({ &this->U }, { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } }, { p.Wind[0] });
+  advect({ &this->V }, { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } }, { p.Wind[1] });
+  advect({ &this->W }, { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } }, { p.Wind[2] });
+  // Beyond open sides: no smoke, the ambient temperature.
+  advect({ &this->Density, &this->Temperature }, { { n[0], n[1], n[2] } }, { { 0.5, 0.5, 0.5 } },
+    { 0.0, p.AmbientTemperatureKelvin });
   for (std::size_t c = 0; c < this->Solid.size(); ++c)
   {
     if (this->Solid[c])
@@ -1004,10 +1136,13 @@ Vector3 SmokeSolver::VelocityAt(const Vector3& positionMetres) const
     }
     x[a] = (positionMetres[a] - p.Origin[a]) / p.CellSizeMetres; // cell coordinates
   }
-  // The same views of the faces as Advect's.
-  const FieldView uView{ this->U.data(), { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } } };
-  const FieldView vView{ this->V.data(), { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } } };
-  const FieldView wView{ this->W.data(), { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } } };
+  // The same views of the faces as Advect's, clamped (no wind beyond open sides).
+  const FieldView uView{ this->U.data(), { { n[0] + 1, n[1], n[2] } }, { { 0.0, 0.5, 0.5 } }, false,
+    0.0 };
+  const FieldView vView{ this->V.data(), { { n[0], n[1] + 1, n[2] } }, { { 0.5, 0.0, 0.5 } }, false,
+    0.0 };
+  const FieldView wView{ this->W.data(), { { n[0], n[1], n[2] + 1 } }, { { 0.5, 0.5, 0.0 } }, false,
+    0.0 };
   return { { uView.Sample(x), vView.Sample(x), wView.Sample(x) } };
 }
 

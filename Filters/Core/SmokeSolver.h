@@ -23,18 +23,32 @@
 //     nu_t = (C_s h)^2 |S| (SmagorinskyConstant), applied explicitly (sub-stepped to keep
 //     nu_t dt / h^2 <= 1/6);
 //  4. projection: the pressure that makes the velocity divergence-free, Poisson's
-//     equation on the fluid cells (obstacles and the side and bottom walls: no flow
-//     through them; the top: open, pressure 0) solved by conjugate gradients
-//     preconditioned with a geometric multigrid V-cycle (MGPCG, McAdams et al. 2010:
-//     SmokePressure.h; multithreaded, its iterations about constant as the grid grows)
-//     or, as an option, with an incomplete Cholesky factorisation (Eigen, natural
-//     order, factored once per obstacle layout), each solve started from the last
-//     pressure;
+//     equation on the fluid cells (obstacles and the bottom wall: no flow through them;
+//     the top: open, pressure 0; the sides: walls or open, SideBoundaries below) solved
+//     by conjugate gradients preconditioned with a geometric multigrid V-cycle (MGPCG,
+//     McAdams et al. 2010: SmokePressure.h; multithreaded, its iterations about constant
+//     as the grid grows) or, as an option, with an incomplete Cholesky factorisation
+//     (Eigen, natural order, factored once per obstacle layout), each solve started from
+//     the last pressure;
 //  5. advection of velocity, density and temperature along the projected velocity:
 //     semi-Lagrangian (a second-order backtrace, trilinear samples) or MacCormack
 //     (Selle et al. 2008, clamped to the neighbourhood of the backtraced point);
 //  6. decay: the temperature relaxes to ambient at CoolingPerSecond, the density fades
 //     at DissipationPerSecond.
+//
+// The box's sides (its x and y faces; SmokeParameters::SideBoundaries): walls (no flow
+// through them), or open: the air beyond them is at pressure 0 like the air above the
+// top (Dirichlet in the pressure equation on every multigrid level), their faces'
+// velocities are free (set by the forces, the eddy viscosity and the projection, not
+// zeroed), and the advection sees the air outside as the inflow: the wind's velocity, no
+// smoke, the ambient temperature (one layer of samples beyond each open side holding
+// those values, points farther out taking them too); smoke carried out through an open
+// side leaves the box. Automatic (the default): open when there is wind (|Wind| > 0 and
+// WindCoupling > 0), walls otherwise, so a calm run is exactly what it was with walls.
+// Without open sides a uniform wind in a closed box is (nearly) a pure gradient and the
+// projection removes it: the air barely moves. The top is always open (its advection
+// samples clamped to the last layer), the bottom always a wall, obstacles always solid.
+//
 // Deterministic: every value is written by one thread, in no order that matters; the
 // pressure solve's sums are taken per z-layer and added in layer order (the same for
 // any thread count).
@@ -67,6 +81,14 @@ enum class SmokeAdvection
   MacCormack = 1
 };
 
+/// The box's x and y faces (see the file comment).
+enum class SmokeSideBoundaries
+{
+  Automatic = 0, // open when |Wind| > 0 and WindCoupling > 0, walls otherwise
+  Walls = 1,     // no flow through them
+  Open = 2       // pressure 0 beyond them; inflow: the wind, no smoke, ambient temperature
+};
+
 enum class SmokePressureSolver
 {
   Multigrid = 0,         // MGPCG (SmokePressure.h): multithreaded, cost linear in the cells
@@ -88,6 +110,8 @@ struct SmokeParameters
   double VorticityConfinement = 0.0; // eps (dimensionless)
   Vector3 Wind{ { 0, 0, 0 } };       // [m/s]
   double WindCoupling = 0.0;         // [1/s]: how fast the air takes the wind's speed
+  /// The box's x and y faces: open with wind by default, so the wind blows through.
+  SmokeSideBoundaries SideBoundaries = SmokeSideBoundaries::Automatic;
   SmokeAdvection Advection = SmokeAdvection::MacCormack;
   double MaxCfl = 2.0;             // cells a sample may travel per sub-step
   int MaxSubsteps = 64;            // per Step; more than that is an error
@@ -102,8 +126,13 @@ struct SmokeParameters
 
 /// "" or the first thing wrong with the parameters (non-finite numbers, dimensions < 2
 /// or over 1024 per axis or 2^27 cells, h <= 0, negative rates, an obstacle mask of the
-/// wrong size or covering every cell, emitters with radius <= 0).
+/// wrong size or covering every cell, emitters with radius <= 0, an unknown
+/// SideBoundaries or PressureSolver).
 std::string CheckSmokeParameters(const SmokeParameters& p);
+
+/// Whether the parameters make the box's sides open: SideBoundaries Open, or Automatic
+/// with wind (|Wind| > 0 and WindCoupling > 0).
+bool SmokeSidesOpen(const SmokeParameters& p);
 
 struct SmokeStepReport
 {
@@ -130,6 +159,8 @@ public:
   SmokeStepReport Step(double dt);
 
   const SmokeParameters& GetParameters() const { return this->Parameters; }
+  /// Whether the box's sides are open (SmokeSidesOpen of the parameters).
+  bool GetSidesOpen() const { return this->SidesOpen; }
   double GetTime() const { return this->Time; }
   std::size_t NumberOfCells() const;
   std::size_t CellIndex(int i, int j, int k) const
@@ -146,7 +177,8 @@ public:
   const std::vector<float>& GetV() const { return this->V; }
   const std::vector<float>& GetW() const { return this->W; }
   /// The velocity [m/s] at a point [m]: each component trilinear between its faces (the
-  /// samples the advection uses), the point clamped to each component's box of faces.
+  /// samples the advection uses), the point clamped to each component's box of faces
+  /// (also with open sides: beyond them it is the faces' nearest value, not the wind).
   /// Throws std::invalid_argument for a NaN coordinate.
   Vector3 VelocityAt(const Vector3& positionMetres) const;
   /// The velocity at cell centres (the mean of the two faces per axis), 3 per cell.
@@ -178,6 +210,7 @@ private:
   double MaxSpeed() const;
 
   SmokeParameters Parameters;
+  bool SidesOpen = false; // SmokeSidesOpen(Parameters)
   double Time = 0.0;
   std::vector<float> Density, Temperature, U, V, W;
   std::vector<std::uint8_t> Solid; // per cell
