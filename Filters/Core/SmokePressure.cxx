@@ -41,6 +41,41 @@ void ForLayers(int layers, int threads, const Body& body)
     });
 }
 
+// start + the coupled neighbours of cell c = (i, j, k) on a level with couplings per face
+// (cx[c]: the face toward +x of cell c; cy, cz likewise), added in a fixed order (the
+// operator and the smoother give the same sums whatever the thread).
+inline double AddNeighbours(double start, const float* cx, const float* cy, const float* cz,
+  const double* x, std::size_t c, int i, int nx, std::size_t nxy, bool south, bool north, bool down,
+  bool up)
+{
+  double s = start;
+  if (i + 1 < nx)
+  {
+    s += cx[c] * x[c + 1];
+  }
+  if (i > 0)
+  {
+    s += cx[c - 1] * x[c - 1];
+  }
+  if (north)
+  {
+    s += cy[c] * x[c + nx];
+  }
+  if (south)
+  {
+    s += cy[c - nx] * x[c - nx];
+  }
+  if (up)
+  {
+    s += cz[c] * x[c + nxy];
+  }
+  if (down)
+  {
+    s += cz[c - nxy] * x[c - nxy];
+  }
+  return s;
+}
+
 // The sum of per-layer partial sums, in layer order (independent of the threads).
 double SumInOrder(const std::vector<double>& partial, int layers)
 {
@@ -258,31 +293,7 @@ double SmokePressure::ApplyLayer(const Level& l, int k, const double* x, double*
     for (int i = 0; i < nx; ++i)
     {
       const std::size_t c = row + i;
-      double s = 0.0;
-      if (i + 1 < nx)
-      {
-        s += cxs[c] * x[c + 1];
-      }
-      if (i > 0)
-      {
-        s += cxs[c - 1] * x[c - 1];
-      }
-      if (north)
-      {
-        s += cys[c] * x[c + nx];
-      }
-      if (south)
-      {
-        s += cys[c - nx] * x[c - nx];
-      }
-      if (up)
-      {
-        s += czs[c] * x[c + nxy];
-      }
-      if (down)
-      {
-        s += czs[c - nxy] * x[c - nxy];
-      }
+      const double s = AddNeighbours(0.0, cxs, cys, czs, x, c, i, nx, nxy, south, north, down, up);
       y[c] = diagonal[c] * x[c] - s;
       sum += x[c] * y[c];
     }
@@ -359,31 +370,8 @@ void SmokePressure::Sweep(const Level& l, const double* b, double* x, int colour
         for (int i = (colour + j + k) & 1; i < nx; i += 2)
         {
           const std::size_t c = row + i;
-          double s = b[c];
-          if (i + 1 < nx)
-          {
-            s += cxs[c] * x[c + 1];
-          }
-          if (i > 0)
-          {
-            s += cxs[c - 1] * x[c - 1];
-          }
-          if (north)
-          {
-            s += cys[c] * x[c + nx];
-          }
-          if (south)
-          {
-            s += cys[c - nx] * x[c - nx];
-          }
-          if (up)
-          {
-            s += czs[c] * x[c + nxy];
-          }
-          if (down)
-          {
-            s += czs[c - nxy] * x[c - nxy];
-          }
+          const double s =
+            AddNeighbours(b[c], cxs, cys, czs, x, c, i, nx, nxy, south, north, down, up);
           x[c] = inv[c] * s;
         }
       }
