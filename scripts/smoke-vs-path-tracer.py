@@ -32,9 +32,7 @@ import numpy as np
 
 import nimbus
 from nimbus import harness
-from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
-from vtkmodules.vtkRenderingCore import vtkRenderWindow, vtkRenderer, vtkVolume
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -121,31 +119,7 @@ def render_nimbus(name, image_data):
     mapper.SetEmissionReferenceTemperatureKelvin(EMISSION["reference_kelvin"])
     mapper.SetNumberOfSlices(512)
     mapper.SetExposure(harness.VTK_SCALE)
-    mapper.SetCaptureRadiance(True)
-    volume = vtkVolume()
-    volume.SetMapper(mapper)
-    renderer = vtkRenderer()
-    renderer.AddVolume(volume)
-    renderer.SetBackground(0, 0, 0)
-    camera = renderer.GetActiveCamera()
-    camera.SetPosition(*CAMERA["position"])
-    camera.SetFocalPoint(*CAMERA["focal_point"])
-    camera.SetViewUp(*CAMERA["view_up"])
-    camera.SetViewAngle(CAMERA["view_angle"])
-    camera.SetClippingRange(0.1, 1e4)
-    window = vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetMultiSamples(0)
-    window.SetSize(*args.size)
-    window.AddRenderer(renderer)
-    start = time.perf_counter()
-    window.Render()
-    seconds = time.perf_counter() - start
-    radiance = mapper.GetRadianceImage()
-    width, height, _ = radiance.GetDimensions()
-    image = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
-    window.Finalize()
-    return image[..., :3].astype(np.float32).copy(), seconds
+    return harness.render_mapper_radiance(mapper, CAMERA, args.size, (0.1, 1e4))
 
 
 def blocks(image):

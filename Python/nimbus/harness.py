@@ -230,6 +230,41 @@ def zero_density(scene_path):
 
 # --- error metrics ----------------------------------------------------------------------------
 
+def render_mapper_radiance(mapper, camera, size, clipping=(0.1, 1e6)):
+    """Renders a vtkNimbusCloudVolumeMapper alone (black background, offscreen) from a
+    scene-style camera dict (position, focal_point, view_up, view_angle) at size (W, H).
+
+    Returns (H x W x 3 float32 linear radiance from the mapper's radiance capture, seconds
+    of the render call)."""
+    from vtkmodules.vtkRenderingCore import vtkRenderWindow, vtkRenderer, vtkVolume
+    import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
+    mapper.SetCaptureRadiance(True)
+    volume = vtkVolume()
+    volume.SetMapper(mapper)
+    renderer = vtkRenderer()
+    renderer.AddVolume(volume)
+    renderer.SetBackground(0, 0, 0)
+    view = renderer.GetActiveCamera()
+    view.SetPosition(*camera["position"])
+    view.SetFocalPoint(*camera["focal_point"])
+    view.SetViewUp(*camera["view_up"])
+    view.SetViewAngle(camera["view_angle"])
+    view.SetClippingRange(*clipping)
+    window = vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetMultiSamples(0)
+    window.SetSize(*size)
+    window.AddRenderer(renderer)
+    start = time.perf_counter()
+    window.Render()
+    seconds = time.perf_counter() - start
+    radiance = mapper.GetRadianceImage()
+    width, height, _ = radiance.GetDimensions()
+    image = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
+    window.Finalize()
+    return image[..., :3].astype(np.float32).copy(), seconds
+
+
 def block_means(image, block):
     """Means of block x block pixel tiles of an H x W x 3 image (partial tiles dropped)."""
     h, w = (image.shape[0] // block) * block, (image.shape[1] // block) * block
