@@ -1,18 +1,35 @@
 #include "vtkNimbusCloudRepresentation.h"
 
+#include "vtkBoundingBox.h"
+#include "vtkCamera.h"
+#include "vtkCellData.h"
 #include "vtkCommand.h"
+#include "vtkDataArray.h"
 #include "vtkDataObject.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkDoubleArray.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
+#include "vtkInformationVector.h"
+#include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkMultiProcessController.h"
+#include "vtkOrderedCompositingHelper.h"
 #include "vtkPVLODVolume.h"
 #include "vtkPVRenderView.h"
+#include "vtkPVRenderViewDataDeliveryManager.h"
+#include "vtkPointData.h"
 #include "vtkRenderer.h"
 
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 vtkStandardNewMacro(vtkNimbusCloudRepresentation);
 
@@ -100,8 +117,220 @@ int vtkNimbusCloudRepresentation::ProcessViewRequest(
         vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
     }
     this->CloudMapper->SetSkyBackground(sky);
+    this->ConfigurePiece(view);
   }
   return 1;
+}
+
+int vtkNimbusCloudRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  const int result = this->Superclass::RequestData(request, inputVector, outputVector);
+  for (int c = 0; c < 6; ++c)
+  {
+    this->WholeBounds[c] = (c % 2) ? -1.0 : 1.0;
+  }
+  this->CoarseDensity = nullptr;
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (!controller || controller->GetNumberOfProcesses() < 2)
+  {
+    return result;
+  }
+  // Every rank takes part in both collectives below, with or without a piece.
+  vtkImageData* piece = vtkImageData::SafeDownCast(this->Cache);
+  vtkDataArray* density = nullptr;
+  bool cellData = false;
+  if (piece && piece->GetNumberOfPoints() > 0)
+  {
+    vtkInformation* info = this->GetInputArrayInformation(0);
+    const char* name = info && info->Has(vtkDataObject::FIELD_NAME())
+      ? info->Get(vtkDataObject::FIELD_NAME())
+      : nullptr;
+    const int association = info && info->Has(vtkDataObject::FIELD_ASSOCIATION())
+      ? info->Get(vtkDataObject::FIELD_ASSOCIATION())
+      : vtkDataObject::FIELD_ASSOCIATION_POINTS;
+    if (name && name[0])
+    {
+      cellData = association == vtkDataObject::FIELD_ASSOCIATION_CELLS;
+      density =
+        cellData ? piece->GetCellData()->GetArray(name) : piece->GetPointData()->GetArray(name);
+    }
+    if (!density)
+    {
+      density = piece->GetPointData()->GetScalars();
+      cellData = false;
+      if (!density)
+      {
+        density = piece->GetCellData()->GetScalars();
+        cellData = density != nullptr;
+      }
+    }
+  }
+  // Bounds (world, no actor transform) and spacing of each rank's piece.
+  double mine[9] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 0.0, 0.0, 0.0 };
+  if (density)
+  {
+    piece->GetBounds(mine);
+    piece->GetSpacing(mine + 6);
+  }
+  const int ranks = controller->GetNumberOfProcesses();
+  std::vector<double> all(9 * static_cast<std::size_t>(ranks));
+  controller->AllGather(mine, all.data(), 9);
+  vtkBoundingBox whole;
+  double spacing[3] = { 0.0, 0.0, 0.0 };
+  for (int r = 0; r < ranks; ++r)
+  {
+    const double* b = &all[9 * static_cast<std::size_t>(r)];
+    if (b[0] <= b[1] && b[2] <= b[3] && b[4] <= b[5])
+    {
+      whole.AddBounds(b);
+      for (int a = 0; a < 3; ++a)
+      {
+        spacing[a] = std::max(spacing[a], b[6 + a]);
+      }
+    }
+  }
+  if (!whole.IsValid() || !(spacing[0] > 0.0 && spacing[1] > 0.0 && spacing[2] > 0.0))
+  {
+    return result;
+  }
+  whole.GetBounds(this->WholeBounds);
+  // The coarse lattice: the whole box, every `step` data points, at most
+  // CoarseDensityMaxSide points on a side; each rank adds its points' density to the
+  // nearest lattice point (sum and count), the sums are added over the ranks, and
+  // the mean is the coarse density (a box filter of the step's width).
+  int dims[3];
+  double coarseSpacing[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double length = this->WholeBounds[2 * a + 1] - this->WholeBounds[2 * a];
+    const int points = static_cast<int>(std::lround(length / spacing[a])) + 1;
+    const int step = std::max(1, (points + CoarseDensityMaxSide - 2) / (CoarseDensityMaxSide - 1));
+    dims[a] = std::max(1, (points - 1 + step - 1) / step + 1);
+    coarseSpacing[a] = length > 0.0 && dims[a] > 1 ? length / (dims[a] - 1) : spacing[a];
+  }
+  const std::size_t count = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
+  std::vector<double> sums(2 * count, 0.0); // sum, then count
+  if (density)
+  {
+    const vtkIdType n = cellData ? piece->GetNumberOfCells() : piece->GetNumberOfPoints();
+    int extent[6];
+    piece->GetExtent(extent);
+    const int nx = cellData ? std::max(extent[1] - extent[0], 1) : extent[1] - extent[0] + 1;
+    const int ny = cellData ? std::max(extent[3] - extent[2], 1) : extent[3] - extent[2] + 1;
+    const double* origin = piece->GetOrigin();
+    const double* own = piece->GetSpacing();
+    for (vtkIdType id = 0; id < n; ++id)
+    {
+      const int ijk[3] = { static_cast<int>(id % nx), static_cast<int>((id / nx) % ny),
+        static_cast<int>(id / (static_cast<vtkIdType>(nx) * ny)) };
+      std::size_t lattice = 0;
+      std::size_t stride = 1;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double x = origin[a] + (extent[2 * a] + ijk[a] + (cellData ? 0.5 : 0.0)) * own[a];
+        const int i = std::min(dims[a] - 1,
+          std::max(
+            0, static_cast<int>(std::lround((x - this->WholeBounds[2 * a]) / coarseSpacing[a]))));
+        lattice += stride * static_cast<std::size_t>(i);
+        stride *= static_cast<std::size_t>(dims[a]);
+      }
+      const double v = density->GetComponent(id, 0);
+      sums[lattice] += std::isfinite(v) ? std::max(v, 0.0) : 0.0;
+      sums[count + lattice] += 1.0;
+    }
+  }
+  std::vector<double> total(sums.size(), 0.0);
+  controller->AllReduce(
+    sums.data(), total.data(), static_cast<vtkIdType>(sums.size()), vtkCommunicator::SUM_OP);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("density");
+  values->SetNumberOfTuples(static_cast<vtkIdType>(count));
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    values->SetValue(static_cast<vtkIdType>(i),
+      total[count + i] > 0.0 ? static_cast<float>(total[i] / total[count + i]) : 0.0f);
+  }
+  this->CoarseDensity = vtkSmartPointer<vtkImageData>::New();
+  this->CoarseDensity->SetOrigin(this->WholeBounds[0], this->WholeBounds[2], this->WholeBounds[4]);
+  this->CoarseDensity->SetSpacing(coarseSpacing);
+  this->CoarseDensity->SetDimensions(dims);
+  this->CoarseDensity->GetPointData()->SetScalars(values);
+  return result;
+}
+
+void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
+{
+  vtkNimbusCloudVolumeMapper* mapper = this->CloudMapper;
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  auto* delivery =
+    view ? vtkPVRenderViewDataDeliveryManager::SafeDownCast(view->GetDeliveryManager()) : nullptr;
+  const bool distributed = view && controller && controller->GetNumberOfProcesses() > 1 &&
+    this->CoarseDensity && view->GetUseOrderedCompositing() && delivery &&
+    static_cast<int>(delivery->GetCuts().size()) == controller->GetNumberOfProcesses();
+  if (!distributed)
+  {
+    mapper->SetPieceCompositing(false);
+    mapper->SetDrawOutsideRegions(true);
+    mapper->SetExternalDensity(nullptr);
+    const double none[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
+    mapper->SetSlicingBounds(none);
+    return;
+  }
+  // The order IceT composites in (the view's own helper, same boxes, same camera):
+  // the last rank's image is the bottom layer, so it draws the air and the ground.
+  vtkNew<vtkOrderedCompositingHelper> order;
+  order->SetBoundingBoxes(delivery->GetCuts());
+  const std::vector<int> ranks = order->ComputeSortOrder(view->GetActiveCamera());
+  const bool bottom = !ranks.empty() && ranks.back() == controller->GetLocalProcessId();
+  mapper->SetPieceCompositing(true);
+  mapper->SetDrawOutsideRegions(bottom);
+  mapper->SetExternalDensity(this->CoarseDensity);
+  mapper->SetSlicingBounds(this->WholeBounds);
+  double background[3] = { 0.0, 0.0, 0.0 };
+  if (view->GetRenderer())
+  {
+    view->GetRenderer()->GetBackground(background);
+  }
+  mapper->SetPieceBackground(background);
+  // The bottom piece's pixels are the whole view: its prop bounds must project onto
+  // all of it (IceT composites only the pixels a rank's bounds cover), without
+  // containing the eye. The frustum's corner rays between the cloud's distance and
+  // twice it, widened by half for safety.
+  double cover[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
+  vtkCamera* camera = view->GetActiveCamera();
+  if (bottom && camera && view->GetRenderer())
+  {
+    vtkBoundingBox box;
+    const double* eye = camera->GetPosition();
+    double centre[3];
+    vtkBoundingBox(this->WholeBounds).GetCenter(centre);
+    const double distance = std::max(std::sqrt(vtkMath::Distance2BetweenPoints(eye, centre)), 1e-6);
+    const double* range = camera->GetClippingRange();
+    const double nearest = std::max(range[0], std::min(distance, range[1]));
+    int* size = view->GetRenderer()->GetSize();
+    const double aspect = size && size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0;
+    vtkMatrix4x4* toWorld = camera->GetCompositeProjectionTransformMatrix(aspect, -1.0, 1.0);
+    vtkNew<vtkMatrix4x4> inverse;
+    vtkMatrix4x4::Invert(toWorld, inverse);
+    for (int corner = 0; corner < 4; ++corner)
+    {
+      const double ndc[4] = { (corner & 1) ? 1.5 : -1.5, (corner & 2) ? 1.5 : -1.5, 0.0, 1.0 };
+      double p[4];
+      inverse->MultiplyPoint(ndc, p);
+      double ray[3] = { p[0] / p[3] - eye[0], p[1] / p[3] - eye[1], p[2] / p[3] - eye[2] };
+      vtkMath::Normalize(ray);
+      for (const double d : { nearest, 2.0 * nearest })
+      {
+        box.AddPoint(eye[0] + d * ray[0], eye[1] + d * ray[1], eye[2] + d * ray[2]);
+      }
+    }
+    if (!box.ContainsPoint(eye))
+    {
+      box.GetBounds(cover);
+    }
+  }
+  mapper->SetViewCoverBounds(cover);
 }
 
 void vtkNimbusCloudRepresentation::UpdateMapperParameters()

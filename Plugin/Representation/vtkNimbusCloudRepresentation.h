@@ -21,8 +21,11 @@
 
 #include "NimbusCloudRepresentationModule.h" // for export macro
 #include "vtkImageVolumeRepresentation.h"
+#include "vtkSmartPointer.h" // for vtkSmartPointer
 
+class vtkImageData;
 class vtkNimbusCloudVolumeMapper;
+class vtkPVRenderView;
 
 class NIMBUSCLOUDREPRESENTATION_EXPORT vtkNimbusCloudRepresentation
   : public vtkImageVolumeRepresentation
@@ -207,6 +210,26 @@ protected:
   /// The superclass's array selection and actor set-up; nothing that needs
   /// ParaView's own mappers.
   void UpdateMapperParameters() override;
+
+  /// The superclass's data cache; under MPI (more than one process) also the
+  /// distributed cloud's shared view of itself (issue 18, docs/parallel.md): every
+  /// rank's piece bounds and a coarse copy of the whole density (CoarseDensityMaxSide
+  /// points on its longest side at most), summed over the ranks (collective: every
+  /// rank of the data server executes it).
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+
+  /// Before a render under ordered compositing: this piece's settings on the mapper
+  /// (premultiplied output, the whole cloud's slice planes, the other pieces'
+  /// shadow) and whether this rank, last in the compositing order for the view's
+  /// camera, draws the air and the ground; without ordered compositing, none.
+  void ConfigurePiece(vtkPVRenderView* view);
+
+  /// The union of all ranks' piece bounds (invalid: not distributed) and the coarse
+  /// whole density from the last RequestData.
+  double WholeBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
+  vtkSmartPointer<vtkImageData> CoarseDensity;
+  static constexpr int CoarseDensityMaxSide = 64;
 
   /// Owned through the superclass's VolumeMapper.
   vtkNimbusCloudVolumeMapper* CloudMapper = nullptr;

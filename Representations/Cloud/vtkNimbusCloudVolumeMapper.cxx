@@ -5,6 +5,7 @@
 #include "AtmosphereTable.h"
 #include "CloudDensityTexture.h"
 #include "EmissionTexture.h"
+#include "ExternalShadow.h"
 #include "FiniteSetters.h"
 #include "FrameQuality.h"
 #include "LightningTexture.h"
@@ -42,6 +43,7 @@
 #include "vtkRenderer.h"
 #include "vtkSMPTools.h"
 #include "vtkShaderProgram.h"
+#include "vtkSmartPointer.h"
 #include "vtkTextureObject.h"
 #include "vtkVolume.h"
 #include "vtk_glew.h"
@@ -262,6 +264,10 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   bool Atmosphere = false;     // the atmosphere is drawn (Atmosphere, not Unlit)
   bool Ground = false;         // the ground is drawn (Ground, not Unlit)
   bool OutsideRegions = false; // passes outside the slices (atmosphere or ground)
+  bool ExternalShadow = false; // the other pieces' shadow (ExternalDensity) this frame
+  // World -> the multiple-scattering textures' coordinates (the density texture's
+  // scaled, or for a piece of a distributed cloud, the whole cloud's coarse grid's).
+  std::array<float, 16> WorldToScattering{};
 
   // The renderer's viewport in the framebuffer.
   int Width = 0, Height = 0, X0 = 0, Y0 = 0;
@@ -292,6 +298,9 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   mutable bool FramebuffersPushed = false; // the scene's bindings, popped by the composite
   std::array<float, 16> WorldToTexture{};
   std::array<float, 16> WorldToBox{};
+  // The first slice plane of the whole cloud's slicing (SlicingBounds), else of
+  // this box's: sunward of it no sun line meets the cloud (svsMarchFS.glsl).
+  double FirstPlaneOffset = 0.0;
   vtkNew<vtkMatrix4x4> WorldToNdc;
   vtkNew<vtkMatrix4x4> DataToWorld;
 
@@ -368,6 +377,18 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkOpenGLFramebufferObject> RayEndsFramebuffer;
   vtkNew<vtkImageData> Radiance; // float copy of the last accumulation (CaptureRadiance)
 
+  // The other pieces' optical depth toward the sun (issue 18; ExternalShadow.h): the
+  // coarse whole density, its map facing the sun (keyed by what it depends on) and
+  // the map as a 2-channel float texture.
+  vtkSmartPointer<vtkImageData> ExternalDensity;
+  nimbus::CoarseDensityGrid ExternalGrid;
+  vtkMTimeType ExternalGridTime = 0;
+  std::string ExternalGridError;
+  nimbus::ExternalShadowMap ExternalMap;
+  std::vector<double> ExternalMapKey;
+  vtkNew<vtkTextureObject> ExternalShadowTexture;
+  int ExternalMapBuilds = 0;
+
   // Shadow surface facing the sun (000 Eq. 10).
   vtkNew<vtkTextureObject> Shadow;
   vtkNew<vtkOpenGLFramebufferObject> ShadowFramebuffer;
@@ -404,9 +425,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
     this->Scattering.Release(window);
     this->Lightning.Release(window);
     this->Emission.Release(window);
-    for (vtkTextureObject* t : { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(),
-           Accumulation.GetPointer(), ClearAccumulation.GetPointer(), SceneColor.GetPointer(),
-           SceneDepth.GetPointer(), Shadow.GetPointer(), RayEnds.GetPointer() })
+    for (vtkTextureObject* t :
+      { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(), Accumulation.GetPointer(),
+        ClearAccumulation.GetPointer(), SceneColor.GetPointer(), SceneDepth.GetPointer(),
+        Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
@@ -507,6 +529,13 @@ void vtkNimbusCloudVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume
   // over the scene (the composite, the only pass that writes there, is the last).
   Internals& in = *this->Internal;
   in.PassesLastRender = 0;
+  // ViewCoverBounds serve the render they were set for (ParaView's compositor reads
+  // the props' bounds before it draws them); a camera reset after it must see the
+  // cloud's own bounds.
+  for (int c = 0; c < 6; ++c)
+  {
+    this->ViewCoverBounds[c] = (c % 2) ? -1.0 : 1.0;
+  }
   FrameState frame;
   std::string failure;
   try
@@ -559,10 +588,11 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
   if (frame.Window)
   {
     Internals& in = *this->Internal;
-    for (vtkTextureObject* t : { in.Density.GetTexture(), in.SceneDepth.GetPointer(),
-           in.RayEnds.GetPointer(), in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(),
-           in.Accumulation.GetPointer(), in.SceneColor.GetPointer(),
-           in.ClearAccumulation.GetPointer(), in.AtmosphereTexture.GetPointer() })
+    for (vtkTextureObject* t :
+      { in.Density.GetTexture(), in.SceneDepth.GetPointer(), in.RayEnds.GetPointer(),
+        in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(), in.Accumulation.GetPointer(),
+        in.SceneColor.GetPointer(), in.ClearAccumulation.GetPointer(),
+        in.AtmosphereTexture.GetPointer(), in.ExternalShadowTexture.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -589,6 +619,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     frame.FramebuffersPushed = false;
     return false;
   }
+  this->UpdateExternalShadow(frame);
   this->UpdateMultipleScattering(frame);
   this->UpdateLightning(frame);
   this->UpdateEmission(frame);
@@ -684,6 +715,7 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
       static_cast<double>(in.Scattering.GetNumberOfSolves()), frame.ScatteringScale,
       static_cast<double>(in.Lightning.GetNumberOfUploads()), frame.LightningTexture ? 1.0 : 0.0,
       static_cast<double>(in.Emission.GetNumberOfUploads()), frame.EmissionTexture ? 1.0 : 0.0,
+      static_cast<double>(in.ExternalMapBuilds), frame.ExternalShadow ? 1.0 : 0.0,
       static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),
       frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees,
       frame.Settings.OverSky ? 1.0 : 0.0, static_cast<double>(frame.Width),
@@ -919,8 +951,46 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
     frame.Corners.push_back({ { w[0] / w[3], w[1] / w[3], w[2] / w[3] } });
   }
   const std::array<double, 2> range = nimbus::ProjectedRange(frame.Corners, frame.Axis.Normal);
-  frame.Planes =
-    nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), frame.Level.Slices);
+  const double* sb = this->SlicingBounds;
+  if (sb[0] <= sb[1] && sb[2] <= sb[3] && sb[4] <= sb[5])
+  {
+    // One piece of a distributed cloud: the whole cloud's planes, those that cut
+    // this piece (at least the nearest one, so the passes keep their geometry).
+    std::vector<nimbus::Vector3> whole;
+    for (int c = 0; c < 8; ++c)
+    {
+      whole.push_back({ { sb[(c & 1) ? 1 : 0], sb[(c & 2) ? 3 : 2], sb[(c & 4) ? 5 : 4] } });
+    }
+    const std::array<double, 2> wholeRange = nimbus::ProjectedRange(whole, frame.Axis.Normal);
+    const nimbus::SlicePlanes all = nimbus::MakeSlicePlanes(
+      wholeRange[0], std::max(wholeRange[1], wholeRange[0] + 1e-9), frame.Level.Slices);
+    frame.Planes = all;
+    frame.Planes.Offsets.clear();
+    double nearest = all.Offsets.front();
+    for (const double offset : all.Offsets)
+    {
+      if (offset >= range[0] - 0.5 * all.Spacing && offset <= range[1] + 0.5 * all.Spacing)
+      {
+        frame.Planes.Offsets.push_back(offset);
+      }
+      if (std::abs(offset - 0.5 * (range[0] + range[1])) <
+        std::abs(nearest - 0.5 * (range[0] + range[1])))
+      {
+        nearest = offset;
+      }
+    }
+    if (frame.Planes.Offsets.empty())
+    {
+      frame.Planes.Offsets.push_back(nearest);
+    }
+    frame.FirstPlaneOffset = all.Offsets.front();
+  }
+  else
+  {
+    frame.Planes =
+      nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), frame.Level.Slices);
+    frame.FirstPlaneOffset = frame.Planes.Offsets.front();
+  }
   frame.Shadow = nimbus::ComputeShadowFrame(frame.Corners, frame.ToSun, 0.02);
   frame.SunStepMetres = frame.Planes.Spacing / frame.Axis.SunCosine * frame.Settings.MetresPerUnit;
 
@@ -1195,6 +1265,18 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
   program->SetUniformi("overSky", frame.Settings.OverSky ? 1 : 0);
   program->SetUniformi("sliceJitter", this->SliceJitter ? 1 : 0);
+  program->SetUniformi("externalShadowOn", frame.ExternalShadow ? 1 : 0);
+  // Unused when off, but the sampler must name a 2-D texture unit.
+  program->SetUniformi("externalShadow",
+    (frame.ExternalShadow ? in.ExternalShadowTexture.GetPointer() : in.SceneDepth.GetPointer())
+      ->GetTextureUnit());
+  const nimbus::ShadowFrame& external = in.ExternalMap.Frame;
+  program->SetUniform3f("externalOrigin", external.Origin.data());
+  program->SetUniform3f("externalU", external.U.data());
+  program->SetUniform3f("externalW", external.W.data());
+  const float externalExtent[2] = { static_cast<float>(external.Width),
+    static_cast<float>(external.Height) };
+  program->SetUniform2f("externalExtent", externalExtent);
 }
 
 //------------------------------------------------------------------------------
@@ -1205,6 +1287,10 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
   Internals& in = *this->Internal;
   in.Density.GetTexture()->Activate();
   in.SceneDepth->Activate();
+  if (frame.ExternalShadow)
+  {
+    in.ExternalShadowTexture->Activate();
+  }
   if (frame.Atmosphere)
   {
     in.AtmosphereTexture->Activate();
@@ -1243,6 +1329,10 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Deactivate();
+  }
+  if (frame.ExternalShadow)
+  {
+    in.ExternalShadowTexture->Deactivate();
   }
   if (frame.Atmosphere)
   {
@@ -1299,14 +1389,32 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   options.Threads = vtkSMPTools::GetEstimatedNumberOfThreads();
   request.Optics = { this->Albedo, nimbus::PhaseFunctionKind::CornetteShanks, this->CloudG };
   request.ExtinctionPerDensity = this->ExtinctionPerDensity;
+  // One piece of a distributed cloud (issue 18): the solve runs on the whole cloud's
+  // coarse copy, the same on every rank, so that light crosses the pieces' faces as in
+  // one renderer (each piece's own solve would lose it there: dark seams, measured).
+  const bool wholeCloud = frame.ExternalShadow && this->PieceCompositing;
+  vtkImageData* solveImage = frame.Image;
+  vtkDataArray* solveScalars = frame.Scalars;
+  bool solveCellData = frame.CellData;
+  vtkNew<vtkMatrix4x4> identity;
+  vtkMatrix4x4* solveToWorld = frame.DataToWorld;
   int textureDims[3];
+  int textureFactors[3];
   in.Density.GetDimensions(textureDims);
+  in.Density.GetFactors(textureFactors);
+  if (wholeCloud)
+  {
+    solveImage = in.ExternalDensity;
+    solveScalars = solveImage->GetPointData()->GetScalars();
+    solveCellData = false;
+    solveToWorld = identity; // the coarse grid is in world coordinates
+    solveImage->GetDimensions(textureDims);
+    textureFactors[0] = textureFactors[1] = textureFactors[2] = 1;
+  }
   const int longest = std::max({ textureDims[0], textureDims[1], textureDims[2], 1 });
   request.Downsampling = this->MultipleScatteringDownsampling > 0
     ? this->MultipleScatteringDownsampling
     : (longest + kAutomaticScatteringGridSide - 1) / kAutomaticScatteringGridSide;
-  int textureFactors[3];
-  in.Density.GetFactors(textureFactors);
   for (int k = 0; k < 3; ++k)
   {
     request.TextureDimensions[k] = std::max(textureDims[k], 1);
@@ -1342,6 +1450,10 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   for (const auto& corner : frame.Corners)
   {
     zMiddle += corner[2] / static_cast<double>(frame.Corners.size());
+  }
+  if (wholeCloud)
+  {
+    zMiddle = 0.5 * (this->SlicingBounds[4] + this->SlicingBounds[5]);
   }
   if (this->SkyLight && frame.Atmosphere)
   {
@@ -1402,9 +1514,12 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   }
   const double solvesBefore = in.Scattering.GetNumberOfSolves();
   std::string error;
+  // The density's identity: the uploads of the piece, or (negative, never equal to
+  // those) the coarse copy's modification time.
+  const double densityVersion = wholeCloud ? -1.0 - static_cast<double>(in.ExternalGridTime)
+                                           : static_cast<double>(in.Density.GetNumberOfUploads());
   const bool ok = in.Scattering.Update(
-    frame.Window, frame.Image, frame.Scalars, frame.CellData, frame.DataToWorld,
-    static_cast<double>(in.Density.GetNumberOfUploads()), request,
+    frame.Window, solveImage, solveScalars, solveCellData, solveToWorld, densityVersion, request,
     [this](double fraction) { this->UpdateProgress(fraction); }, error);
   if (!ok)
   {
@@ -1425,6 +1540,39 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     vtkDebugMacro(<< "multiple scattering: " << in.LastPrecomputeSeconds << " s");
   }
   frame.ScatteringTexture = in.Scattering.HasTexture();
+  // World -> the textures: (density texture coordinates) * TextureScale.
+  vtkNew<vtkMatrix4x4> worldToScattering;
+  if (wholeCloud)
+  {
+    // Point data: texel centres at (index + 0.5) / dimensions.
+    const double* origin = solveImage->GetOrigin();
+    const double* spacing = solveImage->GetSpacing();
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = std::max(textureDims[a], 1);
+      worldToScattering->SetElement(a, a, 1.0 / (spacing[a] * d));
+      worldToScattering->SetElement(a, 3, (-origin[a] / spacing[a] + 0.5) / d);
+    }
+  }
+  else
+  {
+    for (int r = 0; r < 4; ++r)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        worldToScattering->SetElement(r, c, frame.WorldToTexture[4 * c + r]);
+      }
+    }
+  }
+  const auto& textureScale = in.Scattering.GetTextureScale();
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      worldToScattering->SetElement(r, c, worldToScattering->GetElement(r, c) * textureScale[r]);
+    }
+  }
+  frame.WorldToScattering = ColumnMajor(worldToScattering);
   frame.ScatteringScale =
     in.SolvedIlluminance > 0.0 ? settings.Sun.Illuminance / in.SolvedIlluminance : 1.0;
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
@@ -1617,6 +1765,127 @@ void vtkNimbusCloudVolumeMapper::GetMultipleScatteringGridDimensions(int dims[3]
 }
 
 //------------------------------------------------------------------------------
+double* vtkNimbusCloudVolumeMapper::GetBounds()
+{
+  double* bounds = this->Superclass::GetBounds();
+  const double* cover = this->ViewCoverBounds;
+  if (!(this->PieceCompositing && this->DrawOutsideRegions) || !bounds || bounds[0] > bounds[1] ||
+    !(cover[0] <= cover[1] && cover[2] <= cover[3] && cover[4] <= cover[5]))
+  {
+    return bounds;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    this->PieceBounds[2 * a] = std::min(bounds[2 * a], cover[2 * a]);
+    this->PieceBounds[2 * a + 1] = std::max(bounds[2 * a + 1], cover[2 * a + 1]);
+  }
+  return this->PieceBounds;
+}
+
+//------------------------------------------------------------------------------
+void vtkNimbusCloudVolumeMapper::SetExternalDensity(vtkImageData* coarse)
+{
+  if (this->Internal->ExternalDensity.GetPointer() != coarse)
+  {
+    this->Internal->ExternalDensity = coarse;
+    this->Modified();
+  }
+}
+
+vtkImageData* vtkNimbusCloudVolumeMapper::GetExternalDensity()
+{
+  return this->Internal->ExternalDensity;
+}
+
+//------------------------------------------------------------------------------
+// The other pieces' shadow (issue 18, ExternalShadow.h): the coarse whole density
+// converted when it changes, its map rebuilt when the sun, the piece, the optics or
+// the grid change (not with the camera), uploaded as a (Beyond, Whole) texture.
+void vtkNimbusCloudVolumeMapper::UpdateExternalShadow(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  vtkImageData* coarse = in.ExternalDensity;
+  frame.ExternalShadow = false;
+  if (!coarse || this->Unlit)
+  {
+    return;
+  }
+  if (coarse->GetMTime() != in.ExternalGridTime)
+  {
+    in.ExternalGridTime = coarse->GetMTime();
+    in.ExternalGrid = nimbus::CoarseDensityGrid();
+    vtkDataArray* values = coarse->GetPointData()->GetScalars();
+    int dims[3];
+    coarse->GetDimensions(dims);
+    if (values && values->GetNumberOfComponents() == 1 &&
+      values->GetNumberOfTuples() == static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2])
+    {
+      const double* origin = coarse->GetOrigin();
+      const double* spacing = coarse->GetSpacing();
+      for (int a = 0; a < 3; ++a)
+      {
+        in.ExternalGrid.Origin[a] = origin[a];
+        in.ExternalGrid.Spacing[a] = spacing[a];
+        in.ExternalGrid.Dimensions[a] = dims[a];
+      }
+      in.ExternalGrid.Values.resize(static_cast<std::size_t>(values->GetNumberOfTuples()));
+      for (vtkIdType i = 0; i < values->GetNumberOfTuples(); ++i)
+      {
+        const double v = values->GetComponent(i, 0);
+        in.ExternalGrid.Values[static_cast<std::size_t>(i)] =
+          std::isfinite(v) ? static_cast<float>(std::max(v, 0.0)) : 0.0f;
+      }
+    }
+    in.ExternalMapKey.clear();
+  }
+  if (!in.ExternalGrid.IsValid())
+  {
+    const std::string message = "The external density (the other pieces' coarse density) "
+                                "has no single-component point scalars on its lattice: the "
+                                "other pieces cast no shadow on this one.";
+    if (message != in.ExternalGridError)
+    {
+      vtkWarningMacro(<< message);
+      in.ExternalGridError = message;
+    }
+    return;
+  }
+  in.ExternalGridError.clear();
+  // The piece's box (world) from its corners.
+  std::array<double, 6> piece = { { VTK_DOUBLE_MAX, VTK_DOUBLE_MIN, VTK_DOUBLE_MAX, VTK_DOUBLE_MIN,
+    VTK_DOUBLE_MAX, VTK_DOUBLE_MIN } };
+  for (const auto& corner : frame.Corners)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      piece[2 * a] = std::min(piece[2 * a], corner[a]);
+      piece[2 * a + 1] = std::max(piece[2 * a + 1], corner[a]);
+    }
+  }
+  // About two texels per coarse cell across the footprint, within [64, 512].
+  const int largest = std::max({ in.ExternalGrid.Dimensions[0], in.ExternalGrid.Dimensions[1],
+    in.ExternalGrid.Dimensions[2] });
+  const int size = std::min(512, std::max(64, 2 * largest));
+  std::vector<double> key(piece.begin(), piece.end());
+  key.insert(key.end(),
+    { frame.ToSun[0], frame.ToSun[1], frame.ToSun[2], this->ExtinctionPerDensity,
+      frame.Settings.MetresPerUnit, static_cast<double>(size),
+      static_cast<double>(in.ExternalGridTime) });
+  if (key != in.ExternalMapKey)
+  {
+    in.ExternalMap = nimbus::ComputeExternalShadowMap(in.ExternalGrid, piece, frame.ToSun,
+      this->ExtinctionPerDensity, frame.Settings.MetresPerUnit, size);
+    in.ExternalMapKey = key;
+    ++in.ExternalMapBuilds;
+    ResetTexture(in.ExternalShadowTexture, frame.Window, true);
+    in.ExternalShadowTexture->Create2DFromRaw(static_cast<unsigned int>(size),
+      static_cast<unsigned int>(size), 2, VTK_FLOAT,
+      const_cast<float*>(in.ExternalMap.Depths.data()));
+  }
+  frame.ExternalShadow = in.ExternalMap.Size > 0;
+}
+
+//------------------------------------------------------------------------------
 // The shadow surface (000 Eq. 10), cleared to optical depth 0.
 void vtkNimbusCloudVolumeMapper::ClearShadowSurface(const FrameState& frame)
 {
@@ -1726,7 +1995,16 @@ void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 // sky).
 void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bool behindBox)
 {
-  if (!frame.OutsideRegions)
+  // A piece whose image goes over the one that draws the air (issue 18): only the
+  // air in front of its box, weighted by its opacity 1 - T_i (and none in its box).
+  // The bottom image has all the air in front of its own box, which compositing
+  // multiplies by the transmittances of the pieces in front; each piece adds back
+  // what its cloud took of the air in front of it: sum_i prod_{j<i} T_j (1 - T_i)
+  // A_i + prod_i T_i A = A_1 + T_1 (A_2 - A_1) + ..., the air in front of each piece
+  // attenuated by the pieces in front of it. The air inside a piece's box counts as
+  // behind its cloud (measured, docs/parallel.md).
+  const bool overAir = this->PieceCompositing && !this->DrawOutsideRegions;
+  if (!frame.OutsideRegions || (overAir && behindBox))
   {
     return;
   }
@@ -1734,8 +2012,15 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
   in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglEnable(GL_BLEND);
-  frame.State->vtkglBlendFuncSeparate(
-    behindBox ? GL_DST_ALPHA : GL_ONE, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
+  if (overAir)
+  {
+    frame.State->vtkglBlendFuncSeparate(GL_ONE_MINUS_DST_ALPHA, GL_ONE, GL_ZERO, GL_ONE);
+  }
+  else
+  {
+    frame.State->vtkglBlendFuncSeparate(
+      behindBox ? GL_DST_ALPHA : GL_ONE, GL_ONE, GL_ZERO, GL_SRC_ALPHA);
+  }
   vtkShaderProgram* program = in.Ready(in.MarchPass, svsMarchFS);
   this->SetCommonUniforms(program, frame);
   program->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
@@ -1744,8 +2029,9 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
   program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   program->SetUniformi("steps", this->AtmosphereSteps);
   program->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
-  program->SetUniformf("firstSliceOffset",
-    static_cast<float>(frame.Planes.Offsets.front() - 0.5 * frame.Planes.Spacing));
+  program->SetUniformf(
+    "firstSliceOffset", static_cast<float>(frame.FirstPlaneOffset - 0.5 * frame.Planes.Spacing));
+
   program->SetUniformi("maxShadowSteps", std::min(frame.Level.Slices, 2 * this->AtmosphereSteps));
   // Only rays through the box have a part behind it: the box's pixels.
   int scissor[4];
@@ -1781,6 +2067,8 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
   sliceProgram->SetUniformf("sunStepMetres", static_cast<float>(frame.SunStepMetres));
   sliceProgram->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   sliceProgram->SetUniformi("unlit", this->Unlit ? 1 : 0);
+  sliceProgram->SetUniformi(
+    "boxAirOn", this->PieceCompositing && !this->DrawOutsideRegions ? 0 : 1);
   // Multiple scattering (issue 14). Without a texture the samplers name the
   // density's unit (a 3-D texture, never read), so no unit has two sampler types.
   sliceProgram->SetUniformf("cloudG", static_cast<float>(this->CloudG));
@@ -1793,10 +2081,8 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
       (frame.ScatteringTexture ? in.Scattering.GetTexture(c) : in.Density.GetTexture())
         ->GetTextureUnit());
   }
-  const auto& scale = in.Scattering.GetTextureScale();
-  const float scatteringScale[3] = { static_cast<float>(scale[0]), static_cast<float>(scale[1]),
-    static_cast<float>(scale[2]) };
-  sliceProgram->SetUniform3f("scatteringTextureScale", scatteringScale);
+  sliceProgram->SetUniformMatrix4x4(
+    "worldToScattering", const_cast<float*>(frame.WorldToScattering.data()));
   // Lightning (issue 16), the same way.
   sliceProgram->SetUniformi("lightningTextureOn", frame.LightningTexture ? 1 : 0);
   const char* lightningSamplers[3] = { "lightningRed", "lightningGreen", "lightningBlue" };
@@ -1969,6 +2255,16 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
   program->SetUniform3f("displayScale", frame.Settings.DisplayScale);
   program->SetUniformi("encodeSrgb", frame.Settings.EncodeSrgb ? 1 : 0);
   program->SetUniformi("skyBackground", frame.Settings.OverSky ? 1 : 0);
+  program->SetUniformi(
+    "premultipliedPiece", this->PieceCompositing && !this->DrawOutsideRegions ? 1 : 0);
+  float pieceBackground[3];
+  for (int c = 0; c < 3; ++c)
+  {
+    pieceBackground[c] = static_cast<float>(this->PieceBackground[c]);
+  }
+  program->SetUniform3f("pieceBackground", pieceBackground);
+  program->SetUniformi(
+    "usePieceBackground", this->PieceCompositing && this->DrawOutsideRegions ? 1 : 0);
   if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Activate();
@@ -2020,6 +2316,18 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
   os << indent << "AirMultipleScattering: " << (this->AirMultipleScattering ? "on" : "off") << "\n";
   os << indent << "Ground: " << this->Ground << "\n";
+  os << indent << "PieceCompositing: " << this->PieceCompositing << "\n";
+  os << indent << "DrawOutsideRegions: " << this->DrawOutsideRegions << "\n";
+  os << indent << "PieceBackground: " << this->PieceBackground[0] << ", "
+     << this->PieceBackground[1] << ", " << this->PieceBackground[2] << "\n";
+  os << indent << "SlicingBounds: " << this->SlicingBounds[0] << " .. " << this->SlicingBounds[1]
+     << ", " << this->SlicingBounds[2] << " .. " << this->SlicingBounds[3] << ", "
+     << this->SlicingBounds[4] << " .. " << this->SlicingBounds[5] << "\n";
+  os << indent << "ViewCoverBounds: " << this->ViewCoverBounds[0] << " .. "
+     << this->ViewCoverBounds[1] << ", " << this->ViewCoverBounds[2] << " .. "
+     << this->ViewCoverBounds[3] << ", " << this->ViewCoverBounds[4] << " .. "
+     << this->ViewCoverBounds[5] << "\n";
+  os << indent << "ExternalDensity: " << this->Internal->ExternalDensity.GetPointer() << "\n";
   os << indent << "GroundHeight: " << this->GroundHeight << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
   os << indent << "Shafts: " << this->Shafts << "\n";

@@ -490,6 +490,56 @@ public:
   vtkImageData* GetRadianceImage();
   ///@}
 
+  ///@{
+  /// One piece of a distributed cloud (issue 18; docs/parallel.md). Under MPI each
+  /// rank renders its piece and ParaView composites the ranks' images in visibility
+  /// order with the premultiplied "over" operator (IceT). ParaView's Cloud
+  /// representation sets these; a VTK program composing its own images may too.
+  ///  - PieceCompositing: this image is one layer of such a composite.
+  ///  - DrawOutsideRegions (with PieceCompositing): this layer is the bottom one (the
+  ///    rank last in the compositing order): it draws the air (all of it, also in
+  ///    the other pieces' boxes) and the ground, their shafts and the cloud's shadow
+  ///    on them, over the view's background (PieceBackground: the renderer's
+  ///    background colour, which ParaView's parallel framebuffer is cleared
+  ///    without), opaque. Without it the layer is premultiplied (radiance, 1 - T_cl)
+  ///    of this piece's cloud over a transparent framebuffer, plus the air in front
+  ///    of the piece weighted by 1 - T_cl, which the bottom layer's air loses under it.
+  ///  - SlicingBounds (world): the slice planes are those of this box (the whole
+  ///    cloud's), kept where they cut the piece, so every piece samples the planes a
+  ///    single renderer would.
+  ///    Invalid (min > max, the default): the piece's own box.
+  ///  - ExternalDensity: a coarse copy of the WHOLE density (point scalars, world
+  ///    origin and spacing, no direction matrix) through which the sun reaches this
+  ///    piece from the other pieces (ExternalShadow.h); nullptr: no other pieces.
+  vtkSetMacro(PieceCompositing, bool);
+  vtkGetMacro(PieceCompositing, bool);
+  vtkBooleanMacro(PieceCompositing, bool);
+  vtkSetMacro(DrawOutsideRegions, bool);
+  vtkGetMacro(DrawOutsideRegions, bool);
+  vtkBooleanMacro(DrawOutsideRegions, bool);
+  vtkSetVector3Macro(PieceBackground, double);
+  vtkGetVector3Macro(PieceBackground, double);
+  vtkSetVector6Macro(SlicingBounds, double);
+  vtkGetVector6Macro(SlicingBounds, double);
+  void SetExternalDensity(vtkImageData* coarse);
+  vtkImageData* GetExternalDensity();
+  ///@}
+
+  ///@{
+  /// The input's bounds; for the piece that draws the air and the ground
+  /// (PieceCompositing and DrawOutsideRegions) together with ViewCoverBounds, a
+  /// box (world) whose projection covers the whole view: ParaView's compositor
+  /// (IceT) keeps of each rank's image only the pixels its props' bounds cover, and
+  /// that piece's pixels are the whole view. The representation sets it from the
+  /// camera before each render (a box around the view frustum between the cloud's
+  /// distance and twice it, which does not contain the eye); Render clears it, so
+  /// that a camera reset between renders sees the cloud's own bounds.
+  double* GetBounds() VTK_SIZEHINT(6) override;
+  using Superclass::GetBounds;
+  vtkSetVector6Macro(ViewCoverBounds, double);
+  vtkGetVector6Macro(ViewCoverBounds, double);
+  ///@}
+
   /// Counters of the last render and of the uploads so far (for tests and
   /// benchmarks): volume uploads, atmosphere-table builds, interval/phase builds,
   /// passes drawn in the last frame.
@@ -565,6 +615,12 @@ protected:
   double TextureMemoryBudgetMiB = 0.0;
   bool CaptureRadiance = false;
   bool UseSceneSky = true;
+  bool PieceCompositing = false;
+  bool DrawOutsideRegions = true;
+  double PieceBackground[3] = { 0.0, 0.0, 0.0 };
+  double SlicingBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
+  double PieceBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
+  double ViewCoverBounds[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   vtkNimbusSkyBackground* SkyBackground = nullptr;
   double FrameBudgetMilliseconds = 200.0;
   double Quality = 1.0;
@@ -604,6 +660,7 @@ private:
   static std::vector<double> FrameSkyKey(const FrameState& frame);
   void BeginPasses(const FrameState& frame);
   void ClearShadowSurface(const FrameState& frame);
+  void UpdateExternalShadow(FrameState& frame);
   void RenderIntervalPhase(const FrameState& frame);
   void RenderRayEnds(const FrameState& frame);
   void ClearAccumulation(const FrameState& frame);

@@ -25,6 +25,15 @@ uniform vec3 shadowOrigin;
 uniform vec3 shadowU;
 uniform vec3 shadowW;
 uniform vec2 shadowExtent;
+// The other pieces of a distributed cloud (issue 18, ExternalShadow.h): optical depth
+// toward the sun outside this piece, (beyond the piece toward the sun, whole line),
+// on a map facing the sun over the whole cloud.
+uniform int externalShadowOn;
+uniform sampler2D externalShadow;
+uniform vec3 externalOrigin;
+uniform vec3 externalU;
+uniform vec3 externalW;
+uniform vec2 externalExtent;
 
 uniform int atmosphereOn;
 uniform sampler2D atmosphereTable;  // rows: sun, Rayleigh source, Mie source, extinction,
@@ -223,16 +232,22 @@ bool ClipToUnitSlab(float o, float d, inout float tIn, inout float tOut)
   return true;
 }
 
-// The interval [tIn, tOut] of the ray origin + t direction inside the cloud box
-// (t may be negative); false when the ray's line misses the box.
-bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
+// The interval [tIn, tOut] of the ray origin + t direction inside the box that
+// `toBox` maps onto [0,1]^3 (t may be negative); false when the ray's line misses it.
+bool BoxIntervalOf(mat4 toBox, vec3 origin, vec3 direction, out float tIn, out float tOut)
 {
-  vec3 o = (worldToBox * vec4(origin, 1.0)).xyz;
-  vec3 d = (worldToBox * vec4(direction, 0.0)).xyz;
+  vec3 o = (toBox * vec4(origin, 1.0)).xyz;
+  vec3 d = (toBox * vec4(direction, 0.0)).xyz;
   tIn = -kInfinity;
   tOut = kInfinity;
   return ClipToUnitSlab(o.x, d.x, tIn, tOut) && ClipToUnitSlab(o.y, d.y, tIn, tOut) &&
     ClipToUnitSlab(o.z, d.z, tIn, tOut) && tIn <= tOut;
+}
+
+// The same for the cloud box.
+bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
+{
+  return BoxIntervalOf(worldToBox, origin, direction, tIn, tOut);
 }
 
 bool InsideBox(vec3 p)
@@ -262,13 +277,38 @@ float ShadowDepth(vec3 p)
   return texture(shadowSurface, st).r;
 }
 
+// The other pieces' optical depth toward the sun on p's sun line (0 without them):
+// .x beyond this piece (for points inside it), .y the whole line outside it.
+vec2 ExternalDepths(vec3 p)
+{
+  if (externalShadowOn == 0)
+  {
+    return vec2(0.0);
+  }
+  vec3 q = p - externalOrigin;
+  vec2 st = vec2(dot(q, externalU), dot(q, externalW)) / externalExtent;
+  if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0))))
+  {
+    return vec2(0.0);
+  }
+  return texture(externalShadow, st).rg;
+}
+
+// Cloud optical depth toward the sun of a point inside the box: this piece's slices
+// so far, plus the other pieces' beyond it.
+float CloudDepthInsideBox(vec3 p)
+{
+  return ShadowDepth(p) + ExternalDepths(p).x;
+}
+
 // Cloud optical depth toward the sun of a point outside the box, once the shadow
 // surface is complete (see svsMarchFS.glsl): the whole sun line's when the line
-// toward the sun meets the box, else 0.
+// toward the sun meets the box, else 0; plus the other pieces' on the whole line.
 float CloudDepthOutsideBox(vec3 p)
 {
   float tIn, tOut;
-  return BoxInterval(p, sunDirection, tIn, tOut) && tOut >= 0.0 ? ShadowDepth(p) : 0.0;
+  float own = BoxInterval(p, sunDirection, tIn, tOut) && tOut >= 0.0 ? ShadowDepth(p) : 0.0;
+  return own + ExternalDepths(p).y;
 }
 
 // Radiance of the Lambertian ground at g, toward the eye, before view attenuation.

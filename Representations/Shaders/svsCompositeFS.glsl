@@ -25,6 +25,15 @@ uniform sampler2D rayEnds; // (t_end, t_ground) per pixel, this frame
 uniform vec3 displayScale;
 uniform int encodeSrgb;
 uniform int skyBackground;
+// One piece of a distributed cloud (issue 18, docs/parallel.md). premultipliedPiece:
+// this piece's cloud alone, premultiplied (radiance, 1 - T_cl) over a transparent
+// framebuffer, for IceT's "over" in visibility order. usePieceBackground: the rank
+// that draws the air and the ground, last in that order, composites them over the
+// view's background colour (as the framebuffer would hold it), which the parallel framebuffer
+// does not hold, and is opaque.
+uniform int premultipliedPiece;
+uniform int usePieceBackground;
+uniform vec3 pieceBackground;
 
 void main()
 {
@@ -35,6 +44,26 @@ void main()
   float depth = texture(sceneDepth, texCoord).r;
   vec3 backgroundLinear = encodeSrgb != 0 ? SrgbDecode(background.rgb) : background.rgb;
   vec3 result;
+  if (premultipliedPiece != 0)
+  {
+    // Opaque geometry drawn on this rank stays behind the cloud; elsewhere the
+    // cloud's own opacity.
+    vec3 color = displayScale * sum.rgb + (depth < 1.0 ? sum.a * backgroundLinear : vec3(0.0));
+    float alpha = depth < 1.0 ? 1.0 : 1.0 - sum.a;
+    if (encodeSrgb != 0)
+    {
+      // Encoded unpremultiplied, then premultiplied: exact where one piece covers a
+      // pixel; where several do, "over" then blends encoded values (measured).
+      color = alpha > 0.0 ? SrgbEncode(color / alpha) * alpha : vec3(0.0);
+    }
+    gl_FragData[0] = vec4(color, alpha);
+    gl_FragDepth = depth;
+    return;
+  }
+  if (usePieceBackground != 0 && depth >= 1.0)
+  {
+    backgroundLinear = encodeSrgb != 0 ? SrgbDecode(pieceBackground) : pieceBackground;
+  }
   if (skyBackground != 0 && depth >= 1.0)
   {
     vec3 clearSum = texture(clearAccumulation, texCoord).rgb;

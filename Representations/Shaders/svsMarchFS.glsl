@@ -79,9 +79,14 @@ bool ShadowInterval(vec3 origin, vec3 direction, float t0, float t1, out float a
 {
   a = t0;
   b = t1;
-  vec3 q = origin - shadowOrigin;
-  vec2 s0 = vec2(dot(q, shadowU), dot(q, shadowW)) / shadowExtent;
-  vec2 ds = vec2(dot(direction, shadowU), dot(direction, shadowW)) / shadowExtent;
+  // With other pieces (issue 18), their shadow's rectangle: it covers the whole cloud.
+  vec3 rectOrigin = externalShadowOn != 0 ? externalOrigin : shadowOrigin;
+  vec3 rectU = externalShadowOn != 0 ? externalU : shadowU;
+  vec3 rectW = externalShadowOn != 0 ? externalW : shadowW;
+  vec2 rectExtent = externalShadowOn != 0 ? externalExtent : shadowExtent;
+  vec3 q = origin - rectOrigin;
+  vec2 s0 = vec2(dot(q, rectU), dot(q, rectW)) / rectExtent;
+  vec2 ds = vec2(dot(direction, rectU), dot(direction, rectW)) / rectExtent;
   if (!ClipToUnitSlab(s0.x, ds.x, a, b) || !ClipToUnitSlab(s0.y, ds.y, a, b))
   {
     return false;

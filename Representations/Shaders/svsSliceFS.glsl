@@ -16,13 +16,14 @@ uniform float sliceSpacing;       // Delta d (world)
 uniform float sunStepMetres;      // Delta s = Delta d / dot(n, -L) [m] (000 Eq. 10)
 uniform int shaftsOn;             // atmosphere in cloud shadow
 uniform int unlit;                // benchmark floor: composite the slices without lighting
+uniform int boxAirOn;             // the air in the box (0: the bottom layer has it; issue 18)
 // Multiple scattering (issue 14; Physics/MultipleScattering.h).
 uniform float cloudG;                 // Cornette-Shanks asymmetry of the cloud
 uniform int scatteringTextureOn;      // the solver's in-scattered radiance J(x, w)
 uniform sampler3D scatteringRed;      // SH c_00, c_1-1, c_10, c_11 of J, per channel
 uniform sampler3D scatteringGreen;
 uniform sampler3D scatteringBlue;
-uniform vec3 scatteringTextureScale;  // density texture coordinates -> these textures'
+uniform mat4 worldToScattering;       // world -> these textures' coordinates
 uniform float scatteringScale;        // the sun's illuminance now / at the solve (J is linear in it)
 uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
 uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
@@ -45,7 +46,7 @@ uniform float emissionScale; // E [Y/(sr m) per unit density at T_ref]
 // single scattering (degree-1 spherical harmonics, clamped at 0).
 vec3 InScattering(vec3 p, vec3 w)
 {
-  vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * scatteringTextureScale;
+  vec3 tc = (worldToScattering * vec4(p, 1.0)).xyz;
   vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
   return scatteringScale * max(vec3(dot(texture(scatteringRed, tc), y),
                                  dot(texture(scatteringGreen, tc), y),
@@ -131,7 +132,7 @@ void main()
   {
     float altitude = Altitude(p);
     // Midpoint rule toward the sun: the slices before plus half of this one (000 Eq. 7).
-    float sunDepth = ShadowDepth(p) + 0.5 * sigma * sunStepMetres;
+    float sunDepth = CloudDepthInsideBox(p) + 0.5 * sigma * sunStepMetres;
     float sunTransmittance = exp(-sunDepth);
     source = vec3(0.0);
     if (sigma > 0.0) // (empty parts of the box: the air alone, and no cloud terms to pay)
@@ -142,6 +143,9 @@ void main()
         SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
       if (scatteringTextureOn != 0)
       {
+        // (One piece of a distributed cloud: its own piece's solve. Dimming it by the
+        // other pieces' shade on p's sun line darkened the piece's face toward them;
+        // left as it is, issue 18, docs/parallel.md.)
         source += cloudAlbedo * sigma * InScattering(p, -direction);
       }
       if (lightningTextureOn != 0)
@@ -155,7 +159,7 @@ void main()
       }
     }
     vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);
-    if (atmosphereOn != 0)
+    if (atmosphereOn != 0 && boxAirOn != 0)
     {
       vec3 air = AirSource(altitude, intervalAndPhase.zw);              // 000 Eq. 8, atmosphere
       vec3 multiple = AirMultipleSource(altitude);
