@@ -80,12 +80,13 @@ double CoarseDensityGrid::Sample(const Vector3& p) const
     const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
     const double w = (di ? weight[0] : 1.0 - weight[0]) * (dj ? weight[1] : 1.0 - weight[1]) *
       (dk ? weight[2] : 1.0 - weight[2]);
-    if (w > 0.0)
+    const double v = w > 0.0 ? at(base[0] + di, base[1] + dj, base[2] + dk) : 0.0;
+    if (std::isfinite(v) && v > 0.0) // NaN, infinite and negative densities are empty
     {
-      value += w * at(base[0] + di, base[1] + dj, base[2] + dk);
+      value += w * v;
     }
   }
-  return std::max(value, 0.0); // negative densities are empty, as on the GPU
+  return value;
 }
 
 ExternalShadowMap ComputeExternalShadowMap(const CoarseDensityGrid& grid,

@@ -29,7 +29,8 @@ namespace nimbus
 
 /// A coarse density on a regular lattice of points in world coordinates: value
 /// (i, j, k) at Origin + (i, j, k) * Spacing, i fastest; trilinear between points,
-/// zero outside the lattice's box.
+/// zero outside the lattice's box; NaN, infinite and negative values count as 0 (as
+/// the GPU's density texture has them).
 struct NIMBUSREPRESENTATIONS_EXPORT CoarseDensityGrid
 {
   std::array<double, 3> Origin{ { 0.0, 0.0, 0.0 } };
