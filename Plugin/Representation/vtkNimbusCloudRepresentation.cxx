@@ -27,6 +27,8 @@
 #include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
+#include "NimbusCompositingOrder.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -262,13 +264,7 @@ int vtkNimbusCloudRepresentation::RequestData(
 void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
 {
   vtkNimbusCloudVolumeMapper* mapper = this->CloudMapper;
-  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  auto* delivery =
-    view ? vtkPVRenderViewDataDeliveryManager::SafeDownCast(view->GetDeliveryManager()) : nullptr;
-  const bool distributed = view && controller && controller->GetNumberOfProcesses() > 1 &&
-    this->CoarseDensity && view->GetUseOrderedCompositing() && delivery &&
-    static_cast<int>(delivery->GetCuts().size()) == controller->GetNumberOfProcesses();
-  if (!distributed)
+  if (!this->CoarseDensity || !nimbus::IsOrderedCompositing(view))
   {
     mapper->SetPieceCompositing(false);
     mapper->SetDrawOutsideRegions(true);
@@ -277,12 +273,9 @@ void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
     mapper->SetSlicingBounds(none);
     return;
   }
-  // The order IceT composites in (the view's own helper, same boxes, same camera):
-  // the last rank's image is the bottom layer, so it draws the air and the ground.
-  vtkNew<vtkOrderedCompositingHelper> order;
-  order->SetBoundingBoxes(delivery->GetCuts());
-  const std::vector<int> ranks = order->ComputeSortOrder(view->GetActiveCamera());
-  const bool bottom = !ranks.empty() && ranks.back() == controller->GetLocalProcessId();
+  // The last rank in IceT's order (ParaView's own helper, same boxes, same camera)
+  // is the bottom layer: it draws the air and the ground.
+  const bool bottom = nimbus::IsLastInCompositingOrder(view);
   mapper->SetPieceCompositing(true);
   mapper->SetDrawOutsideRegions(bottom);
   mapper->SetExternalDensity(this->CoarseDensity);

@@ -1,5 +1,7 @@
 #include "vtkNimbusSkyBackgroundRepresentation.h"
 
+#include "NimbusCompositingOrder.h"
+
 #include "vtkAlgorithm.h"
 #include "vtkCamera.h"
 #include "vtkDataObject.h"
@@ -102,6 +104,10 @@ int vtkNimbusSkyBackgroundRepresentation::ProcessViewRequest(
       ++this->NumberOfParameterUpdates;
       this->InputExposure = this->Background->GetSky()->GetExposure();
     }
+    // Under MPI with ordered compositing (a Cloud in the view), the sky is the bottom
+    // layer of the composite: only the rank last in IceT's order draws it (issue 18).
+    auto* renderView = vtkPVRenderView::SafeDownCast(this->GetView());
+    this->Background->SetDrawSky(nimbus::IsLastInCompositingOrder(renderView));
     // The input's Exposure is now on the sky; lower it if this view needs it.
     vtkNimbusSky* sky = this->Background->GetSky();
     if (sky && this->InputExposure >= 0.0)

@@ -2263,8 +2263,8 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
     pieceBackground[c] = static_cast<float>(this->PieceBackground[c]);
   }
   program->SetUniform3f("pieceBackground", pieceBackground);
-  program->SetUniformi(
-    "usePieceBackground", this->PieceCompositing && this->DrawOutsideRegions ? 1 : 0);
+  program->SetUniformi("usePieceBackground",
+    this->PieceCompositing && this->DrawOutsideRegions && !frame.Settings.OverSky ? 1 : 0);
   if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Activate();

@@ -89,9 +89,9 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
   try
   {
     auto* renderer = vtkRenderer::SafeDownCast(viewport);
-    if (!renderer || renderer->GetSelector())
+    if (!renderer || renderer->GetSelector() || !this->DrawSky)
     {
-      return 0; // nothing to pick: the sky is not a selectable prop
+      return 0; // nothing to pick (the sky is not a selectable prop), or another draws it
     }
     auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
     if (!window)
@@ -167,4 +167,5 @@ void vtkNimbusSkyBackground::PrintSelf(ostream& os, vtkIndent indent)
     this->Sky->PrintSelf(os, indent.GetNextIndent());
   }
   os << indent << "NumberOfDraws: " << this->NumberOfDraws << "\n";
+  os << indent << "DrawSky: " << this->DrawSky << "\n";
 }

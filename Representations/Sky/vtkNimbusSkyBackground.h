@@ -56,6 +56,16 @@ public:
   /// Number of sky frames drawn (tests).
   vtkGetMacro(NumberOfDraws, int);
 
+  ///@{
+  /// Whether this prop draws the sky (default on). Off, it stays visible as the
+  /// view's sky (a cloud mapper still follows its sun, air and display settings) but
+  /// draws nothing: under MPI the sky is the bottom layer of the composite, drawn by
+  /// one rank only (issue 18; ParaView's Sky Background representation sets it).
+  vtkSetMacro(DrawSky, bool);
+  vtkGetMacro(DrawSky, bool);
+  vtkBooleanMacro(DrawSky, bool);
+  ///@}
+
   /// Key of a vtkRenderer's information (vtkRenderer::GetInformation()): the sky
   /// background shown by that renderer. Set by whoever adds the background to the
   /// renderer for others to find (ParaView's "Sky Background" representation),
@@ -73,6 +83,7 @@ protected:
 
   vtkNimbusSky* Sky = nullptr;
   int NumberOfDraws = 0;
+  bool DrawSky = true;
 
 private:
   vtkNimbusSkyBackground(const vtkNimbusSkyBackground&) = delete;

@@ -5,7 +5,8 @@ ranks as pvbatch runs with (issue 18), and saves the picture and the timings.
         --plugin Nimbus.so --output image.png [--size 320 240] [--grid 96]
         [--data cloud.vti] [--frames 3] [--timings timings.json]
 
-The density comes from a .vti file (--data; written on the first run, serial, by the
+--sky adds a Nimbus Sky shown as "Sky Background" (the cloud then follows its sun
+and air). The density comes from a .vti file (--data; written on the first run, serial, by the
 Nimbus Metaball Cloud source) through ParaView's XML image reader, which gives each
 rank its own piece of the extent: the representation then renders one piece per
 rank and IceT composites them in visibility order. The timings (seconds): the first
@@ -34,6 +35,8 @@ def main():
     parser.add_argument("--frames", type=int, default=2)
     parser.add_argument("--timings", default=None)
     parser.add_argument("--srgb", type=int, default=1)
+    parser.add_argument("--sky", action="store_true",
+                        help="show a Nimbus Sky (Sky Background) behind the cloud")
     args = parser.parse_args()
 
     LoadPlugin(args.plugin, ns=globals())
@@ -50,6 +53,9 @@ def main():
     view.Background = [0.0, 0.0, 0.0]
     if hasattr(view, "UseColorPaletteForBackground"):
         view.UseColorPaletteForBackground = 0
+    if args.sky:
+        sky = NimbusSky(SunElevationDegrees=45.0)  # noqa: F821 (from the plugin)
+        Show(sky, view)
     display = Show(reader, view)
     display.SetRepresentationType("Cloud")
     display.EncodeSrgb = args.srgb

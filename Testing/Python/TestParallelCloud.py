@@ -9,8 +9,9 @@ with the defaults (sun, air, ground, multiple scattering) with one rank and with
 the absolute difference over all channels, in 8-bit levels. The bounds are measured
 (docs/parallel.md): the pieces' multiple scattering solves see only their own piece
 and the other pieces' shadow comes from a coarse copy of the density. A second pair
-of renders with an empty cloud checks that the sky and the ground are drawn once:
-those images must agree to within 1 level (no double air, no missing ground).
+of renders with an empty cloud checks that the air and the ground are drawn once:
+those images must agree to within 1 level (no double air, no missing ground). A third
+pair puts the cloud over a Nimbus Sky ("Sky Background", drawn by one rank only).
 """
 import argparse
 import os
@@ -106,6 +107,20 @@ def main():
                                                           p99, args.max_p99))
     if numpy.mean(read_png(many)) < 1.0:
         failures.append("the %d-rank image is black" % args.ranks)
+
+    # Over a Nimbus sky ("Sky Background"): the sky drawn by one rank, the cloud
+    # following its sun, air and display settings on every rank.
+    one_sky = prefix + "-sky-1.png"
+    many_sky = prefix + "-sky-%d.png" % args.ranks
+    render(args, 1, one_sky, data, ["--sky"])
+    render(args, args.ranks, many_sky, data, ["--sky"])
+    rmse, p99, largest = compare(one_sky, many_sky)
+    print("cloud over a sky, %d ranks vs 1: RMSE %.3f, 99th percentile %.1f, max %.0f levels"
+          % (args.ranks, rmse, p99, largest))
+    if rmse > args.max_rmse or p99 > args.max_p99:
+        failures.append("the cloud over a sky with %d ranks is off: RMSE %.3f (bound %.3f), "
+                        "99th percentile %.1f (bound %.1f)" % (args.ranks, rmse, args.max_rmse,
+                                                               p99, args.max_p99))
     for failure in failures:
         print("FAIL: " + failure)
     return 1 if failures else 0
