@@ -22,6 +22,11 @@
  * and skipped. Grid names and extents are known after UpdateInformation() without
  * reading voxels (from the file's bounding-box metadata).
  *
+ * Pieces (data parallel): the output is the requested extent (UPDATE_EXTENT: a piece with
+ * its ghost layers under MPI), bit-identical to the same points of the whole image; only
+ * that part is copied into the image, and the limits below count its points. OpenVDB still
+ * reads each selected grid's whole tree from the file.
+ *
  * Bad input ends in an error and an empty output, never in a crash or garbage: the file's
  * layout is checked before OpenVDB reads it (a truncated file is reported with the byte
  * where it ends and the byte a grid needs), each grid is read from its own bytes only,
