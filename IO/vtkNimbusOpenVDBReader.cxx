@@ -5,10 +5,13 @@
 
 #include "vtkCommand.h"
 #include "vtkDataArraySelection.h"
+#include "vtkExtentTranslator.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -39,10 +42,43 @@ struct vtkNimbusOpenVDBReader::Internals
   vtkNew<vtkDataArraySelection> Selection;
   vtkNew<vtkStringArray> Names;
 
-  // The extent RequestData was asked for (UPDATE_EXTENT: a piece with its ghost layers, or
-  // the whole extent); ReadImage reads its intersection with the plan's box.
-  vdb::IndexBox Requested;
-  bool HasRequest = false;
+  // The piece RequestData was asked for (UPDATE_PIECE_NUMBER, UPDATE_NUMBER_OF_PIECES,
+  // UPDATE_NUMBER_OF_GHOST_LEVELS and the split mode); see PieceBox.
+  int Piece = 0;
+  int NumberOfPieces = 1;
+  int GhostLevels = 0;
+  int SplitMode = vtkExtentTranslator::BLOCK_MODE;
+
+  // The box to read. One piece: the plan's whole box, as before pieces were supported
+  // (producing more than a sub-extent request asks for is allowed, and a file series whose
+  // files' boxes differ must get each file whole, not the box of the file its request was
+  // made for). Piece p of n: VTK's block of the whole box grown by the ghost levels and
+  // clamped -- what the executive puts in UPDATE_EXTENT, computed again from this file's box.
+  vdb::IndexBox PieceBox(const vdb::IndexBox& whole) const
+  {
+    if (this->NumberOfPieces <= 1 || whole.Empty())
+    {
+      return whole;
+    }
+    int wholeExtent[6], extent[6];
+    for (int c = 0; c < 3; ++c)
+    {
+      wholeExtent[2 * c] = static_cast<int>(whole.Min[c]);
+      wholeExtent[2 * c + 1] = static_cast<int>(whole.Max[c]);
+    }
+    vtkNew<vtkExtentTranslator> translator;
+    vdb::IndexBox box; // empty
+    if (translator->PieceToExtentThreadSafe(this->Piece, this->NumberOfPieces, this->GhostLevels,
+          wholeExtent, extent, this->SplitMode, 0))
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        box.Min[c] = extent[2 * c];
+        box.Max[c] = extent[2 * c + 1];
+      }
+    }
+    return box.Intersection(whole);
+  }
 
   // The plan of the next read.
   struct Plan
@@ -377,17 +413,19 @@ int vtkNimbusOpenVDBReader::RequestData(
     return 0;
   }
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  this->Internal->HasRequest = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT());
-  if (this->Internal->HasRequest)
-  {
-    int update[6];
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), update);
-    for (int c = 0; c < 3; ++c)
-    {
-      this->Internal->Requested.Min[c] = update[2 * c];
-      this->Internal->Requested.Max[c] = update[2 * c + 1];
-    }
-  }
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  Internals& internal = *this->Internal;
+  internal.Piece =
+    outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+  internal.NumberOfPieces = outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
+    ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
+    : 1;
+  internal.GhostLevels = outInfo->Has(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+    ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+    : 0;
+  internal.SplitMode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+    ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+    : vtkExtentTranslator::BLOCK_MODE;
   // No exception leaves the pipeline: OpenVDB, the standard library and VTK's allocations
   // all end here in an error and an empty output.
   try
@@ -418,11 +456,10 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
 {
   this->Internal->Refresh(this->FileName);
   const Internals::Plan plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
-  // Pieces: only the requested part of the plan's box is read into the image (each voxel's
+  // Pieces: only the piece's part of the plan's box is read into the image (each voxel's
   // value does not depend on the box, so a piece equals the whole image's crop bit for bit).
   // OpenVDB still reads each selected grid's whole tree from the file.
-  const vdb::IndexBox box =
-    this->Internal->HasRequest ? plan.Box.Intersection(this->Internal->Requested) : plan.Box;
+  const vdb::IndexBox box = this->Internal->PieceBox(plan.Box);
   const vdb::TransformInfo& t = plan.Reference->Transform;
   if (box.Empty() && !plan.Box.Empty())
   {
