@@ -2,6 +2,7 @@
 
 #include "CloudAutomaton.h"
 #include "MemoryBudget.h"
+#include "PieceExtent.h"
 
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -213,6 +214,8 @@ int vtkNimbusCloudAutomatonSource::RequestInformation(
   outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
   vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
+  // Pieces: the whole grid is computed, the requested extent output (see Generate).
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
 
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
@@ -240,6 +243,7 @@ int vtkNimbusCloudAutomatonSource::RequestUpdateExtent(
     int wholeExtent[6];
     inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), wholeExtent);
     inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), wholeExtent, 6);
+    nimbus::RequestWholeInput(inInfo); // every piece uses the whole input
     inInfo->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
   }
   return 1;
@@ -699,31 +703,47 @@ int vtkNimbusCloudAutomatonSource::Generate(
     }
   }
 
-  // --- output -----------------------------------------------------------------------------
-  const std::vector<float>& a = internals.Densities.at(step);
-  vtkNew<vtkFloatArray> density;
-  density->SetName("density");
-  density->SetNumberOfTuples(static_cast<vtkIdType>(a.size()));
-  float* out = density->GetPointer(0);
-  if (fraction > 0.0)
-  {
-    const std::vector<float>& b = internals.Densities.at(step + 1);
-    const float t = static_cast<float>(fraction);
-    for (std::size_t i = 0; i < a.size(); ++i)
-    {
-      out[i] = a[i] + t * (b[i] - a[i]); // same as nimbus::InterpolateDensity
-    }
-  }
-  else
-  {
-    std::copy(a.begin(), a.end(), out);
-  }
-
+  // --- output: the requested extent ----------------------------------------------------------
+  // Pieces: a cell's state after n steps depends on cells up to n (2 + |wind shift|) cells
+  // away (f_act reaches 2 cells, the wind moves whole layers, periodic sides wrap), and the
+  // spin-up alone is SpinUpSteps steps, so a piece's dependency region is the whole grid
+  // for any useful setting. Every piece therefore runs the automaton and the smoothing on
+  // the whole grid (cached as before; memory and time are not divided between ranks) and
+  // outputs only its extent: exact, and cheap next to a renderer's work on the piece.
   int extent[6];
   double origin[3], spacing[3];
-  outInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
+  const bool anyPoint = nimbus::RequestedExtent(outInfo, extent);
   outInfo->Get(vtkDataObject::ORIGIN(), origin);
   outInfo->Get(vtkDataObject::SPACING(), spacing);
+  const std::vector<float>& a = internals.Densities.at(step);
+  const std::vector<float>* b = fraction > 0.0 ? &internals.Densities.at(step + 1) : nullptr;
+  const std::size_t rowLength = anyPoint ? static_cast<std::size_t>(extent[1] - extent[0] + 1) : 0;
+  const std::size_t points =
+    anyPoint ? rowLength * (extent[3] - extent[2] + 1) * (extent[5] - extent[4] + 1) : 0;
+  vtkNew<vtkFloatArray> density;
+  density->SetName("density");
+  density->SetNumberOfTuples(static_cast<vtkIdType>(points));
+  float* out = density->GetPointer(0);
+  const float t = static_cast<float>(fraction);
+  for (int k = extent[4]; anyPoint && k <= extent[5]; ++k)
+  {
+    for (int j = extent[2]; j <= extent[3]; ++j)
+    {
+      const std::size_t first = (static_cast<std::size_t>(k) * d[1] + j) * d[0] + extent[0];
+      for (std::size_t i = 0; i < rowLength; ++i, ++out)
+      {
+        const float va = a[first + i];
+        // Same as nimbus::InterpolateDensity.
+        *out = b ? va + t * ((*b)[first + i] - va) : va;
+      }
+    }
+  }
+  out = density->GetPointer(0);
+  if (!anyPoint)
+  {
+    std::fill(extent, extent + 6, 0);
+    extent[1] = extent[3] = extent[5] = -1;
+  }
   output->SetExtent(extent);
   output->SetOrigin(origin);
   output->SetSpacing(spacing);

@@ -30,6 +30,12 @@
  * Spin-up: time 0 shows automaton step SpinUpSteps (default 40), so that the first frame
  * already has grown clouds; time t shows step SpinUpSteps + t / StepDuration.
  *
+ * Pieces (data parallel): the output is the requested extent (a piece with its ghost layers
+ * under MPI), bit-identical to the same points of the serial output. A cell's state after n
+ * steps depends on cells up to n (2 + wind shift) cells away, and time 0 is already
+ * SpinUpSteps steps in, so every piece runs the automaton and the smoothing on the whole grid
+ * and crops: exact, but memory and time are not divided between ranks.
+ *
  * Optional input (port 0): vtkImageData whose point arrays "p_ext", "p_hum", "p_act"
  * (one component, values in [0, 1]) replace the scalar ExtinctionProbability,
  * HumidityProbability, ActivationProbability per cell (arrays given replace the formation

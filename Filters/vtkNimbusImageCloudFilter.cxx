@@ -2,6 +2,7 @@
 
 #include "ImageClouds.h"
 #include "MemoryBudget.h"
+#include "PieceExtent.h"
 
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -221,6 +222,8 @@ int vtkNimbusImageCloudFilter::RequestInformation(
       }
     }
     vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
+    // Pieces: built from the whole image, cropped to the requested extent (see Generate).
+    outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   }
   return 1;
 }
@@ -232,6 +235,7 @@ int vtkNimbusImageCloudFilter::RequestUpdateExtent(
   int wholeExtent[6];
   inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), wholeExtent);
   inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), wholeExtent, 6);
+  nimbus::RequestWholeInput(inInfo); // every piece uses the whole input
   return 1;
 }
 
@@ -563,6 +567,13 @@ int vtkNimbusImageCloudFilter::Generate(
   }
   map->GetPointData()->SetScalars(target);
   map->GetPointData()->AddArray(achieved);
+  // Pieces: the fit rescales each column's balls by its optical depth, which its neighbours'
+  // balls change, for Iterations rounds; the dependency region of a point grows with every
+  // round and the normalisation uses the whole map's maximum. So the cloud is built from the
+  // whole image (requested whole in RequestUpdateExtent) and each output cropped to its
+  // requested extent: exact, but the work is not divided between ranks.
+  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
+  nimbus::CropToRequestedExtent(map, outputVector->GetInformationObject(1));
   this->UpdateProgress(1.0);
   return 1;
 }

@@ -27,6 +27,11 @@
  * Output port 1: the 2-D map at z = BaseHeight with "optical_depth" (the image's target
  * tau) and "column_optical_depth" (the achieved tau of the density).
  *
+ * Pieces (data parallel): both outputs are the requested extents (a piece with its ghost
+ * layers under MPI), bit-identical to the same points of the serial outputs. The fit couples
+ * neighbouring columns and normalises by the whole map, so every piece reads the whole input
+ * image and builds the whole cloud, then crops: exact, but work and memory are not divided.
+ *
  * Bad input ends in an error message and empty outputs, never in an exception or an
  * allocation VTK cannot make: NaN or infinite parameters, values outside the documented
  * ranges (PixelSize and VerticalSpacing in [1e-3, 1e6] m, ExtinctionCoefficient in

@@ -2,6 +2,7 @@
 
 #include "MemoryBudget.h"
 #include "Metaballs.h"
+#include "PieceExtent.h"
 #include "Random.h"
 
 #include "vtkCellArray.h"
@@ -34,6 +35,10 @@ vtkStandardNewMacro(vtkNimbusMetaballCloudSource);
 struct vtkNimbusMetaballCloudSource::vtkInternals
 {
   std::vector<nimbus::Metaball> UserBalls;
+  // What RequestData was asked for: the density's extent (a piece of the whole, with its
+  // ghost layers) and whether port 1 gets the metaballs (only piece 0 of a piece request).
+  nimbus::GridExtent Extent{ { 0, -1, 0, -1, 0, -1 } };
+  bool WithMetaballs = true;
 };
 
 namespace
@@ -409,6 +414,8 @@ int vtkNimbusMetaballCloudSource::RequestInformation(
   outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
   vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
+  // Pieces: the growth runs on the whole grid, the final sampling on the requested extent.
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   return 1;
 }
 
@@ -423,6 +430,17 @@ int vtkNimbusMetaballCloudSource::RequestData(
   {
     return 1; // empty outputs; the error has been reported
   }
+  int extent[6];
+  const bool anyPoint = nimbus::RequestedExtent(outputVector->GetInformationObject(0), extent);
+  std::copy(extent, extent + 6, this->Internals->Extent.begin());
+  if (!anyPoint)
+  {
+    this->Internals->Extent = { { 0, -1, 0, -1, 0, -1 } };
+  }
+  vtkInformation* ballInfo = outputVector->GetInformationObject(1);
+  this->Internals->WithMetaballs =
+    !ballInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) ||
+    ballInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) == 0;
   // The budget above is an estimate: whatever still goes wrong ends here, not in ParaView.
   try
   {
@@ -587,21 +605,28 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
   }
   fieldArray->SetArray(nullptr, 0, 1);
 
-  // Final density on the output grid.
+  // Final density on the requested extent only (the whole grid, or a piece with its ghost
+  // layers): SampleMetaballs gives every point the same sum as the whole grid's sampling.
   stepStart = this->NumberOfLevels;
   this->UpdateProgress(stepStart / totalSteps);
-  if (!nimbus::SampleMetaballs(balls, grid, density, progress))
+  const nimbus::GridExtent& extent = this->Internals->Extent;
+  const bool anyPoint = extent[0] <= extent[1];
+  if (anyPoint && !nimbus::SampleMetaballs(balls, grid, extent, density, progress))
   {
     return aborted();
   }
-  if (this->FlatBase)
+  if (!anyPoint)
   {
-    nimbus::ApplyCloudBase(grid, this->BaseHeight, this->BaseTransitionThickness, density);
+    density.clear();
+  }
+  if (this->FlatBase && anyPoint)
+  {
+    nimbus::ApplyCloudBase(grid, extent, this->BaseHeight, this->BaseTransitionThickness, density);
   }
 
-  int extent[6] = { 0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0,
-    grid.Dimensions[2] - 1 };
-  image->SetExtent(extent);
+  int outputExtent[6];
+  std::copy(extent.begin(), extent.end(), outputExtent);
+  image->SetExtent(outputExtent);
   image->SetOrigin(grid.Origin.data());
   image->SetSpacing(grid.Spacing.data());
   vtkNew<vtkFloatArray> densityArray;
@@ -618,7 +643,12 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
     return aborted();
   }
 
-  // Port 1: the metaballs themselves.
+  // Port 1: the metaballs themselves (once: on piece 0 of a piece request).
+  if (!this->Internals->WithMetaballs)
+  {
+    this->UpdateProgress(1.0);
+    return 1;
+  }
   vtkNew<vtkPoints> centres;
   centres->SetDataTypeToDouble();
   vtkNew<vtkDoubleArray> radii;

@@ -16,6 +16,12 @@
  * Output port 1: vtkPolyData with one vertex per metaball at its centre and point
  * arrays "radius" (m), "density" and "level" (0 = basic shape).
  *
+ * Pieces (data parallel): port 0 produces the requested extent (a piece with its ghost
+ * layers under MPI), bit-identical to the same points of the serial output. The growth
+ * levels extract the isosurface of the whole field, so every piece runs them on the whole
+ * grid (redundant work); only the final sampling is restricted to the piece. Port 1 holds
+ * the metaballs on piece 0 only (the other pieces' port 1 is empty).
+ *
  * Units: Bounds, radii, heights in metres. The result depends only on the
  * parameters and Seed (same seed -> identical bytes).
  * Invalid parameters (non-positive dimensions, empty or non-finite bounds, no

@@ -1,5 +1,6 @@
 #include "vtkNimbusSmokeSource.h"
 
+#include "PieceExtent.h"
 #include "SmokePuffs.h"
 #include "SmokeSolver.h"
 #include "Voxelize.h"
@@ -142,6 +143,8 @@ int vtkNimbusSmokeSource::RequestInformation(
     const double range[2] = { 0.0, times.back() };
     outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
+  // Pieces: the whole simulation runs, the requested extent is output (see RequestData).
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   return 1;
 }
 
@@ -152,6 +155,8 @@ int vtkNimbusSmokeSource::RequestUpdateExtent(
   if (vtkInformation* inInfo = inputVector[0]->GetInformationObject(0))
   {
     inInfo->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    // Every piece simulates the whole domain: the whole obstacle input, without ghosts.
+    nimbus::RequestWholeInput(inInfo);
     if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
     {
       inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
@@ -531,6 +536,9 @@ int vtkNimbusSmokeSource::RequestData(
     std::copy(obstacles.begin(), obstacles.end(), obstacle->GetPointer(0));
     output->GetPointData()->AddArray(obstacle);
   }
+  // Pieces: the pressure solve is global, so every piece runs the whole simulation
+  // (redundantly: memory and time are not divided between ranks) and outputs its extent.
+  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
   output->GetInformation()->Set(
     vtkDataObject::DATA_TIME_STEP(), frame * this->FrameDurationSeconds);
   return 1;

@@ -34,6 +34,12 @@
  * With Puffs on, the output grid is PuffResolution times finer and its density is the
  * puffs' (see Puffs below).
  *
+ * Pieces (data parallel): the output is the requested extent (a piece with its ghost layers
+ * under MPI), bit-identical to the same points of the serial output. The pressure solve is
+ * global and a distributed solver is out of scope, so every rank runs the whole simulation
+ * redundantly (on the whole obstacle input) and outputs only its extent: memory and time
+ * are NOT divided between ranks, only the data handed downstream is.
+ *
  * Bad input (an error naming it, empty output): the solver's refusals
  * (CheckSmokeParameters: non-finite or out-of-range numbers, grid sizes, obstacles
  * covering every cell), an obstacle input of the wrong size, a frame that needs more than

@@ -5,10 +5,13 @@
 
 #include "vtkCommand.h"
 #include "vtkDataArraySelection.h"
+#include "vtkExtentTranslator.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -38,6 +41,44 @@ struct vtkNimbusOpenVDBReader::Internals
 
   vtkNew<vtkDataArraySelection> Selection;
   vtkNew<vtkStringArray> Names;
+
+  // The piece RequestData was asked for (UPDATE_PIECE_NUMBER, UPDATE_NUMBER_OF_PIECES,
+  // UPDATE_NUMBER_OF_GHOST_LEVELS and the split mode); see PieceBox.
+  int Piece = 0;
+  int NumberOfPieces = 1;
+  int GhostLevels = 0;
+  int SplitMode = vtkExtentTranslator::BLOCK_MODE;
+
+  // The box to read. One piece: the plan's whole box, as before pieces were supported
+  // (producing more than a sub-extent request asks for is allowed, and a file series whose
+  // files' boxes differ must get each file whole, not the box of the file its request was
+  // made for). Piece p of n: VTK's block of the whole box grown by the ghost levels and
+  // clamped -- what the executive puts in UPDATE_EXTENT, computed again from this file's box.
+  vdb::IndexBox PieceBox(const vdb::IndexBox& whole) const
+  {
+    if (this->NumberOfPieces <= 1 || whole.Empty())
+    {
+      return whole;
+    }
+    int wholeExtent[6], extent[6];
+    for (int c = 0; c < 3; ++c)
+    {
+      wholeExtent[2 * c] = static_cast<int>(whole.Min[c]);
+      wholeExtent[2 * c + 1] = static_cast<int>(whole.Max[c]);
+    }
+    vtkNew<vtkExtentTranslator> translator;
+    vdb::IndexBox box; // empty
+    if (translator->PieceToExtentThreadSafe(this->Piece, this->NumberOfPieces, this->GhostLevels,
+          wholeExtent, extent, this->SplitMode, 0))
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        box.Min[c] = extent[2 * c];
+        box.Max[c] = extent[2 * c + 1];
+      }
+    }
+    return box.Intersection(whole);
+  }
 
   // The plan of the next read.
   struct Plan
@@ -322,8 +363,8 @@ int vtkNimbusOpenVDBReader::RequestInformation(
   outInfo->Set(vtkDataObject::ORIGIN(), t.Origin.data(), 3);
   outInfo->Set(vtkDataObject::SPACING(), t.Spacing.data(), 3);
   outInfo->Set(vtkDataObject::DIRECTION(), direction, 9);
-  // The whole image is produced in one piece.
-  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 0);
+  // Pieces (data parallel): RequestData produces the requested extent (UPDATE_EXTENT).
+  outInfo->Set(CAN_PRODUCE_SUB_EXTENT(), 1);
   return 1;
 }
 
@@ -371,6 +412,20 @@ int vtkNimbusOpenVDBReader::RequestData(
     vtkErrorMacro("FileName is not set: give the .vdb file to read");
     return 0;
   }
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  Internals& internal = *this->Internal;
+  internal.Piece =
+    outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+  internal.NumberOfPieces = outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
+    ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
+    : 1;
+  internal.GhostLevels = outInfo->Has(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+    ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+    : 0;
+  internal.SplitMode = outInfo->Has(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+    ? outInfo->Get(vtkExtentTranslator::UPDATE_SPLIT_MODE())
+    : vtkExtentTranslator::BLOCK_MODE;
   // No exception leaves the pipeline: OpenVDB, the standard library and VTK's allocations
   // all end here in an error and an empty output.
   try
@@ -401,10 +456,25 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
 {
   this->Internal->Refresh(this->FileName);
   const Internals::Plan plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
+  // Pieces: only the piece's part of the plan's box is read into the image (each voxel's
+  // value does not depend on the box, so a piece equals the whole image's crop bit for bit).
+  // OpenVDB still reads each selected grid's whole tree from the file.
+  const vdb::IndexBox box = this->Internal->PieceBox(plan.Box);
+  const vdb::TransformInfo& t = plan.Reference->Transform;
+  if (box.Empty() && !plan.Box.Empty())
+  {
+    // A piece with no point of the image (more pieces than points): an empty image.
+    output->SetOrigin(t.Origin.data());
+    output->SetSpacing(t.Spacing.data());
+    double direction[9];
+    RowMajorDirection(t, direction);
+    output->SetDirectionMatrix(direction);
+    return 1;
+  }
 
   // Refuse absurd reads before allocating anything: the voxel limit counts every selected
   // grid's values (points x grids), the memory budget every byte of the read.
-  const uint64_t voxels = plan.Box.VoxelCount();
+  const uint64_t voxels = box.VoxelCount();
   uint64_t components = 0;
   uint64_t workBytes = 0; // the largest grid's file bytes and tree, while it is read
   for (const auto* g : plan.Read)
@@ -419,9 +489,8 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
     workBytes = std::max(workBytes, std::min(UINT64_MAX / 4, tree + uint64_t(g->FileBytes)));
   }
   std::ostringstream dims;
-  dims << (plan.Box.Max[0] - plan.Box.Min[0] + 1) << " x "
-       << (plan.Box.Max[1] - plan.Box.Min[1] + 1) << " x "
-       << (plan.Box.Max[2] - plan.Box.Min[2] + 1);
+  dims << (box.Max[0] - box.Min[0] + 1) << " x " << (box.Max[1] - box.Min[1] + 1) << " x "
+       << (box.Max[2] - box.Min[2] + 1);
   uint64_t values = 0;
   const bool valuesFit =
     nimbus::CheckedProduct({ voxels, static_cast<uint64_t>(plan.Read.size()) }, values);
@@ -459,7 +528,6 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   }
 
   // Say what happened to transforms, names, empty grids and unsupported grids.
-  const vdb::TransformInfo& t = plan.Reference->Transform;
   if (!t.Note.empty())
   {
     vtkWarningMacro(<< "grid " << Quote(plan.Reference->Name) << " of " << this->FileName << ": "
@@ -514,8 +582,8 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   int extent[6];
   for (int c = 0; c < 3; ++c)
   {
-    extent[2 * c] = static_cast<int>(plan.Box.Min[c]);
-    extent[2 * c + 1] = static_cast<int>(plan.Box.Max[c]);
+    extent[2 * c] = static_cast<int>(box.Min[c]);
+    extent[2 * c + 1] = static_cast<int>(box.Max[c]);
   }
   output->SetExtent(extent);
   output->SetOrigin(t.Origin.data());
@@ -542,7 +610,7 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   std::vector<std::string> resampled;
   vdb::TransformInfo exact = t;
   vdb::ReadDense(
-    this->FileName, names, t, plan.Box, targets, &resampled,
+    this->FileName, names, t, box, targets, &resampled,
     [this](double f) { this->UpdateProgress(f); }, &exact);
   // The transform read with the voxels (bit-exact; see ReadDense).
   output->SetOrigin(exact.Origin.data());

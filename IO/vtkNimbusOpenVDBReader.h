@@ -22,6 +22,14 @@
  * and skipped. Grid names and extents are known after UpdateInformation() without
  * reading voxels (from the file's bounding-box metadata).
  *
+ * Pieces (data parallel): for piece p of n (UPDATE_PIECE_NUMBER, UPDATE_NUMBER_OF_PIECES,
+ * UPDATE_NUMBER_OF_GHOST_LEVELS) the output is VTK's block of the image for that piece grown
+ * by the ghost levels (the executive's UPDATE_EXTENT, computed from this file's box so that a
+ * file series whose boxes differ stays right), bit-identical to the same points of the whole
+ * image; only that part is copied into the image, and the limits below count its points.
+ * OpenVDB still reads each selected grid's whole tree from the file. A one-piece request
+ * gets the whole image, as before.
+ *
  * Bad input ends in an error and an empty output, never in a crash or garbage: the file's
  * layout is checked before OpenVDB reads it (a truncated file is reported with the byte
  * where it ends and the byte a grid needs), each grid is read from its own bytes only,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace nimbus
 {
@@ -99,25 +100,59 @@ double MetaballBoxPoints(double radius, const GridGeometry& grid)
   return points;
 }
 
+GridExtent WholeExtent(const GridGeometry& grid)
+{
+  return { { 0, grid.Dimensions[0] - 1, 0, grid.Dimensions[1] - 1, 0, grid.Dimensions[2] - 1 } };
+}
+
+namespace
+{
+// Number of points of an extent within the grid; throws for one outside it.
+std::size_t CheckedExtentPoints(const GridGeometry& grid, const GridExtent& extent)
+{
+  std::size_t points = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (extent[2 * a] < 0 || extent[2 * a + 1] >= grid.Dimensions[a] ||
+      extent[2 * a] > extent[2 * a + 1])
+    {
+      throw std::invalid_argument("metaball sampling: the extent is empty or outside the grid");
+    }
+    points *= static_cast<std::size_t>(extent[2 * a + 1] - extent[2 * a] + 1);
+  }
+  return points;
+}
+}
+
 bool SampleMetaballs(const std::vector<Metaball>& balls, const GridGeometry& grid,
   std::vector<float>& density, const ProgressCallback& progress)
 {
-  const auto& dims = grid.Dimensions;
-  density.assign(grid.NumberOfPoints(), 0.0f);
+  return SampleMetaballs(balls, grid, WholeExtent(grid), density, progress);
+}
+
+bool SampleMetaballs(const std::vector<Metaball>& balls, const GridGeometry& grid,
+  const GridExtent& extent, std::vector<float>& density, const ProgressCallback& progress)
+{
+  density.assign(CheckedExtentPoints(grid, extent), 0.0f);
+  const int nx = extent[1] - extent[0] + 1;
+  const int ny = extent[3] - extent[2] + 1;
   double sinceReport = 0.0;
   for (std::size_t b = 0; b < balls.size(); ++b)
   {
     const Metaball& ball = balls[b];
-    // Index range of the ball's bounding box, clipped to the grid.
+    // Index range of the ball's bounding box, clipped to the grid, then to the extent.
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a)
     {
-      AxisRange(
-        ball.Center[a], ball.Radius, grid.Origin[a], grid.Spacing[a], dims[a], lo[a], hi[a]);
+      AxisRange(ball.Center[a], ball.Radius, grid.Origin[a], grid.Spacing[a], grid.Dimensions[a],
+        lo[a], hi[a]);
+      lo[a] = std::max(lo[a], extent[2 * a]);
+      hi[a] = std::min(hi[a], extent[2 * a + 1]);
     }
     const double r2 = ball.Radius * ball.Radius;
     for (int k = lo[2]; k <= hi[2]; ++k)
     {
+      // Positions from the whole grid's indices: the same numbers in every piece.
       const double dz = grid.Origin[2] + k * grid.Spacing[2] - ball.Center[2];
       for (int j = lo[1]; j <= hi[1]; ++j)
       {
@@ -127,11 +162,13 @@ bool SampleMetaballs(const std::vector<Metaball>& balls, const GridGeometry& gri
         {
           continue;
         }
-        float* row = density.data() + (static_cast<std::size_t>(k) * dims[1] + j) * dims[0];
+        float* row =
+          density.data() + (static_cast<std::size_t>(k - extent[4]) * ny + (j - extent[2])) * nx;
         for (int i = lo[0]; i <= hi[0]; ++i)
         {
           const double dx = grid.Origin[0] + i * grid.Spacing[0] - ball.Center[0];
-          row[i] += static_cast<float>(ball.Density * WyvillFalloff(dx * dx + dyz2, r2));
+          row[i - extent[0]] +=
+            static_cast<float>(ball.Density * WyvillFalloff(dx * dx + dyz2, r2));
         }
       }
       if (progress && hi[0] >= lo[0] && hi[1] >= lo[1])
@@ -155,9 +192,20 @@ bool SampleMetaballs(const std::vector<Metaball>& balls, const GridGeometry& gri
 void ApplyCloudBase(const GridGeometry& grid, double baseHeight, double transitionThickness,
   std::vector<float>& density)
 {
-  const auto& dims = grid.Dimensions;
-  const std::size_t sliceSize = static_cast<std::size_t>(dims[0]) * dims[1];
-  for (int k = 0; k < dims[2]; ++k)
+  ApplyCloudBase(grid, WholeExtent(grid), baseHeight, transitionThickness, density);
+}
+
+void ApplyCloudBase(const GridGeometry& grid, const GridExtent& extent, double baseHeight,
+  double transitionThickness, std::vector<float>& density)
+{
+  const std::size_t points = CheckedExtentPoints(grid, extent);
+  if (density.size() != points)
+  {
+    throw std::invalid_argument("ApplyCloudBase: the density does not match the extent");
+  }
+  const std::size_t sliceSize =
+    static_cast<std::size_t>(extent[1] - extent[0] + 1) * (extent[3] - extent[2] + 1);
+  for (int k = extent[4]; k <= extent[5]; ++k)
   {
     const double z = grid.Origin[2] + k * grid.Spacing[2];
     double weight;
@@ -178,7 +226,7 @@ void ApplyCloudBase(const GridGeometry& grid, double baseHeight, double transiti
     {
       continue;
     }
-    float* slice = density.data() + k * sliceSize;
+    float* slice = density.data() + static_cast<std::size_t>(k - extent[4]) * sliceSize;
     for (std::size_t idx = 0; idx < sliceSize; ++idx)
     {
       slice[idx] = static_cast<float>(slice[idx] * weight);

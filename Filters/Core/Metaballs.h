@@ -73,6 +73,20 @@ NIMBUSFILTERS_EXPORT bool SampleMetaballs(const std::vector<Metaball>& balls,
   const GridGeometry& grid, std::vector<float>& density,
   const ProgressCallback& progress = nullptr);
 
+/// An index box of a grid: (i0, i1, j0, j1, k0, k1), inclusive (VTK's extent order).
+using GridExtent = std::array<int, 6>;
+
+/// The whole grid's extent: (0, nx - 1, 0, ny - 1, 0, nz - 1).
+NIMBUSFILTERS_EXPORT GridExtent WholeExtent(const GridGeometry& grid);
+
+/// SampleMetaballs over the points of `extent` only (a piece of the grid, within it):
+/// density holds the extent's points, x fastest. Every point gets the same terms, added in
+/// the same ball order, as in the whole grid's sampling, so a piece equals the whole's crop
+/// bit for bit. Throws std::invalid_argument for an extent outside the grid.
+NIMBUSFILTERS_EXPORT bool SampleMetaballs(const std::vector<Metaball>& balls,
+  const GridGeometry& grid, const GridExtent& extent, std::vector<float>& density,
+  const ProgressCallback& progress = nullptr);
+
 /// Number of grid points a ball of this radius visits in SampleMetaballs at most (its
 /// bounding box clipped to the grid), as a double so that nothing overflows. For work
 /// estimates.
@@ -83,6 +97,10 @@ NIMBUSFILTERS_EXPORT double MetaballBoxPoints(double radius, const GridGeometry&
 /// base the air is not saturated (lifting condensation level), so no cloud.
 NIMBUSFILTERS_EXPORT void ApplyCloudBase(const GridGeometry& grid, double baseHeight,
   double transitionThickness, std::vector<float>& density);
+
+/// ApplyCloudBase on the points of `extent` (density holds them, x fastest).
+NIMBUSFILTERS_EXPORT void ApplyCloudBase(const GridGeometry& grid, const GridExtent& extent,
+  double baseHeight, double transitionThickness, std::vector<float>& density);
 
 /// Parameters of the random basic shape (the first, largest balls).
 struct BasicShapeParameters

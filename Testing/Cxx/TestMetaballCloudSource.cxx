@@ -26,6 +26,7 @@
 #include <cstring>
 #include <iostream>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -122,6 +123,43 @@ TEST(SampleMetaballs, MatchesPointEvaluation)
         const std::array<double, 3> p{ { -2.0 + 0.5 * i, -2.0 + 0.5 * j, -1.5 + 0.5 * k } };
         EXPECT_NEAR(density[idx], nimbus::MetaballDensity(balls, p), 1e-6);
       }
+}
+
+TEST(SampleMetaballs, PieceEqualsCropOfWhole)
+{
+  std::vector<nimbus::Metaball> balls(3);
+  balls[0].Center = { { 0.3, -0.2, 0.1 } };
+  balls[0].Radius = 1.7;
+  balls[1].Center = { { -1.1, 0.9, 0.4 } };
+  balls[1].Radius = 1.1;
+  balls[1].Density = 0.7;
+  balls[2].Center = { { 1.4, 1.2, -0.6 } };
+  balls[2].Radius = 0.9;
+  nimbus::GridGeometry grid;
+  grid.Dimensions = { { 11, 9, 8 } };
+  grid.Origin = { { -2.5, -2.0, -1.5 } };
+  grid.Spacing = { { 0.45, 0.5, 0.41 } };
+  std::vector<float> whole, piece;
+  nimbus::SampleMetaballs(balls, grid, whole);
+  nimbus::ApplyCloudBase(grid, -1.0, 0.6, whole);
+  const nimbus::GridExtent extent{ { 3, 9, 0, 4, 2, 7 } };
+  nimbus::SampleMetaballs(balls, grid, extent, piece);
+  nimbus::ApplyCloudBase(grid, extent, -1.0, 0.6, piece);
+  ASSERT_EQ(piece.size(), std::size_t(7 * 5 * 6));
+  std::size_t idx = 0;
+  int nonzero = 0;
+  for (int k = extent[4]; k <= extent[5]; ++k)
+    for (int j = extent[2]; j <= extent[3]; ++j)
+      for (int i = extent[0]; i <= extent[1]; ++i, ++idx)
+      {
+        const float expected = whole[(std::size_t(k) * 9 + j) * 11 + i];
+        ASSERT_EQ(std::memcmp(&piece[idx], &expected, sizeof(float)), 0)
+          << i << " " << j << " " << k;
+        nonzero += expected != 0.0f;
+      }
+  EXPECT_GT(nonzero, 20);
+  const nimbus::GridExtent outside{ { 3, 11, 0, 4, 2, 7 } };
+  EXPECT_THROW(nimbus::SampleMetaballs(balls, grid, outside, piece), std::invalid_argument);
 }
 
 TEST(Random, SameSeedSameSequenceInUnitInterval)
