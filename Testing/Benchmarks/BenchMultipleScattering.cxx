@@ -13,6 +13,7 @@
 #include "MultipleScatteringTexture.h"
 #include "TestCumulus.h"
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 
 #include "vtkCamera.h"
 #include "vtkDataArray.h"
@@ -93,6 +94,11 @@ const char* MethodName(int method)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   const int threads = argc > 1 ? std::max(1, std::atoi(argv[1])) : 2;
   const int frames = argc > 2 ? std::max(1, std::atoi(argv[2])) : 5;
   vtkSmartPointer<vtkImageData> cloud = nimbus::testing::TestCumulus(128, 128, 128);
