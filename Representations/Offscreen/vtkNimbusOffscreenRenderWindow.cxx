@@ -1,5 +1,6 @@
 #include "vtkNimbusOffscreenRenderWindow.h"
 
+#include "vtkGenericRenderWindowInteractor.h"
 #include "vtkObjectFactory.h"
 #include "vtkObjectFactoryCollection.h"
 #include "vtkOpenGLState.h"
@@ -183,10 +184,20 @@ std::vector<DisplayCandidate> DisplayCandidates()
 }
 
 //------------------------------------------------------------------------------
-// The override vtkRenderWindow -> vtkNimbusOffscreenRenderWindow.
+// The overrides vtkRenderWindow -> vtkNimbusOffscreenRenderWindow and
+// vtkRenderWindowInteractor -> vtkGenericRenderWindowInteractor: VTK's own interactor
+// (vtkXRenderWindowInteractor) opens the X display when a window it watches first renders
+// (ParaView's views have one), and there is none.
+const char* const OverriddenClasses[] = { "vtkRenderWindow", "vtkRenderWindowInteractor" };
+
 vtkObject* NewOffscreenWindow()
 {
   return vtkNimbusOffscreenRenderWindow::New();
+}
+
+vtkObject* NewGenericInteractor()
+{
+  return vtkGenericRenderWindowInteractor::New();
 }
 
 class vtkNimbusOffscreenFactory : public vtkObjectFactory
@@ -210,6 +221,8 @@ protected:
   {
     this->RegisterOverride("vtkRenderWindow", "vtkNimbusOffscreenRenderWindow",
       "EGL pbuffer render window, no X server", 1, NewOffscreenWindow);
+    this->RegisterOverride("vtkRenderWindowInteractor", "vtkGenericRenderWindowInteractor",
+      "an interactor that needs no X server", 1, NewGenericInteractor);
   }
 
 private:
@@ -261,18 +274,23 @@ void vtkNimbusOffscreenRenderWindow::InstallFactory()
     return;
   }
   // vtkObjectFactory::CreateInstance asks the registered factories in order and the first
-  // override wins; VTK's own (vtkRenderingOpenGL2's vtkXOpenGLRenderWindow) registered at
-  // start-up, so take the factories that override vtkRenderWindow out, register ours and
-  // put them back behind it. Factories registered later also come after ours.
+  // override wins; VTK's own (vtkRenderingOpenGL2's vtkXOpenGLRenderWindow, vtkRenderingUI's
+  // vtkXRenderWindowInteractor) registered at start-up, so take the factories that override
+  // either class out, register ours and put them back behind it. Factories registered later
+  // also come after ours.
   std::vector<vtkSmartPointer<vtkObjectFactory>> others;
   vtkObjectFactoryCollection* registered = vtkObjectFactory::GetRegisteredFactories();
   vtkCollectionSimpleIterator it;
   registered->InitTraversal(it);
   while (vtkObjectFactory* factory = registered->GetNextObjectFactory(it))
   {
-    if (factory->HasOverride("vtkRenderWindow"))
+    for (const char* overridden : OverriddenClasses)
     {
-      others.emplace_back(factory);
+      if (factory->HasOverride(overridden))
+      {
+        others.emplace_back(factory);
+        break;
+      }
     }
   }
   for (auto& factory : others)

@@ -28,8 +28,10 @@
  * `egl`; InstallFactoryIfRequested() reads only the variable (Python, the ParaView plugin).
  * NIMBUS_OFFSCREEN unset, empty or `0` is off; any other value is an error.
  *
- * No interactor: vtkRenderWindowInteractor::Start() on this window has nothing to show;
- * programs that render offscreen must not start one (see IsFactoryInstalled()).
+ * The factory also makes vtkRenderWindowInteractor::New() a vtkGenericRenderWindowInteractor:
+ * VTK's X interactor opens the X display when its window first renders (ParaView's views
+ * have one). Its Start() has no event loop and nothing to show; programs that render
+ * offscreen do not start one (see IsFactoryInstalled()).
  */
 
 #ifndef vtkNimbusOffscreenRenderWindow_h
@@ -50,8 +52,9 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   /**
-   * Register the object-factory override vtkRenderWindow -> this class, ahead of VTK's
-   * own (vtkXOpenGLRenderWindow). Idempotent.
+   * Register the object-factory overrides vtkRenderWindow -> this class and
+   * vtkRenderWindowInteractor -> vtkGenericRenderWindowInteractor, ahead of VTK's own
+   * (vtkXOpenGLRenderWindow, vtkXRenderWindowInteractor). Idempotent.
    */
   static void InstallFactory();
 

@@ -8,6 +8,7 @@
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
+#include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
 #include "vtkSphereSource.h"
@@ -111,6 +112,11 @@ TEST(OffscreenRenderWindow, FactoryOverride)
   EXPECT_TRUE(window->IsA("vtkNimbusOffscreenRenderWindow")) << window->GetClassName();
   vtkNew<vtkRenderWindow> viaNew;
   EXPECT_TRUE(viaNew->IsA("vtkNimbusOffscreenRenderWindow")) << viaNew->GetClassName();
+  // No X interactor either (it opens the display when its window first renders).
+  vtkNew<vtkRenderWindowInteractor> interactor;
+  EXPECT_TRUE(interactor->IsA("vtkGenericRenderWindowInteractor")) << interactor->GetClassName();
+  interactor->SetRenderWindow(window);
+  window->Render();
 
   vtkNimbusOffscreenRenderWindow::RemoveFactory();
   vtkSmartPointer<vtkRenderWindow> other = vtkSmartPointer<vtkRenderWindow>::New();
