@@ -9,7 +9,7 @@
 // adds to a cloud frame (the background pass plus the mapper's second target).
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
-// under Testing/with-display.sh (needs an OpenGL context).
+// under Testing/with-display.sh (needs an OpenGL context), or with --offscreen (EGL, no X).
 #include "TestCumulus.h"
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusOffscreenRenderWindow.h"

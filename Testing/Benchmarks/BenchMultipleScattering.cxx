@@ -7,8 +7,9 @@
 // Part 1 runs the solver alone (Physics/MultipleScattering.h) on the test cumulus
 // (128^3, 3 km wide, k_cl 0.02 /m) downsampled by D; part 2 renders that cumulus at
 // 320x240 with vtkNimbusCloudVolumeMapper (needs an OpenGL context: run it under
-// Testing/with-display.sh). Every ratio compares timings taken in this one run; the
-// frame times of the methods and of single scattering are interleaved, frame by frame.
+// Testing/with-display.sh, or with --offscreen for EGL without X). Every ratio compares timings
+// taken in this one run; the frame times of the methods and of single scattering are interleaved,
+// frame by frame.
 #include "MultipleScattering.h"
 #include "MultipleScatteringTexture.h"
 #include "TestCumulus.h"
