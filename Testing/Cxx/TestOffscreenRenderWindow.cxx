@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -151,6 +152,9 @@ TEST(OffscreenRenderWindow, RendersAndReadsBack)
   const std::string report = scene.Window->ReportCapabilities();
   EXPECT_NE(report.find("EGL platform: "), std::string::npos) << report;
   EXPECT_NE(report.find("OpenGL renderer string"), std::string::npos) << report;
+  // Which EGL display and GL renderer this machine gave (logged for the record).
+  const std::size_t extensions = report.find("OpenGL extensions");
+  std::cout << report.substr(0, extensions) << std::flush;
 }
 
 TEST(OffscreenRenderWindow, TwoWindowsTakeTurns)
