@@ -31,6 +31,8 @@ packages=(
   libopenvdb-dev python3-openvdb
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
+  # no X at all: EGL (vtkNimbusOffscreenRenderWindow, NIMBUS_OFFSCREEN=egl)
+  libegl-dev libegl-mesa0
 )
 
 missing=()

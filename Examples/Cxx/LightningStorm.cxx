@@ -15,6 +15,7 @@
 #include "vtkNimbusLightningIllumination.h"
 #include "vtkNimbusLightningSource.h"
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -53,6 +54,11 @@ bool ParseNumber(const char* text, double& value)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   std::string output = "lightning-storm.png";
   double time = -1.0; // < 0: the return stroke's peak
   double width = 960, height = 540;
@@ -63,7 +69,8 @@ int main(int argc, char* argv[])
     if (arg == "--help" || arg == "-h")
     {
       std::cout << "usage: nimbus-lightning-storm [--output FILE.png] [--time SECONDS] "
-                   "[--size W H]\n";
+                   "[--size W H] [--offscreen]\n"
+                   "  --offscreen (or NIMBUS_OFFSCREEN=egl): render with EGL, no X server.\n";
       return 0;
     }
     else if (arg == "--output" && i + 1 < argc)

@@ -13,6 +13,7 @@
 // Units: metres; z up.
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -34,11 +35,13 @@ namespace
 {
 void Usage()
 {
-  std::cout << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
-               " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E] [--no-sky]\n"
-               "  W, H in [16, 8192] pixels; sun elevation in [-90, 90] degrees, azimuth within"
-               " +-1e6 degrees;\n  seed a 32-bit integer; k-multi in [0, 100]; exposure in"
-               " [0, 1e6]. A bad value exits with status 2.\n";
+  std::cout
+    << "usage: nimbus-demo [--output FILE.png] [--size W H] [--sun-elevation DEG]"
+       " [--sun-azimuth DEG] [--seed N] [--k-multi K] [--exposure E] [--no-sky] [--offscreen]\n"
+       "  W, H in [16, 8192] pixels; sun elevation in [-90, 90] degrees, azimuth within"
+       " +-1e6 degrees;\n  seed a 32-bit integer; k-multi in [0, 100]; exposure in"
+       " [0, 1e6]. A bad value exits with status 2.\n"
+       "  --offscreen (or NIMBUS_OFFSCREEN=egl): render with EGL, no X server.\n";
 }
 
 bool ParseNumber(const char* text, double& value)
@@ -51,6 +54,11 @@ bool ParseNumber(const char* text, double& value)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   std::string output = "nimbus-demo.png";
   double width = 960, height = 540, sunElevation = 35.0, sunAzimuth = 120.0, seed = 7, kMulti = 0.0,
          exposure = 8.0;

@@ -25,6 +25,9 @@ import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (the OpenGL factory)
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401
 from vtkmodules.vtkRenderingVolume import vtkGPUVolumeRayCastMapper
 
+# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (README, Without a display).
+nimbus.offscreen_if_requested()
+
 NX, NY, NZ = 128, 96, 32
 CELL = 100.0  # metres
 STEP_SECONDS = 10.0

@@ -21,6 +21,9 @@ import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401
 from vtkmodules.vtkRenderingVolume import vtkGPUVolumeRayCastMapper
 
+# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (README, Without a display).
+nimbus.offscreen_if_requested()
+
 SIZE = 300
 
 

@@ -25,6 +25,9 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkRendere
                                          vtkRenderWindow, vtkVolume, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
+# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (README, Without a display).
+nimbus.offscreen_if_requested()
+
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("output", nargs="?", default="smoke_obstacle.png")
 parser.add_argument("--seconds", type=float, default=5.0)

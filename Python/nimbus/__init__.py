@@ -17,6 +17,17 @@ except ModuleNotFoundError:
 __version__ = "0.1.0"
 
 
+def offscreen_if_requested():
+    """NIMBUS_OFFSCREEN=egl: make vtkRenderWindow() an EGL pbuffer window
+    (vtkNimbusOffscreenRenderWindow), so that rendering needs no X server. Returns True
+    when installed, False when the variable is unset, empty or 0; exits with a message
+    (status 2) on any other value. Call before the first vtkRenderWindow() is made."""
+    installed = vtkNimbusOffscreenRenderWindow.InstallFactoryIfRequested()  # noqa: F405
+    if installed < 0:
+        raise SystemExit(2)
+    return installed == 1
+
+
 def find_cloud_mapper(renderer):
     """The first visible vtkNimbusCloudVolumeMapper among `renderer`'s volumes, or None
     (e.g. ParaView's Cloud representation: view.SMProxy.GetRenderer())."""

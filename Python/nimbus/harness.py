@@ -53,6 +53,9 @@ from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPiecewiseFunction
 from vtkmodules.vtkIOImage import vtkPNGWriter
 
+# NIMBUS_OFFSCREEN=egl: every render window below is an EGL pbuffer (no X server).
+nimbus.offscreen_if_requested()
+
 # The reference each scene is measured against (see --reference).
 REFERENCE_SETTINGS = {
     "single": {"mode": "single", "step_scale": 0.5, "tolerance": 1e-3, "max_refinements": 6},

@@ -9,9 +9,10 @@
 // adds to a cloud frame (the background pass plus the mapper's second target).
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
-// under Testing/with-display.sh (needs an OpenGL context).
+// under Testing/with-display.sh (needs an OpenGL context), or with --offscreen (EGL, no X).
 #include "TestCumulus.h"
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -138,6 +139,11 @@ double TimeVtkGpu(vtkImageData* image, double reach)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   if (argc > 1)
     Frames = std::max(1, std::atoi(argv[1]));
   if (argc > 2)

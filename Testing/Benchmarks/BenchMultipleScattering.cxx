@@ -7,12 +7,14 @@
 // Part 1 runs the solver alone (Physics/MultipleScattering.h) on the test cumulus
 // (128^3, 3 km wide, k_cl 0.02 /m) downsampled by D; part 2 renders that cumulus at
 // 320x240 with vtkNimbusCloudVolumeMapper (needs an OpenGL context: run it under
-// Testing/with-display.sh). Every ratio compares timings taken in this one run; the
-// frame times of the methods and of single scattering are interleaved, frame by frame.
+// Testing/with-display.sh, or with --offscreen for EGL without X). Every ratio compares timings
+// taken in this one run; the frame times of the methods and of single scattering are interleaved,
+// frame by frame.
 #include "MultipleScattering.h"
 #include "MultipleScatteringTexture.h"
 #include "TestCumulus.h"
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 
 #include "vtkCamera.h"
 #include "vtkDataArray.h"
@@ -93,6 +95,11 @@ const char* MethodName(int method)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   const int threads = argc > 1 ? std::max(1, std::atoi(argv[1])) : 2;
   const int frames = argc > 2 ? std::max(1, std::atoi(argv[2])) : 5;
   vtkSmartPointer<vtkImageData> cloud = nimbus::testing::TestCumulus(128, 128, 128);

@@ -3,6 +3,7 @@
 // (c) a scene of 5 boxes + ground without and (d) with the pass (aerial
 // perspective). Tables are built before timing (the first frame). Usage:
 // BenchSkyPass [frames=30] [width=640] [height=480]
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyPass.h"
 
@@ -91,6 +92,11 @@ double FrameSeconds(bool scene, bool sky, int frames, int width, int height)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   const int frames = argc > 1 ? std::atoi(argv[1]) : 30;
   const int width = argc > 2 ? std::atoi(argv[2]) : 640;
   const int height = argc > 3 ? std::atoi(argv[3]) : 480;

@@ -8,6 +8,7 @@
 //
 // Prints one line per case: ok/FAIL, the case, what happened.
 #include "vtkNimbusCloudVolumeMapper.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 #include "vtkNimbusSkyDomeSource.h"
@@ -666,6 +667,11 @@ Result AbsurdDimensions()
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   using M = vtkNimbusCloudVolumeMapper;
   const std::vector<std::pair<std::string, std::function<Result()>>> cases = {
     { "SunElevationNaN",

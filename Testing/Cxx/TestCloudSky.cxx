@@ -18,6 +18,7 @@
 
 #include "vtkNimbusCloudVolumeMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -256,6 +257,11 @@ int RunChecks()
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "checks" && argc == 2)
   {

@@ -10,6 +10,7 @@
 #include "vtkNimbusLightningIllumination.h"
 #include "vtkNimbusLightningSource.h"
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 
 #include "BlackbodyEmission.h"
 #include "ImageComparison.h"
@@ -1019,6 +1020,11 @@ bool Downsampling(const Context&)
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   const std::map<std::string, std::function<bool(const Context&)>> cases = { { "Noon", Noon },
     { "Sunset", Sunset }, { "SilverLining", SilverLining }, { "FacingSun", FacingSun },
     { "GroundShadows", GroundShadows }, { "ShaftsThroughGap", ShaftsThroughGap },

@@ -6,6 +6,7 @@
 // Writes its render to <output dir>/TestMetaballCloudImage.png and compares it
 // with the baseline (criteria and their measured justification: ImageComparison.h).
 #include "vtkNimbusMetaballCloudSource.h"
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSunlight.h"
 
 #include "vtkCamera.h"
@@ -31,6 +32,11 @@
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   if (argc != 3)
   {
     std::cerr << "usage: TestMetaballCloudImage baseline.png outputdir\n";

@@ -4,6 +4,7 @@
 // <baseline.png> <outputdir>.
 #include "ImageComparison.h"
 
+#include "vtkNimbusOffscreenRenderWindow.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyPass.h"
 #include "vtkNimbusSunlight.h"
@@ -46,6 +47,11 @@ void AddActor(vtkRenderer* renderer, vtkAlgorithm* source, double r, double g, d
 
 int main(int argc, char* argv[])
 {
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
   if (argc != 4)
   {
     std::cerr << "usage: TestSkyImage noon|sunset|twilight|aerial baseline.png outputdir\n";
