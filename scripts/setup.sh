@@ -5,6 +5,7 @@
 #
 #   NIMBUS_BUILD_DIR   build directory (default: <repo>/build)
 #   NIMBUS_JOBS        parallel build jobs (default: number of cores)
+#   NIMBUS_OFFSCREEN   egl: no Xvfb (not installed, tests on EGL only)
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -35,8 +36,17 @@ packages=(
   libegl-dev libegl-mesa0
 )
 
+# NIMBUS_OFFSCREEN=egl: no X at all (a cluster node, a container): Xvfb is neither
+# installed nor used, and the tests run on EGL only (docs/offscreen.md).
+configure=()
+if [ "${NIMBUS_OFFSCREEN:-}" = "egl" ]; then
+  packages=("${packages[@]/xvfb/}")
+  configure+=(-DNIMBUS_XVFB=OFF)
+fi
+
 missing=()
 for package in "${packages[@]}"; do
+  [ -n "$package" ] || continue
   if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
     missing+=("$package")
   fi
@@ -53,6 +63,6 @@ fi
 # on PATH (pyenv, conda) would not.
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-    -DPython3_EXECUTABLE=/usr/bin/python3
+    -DPython3_EXECUTABLE=/usr/bin/python3 "${configure[@]}"
 fi
 cmake --build "$build" --parallel "$jobs"

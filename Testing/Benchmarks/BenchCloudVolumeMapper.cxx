@@ -3,9 +3,10 @@
 // ratio to the floor (the same slices composited unlit) and to VTK's
 // vtkGPUVolumeRayCastMapper with volumetric scattering (GlobalIlluminationReach 1).
 //
-//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky]
+//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky | side]
 //
-// With "sky" only the sky table runs: what a vtkNimbusSkyBackground
+// With a number `side` the volume sweep adds a side^3 cloud (one node's piece of a
+// large field, issue 18). With "sky" only the sky table runs: what a vtkNimbusSkyBackground
 // adds to a cloud frame (the background pass plus the mapper's second target).
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
@@ -29,6 +30,7 @@
 #include "vtkVolumeProperty.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -42,6 +44,7 @@ namespace
 int Frames = 5;
 int Width = 320;
 int Height = 240;
+int ExtraSide = 0; // the volume sweep's extra side^3 cloud (0: none)
 
 struct Bench
 {
@@ -150,6 +153,8 @@ int main(int argc, char* argv[])
     Width = std::max(16, std::atoi(argv[2]));
   if (argc > 3)
     Height = std::max(16, std::atoi(argv[3]));
+  if (argc > 4 && std::isdigit(static_cast<unsigned char>(argv[4][0])))
+    ExtraSide = std::max(2, std::atoi(argv[4]));
   std::printf("BenchCloudVolumeMapper: %dx%d pixels, median of %d frames, times in ms\n", Width,
     Height, Frames);
   Bench bench;
@@ -202,7 +207,12 @@ int main(int argc, char* argv[])
     std::printf("| 128^3 | %d | %.1f | %.1f | %.1f | %.2f | %.2f |\n", slices, full, cloud, floor,
       cloud / floor, full / floor);
   }
-  for (const auto& dims : std::vector<std::array<int, 3>>{ { 64, 64, 64 }, { 256, 256, 64 } })
+  std::vector<std::array<int, 3>> volumes{ { 64, 64, 64 }, { 256, 256, 64 } };
+  if (ExtraSide > 0)
+  {
+    volumes.push_back({ ExtraSide, ExtraSide, ExtraSide }); // e.g. one node's piece of 2048^3
+  }
+  for (const auto& dims : volumes)
   {
     vtkSmartPointer<vtkImageData> c = nimbus::testing::TestCumulus(dims[0], dims[1], dims[2]);
     const double full = TimeSvs(c, 256, none);
