@@ -83,44 +83,35 @@ def main():
         writer.SetInputData(image)
         writer.SetFileName(empty)
         writer.Write()
-    one_empty = prefix + "-empty-1.png"
-    many_empty = prefix + "-empty-%d.png" % args.ranks
-    render(args, 1, one_empty, empty)
-    render(args, args.ranks, many_empty, empty)
-    rmse, p99, largest = compare(one_empty, many_empty)
-    print("empty cloud, %d ranks vs 1: RMSE %.3f, 99th percentile %.1f, max %.0f levels"
-          % (args.ranks, rmse, p99, largest))
+    def render_pair(name, data_file, extra=()):
+        """One rank's and --ranks ranks' pictures of the same scene, and their difference."""
+        one = "%s-%s-1.png" % (prefix, name)
+        many = "%s-%s-%d.png" % (prefix, name, args.ranks)
+        render(args, 1, one, data_file, extra)
+        render(args, args.ranks, many, data_file, extra)
+        rmse, p99, largest = compare(one, many)
+        print("%s, %d ranks vs 1: RMSE %.3f, 99th percentile %.1f, max %.0f levels"
+              % (name, args.ranks, rmse, p99, largest))
+        if numpy.mean(read_png(many)) < 1.0:
+            failures.append("the %d-rank image of %s is black" % (args.ranks, name))
+        return rmse, p99, largest
+
+    def within_bounds(name, rmse, p99):
+        if rmse > args.max_rmse or p99 > args.max_p99:
+            failures.append("%s with %d ranks is off: RMSE %.3f (bound %.3f), 99th percentile "
+                            "%.1f (bound %.1f)" % (name, args.ranks, rmse, args.max_rmse, p99,
+                                                   args.max_p99))
+
+    _, _, largest = render_pair("empty", empty)
     if largest > 1.0:
         failures.append("the air and the ground differ with %d ranks (max %.0f levels)"
                         % (args.ranks, largest))
-
-    one = prefix + "-1.png"
-    many = prefix + "-%d.png" % args.ranks
-    render(args, 1, one, data, ["--timings", prefix + "-1.json"])
-    render(args, args.ranks, many, data, ["--timings", prefix + "-%d.json" % args.ranks])
-    rmse, p99, largest = compare(one, many)
-    print("cloud, %d ranks vs 1: RMSE %.3f, 99th percentile %.1f, max %.0f levels"
-          % (args.ranks, rmse, p99, largest))
-    if rmse > args.max_rmse or p99 > args.max_p99:
-        failures.append("the cloud with %d ranks is off: RMSE %.3f (bound %.3f), 99th "
-                        "percentile %.1f (bound %.1f)" % (args.ranks, rmse, args.max_rmse,
-                                                          p99, args.max_p99))
-    if numpy.mean(read_png(many)) < 1.0:
-        failures.append("the %d-rank image is black" % args.ranks)
-
+    rmse, p99, _ = render_pair("cloud", data)
+    within_bounds("the cloud", rmse, p99)
     # Over a Nimbus sky ("Sky Background"): the sky drawn by one rank, the cloud
     # following its sun, air and display settings on every rank.
-    one_sky = prefix + "-sky-1.png"
-    many_sky = prefix + "-sky-%d.png" % args.ranks
-    render(args, 1, one_sky, data, ["--sky"])
-    render(args, args.ranks, many_sky, data, ["--sky"])
-    rmse, p99, largest = compare(one_sky, many_sky)
-    print("cloud over a sky, %d ranks vs 1: RMSE %.3f, 99th percentile %.1f, max %.0f levels"
-          % (args.ranks, rmse, p99, largest))
-    if rmse > args.max_rmse or p99 > args.max_p99:
-        failures.append("the cloud over a sky with %d ranks is off: RMSE %.3f (bound %.3f), "
-                        "99th percentile %.1f (bound %.1f)" % (args.ranks, rmse, args.max_rmse,
-                                                               p99, args.max_p99))
+    rmse, p99, _ = render_pair("sky", data, ["--sky"])
+    within_bounds("the cloud over a sky", rmse, p99)
     for failure in failures:
         print("FAIL: " + failure)
     return 1 if failures else 0
