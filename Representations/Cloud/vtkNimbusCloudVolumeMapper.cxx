@@ -1782,6 +1782,11 @@ double* vtkNimbusCloudVolumeMapper::GetBounds()
   return this->PieceBounds;
 }
 
+void vtkNimbusCloudVolumeMapper::SetViewCoverBounds(const double bounds[6])
+{
+  std::copy(bounds, bounds + 6, this->ViewCoverBounds);
+}
+
 //------------------------------------------------------------------------------
 void vtkNimbusCloudVolumeMapper::SetExternalDensity(vtkImageData* coarse)
 {

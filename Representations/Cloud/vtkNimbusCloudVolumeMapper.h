@@ -533,10 +533,11 @@ public:
   /// that piece's pixels are the whole view. The representation sets it from the
   /// camera before each render (a box around the view frustum between the cloud's
   /// distance and twice it, which does not contain the eye); Render clears it, so
-  /// that a camera reset between renders sees the cloud's own bounds.
+  /// that a camera reset between renders sees the cloud's own bounds. Setting it does
+  /// not modify the mapper (a per-render hint: an unchanged frame is still reused).
   double* GetBounds() VTK_SIZEHINT(6) override;
   using Superclass::GetBounds;
-  vtkSetVector6Macro(ViewCoverBounds, double);
+  void SetViewCoverBounds(const double bounds[6]);
   vtkGetVector6Macro(ViewCoverBounds, double);
   ///@}
 
