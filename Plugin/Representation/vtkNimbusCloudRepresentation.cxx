@@ -426,6 +426,10 @@ void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent
      << "MieScatteringPerMetre (override, -1 = from Turbidity): " << this->MieScatteringOverride
      << "\n";
+  os << indent << "WholeBounds (all ranks' pieces): " << this->WholeBounds[0] << " .. "
+     << this->WholeBounds[1] << ", " << this->WholeBounds[2] << " .. " << this->WholeBounds[3]
+     << ", " << this->WholeBounds[4] << " .. " << this->WholeBounds[5] << "\n";
+  os << indent << "CoarseDensity: " << this->CoarseDensity.GetPointer() << "\n";
   os << indent << "CloudMapper:\n";
   this->CloudMapper->PrintSelf(os, indent.GetNextIndent());
 }
