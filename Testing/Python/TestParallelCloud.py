@@ -19,19 +19,12 @@ import subprocess
 import sys
 
 import numpy
-from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkIOImage import vtkPNGReader
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from image_compare import read_png  # noqa: E402
 
 
-def read_png(path):
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
-    return pixels[:, :3].astype(float)
 
 
 def render(args, ranks, output, data, extra=()):

@@ -25,22 +25,13 @@ import sys
 
 from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
                              SaveData, SaveScreenshot, Show, XMLImageDataReader)
-from vtkmodules.vtkIOImage import vtkPNGReader
-from vtkmodules.util.numpy_support import vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from image_compare import compare_with_baseline  # noqa: E402
+from image_compare import compare_with_baseline, read_png  # noqa: E402
 
 SIZE = [320, 240]
 
 
-def read_png(path):
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
-    return pixels[:, :3].astype(float)
 
 
 def cloud_mapper(view):
@@ -272,8 +263,8 @@ def main():
     if change < 5.0:
         failures.append("changing SunElevationDegrees changed the image by only %.2f" % change)
     # The low sun through the atmosphere is redder relative to blue.
-    red_blue_noon = a[:, 0].mean() / max(a[:, 2].mean(), 1e-6)
-    red_blue_low = b[:, 0].mean() / max(b[:, 2].mean(), 1e-6)
+    red_blue_noon = a[..., 0].mean() / max(a[..., 2].mean(), 1e-6)
+    red_blue_low = b[..., 0].mean() / max(b[..., 2].mean(), 1e-6)
     print("mean red/blue: noon %.3f, low sun %.3f" % (red_blue_noon, red_blue_low))
     if not red_blue_low > red_blue_noon:
         failures.append("the low sun is not redder than noon")

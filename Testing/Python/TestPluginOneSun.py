@@ -29,8 +29,9 @@ import sys
 from paraview import servermanager
 from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
                              SaveScreenshot, Show)
-from vtkmodules.vtkIOImage import vtkPNGReader
-from vtkmodules.util.numpy_support import vtk_to_numpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from image_compare import read_png  # noqa: E402
 
 # A paper's equation, section or symbol in GUI text (labels belong to users; the
 # mapping to the papers is docs/paraview-properties.md).
@@ -44,14 +45,6 @@ SKY_SET = ["SunElevationDegrees", "SunAzimuthDegrees", "SunIlluminance", "SunTem
 SHARED_DEFAULTS = ["SunElevationDegrees", "SunAzimuthDegrees", "GroundAlbedo", "Exposure"]
 
 
-def read_png(path):
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    width, height, _ = image.GetDimensions()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, -1)
-    return pixels[::-1, :, :3].astype(float)
 
 
 def value(proxy, name):

@@ -26,11 +26,9 @@ import sys
 from paraview import servermanager
 from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
                              SaveScreenshot, Show)
-from vtkmodules.vtkIOImage import vtkPNGReader
-from vtkmodules.util.numpy_support import vtk_to_numpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from image_compare import compare_with_baseline  # noqa: E402
+from image_compare import compare_with_baseline, read_png  # noqa: E402
 
 SIZE = [320, 240]
 HORIZON_ROW = SIZE[1] // 2          # the camera looks horizontally: the horizon is mid-height
@@ -38,15 +36,6 @@ BACKGROUND = [1.0, 0.0, 1.0]        # magenta: R = B, unlike any sky
 BACKGROUND_8BIT = [255.0, 0.0, 255.0]
 
 
-def read_png(path):
-    """Pixels as a float array [row, column, rgb], row 0 at the top."""
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    width, height, _ = image.GetDimensions()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width, -1)
-    return pixels[::-1, :, :3].astype(float)
 
 
 class Checker:
