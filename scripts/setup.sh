@@ -30,6 +30,8 @@ packages=(
   libbenchmark-dev clang-format git
   # OpenVDB reader/writer (IO/) and the tests' independent .vdb producer
   libopenvdb-dev python3-openvdb
+  # Data/UserData's LES-like NetCDF sample (scripts/make-user-sample-data.py)
+  python3-netcdf4
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
   # no X at all: EGL (vtkNimbusOffscreenRenderWindow, NIMBUS_OFFSCREEN=egl)
