@@ -2,10 +2,12 @@
 
 #include "MemoryBudget.h"
 #include "VdbGrids.h"
+#include "VdbUpAxis.h"
 
 #include "vtkCommand.h"
 #include "vtkDataArraySelection.h"
 #include "vtkExtentTranslator.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -38,6 +40,11 @@ struct vtkNimbusOpenVDBReader::Internals
   long long CachedMTime = -1;
   long long CachedSize = -1;
   std::vector<vdb::GridInfo> Grids;
+  std::map<std::string, std::string> FileStrings; // file-level string metadata
+
+  // The up axis of the last RequestInformation/RequestData (Choose).
+  vdb::UpAxisChoice UpChoice;
+  bool UpChosen = false;
 
   vtkNew<vtkDataArraySelection> Selection;
   vtkNew<vtkStringArray> Names;
@@ -90,6 +97,21 @@ struct vtkNimbusOpenVDBReader::Internals
 
   // Reads the descriptors (if stale) and refreshes the selection list. Throws vdb::Error.
   void Refresh(const std::string& path);
+  // The up axis for the UpAxis property `requested` and this file (after Refresh).
+  const vdb::UpAxisChoice& ChooseUp(int requested)
+  {
+    std::vector<std::string> creators;
+    for (const auto& g : this->Grids)
+    {
+      if (!g.Creator.empty())
+      {
+        creators.push_back(g.Creator);
+      }
+    }
+    this->UpChoice = vdb::ChooseUpAxis(requested, this->FileStrings, creators);
+    this->UpChosen = true;
+    return this->UpChoice;
+  }
   // Which grids to read, the reference transform and the index box. Throws vdb::Error.
   Plan MakePlan(const char* boundsGrid, const std::string& path) const;
 };
@@ -125,7 +147,8 @@ void vtkNimbusOpenVDBReader::Internals::Refresh(const std::string& path)
     return;
   }
   in.CachedPath.clear();
-  in.Grids = vdb::ReadFileInfo(path);
+  in.UpChosen = false;
+  in.Grids = vdb::ReadFileInfo(path, &in.FileStrings);
   in.CachedPath = path;
   in.CachedMTime = mtime;
   in.CachedSize = size;
@@ -334,6 +357,7 @@ int vtkNimbusOpenVDBReader::RequestInformation(
     return 0;
   }
   Internals::Plan plan;
+  this->Internal->UpChosen = false;
   try
   {
     this->Internal->Refresh(this->FileName);
@@ -349,12 +373,16 @@ int vtkNimbusOpenVDBReader::RequestInformation(
     vtkErrorMacro(<< "cannot read the grids of " << this->FileName << ": " << e.what());
     return 0;
   }
-  const vdb::TransformInfo& t = plan.Reference->Transform;
+  // The image in the up frame: its extent, origin, spacing and direction (the file's own
+  // for +Z). Pieces are requested in this frame.
+  const vdb::UpTurn turn(this->Internal->ChooseUp(this->UpAxis).Axis, plan.Reference->Transform);
+  const vdb::TransformInfo t = turn.TurnTransform(plan.Reference->Transform);
+  const vdb::IndexBox box = turn.TurnBox(plan.Box);
   int extent[6];
   for (int c = 0; c < 3; ++c)
   {
-    extent[2 * c] = static_cast<int>(plan.Box.Min[c]);
-    extent[2 * c + 1] = static_cast<int>(plan.Box.Max[c]);
+    extent[2 * c] = static_cast<int>(box.Min[c]);
+    extent[2 * c + 1] = static_cast<int>(box.Max[c]);
   }
   double direction[9];
   RowMajorDirection(t, direction);
@@ -452,32 +480,36 @@ int vtkNimbusOpenVDBReader::RequestData(
   return 0;
 }
 
-int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
+namespace
 {
-  this->Internal->Refresh(this->FileName);
-  const Internals::Plan plan = this->Internal->MakePlan(this->BoundsGrid, this->FileName);
-  // Pieces: only the piece's part of the plan's box is read into the image (each voxel's
-  // value does not depend on the box, so a piece equals the whole image's crop bit for bit).
-  // OpenVDB still reads each selected grid's whole tree from the file.
-  const vdb::IndexBox box = this->Internal->PieceBox(plan.Box);
-  const vdb::TransformInfo& t = plan.Reference->Transform;
-  if (box.Empty() && !plan.Box.Empty())
-  {
-    // A piece with no point of the image (more pieces than points): an empty image.
-    output->SetOrigin(t.Origin.data());
-    output->SetSpacing(t.Spacing.data());
-    double direction[9];
-    RowMajorDirection(t, direction);
-    output->SetDirectionMatrix(direction);
-    return 1;
-  }
+void SetGeometry(vtkImageData* output, const vdb::TransformInfo& t)
+{
+  output->SetOrigin(t.Origin.data());
+  output->SetSpacing(t.Spacing.data());
+  double direction[9];
+  RowMajorDirection(t, direction);
+  output->SetDirectionMatrix(direction);
+}
 
-  // Refuse absurd reads before allocating anything: the voxel limit counts every selected
-  // grid's values (points x grids), the memory budget every byte of the read.
+/// The field-data string array that says which axis was taken as up, and why.
+void AddUpAxisSource(vtkImageData* output, const std::string& source)
+{
+  vtkNew<vtkStringArray> array;
+  array->SetName(vtkNimbusOpenVDBReader::UpAxisSourceArrayName());
+  array->InsertNextValue(source);
+  output->GetFieldData()->AddArray(array);
+}
+
+/// The voxel limit and the memory budget, checked before anything is allocated. `turning`:
+/// the voxels are re-indexed into the up frame, through a copy of the largest grid's array.
+bool WithinLimits(vtkNimbusOpenVDBReader* self, const std::vector<const vdb::GridInfo*>& read,
+  const vdb::IndexBox& box, bool turning)
+{
+  const char* fileName = self->GetFileName();
   const uint64_t voxels = box.VoxelCount();
   uint64_t components = 0;
   uint64_t workBytes = 0; // the largest grid's file bytes and tree, while it is read
-  for (const auto* g : plan.Read)
+  for (const auto* g : read)
   {
     components += static_cast<uint64_t>(g->Components);
     const uint64_t active = g->ActiveVoxelCount > 0 ? uint64_t(g->ActiveVoxelCount) : 0;
@@ -487,14 +519,20 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
       tree = UINT64_MAX / 2;
     }
     workBytes = std::max(workBytes, std::min(UINT64_MAX / 4, tree + uint64_t(g->FileBytes)));
+    if (turning)
+    {
+      // The copy a grid's values are re-indexed from (after its tree is gone).
+      workBytes = std::max(workBytes, voxels * uint64_t(g->Components) * 4);
+    }
   }
   std::ostringstream dims;
   dims << (box.Max[0] - box.Min[0] + 1) << " x " << (box.Max[1] - box.Min[1] + 1) << " x "
        << (box.Max[2] - box.Min[2] + 1);
   uint64_t values = 0;
   const bool valuesFit =
-    nimbus::CheckedProduct({ voxels, static_cast<uint64_t>(plan.Read.size()) }, values);
-  if (!valuesFit || values > static_cast<uint64_t>(this->MaximumNumberOfVoxels))
+    nimbus::CheckedProduct({ voxels, static_cast<uint64_t>(read.size()) }, values);
+  const vtkIdType maximum = self->GetMaximumNumberOfVoxels();
+  if (!valuesFit || values > static_cast<uint64_t>(maximum))
   {
     std::ostringstream values_text;
     if (valuesFit)
@@ -505,37 +543,45 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
     {
       values_text << "more than 2^64";
     }
-    vtkErrorMacro(<< "refusing to read " << this->FileName << ": the image would have "
-                  << dims.str() << " = " << voxels << " points x " << plan.Read.size()
-                  << " grid(s) = " << values_text.str() << " voxels ("
-                  << nimbus::FormatBytes(double(voxels) * double(components) * 4.0)
-                  << "), more than MaximumNumberOfVoxels = " << this->MaximumNumberOfVoxels
-                  << " (all grids of the file together); raise MaximumNumberOfVoxels, select "
-                     "fewer grids or set BoundsGrid");
-    return 0;
+    vtkErrorWithObjectMacro(
+      self, << "refusing to read " << fileName << ": the image would have " << dims.str() << " = "
+            << voxels << " points x " << read.size() << " grid(s) = " << values_text.str()
+            << " voxels (" << nimbus::FormatBytes(double(voxels) * double(components) * 4.0)
+            << "), more than MaximumNumberOfVoxels = " << maximum
+            << " (all grids of the file together); raise MaximumNumberOfVoxels, select "
+               "fewer grids or set BoundsGrid");
+    return false;
   }
-  const double budgetMiB =
-    this->MemoryBudgetMiB > 0.0 ? this->MemoryBudgetMiB : nimbus::DefaultMemoryBudgetMiB();
+  const double budgetMiB = self->GetMemoryBudgetMiB() > 0.0 ? self->GetMemoryBudgetMiB()
+                                                            : nimbus::DefaultMemoryBudgetMiB();
   const double outputBytes = double(voxels) * double(components) * 4.0;
-  const std::string over = nimbus::OverBudgetMessage("reading " + std::string(this->FileName) +
-      " (" + dims.str() + " points, " + std::to_string(components) +
+  const std::string over = nimbus::OverBudgetMessage("reading " + std::string(fileName) + " (" +
+      dims.str() + " points, " + std::to_string(components) +
       " float components in all, plus the largest grid while it is read)",
     outputBytes + double(workBytes), budgetMiB * 1024.0 * 1024.0);
   if (!over.empty())
   {
-    vtkErrorMacro(<< over << "; raise MemoryBudgetMiB, select fewer grids or set BoundsGrid");
-    return 0;
+    vtkErrorWithObjectMacro(
+      self, << over << "; raise MemoryBudgetMiB, select fewer grids or set BoundsGrid");
+    return false;
   }
+  return true;
+}
 
-  // Say what happened to transforms, names, empty grids and unsupported grids.
-  if (!t.Note.empty())
+/// Says what happened to transforms, names, empty grids and unsupported grids.
+void WarnAboutGrids(vtkNimbusOpenVDBReader* self, const std::vector<vdb::GridInfo>& grids,
+  const std::vector<const vdb::GridInfo*>& read, const vdb::GridInfo& reference,
+  const std::string& transformNote)
+{
+  const char* fileName = self->GetFileName();
+  if (!transformNote.empty())
   {
-    vtkWarningMacro(<< "grid " << Quote(plan.Reference->Name) << " of " << this->FileName << ": "
-                    << t.Note);
+    vtkWarningWithObjectMacro(
+      self, << "grid " << Quote(reference.Name) << " of " << fileName << ": " << transformNote);
   }
   std::string unsupported;
   std::map<std::string, std::vector<std::string>> repeated;
-  for (const auto& g : this->Internal->Grids)
+  for (const auto& g : grids)
   {
     if (!g.Supported())
     {
@@ -545,8 +591,9 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   }
   if (!unsupported.empty())
   {
-    vtkWarningMacro(<< "skipped grids of unsupported value type in " << this->FileName << ": "
-                    << unsupported << "; only float, double, Vec3s and Vec3d grids are read");
+    vtkWarningWithObjectMacro(self, << "skipped grids of unsupported value type in " << fileName
+                                    << ": " << unsupported
+                                    << "; only float, double, Vec3s and Vec3d grids are read");
   }
   for (const auto& r : repeated)
   {
@@ -559,39 +606,124 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
       }
       if (r.first.empty())
       {
-        vtkWarningMacro(<< this->FileName << " has " << r.second.size()
-                        << " unnamed grid(s): listed as " << list);
+        vtkWarningWithObjectMacro(self,
+          << fileName << " has " << r.second.size() << " unnamed grid(s): listed as " << list);
       }
       else
       {
-        vtkWarningMacro(<< this->FileName << " has " << r.second.size() << " grids named "
-                        << Quote(r.first) << ": all are listed, as " << list
-                        << " (OpenVDB's names for repeated grids, in file order)");
+        vtkWarningWithObjectMacro(self, << fileName << " has " << r.second.size() << " grids named "
+                                        << Quote(r.first) << ": all are listed, as " << list
+                                        << " (OpenVDB's names for repeated grids, in file order)");
       }
     }
   }
-  for (const auto* g : plan.Read)
+  for (const auto* g : read)
   {
     if (g->ActiveBox.Empty())
     {
-      vtkWarningMacro(<< "grid " << Quote(g->Name)
-                      << " has no active voxels: its array holds the grid's background value");
+      vtkWarningWithObjectMacro(
+        self, << "grid " << Quote(g->Name)
+              << " has no active voxels: its array holds the grid's background value");
     }
+  }
+}
+
+/// Values that are no density: said, with counts (they are read as they are).
+void WarnAboutValues(vtkNimbusOpenVDBReader* self,
+  const std::vector<vtkSmartPointer<vtkFloatArray>>& arrays,
+  const std::vector<const vdb::GridInfo*>& read)
+{
+  for (size_t i = 0; i < arrays.size(); ++i)
+  {
+    nimbus::ValueCensus census = nimbus::TakeCensus(
+      arrays[i]->GetPointer(0), static_cast<std::size_t>(arrays[i]->GetNumberOfValues()));
+    const bool densityLike = arrays[i]->GetNumberOfComponents() == 1 && LooksLikeDensity(*read[i]);
+    if (!densityLike)
+    {
+      census.Negative = 0;
+    }
+    if (!census.AllFiniteNonNegative())
+    {
+      vtkWarningWithObjectMacro(
+        self, << "grid " << Quote(read[i]->Name) << " of " << self->GetFileName() << " has "
+              << nimbus::DescribeCensus(census) << " (of " << arrays[i]->GetNumberOfValues() << ")"
+              << (census.Negative ? "; negative values are no density" : "")
+              << ": they are read as they are; clean them before rendering");
+    }
+  }
+}
+
+/// The arrays read over the file's box `box`, turned into the up frame in place (through a
+/// copy of one array at a time when the voxels are re-indexed).
+void TurnArrays(const vdb::UpTurn& turn, const vdb::IndexBox& box,
+  const std::vector<vtkSmartPointer<vtkFloatArray>>& arrays)
+{
+  if (turn.Identity())
+  {
+    return;
+  }
+  std::vector<float> copy;
+  for (const auto& array : arrays)
+  {
+    float* values = array->GetPointer(0);
+    const int components = array->GetNumberOfComponents();
+    if (turn.Reindexes())
+    {
+      copy.assign(values, values + array->GetNumberOfValues());
+      turn.TurnValues(box, copy.data(), components, values);
+    }
+    else
+    {
+      turn.TurnValues(box, values, components, values);
+    }
+  }
+}
+}
+
+int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
+{
+  Internals& internal = *this->Internal;
+  internal.Refresh(this->FileName);
+  const Internals::Plan plan = internal.MakePlan(this->BoundsGrid, this->FileName);
+  // The image is the file's, turned into the up frame (nothing changes for +Z). Pieces are
+  // pieces of the turned image: only the piece's part of the plan's box is read into the
+  // image (each voxel's value does not depend on the box, so a piece equals the whole image's
+  // crop bit for bit). OpenVDB still reads each selected grid's whole tree from the file.
+  const vdb::UpAxisChoice& up = internal.ChooseUp(this->UpAxis);
+  const vdb::UpTurn turn(up.Axis, plan.Reference->Transform);
+  const vdb::IndexBox turnedBox = internal.PieceBox(turn.TurnBox(plan.Box));
+  const vdb::IndexBox box = turn.FileBox(turnedBox); // the file's index box to read
+  const vdb::TransformInfo turned = turn.TurnTransform(plan.Reference->Transform);
+  if (box.Empty() && !plan.Box.Empty())
+  {
+    // A piece with no point of the image (more pieces than points): an empty image.
+    SetGeometry(output, turned);
+    AddUpAxisSource(output, up.Source);
+    return 1;
+  }
+
+  // Refuse absurd reads before allocating anything: the voxel limit counts every selected
+  // grid's values (points x grids), the memory budget every byte of the read.
+  if (!WithinLimits(this, plan.Read, box, turn.Reindexes()))
+  {
+    return 0;
+  }
+  WarnAboutGrids(this, internal.Grids, plan.Read, *plan.Reference, turned.Note);
+  if (!up.Warning.empty())
+  {
+    vtkWarningMacro(<< this->FileName << ": " << up.Warning);
   }
 
   int extent[6];
   for (int c = 0; c < 3; ++c)
   {
-    extent[2 * c] = static_cast<int>(box.Min[c]);
-    extent[2 * c + 1] = static_cast<int>(box.Max[c]);
+    extent[2 * c] = static_cast<int>(turnedBox.Min[c]);
+    extent[2 * c + 1] = static_cast<int>(turnedBox.Max[c]);
   }
   output->SetExtent(extent);
-  output->SetOrigin(t.Origin.data());
-  output->SetSpacing(t.Spacing.data());
-  double direction[9];
-  RowMajorDirection(t, direction);
-  output->SetDirectionMatrix(direction);
+  SetGeometry(output, turned);
 
+  const uint64_t voxels = box.VoxelCount();
   std::vector<std::string> names;
   std::vector<float*> targets;
   std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
@@ -608,15 +740,13 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
     arrays.push_back(array);
   }
   std::vector<std::string> resampled;
-  vdb::TransformInfo exact = t;
+  vdb::TransformInfo exact = plan.Reference->Transform;
   vdb::ReadDense(
-    this->FileName, names, t, box, targets, &resampled,
+    this->FileName, names, plan.Reference->Transform, box, targets, &resampled,
     [this](double f) { this->UpdateProgress(f); }, &exact);
-  // The transform read with the voxels (bit-exact; see ReadDense).
-  output->SetOrigin(exact.Origin.data());
-  output->SetSpacing(exact.Spacing.data());
-  RowMajorDirection(exact, direction);
-  output->SetDirectionMatrix(direction);
+  TurnArrays(turn, box, arrays);
+  // The transform read with the voxels (bit-exact; see ReadDense), turned.
+  SetGeometry(output, turn.TurnTransform(exact));
   for (const auto& name : resampled)
   {
     vtkWarningMacro(<< "grid " << Quote(name)
@@ -625,25 +755,7 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
                     << ": resampled trilinearly at the image points (values are interpolated; "
                        "read it alone, or set BoundsGrid to it, for its own voxels)");
   }
-  // Values that are no density: said, with counts (they are read as they are).
-  for (size_t i = 0; i < arrays.size(); ++i)
-  {
-    nimbus::ValueCensus census = nimbus::TakeCensus(
-      arrays[i]->GetPointer(0), static_cast<std::size_t>(arrays[i]->GetNumberOfValues()));
-    const bool densityLike =
-      arrays[i]->GetNumberOfComponents() == 1 && LooksLikeDensity(*plan.Read[i]);
-    if (!densityLike)
-    {
-      census.Negative = 0;
-    }
-    if (!census.AllFiniteNonNegative())
-    {
-      vtkWarningMacro(<< "grid " << Quote(plan.Read[i]->Name) << " of " << this->FileName << " has "
-                      << nimbus::DescribeCensus(census) << " (of " << arrays[i]->GetNumberOfValues()
-                      << ")" << (census.Negative ? "; negative values are no density" : "")
-                      << ": they are read as they are; clean them before rendering");
-    }
-  }
+  WarnAboutValues(this, arrays, plan.Read);
   for (size_t i = 0; i < arrays.size(); ++i)
   {
     output->GetPointData()->AddArray(arrays[i]);
@@ -659,7 +771,19 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
       output->GetPointData()->SetActiveVectors(arrays[i]->GetName());
     }
   }
+  AddUpAxisSource(output, up.Source);
   return 1;
+}
+
+int vtkNimbusOpenVDBReader::GetResolvedUpAxis()
+{
+  return this->Internal->UpChosen ? static_cast<int>(this->Internal->UpChoice.Axis)
+                                  : static_cast<int>(nimbus::UpAxis::PositiveZ);
+}
+
+const char* vtkNimbusOpenVDBReader::GetResolvedUpAxisSource()
+{
+  return this->Internal->UpChosen ? this->Internal->UpChoice.Source.c_str() : "";
 }
 
 void vtkNimbusOpenVDBReader::PrintSelf(ostream& os, vtkIndent indent)
@@ -669,6 +793,10 @@ void vtkNimbusOpenVDBReader::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BoundsGrid: " << (this->BoundsGrid ? this->BoundsGrid : "(union)") << "\n";
   os << indent << "MaximumNumberOfVoxels: " << this->MaximumNumberOfVoxels << "\n";
   os << indent << "MemoryBudgetMiB: " << this->MemoryBudgetMiB << "\n";
+  os << indent << "UpAxis: " << this->UpAxis
+     << (this->UpAxis == nimbus::vdb::AutoUpAxis ? " (Auto)" : "") << "\n";
+  os << indent << "ResolvedUpAxis: "
+     << (this->Internal->UpChosen ? this->Internal->UpChoice.Source : "(not read yet)") << "\n";
   os << indent << "Grids:";
   for (int i = 0; i < this->Internal->Selection->GetNumberOfArrays(); ++i)
   {

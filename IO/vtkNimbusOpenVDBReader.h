@@ -30,6 +30,18 @@
  * OpenVDB still reads each selected grid's whole tree from the file. A one-piece request
  * gets the whole image, as before.
  *
+ * Up axis: the output is in Nimbus's z-up frame (x east, y north, z up). UpAxis says which
+ * axis of the file points up: -1 Auto (default: the file's metadata "up_axis" if it has one,
+ * else +Y when its "creator" names Houdini, else +Z), 0 +X, 1 +Y, 2 +Z, 3 -Y. The data is
+ * turned by the rotation R of Physics/UpAxis.h (U = R W): an axis-aligned image is re-indexed
+ * into an axis-aligned image (a y-up Houdini file of extent [0,9]x[0,19]x[0,4] becomes one of
+ * [0,9]x[-4,0]x[0,19], origin (ox, -oz, oy), spacing (sx, sz, sy)); a rotated one gets the
+ * direction R D and origin R o. 3-component grids (velocities) are rotated, v -> R v. +Z is
+ * the file as it is, bit for bit. Pieces are pieces of the turned image. What was decided is
+ * GetResolvedUpAxis(), GetResolvedUpAxisSource() and the output's field-data string array
+ * "nimbus_up_axis_source" ("+Y (creator 'Houdini 20.5.278/GEO_VDBTranslator')"). See
+ * docs/openvdb.md, "Which way is up".
+ *
  * Bad input ends in an error and an empty output, never in a crash or garbage: the file's
  * layout is checked before OpenVDB reads it (a truncated file is reported with the byte
  * where it ends and the byte a grid needs), each grid is read from its own bytes only,
@@ -107,6 +119,24 @@ public:
   vtkGetMacro(MemoryBudgetMiB, double);
   ///@}
 
+  ///@{
+  /// Which axis of the file points up (Physics/UpAxis.h): -1 Auto (default), 0 +X, 1 +Y,
+  /// 2 +Z, 3 -Y. The output is turned so that this axis becomes +z.
+  vtkSetClampMacro(UpAxis, int, -1, 3);
+  vtkGetMacro(UpAxis, int);
+  ///@}
+
+  /// The up axis used for the file (0 +X, 1 +Y, 2 +Z, 3 -Y), after UpdateInformation().
+  int GetResolvedUpAxis();
+  /// Why, in words: "+Y (file metadata up_axis = 'y')", "+Y (creator 'Houdini ...')",
+  /// "+Z (default)", "+X (chosen)"; empty before UpdateInformation() or when the file could
+  /// not be read. The
+  /// output carries the same text as the field-data string array "nimbus_up_axis_source".
+  const char* GetResolvedUpAxisSource();
+
+  /// Name of the output's field-data string array that says which axis was taken as up.
+  static const char* UpAxisSourceArrayName() { return "nimbus_up_axis_source"; }
+
 protected:
   vtkNimbusOpenVDBReader();
   ~vtkNimbusOpenVDBReader() override;
@@ -120,6 +150,7 @@ protected:
   char* BoundsGrid = nullptr;
   vtkIdType MaximumNumberOfVoxels = vtkIdType(512) * 512 * 512;
   double MemoryBudgetMiB;
+  int UpAxis = -1;
 
 private:
   vtkNimbusOpenVDBReader(const vtkNimbusOpenVDBReader&) = delete;

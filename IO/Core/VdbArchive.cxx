@@ -14,6 +14,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <set>
 #include <sys/stat.h>
@@ -151,8 +152,10 @@ private:
 /// A MetaMap (count, then name, type name, byte count and value per entry), every length
 /// checked against `end`. With `checkSizes`, values of registered fixed-size types must
 /// have exactly their type's size (OpenVDB reads sizeof(T) whatever the count says, so a
-/// wrong count would make it read something else than this scan checked).
-void SkipMetaMap(ByteReader& r, const std::string& what, uint64_t end, bool checkSizes)
+/// wrong count would make it read something else than this scan checked). `strings`, when
+/// given, receives the entries of type "string" of at most 4096 bytes.
+void SkipMetaMap(ByteReader& r, const std::string& what, uint64_t end, bool checkSizes,
+  std::map<std::string, std::string>* strings = nullptr)
 {
   const uint32_t count = r.Value<uint32_t>(what);
   // Each entry takes at least 12 bytes (three 32-bit lengths).
@@ -182,7 +185,20 @@ void SkipMetaMap(ByteReader& r, const std::string& what, uint64_t end, bool chec
           " bytes) but says " + std::to_string(bytes) + " bytes");
       }
     }
+    const uint64_t valuePos = r.Pos;
     r.Skip(bytes, what, end);
+    if (strings && type == openvdb::StringMetadata::staticTypeName() && bytes <= 4096)
+    {
+      std::string value(bytes, '\0');
+      const uint64_t after = r.Pos;
+      r.Pos = valuePos;
+      if (bytes > 0)
+      {
+        r.Read(&value[0], bytes, what);
+      }
+      r.Pos = after;
+      (*strings)[name] = value;
+    }
   }
 }
 
@@ -303,7 +319,8 @@ FileLayout ScanFile(const std::string& path)
     r.Read(uuid, 16, header);
   }
   layout.HeaderEnd = static_cast<int64_t>(r.Pos);
-  SkipMetaMap(r, "its header (file metadata)", layout.FileSize, /*checkSizes=*/false);
+  SkipMetaMap(
+    r, "its header (file metadata)", layout.FileSize, /*checkSizes=*/false, &layout.FileStrings);
   const int32_t count = r.Value<int32_t>("its header (grid count)");
   // A descriptor takes at least 3 lengths and 3 offsets: 36 bytes.
   if (count < 0 || uint64_t(count) > (layout.FileSize - r.Pos) / 36)

@@ -17,6 +17,7 @@
 #define NimbusVdbArchive_h
 
 #include <cstdint>
+#include <map>
 #include <streambuf>
 #include <string>
 #include <vector>
@@ -51,6 +52,9 @@ struct FileLayout
   /// Distinct names, one per grid, in file order: the stored name; a repeated name gets
   /// OpenVDB's own "name[1]", "name[2]"...; an unnamed grid is "unnamed" (then "unnamed[1]"...).
   std::vector<std::string> DistinctNames;
+  /// The file-level metadata entries of type "string" (up to 4096 bytes each), as stored:
+  /// e.g. "creator" (Houdini, Nimbus's writer) and "up_axis" (Nimbus's writer).
+  std::map<std::string, std::string> FileStrings;
 };
 
 /// A stream buffer over bytes [base, base + size) of a file held in memory: reads and seeks

@@ -711,11 +711,16 @@ std::string LibraryVersion()
   return openvdb::getLibraryVersionString();
 }
 
-std::vector<GridInfo> ReadFileInfo(const std::string& path)
+std::vector<GridInfo> ReadFileInfo(
+  const std::string& path, std::map<std::string, std::string>* fileStrings)
 {
   Initialize();
   CheckReadable(path);
   const FileLayout layout = ScanFile(path);
+  if (fileStrings)
+  {
+    *fileStrings = layout.FileStrings;
+  }
   CheckInChildProcessUnlessGuarded(path);
   std::vector<GridInfo> result;
   std::string current;
@@ -742,6 +747,11 @@ std::vector<GridInfo> ReadFileInfo(const std::string& path)
       info.Kind = KindOf(*grid);
       info.Components = ComponentsOf(info.Kind);
       info.GridClass = openvdb::GridBase::gridClassToString(grid->getGridClass());
+      if (const auto creator =
+            grid->getMetadata<openvdb::StringMetadata>(openvdb::GridBase::META_GRID_CREATOR))
+      {
+        info.Creator = creator->value();
+      }
       const auto bmin =
         grid->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
       const auto bmax =
@@ -1022,6 +1032,9 @@ uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& f
         : openvdb::io::COMPRESS_ACTIVE_MASK);
     openvdb::MetaMap meta;
     meta.insertMeta("creator", openvdb::StringMetadata("Nimbus vtkNimbusOpenVDBWriter"));
+    // Nimbus's data is z up (x east, y north, z up: Physics/UpAxis.h); the reader's Auto
+    // up axis reads this key first (VdbUpAxis.h), so a written file reads back as it was.
+    meta.insertMeta("up_axis", openvdb::StringMetadata("+Z"));
     std::ostringstream os(std::ios::out | std::ios::binary);
     archive.WriteTo(os, grids, meta);
     if (!os)

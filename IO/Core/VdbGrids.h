@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -107,6 +108,7 @@ struct GridInfo
   bool TreeRead = false;
   std::array<double, 3> Background{ { 0, 0, 0 } };
   TransformInfo Transform;
+  std::string Creator; // the grid's "creator" metadata (empty when it has none)
   bool Supported() const { return Kind != ValueKind::Unsupported; }
 };
 
@@ -114,8 +116,10 @@ struct GridInfo
 /// lacks bounding-box statistics), after ScanFile (VdbArchive.h) has checked the file's
 /// layout. Throws Error for a missing/unreadable file, a file that is not a VDB, a
 /// truncated or corrupt file. Grids of types OpenVDB does not know are listed as
-/// unsupported (ValueType "unknown type '<type name>'").
-std::vector<GridInfo> ReadFileInfo(const std::string& path);
+/// unsupported (ValueType "unknown type '<type name>'"). `fileStrings`, when given, receives
+/// the file-level string metadata (FileLayout::FileStrings: "creator", "up_axis", ...).
+std::vector<GridInfo> ReadFileInfo(
+  const std::string& path, std::map<std::string, std::string>* fileStrings = nullptr);
 
 /// A dense float array over an index box, x fastest (VTK's point order).
 struct DenseField
@@ -162,13 +166,14 @@ struct FieldToWrite
   bool FogVolume = false; // grid class GRID_FOG_VOLUME (density-like, >= 0)
 };
 
-/// Writes the fields as FloatGrid / Vec3SGrid to `path`. The file is serialised in memory,
-/// then written by WriteFileAtomically (VdbArchive.h): temporary file beside the target,
-/// every write checked, fsync, rename; a failure leaves an existing file byte for byte and
-/// the message names the cause. Non-finite values (NaN, +-Inf) and a non-finite background
-/// are refused (OpenVDB's tolerance test would silently make NaN voxels inactive). `compress`
-/// selects Blosc (else no compression beyond OpenVDB's active-mask encoding). Throws Error on
-/// failure. Returns the number of active voxels written.
+/// Writes the fields as FloatGrid / Vec3SGrid to `path`, with the file metadata "creator"
+/// ("Nimbus vtkNimbusOpenVDBWriter") and "up_axis" ("+Z": the fields are z-up Nimbus data). The
+/// file is serialised in memory, then written by WriteFileAtomically (VdbArchive.h): temporary file
+/// beside the target, every write checked, fsync, rename; a failure leaves an existing file byte
+/// for byte and the message names the cause. Non-finite values (NaN, +-Inf) and a non-finite
+/// background are refused (OpenVDB's tolerance test would silently make NaN voxels inactive).
+/// `compress` selects Blosc (else no compression beyond OpenVDB's active-mask encoding). Throws
+/// Error on failure. Returns the number of active voxels written.
 uint64_t WriteFields(const std::string& path, const std::vector<FieldToWrite>& fields,
   bool compress = true, const Progress& progress = nullptr,
   std::vector<std::string>* notes = nullptr, int* errorNumber = nullptr);
