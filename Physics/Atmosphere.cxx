@@ -523,14 +523,43 @@ double DistanceToTopOfAtmosphere(double r, double mu, double topRadius)
   return std::max(-b + std::sqrt(disc), 0.0);
 }
 
+namespace
+{
+// integral_0^d exp(-(h + s c)/H) ds for h >= 0 (the exponential layer alone), in
+// closed form, with the series for |x| < 1e-2.
+double ExponentialLayerLength(double h, double c, double d, double H)
+{
+  const double x = d * c / H;
+  const double factor = std::abs(x) < 1e-2 ? d * (1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0)
+                                           : H * (1.0 - std::exp(-x)) / c;
+  return std::exp(-h / H) * factor;
+}
+}
+
 double FlatLayerOpticalLength(
   double altitudeMetres, double cosZenith, double distanceMetres, double scaleHeightMetres)
 {
-  const double x = distanceMetres * cosZenith / scaleHeightMetres;
-  const double factor = std::abs(x) < 1e-2
-    ? distanceMetres * (1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0)
-    : scaleHeightMetres * (1.0 - std::exp(-x)) / cosZenith;
-  return std::exp(-std::max(altitudeMetres, 0.0) / scaleHeightMetres) * factor;
+  // Below sea level the density is the sea level's (Atmosphere::Density): the path
+  // splits where it crosses h = 0 into a part of density 1 and an exponential part.
+  double below = 0.0;
+  double start = altitudeMetres;
+  double length = distanceMetres;
+  if (altitudeMetres < 0.0)
+  {
+    if (!(cosZenith > 0.0))
+    {
+      return distanceMetres; // never rises above sea level
+    }
+    below = std::min(distanceMetres, -altitudeMetres / cosZenith);
+    start = 0.0;
+    length = distanceMetres - below;
+  }
+  else if (cosZenith < 0.0)
+  {
+    length = std::min(distanceMetres, altitudeMetres / -cosZenith);
+    below = distanceMetres - length;
+  }
+  return below + ExponentialLayerLength(start, cosZenith, length, scaleHeightMetres);
 }
 
 } // namespace nimbus

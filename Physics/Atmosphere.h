@@ -134,8 +134,10 @@ NIMBUSPHYSICS_EXPORT double DistanceToTopOfAtmosphere(double r, double mu, doubl
 
 /// Sea-level-equivalent length [m] of one exponential layer (scale height H) along a
 /// straight ray in a flat atmosphere: integral_0^d exp(-max(h0 + s cosZenith, 0)/H) ds
-/// in closed form, with the density at the start taken at max(h0, 0):
-///   exp(-max(h0, 0)/H) H (1 - exp(-x)) / cosZenith,  x = d cosZenith / H,
+/// in closed form. The density is constant (1) below sea level, as in
+/// Atmosphere::Density, so the path splits where it crosses h = 0: the part below
+/// counts its length, the part above from altitude h >= 0 is
+///   exp(-h/H) H (1 - exp(-x)) / cosZenith,  x = l cosZenith / H (l its length),
 /// and its series d (1 - x/2 + x^2/6 - x^3/24) for |x| < 1e-2 (truncation error
 /// below 1e-10 relative; no cancellation of 1 - exp(-x) in float either). The GPU
 /// mapper's per-pixel view transmittance (000 Eq. 6 in closed form); its error

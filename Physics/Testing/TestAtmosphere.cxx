@@ -352,6 +352,38 @@ TEST(Atmosphere, FlatLayerOpticalLengthAgainstSphericalEarth)
   EXPECT_LT(worst, 0.05); // measured 3.0e-2, the longest path at the lowest elevation
 }
 
+// Below sea level the density is the sea level's (Atmosphere::Density): the closed
+// form splits the path at h = 0. Against a fine midpoint sum of the clamped profile,
+// for eyes below and above sea level, rays up, down and level.
+TEST(Atmosphere, FlatLayerOpticalLengthBelowSeaLevel)
+{
+  double worst = 0.0;
+  for (double altitude : { -3000.0, -500.0, -1.0, 0.0, 300.0, 2000.0 })
+  {
+    for (double cosZenith : { -1.0, -0.3, -0.01, -1e-7, 0.0, 1e-7, 0.01, 0.3, 1.0 })
+    {
+      for (double distance : { 50.0, 2000.0, 20000.0 })
+      {
+        const double scaleHeight = 1200.0;
+        const int n = 200000;
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i)
+        {
+          const double h = altitude + (i + 0.5) * distance / n * cosZenith;
+          sum += std::exp(-std::max(h, 0.0) / scaleHeight) * distance / n;
+        }
+        const double flat =
+          nimbus::FlatLayerOpticalLength(altitude, cosZenith, distance, scaleHeight);
+        ASSERT_TRUE(std::isfinite(flat));
+        worst = std::max(worst, std::abs(flat - sum) / sum);
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-6); // the midpoint sum's own error at the kink: < 1e-7
+  // Entirely below sea level: the length itself.
+  EXPECT_DOUBLE_EQ(nimbus::FlatLayerOpticalLength(-100.0, -0.5, 700.0, 8000.0), 700.0);
+}
+
 // Angstrom exponent, ozone and turbidity (Atmosphere.h): the published relations.
 TEST(Atmosphere, AngstromOzoneAndTurbidity)
 {

@@ -27,7 +27,9 @@
 #include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
+#include "CloudInputImage.h"
 #include "NimbusCompositingOrder.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
 #include <cmath>
@@ -124,10 +126,116 @@ int vtkNimbusCloudRepresentation::ProcessViewRequest(
   return 1;
 }
 
+int vtkNimbusCloudRepresentation::FillInputPortInformation(int port, vtkInformation* info)
+{
+  this->Superclass::FillInputPortInformation(port, info);
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataSet");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkCompositeDataSet");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// The superclass's data cache, from the prepared image; under MPI (more than one
+// process) also the distributed cloud's shared view of itself.
 int vtkNimbusCloudRepresentation::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  const int result = this->Superclass::RequestData(request, inputVector, outputVector);
+  vtkSmartPointer<vtkDataObject> prepared;
+  try
+  {
+    prepared = this->PrepareCloudImage(inputVector[0]);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro("Cloud: " << error.what() << " The cloud is not drawn.");
+    prepared = vtkSmartPointer<vtkImageData>::New(); // an empty image: nothing drawn
+  }
+  int result = 0;
+  if (prepared && inputVector[0]->GetNumberOfInformationObjects() == 1)
+  {
+    // The superclass reads the image and its whole extent from the input's
+    // information: the same information with the prepared image in it.
+    vtkNew<vtkInformationVector> substitute;
+    vtkNew<vtkInformation> info;
+    info->Copy(inputVector[0]->GetInformationObject(0));
+    info->Set(vtkDataObject::DATA_OBJECT(), prepared);
+    if (auto* image = vtkImageData::SafeDownCast(prepared))
+    {
+      if (this->Resampled || this->DensityUnits != 0)
+      {
+        info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), image->GetExtent(), 6);
+      }
+    }
+    substitute->Append(info);
+    vtkInformationVector* inputs[1] = { substitute };
+    result = this->Superclass::RequestData(request, inputs, outputVector);
+  }
+  else
+  {
+    result = this->Superclass::RequestData(request, inputVector, outputVector);
+  }
+  this->ShareDistributedView();
+  return result;
+}
+
+//------------------------------------------------------------------------------
+vtkSmartPointer<vtkDataObject> vtkNimbusCloudRepresentation::PrepareCloudImage(
+  vtkInformationVector* input)
+{
+  this->Resampled = false;
+  this->ResampledFromCells = false;
+  this->EstimatedExtinctionPerDensity = 0.0;
+  vtkDataObject* data =
+    input->GetNumberOfInformationObjects() == 1 ? vtkDataObject::GetData(input, 0) : nullptr;
+  if (!data)
+  {
+    return nullptr;
+  }
+  nimbus::CloudInputSettings settings;
+  std::copy(this->SamplingDimensions, this->SamplingDimensions + 3, settings.SamplingDimensions);
+  settings.MemoryBudgetBytes = this->ResampleMemoryBudgetMiB * 1024.0 * 1024.0;
+  settings.Units = this->DensityUnits;
+  settings.Optics.Size = static_cast<nimbus::DropletSize>(this->DropletSize);
+  settings.Optics.EffectiveRadiusMicrometres = this->DropletEffectiveRadiusMicrometres;
+  settings.Optics.NumberConcentrationPerCubicCentimetre =
+    this->DropletNumberConcentrationPerCubicCentimetre;
+  settings.AirDensityArray = this->AirDensityArray;
+  settings.TargetOpticalThickness = this->TargetOpticalThickness;
+  settings.Up = static_cast<nimbus::UpAxis>(this->CloudMapper->GetUpAxis());
+  settings.MetresPerUnit = this->CloudMapper->GetMetresPerUnit();
+  settings.SceneAltitudeMetres = this->CloudMapper->GetSceneAltitudeMetres();
+
+  bool resampled = false;
+  vtkSmartPointer<vtkImageData> image = nimbus::CloudImageOf(data, settings, resampled);
+  this->Resampled = resampled;
+  vtkInformation* info = this->GetInputArrayInformation(0);
+  const char* name = info && info->Has(vtkDataObject::FIELD_NAME())
+    ? info->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  bool cellData = info && info->Has(vtkDataObject::FIELD_ASSOCIATION()) &&
+    info->Get(vtkDataObject::FIELD_ASSOCIATION()) == vtkDataObject::FIELD_ASSOCIATION_CELLS;
+  if (resampled && cellData)
+  {
+    // The resampled image holds every array as point data.
+    this->ResampledFromCells = true;
+    cellData = false;
+  }
+  if (this->DensityUnits != 0 && name && name[0] && image->GetNumberOfPoints() > 0)
+  {
+    double estimate = 0.0;
+    image = nimbus::WithExtinction(image, name, cellData, settings, estimate);
+    this->EstimatedExtinctionPerDensity = estimate;
+  }
+  this->CloudMapper->SetExtinctionPerDensity(
+    this->DensityUnits != 0 ? 1.0 : this->UserExtinctionPerDensity);
+  return image;
+}
+
+//------------------------------------------------------------------------------
+// Every rank's piece bounds and a coarse copy of the whole density, summed over the
+// ranks (collective: every rank of the data server executes it).
+void vtkNimbusCloudRepresentation::ShareDistributedView()
+{
   for (int c = 0; c < 6; ++c)
   {
     this->WholeBounds[c] = (c % 2) ? -1.0 : 1.0;
@@ -136,7 +244,7 @@ int vtkNimbusCloudRepresentation::RequestData(
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   if (!controller || controller->GetNumberOfProcesses() < 2)
   {
-    return result;
+    return;
   }
   // Every rank takes part in both collectives below, with or without a piece.
   vtkImageData* piece = vtkImageData::SafeDownCast(this->Cache);
@@ -194,7 +302,7 @@ int vtkNimbusCloudRepresentation::RequestData(
   }
   if (!whole.IsValid() || !(spacing[0] > 0.0 && spacing[1] > 0.0 && spacing[2] > 0.0))
   {
-    return result;
+    return;
   }
   whole.GetBounds(this->WholeBounds);
   // The coarse lattice: the whole box, every `step` data points, at most
@@ -258,7 +366,7 @@ int vtkNimbusCloudRepresentation::RequestData(
   this->CoarseDensity->SetSpacing(coarseSpacing);
   this->CoarseDensity->SetDimensions(dims);
   this->CoarseDensity->GetPointData()->SetScalars(values);
-  return result;
+  return;
 }
 
 void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
@@ -345,6 +453,10 @@ void vtkNimbusCloudRepresentation::UpdateMapperParameters()
     this->CloudMapper->SetScalarModeToDefault();
     this->Actor->SetVisibility(this->GetVisibility());
   }
+  else if (this->ResampledFromCells)
+  {
+    this->CloudMapper->SetScalarModeToUsePointFieldData();
+  }
 }
 
 // Setters forward to the mapper without MarkModified(): the mapper's own
@@ -360,7 +472,6 @@ void vtkNimbusCloudRepresentation::UpdateMapperParameters()
     return this->CloudMapper->Get##name();                                                         \
   }
 
-NIMBUS_FORWARD(ExtinctionPerDensity, double)
 NIMBUS_FORWARD(Albedo, double)
 NIMBUS_FORWARD(CloudG, double)
 NIMBUS_FORWARD(TemperatureEmission, bool)
@@ -387,9 +498,9 @@ NIMBUS_FORWARD(SunTemperatureKelvin, double)
 NIMBUS_FORWARD(Atmosphere, bool)
 NIMBUS_FORWARD(MieG, double)
 NIMBUS_FORWARD(RayleighScatteringPerMetre, double)
-NIMBUS_FORWARD(SceneAltitudeMetres, double)
 NIMBUS_FORWARD(Ground, bool)
 NIMBUS_FORWARD(GroundHeight, double)
+NIMBUS_FORWARD(GroundBelowData, bool)
 NIMBUS_FORWARD(GroundAlbedo, double)
 NIMBUS_FORWARD(Shafts, bool)
 NIMBUS_FORWARD(AirMultipleScattering, bool)
@@ -401,13 +512,154 @@ NIMBUS_FORWARD(AtmosphereSteps, int)
 NIMBUS_FORWARD(SliceJitter, bool)
 NIMBUS_FORWARD(MaximumTextureSize, int)
 NIMBUS_FORWARD(TextureMemoryBudgetMiB, double)
-NIMBUS_FORWARD(MetresPerUnit, double)
 NIMBUS_FORWARD(Exposure, double)
 NIMBUS_FORWARD(EncodeSrgb, bool)
 NIMBUS_FORWARD(FrameBudgetMilliseconds, double)
 NIMBUS_FORWARD(Quality, double)
 
 #undef NIMBUS_FORWARD
+
+// The units' conversion depends on the frame: the mixing ratio's standard
+// atmosphere (altitudes) and the estimate (column lengths in metres).
+bool vtkNimbusCloudRepresentation::UnitsDependOnFrame() const
+{
+  return (this->DensityUnits == static_cast<int>(nimbus::DensityUnits::LiquidWaterMixingRatio) &&
+           this->AirDensityArray.empty()) ||
+    this->DensityUnits == nimbus::kEstimatedDensityUnits;
+}
+
+void vtkNimbusCloudRepresentation::SetExtinctionPerDensity(double value)
+{
+  this->CloudMapper->SetExtinctionPerDensity(value); // refuses NaN, clamps
+  this->UserExtinctionPerDensity = this->CloudMapper->GetExtinctionPerDensity();
+  if (this->DensityUnits != 0)
+  {
+    this->CloudMapper->SetExtinctionPerDensity(1.0); // the array is extinction already
+  }
+}
+
+double vtkNimbusCloudRepresentation::GetExtinctionPerDensity()
+{
+  return this->UserExtinctionPerDensity;
+}
+
+void vtkNimbusCloudRepresentation::SetMetresPerUnit(double value)
+{
+  const double before = this->CloudMapper->GetMetresPerUnit();
+  this->CloudMapper->SetMetresPerUnit(value);
+  if (this->CloudMapper->GetMetresPerUnit() != before && this->UnitsDependOnFrame())
+  {
+    this->MarkModified();
+  }
+}
+
+double vtkNimbusCloudRepresentation::GetMetresPerUnit()
+{
+  return this->CloudMapper->GetMetresPerUnit();
+}
+
+void vtkNimbusCloudRepresentation::SetSceneAltitudeMetres(double value)
+{
+  const double before = this->CloudMapper->GetSceneAltitudeMetres();
+  this->CloudMapper->SetSceneAltitudeMetres(value);
+  if (this->CloudMapper->GetSceneAltitudeMetres() != before && this->UnitsDependOnFrame())
+  {
+    this->MarkModified();
+  }
+}
+
+double vtkNimbusCloudRepresentation::GetSceneAltitudeMetres()
+{
+  return this->CloudMapper->GetSceneAltitudeMetres();
+}
+
+void vtkNimbusCloudRepresentation::SetUpAxis(int value)
+{
+  const int before = this->CloudMapper->GetUpAxis();
+  this->CloudMapper->SetUpAxis(value); // refuses values that are not an axis
+  if (this->CloudMapper->GetUpAxis() != before && this->UnitsDependOnFrame())
+  {
+    this->MarkModified();
+  }
+}
+
+int vtkNimbusCloudRepresentation::GetUpAxis()
+{
+  return this->CloudMapper->GetUpAxis();
+}
+
+void vtkNimbusCloudRepresentation::SetDensityUnits(int value)
+{
+  if (!nimbus::IsDensityUnits(value) && value != nimbus::kEstimatedDensityUnits)
+  {
+    vtkErrorMacro("SetDensityUnits(" << value << "): not a choice of units (0 to "
+                                     << nimbus::kEstimatedDensityUnits << "); the units stay "
+                                     << this->DensityUnits);
+    return;
+  }
+  if (value != this->DensityUnits)
+  {
+    this->DensityUnits = value;
+    this->MarkModified();
+  }
+}
+
+void vtkNimbusCloudRepresentation::SetDropletSize(int value)
+{
+  if (!nimbus::IsDropletSize(value))
+  {
+    vtkErrorMacro(
+      "SetDropletSize(" << value << "): 0 (effective radius) or 1 (number concentration)");
+    return;
+  }
+  if (value != this->DropletSize)
+  {
+    this->DropletSize = value;
+    this->MarkModified();
+  }
+}
+
+// The optics' numbers: NaN and infinity refused (CheckCloudOptics refuses the rest
+// with a message at the next execution).
+#define NIMBUS_OPTICS_SETTER(name)                                                                 \
+  void vtkNimbusCloudRepresentation::Set##name(double value)                                       \
+  {                                                                                                \
+    if (!std::isfinite(value))                                                                     \
+    {                                                                                              \
+      vtkErrorMacro("Set" #name "(" << value << "): not a finite number; ignored");                \
+      return;                                                                                      \
+    }                                                                                              \
+    if (value != this->name)                                                                       \
+    {                                                                                              \
+      this->name = value;                                                                          \
+      this->MarkModified();                                                                        \
+    }                                                                                              \
+  }
+NIMBUS_OPTICS_SETTER(DropletEffectiveRadiusMicrometres)
+NIMBUS_OPTICS_SETTER(DropletNumberConcentrationPerCubicCentimetre)
+NIMBUS_OPTICS_SETTER(TargetOpticalThickness)
+NIMBUS_OPTICS_SETTER(ResampleMemoryBudgetMiB)
+#undef NIMBUS_OPTICS_SETTER
+
+void vtkNimbusCloudRepresentation::SetAirDensityArray(const char* name)
+{
+  const std::string value = name ? name : "";
+  if (value != this->AirDensityArray)
+  {
+    this->AirDensityArray = value;
+    this->MarkModified();
+  }
+}
+
+void vtkNimbusCloudRepresentation::SetSamplingDimensions(int x, int y, int z)
+{
+  const int dims[3] = { std::max(x, 1), std::max(y, 1), std::max(z, 1) };
+  if (!std::equal(dims, dims + 3, this->SamplingDimensions))
+  {
+    std::copy(dims, dims + 3, this->SamplingDimensions);
+    this->MarkModified();
+  }
+}
 
 void vtkNimbusCloudRepresentation::SetEmissionTemperatureArray(const char* name)
 {
@@ -423,6 +675,18 @@ void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Turbidity: " << this->Turbidity << "\n";
+  os << indent << "DensityUnits: " << this->DensityUnits << " (extinction per density "
+     << this->UserExtinctionPerDensity << " 1/m; estimated " << this->EstimatedExtinctionPerDensity
+     << " 1/m per unit)\n";
+  os << indent << "DropletSize: " << this->DropletSize << ", effective radius "
+     << this->DropletEffectiveRadiusMicrometres << " um, number concentration "
+     << this->DropletNumberConcentrationPerCubicCentimetre << " /cm^3\n";
+  os << indent << "AirDensityArray: '" << this->AirDensityArray << "'\n";
+  os << indent << "TargetOpticalThickness: " << this->TargetOpticalThickness << "\n";
+  os << indent << "SamplingDimensions: " << this->SamplingDimensions[0] << " "
+     << this->SamplingDimensions[1] << " " << this->SamplingDimensions[2]
+     << " (resampled: " << this->Resampled << ")\n";
+  os << indent << "ResampleMemoryBudgetMiB: " << this->ResampleMemoryBudgetMiB << "\n";
   os << indent
      << "MieScatteringPerMetre (override, -1 = from Turbidity): " << this->MieScatteringOverride
      << "\n";

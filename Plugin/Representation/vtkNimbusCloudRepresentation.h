@@ -2,12 +2,20 @@
  * @class   vtkNimbusCloudRepresentation
  * @brief   ParaView volume representation that renders image data as a cloud.
  *
- * The "Cloud" representation type of image data in ParaView: ParaView's own
+ * The "Cloud" representation type in ParaView: ParaView's own
  * vtkImageVolumeRepresentation (data delivery, outline LOD, scalar array
  * selection through ColorArrayName) with its volume mapper replaced by
  * vtkNimbusCloudVolumeMapper (shadow-view slices, paper 000). The selected
  * point or cell array is the cloud density; the colour and opacity transfer
  * functions are not used.
+ *
+ * Any grid: image data goes to the mapper as it is; rectilinear, structured and
+ * unstructured grids, AMR and multiblock data are first resampled to an image of
+ * SamplingDimensions points over their bounds (as ParaView's Volume resamples), the
+ * memory checked first (ResampleMemoryBudgetMiB). Any units: DensityUnits says what
+ * the array's values are (Physics/CloudOptics.h); other than a dimensionless density
+ * the array is turned into extinction (1/m) before the mapper sees it
+ * (CloudInputImage.h), and ExtinctionPerDensity is not used.
  *
  * The cloud, multiple-scattering, sun, atmosphere, ground and quality
  * parameters are forwarded to the mapper as they are set (see
@@ -22,6 +30,8 @@
 #include "NimbusCloudRepresentationModule.h" // for export macro
 #include "vtkImageVolumeRepresentation.h"
 #include "vtkSmartPointer.h" // for vtkSmartPointer
+
+#include <string> // for std::string
 
 class vtkImageData;
 class vtkNimbusCloudVolumeMapper;
@@ -46,8 +56,57 @@ public:
     vtkInformation* outInfo) override;
 
   ///@{
-  /// Cloud optics: extinction per unit density [1/m], single-scattering albedo,
-  /// Cornette-Shanks g of the cloud, k_multi (000 Eq. 1).
+  /// What the density array's values mean (nimbus::DensityUnits, and 5: a typical
+  /// cloud, estimated): 0 a dimensionless density times ExtinctionPerDensity
+  /// (default), 1 extinction [1/m], 2 liquid water content [g/m^3], 3 liquid water
+  /// mixing ratio [kg/kg] with the air's density (AirDensityArray [kg/m^3], or the
+  /// U.S. Standard Atmosphere 1976 at each sample's altitude: SceneAltitudeMetres +
+  /// up-axis height x MetresPerUnit), 4 ice water content [g/m^3], 5 scaled so that
+  /// the cloud's median vertical optical thickness is TargetOpticalThickness
+  /// (GetEstimatedExtinctionPerDensity says the scale found). Water contents take the
+  /// droplet size from DropletSize: 0 the effective radius [um], 1 the droplet number
+  /// concentration [1/cm^3] (liquid only). A change re-executes the representation.
+  void SetDensityUnits(int value);
+  vtkGetMacro(DensityUnits, int);
+  void SetDropletSize(int value);
+  vtkGetMacro(DropletSize, int);
+  void SetDropletEffectiveRadiusMicrometres(double value);
+  vtkGetMacro(DropletEffectiveRadiusMicrometres, double);
+  void SetDropletNumberConcentrationPerCubicCentimetre(double value);
+  vtkGetMacro(DropletNumberConcentrationPerCubicCentimetre, double);
+  void SetAirDensityArray(const char* name);
+  const char* GetAirDensityArray() { return this->AirDensityArray.c_str(); }
+  void SetTargetOpticalThickness(double value);
+  vtkGetMacro(TargetOpticalThickness, double);
+  /// The scale the estimated units found at the last execution [1/m per unit value].
+  vtkGetMacro(EstimatedExtinctionPerDensity, double);
+  ///@}
+
+  ///@{
+  /// Non-image data: the resampled image's points per axis (default 128^3) and the
+  /// memory budget of the resampled image [MiB; 0: half of the physical memory],
+  /// checked before it is allocated. A change re-executes the representation.
+  void SetSamplingDimensions(int x, int y, int z);
+  vtkGetVector3Macro(SamplingDimensions, int);
+  void SetResampleMemoryBudgetMiB(double value);
+  vtkGetMacro(ResampleMemoryBudgetMiB, double);
+  /// Whether the last execution resampled its input.
+  vtkGetMacro(Resampled, bool);
+  ///@}
+
+  ///@{
+  /// Which axis of the data points up (0 +X, 1 +Y, 2 +Z, 3 -Y): the sun, the sky, the
+  /// ground and the air turn about it (vtkNimbusCloudVolumeMapper::SetUpAxis).
+  void SetUpAxis(int value);
+  int GetUpAxis();
+  /// The ground never above the data's lowest point (default on).
+  void SetGroundBelowData(bool value);
+  bool GetGroundBelowData();
+  ///@}
+
+  ///@{
+  /// Cloud optics: extinction per unit density [1/m] (dimensionless units only), single-scattering
+  /// albedo, Cornette-Shanks g of the cloud, k_multi (000 Eq. 1).
   void SetExtinctionPerDensity(double value);
   double GetExtinctionPerDensity();
   void SetAlbedo(double value);
@@ -194,7 +253,9 @@ public:
   ///@}
 
   ///@{
-  /// Metres per world unit; framebuffer = Exposure * radiance; sRGB encoding.
+  /// Metres per world unit (also the altitudes of the mixing ratio's air and the
+  /// estimate's column lengths: a change re-executes then); framebuffer = Exposure *
+  /// radiance; sRGB encoding.
   void SetMetresPerUnit(double value);
   double GetMetresPerUnit();
   void SetExposure(double value);
@@ -206,6 +267,21 @@ public:
 protected:
   vtkNimbusCloudRepresentation();
   ~vtkNimbusCloudRepresentation() override;
+
+  /// Images as the superclass; any other data set or composite data set too (it is
+  /// resampled to an image).
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+
+  /// The input as the mapper's image: resampled when it is not an image, its density
+  /// turned into extinction when DensityUnits says what it is. Null when there is no
+  /// input on this process; throws std::runtime_error with a message for the user.
+  vtkSmartPointer<vtkDataObject> PrepareCloudImage(vtkInformationVector* input);
+
+  /// The distributed cloud's shared view of itself (see RequestData).
+  void ShareDistributedView();
+
+  /// Whether the units' conversion depends on the frame (altitudes, column lengths).
+  bool UnitsDependOnFrame() const;
 
   /// The superclass's array selection and actor set-up; nothing that needs
   /// ParaView's own mappers.
@@ -233,6 +309,19 @@ protected:
 
   /// Owned through the superclass's VolumeMapper.
   vtkNimbusCloudVolumeMapper* CloudMapper = nullptr;
+
+  int DensityUnits = 0;
+  int DropletSize = 0;
+  double DropletEffectiveRadiusMicrometres = 10.0;
+  double DropletNumberConcentrationPerCubicCentimetre = 100.0;
+  std::string AirDensityArray;
+  double TargetOpticalThickness = 20.0;
+  double EstimatedExtinctionPerDensity = 0.0;
+  double UserExtinctionPerDensity = 0.02; // the mapper's default
+  int SamplingDimensions[3] = { 128, 128, 128 };
+  double ResampleMemoryBudgetMiB = 0.0;
+  bool Resampled = false;
+  bool ResampledFromCells = false;
 
   /// The haze's two settings and the mapper's value from them.
   void ApplyHaze();

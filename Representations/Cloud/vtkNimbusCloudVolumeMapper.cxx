@@ -13,6 +13,7 @@
 #include "MultipleScatteringTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
+#include "UpAxis.h"
 
 #include "ShaderLibrary.h"
 #include "svsCommon.h"
@@ -246,10 +247,11 @@ struct FrameSettings
 {
   nimbus::SunParameters Sun;
   nimbus::SceneAtmosphere Air;
-  double GroundHeight;    // world units
-  double GroundAlbedo;    // dimensionless
-  double MetresPerUnit;   // metres per world unit
-  double DisplayScale[3]; // per channel
+  double GroundHeight; // height along the up axis (up-frame z), world units
+  nimbus::UpAxis Up = nimbus::UpAxis::PositiveZ; // which axis of the world is up
+  double GroundAlbedo;                           // dimensionless
+  double MetresPerUnit;                          // metres per world unit
+  double DisplayScale[3];                        // per channel
   bool EncodeSrgb;
   bool OverSky;
 };
@@ -260,6 +262,7 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   vtkOpenGLRenderWindow* Window = nullptr;
   vtkOpenGLState* State = nullptr;
   vtkCamera* Camera = nullptr;
+  std::array<double, 3> Eye{}; // the camera's position in the up frame
   FrameSettings Settings;
   bool Atmosphere = false;     // the atmosphere is drawn (Atmosphere, not Unlit)
   bool Ground = false;         // the ground is drawn (Ground, not Unlit)
@@ -415,6 +418,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   bool LastBackToFront = false;
   bool LastOverSky = false;
   double LastSunElevationDegrees = 0.0;
+  double LastGroundHeight = 0.0;
   // The error of the last frame that failed: the same error is not repeated every
   // frame, only after a frame that worked or another error.
   std::string LastFrameError;
@@ -727,7 +731,7 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
       static_cast<double>(frame.SceneDepthHash & 0xffffffffu) });
   key.insert(key.end(), frame.WorldToNdc->GetData(), frame.WorldToNdc->GetData() + 16);
   key.insert(key.end(), frame.DataToWorld->GetData(), frame.DataToWorld->GetData() + 16);
-  key.insert(key.end(), frame.Camera->GetPosition(), frame.Camera->GetPosition() + 3);
+  key.insert(key.end(), frame.Eye.begin(), frame.Eye.end());
   key.insert(key.end(), frame.ClippingRange.begin(), frame.ClippingRange.end());
   return key;
 }
@@ -856,6 +860,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
   settings.Air.MieG = this->MieG;
   settings.Air.SceneAltitudeMetres = this->SceneAltitudeMetres;
   settings.GroundHeight = this->GroundHeight;
+  settings.Up = static_cast<nimbus::UpAxis>(this->UpAxis);
   settings.GroundAlbedo = this->GroundAlbedo;
   settings.MetresPerUnit = this->MetresPerUnit;
   std::fill(settings.DisplayScale, settings.DisplayScale + 3, this->Exposure);
@@ -882,9 +887,20 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
     settings.MetresPerUnit = sky->GetMetresPerUnit();
     settings.GroundHeight = -sky->GetSceneAltitudeMetres() / sky->GetMetresPerUnit(); // sea level
     settings.GroundAlbedo = sky->GetGroundAlbedo();
+    settings.Up = static_cast<nimbus::UpAxis>(sky->GetUpAxis());
     sky->GetDisplayScale(settings.DisplayScale);
     settings.EncodeSrgb = true; // the sky background is sRGB-encoded
     settings.OverSky = true;
+  }
+  if (this->Internal->ExternalDensity && settings.Up != nimbus::UpAxis::PositiveZ)
+  {
+    // The other pieces' coarse density and shadow are kept in world axes.
+    this->ReportFrameError(
+      "A distributed cloud (pieces on several ranks) is drawn with +Z up only; "
+      "the up axis is " +
+      nimbus::UpAxisName(settings.Up) +
+      ": turn the data instead (the OpenVDB reader's Up Axis, or ParaView's Transform).");
+    return false;
   }
   frame.Atmosphere = this->Atmosphere && !this->Unlit;
   frame.Ground = this->Ground && !this->Unlit;
@@ -896,8 +912,33 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameSettings(FrameState& frame)
 }
 
 //------------------------------------------------------------------------------
-// Sun, view, slice axis and planes, the box corners and the shadow frame in world
-// coordinates, and the matrices of the shared uniforms. False for an empty viewport.
+namespace
+{
+// R of Physics/UpAxis.h as a 4x4 matrix (world -> up frame).
+void UpFrameMatrix(nimbus::UpAxis up, vtkMatrix4x4* m)
+{
+  const auto r = nimbus::WorldToUpFrame(up);
+  m->Identity();
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      m->SetElement(i, j, r[i][j]);
+    }
+  }
+}
+
+std::array<double, 3> ToUp(nimbus::UpAxis up, const double world[3])
+{
+  return nimbus::ToUpFrame(up, { { world[0], world[1], world[2] } });
+}
+}
+
+//------------------------------------------------------------------------------
+// Sun, view, slice axis and planes, the box corners and the shadow frame in the up
+// frame (world coordinates turned so that the chosen up axis is +z: every pass works
+// there, with the sun, the air and the ground of Physics/), and the matrices of the
+// shared uniforms. False for an empty viewport.
 bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   vtkRenderer* renderer, vtkVolume* volume, FrameState& frame)
 {
@@ -912,9 +953,16 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   this->ChooseFrameLevel(renderer, frame);
   frame.ToSun =
     nimbus::SunDirection(frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees);
-  double projection[3];
-  camera->GetDirectionOfProjection(projection);
-  const double* eye = camera->GetPosition();
+  const nimbus::UpAxis up = frame.Settings.Up;
+  vtkNew<vtkMatrix4x4> worldToUp;
+  UpFrameMatrix(up, worldToUp);
+  double worldProjection[3];
+  camera->GetDirectionOfProjection(worldProjection);
+  const double* worldEye = camera->GetPosition();
+  frame.Eye = ToUp(up, worldEye);
+  const std::array<double, 3> projectionUp = ToUp(up, worldProjection);
+  const double* projection = projectionUp.data();
+  const double* eye = frame.Eye.data();
   const double* clipping = camera->GetClippingRange();
   if (!AllFinite(eye, 3) || !AllFinite(projection, 3) || !AllFinite(clipping, 2) ||
     !(clipping[0] > 0.0 && clipping[1] > clipping[0]))
@@ -933,11 +981,12 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   // Data -> world: the volume's matrix times the image's direction matrix about its
   // origin (VTK 9.2: point = origin + D (index * spacing); the density box is in
   // the unrotated frame origin + index * spacing).
-  vtkNew<vtkMatrix4x4> dataToWorld;
-  if (!this->ComputeDataToWorld(volume, dataToWorld))
+  vtkNew<vtkMatrix4x4> dataToWorld, volumeToWorld;
+  if (!this->ComputeDataToWorld(volume, volumeToWorld))
   {
     return false;
   }
+  vtkMatrix4x4::Multiply4x4(worldToUp, volumeToWorld, dataToWorld);
   frame.DataToWorld->DeepCopy(dataToWorld);
   const double* boxOrigin = density.GetBoxOrigin();
   const double* boxSize = density.GetBoxSize();
@@ -959,7 +1008,8 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
     std::vector<nimbus::Vector3> whole;
     for (int c = 0; c < 8; ++c)
     {
-      whole.push_back({ { sb[(c & 1) ? 1 : 0], sb[(c & 2) ? 3 : 2], sb[(c & 4) ? 5 : 4] } });
+      const double corner[3] = { sb[(c & 1) ? 1 : 0], sb[(c & 2) ? 3 : 2], sb[(c & 4) ? 5 : 4] };
+      whole.push_back(ToUp(up, corner));
     }
     const std::array<double, 2> wholeRange = nimbus::ProjectedRange(whole, frame.Axis.Normal);
     const nimbus::SlicePlanes all = nimbus::MakeSlicePlanes(
@@ -991,6 +1041,7 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
       nimbus::MakeSlicePlanes(range[0], std::max(range[1], range[0] + 1e-9), frame.Level.Slices);
     frame.FirstPlaneOffset = frame.Planes.Offsets.front();
   }
+  this->PlaceGroundBelowData(frame);
   frame.Shadow = nimbus::ComputeShadowFrame(frame.Corners, frame.ToSun, 0.02);
   frame.SunStepMetres = frame.Planes.Spacing / frame.Axis.SunCosine * frame.Settings.MetresPerUnit;
 
@@ -1012,7 +1063,12 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   frame.WorldToBox = ColumnMajor(worldToBox);
 
   const double aspect = static_cast<double>(frame.Width) / frame.Height;
-  frame.WorldToNdc->DeepCopy(camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1));
+  // World -> NDC of the camera, after up -> world (R^T): the passes' points are in
+  // the up frame.
+  vtkNew<vtkMatrix4x4> upToWorld;
+  vtkMatrix4x4::Transpose(worldToUp, upToWorld);
+  vtkMatrix4x4::Multiply4x4(
+    camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1), upToWorld, frame.WorldToNdc);
   vtkNew<vtkMatrix4x4> inverseViewProjection;
   inverseViewProjection->DeepCopy(frame.WorldToNdc);
   inverseViewProjection->Invert();
@@ -1037,8 +1093,10 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   frame.InverseViewProjectionFromEye = ColumnMajor(eyeToNdc);
   // The eye's forward axis: minus the third row of the view matrix.
   vtkMatrix4x4* viewMatrix = camera->GetViewTransformMatrix();
-  const double forward[3] = { -viewMatrix->GetElement(2, 0), -viewMatrix->GetElement(2, 1),
+  const double worldForward[3] = { -viewMatrix->GetElement(2, 0), -viewMatrix->GetElement(2, 1),
     -viewMatrix->GetElement(2, 2) };
+  const std::array<double, 3> forwardUp = ToUp(up, worldForward);
+  const double* forward = forwardUp.data();
   const double length =
     std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
   for (int k = 0; k < 3; ++k)
@@ -1047,6 +1105,58 @@ bool vtkNimbusCloudVolumeMapper::ComputeFrameGeometry(
   }
   frame.ClippingRange = { { static_cast<float>(clipping[0]), static_cast<float>(clipping[1]) } };
   return true;
+}
+
+//------------------------------------------------------------------------------
+// GroundBelowData: the ground no higher than the bottom of the data's box (the
+// whole cloud's box for one piece of a distributed cloud, so that every rank draws
+// the same ground).
+void vtkNimbusCloudVolumeMapper::PlaceGroundBelowData(FrameState& frame)
+{
+  FrameSettings& settings = frame.Settings;
+  if (this->GroundBelowData && frame.Ground)
+  {
+    double bottom = std::numeric_limits<double>::infinity();
+    for (const auto& corner : frame.Corners)
+    {
+      bottom = std::min(bottom, corner[2]);
+    }
+    const double* sb = this->SlicingBounds;
+    if (sb[0] <= sb[1] && sb[2] <= sb[3] && sb[4] <= sb[5])
+    {
+      for (int c = 0; c < 8; ++c)
+      {
+        const double corner[3] = { sb[(c & 1) ? 1 : 0], sb[(c & 2) ? 3 : 2], sb[(c & 4) ? 5 : 4] };
+        bottom = std::min(bottom, ToUp(settings.Up, corner)[2]);
+      }
+    }
+    if (std::isfinite(bottom))
+    {
+      settings.GroundHeight = std::min(settings.GroundHeight, bottom);
+    }
+  }
+  this->Internal->LastGroundHeight = settings.GroundHeight;
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastGroundHeight() const
+{
+  return this->Internal->LastGroundHeight;
+}
+
+void vtkNimbusCloudVolumeMapper::SetUpAxis(int value)
+{
+  if (!nimbus::IsUpAxis(value))
+  {
+    vtkErrorMacro("SetUpAxis(" << value
+                               << "): not an up axis (0 +X, 1 +Y, 2 +Z, 3 -Y); the up axis stays "
+                               << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis)));
+    return;
+  }
+  if (value != this->UpAxis)
+  {
+    this->UpAxis = value;
+    this->Modified();
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -1163,8 +1273,15 @@ bool vtkNimbusCloudVolumeMapper::UpdateAtmosphereTable(FrameState& frame)
   {
     boxZMin = std::min(boxZMin, corner[2]);
   }
-  const double zLow =
+  // The lowest point a pass samples: the box, the ground and the eye (below both,
+  // e.g. under the ground; rounded down to 100 m so a moving eye rebuilds rarely).
+  double zLow =
     (std::min(boxZMin, frame.Ground ? settings.GroundHeight : boxZMin)) * settings.MetresPerUnit;
+  const double eyeZ = frame.Eye[2] * settings.MetresPerUnit;
+  if (eyeZ < zLow)
+  {
+    zLow = 100.0 * std::floor(eyeZ / 100.0);
+  }
   const nimbus::SceneAtmosphere& air = settings.Air;
   const double zHigh = air.TopRadiusMetres - air.EarthRadiusMetres - air.SceneAltitudeMetres;
   const std::vector<double> tableKey = { settings.Sun.AzimuthDegrees, settings.Sun.ElevationDegrees,
@@ -1226,7 +1343,7 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniform3f("viewForward", frame.ViewForward.data());
   program->SetUniform2f("clippingRange", frame.ClippingRange.data());
   program->SetUniformi("perspective", frame.Camera->GetParallelProjection() ? 0 : 1);
-  program->SetUniform3f("cameraPosition", frame.Camera->GetPosition());
+  program->SetUniform3f("cameraPosition", frame.Eye.data());
   program->SetUniformMatrix4x4("worldToTexture", const_cast<float*>(frame.WorldToTexture.data()));
   program->SetUniformMatrix4x4("worldToBox", const_cast<float*>(frame.WorldToBox.data()));
   program->SetUniform3f("sunDirection", frame.ToSun.data());
@@ -1453,7 +1570,9 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   }
   if (wholeCloud)
   {
-    zMiddle = 0.5 * (this->SlicingBounds[4] + this->SlicingBounds[5]);
+    const double* sb = this->SlicingBounds;
+    const double low[3] = { sb[0], sb[2], sb[4] }, high[3] = { sb[1], sb[3], sb[5] };
+    zMiddle = 0.5 * (ToUp(settings.Up, low)[2] + ToUp(settings.Up, high)[2]);
   }
   if (this->SkyLight && frame.Atmosphere)
   {
@@ -2334,6 +2453,9 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << this->ViewCoverBounds[5] << "\n";
   os << indent << "ExternalDensity: " << this->Internal->ExternalDensity.GetPointer() << "\n";
   os << indent << "GroundHeight: " << this->GroundHeight << "\n";
+  os << indent << "GroundBelowData: " << this->GroundBelowData << "\n";
+  os << indent << "UpAxis: " << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis))
+     << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
   os << indent << "Shafts: " << this->Shafts << "\n";
   os << indent << "NumberOfSlices: " << this->NumberOfSlices << "\n";

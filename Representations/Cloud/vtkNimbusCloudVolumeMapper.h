@@ -29,7 +29,9 @@
  *    the air's source and the sky's light on the ground, neither shadowed by the
  *    cloud (rows 4 and 5 of the atmosphere texture, AtmosphereTable.h).
  *
- * Frame and units: world z is up; MetresPerUnit metres per world unit (1 by
+ * Frame and units: the world's UpAxis (+Z by default; +X, +Y, -Y for data made y up
+ * or x up) is up: the sun, the sky, the ground and the air turn with it, the data
+ * and the camera stay where they are (Physics/UpAxis.h); MetresPerUnit metres per world unit (1 by
  * default); extinction in 1/m per unit density; radiance relative to the sun
  * (SunIlluminance = luminance of its irradiance above the atmosphere), in linear
  * sRGB, times Exposure in the framebuffer (EncodeSrgb applies the display
@@ -309,7 +311,25 @@ public:
   ///@}
 
   ///@{
-  /// Ground plane z = GroundHeight (world units) with a grey Lambertian albedo.
+  /// Which axis of the world points up (nimbus::UpAxis: 0 +X, 1 +Y, 2 +Z (default),
+  /// 3 -Y). The sun's azimuth and elevation, the ground plane, the altitude of the
+  /// air and the sky are taken about that axis; the data and the camera are not
+  /// moved (a y-up file looks right from a y-up camera). Over a Nimbus sky the sky's
+  /// up axis is used (vtkNimbusSky::UpAxis).
+  virtual void SetUpAxis(int value);
+  vtkGetMacro(UpAxis, int);
+  ///@}
+
+  ///@{
+  /// Ground plane at height GroundHeight along the up axis (world units) with a
+  /// grey Lambertian albedo. With GroundBelowData (default on) the ground is never
+  /// above the data's lowest point: it lies at min(GroundHeight, the bottom of the
+  /// data's box), so a cloud that reaches below GroundHeight is not cut by it
+  /// (GetLastGroundHeight says where it was drawn). Off: exactly at GroundHeight.
+  vtkSetMacro(GroundBelowData, bool);
+  vtkGetMacro(GroundBelowData, bool);
+  vtkBooleanMacro(GroundBelowData, bool);
+  double GetLastGroundHeight() const;
   vtkSetMacro(Ground, bool);
   vtkGetMacro(Ground, bool);
   vtkBooleanMacro(Ground, bool);
@@ -601,6 +621,8 @@ protected:
   bool AirMultipleScattering = true;
   bool Ground = true;
   double GroundHeight = 0.0;
+  bool GroundBelowData = true;
+  int UpAxis = 2;
   double GroundAlbedo = 0.2;
   bool Shafts = true;
   int NumberOfSlices = 256;
@@ -651,6 +673,7 @@ private:
   void ChooseFrameLevel(vtkRenderer* renderer, FrameState& frame);
   std::vector<double> FrameReuseKey(const FrameState& frame);
   bool ComputeDataToWorld(vtkVolume* volume, vtkMatrix4x4* dataToWorld);
+  void PlaceGroundBelowData(FrameState& frame);
   void CopySceneColorAndDepth(FrameState& frame);
   bool UpdateAtmosphereTable(FrameState& frame);
   void UpdateMultipleScattering(FrameState& frame);

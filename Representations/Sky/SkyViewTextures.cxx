@@ -2,7 +2,11 @@
 
 #include "ShaderLibrary.h"
 #include "Sky.h"
+#include "UpAxis.h"
+#include "vtkCamera.h"
 #include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
 #include "vtkNimbusSky.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderUtilities.h"
@@ -53,6 +57,27 @@ vtkShaderProgram* SkyViewTextures::ReadyQuad(vtkOpenGLRenderWindow* window,
   }
   vtkShaderProgram* program = quad->Program;
   return program && program->GetCompiled() ? program : nullptr;
+}
+
+void SkyViewTextures::CameraInUpFrame(vtkNimbusSky* sky, vtkCamera* camera, double aspect,
+  double eye[3], vtkMatrix4x4* inverseViewProjection)
+{
+  const auto up = static_cast<UpAxis>(sky->GetUpAxis());
+  const double* position = camera->GetPosition();
+  const auto turned = ToUpFrame(up, { { position[0], position[1], position[2] } });
+  std::copy(turned.begin(), turned.end(), eye);
+  const auto r = WorldToUpFrame(up);
+  vtkNew<vtkMatrix4x4> upToWorld; // R^T
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      upToWorld->SetElement(i, j, r[j][i]);
+    }
+  }
+  vtkMatrix4x4::Multiply4x4(camera->GetCompositeProjectionTransformMatrix(aspect, -1.0, 1.0),
+    upToWorld, inverseViewProjection);
+  inverseViewProjection->Invert();
 }
 
 double SkyViewTextures::CameraAltitude(vtkNimbusSky* sky, double z)

@@ -9,6 +9,8 @@
 #include <memory>
 #include <string>
 
+class vtkCamera;
+class vtkMatrix4x4;
 class vtkNimbusSky;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
@@ -38,6 +40,13 @@ public:
   /// The altitude a camera at scene height z sees the sky from:
   /// SceneAltitudeMetres + z MetresPerUnit, at least 0.
   static double CameraAltitude(vtkNimbusSky* sky, double z);
+
+  /// The camera in the sky's up frame (vtkNimbusSky::UpAxis, Physics/UpAxis.h: the
+  /// world turned so that the up axis is +z, where the sky's tables live): its
+  /// position and the inverse of projection x view x (up frame -> world), for the
+  /// view rays of a full-screen pass. `aspect` = viewport width / height.
+  static void CameraInUpFrame(vtkNimbusSky* sky, vtkCamera* camera, double aspect, double eye[3],
+    vtkMatrix4x4* inverseViewProjection);
   void Deactivate();
   void Release(vtkWindow* window);
 

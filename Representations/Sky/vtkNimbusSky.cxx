@@ -1,6 +1,7 @@
 #include "vtkNimbusSky.h"
 
 #include "Sky.h"
+#include "UpAxis.h"
 
 #include "FiniteSetters.h"
 #include "vtkMath.h"
@@ -20,6 +21,22 @@ nimbusDefineFiniteSetter(vtkNimbusSky, GroundAlbedo);
 nimbusDefineFiniteSetter(vtkNimbusSky, Exposure);
 nimbusDefineFiniteSetter(vtkNimbusSky, SceneAltitudeMetres);
 nimbusDefineFiniteSetter(vtkNimbusSky, MetresPerUnit);
+
+void vtkNimbusSky::SetUpAxis(int value)
+{
+  if (!nimbus::IsUpAxis(value))
+  {
+    vtkErrorMacro("SetUpAxis(" << value
+                               << "): not an up axis (0 +X, 1 +Y, 2 +Z, 3 -Y); the up axis stays "
+                               << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis)));
+    return;
+  }
+  if (value != this->UpAxis)
+  {
+    this->UpAxis = value;
+    this->Modified();
+  }
+}
 nimbusDefineFiniteSetter(vtkNimbusSky, MaxAerialDistanceMetres);
 
 struct vtkNimbusSky::Internals
@@ -319,6 +336,8 @@ void vtkNimbusSky::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Exposure: " << this->Exposure << "\n";
   os << indent << "SceneAltitudeMetres: " << this->SceneAltitudeMetres << "\n";
   os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
+  os << indent << "UpAxis: " << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis))
+     << "\n";
   os << indent << "MaxAerialDistanceMetres: " << this->MaxAerialDistanceMetres << "\n";
   os << indent << "ScatteringOrders: " << this->ScatteringOrders << "\n";
   os << indent << "WhiteBalance: " << this->WhiteBalance << "\n";

@@ -20,7 +20,9 @@
  * linear sRGB channel divided by that of the sun outside the atmosphere (as
  * vtkNimbusSunlight).
  *
- * Scene frame: z up, y north, x east; scene lengths x MetresPerUnit = metres;
+ * Scene frame: UpAxis up (+Z by default: z up, y north, x east; +X, +Y or -Y turn the
+ * sun, the sky and the ground about that axis instead, Physics/UpAxis.h); scene
+ * lengths x MetresPerUnit = metres;
  * scene z = 0 is at SceneAltitudeMetres above sea level.
  *
  * For a GL mapper: GetTransmittanceTable / GetMultipleScatteringTable give the
@@ -121,6 +123,13 @@ public:
   vtkGetMacro(SceneAltitudeMetres, double);
   ///@}
   ///@{
+  /// Which axis of the scene points up (nimbus::UpAxis: 0 +X, 1 +Y, 2 +Z (default),
+  /// 3 -Y); the sky and its sun turn about it, and a cloud that follows this sky
+  /// (vtkNimbusCloudVolumeMapper) takes it. Other values are refused with an error.
+  virtual void SetUpAxis(int value);
+  vtkGetMacro(UpAxis, int);
+  ///@}
+  ///@{
   /// Metres per scene unit, (0, 1e6]. Default 1.
   virtual void SetMetresPerUnit(double value);
   virtual double GetMetresPerUnitMinValue() { return 1e-6; }
@@ -204,6 +213,7 @@ protected:
   double Exposure = 10.0;
   double SceneAltitudeMetres = 0.0;
   double MetresPerUnit = 1.0;
+  int UpAxis = 2;
   double MaxAerialDistanceMetres = 1.0e5;
   int ScatteringOrders = 4;
   bool WhiteBalance = true;

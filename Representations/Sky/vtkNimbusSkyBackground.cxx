@@ -108,8 +108,13 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
     in.Window = window;
     std::string error;
     vtkCamera* camera = renderer->GetActiveCamera();
-    const double altitude =
-      nimbus::SkyViewTextures::CameraAltitude(this->Sky, camera->GetPosition()[2]);
+    int width = 0, height = 0, x0 = 0, y0 = 0;
+    renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+    double eye[3];
+    vtkNew<vtkMatrix4x4> inverse;
+    nimbus::SkyViewTextures::CameraInUpFrame(
+      this->Sky, camera, static_cast<double>(width) / std::max(1, height), eye, inverse);
+    const double altitude = nimbus::SkyViewTextures::CameraAltitude(this->Sky, eye[2]);
     if (!in.SkyView.Update(window, this->Sky, altitude, error))
     {
       vtkErrorMacro("Sky tables: " << error);
@@ -122,14 +127,8 @@ int vtkNimbusSkyBackground::RenderOpaqueGeometry(vtkViewport* viewport)
       vtkErrorMacro("The sky background shader did not compile.");
       return 0;
     }
-    int width = 0, height = 0, x0 = 0, y0 = 0;
-    renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
-    vtkNew<vtkMatrix4x4> inverse;
-    inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
-      static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
-    inverse->Invert();
     program->SetUniformMatrix("inverseViewProjection", inverse);
-    program->SetUniform3f("cameraPosition", camera->GetPosition());
+    program->SetUniform3f("cameraPosition", eye);
     in.SkyView.Activate(program, this->Sky);
 
     vtkOpenGLState* state = window->GetState();

@@ -9,6 +9,7 @@
 #include "vtkCamera.h"
 #include "vtkMath.h"
 #include "vtkMatrix4x4.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLFramebufferObject.h"
@@ -20,6 +21,7 @@
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <stdexcept>
@@ -112,8 +114,11 @@ void vtkNimbusSkyPass::Render(const vtkRenderState* s)
     int x, y, width, height;
     renderer->GetTiledSizeAndOrigin(&width, &height, &x, &y);
     this->RenderDelegate(s, width, height);
-    const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(
-      this->Sky, renderer->GetActiveCamera()->GetPosition()[2]);
+    double eye[3];
+    vtkNew<vtkMatrix4x4> inverse;
+    nimbus::SkyViewTextures::CameraInUpFrame(this->Sky, renderer->GetActiveCamera(),
+      static_cast<double>(width) / std::max(1, height), eye, inverse);
+    const double cameraAltitude = nimbus::SkyViewTextures::CameraAltitude(this->Sky, eye[2]);
     if (this->UpdateTables(window, cameraAltitude))
     {
       this->DrawSky(renderer, x, y, width, height);
@@ -249,13 +254,12 @@ void vtkNimbusSkyPass::DrawSky(vtkRenderer* renderer, int x, int y, int width, i
     in.AerialTextures[k]->Activate();
     program->SetUniformi(aerialNames[k], in.AerialTextures[k]->GetTextureUnit());
   }
-  vtkCamera* camera = renderer->GetActiveCamera();
+  double eye[3];
   vtkNew<vtkMatrix4x4> inverse;
-  inverse->DeepCopy(camera->GetCompositeProjectionTransformMatrix(
-    static_cast<double>(width) / std::max(1, height), -1.0, 1.0));
-  inverse->Invert();
+  nimbus::SkyViewTextures::CameraInUpFrame(this->Sky, renderer->GetActiveCamera(),
+    static_cast<double>(width) / std::max(1, height), eye, inverse);
   program->SetUniformMatrix("inverseViewProjection", inverse);
-  program->SetUniform3f("cameraPosition", camera->GetPosition());
+  program->SetUniform3f("cameraPosition", eye);
   program->SetUniformf("metresPerUnit", static_cast<float>(this->Sky->GetMetresPerUnit()));
   const nimbus::SkyViewMapping& m = in.Aerial->GetMapping();
   const float aerialTable[4] = { static_cast<float>(m.HorizonZenith), static_cast<float>(m.Width),
