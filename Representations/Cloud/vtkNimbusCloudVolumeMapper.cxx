@@ -2063,7 +2063,8 @@ void vtkNimbusCloudVolumeMapper::RenderIntervalPhase(const FrameState& frame)
 }
 
 //------------------------------------------------------------------------------
-// Where each view ray ends this frame (opaque depth, ground, top of the atmosphere).
+// Where each view ray ends this frame (opaque depth, ground, top of the atmosphere),
+// and the air's optical lengths to the box entry (BoxEntryOpticalLengths).
 void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
 {
   Internals& in = *this->Internal;
@@ -2073,6 +2074,7 @@ void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
   frame.State->vtkglDisable(GL_BLEND);
   vtkShaderProgram* program = in.Ready(in.RayEndsPass, svsRayEndsFS);
   this->SetCommonUniforms(program, frame);
+  program->SetUniformi("steps", this->AtmosphereSteps); // as the march in front of the box
   in.RayEndsPass->Render();
   ++in.PassesLastRender;
   in.RayEnds->Activate();

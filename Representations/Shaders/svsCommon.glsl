@@ -250,6 +250,76 @@ bool BoxInterval(vec3 origin, vec3 direction, out float tIn, out float tOut)
   return BoxIntervalOf(worldToBox, origin, direction, tIn, tOut);
 }
 
+// The air's sea-level-equivalent optical lengths [m] (Rayleigh, Mie) from the eye to
+// where the view ray enters the cloud box (0 when the eye is inside it or the ray
+// misses it), over the spherical earth: summed as the march sums them in front of the
+// box (samples dense toward the box, the altitude of each over the sphere), so that
+// the slices, which continue from there in closed form (BoxViewTransmittance), see
+// the air beside the box attenuated as the march does, however far the box is: the
+// flat-layer closed form from the eye drifts from the sphere by a few per cent of the
+// optical length 20 km away at a low elevation (TestAtmosphere). From the top of the
+// atmosphere for an eye above it.
+vec2 BoxEntryOpticalLengths(vec3 origin, vec3 direction, float tEnd, int count)
+{
+  float tIn, tOut;
+  if (atmosphereOn == 0 || !BoxInterval(origin, direction, tIn, tOut) || tIn <= 0.0 ||
+    tOut <= 0.0)
+  {
+    return vec2(0.0);
+  }
+  float t1 = min(tIn, tEnd);
+  // Where the ray enters the atmosphere (an eye above its top).
+  vec3 q = vec3(origin.xy * metresPerUnit,
+    earthRadiusMetres + sceneAltitudeMetres + origin.z * metresPerUnit);
+  float r = length(q);
+  float t0 = 0.0;
+  if (r > topRadiusMetres)
+  {
+    float mu = dot(direction, q / r);
+    float disc = r * r * mu * mu - (r * r - topRadiusMetres * topRadiusMetres);
+    if (mu >= 0.0 || disc < 0.0)
+    {
+      return vec2(0.0); // never enters the air
+    }
+    t0 = (-r * mu - sqrt(disc)) / metresPerUnit;
+  }
+  float span = t1 - t0;
+  vec2 lengths = vec2(0.0);
+  int n = max(count, 16);
+  for (int k = 0; k < n && span > 0.0; ++k)
+  {
+    float u = (float(k) + 0.5) / float(n);
+    float t = t1 - span * (1.0 - u) * (1.0 - u); // dense toward the box
+    float dt = span * 2.0 * (1.0 - u) / float(n) * metresPerUnit;
+    float h = max(Altitude(origin + t * direction), 0.0);
+    lengths += exp(-h / vec2(rayleighScaleHeightMetres, mieScaleHeightMetres)) * dt;
+  }
+  return lengths;
+}
+
+// Atmospheric transmittance between the eye and distance t >= the box entry along
+// the view ray: BoxEntryOpticalLengths (ends.ba, from the ray-ends texture), then the
+// flat-layer closed form from the entry point, at its altitude and zenith angle over
+// the sphere. Rays that start inside the box (or miss it): AtmosphereViewTransmittance.
+vec3 BoxViewTransmittance(vec3 origin, vec3 direction, float t, vec2 entryLengths)
+{
+  float tIn, tOut;
+  if (atmosphereOn == 0 || !BoxInterval(origin, direction, tIn, tOut) || tIn <= 0.0)
+  {
+    return AtmosphereViewTransmittance(origin, direction, t);
+  }
+  vec3 entry = origin + tIn * direction;
+  vec3 q = vec3(entry.xy * metresPerUnit,
+    earthRadiusMetres + sceneAltitudeMetres + entry.z * metresPerUnit);
+  float r = length(q);
+  float h = r - earthRadiusMetres;
+  float cosZenith = dot(direction, q / r);
+  float d = min(max(t - tIn, 0.0), 1e7) * metresPerUnit;
+  float lr = min(entryLengths.x + FlatLayerOpticalLength(h, cosZenith, d, rayleighScaleHeightMetres), 1e30);
+  float lm = min(entryLengths.y + FlatLayerOpticalLength(h, cosZenith, d, mieScaleHeightMetres), 1e30);
+  return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
+}
+
 bool InsideBox(vec3 p)
 {
   vec3 box = (worldToBox * vec4(p, 1.0)).xyz;

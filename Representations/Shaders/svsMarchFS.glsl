@@ -114,7 +114,8 @@ void main()
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
   vec4 intervalAndPhase = texture(intervalPhase, texCoord);
-  vec2 ends = texture(rayEnds, texCoord).rg;
+  vec4 rayEnd = texture(rayEnds, texCoord);
+  vec2 ends = rayEnd.rg;
   float tEnd = ends.x;
   float tGround = ends.y;
   float tEndMarch = min(tEnd, 1e9);
@@ -132,7 +133,10 @@ void main()
     t0 = segment == 0 ? 0.0 : min(tOut, tEndMarch);
     t1 = segment == 0 ? min(tIn, tEndMarch) : tEndMarch;
   }
-  vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t0);
+  // Behind the box: from the slices' transmittance at the box exit (BoxViewTransmittance).
+  vec3 viewTransmittance = hitsBox && segment == 1
+    ? BoxViewTransmittance(origin, direction, t0, rayEnd.ba)
+    : AtmosphereViewTransmittance(origin, direction, t0);
   float a, b;
   if (atmosphereOn == 0 || t1 <= t0)
   {

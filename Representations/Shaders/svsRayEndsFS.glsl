@@ -1,7 +1,10 @@
 // Per-frame ray ends (one pass, so the slices need not recompute them): r = the
 // distance at which the view ray stops (opaque geometry, ground, or the top of the
-// atmosphere), g = the distance to the ground (infinity when it misses).
+// atmosphere), g = the distance to the ground (infinity when it misses), ba = the
+// air's optical lengths from the eye to where the ray enters the cloud box
+// (BoxEntryOpticalLengths).
 in vec2 texCoord;
+uniform int steps; // the march's samples per segment (svsMarchFS.glsl)
 
 void main()
 {
@@ -10,5 +13,5 @@ void main()
   float tGround = GroundDistance(origin, direction);
   float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
     tGround);
-  gl_FragData[0] = vec4(tEnd, tGround, 0.0, 0.0);
+  gl_FragData[0] = vec4(tEnd, tGround, BoxEntryOpticalLengths(origin, direction, tEnd, steps));
 }

@@ -158,7 +158,8 @@ void main()
         source += emissionScale * max(texture(emissionRgb, (worldToTexture * vec4(p, 1.0)).xyz).rgb, vec3(0.0));
       }
     }
-    vec3 viewTransmittance = AtmosphereViewTransmittance(origin, direction, t);
+    vec3 viewTransmittance =
+      BoxViewTransmittance(origin, direction, t, texture(rayEnds, texCoord).ba);
     if (atmosphereOn != 0 && boxAirOn != 0)
     {
       vec3 air = AirSource(altitude, intervalAndPhase.zw);              // 000 Eq. 8, atmosphere

@@ -1,5 +1,7 @@
 #include "vtkNimbusSkyDomeSource.h"
 
+#include "UpAxis.h"
+
 #include "vtkNimbusSky.h"
 
 #include "SpectralColor.h"
@@ -76,6 +78,14 @@ NIMBUS_FORWARD(Exposure)
 NIMBUS_FORWARD(SceneAltitudeMetres)
 NIMBUS_FORWARD(MetresPerUnit)
 #undef NIMBUS_FORWARD
+
+void vtkNimbusSkyDomeSource::SetUpAxis(int v)
+{
+  if (this->Sky)
+  {
+    this->Sky->SetUpAxis(v);
+  }
+}
 
 void vtkNimbusSkyDomeSource::SetTurbidity(double v)
 {
@@ -176,6 +186,7 @@ const SkyParameter SkyParameters[] = {
   NIMBUS_PARAMETER(MetresPerUnit, double),
   NIMBUS_PARAMETER(MaxAerialDistanceMetres, double),
   NIMBUS_PARAMETER(ScatteringOrders, int),
+  NIMBUS_PARAMETER(UpAxis, int),
 };
 #undef NIMBUS_PARAMETER
 }
@@ -275,8 +286,11 @@ int vtkNimbusSkyDomeSource::RequestData(
       const double e = vtkMath::RadiansFromDegrees(elevationDeg);
       const double a = vtkMath::RadiansFromDegrees(azimuthDeg);
       const double d[3] = { std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e) };
-      points->InsertNextPoint(this->Center[0] + this->Radius * d[0],
-        this->Center[1] + this->Radius * d[1], this->Center[2] + this->Radius * d[2]);
+      // The dome stands on the sky's up axis: its direction in world axes.
+      const auto w = nimbus::FromUpFrame(
+        static_cast<nimbus::UpAxis>(sky->GetUpAxis()), { { d[0], d[1], d[2] } });
+      points->InsertNextPoint(this->Center[0] + this->Radius * w[0],
+        this->Center[1] + this->Radius * w[1], this->Center[2] + this->Radius * w[2]);
       double L[3];
       sky->GetRadiance(d, L);
       radiance->InsertNextTuple(L);

@@ -20,7 +20,8 @@
  *    setting, both written; read in this order, so the second wins), "GroundAlbedo",
  *  - "Exposure", "WhiteBalance" (0/1), "SunDisc" (0/1),
  *  - "SceneAltitudeMetres" (m), "MetresPerUnit", "MaxAerialDistanceMetres" (m),
- *  - "ScatteringOrders" (1 = single scattering).
+ *  - "ScatteringOrders" (1 = single scattering), "UpAxis" (nimbus::UpAxis: 0 +X, 1 +Y,
+ *    2 +Z, 3 -Y; the dome stands on that axis).
  * Consumers (ParaView's "Sky Background" representation) rebuild the same sky
  * from them with ApplySkyParameters(); AddSkyParameters() writes them.
  */
@@ -75,6 +76,7 @@ public:
   void SetExposure(double v);
   void SetSceneAltitudeMetres(double v);
   void SetMetresPerUnit(double v);
+  void SetUpAxis(int v);
   void SetScatteringOrders(int v);
   void SetWhiteBalance(bool v);
   void SetSunDisc(bool v);
