@@ -31,10 +31,10 @@ is there are the cloud's own. The checks (each explained where it is made):
   seamless air  no step in the air at the outline of the projected data box, in the
       zero-extinction image and, away from the cloud, in the user's image.
   not blank or blown out  enough cloud pixels, mean luminance of the cloud's pixels in
-      [0.15, 0.95], fewer than 5 % of them at 255; where the units are known (netcdf, pvti)
-      and the data's densest column has an optical depth of 10 or more, the cloud changes
-      its brightest-changed 10 % of pixels by 60 levels or more (not a pale ghost: the
-      units were honoured, not off by orders of magnitude).
+      [0.15, 0.96], fewer than 5 % of them at 255; where the units are known (netcdf, pvti)
+      and the data's densest column has an optical depth of 10 or more, the cloud and its
+      shadow change their 10 % most-changed pixels by 60 levels or more (not a pale ghost:
+      the units were honoured, not off by orders of magnitude).
 
 Properties that do not exist yet are reported as failures and the test goes on, so one
 run shows every check. Images and a JSON summary (with the seconds from opening the file to
@@ -59,11 +59,12 @@ from image_compare import read_png  # noqa: E402
 SIZE = [400, 300]
 CLOUD_DIFF_LEVELS = 8.0     # a pixel is the cloud's when a channel changes by more (of 255)
 MIN_CLOUD_FRACTION = 0.003  # fewer cloud pixels than this fraction of the image: blank
-LUMINANCE_RANGE = (0.15, 0.95)
+LUMINANCE_RANGE = (0.15, 0.96)
 MAX_SATURATED_FRACTION = 0.05
 AIR_STEP_LEVELS = 2.0       # the largest mean step allowed at the box outline (of 255)
 THICK_OPTICAL_DEPTH = 10.0  # a cloud whose densest column is this thick (or more) ...
-THICK_CONTRAST_LEVELS = 60.0  # ... changes its brightest 10 % of pixels by this much or more
+THICK_CONTRAST_LEVELS = 60.0  # ... changes the 10 % most-changed pixels (its shadow's
+#                               included) by this much or more
 UP_AXIS_PLUS_Y = 1
 DENSITY_UNITS_EXTINCTION = 1
 DENSITY_UNITS_MIXING_RATIO = 3
@@ -225,6 +226,40 @@ def horizon_row(view):
 
 
 # --- the picture --------------------------------------------------------------------------
+def grid_steps(data):
+    """The largest distance between neighbouring points along x, y and z."""
+    if data.IsA("vtkRectilinearGrid"):
+        return [float(np.diff(vtk_to_numpy(axis)).max()) if axis.GetNumberOfTuples() > 1 else 0.0
+                for axis in (data.GetXCoordinates(), data.GetYCoordinates(),
+                             data.GetZCoordinates())]
+    return list(data.GetSpacing())
+
+
+def silhouette(view, points, steps):
+    """Pixels covered by the projected points, each grown by the projected size of one grid
+    step (so that the points' pixels join into the cloud's outline)."""
+    covered = np.zeros((SIZE[1], SIZE[0]), dtype=bool)
+    if len(points) == 0:
+        return covered
+    centre = points.mean(axis=0)
+    probes = np.array([centre] + [centre + step * np.eye(3)[axis]
+                                  for axis, step in enumerate(steps)])
+    columns, rows = project(view, probes)
+    reach = max(np.hypot(columns[1:] - columns[0], rows[1:] - rows[0]))
+    radius = int(min(np.ceil(reach), 12)) + 1
+    columns, rows = project(view, points)
+    inside = (columns >= 0) & (columns < SIZE[0]) & (rows >= 0) & (rows < SIZE[1])
+    covered[rows[inside].astype(int), columns[inside].astype(int)] = True
+    grown = covered.copy()
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            if dx * dx + dy * dy > radius * radius:
+                continue
+            shifted = np.roll(np.roll(covered, dy, axis=0), dx, axis=1)
+            grown |= shifted
+    return grown
+
+
 def cloud_mask(image, empty):
     """The cloud's pixels: where the image differs from the zero-extinction image."""
     return np.abs(image - empty).max(axis=2) > CLOUD_DIFF_LEVELS
@@ -345,11 +380,16 @@ def check_picture(view, display, source, array_name, name, output_dir, failures,
     Render(view)
     empty = read_png(empty_path)
 
-    mask = cloud_mask(image, empty)
+    # The cloud's pixels: those that change when the cloud is there, within the projection of
+    # its density. The rest of the change is its shadow on the ground and in the air.
+    changed = cloud_mask(image, empty)
+    cloudy = cloudy_points(data, array_name)
+    covered = silhouette(view, cloudy, grid_steps(data))
+    mask = changed & covered
     write_mask(mask, os.path.join(output_dir, name + "-cloud-pixels.png"))
     found = blob(mask)
-    cloudy = cloudy_points(data, array_name)
-    measured = {"blob": found, "bounds": list(bounds)}
+    measured = {"blob": found, "bounds": list(bounds),
+                "shadow_pixels": int((changed & ~covered).sum())}
 
     # --- not blank or blown out -----------------------------------------------------------
     fraction = mask.mean()
@@ -361,7 +401,8 @@ def check_picture(view, display, source, array_name, name, output_dir, failures,
         cloud = image[mask]
         mean_luminance = float(luminance(cloud).mean())
         saturated = float((cloud.min(axis=1) >= 254.5).mean())
-        contrast = float(np.percentile(np.abs(image - empty).max(axis=2)[mask], 90))
+        # The change the cloud makes to the picture, its shadow included.
+        contrast = float(np.percentile(np.abs(image - empty).max(axis=2)[changed], 90))
         measured.update(mean_luminance=mean_luminance, saturated_fraction=saturated,
                         contrast_p90_levels=contrast)
         if not LUMINANCE_RANGE[0] <= mean_luminance <= LUMINANCE_RANGE[1]:
@@ -371,7 +412,8 @@ def check_picture(view, display, source, array_name, name, output_dir, failures,
             failures.append("%s: blown out: %.1f %% of the cloud's pixels are white at 255" % (
                 name, 100 * saturated))
         # Units honoured: a cloud that the data says is optically thick is not a faint haze
-        # (extinction wrong by orders of magnitude shows as a pale ghost of the cloud).
+        # (extinction wrong by orders of magnitude shows as a pale ghost of the cloud with a
+        # faint shadow; a thick one has a dark shadow and a shaded side).
         if optical_depth is not None:
             measured["largest_column_optical_depth"] = optical_depth
             if optical_depth >= THICK_OPTICAL_DEPTH and contrast < THICK_CONTRAST_LEVELS:
@@ -427,7 +469,7 @@ def check_picture(view, display, source, array_name, name, output_dir, failures,
     horizon = horizon_row(view)
     no_cloud = np.zeros(mask.shape, dtype=bool)
     step_empty, edges_empty = air_step_at_box(view, empty, bounds, no_cloud, horizon)
-    step_image, edges_image = air_step_at_box(view, image, bounds, mask, horizon)
+    step_image, edges_image = air_step_at_box(view, image, bounds, changed, horizon)
     measured.update(air_step_zero_extinction=float(step_empty), air_edges_zero=edges_empty,
                     air_step_image=float(step_image), air_edges_image=edges_image)
     for label, step in (("zero-extinction image", step_empty), ("image", step_image)):
