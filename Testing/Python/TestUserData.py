@@ -11,18 +11,20 @@ sets ONLY what a user knows about the data, and checks the picture:
           (U = R W of Physics/UpAxis.h, about the origin).
   netcdf  les_cumulus_ql.nc (CF NetCDF, ql in kg/kg, stretched z, 3 time steps): the
           reader's SphericalCoordinates off (x and y are metres, not longitude and
-          latitude), DensityUnits = liquid water mixing ratio (kg/kg). Cloud must be
-          offered for its rectilinear grid.
+          latitude), colour by ql (the reader sets no active scalars), DensityUnits =
+          liquid water mixing ratio (kg/kg). Cloud must be offered for its rectilinear
+          grid, and follow its time steps.
   pvti    automaton_extinction_km.pvti (extinction in 1/m on a grid in km):
           DensityUnits = extinction (1/m), MetresPerUnit = 1000.
 
 The camera is the GUI's first look (11 degrees down, z up, fitted to the data) turned so
 that the default sun (azimuth 135, elevation 45) is behind the viewer: the cloud is lit
-from the front and its shadow falls behind it, so the pixels that change when the cloud
-is there are the cloud's own. The checks (each explained where it is made):
+from the front and its shadow falls behind and below it. The checks (each explained where
+it is made):
 
-  upright and above the ground  the cloud's pixels (the image minus the same view with the
-      density's extinction scaled to zero) form a blob as tall and as wide as the cloud's
+  upright and above the ground  the cloud's pixels (those that differ from the same view
+      with the density's extinction scaled to zero, within the projection of the density;
+      the rest is its shadow) form a blob as tall and as wide as the cloud's
       density projected through the same camera, reaching down to the projected lowest
       cloudy point (a cloud cut by the ground loses its bottom rows); for the .vdb, a
       tower, the blob is taller than wide (a cloud lying on its side is not). The ground
