@@ -212,6 +212,38 @@ vtkSmartPointer<vtkImageData> CloudImageOf(
   return image;
 }
 
+std::string DefaultDensityArray(vtkImageData* image, bool& cellData)
+{
+  cellData = false;
+  vtkDataSetAttributes* both[2] = { image->GetPointData(), image->GetCellData() };
+  for (int c = 0; c < 2; ++c)
+  {
+    if (vtkDataArray* scalars = both[c]->GetScalars())
+    {
+      if (scalars->GetName() && scalars->GetName()[0])
+      {
+        cellData = c == 1;
+        return scalars->GetName();
+      }
+    }
+  }
+  for (int c = 0; c < 2; ++c)
+  {
+    for (int a = 0; a < both[c]->GetNumberOfArrays(); ++a)
+    {
+      vtkDataArray* array = both[c]->GetArray(a);
+      const std::string name = array && array->GetName() ? array->GetName() : "";
+      if (array && array->GetNumberOfComponents() == 1 && !name.empty() &&
+        name != "vtkValidPointMask" && name != vtkDataSetAttributes::GhostArrayName())
+      {
+        cellData = c == 1;
+        return name;
+      }
+    }
+  }
+  return std::string();
+}
+
 vtkSmartPointer<vtkImageData> WithExtinction(vtkImageData* image, const std::string& name,
   bool cellData, const CloudInputSettings& settings, double& estimate)
 {

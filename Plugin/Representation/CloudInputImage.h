@@ -50,6 +50,11 @@ struct CloudInputSettings
 vtkSmartPointer<vtkImageData> CloudImageOf(
   vtkDataObject* input, const CloudInputSettings& settings, bool& resampled);
 
+/// The array a cloud shows when the user chose none: the point scalars, the cell
+/// scalars, else the first one-component numeric point array, else cell array (not
+/// VTK's own vtkValidPointMask or vtkGhostType). Empty when there is none.
+std::string DefaultDensityArray(vtkImageData* image, bool& cellData);
+
 /// A shallow copy of `image` whose array `name` (point data, or cell data when
 /// `cellData`) holds extinction [1/m] as float, under the same name. With the
 /// estimated units `estimate` receives the scale k found [1/m per unit value].

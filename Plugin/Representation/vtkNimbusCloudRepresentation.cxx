@@ -214,6 +214,15 @@ vtkSmartPointer<vtkDataObject> vtkNimbusCloudRepresentation::PrepareCloudImage(
     : nullptr;
   bool cellData = info && info->Has(vtkDataObject::FIELD_ASSOCIATION()) &&
     info->Get(vtkDataObject::FIELD_ASSOCIATION()) == vtkDataObject::FIELD_ASSOCIATION_CELLS;
+  this->DefaultDensityArray.clear();
+  if (!name || !name[0])
+  {
+    // No array chosen (Coloring is Solid Color): the density is the active scalars, or
+    // else the first one-component array (a NetCDF reader sets no active scalars).
+    this->DefaultDensityArray = nimbus::DefaultDensityArray(image, this->DefaultDensityIsCells);
+    name = this->DefaultDensityArray.empty() ? nullptr : this->DefaultDensityArray.c_str();
+    cellData = this->DefaultDensityIsCells;
+  }
   if (resampled && cellData)
   {
     // The resampled image holds every array as point data.
@@ -447,7 +456,20 @@ void vtkNimbusCloudRepresentation::UpdateMapperParameters()
   vtkInformation* info = this->GetInputArrayInformation(0);
   const bool hasArray = info && info->Has(vtkDataObject::FIELD_NAME()) &&
     info->Get(vtkDataObject::FIELD_NAME()) && info->Get(vtkDataObject::FIELD_NAME())[0] != 0;
-  if (!hasArray)
+  if (!hasArray && !this->DefaultDensityArray.empty())
+  {
+    this->CloudMapper->SelectScalarArray(this->DefaultDensityArray.c_str());
+    if (this->DefaultDensityIsCells && !this->Resampled)
+    {
+      this->CloudMapper->SetScalarModeToUseCellFieldData();
+    }
+    else
+    {
+      this->CloudMapper->SetScalarModeToUsePointFieldData();
+    }
+    this->Actor->SetVisibility(this->GetVisibility());
+  }
+  else if (!hasArray)
   {
     this->CloudMapper->SelectScalarArray(static_cast<const char*>(nullptr));
     this->CloudMapper->SetScalarModeToDefault();

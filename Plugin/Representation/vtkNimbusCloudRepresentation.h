@@ -322,6 +322,9 @@ protected:
   double ResampleMemoryBudgetMiB = 0.0;
   bool Resampled = false;
   bool ResampledFromCells = false;
+  /// The density while no array is chosen (nimbus::DefaultDensityArray), if any.
+  std::string DefaultDensityArray;
+  bool DefaultDensityIsCells = false;
 
   /// The haze's two settings and the mapper's value from them.
   void ApplyHaze();
