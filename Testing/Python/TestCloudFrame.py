@@ -21,8 +21,10 @@ CASE:
                 resampled image over the memory budget ends in an error, not a crash.
   units         Every Density Array Means choice renders the same image as the
                 dimensionless density with the extinction per density computed by
-                hand (uniform water content: one scale), and the estimate scales a
-                field to its target optical thickness.
+                hand (uniform water content: one scale); "Unknown" reports its
+                estimate (EstimatedExtinctionPerDensityInfo, shown in the panel), which
+                goes as 1/Target Optical Thickness, and renders the image of the
+                dimensionless density at that extinction per density.
 """
 import argparse
 import math
@@ -400,6 +402,43 @@ def units(out):
     difference = np.abs(pixels - reference)
     check(difference.max() <= 1.0, "units mixing ratio with rho: max difference %g levels"
           % difference.max())
+    estimated_units(out, spacing, origin, camera, render, dimensionless)
+
+
+def estimated_units(out, spacing, origin, camera, render, dimensionless):
+    """"Unknown": the estimate the panel shows (EstimatedExtinctionPerDensityInfo) is the
+    scale used: 1/target (a quarter of the extinction for a quarter of the optical
+    thickness), and the image is the dimensionless one at that extinction per density."""
+    values = cloud_density(40, 36, 28)   # a smooth field: the columns differ
+
+    def estimate(display):
+        display.UpdatePropertyInformation()
+        return display.GetPropertyValue("EstimatedExtinctionPerDensityInfo")
+
+    view = new_view()
+    display = show_cloud(producer(image_of(values, spacing, origin)), view)
+    display.DensityUnits = 0
+    first_render(view)
+    check(estimate(display) == 0.0, "estimate: 0 while Density Array Means is not Unknown (%g)"
+          % estimate(display))
+    display.DensityUnits = 5
+    estimated = {}
+    for target in (20.0, 5.0):
+        display.TargetOpticalThickness = target
+        pixels = shot(view, os.path.join(out, "units-estimated-tau%g.png" % target), camera)
+        estimated[target] = (estimate(display), pixels)
+    Delete(view)
+    k20, k5 = estimated[20.0][0], estimated[5.0][0]
+    check(k20 > 0.0, "estimate for optical thickness 20: %.6g /m per unit value" % k20)
+    check(k20 > 0.0 and abs(k20 / k5 - 4.0) < 1e-9,
+          "estimate scales as 1/target: k(20) / k(5) = %.12g (4)" % (k20 / k5 if k5 else 0.0))
+    for target, (k, pixels) in estimated.items():
+        by_hand = render(values, dimensionless(k), "estimated-tau%g-by-hand" % target)
+        difference = np.abs(pixels - by_hand)
+        check(difference.max() <= 1.0 and pixels.std() > 5.0,
+              "estimate, optical thickness %g: the image of the dimensionless density at "
+              "%.6g /m per unit value (max difference %g levels)"
+              % (target, k, difference.max()))
 
 
 def main():
