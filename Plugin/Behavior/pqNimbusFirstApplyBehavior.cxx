@@ -12,10 +12,17 @@
 #include "pqPipelineSource.h"
 #include "pqRenderView.h"
 #include "pqServerManagerModel.h"
+#include "pqUndoStack.h"
+#include "vtkCamera.h"
 #include "vtkDataObject.h"
+#include "vtkMatrix4x4.h"
+#include "vtkPVArrayInformation.h"
+#include "vtkPVDataInformation.h"
 #include "vtkSMPVRepresentationProxy.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
+#include "vtkSMRenderViewProxy.h"
+#include "vtkSMSessionProxyManager.h"
 #include "vtkSMTransferFunctionManager.h"
 #include "vtkSMTransferFunctionProxy.h"
 #include "vtkSMViewProxy.h"
@@ -24,6 +31,7 @@
 #include <QTimer>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -194,6 +202,206 @@ bool IsSkyBackground(pqRepresentation* representation)
   const char* type = RepresentationType(representation);
   return type && std::strcmp(type, "Sky Background") == 0;
 }
+
+// A representation added by the user's Apply or Show, not by loading a state file (the
+// GUI's or Python's) or by undo and redo: those bring back values the user had, which the
+// first look must not change.
+bool IsNewlyShown(pqRepresentation* representation)
+{
+  pqApplicationCore* core = pqApplicationCore::instance();
+  pqUndoStack* undo = core ? core->getUndoStack() : nullptr;
+  vtkSMSessionProxyManager* proxies = representation->getProxy()->GetSessionProxyManager();
+  return core && !core->isLoadingState() && !(proxies && proxies->GetInLoadXMLState()) &&
+    !(undo && (undo->getInUndo() || undo->getInRedo()));
+}
+
+// The smoke's optics (NimbusMediumPresets.h): not a cloud's over kilometres.
+void ApplySmokeOptics(pqDataRepresentation* smoke)
+{
+  vtkSMProxy* proxy = smoke->getProxy();
+  const nimbus::MediumPreset& preset = nimbus::kMediumPresets[nimbus::kSmokePreset];
+  const char* names[3] = { "ExtinctionPerDensity", "Albedo", "CloudG" };
+  const double values[3] = { preset.ExtinctionPerDensity, preset.Albedo, preset.CloudG };
+  for (int k = 0; k < 3; ++k)
+  {
+    if (proxy->GetProperty(names[k]))
+    {
+      vtkSMPropertyHelper(proxy, names[k]).Set(values[k]);
+    }
+  }
+  proxy->UpdateVTKObjects();
+}
+
+// A smoke starts empty (time 0: nothing emitted yet). When it is empty at the animation's
+// time, the animation goes to the first time step at or after kSmokeFirstLookSeconds, a
+// plume that has risen (the emitter's density per second times the time, carried up).
+constexpr double kSmokeFirstLookSeconds = 2.0;
+
+void ShowRisenSmoke(pqDataRepresentation* smoke)
+{
+  vtkPVDataInformation* data = smoke->getInputDataInformation();
+  vtkPVArrayInformation* density =
+    data ? data->GetArrayInformation("density", vtkDataObject::POINT) : nullptr;
+  if (!density || density->GetComponentRange(0)[1] > 0.0)
+  {
+    return;
+  }
+  auto* core = pqPVApplicationCore::instance();
+  pqAnimationScene* scene =
+    core && core->animationManager() ? core->animationManager()->getActiveScene() : nullptr;
+  vtkSMProxy* source = smoke->getInput()->getProxy();
+  if (!scene || !source->GetProperty("TimestepValues") ||
+    scene->getAnimationTime() >= kSmokeFirstLookSeconds)
+  {
+    return;
+  }
+  source->UpdatePropertyInformation();
+  vtkSMPropertyHelper steps(source, "TimestepValues");
+  const unsigned int count = steps.GetNumberOfElements();
+  for (unsigned int i = 0; i < count; ++i)
+  {
+    if (steps.GetAsDouble(i) >= kSmokeFirstLookSeconds - 1e-9 || i + 1 == count)
+    {
+      scene->setAnimationTime(steps.GetAsDouble(i));
+      return;
+    }
+  }
+}
+
+bool ValidBounds(const double b[6])
+{
+  return b[0] <= b[1] && b[2] <= b[3] && b[4] <= b[5];
+}
+
+double Diagonal(const double b[6])
+{
+  return std::sqrt(
+    (b[1] - b[0]) * (b[1] - b[0]) + (b[3] - b[2]) * (b[3] - b[2]) + (b[5] - b[4]) * (b[5] - b[4]));
+}
+
+// How much of the view the box takes with this camera: the larger side of its on-screen
+// rectangle, clipped to the view, over the view's side (0: off screen; 1: fills it). The
+// box is clipped against a plane just in front of the eye (homogeneous w = epsilon): its
+// corners in front and the points where its edges cross that plane bound its picture.
+double OnScreenFraction(vtkCamera* camera, double aspect, const double b[6])
+{
+  vtkMatrix4x4* matrix = camera->GetCompositeProjectionTransformMatrix(aspect, -1.0, 1.0);
+  std::array<std::array<double, 4>, 8> clip;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const double in[4] = { b[corner & 1], b[2 + ((corner >> 1) & 1)], b[4 + ((corner >> 2) & 1)],
+      1.0 };
+    matrix->MultiplyPoint(in, clip[corner].data());
+  }
+  constexpr double epsilon = 1e-9;
+  double low[2] = { 1e300, 1e300 }, high[2] = { -1e300, -1e300 };
+  bool any = false;
+  const auto include = [&](const std::array<double, 4>& p)
+  {
+    any = true;
+    for (int k = 0; k < 2; ++k)
+    {
+      low[k] = std::min(low[k], p[k] / p[3]);
+      high[k] = std::max(high[k], p[k] / p[3]);
+    }
+  };
+  for (int i = 0; i < 8; ++i)
+  {
+    if (clip[i][3] > epsilon)
+    {
+      include(clip[i]);
+    }
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const int j = i | (1 << axis); // each edge once: from i (bit clear) to j (bit set)
+      if (j == i || ((clip[i][3] > epsilon) == (clip[j][3] > epsilon)))
+      {
+        continue;
+      }
+      const double t = (epsilon - clip[i][3]) / (clip[j][3] - clip[i][3]);
+      std::array<double, 4> crossing;
+      for (int k = 0; k < 4; ++k)
+      {
+        crossing[k] = clip[i][k] + t * (clip[j][k] - clip[i][k]);
+      }
+      crossing[3] = epsilon;
+      include(crossing);
+    }
+  }
+  if (!any)
+  {
+    return 0.0; // all behind the eye
+  }
+  double fraction = 0.0;
+  for (int k = 0; k < 2; ++k)
+  {
+    const double extent = std::min(high[k], 1.0) - std::max(low[k], -1.0);
+    if (!(extent > 0.0))
+    {
+      return 0.0; // beside the view
+    }
+    fraction = std::max(fraction, extent / 2.0);
+  }
+  return fraction;
+}
+
+// New data smaller on screen than this (a fraction of the view's side) is framed.
+constexpr double kSmallOnScreen = 0.15;
+// Framed with what the view shows when it is at least this fraction of it (the
+// diagonals), alone otherwise (a smoke of metres beside a cloud of kilometres).
+constexpr double kFrameTogether = 0.1;
+
+// Apply frames new data only in an empty view. New Nimbus data that the view's camera
+// shows tiny or not at all is framed, keeping the view's direction.
+void FrameIfHardToSee(pqDataRepresentation* added, pqRenderView* view)
+{
+  auto* viewProxy = vtkSMRenderViewProxy::SafeDownCast(view->getProxy());
+  vtkPVDataInformation* data = added->getInputDataInformation();
+  if (!viewProxy || !data || data->GetNumberOfPoints() == 0 || IsSkyBackground(added) ||
+    !added->isVisible())
+  {
+    return; // a sky background is drawn behind everything: nothing to frame
+  }
+  std::array<double, 6> mine;
+  data->GetBounds(mine.data());
+  if (!ValidBounds(mine.data()))
+  {
+    return;
+  }
+  int size[2] = { 1, 1 };
+  vtkSMPropertyHelper(viewProxy, "ViewSize").Get(size, 2);
+  const double aspect = size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0;
+  if (OnScreenFraction(viewProxy->GetActiveCamera(), std::max(aspect, 1e-3), mine.data()) >=
+    kSmallOnScreen)
+  {
+    return;
+  }
+  std::array<double, 6> all = mine;
+  for (pqRepresentation* other : view->getRepresentations())
+  {
+    auto* otherData = qobject_cast<pqDataRepresentation*>(other);
+    vtkPVDataInformation* info = otherData && other->isVisible() && !IsSkyBackground(other)
+      ? otherData->getInputDataInformation()
+      : nullptr;
+    if (!info || info->GetNumberOfPoints() == 0)
+    {
+      continue;
+    }
+    double b[6];
+    info->GetBounds(b);
+    if (ValidBounds(b))
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        all[2 * k] = std::min(all[2 * k], b[2 * k]);
+        all[2 * k + 1] = std::max(all[2 * k + 1], b[2 * k + 1]);
+      }
+    }
+  }
+  std::array<double, 6>& frame =
+    Diagonal(mine.data()) >= kFrameTogether * Diagonal(all.data()) ? all : mine;
+  viewProxy->ResetCamera(frame.data());
+}
 }
 
 pqNimbusFirstApplyBehavior::pqNimbusFirstApplyBehavior(QObject* parent)
@@ -238,7 +446,7 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
 {
   auto* data = qobject_cast<pqDataRepresentation*>(representation);
   auto* view = qobject_cast<pqRenderView*>(representation ? representation->getView() : nullptr);
-  if (!data || !view)
+  if (!data || !view || !IsNewlyShown(representation))
   {
     return;
   }
@@ -262,22 +470,12 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
 
   if (IsSmoke(data->getInput()))
   {
+    // Whatever the view already shows: smoke's optics, and a plume that has risen.
     AfterApply(this, data,
       [](pqDataRepresentation* smoke)
       {
-        // Smoke's optics (NimbusMediumPresets.h): not a cloud's over kilometres.
-        vtkSMProxy* proxy = smoke->getProxy();
-        const nimbus::MediumPreset& preset = nimbus::kMediumPresets[nimbus::kSmokePreset];
-        const char* names[3] = { "ExtinctionPerDensity", "Albedo", "CloudG" };
-        const double values[3] = { preset.ExtinctionPerDensity, preset.Albedo, preset.CloudG };
-        for (int k = 0; k < 3; ++k)
-        {
-          if (proxy->GetProperty(names[k]))
-          {
-            vtkSMPropertyHelper(proxy, names[k]).Set(values[k]);
-          }
-        }
-        proxy->UpdateVTKObjects();
+        ApplySmokeOptics(smoke);
+        ShowRisenSmoke(smoke);
       });
   }
 
@@ -318,6 +516,17 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
     if (other != representation && other->isVisible() && !IsSkyBackground(other) && otherData &&
       !inputs.contains(otherData->getInput()))
     {
+      // A view that already shows data keeps its camera unless the new data would be hard
+      // to see in it.
+      QPointer<pqRenderView> guardedView(view);
+      AfterApply(this, data,
+        [guardedView](pqDataRepresentation* added)
+        {
+          if (guardedView)
+          {
+            FrameIfHardToSee(added, guardedView);
+          }
+        });
       return;
     }
   }

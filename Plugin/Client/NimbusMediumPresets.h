@@ -1,7 +1,8 @@
-// The Cloud representation's media presets (issue 17), shared by the panel's Medium
+// The Cloud representation's media presets, shared by the panel's Medium
 // Preset menu (pqNimbusMediumPresetWidget) and the first Apply of a Nimbus Smoke
 // (pqNimbusFirstApplyBehavior). A preset sets the optics and the temperature emission;
-// every value stays editable afterwards.
+// every value stays editable afterwards, and the menu shows the preset whose values the
+// display has (MatchingMediumPreset), or "Custom".
 #ifndef NimbusMediumPresets_h
 #define NimbusMediumPresets_h
 
@@ -38,6 +39,47 @@ constexpr MediumPreset kMediumPresets[] = {
     1.5, 0.6, 0.3, 1, 1.0 },
 };
 constexpr int kSmokePreset = 1;
+constexpr int kNumberOfMediumPresets =
+  static_cast<int>(sizeof(kMediumPresets) / sizeof(kMediumPresets[0]));
+
+// The values a preset sets, as a display has them.
+struct MediumValues
+{
+  double ExtinctionPerDensity;
+  double Albedo;
+  double CloudG;
+  int TemperatureEmission;
+  double EmissionRadiancePerMetre;
+};
+
+// Equal within a small tolerance: 1e-3 relative, with an absolute floor of 1e-6, so a
+// value typed with fewer digits or read back through text still matches its preset.
+inline bool SameMediumValue(double a, double b)
+{
+  const double difference = a > b ? a - b : b - a;
+  const double magnitude = b < 0.0 ? -b : b;
+  return difference <= 1e-6 + 1e-3 * magnitude;
+}
+
+// The preset whose values these are (its index in kMediumPresets), or -1: none (the
+// menu's "Custom"). The glow's brightness counts only while the glow is on.
+inline int MatchingMediumPreset(const MediumValues& values)
+{
+  for (int i = 0; i < kNumberOfMediumPresets; ++i)
+  {
+    const MediumPreset& preset = kMediumPresets[i];
+    if (SameMediumValue(values.ExtinctionPerDensity, preset.ExtinctionPerDensity) &&
+      SameMediumValue(values.Albedo, preset.Albedo) &&
+      SameMediumValue(values.CloudG, preset.CloudG) &&
+      (values.TemperatureEmission != 0) == (preset.TemperatureEmission != 0) &&
+      (values.TemperatureEmission == 0 ||
+        SameMediumValue(values.EmissionRadiancePerMetre, preset.EmissionRadiancePerMetre)))
+    {
+      return i;
+    }
+  }
+  return -1;
+}
 } // namespace nimbus
 
 #endif
