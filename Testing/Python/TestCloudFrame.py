@@ -25,6 +25,13 @@ CASE:
                 estimate (EstimatedExtinctionPerDensityInfo, shown in the panel), which
                 goes as 1/Target Optical Thickness, and renders the image of the
                 dimensionless density at that extinction per density.
+  bad-input     Every new property of the Cloud representation (Up Axis, Density Array
+                Means and the droplets, the target, Sampling Dimensions, the resample
+                budget, Metres Per Unit, the ground) set to values outside its meaning
+                (NaN, infinities, zero, negative, huge, missing arrays), and data with
+                NaN, infinite and negative values in every unit: each render ends (an
+                error message, or a finite picture), and setting the good value back gives
+                the first picture again (nothing is stuck or lost).
 """
 import argparse
 import math
@@ -441,17 +448,99 @@ def estimated_units(out, spacing, origin, camera, render, dimensionless):
               % (target, k, difference.max()))
 
 
+# --- bad input -------------------------------------------------------------------------
+BAD_VALUES = {
+    "UpAxis": [-1, 4, 99],
+    "DensityUnits": [-1, 6, 1000],
+    "DropletSize": [-1, 2],
+    "DropletEffectiveRadiusMicrometres": [0.0, -5.0, float("nan"), float("inf"), 1e30],
+    "DropletNumberConcentrationPerCubicCentimetre": [0.0, -1.0, float("nan"), float("-inf"),
+                                                     1e30],
+    "TargetOpticalThickness": [0.0, -1.0, float("nan"), float("inf"), 1e300],
+    "CloudSamplingDimensions": [[0, 0, 0], [-5, 10, 10], [1, 1, 1], [1 << 30] * 3],
+    "ResampleMemoryBudgetMiB": [-1.0, float("nan"), 1e-9],
+    "MetresPerUnit": [0.0, -1.0, float("nan"), float("inf"), 1e-300, 1e300],
+    "AirDensityArray": ["missing", "density"],
+    "GroundHeight": [float("nan"), float("inf"), -1e30, 1e30],
+}
+# The units each property matters for (the others ignore it).
+UNITS_FOR = {"DropletSize": 2, "DropletEffectiveRadiusMicrometres": 2,
+             "DropletNumberConcentrationPerCubicCentimetre": 2, "TargetOpticalThickness": 5,
+             "AirDensityArray": 3}
+
+
+def bad_input(out):
+    density = cloud_density(24, 20, 16)
+    spacing, origin = (60.0, 60.0, 60.0), (-690.0, -570.0, 300.0)
+    camera = ([-2400.0, -2000.0, 700.0], [0.0, 0.0, 750.0], [0.0, 0.0, 1.0])
+    sources = {"image": producer(image_of(density * 0.3, spacing, origin))}
+    sources["unstructured"] = Tetrahedralize(Input=sources["image"])
+    count = 0
+    for kind, source in sources.items():
+        for name, values in BAD_VALUES.items():
+            view = new_view()
+            view.ViewSize = [160, 120]
+            display = show_cloud(source, view)
+            display.CloudSamplingDimensions = [24, 24, 24]   # a quick resample
+            display.DropletSize = 1 if name == "DropletNumberConcentrationPerCubicCentimetre" else 0
+            display.DensityUnits = UNITS_FOR.get(name, 2)
+            first_render(view)
+            good = display.GetPropertyValue(name)
+            good = list(good) if isinstance(good, (list, tuple)) or hasattr(good, "__len__") \
+                and not isinstance(good, str) else good
+            size = [160, 120]
+            path = os.path.join(out, "bad-%s-%s-good.png" % (kind, name))
+            view.CameraPosition, view.CameraFocalPoint, view.CameraViewUp = camera
+            Render(view)
+            SaveScreenshot(path, view, ImageResolution=size)
+            first = read_png(path)
+            for value in values:
+                setattr(display, name, value)
+                Render(view)   # an error message, or a picture: never a crash or a hang
+                count += 1
+            setattr(display, name, good)
+            Render(view)
+            SaveScreenshot(path.replace("-good", "-again"), view, ImageResolution=size)
+            again = read_png(path.replace("-good", "-again"))
+            difference = np.abs(again - first).max()
+            check(difference <= 1.0 and first.std() > 3.0,
+                  "%s, %s: %d bad values rendered or refused, the good value gives the first "
+                  "picture again (max difference %g levels)" % (kind, name, len(values),
+                                                                difference))
+            Delete(view)
+    # Data with NaN, infinite and negative values, in every unit.
+    poisoned = density * 0.3
+    flat = poisoned.reshape(-1)
+    flat[::7] = np.nan
+    flat[3::11] = np.inf
+    flat[5::13] = -np.inf
+    flat[2::17] = -1.0
+    for units in (0, 1, 2, 3, 4, 5):
+        view = new_view()
+        view.ViewSize = [160, 120]
+        display = show_cloud(producer(image_of(poisoned, spacing, origin)), view)
+        display.DensityUnits = units
+        first_render(view)
+        pixels = shot(view, os.path.join(out, "bad-poisoned-units%d.png" % units), camera)
+        count += 1
+        check(np.isfinite(pixels).all() and (pixels >= 254.5).mean() < 0.5,
+              "NaN/Inf/negative data, Density Array Means %d: a picture, not blown out "
+              "(%.1f %% white)" % (units, 100 * (pixels >= 254.5).mean()))
+        Delete(view)
+    print("%d bad inputs rendered" % count)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--plugin", required=True)
     parser.add_argument("--output-dir", required=True)
     parser.add_argument("--case", required=True,
-                        choices=["seamless-air", "up-axis", "any-grid", "units"])
+                        choices=["seamless-air", "up-axis", "any-grid", "units", "bad-input"])
     args = parser.parse_args()
     os.makedirs(args.output_dir, exist_ok=True)
     LoadPlugin(args.plugin, ns=globals())
     {"seamless-air": seamless_air, "up-axis": up_axis, "any-grid": any_grid,
-     "units": units}[args.case](args.output_dir)
+     "units": units, "bad-input": bad_input}[args.case](args.output_dir)
     if FAILURES:
         print("%d check(s) failed" % len(FAILURES))
         sys.exit(1)
