@@ -90,6 +90,32 @@ bool IsLightningIllumination(pqPipelineSource* source)
   return name && std::strcmp(name, "NimbusLightningIllumination") == 0;
 }
 
+bool IsOpenVdb(pqPipelineSource* source)
+{
+  const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
+  return name && std::strcmp(name, "NimbusOpenVDBReader") == 0;
+}
+
+// "Unknown: a typical cloud (estimated)" (Density Array Means): a .vdb's density has no
+// physical unit (Houdini's and Blender's are 0..1 by convention, at any voxel size), so the
+// first look scales it to a cumulus's optical thickness rather than taking it as Nimbus's
+// own density (docs/density-units.md). Only while the display is a Cloud with the default
+// units, so a user's or a state file's choice stays.
+constexpr int kEstimatedDensityUnits = 5;
+
+void EstimateVdbDensity(pqDataRepresentation* cloud)
+{
+  vtkSMProxy* proxy = cloud->getProxy();
+  const char* type = RepresentationType(cloud);
+  if (!type || std::strcmp(type, "Cloud") != 0 || !proxy->GetProperty("DensityUnits") ||
+    vtkSMPropertyHelper(proxy, "DensityUnits").GetAsInt() != 0)
+  {
+    return;
+  }
+  vtkSMPropertyHelper(proxy, "DensityUnits").Set(kEstimatedDensityUnits);
+  proxy->UpdateVTKObjects();
+}
+
 bool IsSmoke(pqPipelineSource* source)
 {
   const char* name = source && source->getProxy() ? source->getProxy()->GetXMLName() : nullptr;
@@ -477,6 +503,11 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
         ApplySmokeOptics(smoke);
         ShowRisenSmoke(smoke);
       });
+  }
+
+  if (IsOpenVdb(data->getInput()))
+  {
+    AfterApply(this, data, [](pqDataRepresentation* cloud) { EstimateVdbDensity(cloud); });
   }
 
   if (IsLightningIllumination(data->getInput()))
