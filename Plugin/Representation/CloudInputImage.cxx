@@ -13,9 +13,11 @@
 #include "vtkNew.h"
 #include "vtkPResampleToImage.h"
 #include "vtkPointData.h"
+#include "vtkRectilinearGrid.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -162,6 +164,87 @@ double AltitudeOf(vtkImageData* image, vtkIdType id, const int dims[3], bool cel
   const double z = ToUpFrame(settings.Up, { { world[0], world[1], world[2] } })[2];
   return settings.SceneAltitudeMetres + z * settings.MetresPerUnit;
 }
+// Points of a rectilinear axis: its length over its finest spacing, + 1 (a stretched LES
+// level keeps its finest layer).
+int AxisPointsOf(vtkDataArray* coordinates)
+{
+  const vtkIdType n = coordinates ? coordinates->GetNumberOfTuples() : 0;
+  if (n < 2)
+  {
+    return 1;
+  }
+  double finest = std::numeric_limits<double>::infinity();
+  for (vtkIdType i = 1; i < n; ++i)
+  {
+    const double step =
+      std::abs(coordinates->GetComponent(i, 0) - coordinates->GetComponent(i - 1, 0));
+    if (step > 0.0)
+    {
+      finest = std::min(finest, step);
+    }
+  }
+  const double length =
+    std::abs(coordinates->GetComponent(n - 1, 0) - coordinates->GetComponent(0, 0));
+  return std::isfinite(finest) && length > 0.0
+    ? static_cast<int>(std::ceil(length / finest - 1e-9)) + 1
+    : 1;
+}
+
+// Automatic sampling: the data's own resolution, at most kMaxAutomaticPoints a side.
+constexpr int kMaxAutomaticPoints = 256;
+
+void AutomaticDimensions(vtkDataObject* input, int dims[3])
+{
+  int automatic[3] = { 1, 1, 1 };
+  if (auto* grid = vtkRectilinearGrid::SafeDownCast(input))
+  {
+    automatic[0] = AxisPointsOf(grid->GetXCoordinates());
+    automatic[1] = AxisPointsOf(grid->GetYCoordinates());
+    automatic[2] = AxisPointsOf(grid->GetZCoordinates());
+  }
+  else
+  {
+    // As many points as the data has, spread evenly over its bounds.
+    double bounds[6] = { 0, -1, 0, -1, 0, -1 };
+    vtkIdType points = 0;
+    if (auto* dataSet = vtkDataSet::SafeDownCast(input))
+    {
+      dataSet->GetBounds(bounds);
+      points = dataSet->GetNumberOfPoints();
+    }
+    else if (auto* composite = vtkCompositeDataSet::SafeDownCast(input))
+    {
+      composite->GetBounds(bounds);
+      points = composite->GetNumberOfPoints();
+    }
+    double volume = 1.0;
+    int extended = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double length = bounds[2 * a + 1] - bounds[2 * a];
+      if (length > 0.0)
+      {
+        volume *= length;
+        ++extended;
+      }
+    }
+    const double spacing =
+      extended > 0 && points > 0 ? std::pow(volume / points, 1.0 / extended) : 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double length = bounds[2 * a + 1] - bounds[2 * a];
+      automatic[a] =
+        length > 0.0 && spacing > 0.0 ? static_cast<int>(std::lround(length / spacing)) + 1 : 1;
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (dims[a] == 0)
+    {
+      dims[a] = std::min(std::max(automatic[a], 1), kMaxAutomaticPoints);
+    }
+  }
+}
 } // namespace
 
 vtkSmartPointer<vtkImageData> CloudImageOf(
@@ -172,7 +255,9 @@ vtkSmartPointer<vtkImageData> CloudImageOf(
   {
     return image;
   }
-  const int* dims = settings.SamplingDimensions;
+  int dims[3] = { settings.SamplingDimensions[0], settings.SamplingDimensions[1],
+    settings.SamplingDimensions[2] };
+  AutomaticDimensions(input, dims); // the axes set to 0
   if (dims[0] < 1 || dims[1] < 1 || dims[2] < 1)
   {
     std::ostringstream message;

@@ -28,11 +28,14 @@ constexpr int kEstimatedDensityUnits = 5;
 
 struct CloudInputSettings
 {
-  int SamplingDimensions[3] = { 128, 128, 128 }; // points of the resampled image
-  double MemoryBudgetBytes = 0.0;                // <= 0: DefaultMemoryBudgetBytes()
-  int Units = 0;                                 // 0..4 DensityUnits, 5 estimated
-  CloudOpticsParameters Optics;                  // radius, number concentration
-  std::string AirDensityArray;                   // kg/m^3; empty: standard atmosphere
+  // Points of the resampled image per axis; 0: automatic, the data's own resolution (a
+  // rectilinear axis: its length over its finest spacing; other data: its points spread
+  // evenly over its bounds), at most 256.
+  int SamplingDimensions[3] = { 0, 0, 0 };
+  double MemoryBudgetBytes = 0.0; // <= 0: DefaultMemoryBudgetBytes()
+  int Units = 0;                  // 0..4 DensityUnits, 5 estimated
+  CloudOpticsParameters Optics;   // radius, number concentration
+  std::string AirDensityArray;    // kg/m^3; empty: standard atmosphere
   double TargetOpticalThickness = kDefaultTargetOpticalThickness;
   // The frame the altitudes of the mixing ratio's air and the estimate's columns
   // are taken in (the mapper's, Physics/UpAxis.h).
@@ -44,7 +47,8 @@ struct CloudInputSettings
 /// The input as one image: an image passes through (resampled = false); any other
 /// data set or composite data set (rectilinear, structured, unstructured grids,
 /// AMR, multiblock) is resampled on SamplingDimensions points over its bounds (all
-/// ranks' bounds under MPI), its point and cell arrays becoming point arrays.
+/// ranks' bounds under MPI), its point and cell arrays becoming point arrays. Axes of
+/// SamplingDimensions set to 0 take the data's own resolution.
 /// Throws std::runtime_error with a plain-words message: no points, dimensions
 /// below 1 or an image over the memory budget (checked before allocating).
 vtkSmartPointer<vtkImageData> CloudImageOf(

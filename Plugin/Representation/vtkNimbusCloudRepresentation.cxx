@@ -675,7 +675,7 @@ void vtkNimbusCloudRepresentation::SetAirDensityArray(const char* name)
 
 void vtkNimbusCloudRepresentation::SetSamplingDimensions(int x, int y, int z)
 {
-  const int dims[3] = { std::max(x, 1), std::max(y, 1), std::max(z, 1) };
+  const int dims[3] = { std::max(x, 0), std::max(y, 0), std::max(z, 0) }; // 0: automatic
   if (!std::equal(dims, dims + 3, this->SamplingDimensions))
   {
     std::copy(dims, dims + 3, this->SamplingDimensions);

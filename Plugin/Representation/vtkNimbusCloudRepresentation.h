@@ -83,7 +83,8 @@ public:
   ///@}
 
   ///@{
-  /// Non-image data: the resampled image's points per axis (default 128^3) and the
+  /// Non-image data: the resampled image's points per axis (0, the default: the data's
+  /// own resolution, at most 256; CloudInputImage.h) and the
   /// memory budget of the resampled image [MiB; 0: half of the physical memory],
   /// checked before it is allocated. A change re-executes the representation.
   void SetSamplingDimensions(int x, int y, int z);
@@ -318,7 +319,7 @@ protected:
   double TargetOpticalThickness = 20.0;
   double EstimatedExtinctionPerDensity = 0.0;
   double UserExtinctionPerDensity = 0.02; // the mapper's default
-  int SamplingDimensions[3] = { 128, 128, 128 };
+  int SamplingDimensions[3] = { 0, 0, 0 };
   double ResampleMemoryBudgetMiB = 0.0;
   bool Resampled = false;
   bool ResampledFromCells = false;
