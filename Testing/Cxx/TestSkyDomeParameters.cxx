@@ -31,6 +31,7 @@ void ExpectSameSky(vtkNimbusSky* a, vtkNimbusSky* b)
   EXPECT_EQ(a->GetMetresPerUnit(), b->GetMetresPerUnit());
   EXPECT_EQ(a->GetMaxAerialDistanceMetres(), b->GetMaxAerialDistanceMetres());
   EXPECT_EQ(a->GetScatteringOrders(), b->GetScatteringOrders());
+  EXPECT_EQ(a->GetUpAxis(), b->GetUpAxis());
 }
 }
 
@@ -49,11 +50,13 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
   dome->SetScatteringOrders(2);
   dome->SetWhiteBalance(false);
   dome->SetSunDisc(false);
+  dome->SetUpAxis(1); // +Y
   dome->Update();
   vtkFieldData* fields = dome->GetOutput()->GetFieldData();
   const char* names[] = { "SunElevationDegrees", "SunAzimuthDegrees", "Turbidity",
     "MieScatteringPerMetre", "GroundAlbedo", "Exposure", "WhiteBalance", "SunDisc",
-    "SceneAltitudeMetres", "MetresPerUnit", "MaxAerialDistanceMetres", "ScatteringOrders" };
+    "SceneAltitudeMetres", "MetresPerUnit", "MaxAerialDistanceMetres", "ScatteringOrders",
+    "UpAxis" };
   for (const char* name : names)
   {
     vtkDataArray* array = fields->GetArray(name);
@@ -62,7 +65,7 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
     EXPECT_EQ(array->GetNumberOfComponents(), 1) << name;
     EXPECT_TRUE(vtkDoubleArray::SafeDownCast(array)) << name;
   }
-  EXPECT_EQ(fields->GetNumberOfArrays(), 12);
+  EXPECT_EQ(fields->GetNumberOfArrays(), 13);
   EXPECT_EQ(fields->GetArray("SunElevationDegrees")->GetComponent(0, 0), 2.0);
   EXPECT_EQ(fields->GetArray("SunAzimuthDegrees")->GetComponent(0, 0), 270.0);
   EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 25.0);
@@ -72,14 +75,15 @@ TEST(SkyDomeParameters, OutputFieldDataAfterPreset)
 
   // Read back into another sky: the same parameters.
   vtkNew<vtkNimbusSky> copy;
-  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(fields, copy), 12);
+  EXPECT_EQ(fields->GetArray("UpAxis")->GetComponent(0, 0), 1.0);
+  EXPECT_EQ(vtkNimbusSkyDomeSource::ApplySkyParameters(fields, copy), 13);
   ExpectSameSky(dome->GetSky(), copy);
 
   // A second update replaces the arrays instead of adding more.
   dome->SetExposure(5.0);
   dome->Update();
   fields = dome->GetOutput()->GetFieldData();
-  EXPECT_EQ(fields->GetNumberOfArrays(), 12);
+  EXPECT_EQ(fields->GetNumberOfArrays(), 13);
   EXPECT_EQ(fields->GetArray("Exposure")->GetComponent(0, 0), 5.0);
 }
 
