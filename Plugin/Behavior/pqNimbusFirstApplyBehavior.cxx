@@ -11,7 +11,9 @@
 #include "pqPipelineFilter.h"
 #include "pqPipelineSource.h"
 #include "pqRenderView.h"
+#include "pqServer.h"
 #include "pqServerManagerModel.h"
+#include "pqTimeKeeper.h"
 #include "pqUndoStack.h"
 #include "vtkCamera.h"
 #include "vtkDataObject.h"
@@ -40,6 +42,35 @@ namespace
 // The sun of a cloud lit by lightning on first Apply: below the horizon (nautical
 // twilight, a dark sky), so the flash is what lights it.
 constexpr double kNightSunElevationDegrees = -12.0;
+
+// Moves the animation to `time`, and again until the views are there. A first-Apply style
+// runs from the event loop, which ParaView also runs inside a render's progress events; once,
+// on a loaded machine, a time set so moved the animation's clock but not the views' (the
+// toolbar at 2 s, the view's time and picture still at 0). So the time keeper is checked a
+// little later and the time pushed again while it differs (and the user has not moved it).
+void SetAnimationTime(QObject* context, pqAnimationScene* scene, double time, int tries = 40)
+{
+  if (!scene)
+  {
+    return;
+  }
+  vtkSMProxy* proxy = scene->getProxy();
+  vtkSMPropertyHelper(proxy, "AnimationTime").Set(time);
+  proxy->UpdateProperty("AnimationTime", /*force=*/1);
+  QPointer<pqAnimationScene> guarded(scene);
+  QTimer::singleShot(250, context,
+    [context, guarded, time, tries]()
+    {
+      pqTimeKeeper* keeper =
+        guarded && guarded->getServer() ? guarded->getServer()->getTimeKeeper() : nullptr;
+      if (keeper && std::abs(keeper->getTime() - time) > 1e-9 * std::max(1.0, std::abs(time)) &&
+        tries > 0 &&
+        std::abs(guarded->getAnimationTime() - time) <= 1e-9 * std::max(1.0, std::abs(time)))
+      {
+        SetAnimationTime(context, guarded, time, tries - 1);
+      }
+    });
+}
 
 // Sources and filters of clouds and the sky (proxy XML names).
 bool IsNimbusCloudProducer(pqPipelineSource* source)
@@ -263,7 +294,7 @@ void ApplySmokeOptics(pqDataRepresentation* smoke)
 // plume that has risen (the emitter's density per second times the time, carried up).
 constexpr double kSmokeFirstLookSeconds = 2.0;
 
-void ShowRisenSmoke(pqDataRepresentation* smoke)
+void ShowRisenSmoke(QObject* context, pqDataRepresentation* smoke)
 {
   vtkPVDataInformation* data = smoke->getInputDataInformation();
   vtkPVArrayInformation* density =
@@ -288,7 +319,7 @@ void ShowRisenSmoke(pqDataRepresentation* smoke)
   {
     if (steps.GetAsDouble(i) >= kSmokeFirstLookSeconds - 1e-9 || i + 1 == count)
     {
-      scene->setAnimationTime(steps.GetAsDouble(i));
+      SetAnimationTime(context, scene, steps.GetAsDouble(i));
       return;
     }
   }
@@ -498,10 +529,10 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
   {
     // Whatever the view already shows: smoke's optics, and a plume that has risen.
     AfterApply(this, data,
-      [](pqDataRepresentation* smoke)
+      [this](pqDataRepresentation* smoke)
       {
         ApplySmokeOptics(smoke);
-        ShowRisenSmoke(smoke);
+        ShowRisenSmoke(this, smoke);
       });
   }
 
