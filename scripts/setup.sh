@@ -34,6 +34,8 @@ packages=(
   python3-netcdf4
   # headless OpenGL: Xvfb + Mesa llvmpipe
   xvfb libgl1-mesa-dri libglx-mesa0
+  # driving and photographing the real GUI by hand (docs/images/gui: xdotool, import)
+  xdotool imagemagick
   # no X at all: EGL (vtkNimbusOffscreenRenderWindow, NIMBUS_OFFSCREEN=egl)
   libegl-dev libegl-mesa0
 )
