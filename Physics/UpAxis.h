@@ -96,6 +96,19 @@ inline std::string UpAxisName(UpAxis axis)
   }
 }
 
+/// The message of a setter refusing `value` (empty when it is an up axis): the values
+/// allowed and the axis kept (`current`).
+inline std::string UpAxisRefusal(int value, int current)
+{
+  if (IsUpAxis(value))
+  {
+    return std::string();
+  }
+  return "SetUpAxis(" + std::to_string(value) +
+    "): not an up axis (0 +X, 1 +Y, 2 +Z, 3 -Y); the up axis stays " +
+    UpAxisName(static_cast<UpAxis>(current));
+}
+
 } // namespace nimbus
 
 #endif

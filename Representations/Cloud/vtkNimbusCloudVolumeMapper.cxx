@@ -1145,11 +1145,10 @@ double vtkNimbusCloudVolumeMapper::GetLastGroundHeight() const
 
 void vtkNimbusCloudVolumeMapper::SetUpAxis(int value)
 {
-  if (!nimbus::IsUpAxis(value))
+  const std::string refusal = nimbus::UpAxisRefusal(value, this->UpAxis);
+  if (!refusal.empty())
   {
-    vtkErrorMacro("SetUpAxis(" << value
-                               << "): not an up axis (0 +X, 1 +Y, 2 +Z, 3 -Y); the up axis stays "
-                               << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis)));
+    vtkErrorMacro(<< refusal);
     return;
   }
   if (value != this->UpAxis)

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 vtkStandardNewMacro(vtkNimbusSky);
 
@@ -24,11 +25,10 @@ nimbusDefineFiniteSetter(vtkNimbusSky, MetresPerUnit);
 
 void vtkNimbusSky::SetUpAxis(int value)
 {
-  if (!nimbus::IsUpAxis(value))
+  const std::string refusal = nimbus::UpAxisRefusal(value, this->UpAxis);
+  if (!refusal.empty())
   {
-    vtkErrorMacro("SetUpAxis(" << value
-                               << "): not an up axis (0 +X, 1 +Y, 2 +Z, 3 -Y); the up axis stays "
-                               << nimbus::UpAxisName(static_cast<nimbus::UpAxis>(this->UpAxis)));
+    vtkErrorMacro(<< refusal);
     return;
   }
   if (value != this->UpAxis)
