@@ -85,7 +85,8 @@ bool CloudDensityTexture::NeedsUpload(
 {
   return !this->HasDensity || this->UploadedArray != scalars || this->UploadedImage != image ||
     scalars->GetMTime() > this->UploadTime || GeometryOf(image) != this->UploadedGeometry ||
-    this->UploadedMaximumSize != maximumSize || this->UploadedBudgetBytes != budgetBytes;
+    this->UploadedMaximumSize != maximumSize || this->UploadedBudgetBytes != budgetBytes ||
+    (this->KeepTexels && this->Texels.empty());
 }
 
 bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
@@ -226,6 +227,12 @@ bool CloudDensityTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* im
     return false;
   }
   this->SetBox(image, cellData, plan);
+  this->Texels.clear();
+  this->Texels.shrink_to_fit();
+  if (this->KeepTexels)
+  {
+    this->Texels.assign(density.Data(), density.Data() + plan.OutputSize());
+  }
   std::copy(texDims.begin(), texDims.end(), this->Dimensions);
   std::copy(plan.Factors.begin(), plan.Factors.end(), this->Factors);
   this->UploadedArray = scalars;
@@ -315,5 +322,7 @@ void CloudDensityTexture::Release(vtkWindow* window)
   this->UploadedArray = nullptr;
   this->UploadedImage = nullptr;
   this->HasDensity = false;
+  this->Texels.clear();
+  this->Texels.shrink_to_fit();
 }
 } // namespace nimbus

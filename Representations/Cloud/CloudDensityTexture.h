@@ -60,6 +60,13 @@ public:
   void GetDimensions(int dimensions[3]) const;
   /// Input samples per texel per axis of the last upload (the block factors).
   void GetFactors(int factors[3]) const;
+  /// Keep a copy of the uploaded texels on the CPU (the ray-marched method's
+  /// sun-depth volume reads them; 4 bytes per texel, within the budget's 8). Turning
+  /// it on makes the next Update upload again when no copy is kept.
+  void SetKeepTexels(bool keep) { this->KeepTexels = keep; }
+  /// The uploaded texels (x fastest; NaN and infinite as 0, negative clamped, as in
+  /// the texture), when KeepTexels was on at the upload; else empty.
+  const std::vector<float>& GetTexels() const { return this->Texels; }
   /// Uploads so far (tests and benchmarks).
   int GetNumberOfUploads() const { return this->Uploads; }
 
@@ -96,6 +103,8 @@ private:
   vtkDataArray* ReportedArray = nullptr; // identity only, never dereferenced
   vtkTimeStamp ReportTime;
   bool HasDensity = false;
+  bool KeepTexels = false;
+  std::vector<float> Texels;
   int Uploads = 0;
   int Dimensions[3] = { 0, 0, 0 };
   int Factors[3] = { 1, 1, 1 };

@@ -13,9 +13,13 @@
 #include "MultipleScatteringTexture.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
+#include "SunDepthVolume.h"
 #include "UpAxis.h"
 
 #include "ShaderLibrary.h"
+#include "cloudAirFroxelsFS.h"
+#include "cloudLight.h"
+#include "cloudMarchFS.h"
 #include "svsCommon.h"
 #include "svsCompositeFS.h"
 #include "svsIntervalPhaseFS.h"
@@ -80,6 +84,7 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunIlluminance);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SunTemperatureKelvin);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieScatteringPerMetre);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MieG);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, RayMarchStepTexels);
 
 void vtkNimbusCloudVolumeMapper::SetTurbidity(double turbidity)
 {
@@ -142,11 +147,13 @@ std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
   return out;
 }
 
-std::string FragmentSource(const char* pass)
+// A pass's fragment shader: the GLSL library, svsCommon.glsl, for the passes that
+// light the cloud cloudLight.glsl, then the pass.
+std::string FragmentSource(const char* pass, bool cloudLight)
 {
   return nimbus::WithShaderLibrary(
     std::string("//VTK::System::Dec\n//VTK::Output::Dec\n//NIMBUS::Library\n") + svsCommon + "\n" +
-    pass);
+    (cloudLight ? std::string(::cloudLight) + "\n" : std::string()) + pass);
 }
 
 // Frees a texture's storage and sets clamp-to-edge wrapping and its filter, ready
@@ -396,8 +403,21 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkTextureObject> Shadow;
   vtkNew<vtkOpenGLFramebufferObject> ShadowFramebuffer;
 
+  // The ray-marched method: the cloud's optical depth toward the sun per density
+  // texel and the density's block maxima (keyed by what they depend on), and the
+  // clear air's look-up volume over the view (an atlas: in-scattering, transmittance).
+  vtkNew<vtkTextureObject> SunDepthTexture;
+  vtkNew<vtkTextureObject> BlockTexture;
+  std::array<int, 3> BlockCount{ { 1, 1, 1 } };
+  std::vector<double> SunDepthKey;
+  int SunDepthBuilds = 0;
+  double LastSunDepthSeconds = 0.0;
+  vtkNew<vtkTextureObject> FroxelScattering;
+  vtkNew<vtkTextureObject> FroxelTransmittance;
+  vtkNew<vtkOpenGLFramebufferObject> FroxelFramebuffer;
+
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass, RayEndsPass;
+    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass;
 
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
@@ -432,18 +452,21 @@ struct vtkNimbusCloudVolumeMapper::Internals
     for (vtkTextureObject* t :
       { AtmosphereTexture.GetPointer(), IntervalPhase.GetPointer(), Accumulation.GetPointer(),
         ClearAccumulation.GetPointer(), SceneColor.GetPointer(), SceneDepth.GetPointer(),
-        Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer() })
+        Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer(),
+        SunDepthTexture.GetPointer(), BlockTexture.GetPointer(), FroxelScattering.GetPointer(),
+        FroxelTransmittance.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
-    for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
-           SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
-           AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer() })
+    for (vtkOpenGLFramebufferObject* f :
+      { IntervalPhaseFramebuffer.GetPointer(), SceneFramebuffer.GetPointer(),
+        RayEndsFramebuffer.GetPointer(), AccumulationFramebuffer.GetPointer(),
+        ShadowFramebuffer.GetPointer(), FroxelFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
-    for (auto* pass :
-      { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass, &RayEndsPass })
+    for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
+           &RayEndsPass, &CloudMarchPass, &FroxelPass })
     {
       if (*pass)
       {
@@ -453,16 +476,18 @@ struct vtkNimbusCloudVolumeMapper::Internals
     }
     AtmosphereKey.clear();
     IntervalPhaseKey.clear();
+    SunDepthKey.clear();
     ReuseKey.clear();
     ReuseValid = false;
     Window = nullptr;
   }
 
-  vtkShaderProgram* Ready(std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source)
+  vtkShaderProgram* Ready(
+    std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source, bool cloudLight = false)
   {
     if (!pass)
     {
-      const std::string fs = FragmentSource(source);
+      const std::string fs = FragmentSource(source, cloudLight);
       pass = std::make_unique<vtkOpenGLQuadHelper>(Window, nullptr, fs.c_str(), "");
     }
     else
@@ -596,7 +621,9 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
       { in.Density.GetTexture(), in.SceneDepth.GetPointer(), in.RayEnds.GetPointer(),
         in.IntervalPhase.GetPointer(), in.Shadow.GetPointer(), in.Accumulation.GetPointer(),
         in.SceneColor.GetPointer(), in.ClearAccumulation.GetPointer(),
-        in.AtmosphereTexture.GetPointer(), in.ExternalShadowTexture.GetPointer() })
+        in.AtmosphereTexture.GetPointer(), in.ExternalShadowTexture.GetPointer(),
+        in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
+        in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -627,6 +654,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
   this->UpdateMultipleScattering(frame);
   this->UpdateLightning(frame);
   this->UpdateEmission(frame);
+  this->UpdateSunDepthVolume(frame);
   // Nothing the cloud depends on changed since the last complete frame: its image
   // (the accumulation targets) is composited again without a pass.
   std::vector<double> key = this->FrameReuseKey(frame);
@@ -643,6 +671,12 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
   if (reuse)
   {
     in.RayEnds->Activate();
+  }
+  else if (this->UsesRayMarching())
+  {
+    this->RenderAirFroxels(frame);
+    this->RenderCloudMarch(frame);
+    this->CaptureRadianceImage(frame);
   }
   else
   {
@@ -820,8 +854,9 @@ bool vtkNimbusCloudVolumeMapper::UpdateDensityTexture(vtkRenderer* renderer, Fra
     : static_cast<double>(nimbus::DefaultMemoryBudgetBytes());
   std::vector<std::string> warnings;
   std::string error;
-  const bool ok =
-    in.Density.Update(window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error);
+  const bool ok = (in.Density.SetKeepTexels(this->UsesRayMarching()),
+    in.Density.Update(
+      window, image, scalars, cellFlag != 0, maxSize, budgetBytes, warnings, error));
   frame.Image = image;
   frame.Scalars = scalars;
   frame.CellData = cellFlag != 0;
@@ -1351,7 +1386,10 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformi("density", in.Density.GetTexture()->GetTextureUnit());
   program->SetUniformf("extinctionPerDensity", static_cast<float>(this->ExtinctionPerDensity));
   program->SetUniformf("cloudAlbedo", static_cast<float>(this->Albedo));
-  program->SetUniformi("shadowSurface", in.Shadow->GetTextureUnit());
+  // (The ray march has no shadow surface; its sampler names a 2-D unit still.)
+  program->SetUniformi("shadowSurface",
+    (in.Shadow->GetTextureUnit() >= 0 ? in.Shadow.GetPointer() : in.SceneDepth.GetPointer())
+      ->GetTextureUnit());
   program->SetUniform3f("shadowOrigin", frame.Shadow.Origin.data());
   program->SetUniform3f("shadowU", frame.Shadow.U.data());
   program->SetUniform3f("shadowW", frame.Shadow.W.data());
@@ -1381,6 +1419,13 @@ void vtkNimbusCloudVolumeMapper::SetCommonUniforms(
   program->SetUniformi("sceneDepth", in.SceneDepth->GetTextureUnit());
   program->SetUniformi("overSky", frame.Settings.OverSky ? 1 : 0);
   program->SetUniformi("sliceJitter", this->SliceJitter ? 1 : 0);
+  program->SetUniformf(
+    "firstSliceOffset", static_cast<float>(frame.FirstPlaneOffset - 0.5 * frame.Planes.Spacing));
+  const bool sunDepth = this->UsesRayMarching() && in.SunDepthTexture->GetHandle();
+  program->SetUniformi("sunDepthVolumeOn", sunDepth ? 1 : 0);
+  // Unused when off, but the sampler must name a 3-D texture unit.
+  program->SetUniformi("sunDepthVolume",
+    (sunDepth ? in.SunDepthTexture.GetPointer() : in.Density.GetTexture())->GetTextureUnit());
   program->SetUniformi("externalShadowOn", frame.ExternalShadow ? 1 : 0);
   // Unused when off, but the sampler must name a 2-D texture unit.
   program->SetUniformi("externalShadow",
@@ -1429,6 +1474,11 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
   {
     in.Emission.GetTexture()->Activate();
   }
+  if (this->UsesRayMarching())
+  {
+    in.SunDepthTexture->Activate();
+    in.BlockTexture->Activate();
+  }
   frame.State->vtkglDisable(GL_DEPTH_TEST);
   frame.State->vtkglDepthMask(GL_FALSE);
 }
@@ -1471,6 +1521,15 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   if (frame.EmissionTexture)
   {
     in.Emission.GetTexture()->Deactivate();
+  }
+  for (vtkTextureObject* t : { in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
+         in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
+         in.ClearAccumulation.GetPointer() })
+  {
+    if (t->GetContext())
+    {
+      t->Deactivate();
+    }
   }
 }
 
@@ -2097,6 +2156,7 @@ void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
   in.Accumulation->SetMagnificationFilter(filter);
   DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
   in.AccumulationFramebuffer->RemoveColorAttachment(1);
+  in.AccumulationFramebuffer->RemoveColorAttachment(2);
   if (frame.Settings.OverSky)
   {
     EnsureTexture2D(
@@ -2154,8 +2214,6 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
   program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
   program->SetUniformi("steps", this->AtmosphereSteps);
   program->SetUniformf("sliceSpacing", static_cast<float>(frame.Planes.Spacing));
-  program->SetUniformf(
-    "firstSliceOffset", static_cast<float>(frame.FirstPlaneOffset - 0.5 * frame.Planes.Spacing));
 
   program->SetUniformi("maxShadowSteps", std::min(frame.Level.Slices, 2 * this->AtmosphereSteps));
   // Only rays through the box have a part behind it: the box's pixels.
@@ -2177,6 +2235,326 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
 }
 
 //------------------------------------------------------------------------------
+// The uniforms of cloudLight.glsl: multiple scattering, lightning, emission, octaves.
+void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
+  vtkShaderProgram* program, const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  // Multiple scattering. Without a texture the samplers name the
+  // density's unit (a 3-D texture, never read), so no unit has two sampler types.
+  program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+  program->SetUniformi("scatteringTextureOn", frame.ScatteringTexture ? 1 : 0);
+  program->SetUniformf("scatteringScale", static_cast<float>(frame.ScatteringScale));
+  const char* scatteringSamplers[3] = { "scatteringRed", "scatteringGreen", "scatteringBlue" };
+  for (int c = 0; c < 3; ++c)
+  {
+    program->SetUniformi(scatteringSamplers[c],
+      (frame.ScatteringTexture ? in.Scattering.GetTexture(c) : in.Density.GetTexture())
+        ->GetTextureUnit());
+  }
+  program->SetUniformMatrix4x4(
+    "worldToScattering", const_cast<float*>(frame.WorldToScattering.data()));
+  // Lightning, the same way.
+  program->SetUniformi("lightningTextureOn", frame.LightningTexture ? 1 : 0);
+  const char* lightningSamplers[3] = { "lightningRed", "lightningGreen", "lightningBlue" };
+  for (int c = 0; c < 3; ++c)
+  {
+    program->SetUniformi(lightningSamplers[c],
+      (frame.LightningTexture ? in.Lightning.GetTexture(c) : in.Density.GetTexture())
+        ->GetTextureUnit());
+  }
+  const auto& lightningScale = in.Lightning.GetTextureScale();
+  const float lightningTextureScale[3] = { static_cast<float>(lightningScale[0]),
+    static_cast<float>(lightningScale[1]), static_cast<float>(lightningScale[2]) };
+  program->SetUniform3f("lightningTextureScale", lightningTextureScale);
+  // Temperature emission: the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
+  // E [Y/(sr m)] scales them.
+  program->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);
+  program->SetUniformi("emissionRgb",
+    (frame.EmissionTexture ? in.Emission.GetTexture() : in.Density.GetTexture())->GetTextureUnit());
+  program->SetUniformf("emissionScale",
+    static_cast<float>(frame.EmissionTexture ? this->EmissionRadiancePerMetre : 0.0));
+  program->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
+  program->SetUniformi("octaves", frame.Octaves);
+  const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
+    static_cast<float>(this->OctaveScatteringScale),
+    static_cast<float>(this->OctaveAsymmetryScale) };
+  program->SetUniform3f("octaveScales", octaveScales);
+}
+
+//------------------------------------------------------------------------------
+// The ray-marched method (docs/ray-march.md). A piece of a distributed cloud keeps the
+// slices: its air and its premultiplied layer are the slices' passes' (docs/parallel.md).
+bool vtkNimbusCloudVolumeMapper::UsesRayMarching() const
+{
+  return this->RenderingMethod == RayMarching && !this->PieceCompositing;
+}
+
+int vtkNimbusCloudVolumeMapper::GetNumberOfSunDepthBuilds() const
+{
+  return this->Internal->SunDepthBuilds;
+}
+
+double vtkNimbusCloudVolumeMapper::GetLastSunDepthSeconds() const
+{
+  return this->Internal->LastSunDepthSeconds;
+}
+
+namespace
+{
+// The density texture's grid for SunDepthVolume: world (up frame) -> texel index
+// (index = texture coordinate x texels - 1/2) and the box in index coordinates.
+nimbus::SunDepthGrid SunDepthGridOf(const std::array<float, 16>& worldToTexture,
+  const std::array<float, 16>& worldToBox, const int dims[3])
+{
+  nimbus::SunDepthGrid grid;
+  vtkNew<vtkMatrix4x4> toTexture, toBox, boxToWorld, boxToTexture;
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      toTexture->SetElement(r, c, worldToTexture[4 * c + r]);
+      toBox->SetElement(r, c, worldToBox[4 * c + r]);
+    }
+  }
+  vtkMatrix4x4::Invert(toBox, boxToWorld);
+  vtkMatrix4x4::Multiply4x4(toTexture, boxToWorld, boxToTexture);
+  for (int r = 0; r < 3; ++r)
+  {
+    grid.Dimensions[r] = dims[r];
+    for (int c = 0; c < 3; ++c)
+    {
+      grid.Linear[3 * r + c] = dims[r] * toTexture->GetElement(r, c);
+    }
+    // The box's corners (0 and 1 in box coordinates) in index coordinates.
+    const double low = dims[r] * boxToTexture->GetElement(r, 3) - 0.5;
+    double high = low;
+    for (int c = 0; c < 3; ++c)
+    {
+      high += dims[r] * boxToTexture->GetElement(r, c);
+    }
+    grid.BoxLow[r] = std::min(low, high);
+    grid.BoxHigh[r] = std::max(low, high);
+  }
+  return grid;
+}
+
+// The ray march's empty-space blocks (texels per side) and the air's look-up volume:
+// columns across the view (rows by its aspect) and distances along each ray.
+constexpr int kRayMarchBlockTexels = 4;
+constexpr int kFroxelColumns = 32;
+constexpr int kFroxelSlices = 64;
+
+// The look-up volume's ladder of distances (world units): d_1 and 1 / log(d_{k+1} / d_k),
+// from 1e-5 of the farthest distance to it, the ray from the eye that grazes the
+// ground to the top of the atmosphere.
+std::array<float, 2> FroxelLadder(
+  const std::array<double, 3>& eye, const nimbus::SceneAtmosphere& air, double metresPerUnit)
+{
+  const double ground = air.EarthRadiusMetres;
+  const double r = std::max(ground + air.SceneAltitudeMetres + eye[2] * metresPerUnit, ground);
+  const double farthest =
+    (std::sqrt(std::max(r * r - ground * ground, 0.0)) +
+      std::sqrt(std::max(air.TopRadiusMetres * air.TopRadiusMetres - ground * ground, 0.0))) /
+    metresPerUnit;
+  const double nearest = 1e-5 * farthest;
+  const double logRatio = std::log(farthest / nearest) / (kFroxelSlices - 2);
+  return { { static_cast<float>(nearest), static_cast<float>(1.0 / logRatio) } };
+}
+
+// The length in world units of the density's smallest texel side.
+double SmallestTexelLength(const nimbus::SunDepthGrid& grid)
+{
+  double smallest = std::numeric_limits<double>::max();
+  for (int r = 0; r < 3; ++r)
+  {
+    const double* row = &grid.Linear[3 * r];
+    const double norm = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+    if (norm > 0.0 && grid.Dimensions[r] > 1)
+    {
+      smallest = std::min(smallest, 1.0 / norm);
+    }
+  }
+  return smallest == std::numeric_limits<double>::max() ? 1.0 : smallest;
+}
+
+void UploadVolume(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, const int dims[3],
+  const float* values, bool linear)
+{
+  ResetTexture(texture, window, linear);
+  if (!texture->Create3DFromRaw(
+        dims[0], dims[1], dims[2], 1, VTK_FLOAT, const_cast<float*>(values)))
+  {
+    throw std::runtime_error("could not upload a 3-D texture of the ray march");
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+// The cloud's optical depth toward the sun per density texel and the density's block
+// maxima, computed again only when the density, the sun or the optics change.
+void vtkNimbusCloudVolumeMapper::UpdateSunDepthVolume(FrameState& frame)
+{
+  if (!this->UsesRayMarching())
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  int dims[3];
+  in.Density.GetDimensions(dims);
+  const std::vector<float>& texels = in.Density.GetTexels();
+  std::vector<double> key{ static_cast<double>(in.Density.GetNumberOfUploads()), frame.ToSun[0],
+    frame.ToSun[1], frame.ToSun[2], this->ExtinctionPerDensity, frame.Settings.MetresPerUnit };
+  key.insert(key.end(), frame.WorldToTexture.begin(), frame.WorldToTexture.end());
+  key.insert(key.end(), frame.WorldToBox.begin(), frame.WorldToBox.end());
+  if (key == in.SunDepthKey && in.SunDepthTexture->GetHandle())
+  {
+    return;
+  }
+  if (texels.size() !=
+    static_cast<std::size_t>(dims[0]) * dims[1] * static_cast<std::size_t>(dims[2]))
+  {
+    throw std::runtime_error("the density's texels are not kept for the ray march");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const nimbus::SunDepthGrid grid = SunDepthGridOf(frame.WorldToTexture, frame.WorldToBox, dims);
+  const std::vector<float> depth =
+    nimbus::ComputeSunDepthVolume(texels.data(), grid, frame.ToSun, this->ExtinctionPerDensity,
+      frame.Settings.MetresPerUnit, vtkSMPTools::GetEstimatedNumberOfThreads());
+  UploadVolume(in.SunDepthTexture, frame.Window, dims, depth.data(), true);
+  const std::vector<float> maxima =
+    nimbus::ComputeBlockMaxima(texels.data(), grid.Dimensions, kRayMarchBlockTexels, in.BlockCount);
+  UploadVolume(in.BlockTexture, frame.Window, in.BlockCount.data(), maxima.data(), false);
+  in.SunDepthKey = std::move(key);
+  ++in.SunDepthBuilds;
+  in.LastSunDepthSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+//------------------------------------------------------------------------------
+// The clear air's look-up volume over the view (cloudAirFroxelsFS.glsl): a ladder of
+// kFroxelSlices distances from 1e-5 of the farthest one to the farthest: the ray that
+// grazes the ground to the top of the atmosphere.
+void vtkNimbusCloudVolumeMapper::RenderAirFroxels(const FrameState& frame)
+{
+  if (!frame.Atmosphere)
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  const int columns = kFroxelColumns;
+  const int rows = std::max(8,
+    std::min(kFroxelColumns,
+      static_cast<int>(std::lround(
+        static_cast<double>(columns) * frame.Level.Height / std::max(frame.Level.Width, 1)))));
+  for (vtkTextureObject* t :
+    { in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer() })
+  {
+    EnsureTexture2D(t, frame.Window, columns, rows * kFroxelSlices, 4, false);
+    t->SetMinificationFilter(vtkTextureObject::Linear);
+    t->SetMagnificationFilter(vtkTextureObject::Linear);
+  }
+  DrawInto(in.FroxelFramebuffer, in.FroxelScattering, frame.Window);
+  in.FroxelFramebuffer->RemoveColorAttachment(1);
+  in.FroxelFramebuffer->AddColorAttachment(1, in.FroxelTransmittance);
+  in.FroxelFramebuffer->ActivateDrawBuffers(2);
+  frame.State->vtkglViewport(0, 0, columns, rows * kFroxelSlices);
+  frame.State->vtkglDisable(GL_BLEND);
+  vtkShaderProgram* program = in.Ready(in.FroxelPass, cloudAirFroxelsFS);
+  this->SetCommonUniforms(program, frame);
+  const float size[3] = { static_cast<float>(columns), static_cast<float>(rows),
+    static_cast<float>(kFroxelSlices) };
+  program->SetUniform3f("froxelDimensions", size);
+  const std::array<float, 2> depths =
+    FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
+  program->SetUniform2f("froxelDepths", depths.data());
+  program->SetUniformi("stepsPerInterval", std::max(1, this->AtmosphereSteps / 16));
+  program->SetUniformf("mieG", static_cast<float>(frame.Settings.Air.MieG));
+  in.FroxelPass->Render();
+  ++in.PassesLastRender;
+  in.FroxelScattering->Activate();
+  in.FroxelTransmittance->Activate();
+}
+
+//------------------------------------------------------------------------------
+// The ray march (cloudMarchFS.glsl) into the accumulation targets: the cloud's and
+// the air's radiance and the cloud's transmittance, the same without the cloud, and
+// the ray ends the composite reads.
+void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
+    ? vtkTextureObject::Nearest
+    : vtkTextureObject::Linear;
+  for (vtkTextureObject* t : { in.Accumulation.GetPointer(), in.ClearAccumulation.GetPointer() })
+  {
+    EnsureTexture2D(t, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+    t->SetMinificationFilter(filter);
+    t->SetMagnificationFilter(filter);
+  }
+  EnsureTexture2D(in.RayEnds, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+  DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
+  in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
+  in.AccumulationFramebuffer->AddColorAttachment(2, in.RayEnds);
+  in.AccumulationFramebuffer->ActivateDrawBuffers(3);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
+  frame.State->vtkglDisable(GL_BLEND);
+  vtkShaderProgram* program = in.Ready(in.CloudMarchPass, cloudMarchFS, true);
+  this->SetCommonUniforms(program, frame);
+  this->SetCloudLightUniforms(program, frame);
+  int dims[3];
+  in.Density.GetDimensions(dims);
+  const nimbus::SunDepthGrid grid = SunDepthGridOf(frame.WorldToTexture, frame.WorldToBox, dims);
+  // Fewer samples at a lower quality level, as the slices (ComputeFrameLevel).
+  const double levelScale =
+    static_cast<double>(this->NumberOfSlices) / std::max(frame.Level.Slices, 1);
+  const double step = this->RayMarchStepTexels * levelScale * SmallestTexelLength(grid);
+  double diagonal = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    const double side = (grid.BoxHigh[a] - grid.BoxLow[a] + 1.0) * SmallestTexelLength(grid);
+    diagonal += side * side;
+  }
+  const int blocks = std::max({ in.BlockCount[0], in.BlockCount[1], in.BlockCount[2] });
+  const double steps = std::sqrt(diagonal) / step + 3.0 * blocks + 8.0;
+  program->SetUniformf("stepLength", static_cast<float>(step));
+  program->SetUniformi("maxSteps", static_cast<int>(std::min(steps, 1e6)));
+  const float size[3] = { static_cast<float>(dims[0]), static_cast<float>(dims[1]),
+    static_cast<float>(dims[2]) };
+  program->SetUniform3f("densitySize", size);
+  program->SetUniformi("blockMaxima", in.BlockTexture->GetTextureUnit());
+  program->SetUniformf("blockTexels", static_cast<float>(kRayMarchBlockTexels));
+  const float blockCount[3] = { static_cast<float>(in.BlockCount[0]),
+    static_cast<float>(in.BlockCount[1]), static_cast<float>(in.BlockCount[2]) };
+  program->SetUniform3f("blockCount", blockCount);
+  program->SetUniformi("unlit", this->Unlit ? 1 : 0);
+  program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
+  program->SetUniformi("shaftSteps", std::max(this->AtmosphereSteps / 2, 1));
+  program->SetUniformf("mieG", static_cast<float>(frame.Settings.Air.MieG));
+  program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
+  // Without air the look-up volume is not read; its samplers name a 2-D unit.
+  vtkTextureObject* scattering =
+    frame.Atmosphere ? in.FroxelScattering.GetPointer() : in.SceneDepth.GetPointer();
+  vtkTextureObject* transmittance =
+    frame.Atmosphere ? in.FroxelTransmittance.GetPointer() : in.SceneDepth.GetPointer();
+  program->SetUniformi("froxelScattering", scattering->GetTextureUnit());
+  program->SetUniformi("froxelTransmittance", transmittance->GetTextureUnit());
+  const float froxelSize[3] = { static_cast<float>(in.FroxelScattering->GetWidth()),
+    static_cast<float>(in.FroxelScattering->GetHeight() / kFroxelSlices),
+    static_cast<float>(kFroxelSlices) };
+  program->SetUniform3f("froxelDimensions", froxelSize);
+  const std::array<float, 2> depths =
+    FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
+  program->SetUniform2f("froxelDepths", depths.data());
+  in.CloudMarchPass->Render();
+  ++in.PassesLastRender;
+  in.AccumulationFramebuffer->RemoveColorAttachment(2);
+  in.AccumulationFramebuffer->RemoveColorAttachment(1);
+  in.AccumulationFramebuffer->ActivateDrawBuffers(1);
+  in.RayEnds->Activate();
+}
+
+//------------------------------------------------------------------------------
 // The slices (000 §4.2-4.3), in order of increasing distance from the sun: each
 // seen from the eye with the shadow so far, then added to the shadow surface. The
 // eye pass is scissored to the slice's pixels (only the box's part of the slice is
@@ -2184,7 +2562,7 @@ void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bo
 bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS);
+  vtkShaderProgram* sliceProgram = in.Ready(in.SlicePass, svsSliceFS, true);
   this->SetCommonUniforms(sliceProgram, frame);
   sliceProgram->SetUniformi("intervalPhase", in.IntervalPhase->GetTextureUnit());
   sliceProgram->SetUniformi("rayEnds", in.RayEnds->GetTextureUnit());
@@ -2194,46 +2572,7 @@ bool vtkNimbusCloudVolumeMapper::RenderSlices(vtkRenderer* renderer, const Frame
   sliceProgram->SetUniformi("unlit", this->Unlit ? 1 : 0);
   sliceProgram->SetUniformi(
     "boxAirOn", this->PieceCompositing && !this->DrawOutsideRegions ? 0 : 1);
-  // Multiple scattering (issue 14). Without a texture the samplers name the
-  // density's unit (a 3-D texture, never read), so no unit has two sampler types.
-  sliceProgram->SetUniformf("cloudG", static_cast<float>(this->CloudG));
-  sliceProgram->SetUniformi("scatteringTextureOn", frame.ScatteringTexture ? 1 : 0);
-  sliceProgram->SetUniformf("scatteringScale", static_cast<float>(frame.ScatteringScale));
-  const char* scatteringSamplers[3] = { "scatteringRed", "scatteringGreen", "scatteringBlue" };
-  for (int c = 0; c < 3; ++c)
-  {
-    sliceProgram->SetUniformi(scatteringSamplers[c],
-      (frame.ScatteringTexture ? in.Scattering.GetTexture(c) : in.Density.GetTexture())
-        ->GetTextureUnit());
-  }
-  sliceProgram->SetUniformMatrix4x4(
-    "worldToScattering", const_cast<float*>(frame.WorldToScattering.data()));
-  // Lightning (issue 16), the same way.
-  sliceProgram->SetUniformi("lightningTextureOn", frame.LightningTexture ? 1 : 0);
-  const char* lightningSamplers[3] = { "lightningRed", "lightningGreen", "lightningBlue" };
-  for (int c = 0; c < 3; ++c)
-  {
-    sliceProgram->SetUniformi(lightningSamplers[c],
-      (frame.LightningTexture ? in.Lightning.GetTexture(c) : in.Density.GetTexture())
-        ->GetTextureUnit());
-  }
-  const auto& lightningScale = in.Lightning.GetTextureScale();
-  const float lightningTextureScale[3] = { static_cast<float>(lightningScale[0]),
-    static_cast<float>(lightningScale[1]), static_cast<float>(lightningScale[2]) };
-  sliceProgram->SetUniform3f("lightningTextureScale", lightningTextureScale);
-  // Temperature emission (issue 17): the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
-  // E [Y/(sr m)] scales them.
-  sliceProgram->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);
-  sliceProgram->SetUniformi("emissionRgb",
-    (frame.EmissionTexture ? in.Emission.GetTexture() : in.Density.GetTexture())->GetTextureUnit());
-  sliceProgram->SetUniformf("emissionScale",
-    static_cast<float>(frame.EmissionTexture ? this->EmissionRadiancePerMetre : 0.0));
-  sliceProgram->SetUniformf("forwardPeakFraction", static_cast<float>(frame.ForwardPeakFraction));
-  sliceProgram->SetUniformi("octaves", frame.Octaves);
-  const float octaveScales[3] = { static_cast<float>(this->OctaveExtinctionScale),
-    static_cast<float>(this->OctaveScatteringScale),
-    static_cast<float>(this->OctaveAsymmetryScale) };
-  sliceProgram->SetUniform3f("octaveScales", octaveScales);
+  this->SetCloudLightUniforms(sliceProgram, frame);
   vtkShaderProgram* shadowProgram = nullptr;
   if (!this->Unlit)
   {

@@ -373,6 +373,43 @@ public:
   ///@}
 
   ///@{
+  /// How the cloud is drawn (docs/ray-march.md):
+  ///  - ShadowViewSlicing (0, the default of this class): the paper's method (000):
+  ///    NumberOfSlices slices, each seen from the eye and added to a shadow surface
+  ///    facing the sun, then the air outside the box marched per pixel.
+  ///  - RayMarching (1, the default of ParaView's Cloud representation): one pass
+  ///    per frame that marches each view ray through the box with a step of
+  ///    RayMarchStepTexels texels, reading the sun's transmittance from a volume of
+  ///    the cloud's optical depth toward the sun (computed on the CPU when the
+  ///    density, the sun or the optics change: SunDepthVolume.h), skipping empty
+  ///    blocks and stopping where the cloud is opaque; the air comes from a
+  ///    look-up volume over the view (Hillaire 2020's aerial perspective), and the
+  ///    cloud's shadow in it is marched only where it can fall (AtmosphereSteps / 2
+  ///    samples). Several times faster on the same picture; it loses where a
+  ///    shadow's edge is finer than the density's texels. One piece of a
+  ///    distributed cloud (PieceCompositing) is always drawn by slicing.
+  enum
+  {
+    ShadowViewSlicing = 0,
+    RayMarching = 1
+  };
+  vtkSetClampMacro(RenderingMethod, int, ShadowViewSlicing, RayMarching);
+  vtkGetMacro(RenderingMethod, int);
+  void SetRenderingMethodToShadowViewSlicing() { this->SetRenderingMethod(ShadowViewSlicing); }
+  void SetRenderingMethodToRayMarching() { this->SetRenderingMethod(RayMarching); }
+  /// The ray march's step in texels of the density (the smallest texel side; default
+  /// 1). Larger: faster, with more grain in thin cloud and softer detail.
+  virtual void SetRayMarchStepTexels(double value);
+  virtual double GetRayMarchStepTexelsMinValue() { return 0.05; }
+  virtual double GetRayMarchStepTexelsMaxValue() { return 16.0; }
+  vtkGetMacro(RayMarchStepTexels, double);
+  /// Times the sun-depth volume was computed (tests and benchmarks), and the seconds
+  /// of the last computation.
+  int GetNumberOfSunDepthBuilds() const;
+  double GetLastSunDepthSeconds() const;
+  ///@}
+
+  ///@{
   /// Jittered slices (default on): each pixel's slice planes, and each shadow
   /// texel's, are shifted by a fixed fraction of the slice spacing in
   /// [-1/2, 1/2) (interleaved gradient noise of the pixel), so the planes do not
@@ -631,6 +668,8 @@ protected:
   double SliceAngleRatio = 1.0;
   int ShadowSurfaceSize = 512;
   int AtmosphereSteps = 32;
+  int RenderingMethod = ShadowViewSlicing;
+  double RayMarchStepTexels = 1.0;
   bool SliceJitter = true;
   double MetresPerUnit = 1.0;
   double Exposure = 1.0;
@@ -692,6 +731,12 @@ private:
   void ClearAccumulation(const FrameState& frame);
   void RenderOutsideRegion(const FrameState& frame, bool behindBox);
   bool RenderSlices(vtkRenderer* renderer, const FrameState& frame);
+  // The ray-marched method (RayMarching).
+  bool UsesRayMarching() const;
+  void UpdateSunDepthVolume(FrameState& frame);
+  void RenderAirFroxels(const FrameState& frame);
+  void RenderCloudMarch(const FrameState& frame);
+  void SetCloudLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
   void RenderComposite(const FrameState& frame);
   void EndPasses(const FrameState& frame);

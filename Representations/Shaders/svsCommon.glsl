@@ -25,7 +25,7 @@ uniform vec3 shadowOrigin;
 uniform vec3 shadowU;
 uniform vec3 shadowW;
 uniform vec2 shadowExtent;
-// The other pieces of a distributed cloud (issue 18, ExternalShadow.h): optical depth
+// The other pieces of a distributed cloud (ExternalShadow.h): optical depth
 // toward the sun outside this piece, (beyond the piece toward the sun, whole line),
 // on a map facing the sun over the whole cloud.
 uniform int externalShadowOn;
@@ -59,6 +59,11 @@ uniform sampler2D sceneDepth;       // depth of the opaque geometry already draw
 // is accumulated behind the ground either way: rays end there).
 uniform int overSky;
 uniform int sliceJitter;            // 1: slice planes shifted per pixel (SliceJitter)
+uniform float firstSliceOffset;     // d where the slicing starts: sunward of it, no shadow
+// The ray-marched method (cloudMarchFS.glsl): the cloud's optical depth toward the sun
+// at every density texel (SunDepthVolume.h), in place of the shadow surface.
+uniform int sunDepthVolumeOn;
+uniform sampler3D sunDepthVolume;
 
 const float kInfinity = 1e30;
 
@@ -364,21 +369,75 @@ vec2 ExternalDepths(vec3 p)
   return texture(externalShadow, st).rg;
 }
 
+// The cloud's optical depth toward the sun at a point of the box: the ray march's
+// sun-depth volume, or the slices' shadow surface so far.
+float OwnDepthInsideBox(vec3 p)
+{
+  if (sunDepthVolumeOn != 0)
+  {
+    return texture(sunDepthVolume, (worldToTexture * vec4(p, 1.0)).xyz).r;
+  }
+  return ShadowDepth(p);
+}
+
 // Cloud optical depth toward the sun of a point inside the box: this piece's slices
-// so far, plus the other pieces' beyond it.
+// so far (or the sun-depth volume), plus the other pieces' beyond it.
 float CloudDepthInsideBox(vec3 p)
 {
-  return ShadowDepth(p) + ExternalDepths(p).x;
+  return OwnDepthInsideBox(p) + ExternalDepths(p).x;
 }
 
 // Cloud optical depth toward the sun of a point outside the box, once the shadow
 // surface is complete (see svsMarchFS.glsl): the whole sun line's when the line
 // toward the sun meets the box, else 0; plus the other pieces' on the whole line.
+// With the sun-depth volume: its value where the sun line enters the box.
 float CloudDepthOutsideBox(vec3 p)
 {
   float tIn, tOut;
-  float own = BoxInterval(p, sunDirection, tIn, tOut) && tOut >= 0.0 ? ShadowDepth(p) : 0.0;
+  float own = 0.0;
+  if (BoxInterval(p, sunDirection, tIn, tOut) && tOut >= 0.0)
+  {
+    own = sunDepthVolumeOn != 0 ? OwnDepthInsideBox(p + max(tIn, 0.0) * sunDirection)
+                                : ShadowDepth(p);
+  }
   return own + ExternalDepths(p).y;
+}
+
+// The part [a, b] of [t0, t1] where the ray can be in the cloud's shadow: its sun
+// line crosses the shadow surface's rectangle, and it is past the first slice
+// plane (sunward of that plane the line toward the sun never meets the box).
+bool ShadowInterval(vec3 origin, vec3 direction, float t0, float t1, out float a, out float b)
+{
+  a = t0;
+  b = t1;
+  // With other pieces, their shadow's rectangle: it covers the whole cloud.
+  vec3 rectOrigin = externalShadowOn != 0 ? externalOrigin : shadowOrigin;
+  vec3 rectU = externalShadowOn != 0 ? externalU : shadowU;
+  vec3 rectW = externalShadowOn != 0 ? externalW : shadowW;
+  vec2 rectExtent = externalShadowOn != 0 ? externalExtent : shadowExtent;
+  vec3 q = origin - rectOrigin;
+  vec2 s0 = vec2(dot(q, rectU), dot(q, rectW)) / rectExtent;
+  vec2 ds = vec2(dot(direction, rectU), dot(direction, rectW)) / rectExtent;
+  if (!ClipToUnitSlab(s0.x, ds.x, a, b) || !ClipToUnitSlab(s0.y, ds.y, a, b))
+  {
+    return false;
+  }
+  float vn = dot(direction, sliceNormal);
+  float d0 = dot(origin, sliceNormal);
+  if (abs(vn) < 1e-30)
+  {
+    return d0 >= firstSliceOffset && a < b;
+  }
+  float tPlane = (firstSliceOffset - d0) / vn;
+  if (vn > 0.0)
+  {
+    a = max(a, tPlane);
+  }
+  else
+  {
+    b = min(b, tPlane);
+  }
+  return a < b;
 }
 
 // Radiance of the Lambertian ground at g, toward the eye, before view attenuation.

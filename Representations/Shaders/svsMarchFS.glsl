@@ -20,7 +20,6 @@ uniform int segment;        // 0: in front of the box (or the whole ray), 1: beh
 uniform int shaftsOn;
 uniform int steps;          // samples per segment outside the cloud's shadow
 uniform float sliceSpacing; // Delta d of the slices (world)
-uniform float firstSliceOffset; // d where the slicing starts: sunward of it, no shadow
 uniform int maxShadowSteps; // cap of the samples in the shadow (the number of slices)
 
 const int kDenseAtStart = 0;
@@ -70,43 +69,6 @@ void MarchAir(vec3 origin, vec3 direction, vec2 phase, float t0, float t1, int s
     clearColor += clearAir * viewTransmittance * weight;
     viewTransmittance *= stepTransmittance;
   }
-}
-
-// The part [a, b] of [t0, t1] where the ray can be in the cloud's shadow: its sun
-// line crosses the shadow surface's rectangle, and it is past the first slice
-// plane (sunward of that plane the line toward the sun never meets the box).
-bool ShadowInterval(vec3 origin, vec3 direction, float t0, float t1, out float a, out float b)
-{
-  a = t0;
-  b = t1;
-  // With other pieces (issue 18), their shadow's rectangle: it covers the whole cloud.
-  vec3 rectOrigin = externalShadowOn != 0 ? externalOrigin : shadowOrigin;
-  vec3 rectU = externalShadowOn != 0 ? externalU : shadowU;
-  vec3 rectW = externalShadowOn != 0 ? externalW : shadowW;
-  vec2 rectExtent = externalShadowOn != 0 ? externalExtent : shadowExtent;
-  vec3 q = origin - rectOrigin;
-  vec2 s0 = vec2(dot(q, rectU), dot(q, rectW)) / rectExtent;
-  vec2 ds = vec2(dot(direction, rectU), dot(direction, rectW)) / rectExtent;
-  if (!ClipToUnitSlab(s0.x, ds.x, a, b) || !ClipToUnitSlab(s0.y, ds.y, a, b))
-  {
-    return false;
-  }
-  float vn = dot(direction, sliceNormal);
-  float d0 = dot(origin, sliceNormal);
-  if (abs(vn) < 1e-30)
-  {
-    return d0 >= firstSliceOffset && a < b;
-  }
-  float tPlane = (firstSliceOffset - d0) / vn;
-  if (vn > 0.0)
-  {
-    a = max(a, tPlane);
-  }
-  else
-  {
-    b = min(b, tPlane);
-  }
-  return a < b;
 }
 
 void main()

@@ -1,0 +1,105 @@
+// The cloud's light at a sample, shared by the shadow-view slices (svsSliceFS.glsl)
+// and the ray march (cloudMarchFS.glsl): the sun's single scattering through the
+// cloud's optical depth toward the sun, the multiple scattering of the solver's
+// texture or of the octaves, lightning and temperature emission. Prepended after
+// svsCommon.glsl to the passes that light the cloud.
+// Multiple scattering (Physics/MultipleScattering.h).
+uniform float cloudG;                 // Cornette-Shanks asymmetry of the cloud
+uniform int scatteringTextureOn;      // the solver's in-scattered radiance J(x, w)
+uniform sampler3D scatteringRed;      // SH c_00, c_1-1, c_10, c_11 of J, per channel
+uniform sampler3D scatteringGreen;
+uniform sampler3D scatteringBlue;
+uniform mat4 worldToScattering;       // world -> these textures' coordinates
+uniform float scatteringScale;        // the sun's illuminance now / at the solve (J is linear in it)
+uniform float forwardPeakFraction;    // delta-M f of the discrete-direction solve
+uniform int octaves;                  // Wrenninge et al. 2013: terms incl. the single one
+uniform vec3 octaveScales;            // a (extinction), b (scattering), c (asymmetry)
+// Lightning (vtkNimbusLightningIllumination, 003 Eqs. 8-10): J of the strokes'
+// light, all orders, in the same layout and units.
+uniform int lightningTextureOn;
+uniform sampler3D lightningRed;
+uniform sampler3D lightningGreen;
+uniform sampler3D lightningBlue;
+uniform vec3 lightningTextureScale;   // density texture coordinates -> these textures'
+// Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
+// [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
+uniform int emissionOn;
+uniform sampler3D emissionRgb;
+uniform float emissionScale; // E [Y/(sr m) per unit density at T_ref]
+
+// J(p, w) of the solver: the radiance the cloud's particles at p scatter toward w
+// (w the direction of travel) per unit scattering coefficient, beyond the sun's
+// single scattering (degree-1 spherical harmonics, clamped at 0).
+vec3 InScattering(vec3 p, vec3 w)
+{
+  vec3 tc = (worldToScattering * vec4(p, 1.0)).xyz;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return scatteringScale * max(vec3(dot(texture(scatteringRed, tc), y),
+                                 dot(texture(scatteringGreen, tc), y),
+                                 dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+}
+
+// J(p, w) of the lightning (the same form as InScattering, without the sun's scale).
+vec3 LightningInScattering(vec3 p, vec3 w)
+{
+  vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * lightningTextureScale;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return max(vec3(dot(texture(lightningRed, tc), y), dot(texture(lightningGreen, tc), y),
+               dot(texture(lightningBlue, tc), y)), vec3(0.0));
+}
+
+// The sun's light scattered more than once that the mapper evaluates per sample,
+// as a multiple of sigma_s E_sun: the part of the forward peak the delta-M solve
+// left on the sun's direction, (1 - f) p(mu) (exp(-(1 - f albedo) tau) - exp(-tau)), and
+// the octaves sum_{i>=1} b^i p(mu; c^i g) exp(-a^i tau).
+float SunMultipleScattering(float mu, float tau)
+{
+  float sum = 0.0;
+  if (forwardPeakFraction > 0.0)
+  {
+    // delta-M: the beam's excess leaves it at sigma_s (1 - f) (the rest stays in the
+    // peak), by the cloud's own phase function for the last scattering. Measured
+    // against the path tracer (docs/multiple-scattering.md): with p alone the backlit
+    // cloud is too bright (silver_lining RMSE 0.109); with the truncated HG(g') the
+    // glow near the sun too dim (haze_shafts 0.108); this way 0.038 and 0.092.
+    sum += (1.0 - forwardPeakFraction) * CornetteShanks(mu, cloudG) *
+      (exp(-(1.0 - forwardPeakFraction * cloudAlbedo) * tau) - exp(-tau));
+  }
+  float a = 1.0, b = 1.0, c = 1.0;
+  for (int i = 1; i < octaves; ++i)
+  {
+    a *= octaveScales.x;
+    b *= octaveScales.y;
+    c *= octaveScales.z;
+    sum += b * CornetteShanks(mu, c * cloudG) * exp(-a * tau);
+  }
+  return sum;
+}
+
+
+// The radiance the cloud sends toward the eye per metre at p [relative to the sun],
+// before the view's attenuation: sigma = k rho [1/m], sunDepth = the cloud's optical
+// depth toward the sun, cloudPhase = the pixel's phase value (beta_cl + k_multi / 4 pi,
+// 000 Eq. 8), direction = the view ray's.
+vec3 CloudSource(vec3 p, vec3 direction, float sigma, float sunDepth, float cloudPhase,
+  float altitude)
+{
+  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+  vec3 source = cloudAlbedo * sigma *
+    (cloudPhase * exp(-sunDepth) + SunMultipleScattering(mu, sunDepth)) *
+    SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
+  if (scatteringTextureOn != 0)
+  {
+    source += cloudAlbedo * sigma * InScattering(p, -direction);
+  }
+  if (lightningTextureOn != 0)
+  {
+    source += cloudAlbedo * sigma * LightningInScattering(p, -direction);
+  }
+  if (emissionOn != 0)
+  {
+    // The source term of the RTE, eta ds: attenuated in the slab like the scattering.
+    source += emissionScale * max(texture(emissionRgb, (worldToTexture * vec4(p, 1.0)).xyz).rgb, vec3(0.0));
+  }
+  return source;
+}
