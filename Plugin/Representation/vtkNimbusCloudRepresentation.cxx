@@ -42,6 +42,8 @@ vtkNimbusCloudRepresentation::vtkNimbusCloudRepresentation()
   // Replace the superclass's vtkMultiBlockVolumeMapper; the superclass connects
   // the delivered data to VolumeMapper at each render request.
   this->CloudMapper = vtkNimbusCloudVolumeMapper::New();
+  // ParaView's Cloud is drawn by the ray march unless the user picks the paper's slices.
+  this->CloudMapper->SetRenderingMethodToRayMarching();
   this->VolumeMapper.TakeReference(this->CloudMapper);
   this->CloudMapper->AddObserver(
     vtkCommand::ProgressEvent, this, &vtkNimbusCloudRepresentation::ForwardMapperProgress);
@@ -527,6 +529,8 @@ NIMBUS_FORWARD(GroundAlbedo, double)
 NIMBUS_FORWARD(Shafts, bool)
 NIMBUS_FORWARD(AirMultipleScattering, bool)
 NIMBUS_FORWARD(UseSceneSky, bool)
+NIMBUS_FORWARD(RenderingMethod, int)
+NIMBUS_FORWARD(RayMarchStepTexels, double)
 NIMBUS_FORWARD(NumberOfSlices, int)
 NIMBUS_FORWARD(SliceAngleRatio, double)
 NIMBUS_FORWARD(ShadowSurfaceSize, int)

@@ -224,9 +224,14 @@ public:
   ///@}
 
   ///@{
-  /// Quality: slice count, a of theta_e : theta_s = 1 : a (000 §4.2), shadow
-  /// surface texels per side, atmosphere samples per pixel, largest density
-  /// texture side (0: the GL limit).
+  /// Quality: the rendering method (ray marching, the default here, or the paper's
+  /// slices) and the march's step in voxels, slice count, a of theta_e : theta_s = 1 : a (000
+  /// §4.2), shadow surface texels per side, atmosphere samples per pixel, largest density texture
+  /// side (0: the GL limit).
+  void SetRenderingMethod(int value);
+  int GetRenderingMethod();
+  void SetRayMarchStepTexels(double value);
+  double GetRayMarchStepTexels();
   void SetNumberOfSlices(int value);
   int GetNumberOfSlices();
   void SetSliceAngleRatio(double value);

@@ -11,6 +11,7 @@
 #include "LightningTexture.h"
 #include "MemoryBudget.h"
 #include "MultipleScatteringTexture.h"
+#include "PassTimer.h"
 #include "SliceGeometry.h"
 #include "SunAndAir.h"
 #include "SunDepthVolume.h"
@@ -416,6 +417,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkTextureObject> FroxelTransmittance;
   vtkNew<vtkOpenGLFramebufferObject> FroxelFramebuffer;
 
+  // The GPU time of each pass (TimePasses).
+  nimbus::PassTimer Timer;
+  std::string LastPassTimes;
+
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
     CompositePass, RayEndsPass, CloudMarchPass, FroxelPass;
 
@@ -474,6 +479,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
         pass->reset();
       }
     }
+    Timer.Release();
     AtmosphereKey.clear();
     IntervalPhaseKey.clear();
     SunDepthKey.clear();
@@ -668,37 +674,49 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
   in.LastFrameSeconds = 0.0;
   this->BeginPasses(frame);
   frame.PassesStart = std::chrono::steady_clock::now();
+  in.Timer.BeginFrame(this->TimePasses && !reuse);
   if (reuse)
   {
     in.RayEnds->Activate();
   }
   else if (this->UsesRayMarching())
   {
+    in.Timer.Begin("air look-up volume");
     this->RenderAirFroxels(frame);
+    in.Timer.Begin("ray march");
     this->RenderCloudMarch(frame);
     this->CaptureRadianceImage(frame);
   }
   else
   {
     this->ClearShadowSurface(frame);
+    in.Timer.Begin("interval and phase");
     this->RenderIntervalPhase(frame);
+    in.Timer.Begin("ray ends");
     this->RenderRayEnds(frame);
     this->ClearAccumulation(frame);
+    in.Timer.Begin("slices");
     if (!this->RenderSlices(renderer, frame))
     {
       // Aborted: nothing is drawn over the scene this frame.
       frame.State->PopFramebufferBindings();
       frame.FramebuffersPushed = false;
       this->EndPasses(frame);
+      in.Timer.BeginFrame(false);
       in.LastAborted = true;
       return true;
     }
     // Behind the box first: its blend reads the cloud transmittance the slices left.
+    in.Timer.Begin("air behind the box");
     this->RenderOutsideRegion(frame, true);
+    in.Timer.Begin("air in front of the box");
     this->RenderOutsideRegion(frame, false);
+    in.Timer.End();
     this->CaptureRadianceImage(frame);
   }
+  in.Timer.Begin("composite");
   this->RenderComposite(frame);
+  in.Timer.End();
   this->EndPasses(frame);
   if (!reuse)
   {
@@ -707,6 +725,8 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     in.LastFrameSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - frame.PassesStart).count();
     in.Cost.AddSample(frame.Level.Quality, in.LastFrameSeconds);
+    in.Timer.Collect();
+    in.LastPassTimes = this->TimePasses ? in.Timer.Report() : std::string();
   }
   in.ReuseKey = std::move(key);
   in.ReuseValid = true;
@@ -2290,6 +2310,11 @@ bool vtkNimbusCloudVolumeMapper::UsesRayMarching() const
   return this->RenderingMethod == RayMarching && !this->PieceCompositing;
 }
 
+const char* vtkNimbusCloudVolumeMapper::GetLastPassTimes() const
+{
+  return this->Internal->LastPassTimes.c_str();
+}
+
 int vtkNimbusCloudVolumeMapper::GetNumberOfSunDepthBuilds() const
 {
   return this->Internal->SunDepthBuilds;
@@ -2516,9 +2541,10 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
     diagonal += side * side;
   }
   const int blocks = std::max({ in.BlockCount[0], in.BlockCount[1], in.BlockCount[2] });
-  const double steps = std::sqrt(diagonal) / step + 3.0 * blocks + 8.0;
+  const double steps = std::sqrt(diagonal) / step + 8.0;
   program->SetUniformf("stepLength", static_cast<float>(step));
   program->SetUniformi("maxSteps", static_cast<int>(std::min(steps, 1e6)));
+  program->SetUniformi("maxBlockSteps", 3 * blocks + 8);
   const float size[3] = { static_cast<float>(dims[0]), static_cast<float>(dims[1]),
     static_cast<float>(dims[2]) };
   program->SetUniform3f("densitySize", size);

@@ -410,6 +410,17 @@ public:
   ///@}
 
   ///@{
+  /// Time each pass on the GPU with timer queries (GL_TIME_ELAPSED; default off: the
+  /// mapper then waits for the frame's queries at its end). GetLastPassTimes: the last
+  /// frame drawn in full, "pass seconds; pass seconds; ..." in the order of the passes
+  /// (the slices and their shadow updates summed as "slices"); empty when off.
+  vtkSetMacro(TimePasses, bool);
+  vtkGetMacro(TimePasses, bool);
+  vtkBooleanMacro(TimePasses, bool);
+  const char* GetLastPassTimes() const;
+  ///@}
+
+  ///@{
   /// Jittered slices (default on): each pixel's slice planes, and each shadow
   /// texel's, are shifted by a fixed fraction of the slice spacing in
   /// [-1/2, 1/2) (interleaved gradient noise of the pixel), so the planes do not
@@ -670,6 +681,7 @@ protected:
   int AtmosphereSteps = 32;
   int RenderingMethod = ShadowViewSlicing;
   double RayMarchStepTexels = 1.0;
+  bool TimePasses = false;
   bool SliceJitter = true;
   double MetresPerUnit = 1.0;
   double Exposure = 1.0;

@@ -1,8 +1,8 @@
 // The ray-marched Cloud method: the whole picture of a pixel in one pass. The view
 // ray is marched through the cloud box with a fixed step (jittered per pixel), the
-// sun's transmittance read from the sun-depth volume (SunDepthVolume.h), empty
-// blocks skipped (blockMaxima) and the march stopped once the cloud lets less than
-// 1e-4 through. The air comes from the look-up volume of cloudAirFroxelsFS.glsl, and
+// sun's transmittance read from the sun-depth volume (SunDepthVolume.h), only between
+// the first and the last block that holds density (blockMaxima) and only until the
+// cloud lets less than 1e-4 through. The air comes from the look-up volume of cloudAirFroxelsFS.glsl, and
 // the cloud's shadow in it (the shafts) is marched only where it can fall
 // (ShadowInterval). Output 0: (radiance before exposure, cloud transmittance; 0 where
 // the ground closes the ray, not over a sky), as the slices and the march passes of
@@ -14,6 +14,7 @@ uniform int shaftsOn;
 uniform int shaftSteps;           // samples of the cloud's shadow in the air
 uniform float stepLength;         // the march's step (world units)
 uniform int maxSteps;
+uniform int maxBlockSteps;        // blocks a ray can cross
 uniform vec3 densitySize;         // texels per axis
 uniform sampler3D blockMaxima;    // the largest density a sample in each block can read
 uniform float blockTexels;        // texels per block side
@@ -60,11 +61,10 @@ void AirTo(vec2 uv, float t, out vec3 radiance, out vec3 transmittance)
   transmittance = mix(texture(froxelTransmittance, c0).rgb, texture(froxelTransmittance, c1).rgb, f);
 }
 
-// The distance to where the ray leaves the density block that index point x lies in
-// (x = o + t d in texel index coordinates).
-float BlockExit(vec3 o, vec3 d, vec3 x)
+// The distance to where the ray leaves density block `block` (o + t d in texel index
+// coordinates).
+float BlockExit(vec3 o, vec3 d, vec3 block)
 {
-  vec3 block = floor(x / blockTexels);
   vec3 lo = block * blockTexels, hi = lo + blockTexels;
   vec3 exits = vec3(kInfinity);
   for (int a = 0; a < 3; ++a)
@@ -81,6 +81,31 @@ float BlockExit(vec3 o, vec3 d, vec3 x)
   return min(exits.x, min(exits.y, exits.z));
 }
 
+// The part [first, last] of [t0, t1] between the first and the last block that holds
+// any density, by a walk over the blocks (one look-up each): the march then steps
+// only through it, with no test per step (on a GPU that runs pixels in lock-step, as
+// llvmpipe does, a per-step test costs every pixel its both branches).
+bool OccupiedSpan(vec3 o, vec3 d, float t0, float t1, out float first, out float last)
+{
+  first = kInfinity;
+  last = -kInfinity;
+  float nudge = 1e-3 * stepLength;
+  float t = t0;
+  for (int i = 0; i < maxBlockSteps && t < t1; ++i)
+  {
+    vec3 block = floor((o + (t + nudge) * d) / blockTexels);
+    float exit = max(BlockExit(o, d, block), t + nudge);
+    if (texture(blockMaxima, (block + 0.5) / blockCount).r > 0.0)
+    {
+      first = min(first, t);
+      last = exit;
+    }
+    t = exit;
+  }
+  last = min(last, t1);
+  return first < last;
+}
+
 // The cloud along [t0, t1]: its radiance toward the eye (the clear air's transmittance
 // from the eye included, interpolated geometrically between airIn and airOut) and its
 // transmittance.
@@ -89,46 +114,39 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
 {
   radiance = vec3(0.0);
   transmittance = 1.0;
-  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
-  float cloudPhase = CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * kPi);
   // Texel index coordinates of the ray, for the blocks.
   vec3 o = (worldToTexture * vec4(origin, 1.0)).xyz * densitySize - 0.5;
   vec3 d = (worldToTexture * vec4(direction, 0.0)).xyz * densitySize;
+  float first, last;
+  if (!OccupiedSpan(o, d, t0, t1, first, last))
+  {
+    return;
+  }
+  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+  float cloudPhase = CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * kPi);
   float span = max(t1 - t0, 1e-30);
-  vec3 airRatio = airOut / max(airIn, vec3(1e-30));
+  // log of the clear air's transmittance ratio across the box (geometric interpolation).
+  vec3 airLogRatio = log(max(airOut, vec3(1e-30)) / max(airIn, vec3(1e-30)));
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5; // in [0, 1)
   float stepMetres = stepLength * metresPerUnit;
-  int n = 0;
-  float t = t0 + jitter * stepLength;
-  for (int i = 0; i < maxSteps && t < t1; ++i)
+  // The steps on the grid t0 + (n + jitter) stepLength that fall in [first, last].
+  float t = t0 + (max(ceil((first - t0) / stepLength - jitter), 0.0) + jitter) * stepLength;
+  for (int i = 0; i < maxSteps && t < last; ++i)
   {
-    vec3 x = o + t * d;
-    vec3 blockCoord = x / (blockTexels * blockCount);
-    if (texture(blockMaxima, blockCoord).r <= 0.0)
-    {
-      // An empty block: on to the first step past it.
-      float exit = BlockExit(o, d, x);
-      t = t0 + (ceil((exit - t0) / stepLength - jitter) + jitter) * stepLength;
-      t = max(t, exit + 1e-6 * stepLength);
-      continue;
-    }
     vec3 p = origin + t * direction;
     float sigma = extinctionPerDensity * max(texture(density, (worldToTexture * vec4(p, 1.0)).xyz).r, 0.0);
-    if (sigma > 0.0)
+    float alpha = exp(-sigma * stepMetres);
+    // Exact integral of a constant source over the step: (1 - alpha) / sigma.
+    float stepIntegral = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
+    vec3 source = unlit != 0 ? vec3(sigma)
+      : CloudSource(p, direction, sigma, CloudDepthInsideBox(p), cloudPhase, Altitude(p)) *
+        airIn * exp(airLogRatio * ((t - t0) / span));
+    radiance += transmittance * source * stepIntegral;
+    transmittance *= alpha;
+    if (transmittance < kOpaque)
     {
-      float alpha = exp(-sigma * stepMetres);
-      // Exact integral of a constant source over the step: (1 - alpha) / sigma.
-      float stepIntegral = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
-      vec3 source = unlit != 0 ? vec3(sigma)
-        : CloudSource(p, direction, sigma, CloudDepthInsideBox(p), cloudPhase, Altitude(p)) *
-          airIn * pow(airRatio, vec3((t - t0) / span));
-      radiance += transmittance * source * stepIntegral;
-      transmittance *= alpha;
-      if (transmittance < kOpaque)
-      {
-        transmittance = 0.0;
-        break;
-      }
+      transmittance = 0.0;
+      break;
     }
     t += stepLength;
   }
@@ -146,7 +164,7 @@ vec3 ShadowedAir(vec3 origin, vec3 direction, float a, float b, vec3 airA, vec3 
     CornetteShanks(clamp(dot(direction, sunDirection), -1.0, 1.0), mieG));
   float span = b - a;
   float dt = span / float(shaftSteps);
-  vec3 ratio = airB / max(airA, vec3(1e-30));
+  vec3 logRatio = log(max(airB, vec3(1e-30)) / max(airA, vec3(1e-30)));
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5;
   vec3 lost = vec3(0.0);
   for (int s = 0; s < shaftSteps; ++s)
@@ -157,7 +175,7 @@ vec3 ShadowedAir(vec3 origin, vec3 direction, float a, float b, vec3 airA, vec3 
     float cloud = pow(max(cloudTransmittance, 1e-30), inBox);
     float depth = InsideBox(p) ? CloudDepthInsideBox(p) : CloudDepthOutsideBox(p);
     lost += AirSource(Altitude(p), phase) * (1.0 - exp(-depth)) * cloud *
-      airA * pow(ratio, vec3((t - a) / max(span, 1e-30)));
+      airA * exp(logRatio * ((t - a) / max(span, 1e-30)));
   }
   return lost * dt * metresPerUnit;
 }

@@ -56,6 +56,8 @@ namespace
 constexpr int kWidth = 64;
 constexpr int kHeight = 48;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
+// --ray-march: every case with the ray-marched method (RenderingMethod RayMarching).
+int gRenderingMethod = vtkNimbusCloudVolumeMapper::ShadowViewSlicing;
 const double kInf = std::numeric_limits<double>::infinity();
 
 vtkSmartPointer<vtkImageData> MakeCloud()
@@ -116,6 +118,7 @@ struct Scene
   explicit Scene(vtkImageData* density)
   {
     this->Mapper->SetInputData(density);
+    this->Mapper->SetRenderingMethod(gRenderingMethod);
     this->Mapper->SetExposure(4.0);
     this->Mapper->SetEncodeSrgb(true);
     this->Mapper->SetNumberOfSlices(24);
@@ -672,6 +675,13 @@ int main(int argc, char* argv[])
   {
     return 2;
   }
+  for (int a = 1; a < argc; ++a)
+  {
+    if (std::string(argv[a]) == "--ray-march")
+    {
+      gRenderingMethod = vtkNimbusCloudVolumeMapper::RayMarching;
+    }
+  }
   using M = vtkNimbusCloudVolumeMapper;
   const std::vector<std::pair<std::string, std::function<Result()>>> cases = {
     { "SunElevationNaN",
@@ -920,7 +930,14 @@ int main(int argc, char* argv[])
           });
       } },
   };
-  std::vector<std::string> selected(argv + 1, argv + argc);
+  std::vector<std::string> selected;
+  for (int a = 1; a < argc; ++a)
+  {
+    if (std::string(argv[a]) != "--ray-march")
+    {
+      selected.emplace_back(argv[a]);
+    }
+  }
   int failures = 0, run = 0;
   const auto start = std::chrono::steady_clock::now();
   for (const auto& entry : cases)
