@@ -10,8 +10,9 @@ writes a CSV and an error-vs-time plot: the Pareto front users choose from.
 
 Renderers: ``vtk-gpu`` (VTK's vtkGPUVolumeRayCastMapper with the scene's optics
 mapped onto its transfer functions; needs a display: run it through
-Testing/with-display.sh), ``svs`` (Nimbus's shadow-view-slice mapper; setting
-``k_multi`` overrides the scene's multiple-scattering constant), ``single``
+Testing/with-display.sh), ``svs`` (Nimbus's cloud mapper, by shadow-view slicing
+or, with setting ``method`` ``march``, by ray marching; setting ``k_multi``
+overrides the scene's multiple-scattering constant), ``single``
 (Nimbus's single-scattering reference at coarser steps) and ``path`` (the Monte
 Carlo path tracer at fewer samples). ``--settings FILE.json`` replaces a
 renderer's default list of settings.
@@ -90,7 +91,10 @@ DEFAULT_SETTINGS = {
     + [{"ms": "patterns", "orders": n} for n in (2, 3)]
     + [{"ms": "directions", "downsampling": d, "directions": n, "orders": k}
        for d, n, k in ((8, 26, 32), (4, 26, 8), (4, 14, 32), (4, 26, 32), (4, 50, 32),
-                       (3, 26, 32), (2, 26, 32))],
+                       (3, 26, 32), (2, 26, 32))]
+    # The same mapper by ray marching (RenderingMethod 1) with the default multiple
+    # scattering, over its step in density texels: its curve beside the slices'.
+    + [{"method": "march", "ms": "directions", "step": s} for s in (4, 2, 1, 0.5)],
     "single": [{"step_scale": s, "max_refinements": 0} for s in (4.0, 2.0, 1.0, 0.5, 0.25)],
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }
@@ -506,10 +510,13 @@ class VtkGpuRenderer:
 
 
 SVS_METHODS = {"none": 0, "octaves": 1, "patterns": 2, "directions": 3}
+# The svs renderer's "method" setting -> the mapper's RenderingMethod.
+SVS_RENDERING_METHODS = {"slices": 0, "march": 1}
 
 
 class SvsRenderer:
-    """Nimbus's shadow-view-slice mapper (vtkNimbusCloudVolumeMapper, paper 000).
+    """Nimbus's cloud mapper (vtkNimbusCloudVolumeMapper): shadow-view slicing (paper
+    000) or ray marching (docs/ray-march.md).
 
     The scene maps one to one onto the mapper: extinction, albedo, the first
     phase component's g (Cornette-Shanks), k_multi, sun, atmosphere, ground.
@@ -517,7 +524,10 @@ class SvsRenderer:
     draws the atmosphere itself) and the image is read back in float from the
     mapper (CaptureRadiance); "constant" is that radiance in the 8-bit
     framebuffer (radiance x VTK_SCALE, quantisation <= 6.5e-4).
-    Settings: slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
+    Settings: method (slices, the default, or march: RenderingMethod 0 or 1; every
+    row sets it, so a march row leaves no state to the next), step
+    (RayMarchStepTexels, the march's step in density texels, default 1),
+    slices, a (SliceAngleRatio), shadow (ShadowSurfaceSize),
     atmosphere_steps, jitter (SliceJitter, default on), unlit (the unlit
     compositing floor, for timing only), k_multi
     (000 Eq. 1's multiple-scattering constant; default the scene's), and the
@@ -574,6 +584,8 @@ class SvsRenderer:
         self.capture_class = vtkWindowToImageFilter
 
     def render(self, settings):
+        self.mapper.SetRenderingMethod(SVS_RENDERING_METHODS[settings.get("method", "slices")])
+        self.mapper.SetRayMarchStepTexels(float(settings.get("step", 1.0)))
         self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
         self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
         self.mapper.SetShadowSurfaceSize(int(settings.get("shadow", 512)))
@@ -647,6 +659,8 @@ def configure_svs_mapper(mapper, scene):
 # --- the harness ------------------------------------------------------------------------------
 
 def setting_label(settings):
+    """The settings as "key=value, ...", every key given: a march row reads
+    "method=march, ..." and a row without "method" is drawn by slices."""
     return ", ".join(f"{key}={value}" for key, value in settings.items())
 
 
@@ -684,8 +698,11 @@ def plot(rows, title, path):
     # (within the reference's noise) is drawn at the floor.
     def series(row):
         name = row["renderer"]
-        if name == "svs":  # one series per multiple-scattering method
-            name += " " + json.loads(row.get("settings_json", "{}")).get("ms", "none")
+        if name == "svs":  # one series per rendering method and multiple-scattering method
+            settings = json.loads(row.get("settings_json", "{}"))
+            if settings.get("method", "slices") == "march":
+                name += " march"
+            name += " " + settings.get("ms", "none")
         return f"{name} vs {row.get('reference', '?').split()[0]}"
 
     for name in sorted({series(row) for row in rows}):
