@@ -99,14 +99,18 @@ double SliceBilinear(
 } // namespace
 
 std::vector<float> ComputeSunDepthVolume(const float* density, const SunDepthGrid& grid,
-  const Vector3& toSun, double extinctionPerDensity, double metresPerUnit, int threads)
+  const Vector3& toSun, double extinctionPerDensity, double metresPerUnit, int threads,
+  SunDepthInterpolation interpolation)
 {
+  // The values swept: tau, or T = exp(-tau) (then tau = -log T at the end).
+  const bool transmittance = interpolation == SunDepthInterpolation::Transmittance;
   const std::array<int, 3>& dims = grid.Dimensions;
   const std::size_t count = static_cast<std::size_t>(std::max(dims[0], 0)) *
     static_cast<std::size_t>(std::max(dims[1], 0)) * static_cast<std::size_t>(std::max(dims[2], 0));
-  std::vector<float> depth(count, 0.0f);
+  std::vector<float> depth(count, transmittance ? 1.0f : 0.0f);
   if (count == 0 || !density)
   {
+    std::fill(depth.begin(), depth.end(), 0.0f);
     return depth;
   }
   const SweepStep sweep = SweepStepOf(grid, toSun, metresPerUnit);
@@ -135,10 +139,11 @@ std::vector<float> ComputeSunDepthVolume(const float* density, const SunDepthGri
             static_cast<double>(i[2]) } };
           const double sigma = k * CleanDensity(density[at]);
           const double exit = StepsToBoxExit(grid, x, sweep.Step);
-          double tau;
+          double value; // tau or T
           if (exit <= 1.0 || upstream < 0 || upstream >= dims[axis])
           {
-            tau = sigma * std::min(exit, 1.0) * sweep.LengthMetres;
+            const double tau = sigma * std::min(exit, 1.0) * sweep.LengthMetres;
+            value = transmittance ? std::exp(-tau) : tau;
           }
           else
           {
@@ -152,15 +157,25 @@ std::vector<float> ComputeSunDepthVolume(const float* density, const SunDepthGri
               SliceBilinear([density](std::size_t m) { return CleanDensity(density[m]); }, dims,
                 axis, upstream, y);
             const float* previous = depth.data();
-            tau =
+            const double before =
               SliceBilinear([previous](std::size_t m) { return static_cast<double>(previous[m]); },
-                dims, axis, upstream, y) +
-              0.5 * (sigma + sigmaY) * sweep.LengthMetres;
+                dims, axis, upstream, y);
+            const double segment = 0.5 * (sigma + sigmaY) * sweep.LengthMetres;
+            value = transmittance ? before * std::exp(-segment) : before + segment;
           }
-          depth[at] =
-            static_cast<float>(std::min(std::isfinite(tau) ? tau : kMaximumDepth, kMaximumDepth));
+          depth[at] = static_cast<float>(transmittance
+              ? (std::isfinite(value) ? std::max(value, 0.0) : 0.0)
+              : std::min(std::isfinite(value) ? value : kMaximumDepth, kMaximumDepth));
         }
       });
+  }
+  if (transmittance)
+  {
+    for (float& value : depth)
+    {
+      value = value > 0.0f ? std::min(-std::log(value), static_cast<float>(kMaximumDepth))
+                           : static_cast<float>(kMaximumDepth);
+    }
   }
   return depth;
 }

@@ -17,6 +17,12 @@
 // every texel). The bilinear interpolation repeated slice after slice blurs a shadow
 // edge by about the square root of the number of slices crossed, in texels
 // (measured in TestSunDepthVolume and docs/ray-march.md).
+//
+// What is interpolated: by default the transmittance T = exp(-tau) (T(x) = T(y)
+// exp(-segment)), so a line between a lit and a shadowed neighbour gets their mean
+// light, as a texel-wide beam would, and a narrow gap between clouds stays lit; tau
+// interpolated instead averages the depths, which darkens every penumbra and gap
+// (measured against the path tracer: docs/ray-march.md).
 #ifndef nimbus_SunDepthVolume_h
 #define nimbus_SunDepthVolume_h
 
@@ -41,13 +47,20 @@ struct SunDepthGrid
   std::array<double, 3> BoxHigh{ { 0, 0, 0 } };
 };
 
+/// What the sweep interpolates between texels (see above).
+enum class SunDepthInterpolation
+{
+  Transmittance,
+  OpticalDepth
+};
+
 /// tau at every texel (x fastest, as `density`), for the unit direction `toSun` in
 /// world coordinates, extinction k = extinctionPerDensity [1/m per density unit] and
 /// metresPerUnit metres per world unit. Negative and non-finite densities count as 0;
 /// tau is capped at 1e30. `threads`: as nimbus::ParallelFor (0: all cores).
 NIMBUSREPRESENTATIONS_EXPORT std::vector<float> ComputeSunDepthVolume(const float* density,
   const SunDepthGrid& grid, const Vector3& toSun, double extinctionPerDensity, double metresPerUnit,
-  int threads = 0);
+  int threads = 0, SunDepthInterpolation interpolation = SunDepthInterpolation::Transmittance);
 
 /// The block maxima of `density` for empty-space skipping: block (I, J, K) holds the
 /// largest density of the texels a trilinear look-up inside that block of

@@ -734,6 +734,11 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+constexpr double kRayMarchMinimumQuality = 0.25 * 0.25 * 0.25;
+}
+
 // The quality level of this frame: Quality for still frames, the level the cost
 // model fits into FrameBudgetMilliseconds for interactive ones.
 void vtkNimbusCloudVolumeMapper::ChooseFrameLevel(vtkRenderer* renderer, FrameState& frame)
@@ -746,6 +751,13 @@ void vtkNimbusCloudVolumeMapper::ChooseFrameLevel(vtkRenderer* renderer, FrameSt
     // The passes get 80 % of the budget; the rest of the frame (the scene's other
     // props, the copies, the swap) the rest.
     quality = this->Internal->Cost.QualityFor(0.8e-3 * this->FrameBudgetMilliseconds, quality);
+    if (this->UsesRayMarching())
+    {
+      // The ray march's interactive frames keep at least a quarter of the view's width and
+      // height (a quarter of the steps, an image of 1/16 of the pixels): its cost is
+      // mostly per pixel, and a smaller image only blurs.
+      quality = std::max(quality, std::min(kRayMarchMinimumQuality, this->Quality));
+    }
   }
   frame.Level = nimbus::ComputeFrameLevel(
     quality, this->NumberOfSlices, this->ShadowSurfaceSize, frame.Width, frame.Height);
@@ -2446,7 +2458,12 @@ void vtkNimbusCloudVolumeMapper::UpdateSunDepthVolume(FrameState& frame)
   const std::vector<float> depth =
     nimbus::ComputeSunDepthVolume(texels.data(), grid, frame.ToSun, this->ExtinctionPerDensity,
       frame.Settings.MetresPerUnit, vtkSMPTools::GetEstimatedNumberOfThreads());
-  UploadVolume(in.SunDepthTexture, frame.Window, dims, depth.data(), true);
+  // Uploaded as the transmittance exp(-tau): the texture's trilinear filter then
+  // averages light, not depth, as the sweep does (SunDepthVolume.h).
+  std::vector<float> transmittance(depth.size());
+  std::transform(
+    depth.begin(), depth.end(), transmittance.begin(), [](float tau) { return std::exp(-tau); });
+  UploadVolume(in.SunDepthTexture, frame.Window, dims, transmittance.data(), true);
   const std::vector<float> maxima =
     nimbus::ComputeBlockMaxima(texels.data(), grid.Dimensions, kRayMarchBlockTexels, in.BlockCount);
   UploadVolume(in.BlockTexture, frame.Window, in.BlockCount.data(), maxima.data(), false);
@@ -2555,7 +2572,8 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   program->SetUniform3f("blockCount", blockCount);
   program->SetUniformi("unlit", this->Unlit ? 1 : 0);
   program->SetUniformi("shaftsOn", this->Shafts ? 1 : 0);
-  program->SetUniformi("shaftSteps", std::max(this->AtmosphereSteps / 2, 1));
+  program->SetUniformi("shaftSteps", std::max(2 * this->AtmosphereSteps, 1));
+  program->SetUniformf("shaftSpacing", static_cast<float>(2.0 * SmallestTexelLength(grid)));
   program->SetUniformf("mieG", static_cast<float>(frame.Settings.Air.MieG));
   program->SetUniformf("multipleScattering", static_cast<float>(this->MultipleScattering));
   // Without air the look-up volume is not read; its samplers name a 2-D unit.

@@ -11,7 +11,8 @@
 in vec2 texCoord;
 uniform int unlit;                // benchmark floor: the cloud's optical depth alone
 uniform int shaftsOn;
-uniform int shaftSteps;           // samples of the cloud's shadow in the air
+uniform int shaftSteps;           // most samples of the cloud's shadow in the air
+uniform float shaftSpacing;       // their spacing where fewer suffice (world units)
 uniform float stepLength;         // the march's step (world units)
 uniform int maxSteps;
 uniform int maxBlockSteps;        // blocks a ray can cross
@@ -154,30 +155,35 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
 
 // The sun's single scattering in the air that the cloud's shadow takes away along
 // [a, b] (the part of the ray where a shadow can fall), with the view's clear-air
-// transmittance interpolated between airA and airB and the cloud's transmittance
-// toward the eye: 1 before the box, cloudTransmittance behind it, in between
-// interpolated geometrically.
-vec3 ShadowedAir(vec3 origin, vec3 direction, float a, float b, vec3 airA, vec3 airB,
-  float boxIn, float boxOut, float cloudTransmittance)
+// transmittance and the air's single-scattering source interpolated geometrically
+// between their values at a and b, and the cloud's transmittance toward the eye: 1
+// before the box, cloudTransmittance behind it, in between interpolated geometrically.
+// One sample per shaftSpacing (two density texels), from shaftSteps / 2 to shaftSteps.
+vec3 ShadowedAir(vec3 origin, vec3 direction, vec2 phase, float a, float b, vec3 airA,
+  vec3 airB, float boxIn, float boxOut, float cloudTransmittance)
 {
-  vec2 phase = vec2(Rayleigh(clamp(dot(direction, sunDirection), -1.0, 1.0)),
-    CornetteShanks(clamp(dot(direction, sunDirection), -1.0, 1.0), mieG));
   float span = b - a;
-  float dt = span / float(shaftSteps);
-  vec3 logRatio = log(max(airB, vec3(1e-30)) / max(airA, vec3(1e-30)));
+  int count = int(clamp(ceil(span / shaftSpacing), float(max(shaftSteps / 2, 1)),
+    float(max(shaftSteps, 1))));
+  float dt = span / float(count);
+  vec3 sourceA = AirSource(Altitude(origin + a * direction), phase);
+  vec3 sourceB = AirSource(Altitude(origin + b * direction), phase);
+  // log of the ratios b / a of the view's transmittance and of the source
+  vec3 logAir = log(max(airB, vec3(1e-30)) / max(airA, vec3(1e-30)));
+  vec3 logSource = log(max(sourceB, vec3(1e-30)) / max(sourceA, vec3(1e-30)));
+  float logCloud = log(max(cloudTransmittance, 1e-30));
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5;
   vec3 lost = vec3(0.0);
-  for (int s = 0; s < shaftSteps; ++s)
+  for (int s = 0; s < count; ++s)
   {
     float t = a + (float(s) + jitter) * dt;
     vec3 p = origin + t * direction;
+    float f = (t - a) / max(span, 1e-30);
     float inBox = clamp((t - boxIn) / max(boxOut - boxIn, 1e-30), 0.0, 1.0);
-    float cloud = pow(max(cloudTransmittance, 1e-30), inBox);
     float depth = InsideBox(p) ? CloudDepthInsideBox(p) : CloudDepthOutsideBox(p);
-    lost += AirSource(Altitude(p), phase) * (1.0 - exp(-depth)) * cloud *
-      airA * exp(logRatio * ((t - a) / max(span, 1e-30)));
+    lost += (1.0 - exp(-depth)) * exp(logCloud * inBox) * exp((logAir + logSource) * f);
   }
-  return lost * dt * metresPerUnit;
+  return sourceA * airA * lost * dt * metresPerUnit;
 }
 
 void main()
@@ -221,7 +227,9 @@ void main()
     vec3 airA, airB, ignored;
     AirTo(texCoord, a, ignored, airA);
     AirTo(texCoord, b, ignored, airB);
-    color -= ShadowedAir(origin, direction, a, b, airA, airB, hitsBox ? t0 : kInfinity,
+    float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+    vec2 phase = vec2(Rayleigh(mu), CornetteShanks(mu, mieG));
+    color -= ShadowedAir(origin, direction, phase, a, b, airA, airB, hitsBox ? t0 : kInfinity,
       hitsBox ? t1 : kInfinity, cloudTransmittance);
     color = max(color, vec3(0.0));
   }

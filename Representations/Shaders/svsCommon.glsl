@@ -60,7 +60,7 @@ uniform sampler2D sceneDepth;       // depth of the opaque geometry already draw
 uniform int overSky;
 uniform int sliceJitter;            // 1: slice planes shifted per pixel (SliceJitter)
 uniform float firstSliceOffset;     // d where the slicing starts: sunward of it, no shadow
-// The ray-marched method (cloudMarchFS.glsl): the cloud's optical depth toward the sun
+// The ray-marched method (cloudMarchFS.glsl): the sun's transmittance through the cloud
 // at every density texel (SunDepthVolume.h), in place of the shadow surface.
 uniform int sunDepthVolumeOn;
 uniform sampler3D sunDepthVolume;
@@ -375,7 +375,9 @@ float OwnDepthInsideBox(vec3 p)
 {
   if (sunDepthVolumeOn != 0)
   {
-    return texture(sunDepthVolume, (worldToTexture * vec4(p, 1.0)).xyz).r;
+    // The texture holds the transmittance exp(-tau) (SunDepthVolume.h); 1e-37 keeps
+    // tau finite (85) where the sun is gone.
+    return -log(max(texture(sunDepthVolume, (worldToTexture * vec4(p, 1.0)).xyz).r, 1e-37));
   }
   return ShadowDepth(p);
 }

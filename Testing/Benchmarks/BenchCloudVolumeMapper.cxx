@@ -3,11 +3,14 @@
 // ratio to the floor (the same slices composited unlit) and to VTK's
 // vtkGPUVolumeRayCastMapper with volumetric scattering (GlobalIlluminationReach 1).
 //
-//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky | side]
+//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky | march | side]
 //
 // With a number `side` the volume sweep adds a side^3 cloud (one node's piece of a
-// large field, issue 18). With "sky" only the sky table runs: what a vtkNimbusSkyBackground
-// adds to a cloud frame (the background pass plus the mapper's second target).
+// large field). With "sky" only the sky table runs: what a vtkNimbusSkyBackground
+// adds to a cloud frame (the background pass plus the mapper's second target). With
+// "march" only the ray-marched method's table runs (docs/ray-march.md): frame time
+// against the volume and the step beside the slices and VTK's plain GPU ray caster, and
+// one frame's passes timed on the GPU.
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
 // under Testing/with-display.sh (needs an OpenGL context), or with --offscreen (EGL, no X).
@@ -93,7 +96,8 @@ struct Bench
 Bench* TheBench = nullptr;
 
 double TimeSvs(vtkImageData* image, int slices,
-  const std::function<void(vtkNimbusCloudVolumeMapper*)>& configure)
+  const std::function<void(vtkNimbusCloudVolumeMapper*)>& configure,
+  std::string* passTimes = nullptr)
 {
   Bench& bench = *TheBench;
   vtkNew<vtkNimbusCloudVolumeMapper> mapper;
@@ -104,9 +108,95 @@ double TimeSvs(vtkImageData* image, int slices,
   configure(mapper);
   bench.Volume->SetMapper(mapper);
   const double t = bench.Time();
+  if (passTimes)
+  {
+    *passTimes = mapper->GetLastPassTimes();
+  }
   bench.Volume->SetMapper(nullptr);
   mapper->ReleaseGraphicsResources(bench.Window);
   return t;
+}
+
+// VTK's GPU ray caster as ParaView's Volume representation draws a still frame: one
+// sample per voxel, absorption and emission without shading.
+double TimeVtkPlain(vtkImageData* image)
+{
+  Bench& bench = *TheBench;
+  vtkNew<vtkGPUVolumeRayCastMapper> mapper;
+  mapper->SetInputData(image);
+  mapper->AutoAdjustSampleDistancesOff();
+  const double spacing = image->GetSpacing()[0];
+  mapper->SetSampleDistance(spacing);
+  vtkNew<vtkPiecewiseFunction> opacity;
+  opacity->AddPoint(0.0, 0.0);
+  opacity->AddPoint(3.0, 1.0);
+  vtkNew<vtkColorTransferFunction> color;
+  color->AddRGBPoint(0.0, 0.2, 0.3, 0.8);
+  color->AddRGBPoint(3.0, 1, 1, 1);
+  vtkNew<vtkVolumeProperty> property;
+  property->SetScalarOpacity(opacity);
+  property->SetColor(color);
+  property->SetInterpolationTypeToLinear();
+  bench.Volume->SetProperty(property);
+  bench.Volume->SetMapper(mapper);
+  const double t = bench.Time();
+  bench.Volume->SetMapper(nullptr);
+  mapper->ReleaseGraphicsResources(bench.Window);
+  return t;
+}
+
+// The ray-marched method's table: frame time against the volume and the step, beside
+// the slices (256) and VTK's plain GPU ray caster; then its passes (GL timer queries).
+void RayMarchTables()
+{
+  const auto march = [](double step, bool air, bool unlit)
+  {
+    return [step, air, unlit](vtkNimbusCloudVolumeMapper* m)
+    {
+      m->SetRenderingMethodToRayMarching();
+      m->SetRayMarchStepTexels(step);
+      m->SetAtmosphere(air);
+      m->SetGround(air);
+      m->SetUnlit(unlit);
+    };
+  };
+  const auto none = [](vtkNimbusCloudVolumeMapper*) {};
+  std::printf(
+    "\nRay march (RenderingMethod RayMarching) against the slices and VTK's plain GPU "
+    "ray caster\n\n| volume | step (texels) | full scene | cloud only | unlit floor | "
+    "slices (256), full | VTK GPU, plain | full / VTK |\n|---|---|---|---|---|---|---|---|\n");
+  for (const int side : { 64, 128, 256 })
+  {
+    vtkSmartPointer<vtkImageData> c = nimbus::testing::TestCumulus(side, side, side);
+    const double slices = TimeSvs(c, 256, none);
+    const double vtkPlain = TimeVtkPlain(c);
+    for (const double step : { 0.5, 1.0, 2.0 })
+    {
+      const double full = TimeSvs(c, 256, march(step, true, false));
+      const double cloud = TimeSvs(c, 256, march(step, false, false));
+      const double floor = TimeSvs(c, 256, march(step, false, true));
+      std::printf("| %d^3 | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f |\n", side, step, full,
+        cloud, floor, slices, vtkPlain, full / vtkPlain);
+    }
+  }
+  std::printf("\nPasses of one frame (128^3, step 1, GL_TIME_ELAPSED), seconds:\n\n");
+  vtkSmartPointer<vtkImageData> c128 = nimbus::testing::TestCumulus(128, 128, 128);
+  for (const int method :
+    { vtkNimbusCloudVolumeMapper::RayMarching, vtkNimbusCloudVolumeMapper::ShadowViewSlicing })
+  {
+    std::string passes;
+    const double t = TimeSvs(
+      c128, 256,
+      [method](vtkNimbusCloudVolumeMapper* m)
+      {
+        m->SetRenderingMethod(method);
+        m->TimePassesOn();
+      },
+      &passes);
+    std::printf("- %s (frame %.1f ms): %s\n",
+      method == vtkNimbusCloudVolumeMapper::RayMarching ? "ray march" : "slices, 256", t,
+      passes.c_str());
+  }
 }
 
 double TimeVtkGpu(vtkImageData* image, double reach)
@@ -167,6 +257,11 @@ int main(int argc, char* argv[])
   };
   const auto unlit = [](vtkNimbusCloudVolumeMapper* m) { m->SetUnlit(true); };
 
+  if (argc > 4 && std::string(argv[4]) == "march")
+  {
+    RayMarchTables();
+    return EXIT_SUCCESS;
+  }
   if (argc > 4 && std::string(argv[4]) == "sky")
   {
     // Sky at 65 deg (as the mapper's sun here); tables built in the warm-up frame.

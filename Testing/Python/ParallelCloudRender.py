@@ -59,6 +59,9 @@ def main():
     display = Show(reader, view)
     display.SetRepresentationType("Cloud")
     display.EncodeSrgb = args.srgb
+    # The pieces of a distributed cloud are drawn by slicing (the ray march draws only a
+    # whole cloud): the one-rank reference is drawn the same way.
+    display.RenderingMethod = 0
     # From the south-west, a little above the cloud's base: the pieces lie behind
     # one another along the view as well as beside one another.
     info = reader.GetDataInformation().GetBounds()
