@@ -77,17 +77,11 @@ float SunMultipleScattering(float mu, float tau)
 }
 
 
-// The radiance the cloud sends toward the eye per metre at p [relative to the sun],
-// before the view's attenuation: sigma = k rho [1/m], sunDepth = the cloud's optical
-// depth toward the sun, cloudPhase = the pixel's phase value (beta_cl + k_multi / 4 pi,
-// 000 Eq. 8), direction = the view ray's.
-vec3 CloudSource(vec3 p, vec3 direction, float sigma, float sunDepth, float cloudPhase,
-  float altitude)
+// The cloud's light at p toward the eye per metre other than the sun's single and
+// forward-peak scattering: the solver's multiple scattering, lightning, emission.
+vec3 CloudOtherSources(vec3 p, vec3 direction, float sigma)
 {
-  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
-  vec3 source = cloudAlbedo * sigma *
-    (cloudPhase * exp(-sunDepth) + SunMultipleScattering(mu, sunDepth)) *
-    SunIrradiance(altitude);                                       // 000 Eq. 8, cloud
+  vec3 source = vec3(0.0);
   if (scatteringTextureOn != 0)
   {
     source += cloudAlbedo * sigma * InScattering(p, -direction);
@@ -102,4 +96,18 @@ vec3 CloudSource(vec3 p, vec3 direction, float sigma, float sunDepth, float clou
     source += emissionScale * max(texture(emissionRgb, (worldToTexture * vec4(p, 1.0)).xyz).rgb, vec3(0.0));
   }
   return source;
+}
+
+// The radiance the cloud sends toward the eye per metre at p [relative to the sun],
+// before the view's attenuation: sigma = k rho [1/m], sunDepth = the cloud's optical
+// depth toward the sun, cloudPhase = the pixel's phase value (beta_cl + k_multi / 4 pi,
+// 000 Eq. 8), direction = the view ray's.
+vec3 CloudSource(vec3 p, vec3 direction, float sigma, float sunDepth, float cloudPhase,
+  float altitude)
+{
+  float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
+  return cloudAlbedo * sigma *
+    (cloudPhase * exp(-sunDepth) + SunMultipleScattering(mu, sunDepth)) *
+    SunIrradiance(altitude) +                                      // 000 Eq. 8, cloud
+    CloudOtherSources(p, direction, sigma);
 }

@@ -6,13 +6,14 @@
 // the cloud's shadow in it (the shafts) is marched only where it can fall
 // (ShadowInterval). Output 0: (radiance before exposure, cloud transmittance; 0 where
 // the ground closes the ray, not over a sky), as the slices and the march passes of
-// the shadow-view-slice method leave it; output 1: the same without the cloud (over
-// a sky; see svsCompositeFS.glsl); output 2: (t_end, t_ground), the composite's.
+// the shadow-view-slice method leave it; output 1 (bound over a sky only): the same
+// without the cloud (see svsCompositeFS.glsl).
 in vec2 texCoord;
 uniform int unlit;                // benchmark floor: the cloud's optical depth alone
 uniform int shaftsOn;
 uniform int shaftSteps;           // most samples of the cloud's shadow in the air
 uniform float shaftSpacing;       // their spacing where fewer suffice (world units)
+uniform mat4 boxToTexture;        // the box as [0,1]^3 -> density texture coordinates
 uniform float stepLength;         // the march's step (world units)
 uniform int maxSteps;
 uniform int maxBlockSteps;        // blocks a ray can cross
@@ -28,7 +29,7 @@ uniform vec2 froxelDepths;        // d_1 (world units), 1 / log(d_{k+1} / d_k)
 uniform float mieG;
 uniform float multipleScattering; // k_multi (000 Eq. 1)
 
-const float kOpaque = 1e-4;       // the cloud transmittance at which the march stops
+const float kOpaque = 1e-3;       // the cloud transmittance at which the march stops
 
 // Where distance t falls on the look-up volume's ladder of distances (a slice index).
 float FroxelSlice(float t)
@@ -38,6 +39,33 @@ float FroxelSlice(float t)
     return max(t, 0.0) / froxelDepths.x;
   }
   return min(1.0 + log(t / froxelDepths.x) * froxelDepths.y, float(FroxelSize().z - 1));
+}
+
+// Where distance t falls in the look-up volume's atlas: the texture coordinates of the
+// two slices around it and the weight of the second.
+void FroxelCoordinates(vec2 uv, float t, out vec2 c0, out vec2 c1, out float f)
+{
+  float s = FroxelSlice(min(t, 1e20));
+  int k0 = int(floor(s));
+  int k1 = min(k0 + 1, FroxelSize().z - 1);
+  f = s - float(k0);
+  vec2 xy = uv * vec2(FroxelSize().xy - 1) + 0.5; // texel units within a slice
+  vec2 atlas = vec2(FroxelSize().x, FroxelSize().y * FroxelSize().z);
+  c0 = vec2(xy.x, xy.y + float(k0 * FroxelSize().y)) / atlas;
+  c1 = vec2(xy.x, xy.y + float(k1 * FroxelSize().y)) / atlas;
+}
+
+// The clear air's transmittance between the eye and distance t along this pixel's ray.
+vec3 AirTransmittanceTo(vec2 uv, float t)
+{
+  if (atmosphereOn == 0)
+  {
+    return vec3(1.0);
+  }
+  vec2 c0, c1;
+  float f;
+  FroxelCoordinates(uv, t, c0, c1, f);
+  return mix(texture(froxelTransmittance, c0).rgb, texture(froxelTransmittance, c1).rgb, f);
 }
 
 // The clear air between the eye and distance t along this pixel's ray: in-scattered
@@ -50,58 +78,49 @@ void AirTo(vec2 uv, float t, out vec3 radiance, out vec3 transmittance)
     transmittance = vec3(1.0);
     return;
   }
-  float s = FroxelSlice(min(t, 1e20));
-  int k0 = int(floor(s));
-  int k1 = min(k0 + 1, FroxelSize().z - 1);
-  float f = s - float(k0);
-  vec2 xy = uv * vec2(FroxelSize().xy - 1) + 0.5; // texel units within a slice
-  vec2 atlas = vec2(FroxelSize().x, FroxelSize().y * FroxelSize().z);
-  vec2 c0 = vec2(xy.x, xy.y + float(k0 * FroxelSize().y)) / atlas;
-  vec2 c1 = vec2(xy.x, xy.y + float(k1 * FroxelSize().y)) / atlas;
+  vec2 c0, c1;
+  float f;
+  FroxelCoordinates(uv, t, c0, c1, f);
   radiance = mix(texture(froxelScattering, c0).rgb, texture(froxelScattering, c1).rgb, f);
   transmittance = mix(texture(froxelTransmittance, c0).rgb, texture(froxelTransmittance, c1).rgb, f);
 }
 
-// The distance to where the ray leaves density block `block` (o + t d in texel index
-// coordinates).
-float BlockExit(vec3 o, vec3 d, vec3 block)
-{
-  vec3 lo = block * blockTexels, hi = lo + blockTexels;
-  vec3 exits = vec3(kInfinity);
-  for (int a = 0; a < 3; ++a)
-  {
-    if (d[a] > 1e-12)
-    {
-      exits[a] = (hi[a] - o[a]) / d[a];
-    }
-    else if (d[a] < -1e-12)
-    {
-      exits[a] = (lo[a] - o[a]) / d[a];
-    }
-  }
-  return min(exits.x, min(exits.y, exits.z));
-}
-
 // The part [first, last] of [t0, t1] between the first and the last block that holds
-// any density, by a walk over the blocks (one look-up each): the march then steps
-// only through it, with no test per step (on a GPU that runs pixels in lock-step, as
-// llvmpipe does, a per-step test costs every pixel its both branches).
+// any density, by a 3-D DDA over the blocks (Amanatides & Woo 1987; one texel fetch per
+// block): the march then steps only through it, with no test per step (on a GPU that
+// runs pixels in lock-step, as llvmpipe does, a per-step test costs every pixel both
+// of its branches). o + t d: the ray in texel index coordinates.
 bool OccupiedSpan(vec3 o, vec3 d, float t0, float t1, out float first, out float last)
 {
   first = kInfinity;
   last = -kInfinity;
-  float nudge = 1e-3 * stepLength;
+  ivec3 count = ivec3(blockCount + 0.5);
+  vec3 start = (o + (t0 + 1e-3 * stepLength) * d) / blockTexels;
+  ivec3 block = clamp(ivec3(floor(start)), ivec3(0), count - 1);
+  ivec3 stepDirection = ivec3(sign(d));
+  vec3 safe = mix(d, vec3(1e-30), lessThan(abs(d), vec3(1e-30)));
+  // The ray's t at the next block boundary per axis, and between two boundaries.
+  vec3 boundary = (vec3(block) + step(0.0, d)) * blockTexels;
+  vec3 tNext = mix((boundary - o) / safe, vec3(kInfinity), lessThan(abs(d), vec3(1e-30)));
+  vec3 tDelta = mix(blockTexels / abs(safe), vec3(kInfinity), lessThan(abs(d), vec3(1e-30)));
   float t = t0;
   for (int i = 0; i < maxBlockSteps && t < t1; ++i)
   {
-    vec3 block = floor((o + (t + nudge) * d) / blockTexels);
-    float exit = max(BlockExit(o, d, block), t + nudge);
-    if (texture(blockMaxima, (block + 0.5) / blockCount).r > 0.0)
+    float exit = min(tNext.x, min(tNext.y, tNext.z));
+    if (texelFetch(blockMaxima, block, 0).r > 0.0)
     {
       first = min(first, t);
       last = exit;
     }
     t = exit;
+    // Step across the nearest boundary.
+    vec3 across = vec3(equal(tNext, vec3(exit)));
+    block += ivec3(across) * stepDirection;
+    tNext += across * tDelta;
+    if (any(lessThan(block, ivec3(0))) || any(greaterThanEqual(block, count)))
+    {
+      break;
+    }
   }
   last = min(last, t1);
   return first < last;
@@ -125,6 +144,10 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
   }
   float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
   float cloudPhase = CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * kPi);
+  // The delta-M forward peak's term of SunMultipleScattering with the sun's transmittance
+  // T read directly: (1 - f) p(mu) (T^(1 - f albedo) - T); the octaves keep the general form.
+  float peakPhase = (1.0 - forwardPeakFraction) * CornetteShanks(mu, cloudG);
+  float peakExponent = 1.0 - forwardPeakFraction * cloudAlbedo;
   float span = max(t1 - t0, 1e-30);
   // log of the clear air's transmittance ratio across the box (geometric interpolation).
   vec3 airLogRatio = log(max(airOut, vec3(1e-30)) / max(airIn, vec3(1e-30)));
@@ -139,9 +162,16 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
     float alpha = exp(-sigma * stepMetres);
     // Exact integral of a constant source over the step: (1 - alpha) / sigma.
     float stepIntegral = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
-    vec3 source = unlit != 0 ? vec3(sigma)
-      : CloudSource(p, direction, sigma, CloudDepthInsideBox(p), cloudPhase, Altitude(p)) *
+    vec3 source = vec3(sigma);
+    if (unlit == 0)
+    {
+      float sun = texture(sunDepthVolume, (worldToTexture * vec4(p, 1.0)).xyz).r; // T
+      float beyond = octaves > 1 ? SunMultipleScattering(mu, -log(max(sun, 1e-37)))
+        : forwardPeakFraction > 0.0 ? peakPhase * (pow(sun, peakExponent) - sun) : 0.0;
+      source = (cloudAlbedo * sigma * (cloudPhase * sun + beyond) * SunIrradiance(Altitude(p)) +
+                 CloudOtherSources(p, direction, sigma)) *
         airIn * exp(airLogRatio * ((t - t0) / span));
+    }
     radiance += transmittance * source * stepIntegral;
     transmittance *= alpha;
     if (transmittance < kOpaque)
@@ -153,35 +183,53 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
   }
 }
 
+// The sun's transmittance through the cloud at a point given in box coordinates
+// (pb, the sun's direction lb there): read in the sun-depth volume where the point's
+// line toward the sun enters the box, or at the point inside it; 1 where the line
+// misses the box or leaves it away from the sun. No world-space matrix per call.
+float SunTransmittanceAt(vec3 pb, vec3 lb)
+{
+  float tIn = -kInfinity, tOut = kInfinity;
+  if (!ClipToUnitSlab(pb.x, lb.x, tIn, tOut) || !ClipToUnitSlab(pb.y, lb.y, tIn, tOut) ||
+    !ClipToUnitSlab(pb.z, lb.z, tIn, tOut) || tIn > tOut || tOut < 0.0)
+  {
+    return 1.0;
+  }
+  vec3 entry = pb + max(tIn, 0.0) * lb;
+  return texture(sunDepthVolume, (boxToTexture * vec4(entry, 1.0)).xyz).r;
+}
+
 // The sun's single scattering in the air that the cloud's shadow takes away along
 // [a, b] (the part of the ray where a shadow can fall), with the view's clear-air
 // transmittance and the air's single-scattering source interpolated geometrically
 // between their values at a and b, and the cloud's transmittance toward the eye: 1
 // before the box, cloudTransmittance behind it, in between interpolated geometrically.
-// One sample per shaftSpacing (two density texels), from shaftSteps / 2 to shaftSteps.
+// One sample per shaftSpacing (two density texels), from shaftSteps / 4 to shaftSteps.
 vec3 ShadowedAir(vec3 origin, vec3 direction, vec2 phase, float a, float b, vec3 airA,
   vec3 airB, float boxIn, float boxOut, float cloudTransmittance)
 {
   float span = b - a;
-  int count = int(clamp(ceil(span / shaftSpacing), float(max(shaftSteps / 2, 1)),
+  int count = int(clamp(ceil(span / shaftSpacing), float(max(shaftSteps / 4, 1)),
     float(max(shaftSteps, 1))));
   float dt = span / float(count);
   vec3 sourceA = AirSource(Altitude(origin + a * direction), phase);
   vec3 sourceB = AirSource(Altitude(origin + b * direction), phase);
   // log of the ratios b / a of the view's transmittance and of the source
-  vec3 logAir = log(max(airB, vec3(1e-30)) / max(airA, vec3(1e-30)));
-  vec3 logSource = log(max(sourceB, vec3(1e-30)) / max(sourceA, vec3(1e-30)));
+  vec3 logRatio = log(max(airB, vec3(1e-30)) / max(airA, vec3(1e-30))) +
+    log(max(sourceB, vec3(1e-30)) / max(sourceA, vec3(1e-30)));
   float logCloud = log(max(cloudTransmittance, 1e-30));
+  // The ray and the sun in box coordinates.
+  vec3 ob = (worldToBox * vec4(origin, 1.0)).xyz;
+  vec3 db = (worldToBox * vec4(direction, 0.0)).xyz;
+  vec3 lb = (worldToBox * vec4(sunDirection, 0.0)).xyz;
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5;
   vec3 lost = vec3(0.0);
   for (int s = 0; s < count; ++s)
   {
     float t = a + (float(s) + jitter) * dt;
-    vec3 p = origin + t * direction;
     float f = (t - a) / max(span, 1e-30);
     float inBox = clamp((t - boxIn) / max(boxOut - boxIn, 1e-30), 0.0, 1.0);
-    float depth = InsideBox(p) ? CloudDepthInsideBox(p) : CloudDepthOutsideBox(p);
-    lost += (1.0 - exp(-depth)) * exp(logCloud * inBox) * exp((logAir + logSource) * f);
+    lost += (1.0 - SunTransmittanceAt(ob + t * db, lb)) * exp(logRatio * f + logCloud * inBox);
   }
   return sourceA * airA * lost * dt * metresPerUnit;
 }
@@ -224,9 +272,8 @@ void main()
   if (unlit == 0 && shaftsOn != 0 && atmosphereOn != 0 &&
     ShadowInterval(origin, direction, 0.0, min(tEnd, 1e9), a, b))
   {
-    vec3 airA, airB, ignored;
-    AirTo(texCoord, a, ignored, airA);
-    AirTo(texCoord, b, ignored, airB);
+    vec3 airA = AirTransmittanceTo(texCoord, a);
+    vec3 airB = AirTransmittanceTo(texCoord, b);
     float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
     vec2 phase = vec2(Rayleigh(mu), CornetteShanks(mu, mieG));
     color -= ShadowedAir(origin, direction, phase, a, b, airA, airB, hitsBox ? t0 : kInfinity,
@@ -245,5 +292,4 @@ void main()
   }
   gl_FragData[0] = vec4(color, alpha);
   gl_FragData[1] = vec4(clearColor, 1.0);
-  gl_FragData[2] = vec4(tEnd, tGround, 0.0, 0.0);
 }

@@ -21,7 +21,6 @@ in vec2 texCoord;
 uniform sampler2D accumulation;
 uniform sampler2D clearAccumulation; // S_clear (over a sky only)
 uniform sampler2D sceneColor;
-uniform sampler2D rayEnds; // (t_end, t_ground) per pixel, this frame
 uniform vec3 displayScale;
 uniform int encodeSrgb;
 uniform int skyBackground;
@@ -86,7 +85,10 @@ void main()
   }
   else
   {
-    float tEnd = texture(rayEnds, texCoord).r;
+    // Where the view ray ends (as svsRayEndsFS.glsl finds it), at this pixel's own
+    // position when the passes drew a smaller image.
+    float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
+      GroundDistance(origin, direction));
     vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
     result = displayScale * sum.rgb + behind * backgroundLinear;
   }
