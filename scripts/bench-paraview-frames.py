@@ -1,9 +1,9 @@
 """Frame times of the Cloud representation in ParaView (pvpython), beside ParaView's own
-Volume representation, in one run (issue 15: interactive speed).
+Volume representation, in one run (interactive speed).
 
     Testing/with-display.sh pvpython scripts/bench-paraview-frames.py \
         --plugin build/lib/paraview-5.11/plugins/Nimbus/Nimbus.so [--size 1280 800] \
-        [--dimensions 128] [--repeats 5] [--json out.json]
+        [--dimensions 128] [--repeats 5] [--method {march,slices}] [--json out.json]
 
 With `import nimbus` on PYTHONPATH (build/lib/python3.11/site-packages) it also measures the
 unlit-slice floor (the mapper's Unlit mode at full quality: the slices without light, the
@@ -52,6 +52,10 @@ def main():
     parser.add_argument("--size", type=int, nargs=2, default=[1280, 800])
     parser.add_argument("--dimensions", type=int, default=128)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--method", choices=["march", "slices"], default="march",
+                        help="the Cloud representation's rendering method: ray marching "
+                             "(march, the representation's default) or shadow-view "
+                             "slicing (slices)")
     parser.add_argument("--json")
     arguments = parser.parse_args()
 
@@ -64,6 +68,8 @@ def main():
     SetActiveView(view)
     display = Show(cloud, view)
     display.SetRepresentationType("Cloud")
+    if arguments.method == "slices":
+        display.RenderingMethod = 0  # shadow-view slicing; 1 (the default) ray marches
     ColorBy(display, ("POINTS", "density"))
     display.SetScalarBarVisibility(view, False)
     view.ResetCamera()
@@ -86,6 +92,8 @@ def main():
         rows["interactive_cloud_passes"] = mapper.GetLastFrameSeconds()
         view.StillRender()
         rows["still_quality"] = mapper.GetLastFrameQuality()
+    if mapper is not None and hasattr(mapper, "GetRenderingMethod"):
+        rows["mapper_rendering_method"] = mapper.GetRenderingMethod()  # 0 slices, 1 march
     # A change that does not touch the cloud: the colour legend.
     bar = GetScalarBar(GetColorTransferFunction("density"), view)
     times = []
@@ -106,6 +114,7 @@ def main():
     rows["volume_interactive"] = timed(view, True, arguments.repeats)
     rows["size"] = arguments.size
     rows["dimensions"] = n
+    rows["method"] = arguments.method
     for key, value in rows.items():
         print(f"{key:22s} {value}")
     if "unlit_floor_still" in rows:
