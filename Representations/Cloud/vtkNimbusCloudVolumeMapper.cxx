@@ -416,6 +416,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkTextureObject> FroxelScattering;
   vtkNew<vtkTextureObject> FroxelTransmittance;
   vtkNew<vtkOpenGLFramebufferObject> FroxelFramebuffer;
+  vtkNew<vtkOpenGLFramebufferObject> MarchFramebuffer;
 
   // The GPU time of each pass (TimePasses).
   nimbus::PassTimer Timer;
@@ -463,10 +464,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
     {
       t->ReleaseGraphicsResources(window);
     }
-    for (vtkOpenGLFramebufferObject* f :
-      { IntervalPhaseFramebuffer.GetPointer(), SceneFramebuffer.GetPointer(),
-        RayEndsFramebuffer.GetPointer(), AccumulationFramebuffer.GetPointer(),
-        ShadowFramebuffer.GetPointer(), FroxelFramebuffer.GetPointer() })
+    for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
+           SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
+           AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer(),
+           FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
@@ -2527,6 +2528,8 @@ void vtkNimbusCloudVolumeMapper::RenderAirFroxels(const FrameState& frame)
   in.FroxelFramebuffer->RemoveColorAttachment(1);
   in.FroxelFramebuffer->AddColorAttachment(1, in.FroxelTransmittance);
   in.FroxelFramebuffer->ActivateDrawBuffers(2);
+  const GLenum buffers[2] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1 };
+  glDrawBuffers(2, buffers); // as in RenderCloudMarch
   frame.State->vtkglViewport(0, 0, columns, rows * kFroxelSlices);
   frame.State->vtkglDisable(GL_BLEND);
   vtkShaderProgram* program = in.Ready(in.FroxelPass, cloudAirFroxelsFS);
@@ -2555,26 +2558,23 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
     ? vtkTextureObject::Nearest
     : vtkTextureObject::Linear;
-  // The cloud-free target only over a sky (the composite's S_clear).
-  const int targets = frame.Settings.OverSky ? 2 : 1;
+  // Its own framebuffer, always with both targets (the cloud-free one is read over a
+  // sky only).
   for (vtkTextureObject* t : { in.Accumulation.GetPointer(), in.ClearAccumulation.GetPointer() })
   {
-    if (t == in.ClearAccumulation.GetPointer() && targets < 2)
-    {
-      continue;
-    }
     EnsureTexture2D(t, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
     t->SetMinificationFilter(filter);
     t->SetMagnificationFilter(filter);
   }
-  DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
-  in.AccumulationFramebuffer->RemoveColorAttachment(1);
-  in.AccumulationFramebuffer->RemoveColorAttachment(2);
-  if (targets == 2)
-  {
-    in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
-  }
-  in.AccumulationFramebuffer->ActivateDrawBuffers(targets);
+  DrawInto(in.MarchFramebuffer, in.Accumulation, frame.Window);
+  in.MarchFramebuffer->RemoveColorAttachment(1);
+  in.MarchFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
+  in.MarchFramebuffer->ActivateDrawBuffers(2);
+  // This VTK's vtkOpenGLState can take the two draw buffers for a change it already made
+  // (its cache compares with the framebuffer's list of the call before) and leave the
+  // second at GL_NONE (measured: GL_DRAW_BUFFER1 read back as GL_NONE): set them directly.
+  const GLenum buffers[2] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1 };
+  glDrawBuffers(2, buffers);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglDisable(GL_BLEND);
   vtkShaderProgram* program = in.Ready(in.CloudMarchPass, cloudMarchFS, true);
@@ -2630,8 +2630,6 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   program->SetUniform2f("froxelDepths", depths.data());
   in.CloudMarchPass->Render();
   ++in.PassesLastRender;
-  in.AccumulationFramebuffer->RemoveColorAttachment(1);
-  in.AccumulationFramebuffer->ActivateDrawBuffers(1);
 }
 
 //------------------------------------------------------------------------------
@@ -2765,8 +2763,12 @@ void vtkNimbusCloudVolumeMapper::CaptureRadianceImage(const FrameState& frame)
     return;
   }
   Internals& in = *this->Internal;
-  in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
-  in.AccumulationFramebuffer->ActivateReadBuffer(0);
+  // The framebuffer the frame's method drew the accumulation with.
+  vtkOpenGLFramebufferObject* framebuffer = this->UsesRayMarching()
+    ? in.MarchFramebuffer.GetPointer()
+    : in.AccumulationFramebuffer.GetPointer();
+  framebuffer->Bind(GL_FRAMEBUFFER);
+  framebuffer->ActivateReadBuffer(0);
   vtkNew<vtkFloatArray> values;
   values->SetName("radiance");
   values->SetNumberOfComponents(4);

@@ -5,6 +5,8 @@
 //
 //   TestCloudSky aerial <baseline.png> <outputdir>   image test: three identical
 //       cumulus 5, 13 and 31 km away in afternoon haze (aerial perspective)
+//   TestCloudSky aerial-ray-march | checks-ray-march ...: the same drawn by the ray march
+//       (RenderingMethod RayMarching).
 //   TestCloudSky checks                              numeric checks, no baseline:
 //     - a zero-density cloud leaves the sky image unchanged (max 1 of 255),
 //     - a real cloud leaves the sky unchanged away from it and its shadow,
@@ -87,6 +89,9 @@ int MaxDifference(const Frame& a, const Frame& b, Keep keep)
   return worst;
 }
 
+// The method every Scene draws with (the modes ending in -ray-march set the ray march).
+int gRenderingMethod = vtkNimbusCloudVolumeMapper::ShadowViewSlicing;
+
 struct Scene
 {
   vtkNew<vtkRenderer> Renderer;
@@ -101,6 +106,7 @@ struct Scene
     this->Sky->GetSky()->SetExposure(10.0);
     this->Renderer->AddViewProp(this->Sky);
     this->Mapper->SetSkyBackground(this->Sky);
+    this->Mapper->SetRenderingMethod(gRenderingMethod);
     this->Cloud->SetDimensions(64, 64, 48);
     this->Mapper->SetInputConnection(this->Cloud->GetOutputPort());
     this->Mapper->SetMultipleScattering(3.0);
@@ -262,7 +268,14 @@ int main(int argc, char* argv[])
   {
     return 2;
   }
-  const std::string mode = argc > 1 ? argv[1] : "";
+  std::string mode = argc > 1 ? argv[1] : "";
+  const std::string rayMarch = "-ray-march";
+  if (mode.size() > rayMarch.size() &&
+    mode.compare(mode.size() - rayMarch.size(), rayMarch.size(), rayMarch) == 0)
+  {
+    gRenderingMethod = vtkNimbusCloudVolumeMapper::RayMarching;
+    mode.resize(mode.size() - rayMarch.size());
+  }
   if (mode == "checks" && argc == 2)
   {
     return RunChecks();
@@ -282,7 +295,8 @@ int main(int argc, char* argv[])
   vtkNew<vtkWindowToImageFilter> capture;
   capture->SetInput(scene.Window);
   capture->ReadFrontBufferOff();
-  const std::string image = std::string(argv[3]) + "/TestCloudSky_aerial.png";
+  const std::string image = std::string(argv[3]) + "/TestCloudSky_aerial" +
+    (gRenderingMethod == vtkNimbusCloudVolumeMapper::RayMarching ? "_RayMarch" : "") + ".png";
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(image.c_str());
   writer->SetInputConnection(capture->GetOutputPort());
