@@ -126,35 +126,39 @@ bool OccupiedSpan(vec3 o, vec3 d, float t0, float t1, out float first, out float
   return first < last;
 }
 
-// The cloud along [t0, t1]: its radiance toward the eye (the clear air's transmittance
-// from the eye included, interpolated geometrically between airIn and airOut) and its
-// transmittance.
-void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec3 airOut,
-  out vec3 radiance, out float transmittance)
+// The part [first, last] of the view ray between the first and the last density block
+// it crosses inside the box's [t0, t1] (false when it crosses none).
+bool CloudSpan(vec3 origin, vec3 direction, float t0, float t1, out float first, out float last)
 {
-  radiance = vec3(0.0);
-  transmittance = 1.0;
   // Texel index coordinates of the ray, for the blocks.
   vec3 o = (worldToTexture * vec4(origin, 1.0)).xyz * densitySize - 0.5;
   vec3 d = (worldToTexture * vec4(direction, 0.0)).xyz * densitySize;
-  float first, last;
-  if (!OccupiedSpan(o, d, t0, t1, first, last))
-  {
-    return;
-  }
+  return OccupiedSpan(o, d, t0, t1, first, last);
+}
+
+// The cloud along [first, last]: its radiance toward the eye (the clear air's
+// transmittance from the eye included, interpolated geometrically between airIn at
+// first and airOut at last) and its transmittance.
+void MarchCloud(vec3 origin, vec3 direction, float first, float last, vec3 airIn,
+  vec3 airOut, out vec3 radiance, out float transmittance)
+{
+  radiance = vec3(0.0);
+  transmittance = 1.0;
   float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
   float cloudPhase = CornetteShanks(mu, cloudG) + multipleScattering / (4.0 * kPi);
   // The delta-M forward peak's term of SunMultipleScattering with the sun's transmittance
   // T read directly: (1 - f) p(mu) (T^(1 - f albedo) - T); the octaves keep the general form.
   float peakPhase = (1.0 - forwardPeakFraction) * CornetteShanks(mu, cloudG);
   float peakExponent = 1.0 - forwardPeakFraction * cloudAlbedo;
-  float span = max(t1 - t0, 1e-30);
-  // log of the clear air's transmittance ratio across the box (geometric interpolation).
+  float span = max(last - first, 1e-30);
+  // log of the clear air's transmittance ratio across the span (geometric interpolation).
   vec3 airLogRatio = log(max(airOut, vec3(1e-30)) / max(airIn, vec3(1e-30)));
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5; // in [0, 1)
   float stepMetres = stepLength * metresPerUnit;
-  // The steps on the grid t0 + (n + jitter) stepLength that fall in [first, last].
-  float t = t0 + (max(ceil((first - t0) / stepLength - jitter), 0.0) + jitter) * stepLength;
+  // The steps on the grid (n + jitter) stepLength from the ray's origin that fall in
+  // [first, last]: anchored to the eye, not to the box, so the samples do not move with
+  // the box's extent (cell or point data, a piece's bounds).
+  float t = (ceil(first / stepLength - jitter) + jitter) * stepLength;
   for (int i = 0; i < maxSteps && t < last; ++i)
   {
     vec3 p = origin + t * direction;
@@ -170,7 +174,7 @@ void MarchCloud(vec3 origin, vec3 direction, float t0, float t1, vec3 airIn, vec
         : forwardPeakFraction > 0.0 ? peakPhase * (pow(sun, peakExponent) - sun) : 0.0;
       source = (cloudAlbedo * sigma * (cloudPhase * sun + beyond) * SunIrradiance(Altitude(p)) +
                  CloudOtherSources(p, direction, sigma)) *
-        airIn * exp(airLogRatio * ((t - t0) / span));
+        airIn * exp(airLogRatio * ((t - first) / span));
     }
     radiance += transmittance * source * stepIntegral;
     transmittance *= alpha;
@@ -203,15 +207,17 @@ float SunTransmittanceAt(vec3 pb, vec3 lb)
 // [a, b] (the part of the ray where a shadow can fall), with the view's clear-air
 // transmittance and the air's single-scattering source interpolated geometrically
 // between their values at a and b, and the cloud's transmittance toward the eye: 1
-// before the box, cloudTransmittance behind it, in between interpolated geometrically.
-// One sample per shaftSpacing (two density texels), from shaftSteps / 4 to shaftSteps.
+// before the cloud's first block (cloudFirst), cloudTransmittance behind its last
+// (cloudLast), in between interpolated geometrically.
+// Samples every shaftSpacing (four density texels), the spacing doubled until at most
+// shaftSteps fall in [a, b]; placed on a grid anchored to the eye (as the march's steps), so
+// they do not move with the interval's ends.
 vec3 ShadowedAir(vec3 origin, vec3 direction, vec2 phase, float a, float b, vec3 airA,
-  vec3 airB, float boxIn, float boxOut, float cloudTransmittance)
+  vec3 airB, float cloudFirst, float cloudLast, float cloudTransmittance)
 {
   float span = b - a;
-  int count = int(clamp(ceil(span / shaftSpacing), float(max(shaftSteps / 4, 1)),
-    float(max(shaftSteps, 1))));
-  float dt = span / float(count);
+  float dt = shaftSpacing *
+    exp2(max(ceil(log2(span / (shaftSpacing * float(max(shaftSteps, 1))))), 0.0));
   vec3 sourceA = AirSource(Altitude(origin + a * direction), phase);
   vec3 sourceB = AirSource(Altitude(origin + b * direction), phase);
   // log of the ratios b / a of the view's transmittance and of the source
@@ -224,12 +230,12 @@ vec3 ShadowedAir(vec3 origin, vec3 direction, vec2 phase, float a, float b, vec3
   vec3 lb = (worldToBox * vec4(sunDirection, 0.0)).xyz;
   float jitter = SliceJitterFraction(gl_FragCoord.xy) + 0.5;
   vec3 lost = vec3(0.0);
-  for (int s = 0; s < count; ++s)
+  float t = (ceil(a / dt - jitter) + jitter) * dt;
+  for (int s = 0; s <= shaftSteps && t < b; ++s, t += dt)
   {
-    float t = a + (float(s) + jitter) * dt;
     float f = (t - a) / max(span, 1e-30);
-    float inBox = clamp((t - boxIn) / max(boxOut - boxIn, 1e-30), 0.0, 1.0);
-    lost += (1.0 - SunTransmittanceAt(ob + t * db, lb)) * exp(logRatio * f + logCloud * inBox);
+    float inCloud = clamp((t - cloudFirst) / max(cloudLast - cloudFirst, 1e-30), 0.0, 1.0);
+    lost += (1.0 - SunTransmittanceAt(ob + t * db, lb)) * exp(logRatio * f + logCloud * inCloud);
   }
   return sourceA * airA * lost * dt * metresPerUnit;
 }
@@ -249,20 +255,27 @@ void main()
   vec3 color = airEnd;      // the clear air, corrected below where the cloud is
   vec3 clearColor = airEnd; // without the cloud (over a sky)
   float cloudTransmittance = 1.0;
-  vec3 air0 = vec3(0.0), air1 = vec3(0.0), transmittance0 = vec3(1.0), transmittance1 = vec3(1.0);
-  if (hitsBox)
+  // The cloud's blocks along the ray: [first, last] (empty: first = last = kInfinity).
+  float first, last;
+  bool cloudy = hitsBox && CloudSpan(origin, direction, t0, t1, first, last);
+  if (!cloudy)
   {
-    AirTo(texCoord, t0, air0, transmittance0);
-    AirTo(texCoord, t1, air1, transmittance1);
+    first = kInfinity;
+    last = kInfinity;
+  }
+  else
+  {
+    vec3 airFirst, airLast, transmittanceFirst, transmittanceLast;
+    AirTo(texCoord, first, airFirst, transmittanceFirst);
+    AirTo(texCoord, last, airLast, transmittanceLast);
     vec3 cloudRadiance;
-    MarchCloud(origin, direction, t0, t1, transmittance0, transmittance1, cloudRadiance,
-      cloudTransmittance);
-    // The air in the box and behind it, seen through the cloud: the box's share taken
-    // as spread evenly, dimmed by the cloud's transmittance at the box's middle.
-    vec3 boxAir = air1 - air0;
-    vec3 behindAir = airEnd - air1;
-    color = air0 + sqrt(cloudTransmittance) * boxAir + cloudTransmittance * behindAir +
-      cloudRadiance;
+    MarchCloud(origin, direction, first, last, transmittanceFirst, transmittanceLast,
+      cloudRadiance, cloudTransmittance);
+    // The air in front of the cloud's first block as it is, the air between its first
+    // and last block taken as spread evenly and dimmed by the cloud's transmittance at
+    // their middle, the air behind the last block by the whole transmittance.
+    color = airFirst + sqrt(cloudTransmittance) * (airLast - airFirst) +
+      cloudTransmittance * (airEnd - airLast) + cloudRadiance;
     if (unlit != 0)
     {
       color = cloudRadiance;
@@ -276,16 +289,16 @@ void main()
     vec3 airB = AirTransmittanceTo(texCoord, b);
     float mu = clamp(dot(direction, sunDirection), -1.0, 1.0);
     vec2 phase = vec2(Rayleigh(mu), CornetteShanks(mu, mieG));
-    color -= ShadowedAir(origin, direction, phase, a, b, airA, airB, hitsBox ? t0 : kInfinity,
-      hitsBox ? t1 : kInfinity, cloudTransmittance);
+    color -= ShadowedAir(origin, direction, phase, a, b, airA, airB, first, last,
+      cloudTransmittance);
     color = max(color, vec3(0.0));
   }
   float alpha = cloudTransmittance;
   if (unlit == 0 && tGround < kInfinity && tGround <= tEnd)
   {
     vec3 g = origin + tGround * direction;
-    // Behind (or inside) the box the ground is seen through the cloud.
-    float through = hitsBox && tGround >= t0 ? cloudTransmittance : 1.0;
+    // Behind (or inside) the cloud's blocks the ground is seen through the cloud.
+    float through = tGround >= first ? cloudTransmittance : 1.0;
     color += GroundRadiance(g, CloudDepthOutsideBox(g)) * transmittanceEnd * through;
     clearColor += GroundRadiance(g, 0.0) * transmittanceEnd;
     alpha = overSky != 0 ? cloudTransmittance : 0.0;

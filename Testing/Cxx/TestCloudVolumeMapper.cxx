@@ -41,6 +41,7 @@
 #include "vtkUnsignedShortArray.h"
 #include "vtkVolume.h"
 #include "vtkWindowToImageFilter.h"
+#include <vtksys/SystemTools.hxx>
 
 #include <algorithm>
 #include <array>
@@ -59,7 +60,7 @@ constexpr int kHeight = 150;
 // The method every Scene draws with (RayMarch<case> sets the ray march).
 int gRenderingMethod = vtkNimbusCloudVolumeMapper::ShadowViewSlicing;
 // The largest 8-bit RMSE between a ray-marched image case and the slices' baseline:
-// measured 0.59 (HazeOnly) to 6.8 (FacingSun, the bright rim), llvmpipe.
+// measured 0.51 (Sunset) to 6.9 (FacingSun, the bright rim), llvmpipe.
 constexpr double kRayMarchVersusSlicesRmse = 8.0;
 
 vtkSmartPointer<vtkImageData> MakeCloud(int seed = 1)
@@ -871,7 +872,12 @@ bool LightingChangeKeepsVolume(const Context&)
   s.Mapper->SetAtmosphere(false);
   s.Mapper->SetGround(false);
   s.Render();
-  ok &= Check(s.Mapper->GetNumberOfPassesLastRender() == 2 * s.Mapper->GetNumberOfSlices() + 2,
+  // The slices: ray ends, each slice from the eye and into the shadow, the composite; the
+  // ray march: the march and the composite (no air: no look-up volume).
+  const int passes = gRenderingMethod == vtkNimbusCloudVolumeMapper::RayMarching
+    ? 2
+    : 2 * s.Mapper->GetNumberOfSlices() + 2;
+  ok &= Check(s.Mapper->GetNumberOfPassesLastRender() == passes,
     "without atmosphere and ground: only ray ends, slices, shadow updates and the composite (" +
       std::to_string(s.Mapper->GetNumberOfPassesLastRender()) + " passes)");
   vtkNew<vtkImageData> changed;
@@ -942,6 +948,11 @@ bool DataLayouts(const Context&)
   cells->GetCellData()->SetScalars(cellValues);
   Scene cellScene(cells);
   const double cellRmse = Rmse(expected, cellScene.Render());
+  // The ray march reads the sun's transmittance outside the box where the sun's line
+  // enters it, and the cell box is half a texel larger: the ground's shadow is sampled
+  // half a texel apart (the cloud itself is the same to float precision). Measured:
+  // 0.54 with the ray march; the slices, below 0.2.
+  const double cellBound = gRenderingMethod == vtkNimbusCloudVolumeMapper::RayMarching ? 0.7 : 0.2;
   // The cell box is half a voxel larger on every side, where the point data's
   // box clips the cloud; the cloud's rim has density ~0 there. Measured 0.026
   // (quantisation to 1/1000) and 0.054 (the rim) with the slices over the whole
@@ -950,8 +961,9 @@ bool DataLayouts(const Context&)
   // and the slices' planes and jitter with it (a few pixels off by 1 of 255).
   return Check(typedRmse < 0.1,
            "unsigned short x1000 vs float: RMSE " + std::to_string(typedRmse) + " < 0.1") &&
-    Check(cellRmse < 0.2,
-      "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < 0.2");
+    Check(cellRmse < cellBound,
+      "cell data at the point samples vs point data: RMSE " + std::to_string(cellRmse) + " < " +
+        std::to_string(cellBound));
 }
 
 // Two viewports side by side each show what a window of their size shows (with and
@@ -973,6 +985,7 @@ bool ViewportsAndParallelProjection(const Context&)
     split.Window->SetSize(2 * kWidth, kHeight);
     split.Renderer->SetViewport(0.0, 0.0, 0.5, 1.0);
     vtkNew<vtkNimbusCloudVolumeMapper> otherMapper;
+    otherMapper->SetRenderingMethod(gRenderingMethod);
     otherMapper->SetInputData(cloud);
     otherMapper->SetExposure(4.0);
     otherMapper->SetEncodeSrgb(true);
@@ -1074,15 +1087,21 @@ int main(int argc, char* argv[])
     return cases.at(argv[1])(context) ? EXIT_SUCCESS : EXIT_FAILURE;
   }
   // The ray march: its own baseline, then the slices' picture within the difference
-  // measured between the methods on these scenes (kRayMarchVersusSlicesRmse).
+  // measured between the methods on these scenes (kRayMarchVersusSlicesRmse). A case
+  // without a baseline (a stability case) runs with the ray march alone.
   gRenderingMethod = vtkNimbusCloudVolumeMapper::RayMarching;
   const bool own = cases.at(caseName)(context);
+  const std::string slicesBaseline =
+    context.BaselineDir + "/TestCloudVolumeMapper_" + caseName + ".png";
+  if (!vtksys::SystemTools::FileExists(slicesBaseline))
+  {
+    return own ? EXIT_SUCCESS : EXIT_FAILURE;
+  }
   nimbus::testing::ImageComparisonLimits methods;
   methods.VTKThreshold = 1e9; // the RMSE bound alone: the methods differ everywhere a little
   methods.MaxRMSE = kRayMarchVersusSlicesRmse;
   std::cout << "against the slices' baseline:\n";
-  const bool slices = nimbus::testing::CompareImageFiles(context.Png(),
-    context.BaselineDir + "/TestCloudVolumeMapper_" + caseName + ".png", context.OutputDir, methods,
-    std::cout);
+  const bool slices = nimbus::testing::CompareImageFiles(
+    context.Png(), slicesBaseline, context.OutputDir, methods, std::cout);
   return own && slices ? EXIT_SUCCESS : EXIT_FAILURE;
 }
