@@ -179,7 +179,7 @@ void RayMarchTables()
         cloud, floor, slices, vtkPlain, full / vtkPlain);
     }
   }
-  std::printf("\nPasses of one frame (128^3, step 1, GL_TIME_ELAPSED), seconds:\n\n");
+  std::printf("\nPasses of one frame (128^3, the default step, GL_TIME_ELAPSED), seconds:\n\n");
   vtkSmartPointer<vtkImageData> c128 = nimbus::testing::TestCumulus(128, 128, 128);
   for (const int method :
     { vtkNimbusCloudVolumeMapper::RayMarching, vtkNimbusCloudVolumeMapper::ShadowViewSlicing })
