@@ -2879,6 +2879,10 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << "\n";
   os << indent << "GroundAlbedo: " << this->GroundAlbedo << "\n";
   os << indent << "Shafts: " << this->Shafts << "\n";
+  os << indent << "RenderingMethod: "
+     << (this->RenderingMethod == RayMarching ? "RayMarching" : "ShadowViewSlicing") << "\n";
+  os << indent << "RayMarchStepTexels: " << this->RayMarchStepTexels << "\n";
+  os << indent << "TimePasses: " << (this->TimePasses ? "On" : "Off") << "\n";
   os << indent << "NumberOfSlices: " << this->NumberOfSlices << "\n";
   os << indent << "SliceAngleRatio (a): " << this->SliceAngleRatio << "\n";
   os << indent << "ShadowSurfaceSize: " << this->ShadowSurfaceSize << "\n";

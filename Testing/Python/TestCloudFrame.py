@@ -462,6 +462,8 @@ BAD_VALUES = {
     "MetresPerUnit": [0.0, -1.0, float("nan"), float("inf"), 1e-300, 1e300],
     "AirDensityArray": ["missing", "density"],
     "GroundHeight": [float("nan"), float("inf"), -1e30, 1e30],
+    "RenderingMethod": [-1, 2, 99],
+    "RayMarchStepTexels": [0.0, -1.0, float("nan"), float("inf"), 1e-30, 1e30],
 }
 # The units each property matters for (the others ignore it).
 UNITS_FOR = {"DropletSize": 2, "DropletEffectiveRadiusMicrometres": 2,
