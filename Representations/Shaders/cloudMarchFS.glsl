@@ -2,12 +2,12 @@
 // ray is marched through the cloud box with a fixed step (jittered per pixel), the
 // sun's transmittance read from the sun-depth volume (SunDepthVolume.h), only between
 // the first and the last block that holds density (blockMaxima) and only until the
-// cloud lets less than 1e-4 through. The air comes from the look-up volume of cloudAirFroxelsFS.glsl, and
-// the cloud's shadow in it (the shafts) is marched only where it can fall
-// (ShadowInterval). Output 0: (radiance before exposure, cloud transmittance; 0 where
-// the ground closes the ray, not over a sky), as the slices and the march passes of
-// the shadow-view-slice method leave it; output 1 (bound over a sky only): the same
-// without the cloud (see svsCompositeFS.glsl).
+// cloud lets less than 1e-3 through. The air comes from the look-up volume of
+// cloudAirFroxelsFS.glsl, and the cloud's shadow in it (the shafts) is marched only
+// where it can fall (ShadowInterval). Output 0: (radiance before exposure, cloud
+// transmittance; 0 where the ground closes the ray, not over a sky), as the slices and
+// the march passes of the shadow-view-slice method leave it; output 1: the same without
+// the cloud (read over a sky only; see svsCompositeFS.glsl).
 in vec2 texCoord;
 uniform int unlit;                // benchmark floor: the cloud's optical depth alone
 uniform int shaftsOn;
@@ -23,7 +23,7 @@ uniform float blockTexels;        // texels per block side
 uniform vec3 blockCount;          // blocks per axis
 uniform sampler2D froxelScattering;
 uniform sampler2D froxelTransmittance;
-uniform vec3 froxelDimensions; // columns, rows, slices
+uniform vec3 froxelDimensions;    // columns, rows, slices
 ivec3 FroxelSize() { return ivec3(froxelDimensions + 0.5); }
 uniform vec2 froxelDepths;        // d_1 (world units), 1 / log(d_{k+1} / d_k)
 uniform float mieG;
