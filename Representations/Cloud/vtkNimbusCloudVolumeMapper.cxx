@@ -2172,30 +2172,34 @@ void vtkNimbusCloudVolumeMapper::RenderRayEnds(const FrameState& frame)
 }
 
 //------------------------------------------------------------------------------
+// A float RGBA target of this frame's image size (the accumulation, the cloud-free
+// one): linear where the composite scales a smaller image (a lower quality level) to
+// the viewport; nearest at full size, where the composite's texture coordinates,
+// interpolated across a viewport at an offset, can miss texel centres by a rounding
+// error that linear filtering would turn into a neighbour's share.
+void vtkNimbusCloudVolumeMapper::EnsureImageTarget(
+  vtkTextureObject* target, const FrameState& frame)
+{
+  const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
+    ? vtkTextureObject::Nearest
+    : vtkTextureObject::Linear;
+  EnsureTexture2D(target, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+  target->SetMinificationFilter(filter);
+  target->SetMagnificationFilter(filter);
+}
+
+//------------------------------------------------------------------------------
 // The accumulation target (S, cloud transmittance), cleared to (0, 0, 0, 1); over a
 // sky a second target, S_clear, summed by the same blend (its alpha stays 1).
 void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  // Linear where the composite scales a smaller image (a lower quality level) to
-  // the viewport; nearest at full size, where the composite's texture coordinates,
-  // interpolated across a viewport at an offset, can miss texel centres by a
-  // rounding error that linear filtering would turn into a neighbour's share.
-  const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
-    ? vtkTextureObject::Nearest
-    : vtkTextureObject::Linear;
-  EnsureTexture2D(in.Accumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
-  in.Accumulation->SetMinificationFilter(filter);
-  in.Accumulation->SetMagnificationFilter(filter);
+  this->EnsureImageTarget(in.Accumulation, frame);
   DrawInto(in.AccumulationFramebuffer, in.Accumulation, frame.Window);
   in.AccumulationFramebuffer->RemoveColorAttachment(1);
-  in.AccumulationFramebuffer->RemoveColorAttachment(2);
   if (frame.Settings.OverSky)
   {
-    EnsureTexture2D(
-      in.ClearAccumulation, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
-    in.ClearAccumulation->SetMinificationFilter(filter);
-    in.ClearAccumulation->SetMagnificationFilter(filter);
+    this->EnsureImageTarget(in.ClearAccumulation, frame);
     in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
     in.AccumulationFramebuffer->ActivateDrawBuffers(2);
   }
@@ -2555,17 +2559,10 @@ void vtkNimbusCloudVolumeMapper::RenderAirFroxels(const FrameState& frame)
 void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
 {
   Internals& in = *this->Internal;
-  const int filter = frame.Level.Width == frame.Width && frame.Level.Height == frame.Height
-    ? vtkTextureObject::Nearest
-    : vtkTextureObject::Linear;
   // Its own framebuffer, always with both targets (the cloud-free one is read over a
   // sky only).
-  for (vtkTextureObject* t : { in.Accumulation.GetPointer(), in.ClearAccumulation.GetPointer() })
-  {
-    EnsureTexture2D(t, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
-    t->SetMinificationFilter(filter);
-    t->SetMagnificationFilter(filter);
-  }
+  this->EnsureImageTarget(in.Accumulation, frame);
+  this->EnsureImageTarget(in.ClearAccumulation, frame);
   DrawInto(in.MarchFramebuffer, in.Accumulation, frame.Window);
   in.MarchFramebuffer->RemoveColorAttachment(1);
   in.MarchFramebuffer->AddColorAttachment(1, in.ClearAccumulation);

@@ -82,6 +82,7 @@
 #include <vector> // for std::vector
 
 class vtkImageData;
+class vtkTextureObject;
 class vtkMatrix4x4;
 namespace nimbus
 {
@@ -747,6 +748,7 @@ private:
   bool RenderSlices(vtkRenderer* renderer, const FrameState& frame);
   // The ray-marched method (RayMarching).
   bool UsesRayMarching() const;
+  void EnsureImageTarget(vtkTextureObject* target, const FrameState& frame);
   void UpdateSunDepthVolume(FrameState& frame);
   void RenderAirFroxels(const FrameState& frame);
   void RenderCloudMarch(const FrameState& frame);

@@ -244,9 +244,8 @@ void main()
 {
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
-  float tGround = GroundDistance(origin, direction);
-  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-    tGround);
+  float tGround;
+  float tEnd = RayEnd(texCoord, origin, direction, tGround);
   float tIn, tOut;
   bool hitsBox = BoxInterval(origin, direction, tIn, tOut) && tOut > 0.0 && tIn < tEnd;
   float t0 = max(tIn, 0.0), t1 = min(tOut, tEnd);

@@ -149,6 +149,14 @@ float TopDistance(vec3 origin, vec3 direction)
   return DistanceToTopOfAtmosphere(r0, direction.z, topRadiusMetres) / metresPerUnit;
 }
 
+// Where the view ray through uv ends: opaque geometry, the ground or the top of the
+// atmosphere (distance along the ray, world units); tGround: the ground's alone.
+float RayEnd(vec2 uv, vec3 origin, vec3 direction, out float tGround)
+{
+  tGround = GroundDistance(origin, direction);
+  return min(min(OpaqueDistance(uv, origin, direction), TopDistance(origin, direction)), tGround);
+}
+
 // Atmosphere table row at altitude h [m] (000: the "atmosphere texture").
 vec3 AtmosphereRow(int row, float altitude)
 {

@@ -85,10 +85,10 @@ void main()
   }
   else
   {
-    // Where the view ray ends (as svsRayEndsFS.glsl finds it), at this pixel's own
-    // position when the passes drew a smaller image.
-    float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-      GroundDistance(origin, direction));
+    // Where the view ray ends, at this pixel's own position when the passes drew a
+    // smaller image.
+    float tGround;
+    float tEnd = RayEnd(texCoord, origin, direction, tGround);
     vec3 behind = sum.a * AtmosphereViewTransmittance(origin, direction, tEnd);
     result = displayScale * sum.rgb + behind * backgroundLinear;
   }

@@ -10,8 +10,7 @@ void main()
 {
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
-  float tGround = GroundDistance(origin, direction);
-  float tEnd = min(min(OpaqueDistance(texCoord, origin, direction), TopDistance(origin, direction)),
-    tGround);
+  float tGround;
+  float tEnd = RayEnd(texCoord, origin, direction, tGround);
   gl_FragData[0] = vec4(tEnd, tGround, BoxEntryOpticalLengths(origin, direction, tEnd, steps));
 }

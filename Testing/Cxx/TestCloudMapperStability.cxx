@@ -668,22 +668,11 @@ Result AbsurdDimensions()
 }
 }
 
-int main(int argc, char* argv[])
+// The values refused with a message: NaN and infinities of every setter.
+std::vector<std::pair<std::string, std::function<Result()>>> RefusedValueCases()
 {
-  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
-  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
-  {
-    return 2;
-  }
-  for (int a = 1; a < argc; ++a)
-  {
-    if (std::string(argv[a]) == "--ray-march")
-    {
-      gRenderingMethod = vtkNimbusCloudVolumeMapper::RayMarching;
-    }
-  }
   using M = vtkNimbusCloudVolumeMapper;
-  const std::vector<std::pair<std::string, std::function<Result()>>> cases = {
+  return {
     { "SunElevationNaN",
       []
       {
@@ -820,6 +809,13 @@ int main(int argc, char* argv[])
           "SliceAngleRatio", [](M* m) { m->SetSliceAngleRatio(kNaN); },
           [](M* m) { return m->GetSliceAngleRatio(); });
       } },
+  };
+}
+
+// The extremes that must give a finite picture or a clear message.
+std::vector<std::pair<std::string, std::function<Result()>>> ExtremeCases()
+{
+  return {
     { "SunElevation+90", [] { return SunElevation(90.0); } },
     { "SunElevation-90", [] { return SunElevation(-90.0); } },
     { "SunElevation0", [] { return SunElevation(0.0); } },
@@ -930,6 +926,32 @@ int main(int argc, char* argv[])
           });
       } },
   };
+}
+
+// Every case: a name and the check that runs it.
+std::vector<std::pair<std::string, std::function<Result()>>> AllCases()
+{
+  auto cases = RefusedValueCases();
+  const auto extremes = ExtremeCases();
+  cases.insert(cases.end(), extremes.begin(), extremes.end());
+  return cases;
+}
+
+int main(int argc, char* argv[])
+{
+  // --offscreen or NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server.
+  if (vtkNimbusOffscreenRenderWindow::InstallIfRequested(argc, argv) < 0)
+  {
+    return 2;
+  }
+  for (int a = 1; a < argc; ++a)
+  {
+    if (std::string(argv[a]) == "--ray-march")
+    {
+      gRenderingMethod = vtkNimbusCloudVolumeMapper::RayMarching;
+    }
+  }
+  const auto cases = AllCases();
   std::vector<std::string> selected;
   for (int a = 1; a < argc; ++a)
   {
