@@ -8,19 +8,24 @@
 #include "ExternalShadow.h"
 #include "FiniteSetters.h"
 #include "FrameQuality.h"
+#include "LightShadowMaps.h"
 #include "LightningTexture.h"
 #include "MemoryBudget.h"
 #include "MultipleScatteringTexture.h"
 #include "PassTimer.h"
 #include "SliceGeometry.h"
+#include "SpectralColor.h"
 #include "SunAndAir.h"
 #include "SunDepthVolume.h"
 #include "UpAxis.h"
+#include "ViewLights.h"
 
 #include "ShaderLibrary.h"
 #include "cloudAirFroxelsFS.h"
 #include "cloudLight.h"
 #include "cloudMarchFS.h"
+#include "cloudVirtualPlanesFS.h"
+#include "nimbusLights.h"
 #include "svsCommon.h"
 #include "svsCompositeFS.h"
 #include "svsIntervalPhaseFS.h"
@@ -37,6 +42,8 @@
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
@@ -75,6 +82,8 @@ vtkCxxSetObjectMacro(vtkNimbusCloudVolumeMapper, SkyBackground, vtkNimbusSkyBack
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, ExtinctionPerDensity);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Albedo);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, CloudG);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, LightIntensityScale);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, SpotEdgeWidthDegrees);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, MultipleScattering);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, EmissionRadiancePerMetre);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, EmissionReferenceTemperatureKelvin);
@@ -154,7 +163,7 @@ std::string FragmentSource(const char* pass, bool cloudLight)
 {
   return nimbus::WithShaderLibrary(
     std::string("//VTK::System::Dec\n//VTK::Output::Dec\n//NIMBUS::Library\n") + svsCommon + "\n" +
-    (cloudLight ? std::string(::cloudLight) + "\n" : std::string()) + pass);
+    (cloudLight ? std::string(::cloudLight) + "\n" + nimbusLights + "\n" : std::string()) + pass);
 }
 
 // Frees a texture's storage and sets clamp-to-edge wrapping and its filter, ready
@@ -336,6 +345,14 @@ struct vtkNimbusCloudVolumeMapper::FrameState
 
   // A hash of the opaque scene's depth in the viewport (0 without one).
   std::uint64_t SceneDepthHash = 0;
+
+  // The view's lights this frame (up frame; docs/lights.md), whether their shadow maps
+  // were drawn, and what the frame's image depends on through them.
+  std::vector<nimbus::ViewLight> Lights;
+  bool LightShadows = false;
+  bool LightMap = false;
+  std::array<double, 6> LightRegion{ { 0, -1, 0, -1, 0, -1 } }; // up frame
+  std::vector<double> LightsKey;
 };
 
 struct vtkNimbusCloudVolumeMapper::Internals
@@ -418,12 +435,22 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkOpenGLFramebufferObject> FroxelFramebuffer;
   vtkNew<vtkOpenGLFramebufferObject> MarchFramebuffer;
 
+  // The view's lights: the opaque scene's shadow maps, the light map's luminance, the
+  // virtual planes' target (LightShaftsByVirtualPlanes).
+  nimbus::LightShadowMaps ShadowMaps;
+  vtkNew<vtkTextureObject> LightMapTexture;
+  vtkMTimeType LightMapTime = 0;
+  vtkNew<vtkTextureObject> LightsImage;
+  vtkNew<vtkOpenGLFramebufferObject> LightsFramebuffer;
+  int LightsLastRender = 0;
+  std::string LightsMessage;
+
   // The GPU time of each pass (TimePasses).
   nimbus::PassTimer Timer;
   std::string LastPassTimes;
 
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass;
+    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass;
 
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
@@ -460,19 +487,22 @@ struct vtkNimbusCloudVolumeMapper::Internals
         ClearAccumulation.GetPointer(), SceneColor.GetPointer(), SceneDepth.GetPointer(),
         Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer(),
         SunDepthTexture.GetPointer(), BlockTexture.GetPointer(), FroxelScattering.GetPointer(),
-        FroxelTransmittance.GetPointer() })
+        FroxelTransmittance.GetPointer(), LightMapTexture.GetPointer(), LightsImage.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
+    ShadowMaps.Release(window);
+    LightMapTime = 0;
     for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
            SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
            AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer(),
-           FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer() })
+           FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer(),
+           LightsFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
     for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
-           &RayEndsPass, &CloudMarchPass, &FroxelPass })
+           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass })
     {
       if (*pass)
       {
@@ -513,6 +543,7 @@ vtkNimbusCloudVolumeMapper::vtkNimbusCloudVolumeMapper()
 vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper()
 {
   this->SetSkyBackground(nullptr);
+  this->SetLightMap(nullptr);
 }
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfVolumeUploads() const
@@ -630,7 +661,8 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
         in.SceneColor.GetPointer(), in.ClearAccumulation.GetPointer(),
         in.AtmosphereTexture.GetPointer(), in.ExternalShadowTexture.GetPointer(),
         in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
-        in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer() })
+        in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
+        in.ShadowMaps.GetTexture(), in.LightMapTexture.GetPointer(), in.LightsImage.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -658,6 +690,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     return false;
   }
   this->UpdateExternalShadow(frame);
+  this->UpdateViewLights(renderer, frame);
   this->UpdateMultipleScattering(frame);
   this->UpdateLightning(frame);
   this->UpdateEmission(frame);
@@ -686,6 +719,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     this->RenderAirFroxels(frame);
     in.Timer.Begin("ray march");
     this->RenderCloudMarch(frame);
+    this->RenderVirtualPlanes(frame);
     this->CaptureRadianceImage(frame);
   }
   else
@@ -737,6 +771,9 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
 //------------------------------------------------------------------------------
 namespace
 {
+// Distances to a view light are at least this (a lamp's size): a light on a view ray
+// or at the eye gives a finite beam (docs/lights.md).
+constexpr double kLightRadiusMetres = 0.05;
 constexpr double kRayMarchMinimumQuality = 0.25 * 0.25 * 0.25;
 }
 
@@ -800,6 +837,7 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
   key.insert(key.end(), frame.DataToWorld->GetData(), frame.DataToWorld->GetData() + 16);
   key.insert(key.end(), frame.Eye.begin(), frame.Eye.end());
   key.insert(key.end(), frame.ClippingRange.begin(), frame.ClippingRange.end());
+  key.insert(key.end(), frame.LightsKey.begin(), frame.LightsKey.end());
   return key;
 }
 
@@ -1511,6 +1549,14 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
   {
     in.SunDepthTexture->Activate();
     in.BlockTexture->Activate();
+  }
+  if (frame.LightShadows)
+  {
+    in.ShadowMaps.GetTexture()->Activate();
+  }
+  if (frame.LightMap)
+  {
+    in.LightMapTexture->Activate();
   }
   frame.State->vtkglDisable(GL_DEPTH_TEST);
   frame.State->vtkglDepthMask(GL_FALSE);
@@ -2317,6 +2363,7 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
     static_cast<float>(this->OctaveScatteringScale),
     static_cast<float>(this->OctaveAsymmetryScale) };
   program->SetUniform3f("octaveScales", octaveScales);
+  this->SetViewLightUniforms(program, frame);
 }
 
 //------------------------------------------------------------------------------
@@ -2625,6 +2672,9 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   const std::array<float, 2> depths =
     FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
   program->SetUniform2f("froxelDepths", depths.data());
+  program->SetUniformi("lightSamples", this->LightSamples);
+  program->SetUniformi(
+    "lightsInAir", this->LightShaftMethod == LightShaftsByRayMarching ? 1 : 0);
   in.CloudMarchPass->Render();
   ++in.PassesLastRender;
 }
@@ -2807,6 +2857,15 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
   program->SetUniform3f("pieceBackground", pieceBackground);
   program->SetUniformi("usePieceBackground",
     this->PieceCompositing && this->DrawOutsideRegions && !frame.Settings.OverSky ? 1 : 0);
+  const bool planes = !frame.Lights.empty() && this->UsesRayMarching() &&
+    this->LightShaftMethod == LightShaftsByVirtualPlanes;
+  if (planes)
+  {
+    in.LightsImage->Activate();
+  }
+  program->SetUniformi("lightsImageOn", planes ? 1 : 0);
+  program->SetUniformi(
+    "lightsImage", (planes ? in.LightsImage.GetPointer() : in.Accumulation.GetPointer())->GetTextureUnit());
   if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Activate();
@@ -2819,6 +2878,318 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
   }
   in.CompositePass->Render();
   ++in.PassesLastRender;
+}
+
+//------------------------------------------------------------------------------
+// The view's lights (docs/lights.md).
+void vtkNimbusCloudVolumeMapper::SetLightMap(vtkImageData* image)
+{
+  vtkSetObjectBodyMacro(LightMap, vtkImageData, image);
+}
+
+int vtkNimbusCloudVolumeMapper::GetNumberOfLightsLastRender() const
+{
+  return this->Internal->LightsLastRender;
+}
+
+int vtkNimbusCloudVolumeMapper::GetNumberOfShadowCastersLastRender() const
+{
+  return this->Internal->ShadowMaps.GetNumberOfCasters();
+}
+
+namespace
+{
+// The renderer's switched-on positional lights as ViewLights (VTK world).
+std::vector<nimbus::ViewLight> PositionalLightsOf(
+  vtkRenderer* renderer, double intensityScale, double edgeWidthDegrees)
+{
+  std::vector<nimbus::ViewLight> lights;
+  vtkLightCollection* collection = renderer->GetLights();
+  vtkCollectionSimpleIterator it;
+  collection->InitTraversal(it);
+  while (vtkLight* light = collection->GetNextLight(it))
+  {
+    if (!light->GetSwitch() || !light->GetPositional())
+    {
+      continue;
+    }
+    double position[3], focal[3];
+    light->GetTransformedPosition(position);
+    light->GetTransformedFocalPoint(focal);
+    nimbus::ViewLight v;
+    v.Position = { { position[0], position[1], position[2] } };
+    const nimbus::Vector3 axis{ { focal[0] - position[0], focal[1] - position[1],
+      focal[2] - position[2] } };
+    const double length = nimbus::Length(axis);
+    if (length > 0.0 && std::isfinite(length))
+    {
+      v.Spot.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
+      v.Spot.ConeHalfAngleDegrees = light->GetConeAngle();
+    }
+    v.Spot.EdgeWidthDegrees = std::min(edgeWidthDegrees, std::max(v.Spot.ConeHalfAngleDegrees, 0.0));
+    const double* color = light->GetDiffuseColor();
+    const double intensity = light->GetIntensity() * intensityScale;
+    v.Intensity = { { intensity * color[0], intensity * color[1], intensity * color[2] } };
+    lights.push_back(v);
+  }
+  return lights;
+}
+
+// The region the lights must reach and the shadow maps cover: the visible props'
+// bounds (the cloud's box among them), VTK world.
+std::array<double, 6> LightRegionOf(vtkRenderer* renderer)
+{
+  double bounds[6];
+  renderer->ComputeVisiblePropBounds(bounds);
+  return { { bounds[0], bounds[1], bounds[2], bounds[3], bounds[4], bounds[5] } };
+}
+}
+
+// The lights this frame draws: the renderer's, selected (ViewLights.h), their shadow
+// maps drawn, then turned into the up frame; and the key of the image they light.
+void vtkNimbusCloudVolumeMapper::UpdateViewLights(vtkRenderer* renderer, FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  frame.Lights.clear();
+  frame.LightShadows = false;
+  frame.LightMap = false;
+  frame.LightsKey.clear();
+  in.LightsLastRender = 0;
+  if (this->LightSources == NoLights || !this->UsesRayMarching() || this->Unlit)
+  {
+    return;
+  }
+  const std::vector<nimbus::ViewLight> candidates =
+    PositionalLightsOf(renderer, this->LightIntensityScale, this->SpotEdgeWidthDegrees);
+  if (candidates.empty())
+  {
+    return;
+  }
+  const std::array<double, 6> region = LightRegionOf(renderer);
+  nimbus::ViewLightSelection selection = nimbus::SelectViewLights(candidates, region, this->MaximumLights);
+  if (selection.Message != in.LightsMessage && !selection.Message.empty())
+  {
+    vtkWarningMacro(<< selection.Message);
+  }
+  in.LightsMessage = selection.Message;
+  if (selection.Lights.empty())
+  {
+    return;
+  }
+  if (this->LightShadowMapSize > 0)
+  {
+    frame.LightShadows = in.ShadowMaps.Render(
+      renderer, frame.Window, selection.Lights, region, this->LightShadowMapSize);
+  }
+  this->UpdateLightMapTexture(frame);
+  const nimbus::UpAxis up = frame.Settings.Up;
+  for (nimbus::ViewLight& light : selection.Lights)
+  {
+    frame.LightsKey.insert(frame.LightsKey.end(), light.Position.begin(), light.Position.end());
+    frame.LightsKey.insert(frame.LightsKey.end(), light.Spot.Axis.begin(), light.Spot.Axis.end());
+    frame.LightsKey.insert(frame.LightsKey.end(), light.Intensity.begin(), light.Intensity.end());
+    frame.LightsKey.push_back(light.Spot.ConeHalfAngleDegrees);
+    frame.LightsKey.push_back(light.Spot.EdgeWidthDegrees);
+    light.Position = nimbus::ToUpFrame(up, light.Position);
+    light.Spot.Axis = nimbus::ToUpFrame(up, light.Spot.Axis);
+  }
+  // What the shadow maps hold: the casters' geometry and placement.
+  vtkPropCollection* props = renderer->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    frame.LightsKey.push_back(static_cast<double>(prop->GetRedrawMTime()));
+    frame.LightsKey.push_back(prop->GetVisibility() ? 1.0 : 0.0);
+  }
+  frame.LightsKey.push_back(static_cast<double>(in.LightMapTime));
+  frame.LightsKey.push_back(frame.LightShadows ? 1.0 : 0.0);
+  for (int a = 0; a < 3; ++a)
+  {
+    const double low[3] = { region[0], region[2], region[4] };
+    const double high[3] = { region[1], region[3], region[5] };
+    const auto l = ToUp(up, low), h = ToUp(up, high);
+    frame.LightRegion[2 * a] = std::min(l[a], h[a]);
+    frame.LightRegion[2 * a + 1] = std::max(l[a], h[a]);
+  }
+  frame.Lights = std::move(selection.Lights);
+  in.LightsLastRender = static_cast<int>(frame.Lights.size());
+}
+
+// The light map's luminance as a one-channel float texture, uploaded when the image
+// changed: 8-bit images are sRGB-encoded (decoded first), others taken as linear; one
+// component is the luminance, three or four are linear sRGB (Y = 0.2126 R + 0.7152 G +
+// 0.0722 B).
+void vtkNimbusCloudVolumeMapper::UpdateLightMapTexture(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  vtkDataArray* scalars = this->LightMap ? this->LightMap->GetPointData()->GetScalars() : nullptr;
+  if (!scalars)
+  {
+    return;
+  }
+  int dims[3];
+  this->LightMap->GetDimensions(dims);
+  const vtkMTimeType time = std::max(this->LightMap->GetMTime(), scalars->GetMTime());
+  if (time == in.LightMapTime && in.LightMapTexture->GetHandle())
+  {
+    frame.LightMap = true;
+    return;
+  }
+  const int components = scalars->GetNumberOfComponents();
+  if (dims[0] < 1 || dims[1] < 1 || scalars->GetNumberOfTuples() < static_cast<vtkIdType>(dims[0]) * dims[1])
+  {
+    return;
+  }
+  const bool encoded = scalars->GetDataType() == VTK_UNSIGNED_CHAR;
+  std::vector<float> luminance(static_cast<std::size_t>(dims[0]) * dims[1]);
+  for (std::size_t i = 0; i < luminance.size(); ++i)
+  {
+    double rgb[3];
+    for (int c = 0; c < 3; ++c)
+    {
+      double value = scalars->GetComponent(static_cast<vtkIdType>(i), std::min(c, components - 1));
+      value = encoded ? nimbus::SrgbDecode(value / 255.0) : value;
+      rgb[c] = std::isfinite(value) ? std::max(value, 0.0) : 0.0;
+    }
+    luminance[i] = static_cast<float>(
+      components >= 3 ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : rgb[0]);
+  }
+  in.LightMapTexture->SetContext(frame.Window);
+  in.LightMapTexture->ReleaseGraphicsResources(frame.Window);
+  in.LightMapTexture->SetWrapS(vtkTextureObject::ClampToEdge);
+  in.LightMapTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+  in.LightMapTexture->SetMinificationFilter(vtkTextureObject::Linear);
+  in.LightMapTexture->SetMagnificationFilter(vtkTextureObject::Linear);
+  in.LightMapTexture->Create2DFromRaw(dims[0], dims[1], 1, VTK_FLOAT, luminance.data());
+  in.LightMapTime = time;
+  frame.LightMap = true;
+}
+
+void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
+  vtkShaderProgram* program, const FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  const int count = static_cast<int>(frame.Lights.size());
+  program->SetUniformi("lightCount", count);
+  // Unused when off, but the samplers must name 2-D units.
+  program->SetUniformi("lightMap",
+    (frame.LightMap ? in.LightMapTexture.GetPointer() : in.SceneDepth.GetPointer())->GetTextureUnit());
+  program->SetUniformi("lightShadowAtlas",
+    (frame.LightShadows ? in.ShadowMaps.GetTexture() : in.SceneDepth.GetPointer())->GetTextureUnit());
+  if (count == 0)
+  {
+    return;
+  }
+  float position[nimbus::kMaximumViewLights][3] = {}, axis[nimbus::kMaximumViewLights][3] = {},
+        mapU[nimbus::kMaximumViewLights][3] = {}, mapV[nimbus::kMaximumViewLights][3] = {},
+        intensity[nimbus::kMaximumViewLights][3] = {}, cone[nimbus::kMaximumViewLights][4] = {},
+        range[nimbus::kMaximumViewLights][2] = {};
+  const auto& ranges = in.ShadowMaps.GetRanges();
+  for (int i = 0; i < count; ++i)
+  {
+    const nimbus::ViewLight& light = frame.Lights[i];
+    nimbus::Vector3 e1{ { 1, 0, 0 } }, e2{ { 0, 1, 0 } };
+    nimbus::SpotLightMapFrame(light.Spot.Axis, e1, e2);
+    for (int c = 0; c < 3; ++c)
+    {
+      position[i][c] = static_cast<float>(light.Position[c]);
+      axis[i][c] = static_cast<float>(light.Spot.Axis[c]);
+      mapU[i][c] = static_cast<float>(e1[c]);
+      mapV[i][c] = static_cast<float>(e2[c]);
+      intensity[i][c] = static_cast<float>(light.Intensity[c]);
+    }
+    const double outer = std::clamp(light.Spot.ConeHalfAngleDegrees, 0.0, 180.0) * nimbus::kDegree;
+    const double inner =
+      std::max(outer - std::max(light.Spot.EdgeWidthDegrees, 0.0) * nimbus::kDegree, 0.0);
+    cone[i][0] = static_cast<float>(outer);
+    cone[i][1] = static_cast<float>(inner);
+    cone[i][2] = static_cast<float>(outer < 0.5 * nimbus::kPi ? std::tan(std::max(outer, 1e-6)) : 1.0);
+    cone[i][3] = frame.LightMap ? 1.0f : 0.0f;
+    if (frame.LightShadows && i < static_cast<int>(ranges.size()))
+    {
+      range[i][0] = static_cast<float>(ranges[i][0]);
+      range[i][1] = static_cast<float>(ranges[i][1]);
+    }
+  }
+  program->SetUniform3fv("lightPosition", count, position);
+  program->SetUniform3fv("lightAxis", count, axis);
+  program->SetUniform3fv("lightMapU", count, mapU);
+  program->SetUniform3fv("lightMapV", count, mapV);
+  program->SetUniform3fv("lightIntensity", count, intensity);
+  program->SetUniform4fv("lightCone", count, cone);
+  program->SetUniform2fv("lightShadowRange", count, range);
+  program->SetUniformi("lightShadowsOn", frame.LightShadows ? 1 : 0);
+  const float atlas[2] = { 6.0f, static_cast<float>(count) };
+  program->SetUniform2f("lightShadowAtlasSize", atlas);
+  const auto r = nimbus::WorldToUpFrame(frame.Settings.Up);
+  float upToWorld[9];
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = 0; b < 3; ++b)
+    {
+      upToWorld[a * 3 + b] = static_cast<float>(r[a][b]); // column-major R^T
+    }
+  }
+  program->SetUniformMatrix3x3("lightUpToWorld", upToWorld);
+  program->SetUniformi("lightCloudSteps", this->LightCloudSteps);
+  program->SetUniformf("lightRadiusMetres", static_cast<float>(kLightRadiusMetres));
+  program->SetUniformf("lightMieScattering0", static_cast<float>(in.Table.MieScatteringSeaLevel));
+  program->SetUniformf(
+    "lightPhaseConstant", static_cast<float>(this->MultipleScattering / (4.0 * nimbus::kPi)));
+}
+
+// 002 §6.2's virtual planes: NumberOfVirtualPlanes planes parallel to the screen over
+// the view depths of the lit region, back to front into their own target
+// (cloudVirtualPlanesFS.glsl), which the composite adds.
+void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
+{
+  if (frame.Lights.empty() || this->LightShaftMethod != LightShaftsByVirtualPlanes)
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  in.Timer.Begin("virtual planes");
+  // The lit region's depths along the view's axis.
+  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+  for (int i = 0; i < 8; ++i)
+  {
+    const double corner[3] = { frame.LightRegion[(i & 1) ? 1 : 0],
+      frame.LightRegion[(i & 2) ? 3 : 2], frame.LightRegion[(i & 4) ? 5 : 4] };
+    double depth = 0.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      depth += (corner[a] - frame.Eye[a]) * frame.ViewForward[a];
+    }
+    nearest = std::min(nearest, depth);
+    farthest = std::max(farthest, depth);
+  }
+  nearest = std::max(nearest, static_cast<double>(frame.ClippingRange[0]));
+  farthest = std::min(farthest, static_cast<double>(frame.ClippingRange[1]));
+  this->EnsureImageTarget(in.LightsImage, frame);
+  DrawInto(in.LightsFramebuffer, in.LightsImage, frame.Window);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
+  frame.State->vtkglClearColor(0.0, 0.0, 0.0, 1.0);
+  frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
+  if (!(farthest > nearest))
+  {
+    return;
+  }
+  UseSliceBlend(frame.State, true);
+  vtkShaderProgram* program = in.Ready(in.PlanesPass, cloudVirtualPlanesFS, true);
+  this->SetCommonUniforms(program, frame);
+  this->SetCloudLightUniforms(program, frame);
+  program->SetUniformf("lightsMieG", static_cast<float>(frame.Settings.Air.MieG));
+  const int planes = this->NumberOfVirtualPlanes;
+  const double spacing = (farthest - nearest) / planes;
+  program->SetUniformf("planeSpacing", static_cast<float>(spacing));
+  for (int k = planes - 1; k >= 0; --k)
+  {
+    program->SetUniformf("planeDepth", static_cast<float>(nearest + (k + 0.5) * spacing));
+    in.PlanesPass->Render();
+    ++in.PassesLastRender;
+  }
+  frame.State->vtkglDisable(GL_BLEND);
 }
 
 //------------------------------------------------------------------------------

@@ -413,6 +413,74 @@ public:
   ///@}
 
   ///@{
+  /// The view's own lights (docs/lights.md): lamps and spotlights of the renderer
+  /// (vtkLight, ParaView's Light Inspector) light the air's haze, the cloud and the
+  /// ground, with the shadows of the view's opaque geometry (a shadow map per light) and
+  /// of the cloud (its optical depth toward the light). Drawn by the ray-marched method
+  /// (RayMarching) only; the slices ignore them.
+  ///  - LightSources: NoLights (0), or PositionalLights (1, the default): the switched-on
+  ///    positional lights of the renderer (vtkLight::GetPositional; a ConeAngle below 90
+  ///    degrees makes a spotlight; the headlight and the light kit are not positional).
+  ///  - A light of Intensity I and DiffuseColor c has the radiant intensity
+  ///    LightIntensityScale x I x c on the beam's axis, in Y/sr of the sun's relative
+  ///    units per channel of linear sRGB: at d metres it gives the irradiance
+  ///    LightIntensityScale I c / d^2 (a sun of that illuminance, at normal incidence).
+  ///  - SpotEdgeWidthDegrees: the soft edge inside every spotlight's cone (vtkLight has
+  ///    none): full light within ConeAngle - width of the axis, none beyond ConeAngle.
+  ///  - SetLightMap: an image whose luminance multiplies every spotlight's beam, mapped
+  ///    over the cone as a slide projector throws it (002 §6.2's light map; a gobo or
+  ///    a stained-glass window; Physics/SpotLight.h for the frame). nullptr: none.
+  ///  - LightShaftMethod: how the haze's in-scattering is integrated along the view
+  ///    rays: LightShaftsByRayMarching (0, the default; LightSamples equi-angular samples
+  ///    per light inside its beam, in the ray march) or LightShaftsByVirtualPlanes (1,
+  ///    002 §6.2: NumberOfVirtualPlanes planes parallel to the screen over the lit depth,
+  ///    drawn back to front and added to the picture).
+  ///  - LightShadowMapSize: texels per side of each of a light's six shadow-map faces
+  ///    (0: the opaque geometry casts no shadow). LightCloudSteps: samples of the cloud
+  ///    between a point and a light (0: the cloud casts no shadow in the beams).
+  ///  - MaximumLights: at most this many lights (up to 8), the brightest at the scene
+  ///    first; the others are left out with a warning. Lights whose beam misses the
+  ///    scene's bounds cost nothing.
+  enum
+  {
+    NoLights = 0,
+    PositionalLights = 1
+  };
+  vtkSetClampMacro(LightSources, int, NoLights, PositionalLights);
+  vtkGetMacro(LightSources, int);
+  virtual void SetLightIntensityScale(double value);
+  virtual double GetLightIntensityScaleMinValue() { return 0.0; }
+  virtual double GetLightIntensityScaleMaxValue() { return 1e12; }
+  vtkGetMacro(LightIntensityScale, double);
+  virtual void SetSpotEdgeWidthDegrees(double value);
+  virtual double GetSpotEdgeWidthDegreesMinValue() { return 0.0; }
+  virtual double GetSpotEdgeWidthDegreesMaxValue() { return 90.0; }
+  vtkGetMacro(SpotEdgeWidthDegrees, double);
+  virtual void SetLightMap(vtkImageData* image);
+  vtkGetObjectMacro(LightMap, vtkImageData);
+  enum
+  {
+    LightShaftsByRayMarching = 0,
+    LightShaftsByVirtualPlanes = 1
+  };
+  vtkSetClampMacro(LightShaftMethod, int, LightShaftsByRayMarching, LightShaftsByVirtualPlanes);
+  vtkGetMacro(LightShaftMethod, int);
+  vtkSetClampMacro(LightSamples, int, 1, 1024);
+  vtkGetMacro(LightSamples, int);
+  vtkSetClampMacro(NumberOfVirtualPlanes, int, 1, 4096);
+  vtkGetMacro(NumberOfVirtualPlanes, int);
+  vtkSetClampMacro(LightShadowMapSize, int, 0, 4096);
+  vtkGetMacro(LightShadowMapSize, int);
+  vtkSetClampMacro(LightCloudSteps, int, 0, 256);
+  vtkGetMacro(LightCloudSteps, int);
+  vtkSetClampMacro(MaximumLights, int, 0, 8);
+  vtkGetMacro(MaximumLights, int);
+  /// The lights the last frame drew, and the shadow casters it drew into their maps.
+  int GetNumberOfLightsLastRender() const;
+  int GetNumberOfShadowCastersLastRender() const;
+  ///@}
+
+  ///@{
   /// Time each pass on the GPU with timer queries (GL_TIME_ELAPSED; default off: the
   /// mapper then waits for the frame's queries at its end). GetLastPassTimes: the last
   /// frame drawn in full, "pass seconds; pass seconds; ..." in the order of the passes
@@ -683,6 +751,16 @@ protected:
   int ShadowSurfaceSize = 512;
   int AtmosphereSteps = 32;
   int RenderingMethod = ShadowViewSlicing;
+  int LightSources = PositionalLights;
+  double LightIntensityScale = 1.0;
+  double SpotEdgeWidthDegrees = 2.0;
+  vtkImageData* LightMap = nullptr;
+  int LightShaftMethod = LightShaftsByRayMarching;
+  int LightSamples = 32;
+  int NumberOfVirtualPlanes = 64;
+  int LightShadowMapSize = 256;
+  int LightCloudSteps = 12;
+  int MaximumLights = 8;
   double RayMarchStepTexels = 2.0;
   bool TimePasses = false;
   bool SliceJitter = true;
@@ -752,6 +830,11 @@ private:
   void UpdateSunDepthVolume(FrameState& frame);
   void RenderAirFroxels(const FrameState& frame);
   void RenderCloudMarch(const FrameState& frame);
+  // The view's lights (docs/lights.md).
+  void UpdateViewLights(vtkRenderer* renderer, FrameState& frame);
+  void UpdateLightMapTexture(FrameState& frame);
+  void SetViewLightUniforms(vtkShaderProgram* program, const FrameState& frame);
+  void RenderVirtualPlanes(const FrameState& frame);
   void SetCloudLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
   void RenderComposite(const FrameState& frame);

@@ -28,6 +28,8 @@ ivec3 FroxelSize() { return ivec3(froxelDimensions + 0.5); }
 uniform vec2 froxelDepths;        // d_1 (world units), 1 / log(d_{k+1} / d_k)
 uniform float mieG;
 uniform float multipleScattering; // k_multi (000 Eq. 1)
+uniform int lightSamples;         // samples per view light along the ray (nimbusLights.glsl)
+uniform int lightsInAir;          // 1: the lights' shafts in the air here; 0: by virtual planes
 
 const float kOpaque = 1e-3;       // the cloud transmittance at which the march stops
 
@@ -173,7 +175,8 @@ void MarchCloud(vec3 origin, vec3 direction, float first, float last, vec3 airIn
       float beyond = octaves > 1 ? SunMultipleScattering(mu, -log(max(sun, 1e-37)))
         : forwardPeakFraction > 0.0 ? peakPhase * (pow(sun, peakExponent) - sun) : 0.0;
       source = (cloudAlbedo * sigma * (cloudPhase * sun + beyond) * SunIrradiance(Altitude(p)) +
-                 CloudOtherSources(p, direction, sigma)) *
+                 CloudOtherSources(p, direction, sigma) +
+                 (lightCount > 0 ? CloudLightsSource(p, direction, sigma) : vec3(0.0))) *
         airIn * exp(airLogRatio * ((t - first) / span));
     }
     radiance += transmittance * source * stepIntegral;
@@ -292,13 +295,19 @@ void main()
       cloudTransmittance);
     color = max(color, vec3(0.0));
   }
+  if (unlit == 0 && lightCount > 0 && lightsInAir != 0)
+  {
+    color += LightsInAir(origin, direction, 0.0, tEnd, lightSamples,
+      SliceJitterFraction(gl_FragCoord.xy) + 0.5, mieG, first, last, cloudTransmittance);
+  }
   float alpha = cloudTransmittance;
   if (unlit == 0 && tGround < kInfinity && tGround <= tEnd)
   {
     vec3 g = origin + tGround * direction;
     // Behind (or inside) the cloud's blocks the ground is seen through the cloud.
     float through = tGround >= first ? cloudTransmittance : 1.0;
-    color += GroundRadiance(g, CloudDepthOutsideBox(g)) * transmittanceEnd * through;
+    vec3 ground = GroundRadiance(g, CloudDepthOutsideBox(g));
+    color += (lightCount > 0 ? ground + GroundLightsRadiance(g) : ground) * transmittanceEnd * through;
     clearColor += GroundRadiance(g, 0.0) * transmittanceEnd;
     alpha = overSky != 0 ? cloudTransmittance : 0.0;
   }

@@ -31,6 +31,10 @@ uniform int skyBackground;
 // view's background colour (as the framebuffer would hold it), which the parallel framebuffer
 // does not hold, and is opaque.
 uniform int premultipliedPiece;
+// The view's lights drawn by virtual planes (cloudVirtualPlanesFS.glsl): their shafts'
+// radiance toward the eye, added to the accumulation's.
+uniform int lightsImageOn;
+uniform sampler2D lightsImage;
 uniform int usePieceBackground;
 uniform vec3 pieceBackground;
 
@@ -39,6 +43,10 @@ void main()
   vec3 origin, direction;
   ViewRay(texCoord, origin, direction);
   vec4 sum = texture(accumulation, texCoord);
+  if (lightsImageOn != 0)
+  {
+    sum.rgb += texture(lightsImage, texCoord).rgb;
+  }
   vec4 background = texture(sceneColor, texCoord);
   float depth = texture(sceneDepth, texCoord).r;
   vec3 backgroundLinear = encodeSrgb != 0 ? SrgbDecode(background.rgb) : background.rgb;
