@@ -13,6 +13,10 @@ bool IsSpot(const SpotProfile& profile)
 
 double SpotFactor(const SpotProfile& profile, const Vector3& w)
 {
+  if (!IsFinite(w))
+  {
+    return 0.0; // no direction: no light (never NaN)
+  }
   if (!IsSpot(profile))
   {
     return 1.0;
@@ -44,7 +48,7 @@ void SpotLightMapFrame(const Vector3& axis, Vector3& e1, Vector3& e2)
 bool SpotLightMapCoordinates(const SpotProfile& profile, const Vector3& w, double& u, double& v)
 {
   const double along = Dot(profile.Axis, w);
-  if (!IsSpot(profile) || !(along > 0.0))
+  if (!IsSpot(profile) || !(along > 0.0) || !IsFinite(w))
   {
     return false;
   }

@@ -33,7 +33,8 @@ struct NIMBUSPHYSICS_EXPORT SpotProfile
 /// True when the profile has a cone (ConeHalfAngleDegrees < 90).
 NIMBUSPHYSICS_EXPORT bool IsSpot(const SpotProfile& profile);
 
-/// The beam's factor in [0, 1] toward unit direction w (from the light).
+/// The beam's factor in [0, 1] toward unit direction w (from the light); 0 for a
+/// non-finite w.
 NIMBUSPHYSICS_EXPORT double SpotFactor(const SpotProfile& profile, const Vector3& w);
 
 /// The light map's frame (e1, e2) of the axis (see the header's conventions).
