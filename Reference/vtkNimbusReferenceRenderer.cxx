@@ -5,6 +5,7 @@
 #include "MemoryBudget.h"
 #include "PathTracer.h"
 #include "RenderContext.h"
+#include "SceneAssets.h"
 #include "SceneJson.h"
 #include "SingleScatteringRenderer.h"
 #include "vtkNimbusSceneDensitySource.h"
@@ -138,6 +139,16 @@ int vtkNimbusReferenceRenderer::RequestInformation(
   {
     this->Internals->Scene =
       std::make_unique<nimbus::SceneDescription>(nimbus::LoadScene(this->SceneFileName));
+    // Version 4: the light maps' pixels and the meshes' triangles the scene names.
+    try
+    {
+      nimbus::LoadSceneAssets(*this->Internals->Scene);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      this->Internals->Scene.reset();
+      throw std::invalid_argument(this->SceneFileName + ": " + error.what());
+    }
   }
   catch (const std::exception& error)
   {

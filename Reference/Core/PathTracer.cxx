@@ -301,14 +301,16 @@ enum class Scatterer
   Cloud,
   Rayleigh,
   Mie,
-  Ground
+  Ground,
+  Surface // an occluder (scene format version 4): PathState's normal and albedo
 };
 
 enum class SegmentEndKind
 {
   Leaves, // background
   Ground,
-  Earth // black (the same convention as SingleScatteringRenderer)
+  Earth,  // black (the same convention as SingleScatteringRenderer)
+  Surface // an occluder
 };
 
 enum class FlightEnd
@@ -328,6 +330,10 @@ struct PathState
   std::vector<double> SavedWeight;        // the path's throughput during a sun-peak flight
   std::vector<double> LightTransmittance; // air transmittance toward a light
   int Medium = 0; // the medium of the last cloud scattering event (RenderContext::GetMedia)
+  // The occluder surface of the last Surface vertex: normal (facing where the path came
+  // from) and albedo.
+  Vector3 SurfaceNormal{ { 0.0, 0.0, 1.0 } };
+  double SurfaceAlbedo = 0.0;
   std::uint64_t Steps = 0;
   bool Truncated = false;
 };
@@ -341,7 +347,9 @@ public:
     , Grid(context.GetExtinctionGrid())
     , Media(context.GetMedia())
     , Air(context.GetAtmosphere())
+    , Blockers(context.GetOccluders())
   {
+    this->HasOccluders = !this->Blockers.IsEmpty();
     this->Wavelengths = static_cast<int>(context.GetWavelengths().size());
     this->Emission = context.HasEmission();
     this->HasCloud = !this->Grid.IsEmpty() && (context.CloudMajorant() > 0.0 || this->Emission);
@@ -549,8 +557,15 @@ private:
   /// Adds the sun's single-scattered contribution at p (next-event estimation).
   void SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
     PathState& state, double weight = 1.0) const;
-  /// Where a ray from its origin ends: tEnd and what lies there.
-  double SegmentEnd(const Ray& ray, SegmentEndKind& kind) const;
+  /// Where a ray from its origin ends: tEnd and what lies there (an occluder's surface in
+  /// `surface` when kind is Surface).
+  double SegmentEnd(const Ray& ray, SegmentEndKind& kind, OccluderHit& surface) const;
+  /// Whether an occluder blocks the segment from p along unit direction w up to distance
+  /// tMax (always false without occluders).
+  bool Blocked(const Vector3& p, const Vector3& w, double tMax) const
+  {
+    return this->HasOccluders && this->Blockers.Occluded(p, w, tMax);
+  }
   /// The sun-peak strategy at vertex p (see TracePath): samples a direction from the
   /// cloud's phase function about the sun, flies along it and, at a cloud scattering
   /// event, adds the sun's contribution with the balance-heuristic weight.
@@ -562,6 +577,8 @@ private:
   const DensityGrid& Grid; // the extinction grid (RenderContext::GetExtinctionGrid)
   const std::vector<MediumComponent>& Media;
   const Atmosphere* Air;
+  const OccluderSet& Blockers; // the scene's occluders (RenderContext::GetOccluders)
+  bool HasOccluders = false;
   int Wavelengths = 0;
   bool HasCloud = false;
   bool Emission = false;
@@ -1187,6 +1204,9 @@ void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scat
     case Scatterer::Ground:
       f = this->Context.GetGroundAlbedo() / kPi * std::max(0.0, s[2]);
       break;
+    case Scatterer::Surface:
+      f = state.SurfaceAlbedo / kPi * std::max(0.0, Dot(state.SurfaceNormal, s));
+      break;
     default:
       f = 0.0;
   }
@@ -1202,6 +1222,10 @@ void Integrator::SunNextEvent(const Vector3& p, const Vector3& d, Scatterer scat
     p[2] >= this->Context.GetGroundHeight())
   {
     return;
+  }
+  if (this->Blocked(p, s, kInfinity))
+  {
+    return; // an occluder's shadow
   }
   const double cloud = this->CloudTransmittance(p, s, rng, state);
   if (!(cloud > 0.0))
@@ -1339,6 +1363,17 @@ void Integrator::LightNextEvent(
   {
     c /= r;
   }
+  // A spot's beam (Physics/SpotLight.h) and light map toward p: direction -omega from the
+  // light. 1 for points and segments.
+  double beam = 1.0;
+  if (light.IsSpot)
+  {
+    beam = LightElementFactor(light, { { -omega[0], -omega[1], -omega[2] } });
+    if (!(beam > 0.0))
+    {
+      return;
+    }
+  }
   double f;
   switch (scatterer)
   {
@@ -1354,9 +1389,13 @@ void Integrator::LightNextEvent(
     case Scatterer::Ground:
       f = this->Context.GetGroundAlbedo() / kPi * std::max(0.0, omega[2]);
       break;
+    case Scatterer::Surface:
+      f = state.SurfaceAlbedo / kPi * std::max(0.0, Dot(state.SurfaceNormal, omega));
+      break;
     default:
       f = 0.0;
   }
+  f *= beam;
   if (!(f > 0.0))
   {
     return;
@@ -1369,6 +1408,12 @@ void Integrator::LightNextEvent(
     {
       return;
     }
+  }
+  // Occluders hide the light: a surface strictly between p and the light (one within
+  // 1e-9 of r of the light, at it, does not count).
+  if (this->Blocked(p, omega, r * (1.0 - 1e-9)))
+  {
+    return;
   }
   const double cloud = this->CloudTransmittance(p, omega, rng, state, r);
   if (!(cloud > 0.0))
@@ -1394,7 +1439,7 @@ void Integrator::LightNextEvent(
   }
 }
 
-double Integrator::SegmentEnd(const Ray& ray, SegmentEndKind& kind) const
+double Integrator::SegmentEnd(const Ray& ray, SegmentEndKind& kind, OccluderHit& surface) const
 {
   const double tGround = this->Context.IntersectGround(ray.Origin, ray.Direction, 0.0);
   double tEnd = tGround;
@@ -1423,6 +1468,11 @@ double Integrator::SegmentEnd(const Ray& ray, SegmentEndKind& kind) const
       tEnd = tEarth;
       kind = SegmentEndKind::Earth;
     }
+  }
+  if (this->HasOccluders && this->Blockers.Intersect(ray.Origin, ray.Direction, tEnd, surface))
+  {
+    tEnd = surface.T;
+    kind = SegmentEndKind::Surface;
   }
   return tEnd;
 }
@@ -1478,8 +1528,10 @@ void Integrator::SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scat
     w *= k;
   }
   SegmentEndKind kind;
-  // Cloud events lie inside the box: the flight can stop at its far side.
-  const double tEnd = std::min(this->SegmentEnd(ray, kind), ray.CloudFar);
+  OccluderHit surface;
+  // Cloud events lie inside the box: the flight can stop at its far side (or at an
+  // occluder before it).
+  const double tEnd = std::min(this->SegmentEnd(ray, kind, surface), ray.CloudFar);
   double t;
   Scatterer next = Scatterer::None;
   if (this->FreeFlight(ray, tEnd, rng, state, t, next) == FlightEnd::Collision &&
@@ -1522,7 +1574,8 @@ void Integrator::TracePath(
   for (int order = 0;;)
   {
     SegmentEndKind endKind;
-    const double tEnd = this->SegmentEnd(ray, endKind);
+    OccluderHit surface;
+    const double tEnd = this->SegmentEnd(ray, endKind, surface);
     double t;
     Scatterer scatterer = Scatterer::None;
     const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer, true);
@@ -1545,13 +1598,30 @@ void Integrator::TracePath(
         }
         break;
       }
-      p = Along(ray.Origin, ray.Direction, tEnd);
-      p[2] = this->Context.GetGroundHeight();
-      scatterer = Scatterer::Ground;
       if (++state.Steps > kMaxTrackingStepsPerPath)
       {
         state.Truncated = true;
         break;
+      }
+      if (endKind == SegmentEndKind::Surface)
+      {
+        // An occluder: a grey Lambertian surface; black ones end the path. The vertex
+        // moves off the surface (toward the side the path came from) so that the rays
+        // leaving it do not hit it again.
+        if (!(surface.Albedo > 0.0))
+        {
+          break;
+        }
+        p = OffsetFromSurface(Along(ray.Origin, ray.Direction, tEnd), surface.Normal);
+        scatterer = Scatterer::Surface;
+        state.SurfaceNormal = surface.Normal;
+        state.SurfaceAlbedo = surface.Albedo;
+      }
+      else
+      {
+        p = Along(ray.Origin, ray.Direction, tEnd);
+        p[2] = this->Context.GetGroundHeight();
+        scatterer = Scatterer::Ground;
       }
     }
     else
@@ -1623,6 +1693,18 @@ void Integrator::TracePath(
         for (int i = 0; i < n; ++i)
         {
           state.Weight[i] *= albedo;
+        }
+        break;
+      }
+      case Scatterer::Surface:
+      {
+        // Cosine-weighted about the surface's normal (the side the path came from): the
+        // weight of the Lambertian BRDF times cos over the pdf is the albedo.
+        const double mu = std::sqrt(rng.Uniform());
+        direction = DirectionFromCosine(state.SurfaceNormal, mu, rng.Uniform());
+        for (int i = 0; i < n; ++i)
+        {
+          state.Weight[i] *= state.SurfaceAlbedo;
         }
         break;
       }

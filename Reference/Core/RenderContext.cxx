@@ -102,6 +102,7 @@ RenderContext::RenderContext(const SceneDescription& scene, DensityGrid grid, Sc
   Require(
     scene.Ground.Albedo >= 0.0 && scene.Ground.Albedo <= 1.0, "ground.albedo", "must be in [0, 1]");
   this->SetUpVersion3(scene);
+  this->SetUpVersion4();
 }
 
 namespace
@@ -275,21 +276,26 @@ void RenderContext::SetUpVersion3(const SceneDescription& scene)
     Require(std::isfinite(d.TemperatureKelvin) && d.TemperatureKelvin > 0.0,
       field + ".temperature_kelvin", "must be finite and > 0");
     this->LightSpectra.push_back(SunIrradianceSpectrum(spectrum, d.TemperatureKelvin, 1.0));
-    if (d.Type == "point")
+    if (d.Type == "point" || d.Type == "spot")
     {
       Require(std::isfinite(d.Intensity) && d.Intensity >= 0.0, field + ".intensity",
         "must be finite and >= 0");
+      Require(IsFinite(d.Position), field + ".position", "must be finite");
       LightElement e;
       e.A = e.B = d.Position;
       e.Intensity = d.Intensity;
       e.Light = static_cast<int>(l);
+      if (d.Type == "spot")
+      {
+        this->SetUpSpot(l, e);
+      }
       if (e.Intensity > 0.0)
       {
         this->Lights.push_back(e);
       }
       continue;
     }
-    Require(d.Type == "polyline", field + ".type", "must be point or polyline");
+    Require(d.Type == "polyline", field + ".type", "must be point, polyline or spot");
     Require(d.Vertices.size() >= 2, field + ".vertices", "needs at least 2 vertices");
     Require(std::isfinite(d.IntensityPerMetre) && d.IntensityPerMetre >= 0.0,
       field + ".intensity_per_metre", "must be finite and >= 0");
@@ -309,6 +315,134 @@ void RenderContext::SetUpVersion3(const SceneDescription& scene)
       }
     }
   }
+}
+
+void RenderContext::SetUpSpot(std::size_t index, LightElement& e) const
+{
+  // The context's own copy of the light: the element's map pointer stays valid as long
+  // as the context (which is neither copied nor moved).
+  const LightDescription& d = this->Scene.Lights[index];
+  const std::string field = "lights[" + std::to_string(index) + "]";
+  const Vector3& axis = d.Direction;
+  const double length = std::hypot(std::hypot(axis[0], axis[1]), axis[2]);
+  Require(IsFinite(axis) && length > 0.0 && std::isfinite(length), field + ".direction",
+    "must be a finite, non-zero vector");
+  Require(d.ConeAngleDegrees > 0.0 && d.ConeAngleDegrees < 90.0, field + ".cone_angle_degrees",
+    "must be in (0, 90) (90 or more: use a point light)");
+  Require(d.EdgeDegrees >= 0.0 && d.EdgeDegrees <= d.ConeAngleDegrees, field + ".edge_degrees",
+    "must be in [0, cone_angle_degrees]");
+  e.IsSpot = true;
+  e.Spot.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
+  e.Spot.ConeHalfAngleDegrees = d.ConeAngleDegrees;
+  e.Spot.EdgeWidthDegrees = d.EdgeDegrees;
+  const LightMapDescription& map = d.LightMap;
+  if (map.Path.empty() && map.Luminance.empty())
+  {
+    return;
+  }
+  Require(!map.Luminance.empty(), field + ".light_map",
+    "names an image the renderer was not given ('" + map.Path +
+      "'; nimbus::LoadSceneAssets reads it)");
+  Require(map.Width >= 1 && map.Height >= 1 &&
+      map.Luminance.size() ==
+        static_cast<std::size_t>(map.Width) * static_cast<std::size_t>(map.Height),
+    field + ".light_map",
+    "has " + std::to_string(map.Luminance.size()) + " values for " + std::to_string(map.Width) +
+      " x " + std::to_string(map.Height) + " pixels");
+  std::size_t bad = 0;
+  for (float x : map.Luminance)
+  {
+    bad += std::isfinite(x) && x >= 0.0f ? 0 : 1;
+  }
+  Require(bad == 0, field + ".light_map",
+    "has " + std::to_string(bad) + " NaN, infinite or negative luminance values");
+  e.Map = &map;
+}
+
+void RenderContext::SetUpVersion4()
+{
+  const SceneDescription& scene = this->Scene;
+  for (std::size_t i = 0; i < scene.Occluders.size(); ++i)
+  {
+    const OccluderDescription& o = scene.Occluders[i];
+    const std::string field = "occluders[" + std::to_string(i) + "]";
+    Require(o.Albedo >= 0.0 && o.Albedo <= 1.0, field + ".albedo", "must be in [0, 1]");
+    if (o.Type == "box")
+    {
+      bool ordered = IsFinite(o.Min) && IsFinite(o.Max);
+      for (int a = 0; a < 3; ++a)
+      {
+        ordered = ordered && o.Min[a] <= o.Max[a];
+      }
+      Require(ordered, field + ".max", "must be finite and >= min on every axis");
+      this->Occluders.AddBox(o.Min, o.Max, o.Albedo);
+      continue;
+    }
+    Require(o.Type == "mesh", field + ".type", "must be box or mesh");
+    Require(std::isfinite(o.Scale) && o.Scale > 0.0, field + ".scale", "must be finite and > 0");
+    Require(IsFinite(o.Translate), field + ".translate", "must be finite");
+    Require(!o.TriangleVertices.empty(), field + ".path",
+      "names a mesh whose triangles the renderer was not given ('" + o.Path +
+        "'; nimbus::LoadSceneAssets reads it)");
+    Require(o.TriangleVertices.size() % 3 == 0, field + ".path",
+      "has " + std::to_string(o.TriangleVertices.size()) +
+        " triangle vertices, not a multiple of 3");
+    const std::size_t before = this->Occluders.GetNumberOfTriangles();
+    for (std::size_t v = 0; v < o.TriangleVertices.size(); v += 3)
+    {
+      Vector3 corner[3];
+      for (int k = 0; k < 3; ++k)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          corner[k][a] = o.Scale * o.TriangleVertices[v + k][a] + o.Translate[a];
+        }
+        Require(IsFinite(corner[k]), field + ".path",
+          "has a vertex that is not finite once scaled and translated (triangle " +
+            std::to_string(v / 3) + ")");
+      }
+      this->Occluders.AddTriangle(corner[0], corner[1], corner[2], o.Albedo);
+    }
+    Require(this->Occluders.GetNumberOfTriangles() > before, field + ".path",
+      "has no triangle of non-zero area ('" + o.Path + "')");
+  }
+  this->Occluders.Build();
+}
+
+double SampleLightMap(const LightMapDescription& map, double u, double v)
+{
+  if (!(u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0) || map.Luminance.empty())
+  {
+    return 0.0;
+  }
+  // Pixel centres at (c + 0.5) / Width: x = u Width - 0.5 in [-0.5, Width - 0.5], clamped
+  // to the edge pixels' centres.
+  const double x = std::min(std::max(u * map.Width - 0.5, 0.0), map.Width - 1.0);
+  const double y = std::min(std::max(v * map.Height - 0.5, 0.0), map.Height - 1.0);
+  const int c0 = std::min(static_cast<int>(x), map.Width - 1);
+  const int r0 = std::min(static_cast<int>(y), map.Height - 1);
+  const int c1 = std::min(c0 + 1, map.Width - 1), r1 = std::min(r0 + 1, map.Height - 1);
+  const double fx = x - c0, fy = y - r0;
+  auto at = [&map](int c, int r)
+  { return static_cast<double>(map.Luminance[static_cast<std::size_t>(r) * map.Width + c]); };
+  const double top = at(c0, r0) + fx * (at(c1, r0) - at(c0, r0));
+  const double bottom = at(c0, r1) + fx * (at(c1, r1) - at(c0, r1));
+  return top + fy * (bottom - top);
+}
+
+double LightElementFactor(const LightElement& light, const Vector3& w)
+{
+  if (!light.IsSpot)
+  {
+    return 1.0;
+  }
+  double factor = SpotFactor(light.Spot, w);
+  if (factor > 0.0 && light.Map)
+  {
+    double u, v;
+    factor *= SpotLightMapCoordinates(light.Spot, w, u, v) ? SampleLightMap(*light.Map, u, v) : 0.0;
+  }
+  return factor;
 }
 
 double RenderContext::IntersectGround(

@@ -18,9 +18,11 @@
 #include "Atmosphere.h"
 #include "Camera.h"
 #include "DensityGrid.h"
+#include "Occluders.h"
 #include "PhaseFunctions.h"
 #include "SceneDescription.h"
 #include "SpectralColor.h"
+#include "SpotLight.h"
 #include "SunAndAir.h"
 
 #include <array>
@@ -62,9 +64,10 @@ struct NIMBUSREFERENCE_EXPORT MediumComponent
   std::vector<DensityGrid> BlackbodyEmission;
 };
 
-/// A light of the scene broken into elements for next-event estimation: a point or one
-/// straight segment of a polyline. Intensity is the element's total luminous-like
-/// intensity, Y/sr: a point's `intensity`, a segment's intensity_per_metre x length.
+/// A light of the scene broken into elements for next-event estimation: a point, a spot
+/// or one straight segment of a polyline. Intensity is the element's total luminous-like
+/// intensity, Y/sr: a point's `intensity`, a spot's on its axis, a segment's
+/// intensity_per_metre x length.
 struct NIMBUSREFERENCE_EXPORT LightElement
 {
   Vector3 A{ { 0.0, 0.0, 0.0 } }; // the point, or the segment's first end, m
@@ -72,7 +75,21 @@ struct NIMBUSREFERENCE_EXPORT LightElement
   double Intensity = 0.0;         // Y / sr
   bool IsSegment = false;
   int Light = 0; // index in scene.Lights (and in GetLightSpectra())
+  /// Version 4, a spot: the cone (Spot.Axis unit) and the light map (null: none; it
+  /// points into the context's own copy of the scene).
+  bool IsSpot = false;
+  SpotProfile Spot;
+  const LightMapDescription* Map = nullptr;
 };
+
+/// A light map's luminance at (u, v) (LightMapDescription's conventions): bilinear
+/// between pixel centres, clamped to the edge pixels inside [0, 1]^2, 0 outside.
+NIMBUSREFERENCE_EXPORT double SampleLightMap(const LightMapDescription& map, double u, double v);
+
+/// What multiplies a light element's Intensity toward unit direction w (from the light):
+/// 1 for points and segments; SpotFactor(w) x the light map at
+/// SpotLightMapCoordinates(w) for a spot (Physics/SpotLight.h).
+NIMBUSREFERENCE_EXPORT double LightElementFactor(const LightElement& light, const Vector3& w);
 
 class NIMBUSREFERENCE_EXPORT RenderContext
 {
@@ -81,7 +98,9 @@ public:
 
   /// Validates the parts the renderers rely on (throws std::invalid_argument with
   /// the offending field's name). `fields` holds the grids of additional media and of
-  /// "array" emission fields (version 3); a scene that needs one it lacks is an error.
+  /// "array" emission fields (version 3); a scene that needs one it lacks is an error,
+  /// and so is (version 4) a light map or a mesh whose pixels or triangles the
+  /// description lacks (Reference/SceneAssets.h reads them).
   RenderContext(const SceneDescription& scene, DensityGrid grid, SceneFields fields = {});
   /// Not copied or moved: GetMedia() points into the context's own grids.
   RenderContext(const RenderContext&) = delete;
@@ -136,11 +155,14 @@ public:
   const std::vector<MediumComponent>& GetMedia() const { return this->Media; }
   bool HasAdditionalMedia() const { return this->Media.size() > 1; }
   bool HasEmission() const { return this->AnyEmission; }
-  /// Point lights and polyline segments (scene.Lights), with positive intensity.
+  /// Point lights, spots and polyline segments (scene.Lights), with positive intensity.
   const std::vector<LightElement>& GetLightElements() const { return this->Lights; }
   /// Per scene light: the blackbody spectrum at the sample wavelengths, luminance 1.
   const std::vector<std::vector<double>>& GetLightSpectra() const { return this->LightSpectra; }
   double GetCloudAlbedo() const { return this->Scene.Medium.SingleScatteringAlbedo; }
+  /// Version 4: the scene's occluders (boxes and meshes placed by Scale and Translate),
+  /// in a bounding volume hierarchy; empty without occluders.
+  const OccluderSet& GetOccluders() const { return this->Occluders; }
   const PhaseFunctionMixture& GetCloudPhase() const { return this->CloudPhase; }
 
   // --- atmosphere (absent when disabled): SunAndAir.h
@@ -186,6 +208,8 @@ public:
 
 private:
   void SetUpVersion3(const SceneDescription& scene);
+  void SetUpSpot(std::size_t index, LightElement& element) const;
+  void SetUpVersion4();
 
   SceneDescription Scene;
   Camera ViewCamera;
@@ -200,6 +224,7 @@ private:
   bool AnyEmission = false;
   std::vector<LightElement> Lights;
   std::vector<std::vector<double>> LightSpectra;
+  OccluderSet Occluders;
   std::vector<double> BackgroundRadiance;
 };
 

@@ -86,18 +86,48 @@ struct MediumDescription
   EmissionDescription Emission; // version 3; disabled by default
 };
 
+/// Version 4: a spot light's light map (a gobo), the luminance that multiplies the
+/// spot's intensity toward each direction of its beam. The scene file names the image
+/// (Path); the pixels are read by VTK glue (Reference/SceneAssets.h, used by
+/// vtkNimbusReferenceRenderer), or filled directly by code that builds a description.
+/// Pixel (c, r) is Luminance[r * Width + c]: column c at u = (c + 0.5) / Width, row r at
+/// v = (r + 0.5) / Height, row 0 the image file's first row (the top of the picture as an
+/// image viewer shows it); (u, v) as Physics/SpotLight.h's SpotLightMapCoordinates gives
+/// them. Sampled bilinearly between pixel centres (clamped to the edge pixels within
+/// [0, 1]^2), 0 outside [0, 1]^2. Values are linear luminance, >= 0 (an 8-bit or 16-bit
+/// PNG is decoded from sRGB, a PGM/PPM is linear; colour images give Y of linear sRGB).
+struct LightMapDescription
+{
+  std::string Path;             // resolved, absolute; "" = no light map
+  int Width = 0;                // pixels
+  int Height = 0;               // pixels
+  std::vector<float> Luminance; // Width * Height values, or empty until read
+};
+
 /// Version 3: a light other than the sun. Lights have zero measure (points, lines):
 /// camera rays never see them directly; they light the scene by next-event estimation.
 /// Radiometry in the sun's relative units: a point light of Intensity I (luminance Y
 /// per steradian) at distance d in vacuum gives the irradiance Y = I / d^2 at normal
 /// incidence, as a sun of illuminance I / d^2 would.
+/// Version 4 adds "spot": a point light whose intensity toward a direction w (from the
+/// light) is Intensity x SpotFactor(w) x light map(w) (Physics/SpotLight.h).
 struct LightDescription
 {
-  std::string Type = "point"; // "point" or "polyline"
-  /// "point": the light's position, m.
+  std::string Type = "point"; // "point", "polyline" or (version 4) "spot"
+  /// "point", "spot": the light's position, m.
   std::array<double, 3> Position{ { 0.0, 0.0, 0.0 } };
-  /// "point": radiant intensity's luminance, Y / sr (isotropic).
+  /// "point": radiant intensity's luminance, Y / sr (isotropic); "spot": on the axis.
   double Intensity = 1.0;
+  /// "spot": the beam's axis, away from the light (any non-zero length; stored as
+  /// given, normalised by the renderers).
+  std::array<double, 3> Direction{ { 0.0, 0.0, -1.0 } };
+  /// "spot": the half angle between the axis and the cone's edge, degrees, in (0, 90)
+  /// (VTK's vtkLight::ConeAngle).
+  double ConeAngleDegrees = 30.0;
+  /// "spot": the soft edge's width inside the cone, degrees, in [0, ConeAngleDegrees].
+  double EdgeDegrees = 0.0;
+  /// "spot": optional light map (empty Path and Luminance: none).
+  LightMapDescription LightMap;
   /// "polyline" (a lightning channel): at least 2 vertices, m.
   std::vector<std::array<double, 3>> Vertices;
   /// "polyline": each element dl of the channel radiates isotropically with intensity
@@ -116,6 +146,27 @@ struct AdditionalMediumDescription
   double SingleScatteringAlbedo = 0.99; // sigma_s / sigma_t
   std::vector<PhaseComponentDescription> Phase{ PhaseComponentDescription{} };
   EmissionDescription Emission;
+};
+
+/// Version 4: an opaque surface in the scene: a grey Lambertian reflector of albedo
+/// Albedo that stops every ray (camera, scattered and shadow rays). Surfaces are
+/// two-sided: a box is its six faces, a mesh its triangles.
+struct OccluderDescription
+{
+  std::string Type = "box"; // "box" or "mesh"
+  /// "box": opposite corners, m; Min <= Max on every axis (equal: a flat rectangle).
+  std::array<double, 3> Min{ { 0.0, 0.0, 0.0 } };
+  std::array<double, 3> Max{ { 0.0, 0.0, 0.0 } };
+  /// "mesh": a .ply or .obj file, resolved and absolute like a density's path.
+  std::string Path;
+  /// "mesh": a vertex x of the file is placed at Scale x + Translate (m).
+  std::array<double, 3> Translate{ { 0.0, 0.0, 0.0 } };
+  double Scale = 1.0;
+  double Albedo = 0.0; // grey Lambertian, in [0, 1]; 0 = black
+  /// "mesh": the triangles in the file's coordinates (before Scale and Translate), three
+  /// consecutive vertices each; read by VTK glue (Reference/SceneAssets.h) or filled
+  /// directly. Empty until read.
+  std::vector<std::array<double, 3>> TriangleVertices;
 };
 
 struct GroundDescription
@@ -137,7 +188,7 @@ struct BackgroundDescription
 
 struct SceneDescription
 {
-  static constexpr int kFormatVersion = 3;
+  static constexpr int kFormatVersion = 4;
   std::string Name;
   std::string Description;
   CameraDescription Camera;
@@ -150,6 +201,7 @@ struct SceneDescription
   int SpectralSamples = 16;
   std::vector<LightDescription> Lights;           // version 3
   std::vector<AdditionalMediumDescription> Media; // version 3
+  std::vector<OccluderDescription> Occluders;     // version 4
 
   /// True when the scene uses a version-3 feature (lights, emission, media).
   bool UsesVersion3Features() const
@@ -159,6 +211,19 @@ struct SceneDescription
       return true;
     }
     return false;
+  }
+
+  /// True when the scene uses a version-4 feature (spot lights, occluders).
+  bool UsesVersion4Features() const
+  {
+    for (const LightDescription& light : this->Lights)
+    {
+      if (light.Type == "spot")
+      {
+        return true;
+      }
+    }
+    return !this->Occluders.empty();
   }
 };
 

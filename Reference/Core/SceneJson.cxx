@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -72,6 +73,10 @@ constexpr std::size_t kMaxPolylineVertices = 100000;
 constexpr double kMaxEmissionPerMetre = 1.0e6;
 // Additional media: each one adds a density grid (memory) and a lookup per collision.
 constexpr std::size_t kMaxAdditionalMedia = 16;
+// Version 4. Occluders: each box is tested by every ray that reaches the bounding volume
+// hierarchy's leaf holding it; meshes may hold many triangles each (their limit is the
+// glue's, SceneAssets.h).
+constexpr std::size_t kMaxOccluders = 4096;
 /// Deepest nesting of arrays and objects a scene file may have. A scene needs 5
 /// (scene.medium.density.parameters.Bounds); deeper files are refused before
 /// they cost memory or time.
@@ -638,6 +643,39 @@ CameraDescription ReadCamera(const Json& v, const std::string& path)
   return c;
 }
 
+/// A file's path as the description stores it: relative ones resolved against `base`
+/// (the current directory when empty), absolute and lexically normalised.
+std::string ResolvedPath(const std::string& given, const std::string& base)
+{
+  namespace fs = std::filesystem;
+  fs::path p(given);
+  if (p.is_relative())
+  {
+    p = (base.empty() ? fs::current_path() : fs::absolute(fs::path(base))) / p;
+  }
+  return p.lexically_normal().string();
+}
+
+/// A non-empty file path whose extension (any case) is one of `extensions`, resolved.
+std::string ReadFilePath(const Json& v, const std::string& path, const std::string& base,
+  const std::vector<std::string>& extensions, const std::string& noun)
+{
+  const std::string given = ReadString(v, path, false);
+  std::string extension = std::filesystem::path(given).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (std::find(extensions.begin(), extensions.end(), extension) == extensions.end())
+  {
+    std::string list;
+    for (std::size_t i = 0; i < extensions.size(); ++i)
+    {
+      list += (i == 0 ? "" : (i + 1 == extensions.size() ? " or " : ", ")) + extensions[i];
+    }
+    Fail(path, "expected " + noun + " file (" + list + "), got " + Describe(v));
+  }
+  return ResolvedPath(given, base);
+}
+
 DensitySourceDescription ReadDensity(
   const Json& v, const std::string& path, const std::string& base)
 {
@@ -650,14 +688,7 @@ DensitySourceDescription ReadDensity(
   }
   if (d.Type == "file")
   {
-    const std::string given = ReadString(r.Require("path"), r.Key("path"), false);
-    namespace fs = std::filesystem;
-    fs::path p(given);
-    if (p.is_relative())
-    {
-      p = (base.empty() ? fs::current_path() : fs::absolute(fs::path(base))) / p;
-    }
-    d.Path = p.lexically_normal().string();
+    d.Path = ResolvedPath(ReadString(r.Require("path"), r.Key("path"), false), base);
     if (r.Has("parameters") && !(r["parameters"].is_object() && r["parameters"].empty()))
     {
       Fail(r.Key("parameters"), "only used by type \"metaball_cloud\" (this density is \"file\")");
@@ -768,18 +799,24 @@ EmissionDescription ReadEmission(
   return e;
 }
 
-/// A key that only version 3 knows, in an older file: the same error as any unknown
-/// key, saying which version it needs.
+/// A key that only version `needed` knows, in an older file: the same error as any
+/// unknown key, saying which version it needs.
+void RefuseNewerKey(const Json& v, const std::string& path, const std::string& key, int version,
+  int needed, const std::vector<std::string>& known)
+{
+  if (version < needed && v.is_object() && v.contains(key))
+  {
+    Fail(path + "." + key,
+      "unknown key (known: " + Join(known) + "); \"" + key + "\" needs format version " +
+        std::to_string(needed) + " (\"nimbus_scene\": " + std::to_string(needed) +
+        "), this file is version " + std::to_string(version));
+  }
+}
+
 void RefuseVersion3Key(const Json& v, const std::string& path, const std::string& key, int version,
   const std::vector<std::string>& known)
 {
-  if (version < 3 && v.is_object() && v.contains(key))
-  {
-    Fail(path + "." + key,
-      "unknown key (known: " + Join(known) + "); \"" + key +
-        "\" needs format version 3 (\"nimbus_scene\": 3), this file is version " +
-        std::to_string(version));
-  }
+  RefuseNewerKey(v, path, key, version, 3, known);
 }
 
 /// What the main medium and an additional one share: density, extinction, albedo,
@@ -894,20 +931,70 @@ void RequireSameMetaballGrid(const DensitySourceDescription& main,
   }
 }
 
-const std::vector<std::string> kLightTypes = { "point", "polyline" };
+const std::vector<std::string> kLightTypes3 = { "point", "polyline" };
+const std::vector<std::string> kLightTypes = { "point", "polyline", "spot" };
+// Light maps: images vtkImageReader2Factory reads and SceneAssets.cxx decodes.
+const std::vector<std::string> kLightMapExtensions = { ".png", ".pgm", ".ppm", ".pnm" };
+const std::vector<std::string> kMeshExtensions = { ".ply", ".obj" };
 
-LightDescription ReadLight(const Json& v, const std::string& path)
+/// Version 4: a spot light's keys (the type already read).
+void ReadSpot(const Json& v, const std::string& path, const std::string& base, LightDescription& l)
+{
+  const ObjectReader r(v, path,
+    { "type", "position", "direction", "cone_angle_degrees", "edge_degrees", "intensity",
+      "temperature_kelvin", "light_map" });
+  l.Position = ReadVector3(r.Require("position"), r.Key("position"), Coordinate());
+  l.Direction = ReadVector3(r.Require("direction"), r.Key("direction"));
+  if (!(Length(ScaledToOrderOne(l.Direction)) > 0.0))
+  {
+    Fail(r.Key("direction"), "must be a non-zero vector (the beam's axis, away from the light)");
+  }
+  const Json& cone = r.Require("cone_angle_degrees");
+  if (cone.is_number() && cone.get<double>() >= 90.0)
+  {
+    Fail(r.Key("cone_angle_degrees"),
+      "expected a number in (0, 90), got " + FormatNumber(cone.get<double>()) +
+        " (a cone of 90 degrees or more lights every direction: use a \"point\" light)");
+  }
+  l.ConeAngleDegrees = ReadNumber(cone, r.Key("cone_angle_degrees"), Open(0.0, 90.0));
+  r.Number("edge_degrees", l.EdgeDegrees, Closed(0.0, 90.0));
+  if (!(l.EdgeDegrees <= l.ConeAngleDegrees))
+  {
+    Fail(r.Key("edge_degrees"),
+      "expected a number in [0, cone_angle_degrees] = [0, " + FormatNumber(l.ConeAngleDegrees) +
+        "] (the soft edge lies inside the cone), got " + FormatNumber(l.EdgeDegrees));
+  }
+  r.RequiredNumber("intensity", l.Intensity, Closed(0.0, kMaxLightIntensity));
+  r.Number("temperature_kelvin", l.TemperatureKelvin,
+    Closed(kMinLightTemperatureKelvin, kMaxLightTemperatureKelvin));
+  if (r.Has("light_map"))
+  {
+    l.LightMap.Path =
+      ReadFilePath(r["light_map"], r.Key("light_map"), base, kLightMapExtensions, "an image");
+  }
+}
+
+LightDescription ReadLight(
+  const Json& v, const std::string& path, const std::string& base, int version)
 {
   if (!v.is_object())
   {
     Fail(path, "expected an object, got " + Describe(v));
   }
   LightDescription l;
+  const std::vector<std::string>& types = version >= 4 ? kLightTypes : kLightTypes3;
   if (!v.contains("type"))
   {
-    Fail(path, "missing required key \"type\" (known: " + Join(kLightTypes) + ")");
+    Fail(path, "missing required key \"type\" (known: " + Join(types) + ")");
   }
-  l.Type = ReadEnum(v.at("type"), path + ".type", kLightTypes);
+  if (version < 4 && v.at("type") == "spot")
+  {
+    Fail(path + ".type",
+      "unknown value \"spot\" (known: " + Join(types) +
+        "); \"spot\" needs format version 4 (\"nimbus_scene\": 4), this file is version " +
+        std::to_string(version));
+  }
+  l.Type = ReadEnum(v.at("type"), path + ".type", types);
   const Range temperature = Closed(kMinLightTemperatureKelvin, kMaxLightTemperatureKelvin);
   const Range intensity = Closed(0.0, kMaxLightIntensity);
   if (l.Type == "point")
@@ -916,6 +1003,11 @@ LightDescription ReadLight(const Json& v, const std::string& path)
     l.Position = ReadVector3(r.Require("position"), r.Key("position"), Coordinate());
     r.RequiredNumber("intensity", l.Intensity, intensity);
     r.Number("temperature_kelvin", l.TemperatureKelvin, temperature);
+    return l;
+  }
+  if (l.Type == "spot")
+  {
+    ReadSpot(v, path, base, l);
     return l;
   }
   const ObjectReader r(
@@ -941,6 +1033,50 @@ LightDescription ReadLight(const Json& v, const std::string& path)
   r.RequiredNumber("intensity_per_metre", l.IntensityPerMetre, intensity);
   r.Number("temperature_kelvin", l.TemperatureKelvin, temperature);
   return l;
+}
+
+const std::vector<std::string> kOccluderTypes = { "box", "mesh" };
+
+/// Version 4: one occluder (an opaque Lambertian box or mesh).
+OccluderDescription ReadOccluder(const Json& v, const std::string& path, const std::string& base)
+{
+  if (!v.is_object())
+  {
+    Fail(path, "expected an object, got " + Describe(v));
+  }
+  OccluderDescription o;
+  if (!v.contains("type"))
+  {
+    Fail(path, "missing required key \"type\" (known: " + Join(kOccluderTypes) + ")");
+  }
+  o.Type = ReadEnum(v.at("type"), path + ".type", kOccluderTypes);
+  if (o.Type == "box")
+  {
+    const ObjectReader r(v, path, { "type", "min", "max", "albedo" });
+    o.Min = ReadVector3(r.Require("min"), r.Key("min"), Coordinate());
+    o.Max = ReadVector3(r.Require("max"), r.Key("max"), Coordinate());
+    static const char* axes[] = { "x", "y", "z" };
+    for (int a = 0; a < 3; ++a)
+    {
+      if (!(o.Min[a] <= o.Max[a]))
+      {
+        Fail(r.Key("max"),
+          std::string("expected max >= min on every axis, axis ") + axes[a] + " has min " +
+            FormatNumber(o.Min[a]) + " and max " + FormatNumber(o.Max[a]));
+      }
+    }
+    r.Number("albedo", o.Albedo, Closed(0.0, 1.0));
+    return o;
+  }
+  const ObjectReader r(v, path, { "type", "path", "albedo", "translate", "scale" });
+  o.Path = ReadFilePath(r.Require("path"), r.Key("path"), base, kMeshExtensions, "a mesh");
+  r.Number("albedo", o.Albedo, Closed(0.0, 1.0));
+  if (r.Has("translate"))
+  {
+    o.Translate = ReadVector3(r["translate"], r.Key("translate"), Coordinate());
+  }
+  r.Number("scale", o.Scale, Range{ 0.0, kMaxLengthMetres, true, false });
+  return o;
 }
 
 SunParameters ReadSun(const Json& v, const std::string& path)
@@ -1309,6 +1445,14 @@ Json ToJson(const SceneDescription& s)
       light["position"] = Vector3Json(l.Position);
       light["intensity"] = l.Intensity;
     }
+    else if (l.Type == "spot")
+    {
+      light["position"] = Vector3Json(l.Position);
+      light["direction"] = Vector3Json(l.Direction);
+      light["cone_angle_degrees"] = l.ConeAngleDegrees;
+      light["edge_degrees"] = l.EdgeDegrees;
+      light["intensity"] = l.Intensity;
+    }
     else
     {
       light["vertices"] = Json::array();
@@ -1319,6 +1463,10 @@ Json ToJson(const SceneDescription& s)
       light["intensity_per_metre"] = l.IntensityPerMetre;
     }
     light["temperature_kelvin"] = l.TemperatureKelvin;
+    if (l.Type == "spot" && !l.LightMap.Path.empty())
+    {
+      light["light_map"] = l.LightMap.Path;
+    }
     j["lights"].push_back(light);
   }
   if (!s.Media.empty())
@@ -1337,6 +1485,30 @@ Json ToJson(const SceneDescription& s)
       medium["emission"] = EmissionJson(extra.Emission);
     }
     j["media"].push_back(medium);
+  }
+  // Version 4's occluders, only when there are some.
+  if (!s.Occluders.empty())
+  {
+    j["occluders"] = Json::array();
+  }
+  for (const OccluderDescription& o : s.Occluders)
+  {
+    Json occluder;
+    occluder["type"] = o.Type;
+    if (o.Type == "mesh")
+    {
+      occluder["path"] = o.Path;
+      occluder["albedo"] = o.Albedo;
+      occluder["translate"] = Vector3Json(o.Translate);
+      occluder["scale"] = o.Scale;
+    }
+    else
+    {
+      occluder["min"] = Vector3Json(o.Min);
+      occluder["max"] = Vector3Json(o.Max);
+      occluder["albedo"] = o.Albedo;
+    }
+    j["occluders"].push_back(occluder);
   }
   return j;
 }
@@ -1401,6 +1573,11 @@ SceneDescription ReadScene(
     known.push_back("lights");
     known.push_back("media");
   }
+  RefuseNewerKey(root, path, "occluders", version, 4, known);
+  if (version >= 4)
+  {
+    known.push_back("occluders");
+  }
   const ObjectReader r(root, path, known);
   SceneDescription s;
   if (r.Has("name"))
@@ -1432,8 +1609,8 @@ SceneDescription ReadScene(
     RequireArray(r["lights"], r.Key("lights"), kMaxLights, "lights");
     for (std::size_t i = 0; i < r["lights"].size(); ++i)
     {
-      s.Lights.push_back(
-        ReadLight(r["lights"][i], r.Key("lights") + "[" + std::to_string(i) + "]"));
+      s.Lights.push_back(ReadLight(
+        r["lights"][i], r.Key("lights") + "[" + std::to_string(i) + "]", baseDirectory, version));
     }
   }
   if (r.Has("media"))
@@ -1444,6 +1621,15 @@ SceneDescription ReadScene(
       const std::string mediumPath = r.Key("media") + "[" + std::to_string(i) + "]";
       s.Media.push_back(ReadAdditionalMedium(r["media"][i], mediumPath, baseDirectory));
       RequireSameMetaballGrid(s.Medium.Density, s.Media.back().Density, mediumPath);
+    }
+  }
+  if (r.Has("occluders"))
+  {
+    RequireArray(r["occluders"], r.Key("occluders"), kMaxOccluders, "occluders");
+    for (std::size_t i = 0; i < r["occluders"].size(); ++i)
+    {
+      s.Occluders.push_back(ReadOccluder(
+        r["occluders"][i], r.Key("occluders") + "[" + std::to_string(i) + "]", baseDirectory));
     }
   }
 
@@ -1493,7 +1679,8 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
         Describe(version));
   }
   const std::string number = version.dump();
-  if (number != "1" && number != "2" && number != std::to_string(SceneDescription::kFormatVersion))
+  if (number != "1" && number != "2" && number != "3" &&
+    number != std::to_string(SceneDescription::kFormatVersion))
   {
     Fail(path + ".nimbus_scene",
       "unsupported format version " + number + "; this build of Nimbus reads " + versions);
@@ -1510,7 +1697,7 @@ SceneDescription ParseScene(const std::string& jsonText, const std::string& base
       throw std::invalid_argument(InSceneVersion1Words(error.what()));
     }
   }
-  return ReadScene(root, path, baseDirectory, number == "2" ? 2 : 3);
+  return ReadScene(root, path, baseDirectory, std::stoi(number));
 }
 
 SceneDescription LoadScene(const std::string& path)

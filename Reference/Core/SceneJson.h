@@ -1,13 +1,18 @@
 // The versioned JSON scene file (format: docs/scene-format.md).
 //
-//   {"nimbus_scene": 3, "camera": {...}, "medium": {...}, "sun": {...}, ...}
+//   {"nimbus_scene": 4, "camera": {...}, "medium": {...}, "sun": {...}, ...}
 //
-// Version 3 adds lights (point, polyline), per-voxel emission and additional media;
-// version 2 names the sun's and the air's parameters as Physics/Sun.h and
+// Version 4 adds spot lights (with an optional light map) and opaque occluders (boxes,
+// meshes); version 3 adds lights (point, polyline), per-voxel emission and additional
+// media; version 2 names the sun's and the air's parameters as Physics/Sun.h and
 // Physics/Atmosphere.h do, with their units ("elevation_degrees",
 // "mie_scattering_per_metre"). Version-1 files still load: their keys are renamed
-// on reading (the table in docs/scene-format.md); version-2 files are version-3
-// files without the new keys. SceneToJson writes version 3.
+// on reading (the table in docs/scene-format.md); version-2 and version-3 files are
+// version-4 files without the newer keys. SceneToJson writes version 4.
+//
+// The reader stores the paths of light maps and meshes (resolved like a density's); it
+// does not read those files: Reference/SceneAssets.h (VTK glue) fills the description's
+// pixels and triangles, as vtkNimbusReferenceRenderer does before it renders.
 //
 // ParseScene/LoadScene validate everything they read and throw
 // std::invalid_argument with a message that starts with the key path of the
@@ -27,7 +32,7 @@
 namespace nimbus
 {
 
-/// Parses and validates a scene. A relative medium.density.path is resolved
+/// Parses and validates a scene. A relative path (densities, light maps, meshes) is resolved
 /// against baseDirectory (the current directory when empty) and stored
 /// absolute and lexically normalised. Metaball-cloud parameters are stored in
 /// the source's property order (vtkNimbusMetaballCloudSource.h), whatever

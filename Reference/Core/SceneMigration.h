@@ -5,8 +5,9 @@
 // names them as Physics/Sun.h and Physics/Atmosphere.h do (and as the mapper, the
 // sky, the Python API and the plugin do). A version-1 file is read by renaming
 // those keys; nothing else changed. Version 3 only added keys (lights, media,
-// medium.emission): a version-2 file needs no migration, and SceneJson.cxx refuses the
-// new keys in older files. Private to SceneJson.cxx.
+// medium.emission), and so did version 4 (spot lights, occluders): version-2 and
+// version-3 files need no migration, and SceneJson.cxx refuses the new keys (and the
+// light type "spot") in older files. Private to SceneJson.cxx.
 #ifndef NimbusSceneMigration_h
 #define NimbusSceneMigration_h
 

@@ -124,8 +124,11 @@ void CheckStepScale(double stepScale)
   }
 }
 
-/// The version-3 features (docs/scene-format.md) this renderer does not render: an
-/// error naming them, rather than an image without them.
+/// The version-3 and version-4 features (docs/scene-format.md) this renderer does not
+/// render: an error naming them, rather than an image without them. Lights of every kind
+/// (point, polyline, spot) and occluders are the path tracer's: every scene with
+/// occluders that the project compares renderers on is lit by lights, which this
+/// renderer does not render anyway.
 void RefuseVersion3Features(const SceneDescription& scene)
 {
   std::string missing;
@@ -133,7 +136,10 @@ void RefuseVersion3Features(const SceneDescription& scene)
   { missing += (missing.empty() ? "" : ", ") + what; };
   if (!scene.Lights.empty())
   {
-    add("point and polyline lights (scene.lights)");
+    const bool spots = std::any_of(scene.Lights.begin(), scene.Lights.end(),
+      [](const LightDescription& light) { return light.Type == "spot"; });
+    add(spots ? "point, polyline and spot lights (scene.lights)"
+              : "point and polyline lights (scene.lights)");
   }
   bool emission = scene.Medium.Emission.Enabled;
   for (const auto& m : scene.Media)
@@ -147,6 +153,10 @@ void RefuseVersion3Features(const SceneDescription& scene)
   if (!scene.Media.empty())
   {
     add("additional media (scene.media)");
+  }
+  if (!scene.Occluders.empty())
+  {
+    add("occluders (scene.occluders)");
   }
   if (!missing.empty())
   {

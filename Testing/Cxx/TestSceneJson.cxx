@@ -100,6 +100,15 @@ void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
       EXPECT_EQ(a.Lights[i].Position, b.Lights[i].Position);
       EXPECT_EQ(a.Lights[i].Intensity, b.Lights[i].Intensity);
     }
+    else if (a.Lights[i].Type == "spot")
+    {
+      EXPECT_EQ(a.Lights[i].Position, b.Lights[i].Position);
+      EXPECT_EQ(a.Lights[i].Intensity, b.Lights[i].Intensity);
+      EXPECT_EQ(a.Lights[i].Direction, b.Lights[i].Direction);
+      EXPECT_EQ(a.Lights[i].ConeAngleDegrees, b.Lights[i].ConeAngleDegrees);
+      EXPECT_EQ(a.Lights[i].EdgeDegrees, b.Lights[i].EdgeDegrees);
+      EXPECT_EQ(a.Lights[i].LightMap.Path, b.Lights[i].LightMap.Path);
+    }
     else
     {
       EXPECT_EQ(a.Lights[i].Vertices, b.Lights[i].Vertices);
@@ -123,6 +132,25 @@ void ExpectSameScene(const SceneDescription& a, const SceneDescription& b)
       EXPECT_EQ(a.Media[i].Phase[k].Weight, b.Media[i].Phase[k].Weight);
     }
     sameEmission(a.Media[i].Emission, b.Media[i].Emission);
+  }
+  // Version 4.
+  ASSERT_EQ(a.Occluders.size(), b.Occluders.size());
+  for (std::size_t i = 0; i < a.Occluders.size(); ++i)
+  {
+    const nimbus::OccluderDescription &x = a.Occluders[i], &y = b.Occluders[i];
+    EXPECT_EQ(x.Type, y.Type);
+    EXPECT_EQ(x.Albedo, y.Albedo);
+    if (x.Type == "box")
+    {
+      EXPECT_EQ(x.Min, y.Min);
+      EXPECT_EQ(x.Max, y.Max);
+    }
+    else
+    {
+      EXPECT_EQ(x.Path, y.Path);
+      EXPECT_EQ(x.Translate, y.Translate);
+      EXPECT_EQ(x.Scale, y.Scale);
+    }
   }
 }
 
@@ -213,6 +241,42 @@ SceneDescription Version3Scene()
   haze.SingleScatteringAlbedo = 1.0;
   haze.Phase = { { "isotropic", 0.85, 1.0 } };
   s.Media = { smoke, haze };
+  return s;
+}
+
+/// Version3Scene with every version-4 feature: a soft-edged spot with a light map, a hard
+/// one without, a box occluder and a placed mesh.
+SceneDescription Version4Scene()
+{
+  SceneDescription s = Version3Scene();
+  s.Name = "version4";
+  nimbus::LightDescription spot;
+  spot.Type = "spot";
+  spot.Position = { { 5.0, -3.0, 8.5 } };
+  spot.Direction = { { 0.0, 0.5, -2.0 } };
+  spot.ConeAngleDegrees = 25.0;
+  spot.EdgeDegrees = 4.5;
+  spot.Intensity = 3.0e4;
+  spot.TemperatureKelvin = 3200.0;
+  spot.LightMap.Path = "/data/gobos/leaves.png";
+  nimbus::LightDescription hard = spot;
+  hard.Direction = { { 1.0, 0.0, 0.0 } };
+  hard.EdgeDegrees = 0.0;
+  hard.LightMap.Path.clear();
+  s.Lights.push_back(spot);
+  s.Lights.push_back(hard);
+  nimbus::OccluderDescription box;
+  box.Type = "box";
+  box.Min = { { -1.0, -2.0, 0.0 } };
+  box.Max = { { 1.0, 2.0, 0.0 } }; // flat
+  box.Albedo = 0.3;
+  nimbus::OccluderDescription mesh;
+  mesh.Type = "mesh";
+  mesh.Path = "/data/meshes/post.ply";
+  mesh.Translate = { { 2.0, 0.0, -0.5 } };
+  mesh.Scale = 0.01;
+  mesh.Albedo = 0.0;
+  s.Occluders = { box, mesh };
   return s;
 }
 
@@ -362,7 +426,7 @@ TEST(SceneJson, ProjectScenesPhysics)
 TEST(SceneJson, RoundTrip)
 {
   for (const SceneDescription& s :
-    { SceneDescription{}, NonDefaultScene(), MetaballScene(), Version3Scene() })
+    { SceneDescription{}, NonDefaultScene(), MetaballScene(), Version3Scene(), Version4Scene() })
   {
     SCOPED_TRACE(s.Name);
     const std::string text = nimbus::SceneToJson(s);
@@ -386,11 +450,12 @@ TEST(SceneJson, CanonicalForm)
 {
   const std::string text = nimbus::SceneToJson(MetaballScene());
   // Fixed key order, integers and booleans where the property is one.
-  EXPECT_LT(text.find("\"nimbus_scene\": 3"), text.find("\"camera\""));
-  // Version 3's keys are written only when used.
+  EXPECT_LT(text.find("\"nimbus_scene\": 4"), text.find("\"camera\""));
+  // Version 3's and version 4's keys are written only when used.
   EXPECT_EQ(text.find("\"lights\""), std::string::npos);
   EXPECT_EQ(text.find("\"media\""), std::string::npos);
   EXPECT_EQ(text.find("\"emission\""), std::string::npos);
+  EXPECT_EQ(text.find("\"occluders\""), std::string::npos);
   EXPECT_NE(text.find("\"Seed\": -7"), std::string::npos);
   EXPECT_NE(text.find("\"FlatBase\": false"), std::string::npos);
   EXPECT_NE(text.find("\"width\": 256"), std::string::npos);
@@ -415,8 +480,9 @@ TEST(SceneJson, HashStable)
   EXPECT_EQ(nimbus::SceneHash(s), hash);
   // Pinned: the canonical form (and so every cached reference image's key) changes only
   // on purpose. Update this when a field is added or the format changes deliberately.
-  // Version 3 changed it from 5e1d742df6799b74 (version 2) by the version number alone.
-  EXPECT_EQ(hash, "da42e138a75ee723"); // format version 3
+  // Version 3 changed it from 5e1d742df6799b74 (version 2) by the version number alone,
+  // and version 4 from da42e138a75ee723 (version 3) the same way.
+  EXPECT_EQ(hash, "679165bfed029662"); // format version 4
   EXPECT_EQ(nimbus::SceneHash(nimbus::ParseScene(nimbus::SceneToJson(s), "")), hash);
   // Formatting and key order of the text do not matter, only the description.
   Json a = MinimalJson(), b = Json::parse(R"({
@@ -521,8 +587,8 @@ TEST(SceneJson, Errors)
   ExpectErrorText("{\"nimbus_scene\": 2,", "scene");
   ExpectErrorText("[1, 2]", "scene: expected an object");
   ExpectError(Without("/nimbus_scene"), "scene: missing required key \"nimbus_scene\"");
-  ExpectError(With("/nimbus_scene", 4),
-    "scene.nimbus_scene: unsupported format version 4; this build of Nimbus reads versions 1 to 3");
+  ExpectError(With("/nimbus_scene", 5),
+    "scene.nimbus_scene: unsupported format version 5; this build of Nimbus reads versions 1 to 4");
   ExpectError(With("/nimbus_scene", 0), "scene.nimbus_scene: unsupported format version 0");
   ExpectError(With("/nimbus_scene", "2"), "scene.nimbus_scene: expected the format version");
   ExpectError(With("/nimbus_scene", 1.5), "scene.nimbus_scene: expected the format version");
@@ -883,8 +949,8 @@ TEST(SceneJson, Version1FilesLoadAsTheSameScene)
     ASSERT_TRUE(written[key[0]].contains(key[2])) << key[2];
   }
   ExpectSameScene(Parse(AsVersion1(written)), Parse(written));
-  // Written back, a version-1 scene is version 3.
-  EXPECT_NE(nimbus::SceneToJson(old).find("\"nimbus_scene\": 3"), std::string::npos);
+  // Written back, a version-1 scene is version 4.
+  EXPECT_NE(nimbus::SceneToJson(old).find("\"nimbus_scene\": 4"), std::string::npos);
 }
 
 TEST(SceneJson, Version1ErrorsNameTheVersion1Keys)
@@ -1347,4 +1413,359 @@ TEST(SceneJson, DocumentedExampleParses)
   std::printf("documented channel: %.0f m, %.3g Y/sr in all\n", length,
     length * s.Lights[1].IntensityPerMetre);
   EXPECT_NEAR(length, 2600.0, 200.0); // "about 2.6 km long"
+}
+
+//------------------------------------------------------------------------------
+// Version 4: spot lights (with light maps) and occluders (boxes, meshes).
+
+namespace
+{
+/// MinimalJson as version 4 with every new key: a spot with a light map, a box and a mesh.
+Json Version4Json()
+{
+  Json j = MinimalJson();
+  j["nimbus_scene"] = 4;
+  j["lights"] = Json::parse(R"([
+    {"type": "spot", "position": [0, 0, 10], "direction": [0, 0, -2],
+     "cone_angle_degrees": 30, "edge_degrees": 5, "intensity": 1e4,
+     "light_map": "gobos/leaves.png"},
+    {"type": "point", "position": [0, 0, 1000], "intensity": 1e6}
+  ])");
+  j["occluders"] = Json::parse(R"([
+    {"type": "box", "min": [-1, -1, 0], "max": [1, 1, 4], "albedo": 0.4},
+    {"type": "mesh", "path": "meshes/post.obj", "translate": [3, 0, 0], "scale": 0.5}
+  ])");
+  return j;
+}
+
+Json V4With(const std::string& pointer, const Json& value)
+{
+  return Set(Version4Json(), pointer, value);
+}
+
+Json V4Without(const std::string& pointer)
+{
+  return Remove(Version4Json(), pointer);
+}
+
+/// One bad version-4 scene and the start of the message it must give.
+struct BadScene
+{
+  std::string What;
+  Json Text;
+  std::string Prefix;
+};
+
+/// The classes of bad values of the version-4 keys: every number, vector and path key
+/// with each wrong kind of value, then the rules between keys (ranges, cones, corners,
+/// extensions, required and unknown keys).
+std::vector<BadScene> BadVersion4Scenes()
+{
+  std::vector<BadScene> bad;
+  const std::string spot = "/lights/0", box = "/occluders/0", mesh = "/occluders/1";
+  auto key = [](const std::string& pointer)
+  {
+    // "/lights/0/cone_angle_degrees" -> "scene.lights[0].cone_angle_degrees"
+    std::string path = "scene";
+    std::size_t at = 1;
+    while (at <= pointer.size())
+    {
+      const std::size_t next = std::min(pointer.find('/', at), pointer.size());
+      const std::string token = pointer.substr(at, next - at);
+      path += std::isdigit(static_cast<unsigned char>(token[0])) ? "[" + token + "]" : "." + token;
+      at = next + 1;
+    }
+    return path;
+  };
+  // Numbers: every other JSON type is refused, naming the key.
+  for (const std::string& pointer :
+    { spot + "/cone_angle_degrees", spot + "/edge_degrees", spot + "/intensity",
+      spot + "/temperature_kelvin", box + "/albedo", mesh + "/albedo", mesh + "/scale" })
+  {
+    for (const Json& value :
+      { Json("1"), Json(true), Json(nullptr), Json::array({ 1 }), Json::object() })
+    {
+      bad.push_back({ pointer + " = " + value.dump(), V4With(pointer, value),
+        key(pointer) + ": expected a number" });
+    }
+  }
+  // Vectors of three coordinates: wrong types, lengths, elements.
+  for (const std::string& pointer :
+    { spot + "/position", spot + "/direction", box + "/min", box + "/max", mesh + "/translate" })
+  {
+    bad.push_back(
+      { pointer + " = 5", V4With(pointer, 5), key(pointer) + ": expected an array of 3 numbers" });
+    bad.push_back({ pointer + " has 2", V4With(pointer, Json::array({ 1, 2 })),
+      key(pointer) + ": expected an array of 3 numbers, got 2 elements" });
+    bad.push_back({ pointer + " has 4", V4With(pointer, Json::array({ 1, 2, 3, 4 })),
+      key(pointer) + ": expected an array of 3 numbers, got 4 elements" });
+    bad.push_back({ pointer + "[1] a string", V4With(pointer, Json::parse(R"([1, "a", 3])")),
+      key(pointer) + "[1]: expected a" });
+    if (pointer != spot + "/direction")
+    {
+      bad.push_back({ pointer + "[2] beyond 1e9 m", V4With(pointer, Json::array({ 0, 0, 2e9 })),
+        key(pointer) + "[2]: expected a number in [-1000000000, 1000000000], got 2000000000" });
+    }
+  }
+  // Paths: types, emptiness, extensions.
+  for (const auto& item : { std::make_pair(spot + "/light_map", std::string("an image file")),
+         std::make_pair(mesh + "/path", std::string("a mesh file")) })
+  {
+    const std::string& pointer = item.first;
+    bad.push_back({ pointer + " = 1", V4With(pointer, 1), key(pointer) + ": expected a string" });
+    bad.push_back(
+      { pointer + " empty", V4With(pointer, ""), key(pointer) + ": expected a non-empty string" });
+    for (const char* name : { "file.txt", "file", "file.png.bak", "file.stl", "file.jpg" })
+    {
+      bad.push_back({ pointer + " = " + name, V4With(pointer, name),
+        key(pointer) + ": expected " + item.second + " (" });
+    }
+  }
+  // Rules between keys and ranges.
+  const std::vector<BadScene> rules = {
+    { "cone 0", V4With(spot + "/cone_angle_degrees", 0),
+      "scene.lights[0].cone_angle_degrees: expected a number in (0, 90), got 0" },
+    { "cone -5", V4With(spot + "/cone_angle_degrees", -5),
+      "scene.lights[0].cone_angle_degrees: expected a number in (0, 90), got -5" },
+    { "cone 90", V4With(spot + "/cone_angle_degrees", 90),
+      "scene.lights[0].cone_angle_degrees: expected a number in (0, 90), got 90 (a cone of 90 "
+      "degrees or more lights every direction: use a \"point\" light)" },
+    { "cone 120", V4With(spot + "/cone_angle_degrees", 120),
+      "scene.lights[0].cone_angle_degrees: expected a number in (0, 90), got 120 (a cone" },
+    { "edge wider than the cone", V4With(spot + "/edge_degrees", 31),
+      "scene.lights[0].edge_degrees: expected a number in [0, cone_angle_degrees] = [0, 30] (the "
+      "soft edge lies inside the cone), got 31" },
+    { "edge -1", V4With(spot + "/edge_degrees", -1),
+      "scene.lights[0].edge_degrees: expected a number in [0, 90], got -1" },
+    { "zero direction", V4With(spot + "/direction", Json::array({ 0, 0, 0 })),
+      "scene.lights[0].direction: must be a non-zero vector (the beam's axis, away from the "
+      "light)" },
+    { "tiny but non-zero direction is fine",
+      V4With(spot + "/direction", Json::array({ 0, 0, 1e-300 })), "" },
+    { "intensity -1", V4With(spot + "/intensity", -1),
+      "scene.lights[0].intensity: expected a number in [0, 1000000000000], got -1" },
+    { "intensity 1e13", V4With(spot + "/intensity", 1e13),
+      "scene.lights[0].intensity: expected a number in [0, 1000000000000]" },
+    { "temperature 100", V4With(spot + "/temperature_kelvin", 100),
+      "scene.lights[0].temperature_kelvin: expected a number in [500, 100000], got 100" },
+    { "overflowing cone", Json(), "scene.lights[0].cone_angle_degrees: invalid JSON" },
+    { "no position", V4Without(spot + "/position"),
+      "scene.lights[0]: missing required key \"position\"" },
+    { "no direction", V4Without(spot + "/direction"),
+      "scene.lights[0]: missing required key \"direction\"" },
+    { "no cone", V4Without(spot + "/cone_angle_degrees"),
+      "scene.lights[0]: missing required key \"cone_angle_degrees\"" },
+    { "no intensity", V4Without(spot + "/intensity"),
+      "scene.lights[0]: missing required key \"intensity\"" },
+    { "a spot with vertices", V4With(spot + "/vertices", Json::array()),
+      "scene.lights[0].vertices: unknown key (known: type, position, direction, "
+      "cone_angle_degrees, edge_degrees, intensity, temperature_kelvin, light_map)" },
+    { "a point light with a light map", V4With("/lights/1/light_map", "a.png"),
+      "scene.lights[1].light_map: unknown key (known: type, position, intensity, "
+      "temperature_kelvin)" },
+    { "unknown light type", V4With(spot + "/type", "cone"),
+      "scene.lights[0].type: unknown value \"cone\" (known: point, polyline, spot)" },
+    { "no light type", V4Without(spot + "/type"),
+      "scene.lights[0]: missing required key \"type\" (known: point, polyline, spot)" },
+    { "occluders not an array", V4With("/occluders", Json::object()),
+      "scene.occluders: expected an array of occluders, got the object {}" },
+    { "an occluder not an object", V4With(box, 3),
+      "scene.occluders[0]: expected an object, got 3" },
+    { "no occluder type", V4Without(box + "/type"),
+      "scene.occluders[0]: missing required key \"type\" (known: box, mesh)" },
+    { "unknown occluder type", V4With(box + "/type", "sphere"),
+      "scene.occluders[0].type: unknown value \"sphere\" (known: box, mesh)" },
+    { "min > max on x", V4With(box + "/max/0", -2),
+      "scene.occluders[0].max: expected max >= min on every axis, axis x has min -1 and max -2" },
+    { "min > max on y", V4With(box + "/min/1", 1.5),
+      "scene.occluders[0].max: expected max >= min on every axis, axis y has min 1.5 and max 1" },
+    { "min > max on z", V4With(box + "/min/2", 5),
+      "scene.occluders[0].max: expected max >= min on every axis, axis z has min 5 and max 4" },
+    { "no min", V4Without(box + "/min"), "scene.occluders[0]: missing required key \"min\"" },
+    { "no max", V4Without(box + "/max"), "scene.occluders[0]: missing required key \"max\"" },
+    { "a box with a path", V4With(box + "/path", "post.ply"),
+      "scene.occluders[0].path: unknown key (known: type, min, max, albedo)" },
+    { "albedo 1.5", V4With(box + "/albedo", 1.5),
+      "scene.occluders[0].albedo: expected a number in [0, 1], got 1.5" },
+    { "albedo -0.1", V4With(mesh + "/albedo", -0.1),
+      "scene.occluders[1].albedo: expected a number in [0, 1], got -0.1" },
+    { "no mesh path", V4Without(mesh + "/path"),
+      "scene.occluders[1]: missing required key \"path\"" },
+    { "a mesh with min", V4With(mesh + "/min", Json::array({ 0, 0, 0 })),
+      "scene.occluders[1].min: unknown key (known: type, path, albedo, translate, scale)" },
+    { "scale 0", V4With(mesh + "/scale", 0),
+      "scene.occluders[1].scale: expected a number in (0, 1000000000], got 0" },
+    { "scale -1", V4With(mesh + "/scale", -1),
+      "scene.occluders[1].scale: expected a number in (0, 1000000000], got -1" },
+    { "scale 2e9", V4With(mesh + "/scale", 2e9),
+      "scene.occluders[1].scale: expected a number in (0, 1000000000], got 2000000000" },
+  };
+  bad.insert(bad.end(), rules.begin(), rules.end());
+  {
+    Json many = Version4Json();
+    many["occluders"] = Json::array();
+    for (int i = 0; i < 4097; ++i)
+    {
+      many["occluders"].push_back(Version4Json()["occluders"][0]);
+    }
+    bad.push_back(
+      { "4097 occluders", many, "scene.occluders: expected at most 4096 occluders, got 4097" });
+  }
+  return bad;
+}
+} // namespace
+
+TEST(SceneJson, Version4KeysParse)
+{
+  const SceneDescription s = Parse(Version4Json(), "/scenes");
+  EXPECT_TRUE(s.UsesVersion4Features());
+  EXPECT_TRUE(s.UsesVersion3Features()); // it has lights
+  ASSERT_EQ(s.Lights.size(), 2u);
+  const nimbus::LightDescription& spot = s.Lights[0];
+  EXPECT_EQ(spot.Type, "spot");
+  EXPECT_EQ(spot.Position, (std::array<double, 3>{ { 0.0, 0.0, 10.0 } }));
+  EXPECT_EQ(spot.Direction, (std::array<double, 3>{ { 0.0, 0.0, -2.0 } })); // as given
+  EXPECT_EQ(spot.ConeAngleDegrees, 30.0);
+  EXPECT_EQ(spot.EdgeDegrees, 5.0);
+  EXPECT_EQ(spot.Intensity, 1e4);
+  EXPECT_EQ(spot.TemperatureKelvin, 6500.0);                 // default
+  EXPECT_EQ(spot.LightMap.Path, "/scenes/gobos/leaves.png"); // resolved like a density's
+  EXPECT_TRUE(spot.LightMap.Luminance.empty());              // the reader does not read the image
+  ASSERT_EQ(s.Occluders.size(), 2u);
+  EXPECT_EQ(s.Occluders[0].Type, "box");
+  EXPECT_EQ(s.Occluders[0].Min, (std::array<double, 3>{ { -1.0, -1.0, 0.0 } }));
+  EXPECT_EQ(s.Occluders[0].Max, (std::array<double, 3>{ { 1.0, 1.0, 4.0 } }));
+  EXPECT_EQ(s.Occluders[0].Albedo, 0.4);
+  EXPECT_EQ(s.Occluders[1].Type, "mesh");
+  EXPECT_EQ(s.Occluders[1].Path, "/scenes/meshes/post.obj");
+  EXPECT_EQ(s.Occluders[1].Translate, (std::array<double, 3>{ { 3.0, 0.0, 0.0 } }));
+  EXPECT_EQ(s.Occluders[1].Scale, 0.5);
+  EXPECT_EQ(s.Occluders[1].Albedo, 0.0); // default: black
+  EXPECT_TRUE(s.Occluders[1].TriangleVertices.empty());
+  // Defaults: a spot's edge 0 (a hard edge), no light map; a flat box; a mesh in place.
+  Json j = Version4Json();
+  j["lights"][0].erase("edge_degrees");
+  j["lights"][0].erase("light_map");
+  j["occluders"][0]["max"] = Json::array({ 1, 1, 0 });
+  j["occluders"][1].erase("translate");
+  j["occluders"][1].erase("scale");
+  j["occluders"][1]["path"] = "/abs/Post.PLY"; // any case of the extension
+  const SceneDescription d = Parse(j);
+  EXPECT_EQ(d.Lights[0].EdgeDegrees, 0.0);
+  EXPECT_TRUE(d.Lights[0].LightMap.Path.empty());
+  EXPECT_EQ(d.Occluders[0].Max[2], 0.0);
+  EXPECT_EQ(d.Occluders[1].Translate, (std::array<double, 3>{ { 0.0, 0.0, 0.0 } }));
+  EXPECT_EQ(d.Occluders[1].Scale, 1.0);
+  EXPECT_EQ(d.Occluders[1].Path, "/abs/Post.PLY");
+  // Canonical round trip; a spot without a light map writes none.
+  for (const SceneDescription& scene : { s, d })
+  {
+    const std::string text = nimbus::SceneToJson(scene);
+    EXPECT_NE(text.find("\"occluders\""), std::string::npos);
+    EXPECT_EQ(
+      text.find("\"light_map\"") == std::string::npos, scene.Lights[0].LightMap.Path.empty());
+    const SceneDescription back = nimbus::ParseScene(text, "/elsewhere");
+    ExpectSameScene(back, scene);
+    EXPECT_EQ(nimbus::SceneToJson(back), text);
+  }
+  // Empty occluders mean none, and no spot: no version-4 feature.
+  j = Version4Json();
+  j["occluders"] = Json::array();
+  j["lights"].erase(0);
+  EXPECT_FALSE(Parse(j).UsesVersion4Features());
+}
+
+TEST(SceneJson, Version4KeysNeedVersion4)
+{
+  // A version-3 file with occluders or a spot: an unknown key or value, saying which
+  // version it needs.
+  Json j = Version3Json();
+  j["occluders"] = Json::array();
+  ExpectError(j,
+    "scene.occluders: unknown key (known: nimbus_scene, name, description, camera, medium, sun, "
+    "atmosphere, ground, background, spectral_samples, lights, media); \"occluders\" needs "
+    "format version 4 (\"nimbus_scene\": 4), this file is version 3");
+  j = Version3Json();
+  j["lights"][0]["type"] = "spot";
+  ExpectError(j,
+    "scene.lights[0].type: unknown value \"spot\" (known: point, polyline); \"spot\" needs "
+    "format version 4 (\"nimbus_scene\": 4), this file is version 3");
+  // In a version-2 file lights themselves are unknown (the version-3 message).
+  Json v2 = MinimalJson();
+  v2["occluders"] = Json::array();
+  ExpectError(v2,
+    "scene.occluders: unknown key (known: nimbus_scene, name, description, camera, "
+    "medium, sun, atmosphere, ground, background, spectral_samples); \"occluders\" "
+    "needs format version 4 (\"nimbus_scene\": 4), this file is version 2");
+  // A version-3 file reads exactly as before: the same text marked version 4 gives the same
+  // description and hash (and so does a version-2 one).
+  Json v3 = Version3Json(), v4 = Version3Json();
+  v4["nimbus_scene"] = 4;
+  ExpectSameScene(Parse(v3), Parse(v4));
+  EXPECT_EQ(nimbus::SceneHash(Parse(v3)), nimbus::SceneHash(Parse(v4)));
+  Json m4 = MinimalJson();
+  m4["nimbus_scene"] = 4;
+  EXPECT_EQ(nimbus::SceneHash(Parse(MinimalJson())), nimbus::SceneHash(Parse(m4)));
+}
+
+TEST(SceneJson, Version4Errors)
+{
+  const std::vector<BadScene> bad = BadVersion4Scenes();
+  int refused = 0;
+  for (const BadScene& scene : bad)
+  {
+    SCOPED_TRACE(scene.What);
+    if (scene.Prefix.empty())
+    {
+      EXPECT_NO_THROW(Parse(scene.Text));
+      continue;
+    }
+    if (scene.Text.is_null()) // a number that overflows a double, in the text
+    {
+      std::string text = Version4Json().dump();
+      const std::string from = "\"cone_angle_degrees\":30";
+      ASSERT_NE(text.find(from), std::string::npos);
+      text.replace(text.find(from), from.size(), "\"cone_angle_degrees\":1e999");
+      ExpectErrorText(text, scene.Prefix);
+    }
+    else
+    {
+      ExpectError(scene.Text, scene.Prefix);
+    }
+    ++refused;
+  }
+  std::printf("%d bad version-4 scenes refused, each with its key path\n", refused);
+  EXPECT_GT(refused, 100);
+}
+
+TEST(SceneJson, Version4HashCoversTheNewFields)
+{
+  const std::vector<Mutation> mutations = {
+    { "Spot.Position", [](SceneDescription& s) { s.Lights[2].Position[0] += 1e-6; } },
+    { "Spot.Direction", [](SceneDescription& s) { s.Lights[2].Direction[1] += 0.01; } },
+    { "Spot.Direction length", [](SceneDescription& s) { s.Lights[2].Direction[2] *= 2.0; } },
+    { "Spot.ConeAngleDegrees", [](SceneDescription& s) { s.Lights[2].ConeAngleDegrees += 1; } },
+    { "Spot.EdgeDegrees", [](SceneDescription& s) { s.Lights[2].EdgeDegrees += 1; } },
+    { "Spot.Intensity", [](SceneDescription& s) { s.Lights[2].Intensity *= 1.01; } },
+    { "Spot.Temperature", [](SceneDescription& s) { s.Lights[2].TemperatureKelvin += 1; } },
+    { "Spot.LightMap", [](SceneDescription& s) { s.Lights[2].LightMap.Path += "x"; } },
+    { "Spot.LightMap removed", [](SceneDescription& s) { s.Lights[2].LightMap.Path.clear(); } },
+    { "Occluder.Type", [](SceneDescription& s) { s.Occluders[0].Type = "mesh"; } },
+    { "Occluder.Min", [](SceneDescription& s) { s.Occluders[0].Min[0] -= 1; } },
+    { "Occluder.Max", [](SceneDescription& s) { s.Occluders[0].Max[2] += 1; } },
+    { "Occluder.Albedo", [](SceneDescription& s) { s.Occluders[0].Albedo += 0.1; } },
+    { "Mesh.Path", [](SceneDescription& s) { s.Occluders[1].Path += "x"; } },
+    { "Mesh.Translate", [](SceneDescription& s) { s.Occluders[1].Translate[2] += 1; } },
+    { "Mesh.Scale", [](SceneDescription& s) { s.Occluders[1].Scale *= 2; } },
+    { "Mesh.Albedo", [](SceneDescription& s) { s.Occluders[1].Albedo = 0.5; } },
+    { "Occluders.size", [](SceneDescription& s) { s.Occluders.pop_back(); } },
+    { "Occluders.order", [](SceneDescription& s) { std::swap(s.Occluders[0], s.Occluders[1]); } },
+  };
+  ExpectEachMutationChangesTheHash(Version4Scene(), mutations);
+  // The pixels and triangles the glue reads are not part of the description's text.
+  SceneDescription read = Version4Scene();
+  read.Lights[2].LightMap.Width = read.Lights[2].LightMap.Height = 1;
+  read.Lights[2].LightMap.Luminance = { 0.5f };
+  read.Occluders[1].TriangleVertices = { { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 1, 0 } } };
+  EXPECT_EQ(nimbus::SceneHash(read), nimbus::SceneHash(Version4Scene()));
 }
