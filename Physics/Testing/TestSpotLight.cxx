@@ -138,15 +138,12 @@ TEST(SpotLight, NonFiniteDirectionHasNoLightMapPlace)
   double u = 0.25, v = 0.75;
   EXPECT_FALSE(SpotLightMapCoordinates(spot, { { kNaN, 0.0, -1.0 } }, u, v));
   EXPECT_FALSE(SpotLightMapCoordinates(spot, { { 0.0, 0.0, kNaN } }, u, v));
-  EXPECT_EQ(u, 0.25); // untouched
+  EXPECT_FALSE(SpotLightMapCoordinates(spot, { { kInf, 0.0, -1.0 } }, u, v)); // w.axis = 1
+  EXPECT_EQ(u, 0.25);                                                         // untouched
   EXPECT_EQ(v, 0.75);
 }
 
-// The factor's half of that contract. Disabled while SpotFactor returns NaN for a spot
-// (std::clamp and std::acos pass NaN through) and 1 for a point light given a
-// non-finite direction; enable it with a test `if (!IsFinite(w)) return 0.0;` at the
-// top of SpotFactor (and the same in its GLSL twin).
-TEST(SpotLight, DISABLED_NonFiniteDirectionGivesNoLight)
+TEST(SpotLight, NonFiniteDirectionGivesNoLight)
 {
   const SpotProfile spot = Spot({ { 0, 0, -1 } }, 30.0, 5.0);
   for (const Vector3& w : { Vector3{ { kNaN, 0.0, -1.0 } }, Vector3{ { 0.0, 0.0, kNaN } },
