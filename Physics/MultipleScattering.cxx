@@ -387,7 +387,8 @@ public:
     }
 
     // The first scattering of the sun and the point lights, as a source function
-    // per direction: S1(x, m) = a' J'(x, s_m) (per unit sigma_t').
+    // per direction: S1(x, m) = a' J'(x, s_m) (per unit sigma_t'); a spotlight's
+    // irradiance carries its factor SpotFactor(Spot, d) (SpotLight.h).
     std::vector<float> firstSource(nd * 3 * n, 0.0f);
     if (this->Lighting.HasSun)
     {
@@ -465,6 +466,11 @@ public:
               std::min({ this->Grid.Spacing[0], this->Grid.Spacing[1], this->Grid.Spacing[2] });
             const double r = std::max(Length(d), minimum);
             d = Normalized(Length(d) > 0.0 ? d : Vector3{ { 0, 0, 1 } });
+            const double spot = SpotFactor(light.Spot, d); // exactly 1 for a point light
+            if (spot == 0.0)
+            {
+              continue; // outside the spotlight's cone
+            }
             const double t = std::exp(-OpticalDepthBetween(scaledGrid, lightIndex, idx));
             double sum = 0.0;
             for (std::size_t m = 0; m < nd; ++m)
@@ -474,7 +480,8 @@ public:
             }
             for (std::size_t m = 0; m < nd; ++m)
             {
-              const double w = albedoScaled * lobe[m] / (sum * this->SolidAngle) * t / (r * r);
+              const double w =
+                albedoScaled * lobe[m] / (sum * this->SolidAngle) * t / (r * r) * spot;
               for (int c = 0; c < 3; ++c)
               {
                 firstSource[(m * n + i) * 3 + c] += static_cast<float>(w * light.Intensity[c]);
@@ -778,12 +785,11 @@ private:
       });
   }
 
-  // coefficients += SH projection of radiance(x) arriving along s, weighted by the
-  // direction's solid angle, with degree l scaled by k_l (k_0, k_1).
   // The point lights' first scattering (003 Eq. 1's first term): at every point with
-  // extinction, J1(x, w) = p(w . d) E(x), E = I exp(-tau) / r^2 the unscattered irradiance
-  // through the full (not delta-M scaled) extinction, d the direction of travel from the
-  // light; in degree-1 SH (Funk-Hecke): c_00 += E Y_00, c_1m += E k_1 Y_1m(d).
+  // extinction, J1(x, w) = p(w . d) E(x), E = I S(d) exp(-tau) / r^2 the unscattered
+  // irradiance through the full (not delta-M scaled) extinction, S the spotlight's
+  // factor (1 for a point light), d the direction of travel from the light; in
+  // degree-1 SH (Funk-Hecke): c_00 += E Y_00, c_1m += E k_1 Y_1m(d).
   void AddPointLightFirstScattering(double k1, std::vector<float>& coefficients) const
   {
     const std::size_t n = this->Grid.NumberOfPoints();
@@ -810,12 +816,17 @@ private:
             const double length = Length(d);
             const double r = std::max(length, minimum);
             const Vector3 w = length > 0.0 ? Normalized(d) : Vector3{ { 0, 0, 1 } };
+            const double spot = SpotFactor(light.Spot, w); // exactly 1 for a point light
+            if (spot == 0.0)
+            {
+              continue; // outside the spotlight's cone
+            }
             const double t = std::exp(-OpticalDepthBetween(this->Grid, lightIndex, idx));
             const auto y = ShBasis(w);
             const double k[4] = { 1.0, k1, k1, k1 };
             for (int c = 0; c < 3; ++c)
             {
-              const double e = light.Intensity[c] * t / (r * r);
+              const double e = light.Intensity[c] * spot * t / (r * r);
               for (int b = 0; b < 4; ++b)
               {
                 coefficients[i * kCoefficients + 4 * c + b] += static_cast<float>(k[b] * y[b] * e);
@@ -826,6 +837,8 @@ private:
     }
   }
 
+  // coefficients += SH projection of radiance(x) arriving along s, weighted by the
+  // direction's solid angle, with degree l scaled by k_l (k_0, k_1).
   void Project(const std::vector<float>& radiance, const Vector3& s, double k0, double k1,
     std::vector<float>& coefficients) const
   {
@@ -1089,6 +1102,16 @@ std::string CheckMultipleScatteringInput(const ExtinctionGrid& grid, const Cloud
     if (!IsFinite(light.Position) || !FiniteRgb(light.Intensity))
     {
       return "a point light's position and intensity must be finite";
+    }
+    if (std::isnan(light.Spot.ConeHalfAngleDegrees) || light.Spot.ConeHalfAngleDegrees < 0.0 ||
+      !std::isfinite(light.Spot.EdgeWidthDegrees) || light.Spot.EdgeWidthDegrees < 0.0)
+    {
+      return "a spotlight's cone and edge angles must be >= 0 degrees (edge finite)";
+    }
+    if (IsSpot(light.Spot) &&
+      (!IsFinite(light.Spot.Axis) || std::abs(Length(light.Spot.Axis) - 1.0) > 1e-6))
+    {
+      return "a spotlight's axis must be a finite unit vector";
     }
   }
   if (options.Method == MultipleScatteringMethod::ReferencePatterns &&

@@ -42,6 +42,7 @@
 
 #include "Math.h"
 #include "PhaseFunctions.h"
+#include "SpotLight.h"
 
 #include <array>
 #include <cstddef>
@@ -107,12 +108,24 @@ struct NIMBUSPHYSICS_EXPORT DirectionalLight
   }
 };
 
-/// A point light (lightning, issue 16): world position [m] and radiant intensity
-/// [radiance units x m^2] (irradiance I / r^2 at distance r, before the cloud dims it).
+/// A point light (a lightning stroke's sources, a view's point light or spotlight):
+/// world position [m] and radiant intensity [radiance units x m^2] (irradiance
+/// I / r^2 at distance r, before the cloud dims it), and its beam: the intensity
+/// toward unit direction w (from the light) is I SpotFactor(Spot, w) (SpotLight.h;
+/// Spot.Axis a world direction). The default profile is a point light (factor 1).
+/// Built as {position, intensity} (a point light) or {position, intensity, spot}.
 struct NIMBUSPHYSICS_EXPORT PointLight
 {
+  PointLight() = default;
+  PointLight(const Vector3& position, const Rgb& intensity, const SpotProfile& spot = SpotProfile())
+    : Position(position)
+    , Intensity(intensity)
+    , Spot(spot)
+  {
+  }
   Vector3 Position{ { 0, 0, 0 } };
   Rgb Intensity{ { 1, 1, 1 } };
+  SpotProfile Spot;
 };
 
 /// Everything that lights the cloud from outside. `Sky(w)` is the radiance seen
