@@ -2823,6 +2823,23 @@ void vtkNimbusCloudVolumeMapper::CaptureRadianceImage(const FrameState& frame)
   values->SetNumberOfTuples(static_cast<vtkIdType>(width) * height);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, values->GetPointer(0));
+  if (!frame.Lights.empty() && this->UsesRayMarching() &&
+    this->LightShaftMethod == LightShaftsByVirtualPlanes)
+  {
+    // The virtual planes' shafts, which the composite adds.
+    std::vector<float> shafts(static_cast<std::size_t>(width) * height * 4);
+    in.LightsFramebuffer->Bind(GL_FRAMEBUFFER);
+    in.LightsFramebuffer->ActivateReadBuffer(0);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, shafts.data());
+    float* radiance = values->GetPointer(0);
+    for (std::size_t i = 0; i < shafts.size(); i += 4)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        radiance[i + c] += shafts[i + c];
+      }
+    }
+  }
   in.Radiance->Initialize();
   in.Radiance->SetDimensions(width, height, 1);
   in.Radiance->GetPointData()->SetScalars(values);
@@ -3139,9 +3156,11 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
     "lightPhaseConstant", static_cast<float>(this->MultipleScattering / (4.0 * nimbus::kPi)));
 }
 
-// 002 §6.2's virtual planes: NumberOfVirtualPlanes planes parallel to the screen over
-// the view depths of the lit region, back to front into their own target
-// (cloudVirtualPlanesFS.glsl), which the composite adds.
+// 002 §6.2's virtual planes: NumberOfVirtualPlanes planes parallel to the screen from
+// the near clipping plane to the far side of the lit region, spaced geometrically (the
+// paper places them "in front of the viewpoint"; a light's 1/d^2 and the view's
+// perspective both ask for more planes near the eye), drawn back to front into their
+// own target (cloudVirtualPlanesFS.glsl), which the composite adds.
 void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
 {
   if (frame.Lights.empty() || this->LightShaftMethod != LightShaftsByVirtualPlanes)
@@ -3150,8 +3169,8 @@ void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
   }
   Internals& in = *this->Internal;
   in.Timer.Begin("virtual planes");
-  // The lit region's depths along the view's axis.
-  double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
+  // The lit region's farthest depth along the view's axis.
+  double farthest = 0.0;
   for (int i = 0; i < 8; ++i)
   {
     const double corner[3] = { frame.LightRegion[(i & 1) ? 1 : 0],
@@ -3161,11 +3180,11 @@ void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
     {
       depth += (corner[a] - frame.Eye[a]) * frame.ViewForward[a];
     }
-    nearest = std::min(nearest, depth);
     farthest = std::max(farthest, depth);
   }
-  nearest = std::max(nearest, static_cast<double>(frame.ClippingRange[0]));
   farthest = std::min(farthest, static_cast<double>(frame.ClippingRange[1]));
+  const double nearest =
+    std::max(static_cast<double>(frame.ClippingRange[0]), 1e-4 * farthest);
   this->EnsureImageTarget(in.LightsImage, frame);
   DrawInto(in.LightsFramebuffer, in.LightsImage, frame.Window);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
@@ -3181,11 +3200,13 @@ void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
   this->SetCloudLightUniforms(program, frame);
   program->SetUniformf("lightsMieG", static_cast<float>(frame.Settings.Air.MieG));
   const int planes = this->NumberOfVirtualPlanes;
-  const double spacing = (farthest - nearest) / planes;
-  program->SetUniformf("planeSpacing", static_cast<float>(spacing));
+  const double ratio = std::pow(farthest / nearest, 1.0 / planes);
   for (int k = planes - 1; k >= 0; --k)
   {
-    program->SetUniformf("planeDepth", static_cast<float>(nearest + (k + 0.5) * spacing));
+    // Plane k stands for the slab [nearest r^k, nearest r^(k+1)], at its middle.
+    const double front = nearest * std::pow(ratio, k), back = front * ratio;
+    program->SetUniformf("planeDepth", static_cast<float>(0.5 * (front + back)));
+    program->SetUniformf("planeSpacing", static_cast<float>(back - front));
     in.PlanesPass->Render();
     ++in.PassesLastRender;
   }

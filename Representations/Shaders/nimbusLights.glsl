@@ -91,8 +91,8 @@ int LightShadowFace(vec3 v, out vec3 eye)
     eye = v.y > 0.0 ? vec3(v.x, v.z, v.y) : vec3(-v.x, v.z, -v.y);
     return v.y > 0.0 ? 2 : 3;
   }
-  // Forward +-z, up +y.
-  eye = v.z > 0.0 ? vec3(v.x, v.y, v.z) : vec3(-v.x, v.y, -v.z);
+  // Forward +-z, up +y: right = forward x up = -x for +z, +x for -z.
+  eye = v.z > 0.0 ? vec3(-v.x, v.y, v.z) : vec3(v.x, v.y, -v.z);
   return v.z > 0.0 ? 4 : 5;
 }
 
@@ -311,6 +311,21 @@ vec3 GroundLightsRadiance(vec3 g)
   return sum;
 }
 
+// The integrand of LightsInAir per unit angle theta about light i: the air's single
+// scattering at t = closest + distance tan(theta) times dt/dtheta (metres), with the
+// view's transmittance.
+vec3 LightAirIntegrand(int i, vec3 origin, vec3 direction, float theta, float closest,
+  float distance, float mieG, float cloudFirst, float cloudLast, float logCloud)
+{
+  float t = closest + distance * tan(theta);
+  float c = cos(theta);
+  vec3 p = origin + t * direction;
+  float inCloud = clamp((t - cloudFirst) / max(cloudLast - cloudFirst, 1e-30), 0.0, 1.0);
+  return LightScattering(i, p, direction, 0.0, mieG, LightCloudDepth(i, p)) *
+    AtmosphereViewTransmittance(origin, direction, t) * exp(logCloud * inCloud) *
+    (distance / (c * c) * metresPerUnit);
+}
+
 // The lights' single scattering by the clear air along [t0, t1] of the view ray toward
 // the eye [radiance], with the view's transmittance: the air's in closed form
 // (AtmosphereViewTransmittance) and the cloud's as 1 before cloudFirst,
@@ -318,7 +333,11 @@ vec3 GroundLightsRadiance(vec3 g)
 // own lit particles are MarchCloud's). Samples per light equi-angular about the light
 // (Kulla & Fajardo 2012): t = c + D tan(theta) with theta evenly spaced, so the 1/d^2 of
 // the light's falloff is integrated exactly and the samples gather where the beam is
-// bright; `samples` per light inside its beam, shifted by `jitter` in [0, 1).
+// bright; `samples` per light inside its beam, shifted by `jitter` in [0, 1) (per pixel,
+// against banding). A shifted set of midpoints covers [a + (j - 1/2) h, b + (j - 1/2) h]:
+// the two ends' integrands correct the sum for it, so the error stays of second order
+// in h whatever the shift (measured in TestCloudLights: 0.5 % at 32 samples, against
+// 11 % uncorrected).
 vec3 LightsInAir(vec3 origin, vec3 direction, float t0, float t1, int samples, float jitter,
   float mieG, float cloudFirst, float cloudLast, float cloudTransmittance)
 {
@@ -336,22 +355,30 @@ vec3 LightsInAir(vec3 origin, vec3 direction, float t0, float t1, int samples, f
     {
       continue;
     }
+    // Beyond the distance at which the air has dimmed the view and the light's path by
+    // e^-9 nothing adds up: the samples end there.
+    vec3 extinction = min(AirExtinction(Altitude(origin)), AirExtinction(Altitude(lightPosition[i])));
+    float thinnest = min(extinction.r, min(extinction.g, extinction.b));
+    if (thinnest > 0.0)
+    {
+      b = min(b, max(a, 9.0 / (thinnest * metresPerUnit)));
+    }
     float closest = dot(lightPosition[i] - origin, direction);
     float distance = max(length(lightPosition[i] - origin - closest * direction), minimumDistance);
     float thetaA = atan((a - closest) / distance);
     float thetaB = atan((b - closest) / distance);
     float dTheta = (thetaB - thetaA) / float(samples);
+    vec3 light = vec3(0.0);
     for (int k = 0; k < samples; ++k)
     {
-      float theta = thetaA + (float(k) + jitter) * dTheta;
-      float t = closest + distance * tan(theta);
-      float c = cos(theta);
-      float dt = distance * dTheta / (c * c) * metresPerUnit;
-      vec3 p = origin + t * direction;
-      float inCloud = clamp((t - cloudFirst) / max(cloudLast - cloudFirst, 1e-30), 0.0, 1.0);
-      sum += LightScattering(i, p, direction, 0.0, mieG, LightCloudDepth(i, p)) *
-        AtmosphereViewTransmittance(origin, direction, t) * exp(logCloud * inCloud) * dt;
+      light += LightAirIntegrand(i, origin, direction, thetaA + (float(k) + jitter) * dTheta,
+        closest, distance, mieG, cloudFirst, cloudLast, logCloud);
     }
+    vec3 ends = LightAirIntegrand(i, origin, direction, thetaA, closest, distance, mieG,
+                  cloudFirst, cloudLast, logCloud) -
+      LightAirIntegrand(i, origin, direction, thetaB, closest, distance, mieG, cloudFirst,
+        cloudLast, logCloud);
+    sum += max(light + (jitter - 0.5) * ends, vec3(0.0)) * dTheta;
   }
   return sum;
 }
