@@ -17,9 +17,19 @@ overrides the scene's multiple-scattering constant), ``single``
 Carlo path tracer at fewer samples). ``--settings FILE.json`` replaces a
 renderer's default list of settings.
 
+Scenes with lights (scene format version 4: point and spot lights, light maps,
+occluders; docs/lights-trade.md): ``svs`` draws them by ray marching only (every row
+must be ``method`` ``march``), each light a positional vtkLight of its renderer and
+each occluder an opaque actor; its settings ``light_method`` (``march`` or
+``planes``), ``light_samples``, ``virtual_planes``, ``shadow_map_size`` and
+``light_cloud_steps`` trade the shafts' quality for time, and without --settings a
+scene with lights gets a list over them. ``vtk-gpu`` and ``single`` refuse lights.
+
 The reference (``--reference``): ``path`` is the Monte Carlo path tracer with full
 multiple scattering, run for a time budget (--reference-seconds, default 600 s;
-its image-wide error is printed and stored); ``single`` is converged single
+its image-wide error is printed and stored); ``path-single`` the same path tracer
+stopped at the first scattering (single scattering of the sun and of every light,
+for the scenes ``single`` refuses); ``single`` is converged single
 scattering. ``auto`` (the default) judges each setting by what it models: settings
 that model single scattering only (the ``single`` renderer, ``svs`` with k_multi
 0) against ``single``, every other one against ``path``. Every row, table and plot
@@ -65,6 +75,12 @@ REFERENCE_SETTINGS = {
     # reference's own error, and the metrics are corrected for it (see the module text).
     "path": {"mode": "path", "min_spp": 16, "max_spp": 1 << 20, "time_limit": 600.0,
              "seed": 1},
+    # The path tracer cut at the first scattering (MaxScatteringOrder 1): the single
+    # scattering of the sun and of every light, the ground's direct light included, for
+    # the scenes the "single" renderer refuses (lights); against "path" it measures what
+    # multiple scattering adds.
+    "path-single": {"mode": "path", "min_spp": 16, "max_spp": 1 << 20, "time_limit": 600.0,
+                    "seed": 1, "max_order": 1},
 }
 # The sky-only path-traced reference (vtk-gpu's background) gets this share of the budget.
 SKY_BUDGET_SHARE = 0.25
@@ -99,6 +115,15 @@ DEFAULT_SETTINGS = {
     "path": [{"max_spp": n, "min_spp": n} for n in (1, 4, 16, 64)],
 }
 
+# The svs renderer's default settings for a scene with lights (only the ray march draws
+# them): the shafts by equi-angular samples along each view ray, then by virtual planes,
+# over their counts; the march's step 2 texels (the mapper's default).
+DEFAULT_LIGHT_SETTINGS = (
+    [{"method": "march", "step": 2, "light_method": "march", "light_samples": n}
+     for n in (4, 8, 16, 32, 64)]
+    + [{"method": "march", "step": 2, "light_method": "planes", "virtual_planes": n}
+       for n in (16, 32, 64, 128, 256)])
+
 # Linear radiance -> the [0, 1] range VTK renders into (and back): radiance
 # 1/VTK_SCALE fills VTK's 8-bit framebuffer. 8-bit quantisation then costs at most
 # 1/(2*255*VTK_SCALE) = 6.5e-4 in radiance, below every error the table reports.
@@ -124,7 +149,7 @@ def load_scene(path):
 
 def version3_features(scene):
     """The scene format's version-3 features a canonical scene (load_scene) uses: only the
-    path tracer renders them (docs/scene-format.md); the fast renderers refuse them."""
+    path tracer renders them all (docs/scene-format.md); VTK's GPU mapper none of them."""
     features = []
     if scene.get("lights"):
         features.append("point and polyline lights (scene.lights)")
@@ -136,12 +161,74 @@ def version3_features(scene):
     return features
 
 
-def refuse_version3_features(scene_path, scene, renderer):
-    """A renderer that does not render lights, emission or more media says so by name,
-    rather than render the scene without them."""
-    features = version3_features(scene)
+def version4_features(scene):
+    """The scene format's version-4 features a canonical scene uses: spot lights and
+    occluders."""
+    features = []
+    if any(light["type"] == "spot" for light in scene.get("lights", [])):
+        features.append("spot lights (scene.lights[i] of type spot)")
+    if scene.get("occluders"):
+        features.append("occluders (scene.occluders)")
+    return features
+
+
+def svs_unsupported_features(scene):
+    """What of a canonical scene the SVS mapper cannot draw. It draws point and spot
+    lights (the view's own lights: positional vtkLights, by ray marching only) and
+    occluders (opaque actors that shadow them), as SvsRenderer builds them; not lightning
+    channels, emission or more media, and not spots that differ in what the mapper
+    holds once for all of them (the soft edge's width, the light map), nor more lights
+    than it draws in one frame."""
+    features = []
+    lights = scene.get("lights", [])
+    if any(light["type"] == "polyline" for light in lights):
+        features.append("polyline lights (scene.lights[i] of type polyline)")
+    media = scene.get("media", [])
+    if "emission" in scene["medium"] or any("emission" in m for m in media):
+        features.append("emission (scene.medium.emission, scene.media[i].emission)")
+    if media:
+        features.append("additional media (scene.media)")
+    sun = scene["sun"]
+    if scene.get("occluders") and sun["elevation_degrees"] > 0 and sun["illuminance"] > 0:
+        features.append("occluders in sunlight (the mapper's opaque geometry casts no "
+                        "shadow of the sun; a scene with occluders needs the sun below the "
+                        "horizon or an illuminance of 0)")
+    if len(lights) > SVS_MAXIMUM_LIGHTS:
+        features.append(f"more than {SVS_MAXIMUM_LIGHTS} lights (scene.lights has "
+                        f"{len(lights)}; the mapper draws at most {SVS_MAXIMUM_LIGHTS})")
+    spots = [(i, light) for i, light in enumerate(lights) if light["type"] == "spot"]
+    edges = sorted({light["edge_degrees"] for _, light in spots})
+    if len(edges) > 1:
+        features.append("spot lights with different soft edges (the mapper has one "
+                        "SpotEdgeWidthDegrees for all spots; scene.lights has "
+                        + ", ".join(f"[{i}] {light['edge_degrees']:g}" for i, light in spots)
+                        + " degrees)")
+    maps = sorted({light.get("light_map", "") for _, light in spots})
+    if len(maps) > 1:
+        features.append("spot lights with different light maps (the mapper has one "
+                        "LightMap for all spots; scene.lights has "
+                        + ", ".join(f"[{i}] {light.get('light_map') or 'none'}"
+                                    for i, light in spots) + ")")
+    return features
+
+
+# The renderers whose features the harness checks, their names in messages, and what of a
+# canonical scene each cannot draw.
+UNSUPPORTED_FEATURES = {
+    "vtk-gpu": ("VTK GPU mapper",
+                lambda scene: version3_features(scene) + version4_features(scene)),
+    "svs": ("SVS mapper", svs_unsupported_features),
+}
+
+
+def refuse_unsupported_features(scene_path, scene, renderer):
+    """A renderer ("vtk-gpu" or "svs") that does not draw a feature of the scene (lights,
+    emission, more media, occluders: scene format versions 3 and 4) says so by name,
+    rather than render the scene without it."""
+    name, features_of = UNSUPPORTED_FEATURES[renderer]
+    features = features_of(scene)
     if features:
-        raise ValueError(f"{scene_path}: the {renderer} does not render {', '.join(features)}; "
+        raise ValueError(f"{scene_path}: the {name} does not render {'; '.join(features)}; "
                          "render this scene with the path tracer (--renderer path)")
 
 
@@ -153,12 +240,17 @@ def scene_hash(scene_path, reference):
     digest.update(json.dumps(reference, sort_keys=True).encode())
     densities = [scene.get("medium", {}).get("density", {})]
     densities += [m.get("density", {}) for m in scene.get("media", [])]
+    files = []
     for density in densities:
         if density.get("type") == "file":
-            density_path = os.path.join(os.path.dirname(os.path.abspath(scene_path)),
-                                        density["path"])
-            with open(density_path, "rb") as stream:
-                digest.update(stream.read())
+            files.append(os.path.join(os.path.dirname(os.path.abspath(scene_path)),
+                                      density["path"]))
+    # Version 4: the spots' light maps and the occluders' meshes (absolute paths).
+    files += [light["light_map"] for light in scene.get("lights", []) if light.get("light_map")]
+    files += [o["path"] for o in scene.get("occluders", []) if o.get("type") == "mesh"]
+    for path in files:
+        with open(path, "rb") as stream:
+            digest.update(stream.read())
     return digest.hexdigest()[:16]
 
 
@@ -317,6 +409,8 @@ def models_single_scattering_only(renderer_name, settings, scene):
     single-scattering reference under --reference auto)."""
     if renderer_name == "single":
         return True
+    if scene.get("lights"):  # the single-scattering reference renders no lights
+        return False
     if renderer_name == "svs":
         k_multi = settings.get("k_multi",
                                scene.get("medium", {}).get("multiple_scattering_constant", 0.0))
@@ -389,7 +483,7 @@ class VtkGpuRenderer:
         import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
 
         scene = load_scene(scene_path)
-        refuse_version3_features(scene_path, scene, "VTK GPU mapper")
+        refuse_unsupported_features(scene_path, scene, "vtk-gpu")
         self.scene = scene
         self.sky = sky_image
         self.sky_error = sky_error
@@ -512,6 +606,8 @@ class VtkGpuRenderer:
 SVS_METHODS = {"none": 0, "octaves": 1, "patterns": 2, "directions": 3}
 # The svs renderer's "method" setting -> the mapper's RenderingMethod.
 SVS_RENDERING_METHODS = {"slices": 0, "march": 1}
+# The svs renderer's "light_method" setting -> the mapper's LightShaftMethod.
+SVS_LIGHT_SHAFT_METHODS = {"march": 0, "planes": 1}
 
 
 class SvsRenderer:
@@ -539,6 +635,17 @@ class SvsRenderer:
     only with it off are k_multi = 0 and ms none judged as single scattering). The
     row also reports the last solve's seconds (precompute_seconds) and the solver's
     memory (ms_mib).
+
+    The view's own lights (scene format version 4; docs/lights-trade.md): each point and
+    spot light is a positional vtkLight of the renderer (scene_vtk_lights), each occluder
+    an opaque actor (occluder_actors) that shadows them through the mapper's shadow maps.
+    Only the ray march draws lights: a scene with lights refuses a row that is not
+    method march. Their settings: light_method (march, the default: equi-angular samples
+    along each view ray, or planes: virtual planes, LightShaftMethod), light_samples
+    (LightSamples, default 32), virtual_planes (NumberOfVirtualPlanes, default 64),
+    shadow_map_size (LightShadowMapSize, default 256; 0: no shadows of the occluders)
+    and light_cloud_steps (LightCloudSteps, default 12; 0: the cloud casts no shadow in
+    the beams): the mapper's defaults, set on every row.
     """
 
     def __init__(self, scene_path):
@@ -547,7 +654,7 @@ class SvsRenderer:
         import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 (object factories)
 
         scene = load_scene(scene_path)
-        refuse_version3_features(scene_path, scene, "SVS mapper")
+        refuse_unsupported_features(scene_path, scene, "svs")
         density = nimbus.vtkNimbusSceneDensitySource()
         density.SetSceneFileName(scene_path)
         density.Update()
@@ -560,6 +667,17 @@ class SvsRenderer:
         self.volume.SetMapper(self.mapper)
         self.renderer = vtkRenderer()
         self.renderer.AddVolume(self.volume)
+        # The view's own lights and the opaque scene that shadows them (version 4).
+        self.lights = scene_vtk_lights(scene)
+        for light in self.lights:
+            self.renderer.AddLight(light)
+        self.occluders = occluder_actors(scene)
+        for actor in self.occluders:
+            self.renderer.AddActor(actor)
+        if any(o["albedo"] > 0 for o in scene.get("occluders", [])):
+            print(f"svs: {scene_path}: an occluder of albedo > 0 is shaded by VTK's lights, "
+                  "not as the path tracer's Lambertian surface, and its own light is not in "
+                  "the mapper's radiance this harness measures; use albedo 0", file=sys.stderr)
         background = scene.get("background", {})
         grey = 0.0
         if background.get("type") == "constant":
@@ -584,7 +702,17 @@ class SvsRenderer:
         self.capture_class = vtkWindowToImageFilter
 
     def render(self, settings):
-        self.mapper.SetRenderingMethod(SVS_RENDERING_METHODS[settings.get("method", "slices")])
+        method = settings.get("method", "slices")
+        if self.lights and method != "march":
+            raise ValueError(f"svs: setting {setting_label(settings)}: the scene has lights, "
+                             "which only the ray march draws (method march)")
+        self.mapper.SetRenderingMethod(SVS_RENDERING_METHODS[method])
+        self.mapper.SetLightShaftMethod(SVS_LIGHT_SHAFT_METHODS[settings.get("light_method",
+                                                                             "march")])
+        self.mapper.SetLightSamples(int(settings.get("light_samples", 32)))
+        self.mapper.SetNumberOfVirtualPlanes(int(settings.get("virtual_planes", 64)))
+        self.mapper.SetLightShadowMapSize(int(settings.get("shadow_map_size", 256)))
+        self.mapper.SetLightCloudSteps(int(settings.get("light_cloud_steps", 12)))
         self.mapper.SetRayMarchStepTexels(float(settings.get("step", 1.0)))
         self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
         self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
@@ -653,7 +781,243 @@ def configure_svs_mapper(mapper, scene):
     mapper.SetGround(bool(ground.get("enabled", True)))
     mapper.SetGroundHeight(ground.get("height", 0.0))
     mapper.SetGroundAlbedo(ground.get("albedo", 0.2))
+    differing = [f"{key} {atmosphere[key]:g} (the mapper's {value:g})"
+                 for key, value in SVS_FIXED_AIR.items()
+                 if key in atmosphere and atmosphere[key] != value]
+    if differing:
+        print("svs: the mapper keeps its own " + ", ".join(differing) + "; its air differs "
+              "from the scene's", file=sys.stderr)
+    # The view's own lights (SvsRenderer adds them to its renderer as positional vtkLights):
+    # the mapper's one soft edge and one light map for every spot.
+    mapper.SetLightSources(1)  # PositionalLights
+    mapper.SetLightIntensityScale(1.0)
+    edge = spot_edge_degrees(scene)
+    if edge is not None:
+        mapper.SetSpotEdgeWidthDegrees(edge)
+    light_map = spot_light_map_path(scene)
+    mapper.SetLightMap(read_light_map(light_map) if light_map else None)
     return mapper
+
+
+# The air's parameters the mapper does not take (vtkNimbusCloudVolumeMapper.h: "the other
+# parameters keep their defaults", Physics/Atmosphere.h): a scene with other values is
+# drawn by the mapper with these.
+SVS_FIXED_AIR = {"earth_radius_metres": 6360000.0, "top_radius_metres": 6420000.0,
+                 "rayleigh_scale_height_metres": 8000.0, "mie_scale_height_metres": 1200.0,
+                 "mie_albedo": 0.9}
+
+
+# --- the view's own lights and the opaque scene (scene format version 4) ----------------------
+
+# The most lights vtkNimbusCloudVolumeMapper draws in one frame (MaximumLights' limit).
+SVS_MAXIMUM_LIGHTS = 8
+
+
+def _piecewise_gaussian(wavelength, mean, below, above):
+    sigma = np.where(wavelength < mean, below, above)
+    return np.exp(-0.5 * ((wavelength - mean) / sigma) ** 2)
+
+
+def cie_xyz_bar_1931(wavelength_nm):
+    """CIE 1931 2-degree colour-matching functions (x-bar, y-bar, z-bar) at the given
+    wavelengths (nm): the multi-lobe fit of Wyman, Sloan and Shirley (JCGT 2(2), 2013,
+    Eq. 4), the one Physics/SpectralColor.h uses."""
+    w = np.asarray(wavelength_nm, dtype=np.float64)
+    x = (1.056 * _piecewise_gaussian(w, 599.8, 37.9, 31.0)
+         + 0.362 * _piecewise_gaussian(w, 442.0, 16.0, 26.7)
+         - 0.065 * _piecewise_gaussian(w, 501.1, 20.4, 26.2))
+    y = (0.821 * _piecewise_gaussian(w, 568.8, 46.9, 40.5)
+         + 0.286 * _piecewise_gaussian(w, 530.9, 16.3, 31.1))
+    z = (1.217 * _piecewise_gaussian(w, 437.0, 11.8, 36.0)
+         + 0.681 * _piecewise_gaussian(w, 459.0, 26.0, 13.8))
+    return x, y, z
+
+
+def planck_spectral_radiance(wavelength_nm, temperature_kelvin):
+    """Planck's law, W m^-2 sr^-1 nm^-1 (Physics/SpectralColor.h's PlanckSpectralRadiance)."""
+    h, c, k = 6.62607015e-34, 299792458.0, 1.380649e-23
+    metres = np.asarray(wavelength_nm, dtype=np.float64) * 1e-9
+    exponent = h * c / (metres * k * temperature_kelvin)
+    return 2.0 * h * c * c / metres ** 5 / np.expm1(exponent) * 1e-9
+
+
+# IEC 61966-2-1 XYZ -> linear sRGB (D65), as Physics/SpectralColor.cxx.
+XYZ_TO_LINEAR_SRGB = np.array([[3.2406, -1.5372, -0.4986],
+                               [-0.9689, 1.8758, 0.0415],
+                               [0.0557, -0.2040, 1.0570]])
+
+
+def blackbody_linear_srgb(temperature_kelvin):
+    """The colour of a blackbody at temperature_kelvin in linear sRGB, normalised to
+    luminance Y = 1: the scene format's light spectrum (a blackbody normalised to
+    luminance 1) as a GPU light's colour. Planck against the CIE 1931 functions over
+    380-780 nm at 1 nm (the path tracer samples 16 wavelengths with a spline; the two
+    differ by about 5e-5 in linear sRGB at Y = 1, SpectralColor.h)."""
+    wavelengths = np.arange(380.0, 780.5, 1.0)
+    spectrum = planck_spectral_radiance(wavelengths, temperature_kelvin)
+    xyz = np.array([np.trapz(spectrum * bar, wavelengths)
+                    for bar in cie_xyz_bar_1931(wavelengths)])
+    return XYZ_TO_LINEAR_SRGB @ (xyz / xyz[1])
+
+
+def scene_vtk_lights(scene):
+    """A positional vtkLight per point and spot light of a canonical scene, as
+    vtkNimbusCloudVolumeMapper reads the view's lights (LightSources PositionalLights,
+    LightIntensityScale 1): Intensity x DiffuseColor is the radiant intensity on the
+    axis in Y/sr per channel of linear sRGB, the scene's intensity times its blackbody
+    colour at luminance 1 (blackbody_linear_srgb). A spot's focal point is its position
+    plus its direction and its ConeAngle the scene's cone_angle_degrees (VTK's half
+    angle); a point light's ConeAngle is 180 (no cone). Polyline lights are not made
+    (svs_unsupported_features refuses them)."""
+    from vtkmodules.vtkRenderingCore import vtkLight
+    lights = []
+    for description in scene.get("lights", []):
+        kind = description["type"]
+        if kind not in ("point", "spot"):
+            continue
+        colour = blackbody_linear_srgb(description["temperature_kelvin"])
+        brightest = float(max(colour))
+        light = vtkLight()
+        light.SetLightTypeToSceneLight()
+        light.SetPositional(True)
+        light.SetSwitch(True)
+        position = [float(x) for x in description["position"]]
+        light.SetPosition(*position)
+        if kind == "spot":
+            axis = np.asarray(description["direction"], dtype=np.float64)
+            axis = axis / np.linalg.norm(axis)
+            light.SetFocalPoint(*(np.asarray(position) + axis).tolist())
+            light.SetConeAngle(float(description["cone_angle_degrees"]))
+        else:
+            light.SetFocalPoint(position[0], position[1], position[2] - 1.0)
+            light.SetConeAngle(180.0)
+        # Colour in [0, 1] (VTK's convention), the rest in the intensity.
+        light.SetDiffuseColor(*(colour / brightest).tolist())
+        light.SetIntensity(float(description["intensity"]) * brightest)
+        lights.append(light)
+    return lights
+
+
+def spot_edge_degrees(scene):
+    """The spots' one soft-edge width (the mapper's SpotEdgeWidthDegrees), or None when
+    the scene has no spot. Spots that differ are refused (svs_unsupported_features)."""
+    edges = {light["edge_degrees"] for light in scene.get("lights", []) if light["type"] == "spot"}
+    if len(edges) > 1:
+        raise ValueError(f"the spots' edges differ ({sorted(edges)} degrees); the SVS mapper "
+                         "has one SpotEdgeWidthDegrees")
+    return edges.pop() if edges else None
+
+
+def spot_light_map_path(scene):
+    """The spots' one light map (absolute path), or None."""
+    maps = {light.get("light_map", "") for light in scene.get("lights", [])
+            if light["type"] == "spot"}
+    if len(maps) > 1:
+        raise ValueError(f"the spots' light maps differ ({sorted(maps)}); the SVS mapper has "
+                         "one LightMap")
+    path = maps.pop() if maps else ""
+    return path or None
+
+
+def srgb_decode(encoded):
+    """sRGB's transfer function (IEC 61966-2-1), encoded [0, 1] -> linear."""
+    encoded = np.clip(encoded, 0.0, 1.0)
+    return np.where(encoded <= 0.04045, encoded / 12.92, ((encoded + 0.055) / 1.055) ** 2.4)
+
+
+def read_light_map(path):
+    """A light map as the path tracer reads it (Reference/SceneAssets.h), handed to the
+    mapper as a one-component float vtkImageData of linear luminance: read by
+    vtkImageReader2Factory; 8- or 16-bit samples over their range; PNG decoded from sRGB,
+    PNM taken as linear; Y = 0.2126 R + 0.7152 G + 0.0722 B of three or four channels,
+    the first of one or two. Rows flipped: the path tracer's row 0 (v = 0) is the file's
+    first row, the top of the picture, which VTK's readers put last, and the mapper's
+    v = 0 is the first row of VTK's data (Physics/SpotLight.h for the frame)."""
+    from vtkmodules.vtkIOImage import vtkImageReader2Factory
+    if not os.path.isfile(path):
+        raise ValueError(f"{path}: no such file (the light map)")
+    reader = vtkImageReader2Factory.CreateImageReader2(path)
+    if reader is None:
+        raise ValueError(f"{path}: not an image VTK reads (the light map)")
+    reader.SetFileName(path)
+    reader.Update()
+    image = reader.GetOutput()
+    scalars = image.GetPointData().GetScalars()
+    width, height, depth = image.GetDimensions()
+    if scalars is None or depth != 1 or width < 1 or height < 1:
+        raise ValueError(f"{path}: not a 2-D image (the light map)")
+    values = vtk_to_numpy(scalars).astype(np.float64).reshape(height, width, -1)
+    ranges = {"unsigned char": 255.0, "unsigned short": 65535.0}
+    if scalars.GetDataTypeAsString() not in ranges:
+        raise ValueError(f"{path}: {scalars.GetDataTypeAsString()} samples; a light map needs "
+                         "8 or 16 bits per channel")
+    values = values / ranges[scalars.GetDataTypeAsString()]
+    if path.lower().endswith(".png"):
+        values = srgb_decode(values)
+    if values.shape[2] >= 3:
+        luminance = 0.2126 * values[..., 0] + 0.7152 * values[..., 1] + 0.0722 * values[..., 2]
+    else:
+        luminance = values[..., 0]
+    # VTK's row 0 is the picture's bottom; the mapper's first row must be its top.
+    luminance = np.ascontiguousarray(luminance[::-1], dtype=np.float32)
+    light_map = vtkImageData()
+    light_map.SetDimensions(width, height, 1)
+    array = numpy_to_vtk(luminance.reshape(-1), deep=True)
+    array.SetName("luminance")
+    light_map.GetPointData().SetScalars(array)
+    return light_map
+
+
+def occluder_actors(scene):
+    """A vtkActor per occluder of a canonical scene: boxes by vtkCubeSource, meshes by
+    vtkPLYReader or vtkOBJReader placed by a vtkTransformFilter (scale, then translate),
+    grey = the occluder's albedo, lit by VTK's diffuse term only (ambient and specular 0).
+    With albedo 0 (the light scenes') they are black, as the path tracer's are; a grey one
+    is shaded by VTK's lights, not as the path tracer's Lambertian surface, and its own
+    light is not in the mapper's float radiance the harness measures (only the air and
+    the cloud in front of it)."""
+    from vtkmodules.vtkFiltersGeneral import vtkTransformFilter
+    from vtkmodules.vtkFiltersSources import vtkCubeSource
+    from vtkmodules.vtkCommonTransforms import vtkTransform
+    from vtkmodules.vtkIOGeometry import vtkOBJReader
+    from vtkmodules.vtkIOPLY import vtkPLYReader
+    from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
+    actors = []
+    for description in scene.get("occluders", []):
+        if description["type"] == "box":
+            source = vtkCubeSource()
+            lo, hi = description["min"], description["max"]
+            source.SetBounds(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+            output = source.GetOutputPort()
+        else:
+            path = description["path"]
+            if not os.path.isfile(path):
+                raise ValueError(f"{path}: no such file (an occluder's mesh)")
+            reader = vtkPLYReader() if path.lower().endswith(".ply") else vtkOBJReader()
+            reader.SetFileName(path)
+            transform = vtkTransform()
+            transform.PostMultiply()
+            transform.Scale(description["scale"], description["scale"], description["scale"])
+            transform.Translate(*description["translate"])
+            placed = vtkTransformFilter()
+            placed.SetTransform(transform)
+            placed.SetInputConnection(reader.GetOutputPort())
+            output = placed.GetOutputPort()
+        mapper = vtkPolyDataMapper()
+        mapper.SetInputConnection(output)
+        mapper.ScalarVisibilityOff()
+        mapper.Update()
+        if mapper.GetInput().GetNumberOfCells() == 0:
+            raise ValueError(f"{description['path']}: no surface in this mesh (an occluder)")
+        actor = vtkActor()
+        actor.SetMapper(mapper)
+        grey = float(description["albedo"])
+        actor.GetProperty().SetColor(grey, grey, grey)
+        actor.GetProperty().SetAmbient(0.0)
+        actor.GetProperty().SetDiffuse(1.0)
+        actor.GetProperty().SetSpecular(0.0)
+        actors.append(actor)
+    return actors
 
 
 # --- the harness ------------------------------------------------------------------------------
@@ -838,9 +1202,11 @@ def run(arguments):
     parser.add_argument("--reference", choices=["auto"] + sorted(REFERENCE_SETTINGS),
                         default="auto",
                         help="the ground truth: 'path' (Monte Carlo, full multiple scattering, "
-                             "for --reference-seconds), 'single' (converged single "
+                             "for --reference-seconds), 'path-single' (the same, stopped at "
+                             "the first scattering), 'single' (converged single "
                              "scattering), or 'auto' (default): 'single' for settings that "
-                             "model single scattering only, 'path' for the others")
+                             "model single scattering only (in scenes without lights), "
+                             "'path' for the others")
     parser.add_argument("--reference-seconds", type=float,
                         default=REFERENCE_SETTINGS["path"]["time_limit"],
                         help="time budget of a path-traced reference (default %(default)g s; "
@@ -888,11 +1254,12 @@ def run(arguments):
             if args.settings:
                 with open(args.settings) as stream:
                     settings_list = json.load(stream)
+            elif renderer_name == "svs" and scene.get("lights"):
+                settings_list = DEFAULT_LIGHT_SETTINGS
             else:
                 settings_list = DEFAULT_SETTINGS[renderer_name]
-            if renderer_name in ("vtk-gpu", "svs"):  # before any reference is rendered
-                refuse_version3_features(scene_path, scene, {"vtk-gpu": "VTK GPU mapper",
-                                                             "svs": "SVS mapper"}[renderer_name])
+            if renderer_name in UNSUPPORTED_FEATURES:  # before any reference is rendered
+                refuse_unsupported_features(scene_path, scene, renderer_name)
             if renderer_name == "vtk-gpu":
                 # VTK has no sky: its cloud goes over the sky-only version of the reference
                 # that judges it (every vtk-gpu setting has the same one).
