@@ -1088,9 +1088,11 @@ def plot(rows, title, path):
     plt.close(figure)
 
 
-def write_png(image, path):
-    """Tone-mapped PNG of a linear image (DISPLAY_EXPOSURE, clip, sRGB), like nimbus-render."""
-    encoded = np.clip(image * DISPLAY_EXPOSURE, 0.0, 1.0)
+def write_png(image, path, exposure=None):
+    """Tone-mapped PNG of a linear image (exposure, default DISPLAY_EXPOSURE; clip, sRGB),
+    like nimbus-render."""
+    exposure = DISPLAY_EXPOSURE if exposure is None else exposure
+    encoded = np.clip(image * exposure, 0.0, 1.0)
     encoded = np.where(encoded <= 0.0031308, 12.92 * encoded,
                        1.055 * np.power(encoded, 1.0 / 2.4) - 0.055)
     height, width, _ = image.shape
@@ -1102,6 +1104,20 @@ def write_png(image, path):
     writer.SetFileName(path)
     writer.SetInputData(data)
     writer.Write()
+
+
+# The side-by-side PNGs: the difference is drawn this many times brighter.
+SIDE_BY_SIDE_DIFFERENCE_GAIN = 4.0
+
+
+def write_side_by_side(reference, image, path, exposure=None):
+    """One PNG for looking at a row: the reference, the image and |image - reference| x
+    SIDE_BY_SIDE_DIFFERENCE_GAIN, left to right, at the same exposure, 2 grey pixels
+    apart."""
+    gap = np.full((reference.shape[0], 2, 3), 0.05 / (exposure or DISPLAY_EXPOSURE),
+                  dtype=np.float32)
+    difference = np.abs(image.astype(np.float32) - reference) * SIDE_BY_SIDE_DIFFERENCE_GAIN
+    write_png(np.concatenate([reference, gap, image, gap, difference], axis=1), path, exposure)
 
 
 def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
@@ -1141,7 +1157,9 @@ def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
 class SceneReferences:
     """A scene's reference images (and the sky-only ones), rendered on first use and cached."""
 
-    def __init__(self, scene_path, scene_name, cache_dir, output_dir, reference_seconds):
+    def __init__(self, scene_path, scene_name, cache_dir, output_dir, reference_seconds,
+                 exposure=None):
+        self.exposure = exposure
         self.scene_path = scene_path
         self.scene_name = scene_name
         self.cache_dir = cache_dir
@@ -1187,7 +1205,8 @@ class SceneReferences:
             label = f"{name} (±{100.0 * rms / max(mean, 1e-30):.2g} %)"
         if not sky:
             write_png(image, os.path.join(self.output_dir,
-                                          f"{self.scene_name}-reference-{name}.png"))
+                                          f"{self.scene_name}-reference-{name}.png"),
+                      self.exposure)
         self.images[(name, sky)] = (image, error, label)
         return self.images[(name, sky)]
 
@@ -1216,6 +1235,13 @@ def run(arguments):
     parser.add_argument("--cache-dir", default=None,
                         help="reference cache (default: OUTPUT_DIR/reference-cache)")
     parser.add_argument("--markdown", help="also write the table as Markdown to this file")
+    parser.add_argument("--display-exposure", type=float, default=DISPLAY_EXPOSURE,
+                        help="exposure of the PNGs written for looking at (default %(default)g;"
+                             " not used in any metric)")
+    parser.add_argument("--side-by-side", action="store_true",
+                        help="also write SCENE-RENDERER-INDEX-side.png per row: the reference,"
+                             " the image and |difference| x "
+                             f"{SIDE_BY_SIDE_DIFFERENCE_GAIN:g}")
     parser.add_argument("--path-convergence", type=int, metavar="SPP",
                         help="instead: measure the path tracer at SPP samples per pixel on each "
                              "scene and extrapolate its time to 1%% relative RMSE")
@@ -1229,6 +1255,8 @@ def run(arguments):
         parser.error("--settings needs exactly one --renderer")
     if args.repeats < 1:
         parser.error("--repeats must be >= 1")
+    if not (args.display_exposure > 0 and math.isfinite(args.display_exposure)):
+        parser.error("--display-exposure must be a positive number")
     if not (args.reference_seconds > 0 and math.isfinite(args.reference_seconds)):
         parser.error("--reference-seconds must be a positive number of seconds")
     cache_dir = args.cache_dir or os.path.join(args.output_dir, "reference-cache")
@@ -1241,7 +1269,7 @@ def run(arguments):
         scene_name = os.path.splitext(os.path.basename(scene_path))[0]
         scene = load_scene(scene_path)
         references = SceneReferences(scene_path, scene_name, cache_dir, args.output_dir,
-                                     args.reference_seconds)
+                                     args.reference_seconds, args.display_exposure)
 
         def reference_name(renderer_name, settings):
             if args.reference != "auto":
@@ -1288,7 +1316,12 @@ def run(arguments):
                           f"{seconds:.3f} s, RMSE {row['rmse']:.4g} vs {label}, "
                           f"PSNR {row['psnr_db']:.1f} dB", flush=True)
                     write_png(image, os.path.join(
-                        args.output_dir, f"{scene_name}-{renderer_name}-{index}.png"))
+                        args.output_dir, f"{scene_name}-{renderer_name}-{index}.png"),
+                        args.display_exposure)
+                    if args.side_by_side:
+                        write_side_by_side(reference, image, os.path.join(
+                            args.output_dir, f"{scene_name}-{renderer_name}-{index}-side.png"),
+                            args.display_exposure)
             finally:
                 renderer.close()
         plot(scene_rows, f"{scene_name} (reference: {reference_title(scene_rows)})",

@@ -324,7 +324,9 @@ class HarnessTest(unittest.TestCase):
                       stream)
         self.assertEqual(harness.run([path, "--renderer", "svs", "--settings", settings,
                                       "--reference", "path-single", "--reference-seconds", "4",
-                                      "--repeats", "1", "--output-dir", self.output]), 0)
+                                      "--repeats", "1", "--side-by-side",
+                                      "--display-exposure", "20",
+                                      "--output-dir", self.output]), 0)
         with open(os.path.join(self.output, "trade.csv")) as stream:
             rows = list(csv.DictReader(stream))
         self.assertEqual(len(rows), 2)
@@ -332,6 +334,12 @@ class HarnessTest(unittest.TestCase):
             self.assertRegex(row["reference"], r"^path-single \(")
             # Measured on llvmpipe: 37.7 and 37.2 dB (a 4 s reference, 1250 samples per pixel).
             self.assertGreater(float(row["psnr_db"]), 30.0, row)
+        # Reference, image and difference side by side, 2 pixels apart.
+        from vtkmodules.vtkIOImage import vtkPNGReader
+        reader = vtkPNGReader()
+        reader.SetFileName(os.path.join(self.output, "lit-svs-1-side.png"))
+        reader.Update()
+        self.assertEqual(reader.GetOutput().GetDimensions(), (3 * 48 + 4, 36, 1))
 
 
 if __name__ == "__main__":
