@@ -1751,6 +1751,8 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     };
   }
 
+  this->AddViewLightsToSolve(frame, zMiddle, lighting);
+
   const nimbus::SceneAtmosphere& air = settings.Air;
   request.Key = { static_cast<double>(method), static_cast<double>(options.Orders),
     static_cast<double>(options.NumberOfDirections), options.SkyLight ? 1.0 : 0.0,
@@ -1762,6 +1764,13 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     settings.Sun.TemperatureKelvin, frame.Atmosphere ? 1.0 : 0.0, frame.Ground ? 1.0 : 0.0,
     air.SceneAltitudeMetres, air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG,
     settings.GroundAlbedo, settings.GroundHeight };
+  if (!lighting.PointLights.empty())
+  {
+    // The lights' part of the answer does not scale with the sun's illuminance: with
+    // lights, a new illuminance is a new solve.
+    request.Key.push_back(settings.Sun.Illuminance);
+    request.Key.insert(request.Key.end(), frame.LightsKey.begin(), frame.LightsKey.end());
+  }
   if (method == MultipleScatteringReferencePatterns)
   {
     request.Key.insert(request.Key.end(),
@@ -2895,6 +2904,47 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
   }
   in.CompositePass->Render();
   ++in.PassesLastRender;
+}
+
+//------------------------------------------------------------------------------
+// The view's lights as point lights of the multiple-scattering solve (their orders >= 2
+// in the cloud; the march draws their single scattering): metres in the up frame, each
+// dimmed by the clear air between it and the cloud's middle height (the solve sees no
+// air). The opaque scene's shadows are not in the solve.
+void vtkNimbusCloudVolumeMapper::AddViewLightsToSolve(
+  const FrameState& frame, double cloudMiddleZ, nimbus::CloudLighting& lighting)
+{
+  const Internals& in = *this->Internal;
+  const double metres = frame.Settings.MetresPerUnit;
+  for (const nimbus::ViewLight& light : frame.Lights)
+  {
+    nimbus::PointLight point;
+    point.Position = { { light.Position[0] * metres, light.Position[1] * metres,
+      light.Position[2] * metres } };
+    point.Spot = light.Spot;
+    std::array<double, 3> transmittance{ { 1.0, 1.0, 1.0 } };
+    if (frame.Atmosphere && in.Table.HasAtmosphere)
+    {
+      // Straight up or down to the cloud's middle height: a vertical path's optical length.
+      const double h = frame.Settings.Air.SceneAltitudeMetres + point.Position[2];
+      const double rise = cloudMiddleZ * metres - point.Position[2];
+      const double cosZenith = rise >= 0.0 ? 1.0 : -1.0;
+      const double lr = nimbus::FlatLayerOpticalLength(
+        h, cosZenith, std::abs(rise), in.Table.Air.RayleighScaleHeightMetres);
+      const double lm = nimbus::FlatLayerOpticalLength(
+        h, cosZenith, std::abs(rise), in.Table.Air.MieScaleHeightMetres);
+      for (int c = 0; c < 3; ++c)
+      {
+        transmittance[c] = std::exp(-(in.Table.RayleighExtinctionSeaLevel[c] * lr +
+          in.Table.MieExtinctionSeaLevel * lm));
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      point.Intensity[c] = light.Intensity[c] * transmittance[c];
+    }
+    lighting.PointLights.push_back(point);
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -86,6 +86,7 @@ class vtkTextureObject;
 class vtkMatrix4x4;
 namespace nimbus
 {
+struct CloudLighting;
 class SkyModel;
 class SkyViewLut;
 }
@@ -834,6 +835,8 @@ private:
   void UpdateViewLights(vtkRenderer* renderer, FrameState& frame);
   void UpdateLightMapTexture(FrameState& frame);
   void SetViewLightUniforms(vtkShaderProgram* program, const FrameState& frame);
+  void AddViewLightsToSolve(
+    const FrameState& frame, double cloudMiddleZ, nimbus::CloudLighting& lighting);
   void RenderVirtualPlanes(const FrameState& frame);
   void SetCloudLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
