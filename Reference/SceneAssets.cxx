@@ -23,6 +23,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <stdexcept>
 
@@ -57,8 +58,9 @@ void RequireFile(const std::string& path, const std::string& key)
   }
 }
 
-/// Collects a VTK algorithm's error messages (its own output window stays quiet about
-/// them only if the caller's does; the text goes into the exception).
+/// Collects a VTK algorithm's error and warning messages (a reader that cannot read part
+/// of a file may only warn, as vtkImageReader2 does for a truncated file); the text goes
+/// into the exception. The caller's output window still shows them as VTK reports them.
 class ErrorCollector
 {
 public:
@@ -79,6 +81,7 @@ public:
         *text += (text->empty() ? "" : "; ") + message;
       });
     algorithm->AddObserver(vtkCommand::ErrorEvent, this->Command);
+    algorithm->AddObserver(vtkCommand::WarningEvent, this->Command);
   }
   const std::string& GetText() const { return this->Text; }
 
@@ -86,6 +89,62 @@ private:
   std::string Text;
   vtkNew<vtkCallbackCommand> Command;
 };
+
+/// A binary PGM or PPM (P5, P6) file's header, checked before VTK reads it: vtkPNMReader
+/// reads a truncated file with only a generic warning (no event to observe) and ignores
+/// maxval, so here the file must hold every pixel and maxval must be 255. Other magic
+/// numbers are left to the reader (which refuses them).
+void CheckPnm(const std::string& path, const std::string& key)
+{
+  std::ifstream in(path, std::ios::binary);
+  std::string magic(2, '\0');
+  if (!in.read(&magic[0], 2) || (magic != "P5" && magic != "P6"))
+  {
+    return;
+  }
+  long long fields[3] = { 0, 0, 0 };
+  for (long long& field : fields)
+  {
+    int c = in.get();
+    while (c != EOF && (std::isspace(c) || c == '#'))
+    {
+      if (c == '#')
+      {
+        while (c != EOF && c != '\n')
+        {
+          c = in.get();
+        }
+      }
+      c = in.get();
+    }
+    if (c == EOF || !std::isdigit(c))
+    {
+      Fail(key, "cannot read '" + path + "' as an image: a bad " + magic + " header");
+    }
+    while (c != EOF && std::isdigit(c) && field < 1000000000)
+    {
+      field = 10 * field + (c - '0');
+      c = in.get();
+    }
+  }
+  if (fields[2] != 255)
+  {
+    Fail(key,
+      "'" + path + "' has maxval " + std::to_string(fields[2]) +
+        "; a PGM or PPM light map needs maxval 255 (8 bits)");
+  }
+  const long long header = static_cast<long long>(in.tellg());
+  const long long need = fields[0] * fields[1] * (magic == "P6" ? 3 : 1);
+  std::error_code error;
+  const auto size = static_cast<long long>(std::filesystem::file_size(path, error));
+  if (error || header < 0 || size - header < need)
+  {
+    Fail(key,
+      "cannot read '" + path + "' as an image: it is truncated (" + std::to_string(fields[0]) +
+        " x " + std::to_string(fields[1]) + " pixels need " + std::to_string(need) +
+        " bytes after the header, it has " + std::to_string(std::max(0LL, size - header)) + ")");
+  }
+}
 
 /// sRGB's electro-optical transfer function (IEC 61966-2-1): encoded [0, 1] to linear.
 double DecodeSrgb(double c)
@@ -97,6 +156,11 @@ double DecodeSrgb(double c)
 LightMapDescription ReadLightMap(const std::string& path, const std::string& key)
 {
   RequireFile(path, key);
+  const std::string extension = LowerExtension(path);
+  if (extension == ".pgm" || extension == ".ppm" || extension == ".pnm")
+  {
+    CheckPnm(path, key);
+  }
   vtkSmartPointer<vtkImageReader2> reader;
   reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(path.c_str()));
   if (!reader)
@@ -149,7 +213,7 @@ LightMapDescription ReadLightMap(const std::string& path, const std::string& key
       "'" + path + "' has " + std::string(scalars->GetDataTypeAsString()) +
         " samples; a light map needs 8 or 16 bits per channel");
   }
-  const bool srgb = LowerExtension(path) == ".png";
+  const bool srgb = extension == ".png";
   const int components = scalars->GetNumberOfComponents();
   LightMapDescription map;
   map.Path = path;

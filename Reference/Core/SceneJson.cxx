@@ -77,6 +77,9 @@ constexpr std::size_t kMaxAdditionalMedia = 16;
 // hierarchy's leaf holding it; meshes may hold many triangles each (their limit is the
 // glue's, SceneAssets.h).
 constexpr std::size_t kMaxOccluders = 4096;
+// A mesh's scale (metres per file unit): from nanometres to the length limit; smaller
+// scales would make every triangle's area underflow.
+constexpr double kMinMeshScale = 1.0e-9;
 /// Deepest nesting of arrays and objects a scene file may have. A scene needs 5
 /// (scene.medium.density.parameters.Bounds); deeper files are refused before
 /// they cost memory or time.
@@ -1075,7 +1078,8 @@ OccluderDescription ReadOccluder(const Json& v, const std::string& path, const s
   {
     o.Translate = ReadVector3(r["translate"], r.Key("translate"), Coordinate());
   }
-  r.Number("scale", o.Scale, Range{ 0.0, kMaxLengthMetres, true, false });
+  // A metre per nanometre to a gigametre per unit: areas of ~1e-18 m^2 and more.
+  r.Number("scale", o.Scale, Closed(kMinMeshScale, kMaxLengthMetres));
   return o;
 }
 

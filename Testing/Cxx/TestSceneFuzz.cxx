@@ -9,7 +9,10 @@
 // the test.
 //
 // One more base scene adds version 3's lights (point, polyline) and emission to the first
-// project scene, so that its mutants carry bad values of the new keys.
+// project scene, and another version 4's spot lights (one through a light map) and
+// occluders (a box, a mesh), so that their mutants carry bad values of the new keys. A
+// valid mutant whose light map or mesh cannot be read (a mutated path) is refused by the
+// renderer with a message naming the key: that counts as a clean refusal.
 //
 // Mutations: a number scaled by 0, -1, 1e-308 ... 1e300 (often still valid), a value
 // replaced by an extreme (0, -1, +-1e308, 1e-308, huge integers,
@@ -40,6 +43,7 @@
 #include <fstream>
 #include <map>
 #include <random>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -361,6 +365,48 @@ Json WithVersion3Features(Json j)
   return j;
 }
 
+/// A version-4 scene from a project scene: a searchlight below the cloud through a light
+/// map (a 4 x 4 PGM), a streetlight's spot, a box and a mesh (an OBJ post) in their beams.
+/// The files are written to `work`, and the scene names them by absolute path.
+Json WithVersion4Features(Json j, const fs::path& work)
+{
+  const fs::path gobo = work / "gobo.pgm", post = work / "post.obj";
+  {
+    std::ofstream out(gobo, std::ios::binary);
+    out << "P5\n4 4\n255\n";
+    const unsigned char pixels[16] = { 0, 255, 255, 0, 255, 0, 0, 255, 128, 128, 64, 64, 0, 0, 255,
+      255 };
+    out.write(reinterpret_cast<const char*>(pixels), sizeof(pixels));
+  }
+  std::ofstream(post) << "v 0 0 0\nv 30 0 0\nv 30 0 900\nv 0 0 900\nv 0 30 0\nf 1 2 3 4\nf 1 4 5\n";
+  j["nimbus_scene"] = 4;
+  j["name"] = j["name"].get<std::string>() + "_spots";
+  j["lights"] = Json::parse(R"([
+    {"type": "spot", "position": [0, -200, 10], "direction": [0, 0.2, 1],
+     "cone_angle_degrees": 6, "edge_degrees": 1, "intensity": 1e9, "temperature_kelvin": 5000},
+    {"type": "spot", "position": [-300, -2000, 12], "direction": [0, 0, -1],
+     "cone_angle_degrees": 40, "intensity": 1e5}
+  ])");
+  j["lights"][0]["light_map"] = gobo.string();
+  j["occluders"] = Json::parse(R"([
+    {"type": "box", "min": [-50, -250, 30], "max": [0, -150, 30], "albedo": 0},
+    {"type": "mesh", "translate": [-320, -2020, 0], "scale": 0.01, "albedo": 0.4}
+  ])");
+  j["occluders"][1]["path"] = post.string();
+  return j;
+}
+
+/// A renderer's error about a file the scene names (a light map or a mesh), which names
+/// the scene key ("scene.lights[0].light_map: cannot read ..." from the reader,
+/// "scene: occluders[1].path has ..." from the renderer): a clean refusal of a mutant whose
+/// path was changed.
+bool IsAssetRefusal(const std::string& errors)
+{
+  static const std::regex key(
+    R"(scene(\.|: )(lights\[[0-9]+\]\.light_map|occluders\[[0-9]+\]\.path)[: ])");
+  return std::regex_search(errors, key);
+}
+
 /// In the child: what happens to one mutant.
 std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& sceneFile)
 {
@@ -406,8 +452,10 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
   vtkNew<vtkNimbusReferenceRenderer> renderer;
   nimbus::testing::MessageCatcher messages(renderer);
   renderer->SetSceneFileName(sceneFile.string().c_str());
-  // Version-3 features are the path tracer's: single scattering refuses them by name.
-  const bool refusedBySingleScattering = scene.UsesVersion3Features();
+  // Version-3 and version-4 features are the path tracer's: single scattering refuses them
+  // by name.
+  const bool refusedBySingleScattering =
+    scene.UsesVersion3Features() || scene.UsesVersion4Features();
   renderer->SetModeToSingleScattering();
   renderer->SetMaxRefinements(0);
   renderer->SetStepScale(1.0);
@@ -422,6 +470,10 @@ std::pair<Outcome, std::string> Judge(const Mutant& mutant, const fs::path& scen
   }
   auto* radiance =
     vtkFloatArray::SafeDownCast(renderer->GetOutput()->GetPointData()->GetArray("radiance"));
+  if (!radiance && IsAssetRefusal(messages.AllErrors()))
+  {
+    return { Outcome::Refused, messages.AllErrors() };
+  }
   if (refusedBySingleScattering)
   {
     const std::string errors = messages.AllErrors();
@@ -551,6 +603,7 @@ TEST(SceneFuzz, MutantsAreRefusedCleanlyOrRenderFinite)
   std::sort(scenes.begin(), scenes.end()); // a fixed order: the same mutants every run
   ASSERT_GE(scenes.size(), 5u);
   scenes.push_back(scenes.front()); // again, with the version-3 features (below)
+  scenes.push_back(scenes.front()); // and with the version-4 features
   const fs::path work = fs::temp_directory_path() /
     ("nimbus-scene-fuzz-" + std::to_string(::getpid()) + "-" +
       std::to_string(std::random_device{}()));
@@ -565,7 +618,9 @@ TEST(SceneFuzz, MutantsAreRefusedCleanlyOrRenderFinite)
   for (std::size_t s = 0; s < scenes.size(); ++s)
   {
     const fs::path& file = scenes[s];
-    const Json base = s + 1 == scenes.size() ? WithVersion3Features(Cheap(file)) : Cheap(file);
+    const Json base = s + 2 == scenes.size() ? WithVersion3Features(Cheap(file))
+      : s + 1 == scenes.size()               ? WithVersion4Features(Cheap(file), work)
+                                             : Cheap(file);
     // The unmutated (cheap) scene must render: the oracle is not vacuous.
     const auto original = JudgeInChild({ "none", base.dump(2) }, work / "original.json");
     EXPECT_EQ(original.first, Outcome::Rendered) << file << ": " << original.second;

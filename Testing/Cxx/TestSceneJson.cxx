@@ -353,8 +353,10 @@ fs::path MakeTemporaryDirectory(const std::string& name)
 //------------------------------------------------------------------------------
 TEST(SceneJson, ProjectScenesParse)
 {
+  // The sun-lit scenes, and (format version 4) the scenes lit by lights: a streetlight in
+  // fog behind a post, a spot through a gobo in haze, a searchlight under a cloud.
   const std::set<std::string> expected = { "cumulus_noon", "cumulus_sunset", "silver_lining",
-    "haze_shafts", "cumulonimbus" };
+    "haze_shafts", "cumulonimbus", "streetlight_fog", "gobo_haze", "searchlight_cloud" };
   std::set<std::string> found;
   for (const auto& entry : fs::directory_iterator(NIMBUS_SCENES_DIR))
   {
@@ -1594,11 +1596,11 @@ std::vector<BadScene> BadVersion4Scenes()
     { "a mesh with min", V4With(mesh + "/min", Json::array({ 0, 0, 0 })),
       "scene.occluders[1].min: unknown key (known: type, path, albedo, translate, scale)" },
     { "scale 0", V4With(mesh + "/scale", 0),
-      "scene.occluders[1].scale: expected a number in (0, 1000000000], got 0" },
+      "scene.occluders[1].scale: expected a number in [1e-09, 1000000000], got 0" },
     { "scale -1", V4With(mesh + "/scale", -1),
-      "scene.occluders[1].scale: expected a number in (0, 1000000000], got -1" },
+      "scene.occluders[1].scale: expected a number in [1e-09, 1000000000], got -1" },
     { "scale 2e9", V4With(mesh + "/scale", 2e9),
-      "scene.occluders[1].scale: expected a number in (0, 1000000000], got 2000000000" },
+      "scene.occluders[1].scale: expected a number in [1e-09, 1000000000], got 2000000000" },
   };
   bad.insert(bad.end(), rules.begin(), rules.end());
   {
