@@ -10,6 +10,8 @@
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
+#include "vtkImageReader2.h"
+#include "vtkImageReader2Factory.h"
 #include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
 #include "vtkInformationVector.h"
@@ -27,9 +29,11 @@
 #include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 
+#include "Atmosphere.h" // nimbus::AtmosphereParameters (the haze's albedo)
 #include "CloudInputImage.h"
 #include "NimbusCompositingOrder.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include <vtksys/SystemTools.hxx>
 
 #include <algorithm>
 #include <cmath>
@@ -80,9 +84,34 @@ void vtkNimbusCloudRepresentation::SetMieScatteringPerMetre(double value)
   }
 }
 
+void vtkNimbusCloudRepresentation::SetFogVisibilityMetres(double value)
+{
+  if (!std::isfinite(value) || value < 0.0)
+  {
+    vtkErrorMacro("SetFogVisibilityMetres(" << value
+                                            << "): the visibility must be a finite number of "
+                                               "metres, 0 or more (0: no fog); ignored");
+    return;
+  }
+  if (value != this->FogVisibilityMetres)
+  {
+    this->FogVisibilityMetres = value;
+    this->ApplyHaze();
+    this->Modified();
+  }
+}
+
 void vtkNimbusCloudRepresentation::ApplyHaze()
 {
-  if (this->MieScatteringOverride >= 0.0)
+  if (this->FogVisibilityMetres > 0.0)
+  {
+    // Visibility V = 3.912 / extinction (Koschmieder, 2 % contrast); the haze's
+    // extinction is its scattering / MieAlbedo. The mapper clamps to its range (1/m).
+    constexpr double kKoschmieder = 3.912;
+    this->CloudMapper->SetMieScatteringPerMetre(
+      nimbus::AtmosphereParameters().MieAlbedo * kKoschmieder / this->FogVisibilityMetres);
+  }
+  else if (this->MieScatteringOverride >= 0.0)
   {
     this->CloudMapper->SetMieScatteringPerMetre(this->MieScatteringOverride);
   }
@@ -542,6 +571,15 @@ NIMBUS_FORWARD(Exposure, double)
 NIMBUS_FORWARD(EncodeSrgb, bool)
 NIMBUS_FORWARD(FrameBudgetMilliseconds, double)
 NIMBUS_FORWARD(Quality, double)
+NIMBUS_FORWARD(LightSources, int)
+NIMBUS_FORWARD(LightIntensityScale, double)
+NIMBUS_FORWARD(SpotEdgeWidthDegrees, double)
+NIMBUS_FORWARD(LightShaftMethod, int)
+NIMBUS_FORWARD(LightSamples, int)
+NIMBUS_FORWARD(NumberOfVirtualPlanes, int)
+NIMBUS_FORWARD(LightShadowMapSize, int)
+NIMBUS_FORWARD(LightCloudSteps, int)
+NIMBUS_FORWARD(MaximumLights, int)
 
 #undef NIMBUS_FORWARD
 
@@ -697,6 +735,59 @@ const char* vtkNimbusCloudRepresentation::GetEmissionTemperatureArray()
   return this->CloudMapper->GetEmissionTemperatureArray();
 }
 
+// The light map: read with the reader the factory picks for the file (by its
+// contents and extension); any failure leaves no map and says why.
+void vtkNimbusCloudRepresentation::SetLightMapFile(const char* name)
+{
+  const std::string value = name ? name : "";
+  if (value == this->LightMapFile)
+  {
+    return;
+  }
+  this->LightMapFile = value;
+  this->CloudMapper->SetLightMap(nullptr);
+  if (value.empty())
+  {
+    return;
+  }
+  if (!vtksys::SystemTools::FileExists(value, true))
+  {
+    vtkErrorMacro("Light Map File '" << value
+                                     << "': no such file; the spotlights shine without a "
+                                        "light map.");
+    return;
+  }
+  vtkSmartPointer<vtkImageReader2> reader;
+  reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(value.c_str()));
+  if (!reader)
+  {
+    vtkErrorMacro("Light Map File '" << value
+                                     << "': not an image format VTK reads (.png, .jpg, "
+                                        ".pgm/.ppm, .tif, .bmp); the spotlights shine "
+                                        "without a light map.");
+    return;
+  }
+  reader->SetFileName(value.c_str());
+  reader->Update();
+  vtkImageData* image = reader->GetOutput();
+  int dims[3] = { 0, 0, 0 };
+  if (image)
+  {
+    image->GetDimensions(dims);
+  }
+  if (reader->GetErrorCode() != 0 || !image || dims[0] < 1 || dims[1] < 1 ||
+    !image->GetPointData()->GetScalars())
+  {
+    vtkErrorMacro("Light Map File '" << value << "': the " << reader->GetDescriptiveName()
+                                     << " reader could not read an image from it; the "
+                                        "spotlights shine without a light map.");
+    return;
+  }
+  vtkNew<vtkImageData> copy;
+  copy->ShallowCopy(image);
+  this->CloudMapper->SetLightMap(copy);
+}
+
 void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -716,6 +807,8 @@ void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent
      << "MieScatteringPerMetre (override, -1 = from Turbidity): " << this->MieScatteringOverride
      << "\n";
+  os << indent << "FogVisibilityMetres (0 = no fog): " << this->FogVisibilityMetres << "\n";
+  os << indent << "LightMapFile: '" << this->LightMapFile << "'\n";
   os << indent << "WholeBounds (all ranks' pieces): " << this->WholeBounds[0] << " .. "
      << this->WholeBounds[1] << ", " << this->WholeBounds[2] << " .. " << this->WholeBounds[3]
      << ", " << this->WholeBounds[4] << " .. " << this->WholeBounds[5] << "\n";

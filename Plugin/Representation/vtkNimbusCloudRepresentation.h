@@ -270,6 +270,50 @@ public:
   bool GetEncodeSrgb();
   ///@}
 
+  ///@{
+  /// The view's own lights (vtkNimbusCloudVolumeMapper, "The view's own lights";
+  /// docs/lights.md, docs/lights-paraview.md): the renderer's positional lights (the
+  /// Light Inspector's lights with Positional on; ConeAngle < 90 degrees: a spotlight)
+  /// light the haze, the cloud and the ground, drawn by the ray march only.
+  /// LightSources 0 none, 1 the positional lights (default); LightIntensityScale
+  /// [Y/sr per unit of a light's Intensity]; SpotEdgeWidthDegrees [deg];
+  /// LightShaftMethod 0 ray marching (default), 1 virtual planes; LightSamples per
+  /// light and ray; NumberOfVirtualPlanes; LightShadowMapSize [texels per face side,
+  /// 0: no shadows of the opaque geometry]; LightCloudSteps [samples toward a light,
+  /// 0: the cloud casts no shadow]; MaximumLights (up to 8).
+  void SetLightSources(int value);
+  int GetLightSources();
+  void SetLightIntensityScale(double value);
+  double GetLightIntensityScale();
+  void SetSpotEdgeWidthDegrees(double value);
+  double GetSpotEdgeWidthDegrees();
+  void SetLightShaftMethod(int value);
+  int GetLightShaftMethod();
+  void SetLightSamples(int value);
+  int GetLightSamples();
+  void SetNumberOfVirtualPlanes(int value);
+  int GetNumberOfVirtualPlanes();
+  void SetLightShadowMapSize(int value);
+  int GetLightShadowMapSize();
+  void SetLightCloudSteps(int value);
+  int GetLightCloudSteps();
+  void SetMaximumLights(int value);
+  int GetMaximumLights();
+  /// The light map (a gobo): an image file (.png, .jpg, .pgm/.ppm, .tif, any format
+  /// vtkImageReader2Factory knows) read when the name changes; its luminance
+  /// multiplies every spotlight's beam (vtkNimbusCloudVolumeMapper::SetLightMap). An
+  /// empty name: no map. A file that cannot be read: an error, and no map.
+  void SetLightMapFile(const char* name);
+  const char* GetLightMapFile() { return this->LightMapFile.c_str(); }
+  /// Fog for the lights without a cloud: the meteorological visibility in metres
+  /// (the distance at which a black object fades to 2 % contrast: 3.912 / extinction).
+  /// Above 0 it sets the air's Mie scattering at sea level to
+  /// MieAlbedo x 3.912 / visibility, overriding Turbidity and MieScatteringPerMetre;
+  /// 0 (the default): no fog, the haze is theirs.
+  void SetFogVisibilityMetres(double value);
+  double GetFogVisibilityMetres() { return this->FogVisibilityMetres; }
+  ///@}
+
 protected:
   vtkNimbusCloudRepresentation();
   ~vtkNimbusCloudRepresentation() override;
@@ -332,10 +376,15 @@ protected:
   std::string DefaultDensityArray;
   bool DefaultDensityIsCells = false;
 
-  /// The haze's two settings and the mapper's value from them.
+  /// The haze's three settings and the mapper's value from them: the fog if any, else
+  /// the Mie scattering if >= 0, else the turbidity.
   void ApplyHaze();
   double Turbidity = 2.0;
   double MieScatteringOverride = -1.0;
+  double FogVisibilityMetres = 0.0;
+
+  /// The light map's file name (the mapper holds the image read from it).
+  std::string LightMapFile;
 
 private:
   /// The mapper's progress during a long still render, as this representation's
