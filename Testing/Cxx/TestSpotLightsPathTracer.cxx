@@ -308,6 +308,8 @@ TEST(SpotLightsPathTracer, PointLightAirlightIsTheClosedForm)
   const double quadrature = Simpson(Airlight(camera, { { 0.0, 1.0, 0.0 } }, light, intensity,
                                       albedo * sigmaT, sigmaT, 0.0, [](const V&) { return 1.0; }),
     0.0, rayLength, 1e-14);
+  std::printf("closed form %.12g, Simpson quadrature %.12g (relative difference %.1e)\n", closed,
+    quadrature, quadrature / closed - 1.0);
   EXPECT_NEAR(quadrature / closed, 1.0, 1e-9);
   ExpectPixel(r, Rgb(context, context.GetLightSpectra()[0], closed),
     "point light airlight, closed form (Sun et al. 2005)");
@@ -576,40 +578,79 @@ TEST(SpotLightsPathTracer, LambertianOccludersByLightsAndSun)
 }
 
 //------------------------------------------------------------------------------
-// Light that bounces off the ground onto an occluder (MaxScatteringOrder 2): a 1 m flat
-// plate 50 m above an infinite ground of albedo rho_g lit by the sun; its underside has
-// radiance rho_p rho_g E sin(e) / pi (1 - F), F the form factor from the seen point to
-// the plate's own shadow on the ground (Lambert's polygon formula), ~4e-5 here.
+// Light that bounces off the ground onto an occluder (MaxScatteringOrder 2): a 1 m plate
+// 50 m above an infinite ground of albedo rho_g lit by the sun, seen from below. The
+// ground has radiance rho_g E sin(e) / pi, so the plate's lower side has radiance
+// rho_p rho_g E sin(e) / pi [(1 + cos(tilt)) / 2 - F]: the view factor of the ground from
+// a surface tilted by `tilt` from facing straight down, less F, the form factor to the
+// plate's own shadow on the ground (Lambert's polygon formula; ~1e-4 here). A flat box
+// (horizontal) and a mesh of two triangles tilted by 60 degrees toward the south, where
+// the sampling of directions about the normal decides how much of the ground is seen.
 TEST(SpotLightsPathTracer, PlateLitByTheGroundBelowIt)
 {
   const double rhoP = 0.7, rhoG = 0.4, elevation = 50.0 * kDegree, height = 50.0;
-  const V seen{ { 0.1, 0.15, height } };
-  SceneDescription scene = DarkScene({ { 0.1, -2.0, 1.0 } }, seen);
-  scene.Ground.Enabled = true;
-  scene.Ground.Albedo = rhoG;
-  scene.Sun.Illuminance = 1.0;
-  scene.Sun.ElevationDegrees = 50.0;
-  scene.Sun.AzimuthDegrees = 0.0;
-  scene.Occluders = { Box({ { -0.5, -0.5, height } }, { { 0.5, 0.5, height } }, rhoP) };
-  const RenderContext context(scene, DensityGrid());
-  // The shadow: the plate moved along -s to the ground, s = (0, cos e, sin e).
-  const double shift = height / std::tan(elevation);
-  const std::vector<V> shadow = { { { -0.5, -0.5 - shift, 0.0 } }, { { 0.5, -0.5 - shift, 0.0 } },
-    { { 0.5, 0.5 - shift, 0.0 } }, { { -0.5, 0.5 - shift, 0.0 } } };
-  // Point-to-polygon form factor: F = 1/(2 pi) |sum_i angle_i n . unit(r_i x r_i+1)|.
-  const V n{ { 0.0, 0.0, -1.0 } };
-  double sum = 0.0;
-  for (std::size_t i = 0; i < shadow.size(); ++i)
+  const V sun{ { 0.0, std::cos(elevation), std::sin(elevation) } }; // azimuth 0
+  std::uint64_t seed = 140;
+  for (const double tilt : { 0.0, 60.0 * kDegree })
   {
-    const V a = Unit(Sub(shadow[i], seen)), b = Unit(Sub(shadow[(i + 1) % shadow.size()], seen));
-    sum += std::acos(nimbus::Dot(a, b)) * nimbus::Dot(n, Unit(nimbus::Cross(a, b)));
+    // The plate: centre c, edges ex and ey, the seen side's normal n (down, and south).
+    const V c{ { 0.0, 0.0, height } }, ex{ { 1.0, 0.0, 0.0 } };
+    const V ey{ { 0.0, std::cos(tilt), -std::sin(tilt) } };
+    const V n{ { 0.0, -std::sin(tilt), -std::cos(tilt) } };
+    std::vector<V> corners;
+    for (const auto& k : { std::make_pair(-0.5, -0.5), std::make_pair(0.5, -0.5),
+           std::make_pair(0.5, 0.5), std::make_pair(-0.5, 0.5) })
+    {
+      corners.push_back({ { c[0] + k.first * ex[0] + k.second * ey[0],
+        c[1] + k.first * ex[1] + k.second * ey[1], c[2] + k.first * ex[2] + k.second * ey[2] } });
+    }
+    const V seen = nimbus::Along(nimbus::Along(c, ex, 0.1), ey, 0.15);
+    SceneDescription scene = DarkScene(nimbus::Along(seen, n, 40.0), seen);
+    scene.Ground.Enabled = true;
+    scene.Ground.Albedo = rhoG;
+    scene.Sun.Illuminance = 1.0;
+    scene.Sun.ElevationDegrees = 50.0;
+    scene.Sun.AzimuthDegrees = 0.0;
+    if (tilt == 0.0)
+    {
+      scene.Occluders = { Box({ { -0.5, -0.5, height } }, { { 0.5, 0.5, height } }, rhoP) };
+    }
+    else
+    {
+      OccluderDescription plate;
+      plate.Type = "mesh";
+      plate.Path = "tilted-plate";
+      plate.Albedo = rhoP;
+      plate.TriangleVertices = { corners[0], corners[1], corners[2], corners[0], corners[2],
+        corners[3] };
+      scene.Occluders = { plate };
+    }
+    const RenderContext context(scene, DensityGrid());
+    // The shadow: each corner moved along -s to the ground.
+    std::vector<V> shadow;
+    for (const V& x : corners)
+    {
+      shadow.push_back(nimbus::Along(x, sun, -x[2] / sun[2]));
+    }
+    // Point-to-polygon form factor: F = 1/(2 pi) |sum_i angle_i n . unit(r_i x r_i+1)|.
+    double sum = 0.0;
+    for (std::size_t i = 0; i < shadow.size(); ++i)
+    {
+      const V a = Unit(Sub(shadow[i], seen)), b = Unit(Sub(shadow[(i + 1) % shadow.size()], seen));
+      EXPECT_GT(nimbus::Dot(a, n), 0.0); // the whole shadow is in front of the seen side
+      sum += std::acos(nimbus::Dot(a, b)) * nimbus::Dot(n, Unit(nimbus::Cross(a, b)));
+    }
+    const double form = std::abs(sum) / (2.0 * kPi);
+    const double view = 0.5 * (1.0 + std::cos(tilt));
+    const double scalar = rhoP * rhoG * std::sin(elevation) / kPi * (view - form);
+    std::printf("plate tilted %.0f degrees: ground view factor %.4f, form factor to its shadow "
+                "%.3g\n",
+      tilt / kDegree, view, form);
+    const PathTracingResult r = nimbus::RenderPathTraced(context, Samples(400000, ++seed, 2));
+    ExpectPixel(r, Rgb(context, context.GetSunIrradiance(), scalar),
+      tilt == 0.0 ? "a flat box's underside lit by the sunlit ground (one bounce)"
+                  : "a tilted two-triangle plate lit by the sunlit ground (one bounce)");
   }
-  const double form = std::abs(sum) / (2.0 * kPi);
-  const double scalar = rhoP * rhoG * std::sin(elevation) / kPi * (1.0 - form);
-  std::printf("form factor to the plate's shadow: %.3g\n", form);
-  const PathTracingResult r = nimbus::RenderPathTraced(context, Samples(400000, 140, 2));
-  ExpectPixel(r, Rgb(context, context.GetSunIrradiance(), scalar),
-    "a plate's underside lit by the sunlit ground (one bounce)");
 }
 
 //------------------------------------------------------------------------------
