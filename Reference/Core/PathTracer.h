@@ -1,7 +1,8 @@
 // Monte Carlo volumetric path tracer: the full-multiple-scattering ground truth
 // for the scenes of RenderContext (cloud + Rayleigh/Mie atmosphere + Lambertian
 // ground + background + directional sun; since scene format version 3 also point and
-// polyline lights, emitting media and several media). Everything physical comes from the
+// polyline lights, emitting media and several media; since version 4 spot lights with light
+// maps and opaque Lambertian occluders). Everything physical comes from the
 // RenderContext; this file only integrates the radiative transfer equation
 //     L(x, w) = int_0^d T(x, x_t) [eta(x_t) + sigma_s(x_t) int p(w', w) L(x_t, w') dw'] dt
 //               + T(x, x_d) L_d
@@ -16,6 +17,14 @@
 //    least 1 / block edge); several media through the summed extinction grid, the
 //    scattering medium chosen with probability a_i sigma_t,i / sigma_s and its phase used
 //    at that vertex. None of it runs, or draws a random number, in scenes without it.
+//
+//  - Version 4 (docs/ground-truth.md, "Spot lights and occluders"): a spot is a light
+//    element whose estimate is multiplied by SpotFactor x its light map toward the vertex
+//    (Physics/SpotLight.h); occluders (RenderContext::GetOccluders, a bounding volume
+//    hierarchy) end a segment where a ray meets one (a surface vertex: NEE of the sun and
+//    the lights with f = albedo/pi cos, the next direction cosine-weighted about the
+//    normal, weight x albedo; albedo 0 ends the path) and block the shadow rays of the sun
+//    and of every light. Neither runs, or draws a random number, in scenes without it.
 //
 //  - Free flights: delta tracking against a piecewise-constant majorant
 //    sigma_bar(t) = cloud block majorant (max density of a 4^3-voxel block of the
@@ -67,7 +76,8 @@
 // through the cloud is forward scattering.
 //
 // Termination of a path: it leaves the scene or passes the top of the
-// atmosphere (background radiance), hits the ground plane (reflects), hits the
+// atmosphere (background radiance), hits the ground plane or an occluder (reflects;
+// a black occluder ends it), hits the
 // earth sphere of an enabled atmosphere (reached only with the ground plane
 // disabled: black, no radiance), or is killed by Russian roulette /
 // MaxScatteringOrder. Sun occlusion: without atmosphere the enabled ground plane

@@ -1771,3 +1771,34 @@ TEST(SceneJson, Version4HashCoversTheNewFields)
   read.Occluders[1].TriangleVertices = { { { 0, 0, 0 } }, { { 1, 0, 0 } }, { { 0, 1, 0 } } };
   EXPECT_EQ(nimbus::SceneHash(read), nimbus::SceneHash(Version4Scene()));
 }
+
+// The version-4 example of docs/scene-format.md is a valid scene and says what its notes say.
+TEST(SceneJson, DocumentedVersion4ExampleParses)
+{
+  std::ifstream in(NIMBUS_SCENE_FORMAT_DOC);
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t section = doc.find("#### Version 4 example");
+  ASSERT_NE(section, std::string::npos);
+  const std::size_t begin = doc.find("```json\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = doc.find("```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const SceneDescription s = nimbus::ParseScene(doc.substr(begin + 8, end - begin - 8), "/docs");
+  EXPECT_TRUE(s.UsesVersion4Features());
+  ASSERT_EQ(s.Lights.size(), 2u);
+  EXPECT_EQ(s.Lights[0].Type, "spot");
+  EXPECT_NEAR(s.Lights[0].Intensity / (s.Lights[0].Position[2] * s.Lights[0].Position[2]), 1.4,
+    0.05); // "50 / 6^2 = 1.4"
+  EXPECT_EQ(s.Lights[1].LightMap.Path, "/docs/lights/window_gobo.png");
+  ASSERT_EQ(s.Occluders.size(), 2u);
+  EXPECT_EQ(s.Occluders[0].Albedo, 0.0);                                  // black by default
+  EXPECT_NEAR(s.Occluders[1].Max[0] - s.Occluders[1].Min[0], 0.3, 1e-12); // 30 cm
+  // The projector's axis meets the wall (x = 6) inside it.
+  const auto& p = s.Lights[1].Position;
+  const auto& d = s.Lights[1].Direction;
+  const double t = (6.0 - p[0]) / d[0];
+  EXPECT_GT(p[1] + t * d[1], s.Occluders[1].Min[1]);
+  EXPECT_LT(p[1] + t * d[1], s.Occluders[1].Max[1]);
+  EXPECT_GT(p[2] + t * d[2], 0.0);
+  EXPECT_LT(p[2] + t * d[2], s.Occluders[1].Max[2]);
+}
