@@ -86,10 +86,11 @@ for part in (head, pole, arm, post):
     display.Ambient = 0.5
     display.AmbientColor = [0.1, 0.1, 0.1]
 
-# The first Render resets the camera to the data; the view is set after it.
+# The first Render resets the camera to the data; the view is set after it: at eye
+# height beside the lamp, looking down the street past the post.
 Render(view)
-view.CameraPosition = [-5.0, -7.0, 5.5]
-view.CameraFocalPoint = [4.0, 0.0, 2.0]
+view.CameraPosition = [-3.0, -8.0, 1.7]
+view.CameraFocalPoint = [4.0, 0.0, 2.5]
 view.CameraViewUp = [0.0, 0.0, 1.0]
 view.CameraViewAngle = 42.0
 Render(view)
