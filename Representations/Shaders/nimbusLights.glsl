@@ -279,20 +279,42 @@ vec3 LightScattering(int i, vec3 p, vec3 direction, float sigma, float mieG, flo
     cloudAlbedo * sigma * (CornetteShanks(mu, cloudG) + lightPhaseConstant));
 }
 
-// The lights' light at p in the cloud toward the eye per metre (sigma = k rho > 0).
-vec3 CloudLightsSource(vec3 p, vec3 direction, float sigma)
+// The part of the view ray inside each light's beam, [lightEnter[i], lightLeave[i]]
+// (empty: enter > leave), set once per pixel by LightIntervalsAlong, so that the march's
+// steps test two numbers instead of the beam's angle.
+float lightEnter[kMaxLights];
+float lightLeave[kMaxLights];
+
+void LightIntervalsAlong(vec3 origin, vec3 direction, float t0, float t1)
+{
+  for (int i = 0; i < lightCount; ++i)
+  {
+    float a, b;
+    if (!LightInterval(i, origin, direction, t0, t1, a, b))
+    {
+      a = kInfinity;
+      b = -kInfinity;
+    }
+    lightEnter[i] = a;
+    lightLeave[i] = b;
+  }
+}
+
+// The lights' light at p = origin + t direction in the cloud toward the eye per metre
+// (sigma = k rho > 0); LightIntervalsAlong set the beams' intervals.
+vec3 CloudLightsSource(vec3 p, float t, vec3 direction, float sigma)
 {
   vec3 sum = vec3(0.0);
   for (int i = 0; i < lightCount; ++i)
   {
-    vec3 toLight = normalize(lightPosition[i] - p);
-    if (LightSpotFactor(i, -toLight) <= 0.0)
+    if (t < lightEnter[i] || t > lightLeave[i])
     {
       continue;
     }
+    vec3 toLight;
+    vec3 arriving = LightArriving(i, p, LightCloudDepth(i, p), toLight);
     float mu = clamp(dot(direction, toLight), -1.0, 1.0);
-    sum += cloudAlbedo * sigma * (CornetteShanks(mu, cloudG) + lightPhaseConstant) *
-      LightArriving(i, p, LightCloudDepth(i, p), toLight);
+    sum += cloudAlbedo * sigma * (CornetteShanks(mu, cloudG) + lightPhaseConstant) * arriving;
   }
   return sum;
 }

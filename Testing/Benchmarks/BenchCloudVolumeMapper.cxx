@@ -3,14 +3,17 @@
 // ratio to the floor (the same slices composited unlit) and to VTK's
 // vtkGPUVolumeRayCastMapper with volumetric scattering (GlobalIlluminationReach 1).
 //
-//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky | march | side]
+//   BenchCloudVolumeMapper [frames = 5] [width = 320] [height = 240] [sky | march | lights | side]
 //
 // With a number `side` the volume sweep adds a side^3 cloud (one node's piece of a
 // large field). With "sky" only the sky table runs: what a vtkNimbusSkyBackground
 // adds to a cloud frame (the background pass plus the mapper's second target). With
 // "march" only the ray-marched method's table runs (docs/ray-march.md): frame time
 // against the volume and the step beside the slices and VTK's plain GPU ray caster, and
-// one frame's passes timed on the GPU.
+// one frame's passes timed on the GPU. With "lights" only the view lights' table runs
+// (docs/lights.md): a frame with spotlights (their shafts in the haze, the cloud lit
+// from below, a box's shadow map) against the same frame without them, by ray marching
+// and by virtual planes, against the samples, the planes, the lights and the maps.
 //
 // Prints one table; every ratio compares timings taken in this one run. Run it
 // under Testing/with-display.sh (needs an OpenGL context), or with --offscreen (EGL, no X).
@@ -20,12 +23,16 @@
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
+#include "vtkActor.h"
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkGPUVolumeRayCastMapper.h"
+#include "vtkCubeSource.h"
 #include "vtkImageData.h"
+#include "vtkLight.h"
 #include "vtkNew.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPolyDataMapper.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
@@ -199,6 +206,80 @@ void RayMarchTables()
   }
 }
 
+// The view lights' table: a 128^3 cloud in haze at night, lit from the ground by
+// spotlights beside a 300 m tower (its shadow map), against the same frame with
+// LightSources = NoLights. Every ratio is one run's.
+void LightsTable()
+{
+  Bench& bench = *TheBench;
+  vtkSmartPointer<vtkImageData> c = nimbus::testing::TestCumulus(128, 128, 128);
+  vtkNew<vtkCubeSource> tower;
+  tower->SetBounds(-250, -150, -1900, -1800, 0, 300);
+  vtkNew<vtkPolyDataMapper> towerMapper;
+  towerMapper->SetInputConnection(tower->GetOutputPort());
+  vtkNew<vtkActor> towerActor;
+  towerActor->SetMapper(towerMapper);
+  bench.Renderer->AddActor(towerActor);
+  std::vector<vtkSmartPointer<vtkLight>> lights;
+  for (int i = 0; i < 4; ++i)
+  {
+    auto light = vtkSmartPointer<vtkLight>::New();
+    light->SetPositional(true);
+    light->SetPosition(-200.0 + 150.0 * i, -2000, 10);
+    light->SetFocalPoint(-300.0 + 200.0 * i, 0, 1500);
+    light->SetConeAngle(6.0);
+    light->SetIntensity(2e5);
+    lights.push_back(light);
+  }
+  const auto useLights = [&](int count)
+  {
+    bench.Renderer->RemoveAllLights();
+    for (int i = 0; i < count; ++i)
+    {
+      bench.Renderer->AddLight(lights[i]);
+    }
+  };
+  const auto night = [](int sources, int method, int samples, int maps)
+  {
+    return [=](vtkNimbusCloudVolumeMapper* m)
+    {
+      m->SetRenderingMethodToRayMarching();
+      m->SetSunElevationDegrees(-20);
+      m->SetMieScatteringPerMetre(1e-4);
+      m->SetLightSources(sources);
+      m->SetLightShaftMethod(method);
+      m->SetLightSamples(samples);
+      m->SetNumberOfVirtualPlanes(samples);
+      m->SetLightShadowMapSize(maps);
+      m->SetMultipleScatteringMethodToNone();
+    };
+  };
+  const int march = vtkNimbusCloudVolumeMapper::LightShaftsByRayMarching;
+  const int planes = vtkNimbusCloudVolumeMapper::LightShaftsByVirtualPlanes;
+  useLights(1);
+  const double without = TimeSvs(c, 256, night(vtkNimbusCloudVolumeMapper::NoLights, march, 32, 256));
+  std::printf("\nView lights (128^3 cloud at night, spotlights from the ground beside a tower; "
+              "multiple scattering off)\n\n| lights | method | samples or planes | shadow map | "
+              "frame | / without lights |\n|---|---|---|---|---|---|\n| 0 | - | - | - | %.1f | 1 |\n",
+    without);
+  struct Row
+  {
+    int Lights, Method, Samples, Maps;
+  };
+  for (const Row& row : std::vector<Row>{ { 1, march, 16, 256 }, { 1, march, 32, 256 },
+         { 1, march, 64, 256 }, { 1, march, 32, 0 }, { 1, march, 32, 1024 }, { 4, march, 32, 256 },
+         { 1, planes, 32, 256 }, { 1, planes, 64, 256 }, { 1, planes, 128, 256 } })
+  {
+    useLights(row.Lights);
+    const double t = TimeSvs(c, 256,
+      night(vtkNimbusCloudVolumeMapper::PositionalLights, row.Method, row.Samples, row.Maps));
+    std::printf("| %d | %s | %d | %d | %.1f | %.2f |\n", row.Lights,
+      row.Method == march ? "ray march" : "virtual planes", row.Samples, row.Maps, t, t / without);
+  }
+  bench.Renderer->RemoveAllLights();
+  bench.Renderer->RemoveActor(towerActor);
+}
+
 double TimeVtkGpu(vtkImageData* image, double reach)
 {
   Bench& bench = *TheBench;
@@ -257,6 +338,11 @@ int main(int argc, char* argv[])
   };
   const auto unlit = [](vtkNimbusCloudVolumeMapper* m) { m->SetUnlit(true); };
 
+  if (argc > 4 && std::string(argv[4]) == "lights")
+  {
+    LightsTable();
+    return EXIT_SUCCESS;
+  }
   if (argc > 4 && std::string(argv[4]) == "march")
   {
     RayMarchTables();
