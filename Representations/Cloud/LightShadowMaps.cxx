@@ -13,6 +13,8 @@
 #include <vtkTextureObject.h>
 #include <vtk_glew.h>
 
+#include <cstdint>
+
 namespace nimbus
 {
 struct LightShadowMaps::Internals
@@ -39,6 +41,7 @@ void LightShadowMaps::Release(vtkWindow* window)
   this->Internal->Atlas->ReleaseGraphicsResources(window);
   this->Internal->Framebuffer->ReleaseGraphicsResources(window);
   this->Casters = 0;
+  this->Key.clear();
 }
 
 namespace
@@ -101,17 +104,44 @@ void AimCamera(vtkCamera* camera, const Vector3& position, const ShadowFace& fac
 }
 }
 
-bool LightShadowMaps::Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
+bool LightShadowMaps::Update(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
   const std::vector<ViewLight>& lights, const std::array<double, 6>& region, int faceSize)
 {
-  Internals& in = *this->Internal;
-  this->Ranges.clear();
-  this->Casters = 0;
   const std::vector<vtkActor*> casters = ShadowCasters(renderer);
   if (casters.empty() || lights.empty())
   {
+    this->Ranges.clear();
+    this->Casters = 0;
+    this->Key.clear();
     return false;
   }
+  std::vector<double> key(region.begin(), region.end());
+  key.push_back(faceSize);
+  key.push_back(static_cast<double>(reinterpret_cast<std::uintptr_t>(window)));
+  for (const ViewLight& light : lights)
+  {
+    key.insert(key.end(), light.Position.begin(), light.Position.end());
+  }
+  for (vtkActor* actor : casters)
+  {
+    key.push_back(static_cast<double>(reinterpret_cast<std::uintptr_t>(actor)));
+    key.push_back(static_cast<double>(actor->GetRedrawMTime()));
+  }
+  if (key == this->Key && this->Internal->Atlas->GetHandle())
+  {
+    return true;
+  }
+  this->Key = std::move(key);
+  ++this->Renders;
+  return this->Render(renderer, window, lights, region, faceSize, casters);
+}
+
+bool LightShadowMaps::Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
+  const std::vector<ViewLight>& lights, const std::array<double, 6>& region, int faceSize,
+  const std::vector<vtkActor*>& casters)
+{
+  Internals& in = *this->Internal;
+  this->Ranges.clear();
   faceSize = std::max(faceSize, 16);
   EnsureDepthAtlas(in.Atlas, window, 6 * faceSize, static_cast<int>(lights.size()) * faceSize);
   vtkOpenGLState* state = window->GetState();

@@ -20,6 +20,7 @@
 #include <memory>
 #include <vector>
 
+class vtkActor;
 class vtkOpenGLRenderWindow;
 class vtkRenderer;
 class vtkTextureObject;
@@ -35,10 +36,14 @@ public:
 
   /// Draws the casters of `renderer` into the atlas for `lights` (positions in VTK world
   /// coordinates), `faceSize` texels per face side, depth range from `region` (VTK world
-  /// bounds the shadows must cover). False, with nothing drawn, when the renderer has no
-  /// caster or no light is given.
-  bool Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
+  /// bounds the shadows must cover), unless nothing they depend on changed since the last
+  /// call (the lights, the region, the size, the casters and their modification times):
+  /// a camera that moves costs no shadow map. False, with nothing drawn, when the
+  /// renderer has no caster or no light is given.
+  bool Update(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
     const std::vector<ViewLight>& lights, const std::array<double, 6>& region, int faceSize);
+  /// Times the maps were drawn (tests, benchmarks).
+  int GetNumberOfRenders() const { return this->Renders; }
 
   vtkTextureObject* GetTexture() const;
   /// Near and far plane (world units) of light i's faces.
@@ -50,8 +55,13 @@ public:
 private:
   struct Internals;
   std::unique_ptr<Internals> Internal;
+  bool Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* window,
+    const std::vector<ViewLight>& lights, const std::array<double, 6>& region, int faceSize,
+    const std::vector<vtkActor*>& casters);
   std::vector<std::array<double, 2>> Ranges;
+  std::vector<double> Key;
   int Casters = 0;
+  int Renders = 0;
 };
 }
 

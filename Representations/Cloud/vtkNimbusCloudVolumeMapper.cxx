@@ -428,6 +428,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkTextureObject> BlockTexture;
   std::array<int, 3> BlockCount{ { 1, 1, 1 } };
   std::vector<double> SunDepthKey;
+  double DensityMaximum = 0.0; // the largest density texel (0: no cloud to shadow the lights)
   int SunDepthBuilds = 0;
   double LastSunDepthSeconds = 0.0;
   vtkNew<vtkTextureObject> FroxelScattering;
@@ -2555,6 +2556,7 @@ void vtkNimbusCloudVolumeMapper::UpdateSunDepthVolume(FrameState& frame)
   const std::vector<float> maxima =
     nimbus::ComputeBlockMaxima(texels.data(), grid.Dimensions, kRayMarchBlockTexels, in.BlockCount);
   UploadVolume(in.BlockTexture, frame.Window, in.BlockCount.data(), maxima.data(), false);
+  in.DensityMaximum = maxima.empty() ? 0.0 : *std::max_element(maxima.begin(), maxima.end());
   in.SunDepthKey = std::move(key);
   ++in.SunDepthBuilds;
   in.LastSunDepthSeconds =
@@ -3045,7 +3047,7 @@ void vtkNimbusCloudVolumeMapper::UpdateViewLights(vtkRenderer* renderer, FrameSt
   }
   if (this->LightShadowMapSize > 0)
   {
-    frame.LightShadows = in.ShadowMaps.Render(
+    frame.LightShadows = in.ShadowMaps.Update(
       renderer, frame.Window, selection.Lights, region, this->LightShadowMapSize);
   }
   this->UpdateLightMapTexture(frame);
@@ -3199,7 +3201,8 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
     }
   }
   program->SetUniformMatrix3x3("lightUpToWorld", upToWorld);
-  program->SetUniformi("lightCloudSteps", this->LightCloudSteps);
+  // An empty density (fog around geometry, no cloud) casts no shadow: no samples.
+  program->SetUniformi("lightCloudSteps", in.DensityMaximum > 0.0 ? this->LightCloudSteps : 0);
   program->SetUniformf("lightRadiusMetres", static_cast<float>(kLightRadiusMetres));
   program->SetUniformf("lightMieScattering0", static_cast<float>(in.Table.MieScatteringSeaLevel));
   program->SetUniformf(

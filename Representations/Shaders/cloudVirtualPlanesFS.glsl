@@ -30,7 +30,7 @@ void main()
   vec3 source = vec3(0.0);
   for (int i = 0; i < lightCount; ++i)
   {
-    source += LightScattering(i, p, direction, 0.0, lightsMieG, LightCloudDepth(i, p));
+    source += LightScattering(i, p, direction, 0.0, lightsMieG);
   }
   float sigma = extinctionPerDensity * CloudDensity(p);
   gl_FragData[0] =

@@ -177,10 +177,11 @@ vec3 LightAirTransmittance(int i, vec3 p)
   return exp(-(rayleighExtinction0 * lr + mieExtinction0 * lm));
 }
 
-// The light of light i arriving at p [irradiance on a surface facing it], before the
-// cloud dims it (cloudDepth: LightCloudDepth, or 0): intensity, beam, light map, shadow
-// map and the air between; toLight: the unit direction from p toward the light.
-vec3 LightArriving(int i, vec3 p, float cloudDepth, out vec3 toLight)
+// The light of light i arriving at p [irradiance on a surface facing it]: intensity,
+// beam, light map, shadow map, the air between and (throughCloud) the cloud's optical
+// depth between (LightCloudDepth, only where the beam reaches p); toLight: the unit
+// direction from p toward the light.
+vec3 LightArriving(int i, vec3 p, bool throughCloud, out vec3 toLight)
 {
   vec3 d = lightPosition[i] - p;
   float distance = max(length(d) * metresPerUnit, lightRadiusMetres);
@@ -190,6 +191,7 @@ vec3 LightArriving(int i, vec3 p, float cloudDepth, out vec3 toLight)
   {
     return vec3(0.0);
   }
+  float cloudDepth = throughCloud ? LightCloudDepth(i, p) : 0.0;
   return lightIntensity[i] * beam * LightShadow(i, p) / (distance * distance) *
     LightAirTransmittance(i, p) * exp(-cloudDepth);
 }
@@ -263,11 +265,11 @@ void AirScattering(float h, out vec3 rayleigh, out float mie)
 
 // Light i's single scattering toward the eye per metre at p, by the air (Rayleigh and
 // Mie) and by the cloud (sigma [1/m], its phase plus k_multi / 4 pi), before the view's
-// attenuation; cloudDepth: the cloud's optical depth toward the light.
-vec3 LightScattering(int i, vec3 p, vec3 direction, float sigma, float mieG, float cloudDepth)
+// attenuation, through the cloud's shadow.
+vec3 LightScattering(int i, vec3 p, vec3 direction, float sigma, float mieG)
 {
   vec3 toLight;
-  vec3 arriving = LightArriving(i, p, cloudDepth, toLight);
+  vec3 arriving = LightArriving(i, p, true, toLight);
   float mu = clamp(dot(direction, toLight), -1.0, 1.0);
   vec3 rayleigh = vec3(0.0);
   float mie = 0.0;
@@ -312,7 +314,7 @@ vec3 CloudLightsSource(vec3 p, float t, vec3 direction, float sigma)
       continue;
     }
     vec3 toLight;
-    vec3 arriving = LightArriving(i, p, LightCloudDepth(i, p), toLight);
+    vec3 arriving = LightArriving(i, p, true, toLight);
     float mu = clamp(dot(direction, toLight), -1.0, 1.0);
     sum += cloudAlbedo * sigma * (CornetteShanks(mu, cloudG) + lightPhaseConstant) * arriving;
   }
@@ -327,7 +329,7 @@ vec3 GroundLightsRadiance(vec3 g)
   for (int i = 0; i < lightCount; ++i)
   {
     vec3 toLight;
-    vec3 arriving = LightArriving(i, g, LightCloudDepth(i, g), toLight);
+    vec3 arriving = LightArriving(i, g, true, toLight);
     sum += groundAlbedo / kPi * max(toLight.z, 0.0) * arriving;
   }
   return sum;
@@ -343,7 +345,7 @@ vec3 LightAirIntegrand(int i, vec3 origin, vec3 direction, float theta, float cl
   float c = cos(theta);
   vec3 p = origin + t * direction;
   float inCloud = clamp((t - cloudFirst) / max(cloudLast - cloudFirst, 1e-30), 0.0, 1.0);
-  return LightScattering(i, p, direction, 0.0, mieG, LightCloudDepth(i, p)) *
+  return LightScattering(i, p, direction, 0.0, mieG) *
     AtmosphereViewTransmittance(origin, direction, t) * exp(logCloud * inCloud) *
     (distance / (c * c) * metresPerUnit);
 }
