@@ -176,7 +176,7 @@ void MarchCloud(vec3 origin, vec3 direction, float first, float last, vec3 airIn
         : forwardPeakFraction > 0.0 ? peakPhase * (pow(sun, peakExponent) - sun) : 0.0;
       source = (cloudAlbedo * sigma * (cloudPhase * sun + beyond) * SunIrradiance(Altitude(p)) +
                  CloudOtherSources(p, direction, sigma) +
-                 (lightCount > 0 ? CloudLightsSource(p, t, direction, sigma) : vec3(0.0))) *
+                 (t >= lightsEnter && t <= lightsLeave ? CloudLightsSource(p, t, direction, sigma) : vec3(0.0))) *
         airIn * exp(airLogRatio * ((t - first) / span));
     }
     radiance += transmittance * source * stepIntegral;
@@ -271,6 +271,8 @@ void main()
     AirTo(texCoord, first, airFirst, transmittanceFirst);
     AirTo(texCoord, last, airLast, transmittanceLast);
     vec3 cloudRadiance;
+    lightsEnter = kInfinity;
+    lightsLeave = -kInfinity;
     if (lightCount > 0 && unlit == 0)
     {
       LightIntervalsAlong(origin, direction, first, last);

@@ -286,9 +286,13 @@ vec3 LightScattering(int i, vec3 p, vec3 direction, float sigma, float mieG)
 // steps test two numbers instead of the beam's angle.
 float lightEnter[kMaxLights];
 float lightLeave[kMaxLights];
+float lightsEnter; // the union's ends
+float lightsLeave;
 
 void LightIntervalsAlong(vec3 origin, vec3 direction, float t0, float t1)
 {
+  lightsEnter = kInfinity;
+  lightsLeave = -kInfinity;
   for (int i = 0; i < lightCount; ++i)
   {
     float a, b;
@@ -299,6 +303,8 @@ void LightIntervalsAlong(vec3 origin, vec3 direction, float t0, float t1)
     }
     lightEnter[i] = a;
     lightLeave[i] = b;
+    lightsEnter = min(lightsEnter, a);
+    lightsLeave = max(lightsLeave, b);
   }
 }
 
@@ -335,18 +341,26 @@ vec3 GroundLightsRadiance(vec3 g)
   return sum;
 }
 
+// The cloud's view transmittance ramp of LightsInAir (its log falls linearly from 0 at
+// lightRampStart to its whole over lightRampLength).
+float lightRampStart;
+float lightRampLength;
+float lightRampLog;
+
 // The integrand of LightsInAir per unit angle theta about light i: the air's single
 // scattering at t = closest + distance tan(theta) times dt/dtheta (metres), with the
-// view's transmittance.
-vec3 LightAirIntegrand(int i, vec3 origin, vec3 direction, float theta, float closest,
-  float distance, float mieG, float cloudFirst, float cloudLast, float logCloud)
+// view's transmittance: the air's in closed form, the cloud's as LightsInAir says.
+// (Interpolating the air's between the beam's ends instead cost up to 2 % over a 400 m
+// beam in fog, measured in TestCloudLights.)
+vec3 LightAirIntegrand(
+  int i, vec3 origin, vec3 direction, float theta, float closest, float distance, float mieG)
 {
   float t = closest + distance * tan(theta);
   float c = cos(theta);
   vec3 p = origin + t * direction;
-  float inCloud = clamp((t - cloudFirst) / max(cloudLast - cloudFirst, 1e-30), 0.0, 1.0);
+  float inCloud = clamp((t - lightRampStart) / max(lightRampLength, 1e-30), 0.0, 1.0);
   return LightScattering(i, p, direction, 0.0, mieG) *
-    AtmosphereViewTransmittance(origin, direction, t) * exp(logCloud * inCloud) *
+    AtmosphereViewTransmittance(origin, direction, t) * exp(lightRampLog * inCloud) *
     (distance / (c * c) * metresPerUnit);
 }
 
@@ -370,7 +384,9 @@ vec3 LightsInAir(vec3 origin, vec3 direction, float t0, float t1, int samples, f
   {
     return sum;
   }
-  float logCloud = log(max(cloudTransmittance, 1e-30));
+  lightRampStart = cloudFirst;
+  lightRampLength = cloudLast - cloudFirst;
+  lightRampLog = log(max(cloudTransmittance, 1e-30));
   float minimumDistance = lightRadiusMetres / metresPerUnit;
   for (int i = 0; i < lightCount; ++i)
   {
@@ -395,13 +411,11 @@ vec3 LightsInAir(vec3 origin, vec3 direction, float t0, float t1, int samples, f
     vec3 light = vec3(0.0);
     for (int k = 0; k < samples; ++k)
     {
-      light += LightAirIntegrand(i, origin, direction, thetaA + (float(k) + jitter) * dTheta,
-        closest, distance, mieG, cloudFirst, cloudLast, logCloud);
+      light += LightAirIntegrand(
+        i, origin, direction, thetaA + (float(k) + jitter) * dTheta, closest, distance, mieG);
     }
-    vec3 ends = LightAirIntegrand(i, origin, direction, thetaA, closest, distance, mieG,
-                  cloudFirst, cloudLast, logCloud) -
-      LightAirIntegrand(i, origin, direction, thetaB, closest, distance, mieG, cloudFirst,
-        cloudLast, logCloud);
+    vec3 ends = LightAirIntegrand(i, origin, direction, thetaA, closest, distance, mieG) -
+      LightAirIntegrand(i, origin, direction, thetaB, closest, distance, mieG);
     sum += max(light + (jitter - 0.5) * ends, vec3(0.0)) * dTheta;
   }
   return sum;
