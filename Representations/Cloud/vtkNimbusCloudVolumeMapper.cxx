@@ -159,11 +159,12 @@ std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)
 
 // A pass's fragment shader: the GLSL library, svsCommon.glsl, for the passes that
 // light the cloud cloudLight.glsl, then the pass.
-std::string FragmentSource(const char* pass, bool cloudLight)
+std::string FragmentSource(const char* pass, bool cloudLight, bool viewLights)
 {
   return nimbus::WithShaderLibrary(
     std::string("//VTK::System::Dec\n//VTK::Output::Dec\n//NIMBUS::Library\n") + svsCommon + "\n" +
-    (cloudLight ? std::string(::cloudLight) + "\n" + nimbusLights + "\n" : std::string()) + pass);
+    (cloudLight ? std::string(::cloudLight) + "\n" : std::string()) +
+    (viewLights ? std::string(nimbusLights) + "\n" : std::string()) + pass);
 }
 
 // Frees a texture's storage and sets clamp-to-edge wrapping and its filter, ready
@@ -521,11 +522,12 @@ struct vtkNimbusCloudVolumeMapper::Internals
   }
 
   vtkShaderProgram* Ready(
-    std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source, bool cloudLight = false)
+    std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source, bool cloudLight = false,
+    bool viewLights = false)
   {
     if (!pass)
     {
-      const std::string fs = FragmentSource(source, cloudLight);
+      const std::string fs = FragmentSource(source, cloudLight, viewLights);
       pass = std::make_unique<vtkOpenGLQuadHelper>(Window, nullptr, fs.c_str(), "");
     }
     else
@@ -2632,7 +2634,7 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   glDrawBuffers(2, buffers);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglDisable(GL_BLEND);
-  vtkShaderProgram* program = in.Ready(in.CloudMarchPass, cloudMarchFS, true);
+  vtkShaderProgram* program = in.Ready(in.CloudMarchPass, cloudMarchFS, true, true);
   this->SetCommonUniforms(program, frame);
   this->SetCloudLightUniforms(program, frame);
   int dims[3];
@@ -3153,7 +3155,7 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
   float position[nimbus::kMaximumViewLights][3] = {}, axis[nimbus::kMaximumViewLights][3] = {},
         mapU[nimbus::kMaximumViewLights][3] = {}, mapV[nimbus::kMaximumViewLights][3] = {},
         intensity[nimbus::kMaximumViewLights][3] = {}, cone[nimbus::kMaximumViewLights][4] = {},
-        range[nimbus::kMaximumViewLights][2] = {};
+        range[nimbus::kMaximumViewLights][2] = {}, cosines[nimbus::kMaximumViewLights][2] = {};
   const auto& ranges = in.ShadowMaps.GetRanges();
   for (int i = 0; i < count; ++i)
   {
@@ -3175,6 +3177,8 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
     cone[i][1] = static_cast<float>(inner);
     cone[i][2] = static_cast<float>(outer < 0.5 * nimbus::kPi ? std::tan(std::max(outer, 1e-6)) : 1.0);
     cone[i][3] = frame.LightMap ? 1.0f : 0.0f;
+    cosines[i][0] = static_cast<float>(std::cos(outer));
+    cosines[i][1] = static_cast<float>(std::cos(inner));
     if (frame.LightShadows && i < static_cast<int>(ranges.size()))
     {
       range[i][0] = static_cast<float>(ranges[i][0]);
@@ -3187,6 +3191,7 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
   program->SetUniform3fv("lightMapV", count, mapV);
   program->SetUniform3fv("lightIntensity", count, intensity);
   program->SetUniform4fv("lightCone", count, cone);
+  program->SetUniform2fv("lightConeCosines", count, cosines);
   program->SetUniform2fv("lightShadowRange", count, range);
   program->SetUniformi("lightShadowsOn", frame.LightShadows ? 1 : 0);
   const float atlas[2] = { 6.0f, static_cast<float>(count) };
@@ -3248,7 +3253,7 @@ void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
     return;
   }
   UseSliceBlend(frame.State, true);
-  vtkShaderProgram* program = in.Ready(in.PlanesPass, cloudVirtualPlanesFS, true);
+  vtkShaderProgram* program = in.Ready(in.PlanesPass, cloudVirtualPlanesFS, true, true);
   this->SetCommonUniforms(program, frame);
   this->SetCloudLightUniforms(program, frame);
   program->SetUniformf("lightsMieG", static_cast<float>(frame.Settings.Air.MieG));

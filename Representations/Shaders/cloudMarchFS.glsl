@@ -87,6 +87,13 @@ void AirTo(vec2 uv, float t, out vec3 radiance, out vec3 transmittance)
   transmittance = mix(texture(froxelTransmittance, c0).rgb, texture(froxelTransmittance, c1).rgb, f);
 }
 
+// The air's view transmittance for the lights' shafts (nimbusLights.glsl): from the
+// look-up volume, as the rest of the march's air.
+vec3 LightsViewTransmittance(vec3 origin, vec3 direction, float t)
+{
+  return AirTransmittanceTo(texCoord, t);
+}
+
 // The part [first, last] of [t0, t1] between the first and the last block that holds
 // any density, by a 3-D DDA over the blocks (Amanatides & Woo 1987; one texel fetch per
 // block): the march then steps only through it, with no test per step (on a GPU that

@@ -12,6 +12,13 @@ uniform float planeDepth;   // distance of the plane from the eye along viewForw
 uniform float planeSpacing; // distance to the next plane (world)
 uniform float lightsMieG;
 
+// The shafts' view transmittance of nimbusLights.glsl (unused by the planes, which
+// apply AtmosphereViewTransmittance themselves; defined for the library's prototype).
+vec3 LightsViewTransmittance(vec3 origin, vec3 direction, float t)
+{
+  return AtmosphereViewTransmittance(origin, direction, t);
+}
+
 void main()
 {
   vec3 origin, direction;

@@ -16,6 +16,7 @@ uniform vec3 lightIntensity[kMaxLights]; // Y/sr, linear sRGB
 // x: the cone's half angle [rad] (>= pi/2: a point light), y: the soft edge's inner
 // angle [rad], z: tan(x), w: 1 when the light map applies to this light.
 uniform vec4 lightCone[kMaxLights];
+uniform vec2 lightConeCosines[kMaxLights]; // cos of the cone's half angle, of the inner angle
 uniform sampler2D lightMap;              // luminance in r, v = 0 on the first row
 uniform int lightShadowsOn;
 uniform sampler2D lightShadowAtlas;      // depth; light i's six faces in row i
@@ -39,7 +40,17 @@ float LightSpotFactor(int i, vec3 w)
   {
     return 1.0;
   }
-  float angle = acos(clamp(dot(lightAxis[i], w), -1.0, 1.0));
+  // The cosines first: the angle (an acos) only inside the soft edge.
+  float cosine = clamp(dot(lightAxis[i], w), -1.0, 1.0);
+  if (cosine <= lightConeCosines[i].x)
+  {
+    return 0.0;
+  }
+  if (cosine >= lightConeCosines[i].y)
+  {
+    return 1.0;
+  }
+  float angle = acos(cosine);
   float outer = max(lightCone[i].x, 0.0);
   float inner = lightCone[i].y;
   if (angle >= outer)
@@ -341,6 +352,10 @@ vec3 GroundLightsRadiance(vec3 g)
   return sum;
 }
 
+// The clear air's transmittance between the eye and distance t along the pixel's ray:
+// defined by the pass that draws the lights' shafts (the march reads its look-up volume).
+vec3 LightsViewTransmittance(vec3 origin, vec3 direction, float t);
+
 // The cloud's view transmittance ramp of LightsInAir (its log falls linearly from 0 at
 // lightRampStart to its whole over lightRampLength).
 float lightRampStart;
@@ -349,9 +364,9 @@ float lightRampLog;
 
 // The integrand of LightsInAir per unit angle theta about light i: the air's single
 // scattering at t = closest + distance tan(theta) times dt/dtheta (metres), with the
-// view's transmittance: the air's in closed form, the cloud's as LightsInAir says.
-// (Interpolating the air's between the beam's ends instead cost up to 2 % over a 400 m
-// beam in fog, measured in TestCloudLights.)
+// view's transmittance: the air's (LightsViewTransmittance), the cloud's as LightsInAir
+// says. (Interpolating the air's geometrically between the beam's ends instead cost up
+// to 2 % over a 400 m beam in fog, measured in TestCloudLights.)
 vec3 LightAirIntegrand(
   int i, vec3 origin, vec3 direction, float theta, float closest, float distance, float mieG)
 {
@@ -360,13 +375,13 @@ vec3 LightAirIntegrand(
   vec3 p = origin + t * direction;
   float inCloud = clamp((t - lightRampStart) / max(lightRampLength, 1e-30), 0.0, 1.0);
   return LightScattering(i, p, direction, 0.0, mieG) *
-    AtmosphereViewTransmittance(origin, direction, t) * exp(lightRampLog * inCloud) *
+    LightsViewTransmittance(origin, direction, t) * exp(lightRampLog * inCloud) *
     (distance / (c * c) * metresPerUnit);
 }
 
 // The lights' single scattering by the clear air along [t0, t1] of the view ray toward
-// the eye [radiance], with the view's transmittance: the air's in closed form
-// (AtmosphereViewTransmittance) and the cloud's as 1 before cloudFirst,
+// the eye [radiance], with the view's transmittance: the air's
+// (LightsViewTransmittance) and the cloud's as 1 before cloudFirst,
 // cloudTransmittance after cloudLast, interpolated geometrically between (the cloud's
 // own lit particles are MarchCloud's). Samples per light equi-angular about the light
 // (Kulla & Fajardo 2012): t = c + D tan(theta) with theta evenly spaced, so the 1/d^2 of
