@@ -37,6 +37,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusCloudRepresentation);
@@ -752,9 +753,19 @@ void vtkNimbusCloudRepresentation::SetLightMapFile(const char* name)
   }
   if (!vtksys::SystemTools::FileExists(value, true))
   {
-    vtkErrorMacro("Light Map File '" << value
-                                     << "': no such file; the spotlights shine without a "
-                                        "light map.");
+    // ParaView's file field sets the name at every keystroke: the partial names typed on
+    // the way ("/da", "/data/gob") are not reported, only a missing image file's name.
+    std::string extension =
+      vtksys::SystemTools::LowerCase(vtksys::SystemTools::GetFilenameLastExtension(value));
+    static const char* const imageExtensions[] = { ".png", ".jpg", ".jpeg", ".pgm", ".ppm", ".pnm",
+      ".tif", ".tiff", ".bmp" };
+    if (std::find(std::begin(imageExtensions), std::end(imageExtensions), extension) !=
+      std::end(imageExtensions))
+    {
+      vtkErrorMacro("Light Map File '" << value
+                                       << "': no such file; the spotlights shine without a "
+                                          "light map.");
+    }
     return;
   }
   vtkSmartPointer<vtkImageReader2> reader;

@@ -302,7 +302,9 @@ public:
   /// The light map (a gobo): an image file (.png, .jpg, .pgm/.ppm, .tif, any format
   /// vtkImageReader2Factory knows) read when the name changes; its luminance
   /// multiplies every spotlight's beam (vtkNimbusCloudVolumeMapper::SetLightMap). An
-  /// empty name: no map. A file that cannot be read: an error, and no map.
+  /// empty name: no map. A file that cannot be read: an error, and no map. A name that
+  /// is no file and has no image extension gives no map silently (ParaView's file field
+  /// sets every partial name while one types).
   void SetLightMapFile(const char* name);
   const char* GetLightMapFile() { return this->LightMapFile.c_str(); }
   /// Fog for the lights without a cloud: the meteorological visibility in metres

@@ -25,7 +25,9 @@ Checks:
      FOG_SHADOW_FRACTION of the same pixels with Light Shadow Map Size 0;
   5. a light map whose left half is black dims the beam (LIGHT_MAP_KEPT of it kept);
   6. a light-map file that cannot be read (missing; not an image) gives an error
-     naming the file, and the view still renders the beam without a map.
+     naming the file, and the view still renders the beam without a map; a partial
+     name (no such file, no image extension: the GUI's field sets each name typed on
+     the way) gives none.
 """
 import argparse
 import math
@@ -383,6 +385,15 @@ def main():
         if abs(beam_after - beam) > 0.02 * beam:
             failures.append("after the bad light map %s the beam is %.5f, without a map %.5f"
                             % (bad, beam_after, beam))
+    # A name being typed in the GUI's field (no such file, no image extension yet): no
+    # error, no map.
+    before = len(errors.messages)
+    display.LightMapFile = os.path.join(args.output_dir, "partial-na")
+    partial = mean(shot("partial-name"), "beam")
+    print("partial name: %d error(s); beam %.5f" % (len(errors.messages) - before, partial))
+    if len(errors.messages) != before or abs(partial - beam) > 0.02 * beam:
+        failures.append("a partial name gave errors %s or changed the beam (%.5f)"
+                        % (errors.messages[before:], partial))
     display.LightMapFile = ""
 
     for failure in failures:
