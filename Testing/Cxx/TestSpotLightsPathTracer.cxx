@@ -888,3 +888,124 @@ TEST(SpotLightsPathTracer, SpeedTechniquesStayUnbiasedWithVersion4Features)
   EXPECT_GT(agreement.RmsZ, 0.75);
   EXPECT_LT(agreement.RmsZ, 1.3);
 }
+
+//------------------------------------------------------------------------------
+// A point light in the exponential atmosphere (the haze of the project's night scenes is
+// its aerosols): single scattering along a nearly horizontal ray 10 m above sea level,
+// per wavelength sample the quadrature of
+//   I S(lambda) [beta_R(lambda) rho_R p_R(mu) + beta_M rho_M p_M(mu)] T(camera, x) T(x, light) /
+//   d^2,
+// the transmittances from Atmosphere::OpticalLength (adaptive Gauss-Kronrod), the path
+// tracer's toward the light from its 8-point Gauss-Legendre rule (LightAirTransmittance).
+TEST(SpotLightsPathTracer, PointLightInTheAir)
+{
+  const V camera{ { 0.0, -100.0, 10.0 } }, light{ { 15.0, 40.0, 25.0 } };
+  const double intensity = 1.0e4;
+  SceneDescription scene = DarkScene(camera, { { 0.0, 0.0, 10.0 } });
+  scene.Atmosphere.Enabled = true;
+  scene.Atmosphere.MieScatteringPerMetre = 2.0e-3; // a haze of 2 km visibility
+  scene.Lights = { PointLight(light, intensity) };
+  const RenderContext context(scene, DensityGrid());
+  const PathTracingResult r = nimbus::RenderPathTraced(context, Samples(200000, 160, 1));
+  const nimbus::Atmosphere& air = *context.GetAtmosphere();
+  const nimbus::AtmosphereParameters& a = air.GetParameters();
+  const std::vector<double>& lambda = context.GetWavelengths();
+  const std::vector<double>& betaR = context.GetRayleighScatteringSeaLevel();
+  const double betaM = context.GetMieScatteringSeaLevel();
+  const V d{ { 0.0, 1.0, 0.0 } };
+  auto lengths = [&](const V& from, const V& to)
+  {
+    nimbus::OpticalLengths l;
+    const V q0 = context.EarthCentred(from), q1 = context.EarthCentred(to);
+    l.RayleighLengthMetres = air.OpticalLength(q0, q1, a.RayleighScaleHeightMetres);
+    l.MieLengthMetres = air.OpticalLength(q0, q1, a.MieScaleHeightMetres);
+    return l;
+  };
+  std::vector<double> spectrum(lambda.size(), 0.0);
+  for (std::size_t i = 0; i < lambda.size(); ++i)
+  {
+    auto integrand = [&](double t)
+    {
+      const V x = nimbus::Along(camera, d, t);
+      const V toLight = Sub(light, x);
+      const double r2 = nimbus::Dot(toLight, toLight);
+      const double mu = toLight[1] / std::sqrt(r2);
+      const double h = air.Altitude(context.EarthCentred(x));
+      const double scattering =
+        betaR[i] * air.Density(h, a.RayleighScaleHeightMetres) * air.RayleighPhase(mu) +
+        betaM * air.Density(h, a.MieScaleHeightMetres) * air.MiePhase(mu);
+      return scattering * air.Transmittance(lengths(camera, x), lambda[i]) *
+        air.Transmittance(lengths(x, light), lambda[i]) / r2;
+    };
+    // Beyond 30 km the haze's optical depth (60) leaves nothing.
+    spectrum[i] = intensity * context.GetLightSpectra()[0][i] *
+      (Simpson(integrand, 0.0, 140.0, 1e-13) + Simpson(integrand, 140.0, 1000.0, 1e-13) +
+        Simpson(integrand, 1000.0, 30000.0, 1e-13));
+  }
+  ExpectPixel(r, context.ToLinearSrgb(spectrum),
+    "a point light in hazy air, quadrature with the exact optical lengths");
+}
+
+//------------------------------------------------------------------------------
+// Twilight: the sun 2 degrees below the horizon lights a cloud's upper part (above ~3.9 km
+// the earth no longer hides it) and not its lower part, where the tracer skips the sun's
+// estimate and the sun-peak strategy (SunHidden). All speed techniques on against all off.
+TEST(SpotLightsPathTracer, TwilightCloudTechniquesAgree)
+{
+  const V lo{ { -1000.0, -1000.0, 3000.0 } };
+  const std::array<int, 3> dims{ { 9, 9, 7 } };
+  const V spacing{ { 250.0, 250.0, 300.0 } };
+  std::vector<float> cloud;
+  for (int k = 0; k < 7; ++k)
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i)
+      {
+        const double x = (i - 4) / 4.0, y = (j - 4) / 4.0, z = (k - 3) / 3.0;
+        cloud.push_back(static_cast<float>(std::max(0.0, 1.0 - x * x - y * y - z * z)));
+      }
+  SceneDescription scene = DarkScene({ { 0.0, -9000.0, 3500.0 } }, { { 0.0, 0.0, 3900.0 } });
+  scene.Camera.Width = 12;
+  scene.Camera.Height = 8;
+  scene.Camera.ViewAngle = 25.0;
+  scene.Atmosphere.Enabled = true;
+  scene.Ground.Enabled = true;
+  scene.Background.Type = "atmosphere";
+  scene.Sun.Illuminance = 1.0;
+  scene.Sun.AzimuthDegrees = 10.0;
+  scene.Sun.ElevationDegrees = -2.0;
+  scene.SpectralSamples = 8;
+  scene.Medium.ExtinctionPerDensity = 0.004;
+  scene.Medium.SingleScatteringAlbedo = 0.99;
+  scene.Medium.Phase = { { "henyey_greenstein", 0.85, 1.0 } };
+  const RenderContext context(scene, DensityGrid(dims, lo, spacing, cloud));
+  auto render = [&](bool on, std::uint64_t seed)
+  {
+    PathTracingSettings settings;
+    settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1024;
+    settings.Seed = seed;
+    settings.Threads = 2;
+    settings.SunPeakSampling = on;
+    settings.SunDepthRoulette = on;
+    settings.TabulatedAirTransmittance = on;
+    settings.BlockTraversal = on;
+    return nimbus::RenderPathTraced(context, settings);
+  };
+  const PathTracingResult off = render(false, 171);
+  const PathTracingResult on = render(true, 172);
+  const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(on, off);
+  double sum = 0.0;
+  for (float x : on.Image.Pixels)
+  {
+    sum += x;
+  }
+  std::printf("twilight cloud, techniques on vs off: RMS z %.3f over %d pixel channels, %d "
+              "beyond 4 sigma; image sum %.4g, z %.2f, its relative se %.2f %%\n",
+    agreement.RmsZ, agreement.Count, agreement.Outliers, sum, agreement.ImageSumZ,
+    100.0 * agreement.ImageSumRelativeError);
+  EXPECT_GT(sum, 0.0);
+  EXPECT_EQ(agreement.Count, 3 * 12 * 8);
+  EXPECT_LE(agreement.Outliers, 2);
+  EXPECT_LT(std::abs(agreement.ImageSumZ), 4.0);
+  EXPECT_GT(agreement.RmsZ, 0.75);
+  EXPECT_LT(agreement.RmsZ, 1.3);
+}
