@@ -23,6 +23,7 @@
 #include "ShaderLibrary.h"
 #include "cloudAirFroxelsFS.h"
 #include "cloudLight.h"
+#include "cloudLightDepthFS.h"
 #include "cloudMarchFS.h"
 #include "cloudVirtualPlanesFS.h"
 #include "nimbusLights.h"
@@ -351,6 +352,7 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   // were drawn, and what the frame's image depends on through them.
   std::vector<nimbus::ViewLight> Lights;
   bool LightShadows = false;
+  bool LightCloudVolume = false; // the lights' transmittance volume is drawn
   bool LightMap = false;
   std::array<double, 6> LightRegion{ { 0, -1, 0, -1, 0, -1 } }; // up frame
   std::vector<double> LightsKey;
@@ -444,6 +446,13 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkMTimeType LightMapTime = 0;
   vtkNew<vtkTextureObject> LightsImage;
   vtkNew<vtkOpenGLFramebufferObject> LightsFramebuffer;
+  // The cloud's transmittance toward each light per texel of a coarse copy of the
+  // density's grid (cloudLightDepthFS.glsl), keyed by what it depends on.
+  vtkNew<vtkTextureObject> LightCloudVolume;
+  vtkNew<vtkOpenGLFramebufferObject> LightCloudFramebuffer;
+  std::vector<double> LightCloudKey;
+  int LightCloudSlices = 1;
+  int LightCloudBuilds = 0;
   int LightsLastRender = 0;
   std::string LightsMessage;
 
@@ -452,7 +461,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::string LastPassTimes;
 
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass;
+    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass, LightCloudPass;
 
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
@@ -489,22 +498,25 @@ struct vtkNimbusCloudVolumeMapper::Internals
         ClearAccumulation.GetPointer(), SceneColor.GetPointer(), SceneDepth.GetPointer(),
         Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer(),
         SunDepthTexture.GetPointer(), BlockTexture.GetPointer(), FroxelScattering.GetPointer(),
-        FroxelTransmittance.GetPointer(), LightMapTexture.GetPointer(), LightsImage.GetPointer() })
+        FroxelTransmittance.GetPointer(), LightMapTexture.GetPointer(), LightsImage.GetPointer(),
+        LightCloudVolume.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
     ShadowMaps.Release(window);
     LightMapTime = 0;
+    LightCloudKey.clear();
     for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
            SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
            AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer(),
            FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer(),
-           LightsFramebuffer.GetPointer() })
+           LightsFramebuffer.GetPointer(), LightCloudFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
     for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
-           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass })
+           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass,
+           &LightCloudPass })
     {
       if (*pass)
       {
@@ -665,7 +677,8 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
         in.AtmosphereTexture.GetPointer(), in.ExternalShadowTexture.GetPointer(),
         in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
         in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
-        in.ShadowMaps.GetTexture(), in.LightMapTexture.GetPointer(), in.LightsImage.GetPointer() })
+        in.ShadowMaps.GetTexture(), in.LightMapTexture.GetPointer(), in.LightsImage.GetPointer(),
+        in.LightCloudVolume.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -718,6 +731,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
   }
   else if (this->UsesRayMarching())
   {
+    this->UpdateLightCloudVolume(frame);
     in.Timer.Begin("air look-up volume");
     this->RenderAirFroxels(frame);
     in.Timer.Begin("ray march");
@@ -3206,12 +3220,103 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
     }
   }
   program->SetUniformMatrix3x3("lightUpToWorld", upToWorld);
-  // An empty density (fog around geometry, no cloud) casts no shadow: no samples.
-  program->SetUniformi("lightCloudSteps", in.DensityMaximum > 0.0 ? this->LightCloudSteps : 0);
+  program->SetUniformi("lightCloudVolumeOn", frame.LightCloudVolume ? 1 : 0);
+  // Unused when off, but the sampler must name a 3-D unit.
+  program->SetUniformi("lightCloudVolume",
+    (frame.LightCloudVolume ? in.LightCloudVolume.GetPointer() : in.Density.GetTexture())
+      ->GetTextureUnit());
+  program->SetUniformf("lightCloudVolumeSlices", static_cast<float>(in.LightCloudSlices));
   program->SetUniformf("lightRadiusMetres", static_cast<float>(kLightRadiusMetres));
   program->SetUniformf("lightMieScattering0", static_cast<float>(in.Table.MieScatteringSeaLevel));
   program->SetUniformf(
     "lightPhaseConstant", static_cast<float>(this->MultipleScattering / (4.0 * nimbus::kPi)));
+}
+
+// The cloud's transmittance toward each view light at the texels of a grid over the
+// density's box (at most 64 per axis; cloudLightDepthFS.glsl), lights stacked along the
+// third axis: redrawn when the density, the lights or the optics change, so a view ray's
+// sample reads one texel instead of marching toward the light. An empty density (fog
+// around geometry, no cloud) or LightCloudSteps 0: none.
+void vtkNimbusCloudVolumeMapper::UpdateLightCloudVolume(FrameState& frame)
+{
+  Internals& in = *this->Internal;
+  frame.LightCloudVolume = false;
+  if (frame.Lights.empty() || this->LightCloudSteps <= 0 || !(in.DensityMaximum > 0.0))
+  {
+    return;
+  }
+  int dims[3];
+  in.Density.GetDimensions(dims);
+  int grid[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    grid[a] = std::clamp(dims[a], 2, 64);
+  }
+  const int lights = static_cast<int>(frame.Lights.size());
+  std::vector<double> key{ static_cast<double>(in.Density.GetNumberOfUploads()),
+    this->ExtinctionPerDensity, frame.Settings.MetresPerUnit,
+    static_cast<double>(this->LightCloudSteps) };
+  key.insert(key.end(), frame.WorldToBox.begin(), frame.WorldToBox.end());
+  for (const nimbus::ViewLight& light : frame.Lights)
+  {
+    key.insert(key.end(), light.Position.begin(), light.Position.end());
+  }
+  if (key != in.LightCloudKey || !in.LightCloudVolume->GetHandle())
+  {
+    in.Timer.Begin("lights' cloud transmittance");
+    ResetTexture(in.LightCloudVolume, frame.Window, true);
+    if (!in.LightCloudVolume->Allocate3D(grid[0], grid[1], grid[2] * lights, 1, VTK_FLOAT))
+    {
+      throw std::runtime_error("could not allocate the lights' transmittance volume");
+    }
+    vtkShaderProgram* program = in.Ready(in.LightCloudPass, cloudLightDepthFS);
+    this->SetCommonUniforms(program, frame);
+    vtkNew<vtkMatrix4x4> boxToWorld;
+    for (int r = 0; r < 4; ++r)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        boxToWorld->SetElement(r, c, frame.WorldToBox[c * 4 + r]); // column-major
+      }
+    }
+    boxToWorld->Invert();
+    std::array<float, 16> boxToWorldColumns{};
+    for (int r = 0; r < 4; ++r)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        boxToWorldColumns[c * 4 + r] = static_cast<float>(boxToWorld->GetElement(r, c));
+      }
+    }
+    program->SetUniformMatrix4x4("boxToWorld", boxToWorldColumns.data());
+    program->SetUniformi("cloudSteps", this->LightCloudSteps);
+    frame.State->vtkglDisable(GL_BLEND);
+    frame.State->vtkglViewport(0, 0, grid[0], grid[1]);
+    in.LightCloudFramebuffer->SetContext(frame.Window);
+    in.LightCloudFramebuffer->Bind(GL_FRAMEBUFFER);
+    for (int i = 0; i < lights; ++i)
+    {
+      const float position[3] = { static_cast<float>(frame.Lights[i].Position[0]),
+        static_cast<float>(frame.Lights[i].Position[1]),
+        static_cast<float>(frame.Lights[i].Position[2]) };
+      program->SetUniform3f("sourcePosition", position);
+      for (int z = 0; z < grid[2]; ++z)
+      {
+        in.LightCloudFramebuffer->RemoveColorAttachment(0);
+        in.LightCloudFramebuffer->AddColorAttachment(
+          0, in.LightCloudVolume, static_cast<unsigned int>(i * grid[2] + z));
+        in.LightCloudFramebuffer->ActivateDrawBuffer(0);
+        program->SetUniformf("sliceW", (z + 0.5f) / static_cast<float>(grid[2]));
+        in.LightCloudPass->Render();
+      }
+    }
+    in.LightCloudFramebuffer->RemoveColorAttachment(0);
+    in.LightCloudKey = std::move(key);
+    in.LightCloudSlices = grid[2];
+    ++in.LightCloudBuilds;
+  }
+  in.LightCloudVolume->Activate();
+  frame.LightCloudVolume = true;
 }
 
 // 002 §6.2's virtual planes: NumberOfVirtualPlanes planes parallel to the screen from

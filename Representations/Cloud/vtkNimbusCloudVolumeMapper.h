@@ -437,8 +437,10 @@ public:
   ///    002 §6.2: NumberOfVirtualPlanes planes parallel to the screen over the lit depth,
   ///    drawn back to front and added to the picture).
   ///  - LightShadowMapSize: texels per side of each of a light's six shadow-map faces
-  ///    (0: the opaque geometry casts no shadow). LightCloudSteps: samples of the cloud
-  ///    between a point and a light (0: the cloud casts no shadow in the beams).
+  ///    (0: the opaque geometry casts no shadow). LightCloudSteps (default 48): samples of
+  ///    the cloud between a texel of the lights' transmittance volume (at most 64^3 over
+  ///    the density's box, redrawn when the density or a light moves) and the light (0:
+  ///    the cloud casts no shadow in the beams).
   ///  - MaximumLights: at most this many lights (up to 8), the brightest at the scene
   ///    first; the others are left out with a warning. Lights whose beam misses the
   ///    scene's bounds cost nothing.
@@ -760,7 +762,7 @@ protected:
   int LightSamples = 32;
   int NumberOfVirtualPlanes = 64;
   int LightShadowMapSize = 256;
-  int LightCloudSteps = 12;
+  int LightCloudSteps = 48;
   int MaximumLights = 8;
   double RayMarchStepTexels = 2.0;
   bool TimePasses = false;
@@ -834,6 +836,7 @@ private:
   // The view's lights (docs/lights.md).
   void UpdateViewLights(vtkRenderer* renderer, FrameState& frame);
   void UpdateLightMapTexture(FrameState& frame);
+  void UpdateLightCloudVolume(FrameState& frame);
   void SetViewLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void AddViewLightsToSolve(
     const FrameState& frame, double cloudMiddleZ, nimbus::CloudLighting& lighting);

@@ -23,7 +23,9 @@ uniform sampler2D lightShadowAtlas;      // depth; light i's six faces in row i
 uniform mat3 lightUpToWorld;             // the up frame -> VTK's world (the maps' frame)
 uniform vec2 lightShadowRange[kMaxLights]; // near, far plane (world units)
 uniform vec2 lightShadowAtlasSize;       // faces per row (6), rows (lights)
-uniform int lightCloudSteps;             // samples of the cloud toward a light
+uniform int lightCloudVolumeOn;          // the lights' transmittance volume is drawn
+uniform sampler3D lightCloudVolume;      // light i's in [i, i + 1] / lightCount along z
+uniform float lightCloudVolumeSlices;    // z-slices per light
 uniform float lightRadiusMetres;         // distances to a light are at least this
 uniform float lightMieScattering0;       // the air's Mie scattering at sea level [1/m]
 uniform float lightPhaseConstant;        // k_multi / (4 pi) of the cloud's phase (000 Eq. 1)
@@ -143,33 +145,27 @@ float LightShadow(int i, vec3 p)
   return mix(mix(lit[0], lit[1], weight.x), mix(lit[2], lit[3], weight.x), weight.y);
 }
 
-// The cloud's optical depth between p and light i (lightCloudSteps midpoint samples
-// over the part of the segment inside the density box).
-float LightCloudDepth(int i, vec3 p)
+// The cloud's transmittance between p and light i, read in the light's transmittance
+// volume (cloudLightDepthFS.glsl; lights stacked along its third axis) at the point of
+// the segment from p to the light that lies in the density box nearest to p (beyond it,
+// toward p, there is no cloud); 1 where the segment misses the box or without volume.
+float LightCloudTransmittance(int i, vec3 p)
 {
-  if (lightCloudSteps <= 0)
+  if (lightCloudVolumeOn == 0)
   {
-    return 0.0;
+    return 1.0;
   }
   vec3 d = lightPosition[i] - p;
   float tIn, tOut;
-  if (!BoxInterval(p, d, tIn, tOut))
+  if (!BoxInterval(p, d, tIn, tOut) || tOut <= 0.0 || tIn >= 1.0)
   {
-    return 0.0;
+    return 1.0;
   }
-  tIn = max(tIn, 0.0);
-  tOut = min(tOut, 1.0);
-  if (tOut <= tIn)
-  {
-    return 0.0;
-  }
-  float dt = (tOut - tIn) / float(lightCloudSteps);
-  float sum = 0.0;
-  for (int k = 0; k < lightCloudSteps; ++k)
-  {
-    sum += CloudDensity(p + (tIn + (float(k) + 0.5) * dt) * d);
-  }
-  return extinctionPerDensity * sum * dt * length(d) * metresPerUnit;
+  vec3 q = (worldToBox * vec4(p + max(tIn, 0.0) * d, 1.0)).xyz;
+  float slices = lightCloudVolumeSlices;
+  float w = clamp(q.z, 0.5 / slices, 1.0 - 0.5 / slices);
+  return texture(lightCloudVolume, vec3(clamp(q.xy, 0.0, 1.0),
+    (float(i) + w) / float(lightCount))).r;
 }
 
 // The clear air's transmittance between p and light i (000 Eq. 6, flat layers).
@@ -189,9 +185,9 @@ vec3 LightAirTransmittance(int i, vec3 p)
 }
 
 // The light of light i arriving at p [irradiance on a surface facing it]: intensity,
-// beam, light map, shadow map, the air between and (throughCloud) the cloud's optical
-// depth between (LightCloudDepth, only where the beam reaches p); toLight: the unit
-// direction from p toward the light.
+// beam, light map, shadow map, the air between and (throughCloud) the cloud's
+// transmittance between (LightCloudTransmittance, only where the beam reaches p);
+// toLight: the unit direction from p toward the light.
 vec3 LightArriving(int i, vec3 p, bool throughCloud, out vec3 toLight)
 {
   vec3 d = lightPosition[i] - p;
@@ -202,9 +198,9 @@ vec3 LightArriving(int i, vec3 p, bool throughCloud, out vec3 toLight)
   {
     return vec3(0.0);
   }
-  float cloudDepth = throughCloud ? LightCloudDepth(i, p) : 0.0;
+  float cloud = throughCloud ? LightCloudTransmittance(i, p) : 1.0;
   return lightIntensity[i] * beam * LightShadow(i, p) / (distance * distance) *
-    LightAirTransmittance(i, p) * exp(-cloudDepth);
+    LightAirTransmittance(i, p) * cloud;
 }
 
 // The part [a, b] of [t0, t1] inside light i's beam (a convex cone, or everything for a
