@@ -101,6 +101,16 @@ class HarnessTest(unittest.TestCase):
         self.assertAlmostEqual(plain["rmse"], true_rmse, places=12)
         self.assertEqual(plain["rmse"], plain["rmse_raw"])
 
+    def test_psnr_of_a_robust_peak(self):
+        # One pixel 100 times brighter than the rest (the pixel next to a light) sets the
+        # peak of psnr_db, not that of psnr_p999_db.
+        reference = np.full((40, 50, 3), 0.1)
+        reference[7, 9] = 10.0
+        image = reference + 0.001
+        metrics = harness.error_metrics(image, reference)
+        self.assertAlmostEqual(metrics["psnr_db"], 20.0 * math.log10(10.0 / 0.001), places=6)
+        self.assertAlmostEqual(metrics["psnr_p999_db"], 20.0 * math.log10(0.1 / 0.001), places=6)
+
     def test_svs_mapper_converges_to_the_reference(self):
         settings = os.path.join(self.output, "svs.json")
         with open(settings, "w") as stream:
