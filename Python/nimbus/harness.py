@@ -651,10 +651,10 @@ class SvsRenderer:
     Only the ray march draws lights: a scene with lights refuses a row that is not
     method march. Their settings: light_method (march, the default: equi-angular samples
     along each view ray, or planes: virtual planes, LightShaftMethod), light_samples
-    (LightSamples, default 32), virtual_planes (NumberOfVirtualPlanes, default 64),
-    shadow_map_size (LightShadowMapSize, default 256; 0: no shadows of the occluders)
-    and light_cloud_steps (LightCloudSteps, default 12; 0: the cloud casts no shadow in
-    the beams): the mapper's defaults, set on every row.
+    (LightSamples), virtual_planes (NumberOfVirtualPlanes), shadow_map_size
+    (LightShadowMapSize; 0: no shadows of the occluders) and light_cloud_steps
+    (LightCloudSteps; 0: the cloud casts no shadow in the beams), each the mapper's
+    default when a row leaves it out, set on every row.
     """
 
     def __init__(self, scene_path):
@@ -668,6 +668,11 @@ class SvsRenderer:
         density.SetSceneFileName(scene_path)
         density.Update()
         self.mapper = configure_svs_mapper(nimbus.vtkNimbusCloudVolumeMapper(), scene)
+        # The light settings a row leaves out take the mapper's defaults.
+        self.light_defaults = (self.mapper.GetLightSamples(),
+                               self.mapper.GetNumberOfVirtualPlanes(),
+                               self.mapper.GetLightShadowMapSize(),
+                               self.mapper.GetLightCloudSteps())
         self.k_multi = scene["medium"].get("multiple_scattering_constant", 0.0)
         self.extra = {}
         self.mapper.SetInputConnection(density.GetOutputPort())
@@ -718,10 +723,11 @@ class SvsRenderer:
         self.mapper.SetRenderingMethod(SVS_RENDERING_METHODS[method])
         self.mapper.SetLightShaftMethod(SVS_LIGHT_SHAFT_METHODS[settings.get("light_method",
                                                                              "march")])
-        self.mapper.SetLightSamples(int(settings.get("light_samples", 32)))
-        self.mapper.SetNumberOfVirtualPlanes(int(settings.get("virtual_planes", 64)))
-        self.mapper.SetLightShadowMapSize(int(settings.get("shadow_map_size", 256)))
-        self.mapper.SetLightCloudSteps(int(settings.get("light_cloud_steps", 12)))
+        defaults = self.light_defaults
+        self.mapper.SetLightSamples(int(settings.get("light_samples", defaults[0])))
+        self.mapper.SetNumberOfVirtualPlanes(int(settings.get("virtual_planes", defaults[1])))
+        self.mapper.SetLightShadowMapSize(int(settings.get("shadow_map_size", defaults[2])))
+        self.mapper.SetLightCloudSteps(int(settings.get("light_cloud_steps", defaults[3])))
         self.mapper.SetRayMarchStepTexels(float(settings.get("step", 1.0)))
         self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
         self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
