@@ -218,11 +218,13 @@ UNSUPPORTED_FEATURES = {
     "vtk-gpu": ("VTK GPU mapper",
                 lambda scene: version3_features(scene) + version4_features(scene)),
     "svs": ("SVS mapper", svs_unsupported_features),
+    "single": ("single-scattering renderer",
+               lambda scene: version3_features(scene) + version4_features(scene)),
 }
 
 
 def refuse_unsupported_features(scene_path, scene, renderer):
-    """A renderer ("vtk-gpu" or "svs") that does not draw a feature of the scene (lights,
+    """A renderer ("vtk-gpu", "svs" or "single") that does not draw a feature of the scene (lights,
     emission, more media, occluders: scene format versions 3 and 4) says so by name,
     rather than render the scene without it."""
     name, features_of = UNSUPPORTED_FEATURES[renderer]

@@ -307,8 +307,9 @@ class HarnessTest(unittest.TestCase):
         # run() skips the scenes a renderer refuses (a glob of Data/Scenes holds both
         # kinds) and fails only when nothing is left.
         path = self.write_lit_scene()
-        self.assertEqual(harness.run([path, "--renderer", "vtk-gpu", "--output-dir",
-                                      self.output]), 1)
+        for renderer in ("vtk-gpu", "single"):
+            self.assertEqual(harness.run([path, "--renderer", renderer, "--output-dir",
+                                          self.output]), 1)
         self.assertFalse(os.path.exists(os.path.join(self.output, "trade.csv")))
         # The sun below the horizon or dark: occluders are fine.
         dark = dict(lit, sun={"azimuth_degrees": 0, "elevation_degrees": 20, "illuminance": 0})
