@@ -329,6 +329,16 @@ struct PathState
   std::vector<double> SunTransmittance;
   std::vector<double> SavedWeight;        // the path's throughput during a sun-peak flight
   std::vector<double> LightTransmittance; // air transmittance toward a light
+  std::vector<double> ViewTransmittance;  // air transmittance along a segment (equi-angular)
+  // The segment being flown, for the equi-angular strategy's balance heuristic at its
+  // collisions (Integrator::EquiAngularWeight): origin, direction, end, the proxy's
+  // extinction at the origin, and the collision's distance along it.
+  bool EquiAngular = false;
+  Vector3 SegmentOrigin{ { 0.0, 0.0, 0.0 } };
+  Vector3 SegmentDirection{ { 0.0, 0.0, 1.0 } };
+  double SegmentEnd = 0.0;
+  double SegmentSigma0 = 0.0;
+  double SegmentT = 0.0;
   int Medium = 0; // the medium of the last cloud scattering event (RenderContext::GetMedia)
   // The occluder surface of the last Surface vertex: normal (facing where the path came
   // from) and albedo.
@@ -545,6 +555,29 @@ private:
   /// chosen in proportion to its intensity; a point along a segment, uniformly).
   void LightNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
     PathState& state) const;
+  /// Equi-angular strategy (EquiAngularLightSampling): on the segment from ray.Origin to
+  /// tEnd, one light element and a point on it as LightNextEvent chooses them, a distance t
+  /// with density h / ((theta_b - theta_a)(h^2 + (t - t0)^2)) over the part of the segment
+  /// the light can reach (a spot's cone), and the single scattering there of that light,
+  /// weighted by the balance heuristic against the collisions' estimate.
+  void EquiAngularLightEstimate(
+    const Ray& ray, double tEnd, PathRandom& rng, PathState& state) const;
+  /// The interval [ta, tb] of the segment (origin o, unit direction d, end tEnd) inside a
+  /// spot's cone from y (all of [0, tEnd] for other lights); false if empty.
+  bool LightInterval(const LightElement& light, const Vector3& y, const Vector3& o,
+    const Vector3& d, double tEnd, double& ta, double& tb) const;
+  /// The equi-angular density at distance t on the segment for the light point y over
+  /// [ta, tb] (0 outside it or where the segment's line passes through y).
+  static double EquiAngularPdf(
+    const Vector3& y, const Vector3& o, const Vector3& d, double ta, double tb, double t);
+  /// The collision strategy's stand-in density for the balance heuristic at distance t,
+  /// q(t) = sigma(x) exp(-sigma_0 t): sigma the cloud's extinction plus the air's largest
+  /// over the wavelengths at x, sigma_0 at the segment's origin. Any positive function
+  /// both strategies evaluate alike keeps the weights summing to 1 (Veach 1997, 9.2);
+  /// this one follows the collisions' density where the medium varies slowly.
+  double CollisionProxy(const Vector3& x, double t, double sigma0) const;
+  /// Largest extinction over the wavelengths at x (cloud + air), 1/m.
+  double ExtinctionBound(const Vector3& x) const;
   /// The air's transmittance from p to a light at y per wavelength, as
   /// RenderContext::AtmosphereTransmittanceBetween, by 8-point Gauss-Legendre quadrature of
   /// the densities where the segment's altitude spans at most two of the smaller scale
@@ -1394,6 +1427,25 @@ void Integrator::LightNextEvent(
       return;
     }
   }
+  // At a collision of a segment the equi-angular strategy also sampled: the balance
+  // heuristic's share of this (collision) strategy, q / (q + p_ea). Not for polyline
+  // segments, which that strategy leaves to this one (EquiAngularLightEstimate).
+  if (state.EquiAngular && !light.IsSegment &&
+    (scatterer == Scatterer::Cloud || scatterer == Scatterer::Rayleigh ||
+      scatterer == Scatterer::Mie))
+  {
+    double ta, tb, pdf = 0.0;
+    if (this->LightInterval(
+          light, y, state.SegmentOrigin, state.SegmentDirection, state.SegmentEnd, ta, tb))
+    {
+      pdf = EquiAngularPdf(y, state.SegmentOrigin, state.SegmentDirection, ta, tb, state.SegmentT);
+    }
+    if (pdf > 0.0)
+    {
+      const double q = this->CollisionProxy(p, state.SegmentT, state.SegmentSigma0);
+      beam *= q / (q + pdf);
+    }
+  }
   double f;
   switch (scatterer)
   {
@@ -1456,6 +1508,250 @@ void Integrator::LightNextEvent(
     {
       state.Radiance[i] += state.Weight[i] * k0 * spectrum[i];
     }
+  }
+}
+
+double Integrator::ExtinctionBound(const Vector3& x) const
+{
+  double sigma = this->HasCloud ? this->Context.CloudExtinction(x) : 0.0;
+  if (this->Air)
+  {
+    sigma += this->AirMajorantAt(this->Air->Altitude(this->Context.EarthCentred(x)));
+  }
+  return sigma;
+}
+
+double Integrator::CollisionProxy(const Vector3& x, double t, double sigma0) const
+{
+  return this->ExtinctionBound(x) * std::exp(-sigma0 * t);
+}
+
+bool Integrator::LightInterval(const LightElement& light, const Vector3& y, const Vector3& o,
+  const Vector3& d, double tEnd, double& ta, double& tb) const
+{
+  ta = 0.0;
+  tb = tEnd;
+  if (!light.IsSpot)
+  {
+    return tEnd > 0.0;
+  }
+  // The forward cone {x : (x - y).a >= cos(cone) |x - y|} is convex, so the line meets it
+  // in one interval: f(t) = ((v + t d).a)^2 - c^2 |v + t d|^2 >= 0 with (v + t d).a > 0,
+  // v = o - y, c = cos(cone). The candidates are the roots of f and of the second
+  // condition; the interval is where the midpoints between them satisfy both.
+  const Vector3& a = light.Spot.Axis;
+  const Vector3 v{ { o[0] - y[0], o[1] - y[1], o[2] - y[2] } };
+  const double c = std::cos(light.Spot.ConeHalfAngleDegrees * kDegree), c2 = c * c;
+  const double va = Dot(v, a), da = Dot(d, a), vd = Dot(v, d), vv = Dot(v, v);
+  const double A = da * da - c2, B = 2.0 * (va * da - c2 * vd), C = va * va - c2 * vv;
+  std::vector<double> cuts;
+  cuts.reserve(6);
+  cuts.push_back(0.0);
+  auto add = [&cuts, tEnd](double t)
+  {
+    if (t > 0.0 && t < tEnd && std::isfinite(t))
+    {
+      cuts.push_back(t);
+    }
+  };
+  if (std::abs(A) > 1e-12)
+  {
+    const double disc = B * B - 4.0 * A * C;
+    if (disc >= 0.0)
+    {
+      const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+      add(q / A);
+      if (q != 0.0)
+      {
+        add(C / q);
+      }
+    }
+  }
+  else if (B != 0.0)
+  {
+    add(-C / B);
+  }
+  if (da != 0.0)
+  {
+    add(-va / da);
+  }
+  std::sort(cuts.begin(), cuts.end());
+  const double scale = 1.0 + std::sqrt(vv) + (cuts.empty() ? 0.0 : cuts.back());
+  cuts.push_back(std::isfinite(tEnd) ? tEnd : cuts.back() + 2.0 * scale);
+  auto inside = [&](double t)
+  {
+    const double along = va + t * da;
+    return along > 0.0 && A * t * t + B * t + C >= 0.0;
+  };
+  double lo = kInfinity, hi = -kInfinity;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i)
+  {
+    if (cuts[i + 1] > cuts[i] && inside(0.5 * (cuts[i] + cuts[i + 1])))
+    {
+      lo = std::min(lo, cuts[i]);
+      hi = std::max(hi, cuts[i + 1]);
+    }
+  }
+  if (!(hi > lo))
+  {
+    return false;
+  }
+  ta = lo;
+  // Unbounded toward the far end: the whole rest of the segment.
+  tb = (!std::isfinite(tEnd) && hi == cuts.back()) ? tEnd : hi;
+  return true;
+}
+
+double Integrator::EquiAngularPdf(
+  const Vector3& y, const Vector3& o, const Vector3& d, double ta, double tb, double t)
+{
+  if (!(t >= ta && t <= tb))
+  {
+    return 0.0;
+  }
+  const double t0 = (y[0] - o[0]) * d[0] + (y[1] - o[1]) * d[1] + (y[2] - o[2]) * d[2];
+  const Vector3 foot = Along(o, d, t0);
+  const Vector3 offset{ { y[0] - foot[0], y[1] - foot[1], y[2] - foot[2] } };
+  const double h = std::sqrt(Dot(offset, offset));
+  const double angle = std::atan2(tb - t0, h) - std::atan2(ta - t0, h);
+  if (!(h > 0.0) || !(angle > 0.0) || !std::isfinite(angle))
+  {
+    return 0.0;
+  }
+  return h / (angle * (h * h + (t - t0) * (t - t0)));
+}
+
+void Integrator::EquiAngularLightEstimate(
+  const Ray& ray, double tEnd, PathRandom& rng, PathState& state) const
+{
+  // The light and the point on it, as LightNextEvent chooses them (the same distribution,
+  // so the balance heuristic compares the densities of t given them).
+  const double u = rng.Uniform() * this->LightTotal;
+  const std::size_t k = std::min(this->LightCdf.size() - 1,
+    static_cast<std::size_t>(
+      std::upper_bound(this->LightCdf.begin(), this->LightCdf.end(), u) - this->LightCdf.begin()));
+  const LightElement& light = this->Context.GetLightElements()[k];
+  if (light.IsSegment)
+  {
+    // A polyline's point y is drawn uniformly along it, so near the channel the distance
+    // between y and the segment's line has no small-value cutoff and 1/h (what remains of
+    // 1/d^2 after the equi-angular sampling) would have infinite variance: lightning
+    // channels are left to the collisions (their weight there is 1).
+    return;
+  }
+  const Vector3 y = light.A;
+  const Vector3& o = ray.Origin;
+  const Vector3& d = ray.Direction;
+  double ta, tb;
+  if (!this->LightInterval(light, y, o, d, tEnd, ta, tb))
+  {
+    return;
+  }
+  // t = t0 + h tan(theta), theta uniform between the ends' angles.
+  const double t0 = (y[0] - o[0]) * d[0] + (y[1] - o[1]) * d[1] + (y[2] - o[2]) * d[2];
+  const Vector3 foot = Along(o, d, t0);
+  const Vector3 offset{ { y[0] - foot[0], y[1] - foot[1], y[2] - foot[2] } };
+  const double h = std::sqrt(Dot(offset, offset));
+  const double thetaA = std::atan2(ta - t0, h), thetaB = std::atan2(tb - t0, h);
+  if (!(h > 0.0) || !(thetaB > thetaA))
+  {
+    return; // the segment's line passes through the light: the collisions cover it
+  }
+  const double t =
+    std::clamp(t0 + h * std::tan(thetaA + rng.Uniform() * (thetaB - thetaA)), ta, tb);
+  const double pdf = EquiAngularPdf(y, o, d, ta, tb, t);
+  if (!(pdf > 0.0) || !(t < tEnd))
+  {
+    return;
+  }
+  const Vector3 x = Along(o, d, t);
+  Vector3 omega{ { y[0] - x[0], y[1] - x[1], y[2] - x[2] } };
+  const double r2 = Dot(omega, omega);
+  const double r = std::sqrt(r2);
+  if (!(r > 0.0) || !std::isfinite(r))
+  {
+    return;
+  }
+  for (double& c : omega)
+  {
+    c /= r;
+  }
+  double beam = 1.0;
+  if (light.IsSpot)
+  {
+    beam = LightElementFactor(light, { { -omega[0], -omega[1], -omega[2] } });
+    if (!(beam > 0.0))
+    {
+      return;
+    }
+  }
+  // The scattering at x toward -d: sum over the scatterers of sigma_s f(mu), mu = omega.d.
+  const double mu = Dot(omega, d);
+  double cloud = 0.0;
+  if (this->HasCloud)
+  {
+    if (this->Media.size() > 1)
+    {
+      for (const MediumComponent& m : this->Media)
+      {
+        const double s = m.Albedo * m.ExtinctionPerDensity * m.Density->Sample(x);
+        cloud += s > 0.0 ? s * m.Phase.Evaluate(mu) : 0.0;
+      }
+    }
+    else
+    {
+      const double s = this->CloudAlbedo * this->Context.CloudExtinction(x);
+      cloud = s > 0.0 ? s * this->Context.GetCloudPhase().Evaluate(mu) : 0.0;
+    }
+  }
+  double rayleigh = 0.0, mie = 0.0;
+  if (this->Air)
+  {
+    const double altitude = this->Air->Altitude(this->Context.EarthCentred(x));
+    rayleigh = this->Air->Density(altitude, this->ScaleHeightR) * this->Air->RayleighPhase(mu);
+    mie = this->BetaMs * this->Air->Density(altitude, this->ScaleHeightM) * this->Air->MiePhase(mu);
+  }
+  if (!(cloud > 0.0) && !(rayleigh > 0.0) && !(mie > 0.0))
+  {
+    return;
+  }
+  if (this->Context.HasGround())
+  {
+    const double g = this->Context.GetGroundHeight();
+    if ((x[2] >= g) != (y[2] >= g))
+    {
+      return;
+    }
+  }
+  if (this->Blocked(x, omega, r * (1.0 - 1e-9)))
+  {
+    return;
+  }
+  // Balance heuristic against the collisions' estimate at x.
+  const double q = this->CollisionProxy(x, t, state.SegmentSigma0);
+  const double weight = pdf / (pdf + q);
+  const double toLight = this->CloudTransmittance(x, omega, rng, state, r);
+  if (!(toLight > 0.0) || state.Truncated)
+  {
+    return;
+  }
+  const double view = this->CloudTransmittance(o, d, rng, state, t);
+  if (!(view > 0.0) || state.Truncated)
+  {
+    return;
+  }
+  const double k0 = beam * this->LightTotal / r2 * toLight * view * weight / pdf;
+  const std::vector<double>& spectrum = this->Context.GetLightSpectra()[light.Light];
+  if (this->Air)
+  {
+    this->LightAirTransmittance(x, y, state.LightTransmittance);
+    this->LightAirTransmittance(o, x, state.ViewTransmittance);
+  }
+  for (int i = 0; i < this->Wavelengths; ++i)
+  {
+    const double scattering = cloud + (this->Air ? this->BetaR[i] * rayleigh + mie : 0.0);
+    const double air = this->Air ? state.LightTransmittance[i] * state.ViewTransmittance[i] : 1.0;
+    state.Radiance[i] += state.Weight[i] * k0 * spectrum[i] * scattering * air;
   }
 }
 
@@ -1654,14 +1950,32 @@ void Integrator::TracePath(
   const bool sunPeak = this->Settings.SunPeakSampling && this->SunOn && this->HasCloud &&
     this->CloudPhasePeak >= kSunPeakMinimumPeak;
   double previousPdf = 0.0; // p_A of the current direction; 0 = no sun-peak partner
+  // Equi-angular sampling of the lights on every segment through a medium.
+  const bool equiAngular = this->Settings.EquiAngularLightSampling && this->LightTotal > 0.0 &&
+    (this->HasCloud || this->Air != nullptr);
+  state.EquiAngular = false;
   for (int order = 0;;)
   {
     SegmentEndKind endKind;
     OccluderHit surface;
     const double tEnd = this->SegmentEnd(ray, endKind, surface);
+    state.EquiAngular = equiAngular && tEnd > 0.0;
+    if (state.EquiAngular)
+    {
+      state.SegmentOrigin = ray.Origin;
+      state.SegmentDirection = ray.Direction;
+      state.SegmentEnd = tEnd;
+      state.SegmentSigma0 = this->ExtinctionBound(ray.Origin);
+      this->EquiAngularLightEstimate(ray, tEnd, rng, state);
+      if (state.Truncated)
+      {
+        break;
+      }
+    }
     double t;
     Scatterer scatterer = Scatterer::None;
     const FlightEnd end = this->FreeFlight(ray, tEnd, rng, state, t, scatterer, true);
+    state.SegmentT = t;
     if (end == FlightEnd::Truncated || end == FlightEnd::Absorbed)
     {
       break;

@@ -147,6 +147,13 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// probability min(1, T_est / 0.05) (weighted by its inverse), T_est from a lattice of
   /// the cloud's optical depth toward the sun. Unbiased either way; false = always.
   bool SunDepthRoulette = true;
+  /// Equi-angular sampling of the lights (Kulla & Fajardo 2012): on every segment of a
+  /// path through a medium, a point drawn with density proportional to 1/d^2 about a light
+  /// (within a spot's cone), its single scattering of that light added, combined with the
+  /// lights' estimate at the segment's collisions by the balance heuristic. Unbiased either
+  /// way; without it a point light's estimate near the light has infinite variance (the
+  /// second moment of 1/d^2 over a volume diverges). Runs only in scenes with lights.
+  bool EquiAngularLightSampling = true;
   /// The atmosphere's transmittance toward the sun at air and ground points from a
   /// table checked cell by cell against the exact integral (error in ln T <= 1e-4 where
   /// used, exact elsewhere); false = the exact integral at every point. The table
