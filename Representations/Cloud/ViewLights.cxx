@@ -75,8 +75,41 @@ bool LightReachesBox(const ViewLight& light, const std::array<double, 6>& bounds
   return angle < light.Spot.ConeHalfAngleDegrees * kDegree + std::asin(r / distance);
 }
 
+bool LightReachesFrustum(
+  const ViewLight& light, const std::array<double, 24>& planes, double range)
+{
+  // The sphere around the cone's part within `range`: for a cone of half angle theta,
+  // the sphere through the apex and the base circle (centre on the axis at
+  // range / (2 cos^2 theta), radius the same), or around the apex when that is larger
+  // than the sphere of radius `range` itself.
+  Vector3 centre = light.Position;
+  double radius = range;
+  if (IsSpot(light.Spot))
+  {
+    const double c = std::cos(light.Spot.ConeHalfAngleDegrees * kDegree);
+    const double r = range / (2.0 * std::max(c * c, 1e-12));
+    if (r < range)
+    {
+      centre = Along(light.Position, light.Spot.Axis, r);
+      radius = r;
+    }
+  }
+  for (int p = 0; p < 6; ++p)
+  {
+    const double distance = planes[4 * p] * centre[0] + planes[4 * p + 1] * centre[1] +
+      planes[4 * p + 2] * centre[2] + planes[4 * p + 3];
+    const double norm = std::sqrt(planes[4 * p] * planes[4 * p] +
+      planes[4 * p + 1] * planes[4 * p + 1] + planes[4 * p + 2] * planes[4 * p + 2]);
+    if (norm > 0.0 && distance < -radius * norm)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
 ViewLightSelection SelectViewLights(const std::vector<ViewLight>& candidates,
-  const std::array<double, 6>& region, int maximumLights)
+  const std::array<double, 6>& region, int maximumLights, const std::array<double, 24>* frustum)
 {
   ViewLightSelection selection;
   std::vector<std::pair<double, const ViewLight*>> kept;
@@ -86,7 +119,8 @@ ViewLightSelection SelectViewLights(const std::vector<ViewLight>& candidates,
     {
       continue;
     }
-    if (!LightReachesBox(light, region))
+    if (!LightReachesBox(light, region) ||
+      (frustum && !LightReachesFrustum(light, *frustum, ShadowDepthRange(light.Position, region)[1])))
     {
       ++selection.DroppedOutside;
       continue;

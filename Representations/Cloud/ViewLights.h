@@ -37,7 +37,7 @@ struct ViewLightSelection
 {
   std::vector<ViewLight> Lights;
   int DroppedForCount = 0;
-  int DroppedOutside = 0; // cones that miss the region
+  int DroppedOutside = 0; // cones that miss the region or the view
   std::string Message;
 };
 
@@ -50,12 +50,20 @@ constexpr int kMaximumViewLights = 8;
 NIMBUSREPRESENTATIONS_EXPORT bool LightReachesBox(
   const ViewLight& light, const std::array<double, 6>& bounds);
 
-/// The lights of `candidates` that light `region`, brightest first (intensity's largest
-/// channel over the squared distance to the region's centre, at least its radius), at
-/// most `maximumLights` (clamped to [0, kMaximumViewLights]).
+/// True unless the part of the light's cone within `range` (world units) of the light
+/// lies wholly outside one of the view's frustum planes (a x + b y + c z + d >= 0 inside,
+/// VTK's vtkCamera::GetFrustumPlanes order and sign): the cone against the sphere around
+/// that part (conservative). A point light: the sphere of radius `range`.
+NIMBUSREPRESENTATIONS_EXPORT bool LightReachesFrustum(
+  const ViewLight& light, const std::array<double, 24>& planes, double range);
+
+/// The lights of `candidates` that light `region` (and, when `frustum` is given, reach
+/// the view's frustum within the region), brightest first (intensity's largest channel
+/// over the squared distance to the region's centre, at least its radius), at most
+/// `maximumLights` (clamped to [0, kMaximumViewLights]).
 NIMBUSREPRESENTATIONS_EXPORT ViewLightSelection SelectViewLights(
   const std::vector<ViewLight>& candidates, const std::array<double, 6>& region,
-  int maximumLights);
+  int maximumLights, const std::array<double, 24>* frustum = nullptr);
 
 /// One face of a light's cube of shadow maps: a 90-degree square view from the light
 /// along Forward with Up, Right = Forward x Up. The six faces look along +x, -x, +y,

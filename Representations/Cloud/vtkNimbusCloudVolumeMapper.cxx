@@ -3051,7 +3051,12 @@ void vtkNimbusCloudVolumeMapper::UpdateViewLights(vtkRenderer* renderer, FrameSt
     return;
   }
   const std::array<double, 6> region = LightRegionOf(renderer);
-  nimbus::ViewLightSelection selection = nimbus::SelectViewLights(candidates, region, this->MaximumLights);
+  // The view's frustum (VTK world): lights whose beams miss it cost nothing.
+  std::array<double, 24> frustum{};
+  renderer->GetActiveCamera()->GetFrustumPlanes(
+    renderer->GetTiledAspectRatio(), frustum.data());
+  nimbus::ViewLightSelection selection =
+    nimbus::SelectViewLights(candidates, region, this->MaximumLights, &frustum);
   if (selection.Message != in.LightsMessage && !selection.Message.empty())
   {
     vtkWarningMacro(<< selection.Message);

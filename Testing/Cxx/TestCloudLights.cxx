@@ -106,6 +106,28 @@ void TestSelection()
   const std::array<double, 6> empty{ { 1, -1, 1, -1, 1, -1 } };
   Check(nimbus::SelectViewLights(lights, empty, 8).Lights.empty(),
     "an empty region (no visible prop) keeps none");
+  // The view's frustum: a camera at (0, -50, 10) looking along +y, 60 degrees, square.
+  vtkNew<vtkCamera> camera;
+  camera->SetPosition(0, -50, 10);
+  camera->SetFocalPoint(0, 0, 10);
+  camera->SetViewAngle(60);
+  camera->SetClippingRange(0.1, 1000);
+  std::array<double, 24> planes{};
+  camera->GetFrustumPlanes(1.0, planes.data());
+  Check(nimbus::LightReachesFrustum(Spot({ { 0, 0, 30 } }, { { 0, 0, -1 } }, 20), planes, 100),
+    "a spot in front of the camera reaches its frustum");
+  Check(!nimbus::LightReachesFrustum(Spot({ { 0, -80, 10 } }, { { 0, -1, 0 } }, 10), planes, 100),
+    "a narrow spot behind the camera aimed away does not");
+  Check(nimbus::LightReachesFrustum(Spot({ { 0, -80, 10 } }, { { 0, 1, 0 } }, 10), planes, 100),
+    "a spot behind the camera aimed past it does");
+  Check(!nimbus::LightReachesFrustum(Spot({ { 0, -80, 10 } }, { { 0, 1, 0 } }, 120), planes, 10),
+    "a point light whose reach ends behind the camera does not");
+  const std::array<double, 6> wide{ { -100, 100, -100, 100, 0, 50 } };
+  std::vector<nimbus::ViewLight> pair{ Spot({ { 0, -80, 10 } }, { { 0, -1, 0 } }, 10),
+    Spot({ { 0, 0, 30 } }, { { 0, 0, -1 } }, 20) };
+  const nimbus::ViewLightSelection viewed = nimbus::SelectViewLights(pair, wide, 8, &planes);
+  Check(viewed.Lights.size() == 1 && viewed.DroppedOutside == 1,
+    "the selection drops the light whose beam misses the view");
   const auto range = nimbus::ShadowDepthRange({ { 0, 0, 30 } }, region);
   Check(range[0] > 0.0 && range[1] > std::sqrt(10 * 10 * 2 + 30 * 30.0) && range[0] < range[1],
     "shadow depth range covers the region's farthest corner");
