@@ -73,7 +73,7 @@ LIGHTS_DEFAULTS = {
     "LightSamples": 32,
     "NumberOfVirtualPlanes": 64,
     "LightShadowMapSize": 256,
-    "LightCloudSteps": 12,
+    "LightCloudSteps": 48,
     "MaximumLights": 8,
 }
 
