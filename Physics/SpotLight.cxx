@@ -39,8 +39,8 @@ double SpotFactor(const SpotProfile& profile, const Vector3& w)
 
 void SpotLightMapFrame(const Vector3& axis, Vector3& e1, Vector3& e2)
 {
-  const Vector3 h = std::abs(axis[2]) > 0.999 ? Vector3{ { 0.0, 1.0, 0.0 } }
-                                              : Vector3{ { 0.0, 0.0, 1.0 } };
+  const Vector3 h =
+    std::abs(axis[2]) > 0.999 ? Vector3{ { 0.0, 1.0, 0.0 } } : Vector3{ { 0.0, 0.0, 1.0 } };
   e1 = Normalized(Cross(h, axis));
   e2 = Cross(axis, e1);
 }

@@ -25,7 +25,7 @@ namespace nimbus
 
 struct NIMBUSPHYSICS_EXPORT SpotProfile
 {
-  Vector3 Axis{ { 0.0, 0.0, -1.0 } }; // unit, the beam's direction away from the light
+  Vector3 Axis{ { 0.0, 0.0, -1.0 } };  // unit, the beam's direction away from the light
   double ConeHalfAngleDegrees = 180.0; // >= 90: a point light (isotropic)
   double EdgeWidthDegrees = 0.0;       // in [0, ConeHalfAngleDegrees]
 };

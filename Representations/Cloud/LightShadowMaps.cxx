@@ -86,8 +86,8 @@ void AimCamera(vtkCamera* camera, const Vector3& position, const ShadowFace& fac
   const std::array<double, 2>& range)
 {
   camera->SetPosition(position[0], position[1], position[2]);
-  camera->SetFocalPoint(position[0] + face.Forward[0], position[1] + face.Forward[1],
-    position[2] + face.Forward[2]);
+  camera->SetFocalPoint(
+    position[0] + face.Forward[0], position[1] + face.Forward[1], position[2] + face.Forward[2]);
   camera->SetViewUp(face.Up[0], face.Up[1], face.Up[2]);
   camera->SetClippingRange(range[0], range[1]);
   const std::array<double, 16> p = ShadowFaceProjection(range[0], range[1]);
@@ -145,6 +145,8 @@ bool LightShadowMaps::Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* windo
   faceSize = std::max(faceSize, 16);
   EnsureDepthAtlas(in.Atlas, window, 6 * faceSize, static_cast<int>(lights.size()) * faceSize);
   vtkOpenGLState* state = window->GetState();
+  // The caller's framebuffer bindings come back afterwards (ParaView draws into its own).
+  state->PushFramebufferBindings();
   in.Framebuffer->SetContext(window);
   in.Framebuffer->Bind(GL_FRAMEBUFFER);
   in.Framebuffer->RemoveColorAttachments(4);
@@ -187,7 +189,7 @@ bool LightShadowMaps::Render(vtkRenderer* renderer, vtkOpenGLRenderWindow* windo
   state->vtkglDrawBuffer(GL_COLOR_ATTACHMENT0);
   state->vtkglReadBuffer(GL_COLOR_ATTACHMENT0);
   in.Framebuffer->RemoveDepthAttachment();
-  in.Framebuffer->UnBind();
+  state->PopFramebufferBindings();
   this->Casters = static_cast<int>(casters.size());
   return true;
 }

@@ -42,7 +42,8 @@ bool Usable(const ViewLight& light)
 double Brightness(const ViewLight& light, const std::array<double, 6>& region)
 {
   const Vector3 c = BoxCentre(region);
-  const Vector3 d{ { c[0] - light.Position[0], c[1] - light.Position[1], c[2] - light.Position[2] } };
+  const Vector3 d{ { c[0] - light.Position[0], c[1] - light.Position[1],
+    c[2] - light.Position[2] } };
   const double r = std::max(BoxRadius(region), 1e-30);
   const double distance = std::max(Length(d), r);
   return std::max({ light.Intensity[0], light.Intensity[1], light.Intensity[2] }) /
@@ -62,7 +63,8 @@ bool LightReachesBox(const ViewLight& light, const std::array<double, 6>& bounds
   }
   const Vector3 c = BoxCentre(bounds);
   const double r = BoxRadius(bounds);
-  const Vector3 d{ { c[0] - light.Position[0], c[1] - light.Position[1], c[2] - light.Position[2] } };
+  const Vector3 d{ { c[0] - light.Position[0], c[1] - light.Position[1],
+    c[2] - light.Position[2] } };
   const double distance = Length(d);
   if (distance <= r)
   {
@@ -75,8 +77,7 @@ bool LightReachesBox(const ViewLight& light, const std::array<double, 6>& bounds
   return angle < light.Spot.ConeHalfAngleDegrees * kDegree + std::asin(r / distance);
 }
 
-bool LightReachesFrustum(
-  const ViewLight& light, const std::array<double, 24>& planes, double range)
+bool LightReachesFrustum(const ViewLight& light, const std::array<double, 24>& planes, double range)
 {
   // The sphere around the cone's part within `range`: for a cone of half angle theta,
   // the sphere through the apex and the base circle (centre on the axis at
@@ -120,15 +121,16 @@ ViewLightSelection SelectViewLights(const std::vector<ViewLight>& candidates,
       continue;
     }
     if (!LightReachesBox(light, region) ||
-      (frustum && !LightReachesFrustum(light, *frustum, ShadowDepthRange(light.Position, region)[1])))
+      (frustum &&
+        !LightReachesFrustum(light, *frustum, ShadowDepthRange(light.Position, region)[1])))
     {
       ++selection.DroppedOutside;
       continue;
     }
     kept.emplace_back(Brightness(light, region), &light);
   }
-  std::stable_sort(kept.begin(), kept.end(),
-    [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::stable_sort(
+    kept.begin(), kept.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   const std::size_t limit =
     static_cast<std::size_t>(std::clamp(maximumLights, 0, kMaximumViewLights));
   for (std::size_t i = 0; i < kept.size(); ++i)

@@ -28,7 +28,7 @@ namespace nimbus
 struct ViewLight
 {
   Vector3 Position{ { 0.0, 0.0, 0.0 } }; // world units
-  SpotProfile Spot;                     // a point light unless its cone is < 90 degrees
+  SpotProfile Spot;                      // a point light unless its cone is < 90 degrees
   std::array<double, 3> Intensity{ { 1.0, 1.0, 1.0 } }; // Y/sr on the axis, linear sRGB
 };
 
@@ -62,8 +62,8 @@ NIMBUSREPRESENTATIONS_EXPORT bool LightReachesFrustum(
 /// over the squared distance to the region's centre, at least its radius), at most
 /// `maximumLights` (clamped to [0, kMaximumViewLights]).
 NIMBUSREPRESENTATIONS_EXPORT ViewLightSelection SelectViewLights(
-  const std::vector<ViewLight>& candidates, const std::array<double, 6>& region,
-  int maximumLights, const std::array<double, 24>* frustum = nullptr);
+  const std::vector<ViewLight>& candidates, const std::array<double, 6>& region, int maximumLights,
+  const std::array<double, 24>* frustum = nullptr);
 
 /// One face of a light's cube of shadow maps: a 90-degree square view from the light
 /// along Forward with Up, Right = Forward x Up. The six faces look along +x, -x, +y,
@@ -82,7 +82,8 @@ NIMBUSREPRESENTATIONS_EXPORT std::array<double, 2> ShadowDepthRange(
   const Vector3& lightPosition, const std::array<double, 6>& region);
 
 /// The column-major OpenGL projection of a 90-degree square face for [near, far].
-NIMBUSREPRESENTATIONS_EXPORT std::array<double, 16> ShadowFaceProjection(double nearPlane, double farPlane);
+NIMBUSREPRESENTATIONS_EXPORT std::array<double, 16> ShadowFaceProjection(
+  double nearPlane, double farPlane);
 }
 
 #endif

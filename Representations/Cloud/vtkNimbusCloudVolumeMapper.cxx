@@ -515,8 +515,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
       f->ReleaseGraphicsResources(window);
     }
     for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
-           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass,
-           &LightCloudPass })
+           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass, &LightCloudPass })
     {
       if (*pass)
       {
@@ -533,9 +532,8 @@ struct vtkNimbusCloudVolumeMapper::Internals
     Window = nullptr;
   }
 
-  vtkShaderProgram* Ready(
-    std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source, bool cloudLight = false,
-    bool viewLights = false)
+  vtkShaderProgram* Ready(std::unique_ptr<vtkOpenGLQuadHelper>& pass, const char* source,
+    bool cloudLight = false, bool viewLights = false)
   {
     if (!pass)
     {
@@ -2700,8 +2698,7 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
     FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
   program->SetUniform2f("froxelDepths", depths.data());
   program->SetUniformi("lightSamples", this->LightSamples);
-  program->SetUniformi(
-    "lightsInAir", this->LightShaftMethod == LightShaftsByRayMarching ? 1 : 0);
+  program->SetUniformi("lightsInAir", this->LightShaftMethod == LightShaftsByRayMarching ? 1 : 0);
   in.CloudMarchPass->Render();
   ++in.PassesLastRender;
 }
@@ -2908,8 +2905,8 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
     in.LightsImage->Activate();
   }
   program->SetUniformi("lightsImageOn", planes ? 1 : 0);
-  program->SetUniformi(
-    "lightsImage", (planes ? in.LightsImage.GetPointer() : in.Accumulation.GetPointer())->GetTextureUnit());
+  program->SetUniformi("lightsImage",
+    (planes ? in.LightsImage.GetPointer() : in.Accumulation.GetPointer())->GetTextureUnit());
   if (frame.Settings.OverSky)
   {
     in.ClearAccumulation->Activate();
@@ -2953,8 +2950,8 @@ void vtkNimbusCloudVolumeMapper::AddViewLightsToSolve(
         h, cosZenith, std::abs(rise), in.Table.Air.MieScaleHeightMetres);
       for (int c = 0; c < 3; ++c)
       {
-        transmittance[c] = std::exp(-(in.Table.RayleighExtinctionSeaLevel[c] * lr +
-          in.Table.MieExtinctionSeaLevel * lm));
+        transmittance[c] = std::exp(
+          -(in.Table.RayleighExtinctionSeaLevel[c] * lr + in.Table.MieExtinctionSeaLevel * lm));
       }
     }
     for (int c = 0; c < 3; ++c)
@@ -3011,7 +3008,8 @@ std::vector<nimbus::ViewLight> PositionalLightsOf(
       v.Spot.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
       v.Spot.ConeHalfAngleDegrees = light->GetConeAngle();
     }
-    v.Spot.EdgeWidthDegrees = std::min(edgeWidthDegrees, std::max(v.Spot.ConeHalfAngleDegrees, 0.0));
+    v.Spot.EdgeWidthDegrees =
+      std::min(edgeWidthDegrees, std::max(v.Spot.ConeHalfAngleDegrees, 0.0));
     const double* color = light->GetDiffuseColor();
     const double intensity = light->GetIntensity() * intensityScale;
     v.Intensity = { { intensity * color[0], intensity * color[1], intensity * color[2] } };
@@ -3053,8 +3051,7 @@ void vtkNimbusCloudVolumeMapper::UpdateViewLights(vtkRenderer* renderer, FrameSt
   const std::array<double, 6> region = LightRegionOf(renderer);
   // The view's frustum (VTK world): lights whose beams miss it cost nothing.
   std::array<double, 24> frustum{};
-  renderer->GetActiveCamera()->GetFrustumPlanes(
-    renderer->GetTiledAspectRatio(), frustum.data());
+  renderer->GetActiveCamera()->GetFrustumPlanes(renderer->GetTiledAspectRatio(), frustum.data());
   nimbus::ViewLightSelection selection =
     nimbus::SelectViewLights(candidates, region, this->MaximumLights, &frustum);
   if (selection.Message != in.LightsMessage && !selection.Message.empty())
@@ -3127,7 +3124,8 @@ void vtkNimbusCloudVolumeMapper::UpdateLightMapTexture(FrameState& frame)
     return;
   }
   const int components = scalars->GetNumberOfComponents();
-  if (dims[0] < 1 || dims[1] < 1 || scalars->GetNumberOfTuples() < static_cast<vtkIdType>(dims[0]) * dims[1])
+  if (dims[0] < 1 || dims[1] < 1 ||
+    scalars->GetNumberOfTuples() < static_cast<vtkIdType>(dims[0]) * dims[1])
   {
     return;
   }
@@ -3164,9 +3162,11 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
   program->SetUniformi("lightCount", count);
   // Unused when off, but the samplers must name 2-D units.
   program->SetUniformi("lightMap",
-    (frame.LightMap ? in.LightMapTexture.GetPointer() : in.SceneDepth.GetPointer())->GetTextureUnit());
+    (frame.LightMap ? in.LightMapTexture.GetPointer() : in.SceneDepth.GetPointer())
+      ->GetTextureUnit());
   program->SetUniformi("lightShadowAtlas",
-    (frame.LightShadows ? in.ShadowMaps.GetTexture() : in.SceneDepth.GetPointer())->GetTextureUnit());
+    (frame.LightShadows ? in.ShadowMaps.GetTexture() : in.SceneDepth.GetPointer())
+      ->GetTextureUnit());
   if (count == 0)
   {
     return;
@@ -3194,7 +3194,8 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
       std::max(outer - std::max(light.Spot.EdgeWidthDegrees, 0.0) * nimbus::kDegree, 0.0);
     cone[i][0] = static_cast<float>(outer);
     cone[i][1] = static_cast<float>(inner);
-    cone[i][2] = static_cast<float>(outer < 0.5 * nimbus::kPi ? std::tan(std::max(outer, 1e-6)) : 1.0);
+    cone[i][2] =
+      static_cast<float>(outer < 0.5 * nimbus::kPi ? std::tan(std::max(outer, 1e-6)) : 1.0);
     cone[i][3] = frame.LightMap ? 1.0f : 0.0f;
     cosines[i][0] = static_cast<float>(std::cos(outer));
     cosines[i][1] = static_cast<float>(std::cos(inner));
@@ -3297,6 +3298,7 @@ void vtkNimbusCloudVolumeMapper::UpdateLightCloudVolume(FrameState& frame)
     program->SetUniformi("cloudSteps", this->LightCloudSteps);
     frame.State->vtkglDisable(GL_BLEND);
     frame.State->vtkglViewport(0, 0, grid[0], grid[1]);
+    frame.State->PushFramebufferBindings();
     in.LightCloudFramebuffer->SetContext(frame.Window);
     in.LightCloudFramebuffer->Bind(GL_FRAMEBUFFER);
     for (int i = 0; i < lights; ++i)
@@ -3316,6 +3318,7 @@ void vtkNimbusCloudVolumeMapper::UpdateLightCloudVolume(FrameState& frame)
       }
     }
     in.LightCloudFramebuffer->RemoveColorAttachment(0);
+    frame.State->PopFramebufferBindings();
     in.LightCloudKey = std::move(key);
     in.LightCloudSlices = grid[2];
     ++in.LightCloudBuilds;
@@ -3351,8 +3354,7 @@ void vtkNimbusCloudVolumeMapper::RenderVirtualPlanes(const FrameState& frame)
     farthest = std::max(farthest, depth);
   }
   farthest = std::min(farthest, static_cast<double>(frame.ClippingRange[1]));
-  const double nearest =
-    std::max(static_cast<double>(frame.ClippingRange[0]), 1e-4 * farthest);
+  const double nearest = std::max(static_cast<double>(frame.ClippingRange[0]), 1e-4 * farthest);
   this->EnsureImageTarget(in.LightsImage, frame);
   DrawInto(in.LightsFramebuffer, in.LightsImage, frame.Window);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);

@@ -26,8 +26,8 @@
 #include "vtkActor.h"
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
-#include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkCubeSource.h"
+#include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkLight.h"
 #include "vtkNew.h"
@@ -257,10 +257,12 @@ void LightsTable()
   const int march = vtkNimbusCloudVolumeMapper::LightShaftsByRayMarching;
   const int planes = vtkNimbusCloudVolumeMapper::LightShaftsByVirtualPlanes;
   useLights(1);
-  const double without = TimeSvs(c, 256, night(vtkNimbusCloudVolumeMapper::NoLights, march, 32, 256));
-  std::printf("\nView lights (128^3 cloud at night, spotlights from the ground beside a tower; "
-              "multiple scattering off)\n\n| lights | method | samples or planes | shadow map | "
-              "frame | / without lights |\n|---|---|---|---|---|---|\n| 0 | - | - | - | %.1f | 1 |\n",
+  const double without =
+    TimeSvs(c, 256, night(vtkNimbusCloudVolumeMapper::NoLights, march, 32, 256));
+  std::printf(
+    "\nView lights (128^3 cloud at night, spotlights from the ground beside a tower; "
+    "multiple scattering off)\n\n| lights | method | samples or planes | shadow map | "
+    "frame | / without lights |\n|---|---|---|---|---|---|\n| 0 | - | - | - | %.1f | 1 |\n",
     without);
   struct Row
   {

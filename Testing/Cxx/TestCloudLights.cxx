@@ -239,8 +239,8 @@ struct Scene
     this->Renderer->GetWorldPoint(world);
     const double* eye = this->Renderer->GetActiveCamera()->GetPosition();
     origin = { { eye[0], eye[1], eye[2] } };
-    direction = nimbus::Normalized(
-      { { world[0] / world[3] - eye[0], world[1] / world[3] - eye[1], world[2] / world[3] - eye[2] } });
+    direction = nimbus::Normalized({ { world[0] / world[3] - eye[0], world[1] / world[3] - eye[1],
+      world[2] / world[3] - eye[2] } });
   }
 };
 
@@ -310,8 +310,8 @@ double MieOpticalLength(double h, double cosZenith, double distance)
     nimbus::FlatLayerOpticalLength(h, cosZenith, distance, air.MieScaleHeightMetres);
 }
 
-double Quadrature(const nimbus::Vector3& o, const nimbus::Vector3& d, const Light& light,
-  const double* wall)
+double Quadrature(
+  const nimbus::Vector3& o, const nimbus::Vector3& d, const Light& light, const double* wall)
 {
   const nimbus::AtmosphereParameters air;
   const double end = wall ? std::min(1e5, RayBoxDistance(o, d, wall)) : 1e5;
@@ -486,7 +486,8 @@ void TestExtremes()
   double b[6];
   cumulus->GetBounds(b);
   const nimbus::Vector3 inside{ { 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5]) } };
-  Extreme("light inside the cloud",
+  Extreme(
+    "light inside the cloud",
     [&](Scene& s)
     {
       vtkCamera* camera = s.Renderer->GetActiveCamera();
@@ -499,7 +500,8 @@ void TestExtremes()
     },
     [](Scene& s) { return s.Mapper->GetNumberOfLightsLastRender() == 1; }, cumulus);
   // The cloud lit from inside shows: its brightest pixel well above the unlit night's.
-  Extreme("light inside an occluder",
+  Extreme(
+    "light inside an occluder",
     [](Scene& s)
     {
       const double box[6] = { -1, 1, 7, 9, 4, 6 };
@@ -507,12 +509,26 @@ void TestExtremes()
       s.AddLight({ { 0, 8, 5 } }, { { 0, 8, 0 } }, 40.0, 2.0);
     },
     [](Scene& s) { return s.Mapper->GetNumberOfShadowCastersLastRender() == 1; });
-  Extreme("cone of 0 degrees", [](Scene& s) { s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 0.0, 2.0); },
+  Extreme(
+    "cone of 0 degrees",
+    [](Scene& s) {
+      s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 0.0, 2.0);
+    },
     [](Scene& s) { return s.Mapper->GetNumberOfLightsLastRender() == 0; });
-  Extreme("cone of 180 degrees", [](Scene& s) { s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 180.0, 2.0); },
+  Extreme(
+    "cone of 180 degrees",
+    [](Scene& s) {
+      s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 180.0, 2.0);
+    },
     [](Scene& s) { return s.Mapper->GetNumberOfLightsLastRender() == 1; });
-  Extreme("spot of 89.9 degrees", [](Scene& s) { s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 89.9, 2.0); });
-  Extreme("light at the eye", [](Scene& s) { s.AddLight({ { 0, -15, 3 } }, { { 0, 10, 4 } }, 20.0, 2.0); });
+  Extreme("spot of 89.9 degrees",
+    [](Scene& s) {
+      s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 89.9, 2.0);
+    });
+  Extreme("light at the eye",
+    [](Scene& s) {
+      s.AddLight({ { 0, -15, 3 } }, { { 0, 10, 4 } }, 20.0, 2.0);
+    });
   Extreme("light at the eye, behind a box",
     [](Scene& s)
     {
@@ -520,13 +536,24 @@ void TestExtremes()
       s.AddBox(box);
       s.AddLight({ { 0, -15, 3 } }, { { 0, 10, 4 } }, 180.0, 2.0);
     });
-  Extreme("light 1 km away", [](Scene& s) { s.AddLight({ { 0, 1000, 6 } }, { { 0, 0, 3 } }, 10.0, 1e6); },
+  Extreme(
+    "light 1 km away",
+    [](Scene& s) {
+      s.AddLight({ { 0, 1000, 6 } }, { { 0, 0, 3 } }, 10.0, 1e6);
+    },
     [](Scene& s) { return s.Mapper->GetNumberOfLightsLastRender() == 1; });
-  Extreme("intensity 0", [](Scene& s) { s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 30.0, 0.0); },
+  Extreme(
+    "intensity 0",
+    [](Scene& s) {
+      s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 0 } }, 30.0, 0.0);
+    },
     [](Scene& s) { return s.Mapper->GetNumberOfLightsLastRender() == 0; });
   Extreme("a light with its focal point at its position",
-    [](Scene& s) { s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 6 } }, 30.0, 2.0); });
-  Extreme("a thousand lights",
+    [](Scene& s) {
+      s.AddLight({ { 0, 8, 6 } }, { { 0, 8, 6 } }, 30.0, 2.0);
+    });
+  Extreme(
+    "a thousand lights",
     [](Scene& s)
     {
       for (int i = 0; i < 1000; ++i)
@@ -539,7 +566,8 @@ void TestExtremes()
       return s.Mapper->GetNumberOfLightsLastRender() == 8 &&
         s.Messages.AllWarnings().find("left out") != std::string::npos;
     });
-  Extreme("virtual planes, light at the eye",
+  Extreme(
+    "virtual planes, light at the eye",
     [](Scene& s)
     {
       s.Mapper->SetLightShaftMethod(vtkNimbusCloudVolumeMapper::LightShaftsByVirtualPlanes);
@@ -555,7 +583,8 @@ void TestExtremes()
       }
       return largest > 1e-4;
     });
-  Extreme("non-finite light position",
+  Extreme(
+    "non-finite light position",
     [](Scene& s)
     {
       const double nan = std::numeric_limits<double>::quiet_NaN();
