@@ -24,6 +24,8 @@
 #include "cloudAirFroxelsFS.h"
 #include "cloudLight.h"
 #include "cloudLightDepthFS.h"
+#include "cloudLightShaftsFS.h"
+#include "cloudLightShaftsUpsampleFS.h"
 #include "cloudMarchFS.h"
 #include "cloudVirtualPlanesFS.h"
 #include "nimbusLights.h"
@@ -446,6 +448,12 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkMTimeType LightMapTime = 0;
   vtkNew<vtkTextureObject> LightsImage;
   vtkNew<vtkOpenGLFramebufferObject> LightsFramebuffer;
+  // The shafts on fewer pixels (LightShaftDownsampling): the march's span target (the
+  // cloud's first and last occupied distance, its transmittance, the ray's end), the
+  // shafts' own image and the framebuffer that adds them to the accumulation.
+  vtkNew<vtkTextureObject> CloudSpanImage;
+  vtkNew<vtkTextureObject> ShaftsImage;
+  vtkNew<vtkOpenGLFramebufferObject> ShaftsFramebuffer;
   // The cloud's transmittance toward each light per texel of a coarse copy of the
   // density's grid (cloudLightDepthFS.glsl), keyed by what it depends on.
   vtkNew<vtkTextureObject> LightCloudVolume;
@@ -461,7 +469,8 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::string LastPassTimes;
 
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass, LightCloudPass;
+    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass, LightCloudPass,
+    ShaftsPass, ShaftsUpsamplePass;
 
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
@@ -499,7 +508,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
         Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer(),
         SunDepthTexture.GetPointer(), BlockTexture.GetPointer(), FroxelScattering.GetPointer(),
         FroxelTransmittance.GetPointer(), LightMapTexture.GetPointer(), LightsImage.GetPointer(),
-        LightCloudVolume.GetPointer() })
+        LightCloudVolume.GetPointer(), CloudSpanImage.GetPointer(), ShaftsImage.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
@@ -510,12 +519,14 @@ struct vtkNimbusCloudVolumeMapper::Internals
            SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
            AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer(),
            FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer(),
-           LightsFramebuffer.GetPointer(), LightCloudFramebuffer.GetPointer() })
+           LightsFramebuffer.GetPointer(), LightCloudFramebuffer.GetPointer(),
+           ShaftsFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
     for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
-           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass, &LightCloudPass })
+           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass, &LightCloudPass,
+           &ShaftsPass, &ShaftsUpsamplePass })
     {
       if (*pass)
       {
@@ -676,7 +687,8 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
         in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
         in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
         in.ShadowMaps.GetTexture(), in.LightMapTexture.GetPointer(), in.LightsImage.GetPointer(),
-        in.LightCloudVolume.GetPointer() })
+        in.LightCloudVolume.GetPointer(), in.CloudSpanImage.GetPointer(),
+        in.ShaftsImage.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -734,6 +746,7 @@ bool vtkNimbusCloudVolumeMapper::RenderFrame(
     this->RenderAirFroxels(frame);
     in.Timer.Begin("ray march");
     this->RenderCloudMarch(frame);
+    this->RenderLightShafts(frame);
     this->RenderVirtualPlanes(frame);
     this->CaptureRadianceImage(frame);
   }
@@ -2642,8 +2655,17 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   // This VTK's vtkOpenGLState can take the two draw buffers for a change it already made
   // (its cache compares with the framebuffer's list of the call before) and leave the
   // second at GL_NONE (measured: GL_DRAW_BUFFER1 read back as GL_NONE): set them directly.
-  const GLenum buffers[2] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1 };
-  glDrawBuffers(2, buffers);
+  // The lights' shafts on fewer pixels need the march's span (a third target).
+  const bool spans = this->ShaftsApart(frame);
+  in.MarchFramebuffer->RemoveColorAttachment(2);
+  if (spans)
+  {
+    EnsureTexture2D(
+      in.CloudSpanImage, frame.Window, frame.Level.Width, frame.Level.Height, 4, false);
+    in.MarchFramebuffer->AddColorAttachment(2, in.CloudSpanImage);
+  }
+  const GLenum buffers[3] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2 };
+  glDrawBuffers(spans ? 3 : 2, buffers);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglDisable(GL_BLEND);
   vtkShaderProgram* program = in.Ready(in.CloudMarchPass, cloudMarchFS, true, true);
@@ -2698,7 +2720,8 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
     FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
   program->SetUniform2f("froxelDepths", depths.data());
   program->SetUniformi("lightSamples", this->LightSamples);
-  program->SetUniformi("lightsInAir", this->LightShaftMethod == LightShaftsByRayMarching ? 1 : 0);
+  program->SetUniformi("lightsInAir",
+    this->LightShaftMethod == LightShaftsByRayMarching && !spans ? 1 : 0);
   in.CloudMarchPass->Render();
   ++in.PassesLastRender;
 }
@@ -3236,6 +3259,57 @@ void vtkNimbusCloudVolumeMapper::SetViewLightUniforms(
   program->SetUniformf("lightMieScattering0", static_cast<float>(in.Table.MieScatteringSeaLevel));
   program->SetUniformf(
     "lightPhaseConstant", static_cast<float>(this->MultipleScattering / (4.0 * nimbus::kPi)));
+}
+
+// True when this frame draws the lights' shafts by ray marching on fewer pixels than
+// the march (LightShaftDownsampling > 1), in their own pass.
+bool vtkNimbusCloudVolumeMapper::ShaftsApart(const FrameState& frame) const
+{
+  return !frame.Lights.empty() && this->LightShaftMethod == LightShaftsByRayMarching &&
+    this->LightShaftDownsampling > 1 && frame.Atmosphere;
+}
+
+// The lights' shafts by ray marching on 1 / LightShaftDownsampling of the pixels per
+// side (cloudLightShaftsFS.glsl), then added to the accumulation at every pixel with
+// depth-aware weights (cloudLightShaftsUpsampleFS.glsl): the shafts are smooth except
+// where a ray's end jumps (a silhouette), and the weights follow the ends there.
+void vtkNimbusCloudVolumeMapper::RenderLightShafts(const FrameState& frame)
+{
+  if (!this->ShaftsApart(frame))
+  {
+    return;
+  }
+  Internals& in = *this->Internal;
+  in.Timer.Begin("lights' shafts");
+  const int s = this->LightShaftDownsampling;
+  const int w = std::max((frame.Level.Width + s - 1) / s, 1);
+  const int h = std::max((frame.Level.Height + s - 1) / s, 1);
+  EnsureTexture2D(in.ShaftsImage, frame.Window, w, h, 4, false);
+  in.CloudSpanImage->Activate();
+  DrawInto(in.ShaftsFramebuffer, in.ShaftsImage, frame.Window);
+  frame.State->vtkglViewport(0, 0, w, h);
+  frame.State->vtkglDisable(GL_BLEND);
+  vtkShaderProgram* program = in.Ready(in.ShaftsPass, cloudLightShaftsFS, true, true);
+  this->SetCommonUniforms(program, frame);
+  this->SetCloudLightUniforms(program, frame);
+  program->SetUniformi("cloudSpan", in.CloudSpanImage->GetTextureUnit());
+  program->SetUniformi("lightSamples", this->LightSamples);
+  program->SetUniformf("lightsMieG", static_cast<float>(frame.Settings.Air.MieG));
+  in.ShaftsPass->Render();
+  ++in.PassesLastRender;
+  // Added to the accumulation's radiance (its transmittance kept).
+  in.ShaftsImage->Activate();
+  DrawInto(in.ShaftsFramebuffer, in.Accumulation, frame.Window);
+  frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
+  frame.State->vtkglEnable(GL_BLEND);
+  frame.State->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ZERO, GL_ONE);
+  vtkShaderProgram* upsample = in.Ready(in.ShaftsUpsamplePass, cloudLightShaftsUpsampleFS);
+  upsample->SetUniformi("shafts", in.ShaftsImage->GetTextureUnit());
+  upsample->SetUniformi("cloudSpan", in.CloudSpanImage->GetTextureUnit());
+  in.ShaftsUpsamplePass->Render();
+  ++in.PassesLastRender;
+  frame.State->vtkglDisable(GL_BLEND);
+  in.ShaftsFramebuffer->RemoveColorAttachment(0);
 }
 
 // The cloud's transmittance toward each view light at the texels of a grid over the

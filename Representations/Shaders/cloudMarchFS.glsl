@@ -7,7 +7,8 @@
 // where it can fall (ShadowInterval). Output 0: (radiance before exposure, cloud
 // transmittance; 0 where the ground closes the ray, not over a sky), as the slices and
 // the march passes of the shadow-view-slice method leave it; output 1: the same without
-// the cloud (read over a sky only; see svsCompositeFS.glsl).
+// the cloud (read over a sky only; see svsCompositeFS.glsl); output 2: the cloud's span
+// and the ray's end, for the lights' shafts on fewer pixels.
 in vec2 texCoord;
 uniform int unlit;                // benchmark floor: the cloud's optical depth alone
 uniform int shaftsOn;
@@ -29,7 +30,7 @@ uniform vec2 froxelDepths;        // d_1 (world units), 1 / log(d_{k+1} / d_k)
 uniform float mieG;
 uniform float multipleScattering; // k_multi (000 Eq. 1)
 uniform int lightSamples;         // samples per view light along the ray (nimbusLights.glsl)
-uniform int lightsInAir;          // 1: the lights' shafts in the air here; 0: by virtual planes
+uniform int lightsInAir;          // 1: the lights' shafts in the air here; 0: another pass's
 
 const float kOpaque = 1e-3;       // the cloud transmittance at which the march stops
 
@@ -326,4 +327,6 @@ void main()
   }
   gl_FragData[0] = vec4(color, alpha);
   gl_FragData[1] = vec4(clearColor, 1.0);
+  // For the lights' shafts drawn on fewer pixels (cloudLightShaftsFS.glsl).
+  gl_FragData[2] = vec4(first, last, cloudTransmittance, tEnd);
 }

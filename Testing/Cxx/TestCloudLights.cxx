@@ -174,6 +174,9 @@ struct Scene
     this->Mapper->CaptureRadianceOn();
     this->Mapper->SetExposure(300.0);
     this->Mapper->SetEncodeSrgb(true);
+    // The integrator at every pixel; the shafts on a quarter of the pixels are measured
+    // on their own (TestQuadrature).
+    this->Mapper->SetLightShaftDownsampling(1);
     this->Volume->SetMapper(this->Mapper);
     this->Renderer->AddVolume(this->Volume);
     this->Window->SetOffScreenRendering(1);
@@ -429,6 +432,16 @@ void TestQuadrature()
     light.Spot.ConeHalfAngleDegrees = 30.0;
     light.Spot.EdgeWidthDegrees = 6.0;
     CompareWithQuadrature("spotlight in haze", scene, light, nullptr, 0.01, 0.005);
+  }
+  {
+    // The default: the shafts on a quarter of the pixels, brought to every pixel by
+    // depth-aware weights. Measured: 17.5 % at the pixel next to the light's own glow
+    // (its neighbours' rays pass nearer the light), RMS 4.0 %.
+    Scene scene(EmptyMedium());
+    scene.Mapper->SetLightShaftDownsampling(2);
+    scene.AddLight({ { 1, 8, 6 } }, { { 1, 8, 0 } }, 180.0, 2.0);
+    CompareWithQuadrature("point light in haze, shafts on a quarter of the pixels", scene,
+      { { { 1, 8, 6 } }, {}, 2.0 }, nullptr, 0.20, 0.05);
   }
   // A shadowed half-space: a wall between the light and the right half of the haze.
   const double wall[6] = { 0.0, 0.3, -5.0, 40.0, -50.0, 5.0 };
