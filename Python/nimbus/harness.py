@@ -21,9 +21,10 @@ Scenes with lights (scene format version 4: point and spot lights, light maps,
 occluders; docs/lights-trade.md): ``svs`` draws them by ray marching only (every row
 must be ``method`` ``march``), each light a positional vtkLight of its renderer and
 each occluder an opaque actor; its settings ``light_method`` (``march`` or
-``planes``), ``light_samples``, ``virtual_planes``, ``shadow_map_size`` and
-``light_cloud_steps`` trade the shafts' quality for time, and without --settings a
-scene with lights gets a list over them. ``vtk-gpu`` and ``single`` refuse lights.
+``planes``), ``light_samples``, ``shaft_downsampling``, ``virtual_planes``,
+``shadow_map_size`` and ``light_cloud_steps`` trade the shafts' quality for time,
+and without --settings a scene with lights gets a list over them. ``vtk-gpu`` and
+``single`` refuse lights.
 
 The reference (``--reference``): ``path`` is the Monte Carlo path tracer with full
 multiple scattering, run for a time budget (--reference-seconds, default 600 s;
@@ -116,11 +117,14 @@ DEFAULT_SETTINGS = {
 }
 
 # The svs renderer's default settings for a scene with lights (only the ray march draws
-# them): the shafts by equi-angular samples along each view ray, then by virtual planes,
-# over their counts; the march's step 2 texels (the mapper's default).
+# them): the shafts by equi-angular samples along each view ray (on a quarter of the
+# pixels, the mapper's default, then on all of them and on a sixteenth), then by virtual
+# planes, over their counts; the march's step 2 texels (the mapper's default).
 DEFAULT_LIGHT_SETTINGS = (
     [{"method": "march", "step": 2, "light_method": "march", "light_samples": n}
      for n in (4, 8, 16, 32, 64)]
+    + [{"method": "march", "step": 2, "light_method": "march", "light_samples": 32,
+        "shaft_downsampling": d} for d in (1, 4)]
     + [{"method": "march", "step": 2, "light_method": "planes", "virtual_planes": n}
        for n in (16, 32, 64, 128, 256)])
 
@@ -654,9 +658,10 @@ class SvsRenderer:
     method march. Their settings: light_method (march, the default: equi-angular samples
     along each view ray, or planes: virtual planes, LightShaftMethod), light_samples
     (LightSamples), virtual_planes (NumberOfVirtualPlanes), shadow_map_size
-    (LightShadowMapSize; 0: no shadows of the occluders) and light_cloud_steps
-    (LightCloudSteps; 0: the cloud casts no shadow in the beams), each the mapper's
-    default when a row leaves it out, set on every row.
+    (LightShadowMapSize; 0: no shadows of the occluders), light_cloud_steps
+    (LightCloudSteps; 0: the cloud casts no shadow in the beams) and shaft_downsampling
+    (LightShaftDownsampling: the ray-marched shafts on 1 / n of the pixels per side),
+    each the mapper's default when a row leaves it out, set on every row.
     """
 
     def __init__(self, scene_path):
@@ -674,7 +679,8 @@ class SvsRenderer:
         self.light_defaults = (self.mapper.GetLightSamples(),
                                self.mapper.GetNumberOfVirtualPlanes(),
                                self.mapper.GetLightShadowMapSize(),
-                               self.mapper.GetLightCloudSteps())
+                               self.mapper.GetLightCloudSteps(),
+                               self.mapper.GetLightShaftDownsampling())
         self.k_multi = scene["medium"].get("multiple_scattering_constant", 0.0)
         self.extra = {}
         self.mapper.SetInputConnection(density.GetOutputPort())
@@ -730,6 +736,8 @@ class SvsRenderer:
         self.mapper.SetNumberOfVirtualPlanes(int(settings.get("virtual_planes", defaults[1])))
         self.mapper.SetLightShadowMapSize(int(settings.get("shadow_map_size", defaults[2])))
         self.mapper.SetLightCloudSteps(int(settings.get("light_cloud_steps", defaults[3])))
+        self.mapper.SetLightShaftDownsampling(int(settings.get("shaft_downsampling",
+                                                               defaults[4])))
         self.mapper.SetRayMarchStepTexels(float(settings.get("step", 1.0)))
         self.mapper.SetNumberOfSlices(int(settings.get("slices", 256)))
         self.mapper.SetSliceAngleRatio(float(settings.get("a", 1.0)))
