@@ -278,7 +278,8 @@ public:
   /// LightSources 0 none, 1 the positional lights (default); LightIntensityScale
   /// [Y/sr per unit of a light's Intensity]; SpotEdgeWidthDegrees [deg];
   /// LightShaftMethod 0 ray marching (default), 1 virtual planes; LightSamples per
-  /// light and ray; NumberOfVirtualPlanes; LightShadowMapSize [texels per face side,
+  /// light and ray; LightShaftDownsampling (the ray-marched shafts on 1 in n pixels per
+  /// side, default 2); NumberOfVirtualPlanes; LightShadowMapSize [texels per face side,
   /// 0: no shadows of the opaque geometry]; LightCloudSteps [samples toward a light,
   /// 0: the cloud casts no shadow]; MaximumLights (up to 8).
   void SetLightSources(int value);
@@ -291,6 +292,8 @@ public:
   int GetLightShaftMethod();
   void SetLightSamples(int value);
   int GetLightSamples();
+  void SetLightShaftDownsampling(int value);
+  int GetLightShaftDownsampling();
   void SetNumberOfVirtualPlanes(int value);
   int GetNumberOfVirtualPlanes();
   void SetLightShadowMapSize(int value);

@@ -469,8 +469,8 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::string LastPassTimes;
 
   std::unique_ptr<vtkOpenGLQuadHelper> SlicePass, ShadowPass, IntervalPhasePass, MarchPass,
-    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass, LightCloudPass,
-    ShaftsPass, ShaftsUpsamplePass;
+    CompositePass, RayEndsPass, CloudMarchPass, FroxelPass, PlanesPass, LightCloudPass, ShaftsPass,
+    ShaftsUpsamplePass;
 
   int AtmosphereBuilds = 0;
   int IntervalPhaseBuilds = 0;
@@ -515,18 +515,18 @@ struct vtkNimbusCloudVolumeMapper::Internals
     ShadowMaps.Release(window);
     LightMapTime = 0;
     LightCloudKey.clear();
-    for (vtkOpenGLFramebufferObject* f : { IntervalPhaseFramebuffer.GetPointer(),
-           SceneFramebuffer.GetPointer(), RayEndsFramebuffer.GetPointer(),
-           AccumulationFramebuffer.GetPointer(), ShadowFramebuffer.GetPointer(),
-           FroxelFramebuffer.GetPointer(), MarchFramebuffer.GetPointer(),
-           LightsFramebuffer.GetPointer(), LightCloudFramebuffer.GetPointer(),
-           ShaftsFramebuffer.GetPointer() })
+    for (vtkOpenGLFramebufferObject* f :
+      { IntervalPhaseFramebuffer.GetPointer(), SceneFramebuffer.GetPointer(),
+        RayEndsFramebuffer.GetPointer(), AccumulationFramebuffer.GetPointer(),
+        ShadowFramebuffer.GetPointer(), FroxelFramebuffer.GetPointer(),
+        MarchFramebuffer.GetPointer(), LightsFramebuffer.GetPointer(),
+        LightCloudFramebuffer.GetPointer(), ShaftsFramebuffer.GetPointer() })
     {
       f->ReleaseGraphicsResources(window);
     }
     for (auto* pass : { &SlicePass, &ShadowPass, &IntervalPhasePass, &MarchPass, &CompositePass,
-           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass, &LightCloudPass,
-           &ShaftsPass, &ShaftsUpsamplePass })
+           &RayEndsPass, &CloudMarchPass, &FroxelPass, &PlanesPass, &LightCloudPass, &ShaftsPass,
+           &ShaftsUpsamplePass })
     {
       if (*pass)
       {
@@ -2720,8 +2720,8 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
     FroxelLadder(frame.Eye, frame.Settings.Air, frame.Settings.MetresPerUnit);
   program->SetUniform2f("froxelDepths", depths.data());
   program->SetUniformi("lightSamples", this->LightSamples);
-  program->SetUniformi("lightsInAir",
-    this->LightShaftMethod == LightShaftsByRayMarching && !spans ? 1 : 0);
+  program->SetUniformi(
+    "lightsInAir", this->LightShaftMethod == LightShaftsByRayMarching && !spans ? 1 : 0);
   in.CloudMarchPass->Render();
   ++in.PassesLastRender;
 }

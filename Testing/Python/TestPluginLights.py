@@ -71,6 +71,7 @@ LIGHTS_DEFAULTS = {
     "SpotEdgeWidthDegrees": 2.0,
     "LightShaftMethod": 0,
     "LightSamples": 32,
+    "LightShaftDownsampling": 2,
     "NumberOfVirtualPlanes": 64,
     "LightShadowMapSize": 256,
     "LightCloudSteps": 48,
