@@ -9,11 +9,14 @@
 //  - EdgeWidthDegrees: the soft edge lies inside the cone. The factor is 1 within
 //    ConeHalfAngle - EdgeWidth of the axis, 0 beyond ConeHalfAngle, and a smoothstep of
 //    the angle in between (EdgeWidth 0: a hard edge).
-//  - The light map's frame: e1 = normalize(cross(h, axis)), e2 = cross(axis, e1), where
-//    h = +z unless |axis.z| > 0.999, then h = +y. A direction w (from the light) lands at
+//  - The light map's frame: e1 = normalize(cross(axis, h)), e2 = cross(e1, axis), where
+//    h = +z unless |axis.z| > 0.999, then h = +y: seen from behind the light, looking
+//    along its axis, e1 points right and e2 up. A direction w (from the light) lands at
 //    u = 0.5 + 0.5 (w.e1 / w.axis) / tan(ConeHalfAngle), v the same with e2 (a gnomonic
 //    projection: the map is the image a slide projector would throw on a screen
-//    perpendicular to the axis, filling the cone's circle's bounding square).
+//    perpendicular to the axis, filling the cone's circle's bounding square, upright and
+//    unmirrored to someone standing behind the projector: u = 0 the picture's left edge,
+//    v = 0 its bottom edge).
 #ifndef nimbus_SpotLight_h
 #define nimbus_SpotLight_h
 

@@ -154,7 +154,9 @@ TEST(SpotLight, NonFiniteDirectionGivesNoLight)
   }
 }
 
-TEST(SpotLight, LightMapFrameIsOrthonormalAndRightHanded)
+// Seen from behind the light, looking along the axis, e1 points right and e2 up (a slide
+// projector's frame): e1 x e2 points back toward the viewer, -axis.
+TEST(SpotLight, LightMapFrameIsOrthonormalRightAndUp)
 {
   for (const Vector3& axis : kAxes)
   {
@@ -165,23 +167,24 @@ TEST(SpotLight, LightMapFrameIsOrthonormalAndRightHanded)
     EXPECT_NEAR(nimbus::Length(e2), 1.0, 1e-12);
     EXPECT_NEAR(nimbus::Dot(e1, e2), 0.0, 1e-12);
     EXPECT_NEAR(nimbus::Dot(e1, a), 0.0, 1e-12);
-    const Vector3 third = nimbus::Cross(e1, e2); // e1 x e2 = axis
+    const Vector3 third = nimbus::Cross(e1, e2); // e1 x e2 = -axis
     for (int i = 0; i < 3; ++i)
     {
-      EXPECT_NEAR(third[i], a[i], 1e-12);
+      EXPECT_NEAR(third[i], -a[i], 1e-12);
     }
   }
-  // Axis +-z: the helper vector is +y, e1 = +y x axis.
+  // Axis +-z: the helper vector is +y, e1 = axis x +y.
   Vector3 e1, e2;
   nimbus::SpotLightMapFrame({ { 0, 0, 1 } }, e1, e2);
-  EXPECT_EQ(e1, (Vector3{ { 1, 0, 0 } }));
-  EXPECT_EQ(e2, (Vector3{ { 0, 1, 0 } }));
-  nimbus::SpotLightMapFrame({ { 0, 0, -1 } }, e1, e2);
   EXPECT_EQ(e1, (Vector3{ { -1, 0, 0 } }));
   EXPECT_EQ(e2, (Vector3{ { 0, 1, 0 } }));
-  // Elsewhere +z: the axis +x gives e1 = +z x +x = +y, e2 = +x x +y = +z.
-  nimbus::SpotLightMapFrame({ { 1, 0, 0 } }, e1, e2);
-  EXPECT_EQ(e1, (Vector3{ { 0, 1, 0 } }));
+  nimbus::SpotLightMapFrame({ { 0, 0, -1 } }, e1, e2);
+  EXPECT_EQ(e1, (Vector3{ { 1, 0, 0 } }));
+  EXPECT_EQ(e2, (Vector3{ { 0, 1, 0 } }));
+  // Elsewhere +z: the axis +y (north) gives e1 = +y x +z = +x (east, the right of
+  // someone looking north), e2 = +x x +y = +z (up).
+  nimbus::SpotLightMapFrame({ { 0, 1, 0 } }, e1, e2);
+  EXPECT_EQ(e1, (Vector3{ { 1, 0, 0 } }));
   EXPECT_EQ(e2, (Vector3{ { 0, 0, 1 } }));
 }
 

@@ -418,7 +418,8 @@ double SampleLightMap(const LightMapDescription& map, double u, double v)
   // Pixel centres at (c + 0.5) / Width: x = u Width - 0.5 in [-0.5, Width - 0.5], clamped
   // to the edge pixels' centres.
   const double x = std::min(std::max(u * map.Width - 0.5, 0.0), map.Width - 1.0);
-  const double y = std::min(std::max(v * map.Height - 0.5, 0.0), map.Height - 1.0);
+  // Row 0 is the picture's top (the file's first row), v = 0 its bottom.
+  const double y = std::min(std::max((1.0 - v) * map.Height - 0.5, 0.0), map.Height - 1.0);
   const int c0 = std::min(static_cast<int>(x), map.Width - 1);
   const int r0 = std::min(static_cast<int>(y), map.Height - 1);
   const int c1 = std::min(c0 + 1, map.Width - 1), r1 = std::min(r0 + 1, map.Height - 1);
