@@ -18,6 +18,7 @@
 #include "DensityGridFromImage.h"
 #include "PathTracer.h"
 #include "RenderContext.h"
+#include "SceneAssets.h"
 #include "SceneJson.h"
 #include "vtkNimbusSceneDensitySource.h"
 
@@ -127,6 +128,7 @@ int main(int argc, char* argv[])
   for (const std::string& file : scenes)
   {
     nimbus::SceneDescription scene = nimbus::LoadScene(file);
+    nimbus::LoadSceneAssets(scene); // a version-4 scene's light maps and meshes
     const double scale = static_cast<double>(scene.Camera.Width) * scene.Camera.Height /
       (static_cast<double>(width) * height);
     scene.Camera.Width = width;
