@@ -331,24 +331,31 @@ TEST(ReferenceSceneAssets, LoadSceneAssetsFillsTheDescription)
 
 //------------------------------------------------------------------------------
 // End to end through vtkNimbusReferenceRenderer: a spot aiming north at a white wall
-// through a light map black on its left half (the file's left columns). The light map's
-// frame (Physics/SpotLight.h) has u growing along e1 = -x (west) for a beam aiming north,
-// so the west half of the wall is lit: the left half of the image of a camera behind the
-// light (looking north, east to its right) at single scattering, the right half exactly
-// black (but for the column that holds the map's bilinear ramp across the axis). A post (OBJ mesh)
-// stands in the beam. Single scattering refuses the scene by name; a missing light map is an error
-// naming its key.
+// through a light map black on its left half (the file's left columns), then through one
+// black on its top half (the file's first rows). The light map is thrown like a slide
+// projector's picture, upright and unmirrored to someone behind the light looking along
+// the beam (Physics/SpotLight.h: e1 = +x, east, and e2 = +z, up, for a beam aiming north;
+// the file's first row at the top, v = 1). The camera stands behind the light, looking
+// north (east to its right, up up), so at single scattering it sees the picture as it is:
+// with the first map the east half of the wall (the right half of the image) lit and the
+// west half exactly black (but for the column that holds the map's bilinear ramp across
+// the axis); with the second the lower half lit and the upper half exactly black (but for
+// the row that holds the ramp). A post (OBJ mesh) stands in the lit half of the first
+// beam. Single scattering refuses the scene by name; a missing light map is an error naming
+// its key.
 TEST(ReferenceSceneAssets, SpotThroughALightMapOntoAWall)
 {
-  std::vector<unsigned char> gobo(32 * 32, 0);
+  std::vector<unsigned char> gobo(32 * 32, 0), topBlack(32 * 32, 0);
   for (int row = 0; row < 32; ++row)
   {
-    for (int column = 16; column < 32; ++column)
+    for (int column = 0; column < 32; ++column)
     {
-      gobo[row * 32 + column] = 255;
+      gobo[row * 32 + column] = column < 16 ? 0 : 255;
+      topBlack[row * 32 + column] = row < 16 ? 0 : 255;
     }
   }
   WritePgm("wall-gobo.pgm", 32, 32, gobo);
+  WritePgm("wall-gobo-top-black.pgm", 32, 32, topBlack);
   WriteText("wall-post.obj", "v 0 0 -30\nv 0.5 0 -30\nv 0.5 0 30\nv 0 0 30\nf 1 2 3 4\n");
   const std::string text = R"({
     "nimbus_scene": 4, "name": "wall",
@@ -363,7 +370,7 @@ TEST(ReferenceSceneAssets, SpotThroughALightMapOntoAWall)
                 "cone_angle_degrees": 30, "intensity": 1000, "light_map": "@MAP@"}],
     "occluders": [{"type": "box", "min": [-40, 0, -40], "max": [40, 1, 40], "albedo": 1},
                   {"type": "mesh", "path": "wall-post.obj", "albedo": 0.5,
-                   "translate": [-6, -10, 0]}]
+                   "translate": [5.5, -10, 0]}]
   })";
   auto write = [&](const std::string& name, const std::string& map)
   {
@@ -372,38 +379,80 @@ TEST(ReferenceSceneAssets, SpotThroughALightMapOntoAWall)
     return WriteText(name, t);
   };
   const std::string good = write("wall.json", "wall-gobo.pgm");
+  const std::string top = write("wall-top-black.json", "wall-gobo-top-black.pgm");
   vtkNew<vtkNimbusReferenceRenderer> renderer;
   MessageCatcher messages(renderer);
-  renderer->SetSceneFileName(good.c_str());
   renderer->SetModeToPathTracing();
   renderer->SetMinSamplesPerPixel(64);
   renderer->SetMaxSamplesPerPixel(64);
   renderer->SetMaxScatteringOrder(1);
   renderer->SetNumberOfThreads(2);
-  renderer->Update();
-  ASSERT_EQ(messages.AllErrors(), "");
-  vtkDataArray* radiance = renderer->GetOutput()->GetPointData()->GetArray("radiance");
-  ASSERT_NE(radiance, nullptr);
-  ASSERT_EQ(radiance->GetNumberOfTuples(), 16 * 8);
-  double west = 0.0, east = 0.0;
-  std::string picture;
-  for (int j = 7; j >= 0; --j)
+  // The green radiance of pixel (i, j), i = 0 the image's left (west), j = 0 its bottom.
+  auto render = [&](const std::string& scene, const char* what)
   {
-    for (int i = 0; i < 16; ++i)
+    std::vector<double> green;
+    renderer->SetSceneFileName(scene.c_str());
+    renderer->Update();
+    EXPECT_EQ(messages.AllErrors(), "");
+    vtkDataArray* radiance = renderer->GetOutput()->GetPointData()->GetArray("radiance");
+    EXPECT_NE(radiance, nullptr);
+    if (radiance == nullptr || radiance->GetNumberOfTuples() != 16 * 8)
     {
-      const double g = radiance->GetComponent(j * 16 + i, 1);
-      EXPECT_TRUE(std::isfinite(g));
-      // Column 8 holds the map's ramp between its columns 15 and 16 (u from 0.484 to
-      // 0.516), which reaches 0.37 m east of the axis.
-      west += i < 8 ? g : 0.0;
-      east += i > 8 ? g : 0.0;
-      picture += g > 0.0 ? '#' : '.';
+      ADD_FAILURE() << what << ": no 16 x 8 radiance image";
+      return green;
     }
-    picture += '\n';
+    green.resize(16 * 8);
+    std::string picture;
+    for (int j = 7; j >= 0; --j)
+    {
+      for (int i = 0; i < 16; ++i)
+      {
+        green[j * 16 + i] = radiance->GetComponent(j * 16 + i, 1);
+        EXPECT_TRUE(std::isfinite(green[j * 16 + i]));
+        picture += green[j * 16 + i] > 0.0 ? '#' : '.';
+      }
+      picture += '\n';
+    }
+    std::printf("the wall at single scattering through %s (# lit), west on the left:\n%s", what,
+      picture.c_str());
+    return green;
+  };
+  {
+    const std::vector<double> g = render(good, "a light map black on its left half");
+    ASSERT_EQ(g.size(), 16u * 8u);
+    // The image's columns meet at the axis (x = 0 on the wall, 2.2 m wide): column 7 holds
+    // the map's ramp between its columns 15 and 16 (u from 0.484 to 0.516), which reaches
+    // 0.37 m west of the axis.
+    double west = 0.0, east = 0.0;
+    for (int j = 0; j < 8; ++j)
+    {
+      for (int i = 0; i < 16; ++i)
+      {
+        west += i < 7 ? g[j * 16 + i] : 0.0;
+        east += i > 7 ? g[j * 16 + i] : 0.0;
+      }
+    }
+    EXPECT_EQ(west, 0.0);
+    EXPECT_GT(east, 0.0);
   }
-  std::printf("the wall at single scattering (# lit), west on the left:\n%s", picture.c_str());
-  EXPECT_GT(west, 0.0);
-  EXPECT_EQ(east, 0.0);
+  {
+    const std::vector<double> g = render(top, "a light map black on its top half");
+    ASSERT_EQ(g.size(), 16u * 8u);
+    // The image's rows meet at the axis (z = 5 m on the wall, 2.2 m high): row 4 holds the
+    // map's ramp between its rows 15 and 16 (v from 0.516 to 0.484), which reaches 0.37 m
+    // above the axis.
+    double upper = 0.0, lower = 0.0;
+    for (int j = 0; j < 8; ++j)
+    {
+      for (int i = 0; i < 16; ++i)
+      {
+        upper += j > 4 ? g[j * 16 + i] : 0.0;
+        lower += j < 4 ? g[j * 16 + i] : 0.0;
+      }
+    }
+    EXPECT_EQ(upper, 0.0);
+    EXPECT_GT(lower, 0.0);
+  }
   // Single scattering refuses spots and occluders by name.
   messages.Errors.clear();
   renderer->SetModeToSingleScattering();

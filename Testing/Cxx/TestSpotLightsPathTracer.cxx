@@ -405,20 +405,25 @@ TEST(SpotLightsPathTracer, OccluderShadowsHalfTheHaze)
 
 //------------------------------------------------------------------------------
 // A light map (gobo) black on its left half (columns u < 0.5 of a 64 x 64 map) and, in a
-// second map, on its top half (the file's first rows, v < 0.5). Spot at the origin aiming
-// north (+y): the light map's frame (Physics/SpotLight.h) is e1 = -x (west), e2 = +z (up),
-// so u > 0.5 is west and v > 0.5 is up. A ray along +x crossing the beam 600 m north: the
-// quadrature of the airlight times the hard cone times the map, bilinear between the
-// columns 31 (0) and 32 (1): clamp(64 u - 31.5, 0, 1). Vertical rays: the east half stays
-// exactly black, the west half is lit; with the second map, only above the axis.
+// second map, on its top half (the file's first rows, v > 0.5: row r is at
+// v = 1 - (r + 0.5)/64). Spot at the origin aiming north (+y): the light map is thrown like
+// a slide projector's picture, upright and unmirrored to someone behind the light looking
+// north, so its frame (Physics/SpotLight.h) is e1 = +x (east, that person's right),
+// e2 = +z (up): the picture's right half (u > 0.5) lands east, its top (v > 0.5) up. A ray
+// along +x crossing the beam 600 m north: the quadrature of the airlight times the hard
+// cone times the map, bilinear between the columns 31 (0) and 32 (1):
+// clamp(64 u - 31.5, 0, 1). Vertical rays: the west half stays exactly black, the east half
+// is lit. With the second map only the lower half of the beam is lit: a vertical ray
+// through the axis against the quadrature of its v ramp, and rays along +x above the axis
+// (exactly black) and below it (lit).
 TEST(SpotLightsPathTracer, LightMapLightsOnlyItsBrightHalf)
 {
   const V position{ { 0.0, 0.0, 0.0 } }, axis{ { 0.0, 1.0, 0.0 } };
   const double cone = 25.0, intensity = 1.0e6, sigmaT = 5.0e-4, albedo = 0.8;
   nimbus::Vector3 e1, e2;
   nimbus::SpotLightMapFrame(axis, e1, e2);
-  ASSERT_EQ(e1, (V{ { -1.0, 0.0, 0.0 } }));
-  ASSERT_EQ(e2, (V{ { 0.0, 0.0, 1.0 } }));
+  ASSERT_EQ(e1, (V{ { 1.0, 0.0, 0.0 } })); // east: the right of someone looking north
+  ASSERT_EQ(e2, (V{ { 0.0, 0.0, 1.0 } })); // up
   LightDescription spot = Spot(position, axis, cone, 0.0, intensity);
   spot.LightMap.Path = "left-half-black";
   spot.LightMap.Width = spot.LightMap.Height = 64;
@@ -461,19 +466,21 @@ TEST(SpotLightsPathTracer, LightMapLightsOnlyItsBrightHalf)
     ExpectPixel(result.second, Rgb(*result.first, result.first->GetLightSpectra()[0], truth),
       "a ray across a beam whose light map is black on its left half");
   }
-  // Vertical rays 100 m west and east of the axis: east (u < 0.5, black columns) is black.
+  // Vertical rays 100 m west and east of the axis: west (u < 0.5, the picture's black left
+  // half as seen from behind the light) is black, east is lit.
   {
     const auto west =
       render(spot, { { -100.0, 600.0, -1000.0 } }, { { -100.0, 600.0, 0.0 } }, 121, 20000);
     const auto east =
       render(spot, { { 100.0, 600.0, -1000.0 } }, { { 100.0, 600.0, 0.0 } }, 122, 20000);
-    EXPECT_GT(west.second.Image.At(0, 0)[1], 0.0f);
-    EXPECT_EQ(east.second.Image.At(0, 0)[1], 0.0f);
-    std::printf("vertical rays 100 m west and east of the axis: %.4g and %g\n",
+    EXPECT_EQ(west.second.Image.At(0, 0)[1], 0.0f);
+    EXPECT_GT(east.second.Image.At(0, 0)[1], 0.0f);
+    std::printf("vertical rays 100 m west and east of the axis: %g and %.4g\n",
       west.second.Image.At(0, 0)[1], east.second.Image.At(0, 0)[1]);
   }
-  // The second map: its first 32 rows (the top of the picture) black, so only v > 0.5, up,
-  // is lit: a vertical ray through the axis, against the quadrature of the v ramp.
+  // The second map: its first 32 rows (the top of the picture, thrown up: v > 0.5) black,
+  // so only v < 0.5, below the axis, is lit. Bilinear between the rows 32 (1, at
+  // v = 31.5/64) and 31 (0, at v = 32.5/64): clamp(64 (1 - v) - 31.5, 0, 1).
   LightDescription topBlack = spot;
   for (int row = 0; row < 64; ++row)
   {
@@ -484,7 +491,8 @@ TEST(SpotLightsPathTracer, LightMapLightsOnlyItsBrightHalf)
   }
   {
     const V camera{ { 0.0, 600.0, -1000.0 } }, d{ { 0.0, 0.0, 1.0 } };
-    auto factor = [&](const V& w) { return AngleFromAxis(axis, w) < cone ? ramp(v(w)) : 0.0; };
+    auto factor = [&](const V& w)
+    { return AngleFromAxis(axis, w) < cone ? ramp(1.0 - v(w)) : 0.0; };
     auto along = [&](double t) { return Unit(Sub(nimbus::Along(camera, d, t), position)); };
     const double truth = PiecewiseSimpson(
       Airlight(camera, d, position, intensity, albedo * sigmaT, sigmaT, 0.0, factor),
@@ -494,6 +502,18 @@ TEST(SpotLightsPathTracer, LightMapLightsOnlyItsBrightHalf)
     const auto result = render(topBlack, camera, { { 0.0, 600.0, 0.0 } }, 123, 200000);
     ExpectPixel(result.second, Rgb(*result.first, result.first->GetLightSpectra()[0], truth),
       "a vertical ray through a beam whose light map is black on its top half");
+  }
+  // Rays along +x 100 m above and below the axis: above (v > 0.5, the picture's black top)
+  // is black, below is lit.
+  {
+    const auto above =
+      render(topBlack, { { -1000.0, 600.0, 100.0 } }, { { 0.0, 600.0, 100.0 } }, 124, 20000);
+    const auto below =
+      render(topBlack, { { -1000.0, 600.0, -100.0 } }, { { 0.0, 600.0, -100.0 } }, 125, 20000);
+    EXPECT_EQ(above.second.Image.At(0, 0)[1], 0.0f);
+    EXPECT_GT(below.second.Image.At(0, 0)[1], 0.0f);
+    std::printf("rays along +x 100 m above and below the axis: %g and %.4g\n",
+      above.second.Image.At(0, 0)[1], below.second.Image.At(0, 0)[1]);
   }
 }
 
@@ -788,17 +808,21 @@ TEST(SpotLightsPathTracer, MissingAssetsAndSingleScatteringAreRefused)
       << error.what();
   }
   // Light map sampling: pixel centres, bilinear between them, clamped to the edge pixels
-  // inside [0, 1]^2, 0 outside; row 0 at v = 0.5 / Height.
+  // inside [0, 1]^2, 0 outside; row 0 (the file's first row, the picture's top) at
+  // v = 1 - 0.5 / Height, the last row at v = 0.5 / Height; column 0 at u = 0.5 / Width.
   nimbus::LightMapDescription map;
   map.Width = 2;
   map.Height = 2;
-  map.Luminance = { 0.0f, 1.0f, 2.0f, 3.0f }; // row 0: 0 1; row 1: 2 3
-  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.25, 0.25), 0.0);
-  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.75, 0.25), 1.0);
-  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.25, 0.75), 2.0);
+  map.Luminance = { 0.0f, 1.0f, 2.0f, 3.0f }; // row 0 (top, v = 0.75): 0 1; row 1: 2 3
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.25, 0.25), 2.0); // bottom left: row 1
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.75, 0.25), 3.0); // bottom right: row 1
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.25, 0.75), 0.0); // top left: row 0
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.75, 0.75), 1.0); // top right: row 0
   EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.5, 0.5), 1.5);
-  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.0, 0.0), 0.0);
-  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 1.0, 1.0), 3.0);
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.0, 0.0), 2.0); // the bottom-left corner
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 1.0, 1.0), 1.0); // the top-right corner
+  // A quarter of the way from row 0 (mean 0.5) down to row 1 (mean 2.5).
+  EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.5, 0.625), 1.0);
   EXPECT_DOUBLE_EQ(nimbus::SampleLightMap(map, 0.9, 0.5), 2.0);
   EXPECT_EQ(nimbus::SampleLightMap(map, 1.0001, 0.5), 0.0);
   EXPECT_EQ(nimbus::SampleLightMap(map, 0.5, -0.0001), 0.0);
