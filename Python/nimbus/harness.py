@@ -955,9 +955,9 @@ def read_light_map(path):
     mapper as a one-component float vtkImageData of linear luminance: read by
     vtkImageReader2Factory; 8- or 16-bit samples over their range; PNG decoded from sRGB,
     PNM taken as linear; Y = 0.2126 R + 0.7152 G + 0.0722 B of three or four channels,
-    the first of one or two. Rows flipped: the path tracer's row 0 (v = 0) is the file's
-    first row, the top of the picture, which VTK's readers put last, and the mapper's
-    v = 0 is the first row of VTK's data (Physics/SpotLight.h for the frame)."""
+    the first of one or two. Rows as VTK's readers give them: the first row of VTK's data
+    is the picture's bottom row (the file's last), which both renderers put at v = 0
+    (Physics/SpotLight.h: the picture thrown upright, its top at v = 1)."""
     from vtkmodules.vtkIOImage import vtkImageReader2Factory
     if not os.path.isfile(path):
         raise ValueError(f"{path}: no such file (the light map)")
@@ -983,8 +983,7 @@ def read_light_map(path):
         luminance = 0.2126 * values[..., 0] + 0.7152 * values[..., 1] + 0.0722 * values[..., 2]
     else:
         luminance = values[..., 0]
-    # VTK's row 0 is the picture's bottom; the mapper's first row must be its top.
-    luminance = np.ascontiguousarray(luminance[::-1], dtype=np.float32)
+    luminance = np.ascontiguousarray(luminance, dtype=np.float32)
     light_map = vtkImageData()
     light_map.SetDimensions(width, height, 1)
     array = numpy_to_vtk(luminance.reshape(-1), deep=True)

@@ -256,9 +256,10 @@ class HarnessTest(unittest.TestCase):
         self.assertEqual(actor.GetProperty().GetColor(), (0.5, 0.5, 0.5))
 
     def test_light_map_rows_and_decoding(self):
-        # The file's top row (as a viewer shows it) is the path tracer's row 0 (v = 0);
-        # the mapper's v = 0 is VTK's first row, so the harness flips the rows; 8-bit PNG
-        # is decoded from sRGB, colours give Y of linear sRGB.
+        # Both renderers put the picture's bottom row at v = 0 (thrown upright), and the
+        # mapper's v = 0 is the first row of VTK's data, which VTK's readers make the
+        # picture's bottom: the rows stay as read. 8-bit PNG is decoded from sRGB, colours
+        # give Y of linear sRGB.
         from vtkmodules.util.numpy_support import numpy_to_vtk
         from vtkmodules.vtkCommonDataModel import vtkImageData
         from vtkmodules.vtkIOImage import vtkPNGWriter
@@ -277,9 +278,9 @@ class HarnessTest(unittest.TestCase):
         self.assertEqual(light_map.GetDimensions(), (3, 2, 1))
         from vtkmodules.util.numpy_support import vtk_to_numpy
         values = vtk_to_numpy(light_map.GetPointData().GetScalars()).reshape(2, 3)
-        np.testing.assert_allclose(values[0], 1.0, rtol=1e-6)  # the picture's top row first
         red = ((128 / 255 + 0.055) / 1.055) ** 2.4
-        np.testing.assert_allclose(values[1], 0.2126 * red, rtol=1e-5)
+        np.testing.assert_allclose(values[0], 0.2126 * red, rtol=1e-5)  # the bottom first
+        np.testing.assert_allclose(values[1], 1.0, rtol=1e-6)
         with self.assertRaisesRegex(ValueError, "no such file"):
             harness.read_light_map(os.path.join(self.output, "missing.png"))
 
