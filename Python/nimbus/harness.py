@@ -117,15 +117,18 @@ DEFAULT_SETTINGS = {
 }
 
 # The svs renderer's default settings for a scene with lights (only the ray march draws
-# them): the shafts by equi-angular samples along each view ray (on a quarter of the
-# pixels, the mapper's default, then on all of them and on a sixteenth), then by virtual
-# planes, over their counts; the march's step 2 texels (the mapper's default).
+# them), as the mapper draws by default otherwise (step 2 texels, multiple scattering by
+# discrete directions, which takes the lights' higher orders in the cloud): the shafts
+# by equi-angular samples along each view ray (on a quarter of the pixels, the mapper's
+# default, then on all of them and on a sixteenth), then by virtual planes, over their
+# counts.
+LIGHT_BASE_SETTINGS = {"method": "march", "step": 2, "ms": "directions"}
 DEFAULT_LIGHT_SETTINGS = (
-    [{"method": "march", "step": 2, "light_method": "march", "light_samples": n}
+    [dict(LIGHT_BASE_SETTINGS, light_method="march", light_samples=n)
      for n in (4, 8, 16, 32, 64)]
-    + [{"method": "march", "step": 2, "light_method": "march", "light_samples": 32,
-        "shaft_downsampling": d} for d in (1, 4)]
-    + [{"method": "march", "step": 2, "light_method": "planes", "virtual_planes": n}
+    + [dict(LIGHT_BASE_SETTINGS, light_method="march", light_samples=32, shaft_downsampling=d)
+       for d in (1, 4)]
+    + [dict(LIGHT_BASE_SETTINGS, light_method="planes", virtual_planes=n)
        for n in (16, 32, 64, 128, 256)])
 
 # Linear radiance -> the [0, 1] range VTK renders into (and back): radiance
