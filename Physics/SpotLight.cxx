@@ -42,7 +42,7 @@ void SpotLightMapFrame(const Vector3& axis, Vector3& e1, Vector3& e2)
   const Vector3 h =
     std::abs(axis[2]) > 0.999 ? Vector3{ { 0.0, 1.0, 0.0 } } : Vector3{ { 0.0, 0.0, 1.0 } };
   e1 = Normalized(Cross(axis, h)); // right, seen from behind the light
-  e2 = Cross(e1, axis);             // up
+  e2 = Cross(e1, axis);            // up
 }
 
 bool SpotLightMapCoordinates(const SpotProfile& profile, const Vector3& w, double& u, double& v)

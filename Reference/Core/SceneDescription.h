@@ -93,9 +93,9 @@ struct MediumDescription
 /// Pixel (c, r) is Luminance[r * Width + c]: column c at u = (c + 0.5) / Width, row r at
 /// v = 1 - (r + 0.5) / Height, row 0 the image file's first row (the top of the picture as
 /// an image viewer shows it, thrown upright: Physics/SpotLight.h); (u, v) as
-/// SpotLightMapCoordinates gives them. Sampled bilinearly between pixel centres (clamped to the edge pixels within
-/// [0, 1]^2), 0 outside [0, 1]^2. Values are linear luminance, >= 0 (an 8-bit or 16-bit
-/// PNG is decoded from sRGB, a PGM/PPM is linear; colour images give Y of linear sRGB).
+/// SpotLightMapCoordinates gives them. Sampled bilinearly between pixel centres (clamped to the
+/// edge pixels within [0, 1]^2), 0 outside [0, 1]^2. Values are linear luminance, >= 0 (an 8-bit or
+/// 16-bit PNG is decoded from sRGB, a PGM/PPM is linear; colour images give Y of linear sRGB).
 struct LightMapDescription
 {
   std::string Path;             // resolved, absolute; "" = no light map

@@ -432,8 +432,9 @@ public:
   ///    over the cone as a slide projector throws it (002 §6.2's light map; a gobo or
   ///    a stained-glass window; Physics/SpotLight.h for the frame). nullptr: none.
   ///  - LightShaftMethod: how the haze's in-scattering is integrated along the view
-  ///    rays: LightShaftsByRayMarching (0, the default; LightSamples equi-angular samples
-  ///    per light inside its beam, in the ray march) or LightShaftsByVirtualPlanes (1,
+  ///    rays: LightShaftsByRayMarching (0, the default; LightSamples (default 16)
+  ///    equi-angular samples per light inside its beam, on 1 in LightShaftDownsampling
+  ///    pixels per side) or LightShaftsByVirtualPlanes (1,
   ///    002 §6.2: NumberOfVirtualPlanes planes parallel to the screen over the lit depth,
   ///    drawn back to front and added to the picture).
   ///  - LightShadowMapSize: texels per side of each of a light's six shadow-map faces
@@ -764,7 +765,7 @@ protected:
   double SpotEdgeWidthDegrees = 2.0;
   vtkImageData* LightMap = nullptr;
   int LightShaftMethod = LightShaftsByRayMarching;
-  int LightSamples = 32;
+  int LightSamples = 16;
   int LightShaftDownsampling = 2;
   int NumberOfVirtualPlanes = 64;
   int LightShadowMapSize = 256;

@@ -177,6 +177,7 @@ struct Scene
     // The integrator at every pixel; the shafts on a quarter of the pixels are measured
     // on their own (TestQuadrature).
     this->Mapper->SetLightShaftDownsampling(1);
+    this->Mapper->SetLightSamples(32);
     this->Volume->SetMapper(this->Mapper);
     this->Renderer->AddVolume(this->Volume);
     this->Window->SetOffScreenRendering(1);

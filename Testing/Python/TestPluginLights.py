@@ -70,7 +70,7 @@ LIGHTS_DEFAULTS = {
     "LightIntensityScale": 1.0,
     "SpotEdgeWidthDegrees": 2.0,
     "LightShaftMethod": 0,
-    "LightSamples": 32,
+    "LightSamples": 16,
     "LightShaftDownsampling": 2,
     "NumberOfVirtualPlanes": 64,
     "LightShadowMapSize": 256,
