@@ -7,6 +7,7 @@
 // 1e-6 relative. Scenes are one pixel seen along its centre, with no sun, no air, a black
 // background unless said, so that only the feature under test lights the pixel.
 #include "Airlight.h"
+#include "LightsSceneTesting.h"
 #include "Math.h"
 #include "MonteCarloAgreement.h"
 #include "Occluders.h"
@@ -41,6 +42,11 @@ using nimbus::PathTracingSettings;
 using nimbus::RenderContext;
 using nimbus::SceneDescription;
 using V = std::array<double, 3>;
+using nimbus_test::DarkScene;
+using nimbus_test::ExpectPixel;
+using nimbus_test::Rgb;
+using nimbus_test::Samples;
+using nimbus_test::Simpson;
 
 V Sub(const V& a, const V& b)
 {
@@ -50,27 +56,6 @@ V Sub(const V& a, const V& b)
 V Unit(const V& a)
 {
   return nimbus::Normalized(a);
-}
-
-/// One pixel looking from `from` to `to`; nothing lit, nothing seen.
-SceneDescription DarkScene(const V& from, const V& to)
-{
-  SceneDescription scene;
-  scene.Camera.Position = from;
-  scene.Camera.FocalPoint = to;
-  const V d = Unit(Sub(to, from));
-  scene.Camera.ViewUp = std::abs(d[2]) > 0.9 ? V{ { 0.0, 1.0, 0.0 } } : V{ { 0.0, 0.0, 1.0 } };
-  scene.Camera.ViewAngle = 1.0;
-  scene.Camera.Width = 1;
-  scene.Camera.Height = 1;
-  scene.Atmosphere.Enabled = false;
-  scene.Ground.Enabled = false;
-  scene.Background.Type = "black";
-  scene.Sun.Illuminance = 0.0;
-  scene.Medium.ExtinctionPerDensity = 0.0;
-  scene.Medium.SingleScatteringAlbedo = 1.0;
-  scene.Medium.Phase = { { "isotropic", 0.0, 1.0 } };
-  return scene;
 }
 
 LightDescription PointLight(const V& position, double intensity)
@@ -107,50 +92,6 @@ OccluderDescription Box(const V& lo, const V& hi, double albedo)
   return box;
 }
 
-PathTracingSettings Samples(int n, std::uint64_t seed, int maxOrder)
-{
-  PathTracingSettings settings;
-  settings.MinSamplesPerPixel = n;
-  settings.MaxSamplesPerPixel = n;
-  settings.Seed = seed;
-  settings.Threads = 2;
-  settings.PixelJitter = false;
-  settings.MaxScatteringOrder = maxOrder;
-  return settings;
-}
-
-/// Linear sRGB of `scalar` times a (luminance-1) spectrum.
-std::array<double, 3> Rgb(
-  const RenderContext& context, const std::vector<double>& spectrum, double scalar)
-{
-  std::vector<double> s = spectrum;
-  for (double& x : s)
-  {
-    x *= scalar;
-  }
-  return context.ToLinearSrgb(s);
-}
-
-/// Every channel within 4 standard errors of truth; prints the green channel and the
-/// largest |z|.
-double ExpectPixel(const PathTracingResult& r, const std::array<double, 3>& truth, const char* what)
-{
-  double worst = 0.0;
-  for (int c = 0; c < 3; ++c)
-  {
-    const double mean = r.Image.At(0, 0)[c], se = r.StandardError.At(0, 0)[c];
-    EXPECT_TRUE(std::isfinite(mean) && se > 0.0) << what;
-    const double z = (mean - truth[c]) / se;
-    worst = std::max(worst, std::abs(z));
-    EXPECT_LT(std::abs(z), 4.0) << what << " channel " << c << ": " << mean << " +- " << se
-                                << ", truth " << truth[c];
-  }
-  std::printf("%s: truth G %.6g, mean G %.6g +- %.2g (%.2f %%), max |z| %.2f\n", what, truth[1],
-    r.Image.At(0, 0)[1], r.StandardError.At(0, 0)[1],
-    100.0 * r.StandardError.At(0, 0)[1] / truth[1], worst);
-  return worst;
-}
-
 /// Every channel within `relative` of truth (estimators without variance).
 void ExpectExact(
   const PathTracingResult& r, const std::array<double, 3>& truth, const char* what, double relative)
@@ -167,26 +108,27 @@ void ExpectExact(
     truth[1], r.Image.At(0, 0)[1], worst, r.StandardError.At(0, 0)[1]);
 }
 
-/// Adaptive Simpson quadrature of f over [a, b] to absolute tolerance eps.
-double Simpson(const std::function<double(double)>& f, double a, double b, double eps)
+/// The scene at 1024 samples per pixel from `seed` on 2 threads, with the path tracer's
+/// variance-reducing techniques all on or all off: sun-peak sampling, sun-depth roulette,
+/// the tabulated air transmittance and block traversal, and where `lightTechniques` also
+/// adaptive sampling and equi-angular light sampling (otherwise those at their defaults).
+PathTracingResult RenderWithTechniques(
+  const RenderContext& context, bool on, std::uint64_t seed, bool lightTechniques)
 {
-  std::function<double(double, double, double, double, double, double, double, int)> step =
-    [&](double a0, double b0, double fa, double fm, double fb, double whole, double tol,
-      int depth) -> double
+  PathTracingSettings settings;
+  settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1024;
+  settings.Seed = seed;
+  settings.Threads = 2;
+  settings.SunPeakSampling = on;
+  settings.SunDepthRoulette = on;
+  settings.TabulatedAirTransmittance = on;
+  settings.BlockTraversal = on;
+  if (lightTechniques)
   {
-    const double m = 0.5 * (a0 + b0), lm = 0.5 * (a0 + m), rm = 0.5 * (m + b0);
-    const double flm = f(lm), frm = f(rm);
-    const double left = (m - a0) / 6.0 * (fa + 4.0 * flm + fm);
-    const double right = (b0 - m) / 6.0 * (fm + 4.0 * frm + fb);
-    if (depth <= 0 || std::abs(left + right - whole) <= 15.0 * tol)
-    {
-      return left + right + (left + right - whole) / 15.0;
-    }
-    return step(a0, m, fa, flm, fm, left, 0.5 * tol, depth - 1) +
-      step(m, b0, fm, frm, fb, right, 0.5 * tol, depth - 1);
-  };
-  const double fa = f(a), fb = f(b), fm = f(0.5 * (a + b));
-  return step(a, b, fa, fm, fb, (b - a) / 6.0 * (fa + 4.0 * fm + fb), eps, 40);
+    settings.AdaptiveSampling = on;
+    settings.EquiAngularLightSampling = on;
+  }
+  return nimbus::RenderPathTraced(context, settings);
 }
 
 /// A function of the ray's parameter and the levels where the integrand has a kink or a
@@ -886,22 +828,8 @@ TEST(SpotLightsPathTracer, SpeedTechniquesStayUnbiasedWithVersion4Features)
     // A black plate over the east half of the searchlight's beam.
     Box({ { 100.0, -320.0, 10.0 } }, { { 140.0, -280.0, 10.0 } }, 0.0) };
   const RenderContext context(scene, DensityGrid(dims, lo, spacing, cloud));
-  auto render = [&](bool on, std::uint64_t seed)
-  {
-    PathTracingSettings settings;
-    settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1024;
-    settings.Seed = seed;
-    settings.Threads = 2;
-    settings.SunPeakSampling = on;
-    settings.SunDepthRoulette = on;
-    settings.TabulatedAirTransmittance = on;
-    settings.BlockTraversal = on;
-    settings.AdaptiveSampling = on;
-    settings.EquiAngularLightSampling = on;
-    return nimbus::RenderPathTraced(context, settings);
-  };
-  const PathTracingResult off = render(false, 151);
-  const PathTracingResult on = render(true, 152);
+  const PathTracingResult off = RenderWithTechniques(context, false, 151, true);
+  const PathTracingResult on = RenderWithTechniques(context, true, 152, true);
   const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(on, off);
   EXPECT_TRUE(agreement.Finite);
   std::printf("version-4 scene, techniques on vs off: RMS z %.3f over %d pixel channels, %d "
@@ -1004,20 +932,8 @@ TEST(SpotLightsPathTracer, TwilightCloudTechniquesAgree)
   scene.Medium.SingleScatteringAlbedo = 0.99;
   scene.Medium.Phase = { { "henyey_greenstein", 0.85, 1.0 } };
   const RenderContext context(scene, DensityGrid(dims, lo, spacing, cloud));
-  auto render = [&](bool on, std::uint64_t seed)
-  {
-    PathTracingSettings settings;
-    settings.MinSamplesPerPixel = settings.MaxSamplesPerPixel = 1024;
-    settings.Seed = seed;
-    settings.Threads = 2;
-    settings.SunPeakSampling = on;
-    settings.SunDepthRoulette = on;
-    settings.TabulatedAirTransmittance = on;
-    settings.BlockTraversal = on;
-    return nimbus::RenderPathTraced(context, settings);
-  };
-  const PathTracingResult off = render(false, 171);
-  const PathTracingResult on = render(true, 172);
+  const PathTracingResult off = RenderWithTechniques(context, false, 171, false);
+  const PathTracingResult on = RenderWithTechniques(context, true, 172, false);
   const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(on, off);
   double sum = 0.0;
   for (float x : on.Image.Pixels)
