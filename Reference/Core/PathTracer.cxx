@@ -29,6 +29,37 @@ constexpr double kSunPeakMinimumPeak = 2.0;
 /// Ratio tracking plays Russian roulette once its transmittance falls below this.
 constexpr double kRatioTrackingRouletteThreshold = 0.1;
 
+/// The unit direction omega from x toward y, a point of the light, with r2 the squared
+/// distance and r the distance, and beam the light's factor toward x: a spot's beam
+/// (Physics/SpotLight.h) and light map in the direction -omega from the light, 1 for points
+/// and segments. False where x is at the light itself (a point of zero measure), the
+/// distance is not finite or the beam is zero toward x.
+bool TowardLight(const LightElement& light, const Vector3& x, const Vector3& y, Vector3& omega,
+  double& r2, double& r, double& beam)
+{
+  omega = { { y[0] - x[0], y[1] - x[1], y[2] - x[2] } };
+  r2 = Dot(omega, omega);
+  r = std::sqrt(r2);
+  if (!(r > 0.0) || !std::isfinite(r))
+  {
+    return false;
+  }
+  for (double& c : omega)
+  {
+    c /= r;
+  }
+  beam = 1.0;
+  if (light.IsSpot)
+  {
+    beam = LightElementFactor(light, { { -omega[0], -omega[1], -omega[2] } });
+    if (!(beam > 0.0))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
 //------------------------------------------------------------------------------
 // Counter-based random numbers: SplitMix64 (Steele, Lea & Flood, "Fast Splittable
 // Pseudorandom Number Generators", OOPSLA 2014). The stream of one path starts at
@@ -1405,27 +1436,11 @@ void Integrator::LightNextEvent(
       y[a] = light.A[a] + v * (light.B[a] - light.A[a]);
     }
   }
-  Vector3 omega{ { y[0] - p[0], y[1] - p[1], y[2] - p[2] } };
-  const double r2 = Dot(omega, omega);
-  const double r = std::sqrt(r2);
-  if (!(r > 0.0) || !std::isfinite(r))
+  Vector3 omega;
+  double r2, r, beam;
+  if (!TowardLight(light, p, y, omega, r2, r, beam))
   {
-    return; // the light at the vertex itself: a point of zero measure
-  }
-  for (double& c : omega)
-  {
-    c /= r;
-  }
-  // A spot's beam (Physics/SpotLight.h) and light map toward p: direction -omega from the
-  // light. 1 for points and segments.
-  double beam = 1.0;
-  if (light.IsSpot)
-  {
-    beam = LightElementFactor(light, { { -omega[0], -omega[1], -omega[2] } });
-    if (!(beam > 0.0))
-    {
-      return;
-    }
+    return;
   }
   // At a collision of a segment the equi-angular strategy also sampled: the balance
   // heuristic's share of this (collision) strategy, q / (q + p_ea). Not for polyline
@@ -1665,25 +1680,11 @@ void Integrator::EquiAngularLightEstimate(
     return;
   }
   const Vector3 x = Along(o, d, t);
-  Vector3 omega{ { y[0] - x[0], y[1] - x[1], y[2] - x[2] } };
-  const double r2 = Dot(omega, omega);
-  const double r = std::sqrt(r2);
-  if (!(r > 0.0) || !std::isfinite(r))
+  Vector3 omega;
+  double r2, r, beam;
+  if (!TowardLight(light, x, y, omega, r2, r, beam))
   {
     return;
-  }
-  for (double& c : omega)
-  {
-    c /= r;
-  }
-  double beam = 1.0;
-  if (light.IsSpot)
-  {
-    beam = LightElementFactor(light, { { -omega[0], -omega[1], -omega[2] } });
-    if (!(beam > 0.0))
-    {
-      return;
-    }
   }
   // The scattering at x toward -d: sum over the scatterers of sigma_s f(mu), mu = omega.d.
   const double mu = Dot(omega, d);
