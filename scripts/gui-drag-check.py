@@ -37,7 +37,6 @@ own) are recorded beside them: other work on the same CPUs slows the frames.
 import argparse
 import json
 import os
-import shutil
 import statistics
 import subprocess
 import sys
@@ -45,6 +44,8 @@ import time
 
 import numpy as np
 from PIL import Image
+
+from gui_session import main_window, start_paraview, stop_paraview, view_rectangle, xdo
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 METHODS = {"march": 1, "slices": 0}
@@ -77,10 +78,6 @@ view.GetRenderWindow().AddObserver("EndEvent", frame_ended)
 log.write("# setup done %.3f method %s\n" % (time.time(), display.GetProperty("RenderingMethod").GetData()))
 Render()
 '''
-
-
-def xdo(*arguments):
-    subprocess.run(["xdotool"] + [str(a) for a in arguments], check=True)
 
 
 def shot(path):
@@ -138,30 +135,6 @@ def wait_quiet(log, quiet, timeout, size=None):
     raise SystemExit("no quiet still frame in %s after %.0f s" % (log, timeout))
 
 
-def main_window():
-    out = subprocess.run(["xdotool", "search", "--sync", "--name", "^ParaView"],
-                         stdout=subprocess.PIPE, text=True, timeout=180).stdout.split()
-    best = None
-    for window in out:
-        geometry = subprocess.run(["xdotool", "getwindowgeometry", window],
-                                  stdout=subprocess.PIPE, text=True).stdout
-        w, h = [int(v) for v in geometry.split("Geometry:")[1].split()[0].split("x")]
-        if best is None or w * h > best[1]:
-            best = (window, w * h)
-    return best[0]
-
-
-def view_rectangle(png):
-    """(x, y, w, h) of the render view: inside the active view's blue frame (2 px of
-    0,0,255, then 1 px of gap)."""
-    a = np.asarray(Image.open(png).convert("RGB")).astype(int)
-    blue = (a[:, :, 0] == 0) & (a[:, :, 1] == 0) & (a[:, :, 2] == 255)
-    rows = np.where(blue.sum(axis=1) > 400)[0]
-    cols = np.where(blue.sum(axis=0) > 300)[0]
-    top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
-    return int(left + 3), int(top + 3), int(right - left - 5), int(bottom - top - 5)
-
-
 def crop(png, rectangle):
     x, y, w, h = rectangle
     return np.asarray(Image.open(png).convert("RGB"))[y:y + h, x:x + w].astype(np.int16)
@@ -204,18 +177,10 @@ def run_method(method, args, output):
     log = os.path.join(output, method + "-frames.log")
     if os.path.exists(log):
         os.remove(log)
-    home = os.path.join(output, "home-" + method)
-    shutil.rmtree(home, ignore_errors=True)
-    os.makedirs(home)
-    setup = os.path.join(output, "setup.py")
-    with open(setup, "w") as out:
-        out.write(SETUP)
-    env = dict(os.environ, HOME=home, PV_PLUGIN_PATH=os.path.abspath(args.plugin_dir),
-               PYTHONPATH=args.python_path, NIMBUS_GUI_DRAG_LOG=log,
-               NIMBUS_GUI_DRAG_METHOD=str(METHODS[method]))
-    paraview = subprocess.Popen([args.paraview, "--dr", "--script=" + setup], env=env,
-                                stdout=open(os.path.join(output, method + "-paraview.log"), "w"),
-                                stderr=subprocess.STDOUT)
+    paraview = start_paraview(args.paraview, SETUP, output, "home-" + method, args.plugin_dir,
+                              args.python_path, os.path.join(output, method + "-paraview.log"),
+                              NIMBUS_GUI_DRAG_LOG=log,
+                              NIMBUS_GUI_DRAG_METHOD=str(METHODS[method]))
     result = {"method": method}
     try:
         window = main_window()
@@ -229,7 +194,7 @@ def run_method(method, args, output):
         rows = wait_quiet(log, 3.0, 300, size)       # the still frame at the new size
         first = os.path.join(output, method + "-before.png")
         shot(first)[1].wait()
-        rectangle = view_rectangle(first)
+        rectangle = view_rectangle(first, row_pixels=400)
         result["view_size"] = size
         result["view_rectangle_on_screen"] = rectangle
         print("[%s] render view %dx%d at %s on the screen" % (method, size[0], size[1],
@@ -335,11 +300,7 @@ def run_method(method, args, output):
                                                                   % method))
         xdo("key", "Escape")
     finally:
-        paraview.terminate()
-        try:
-            paraview.wait(10)
-        except subprocess.TimeoutExpired:
-            paraview.kill()
+        stop_paraview(paraview)
     return result
 
 

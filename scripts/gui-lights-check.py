@@ -26,13 +26,14 @@ dark at night) and that at least 8 % of its pixels are above 40 after it (the be
 """
 import argparse
 import os
-import shutil
 import subprocess
 import sys
 import time
 
 import numpy as np
 from PIL import Image
+
+from gui_session import main_window, start_paraview, stop_paraview, view_rectangle, xdo
 
 WINDOW = (1588, 1035)
 
@@ -77,10 +78,6 @@ view.CameraViewUp = [0.0, 0.0, 1.0]
 view.CameraViewAngle = 42.0
 Render(view)
 '''
-
-
-def xdo(*arguments):
-    subprocess.run(["xdotool"] + [str(a) for a in arguments], check=True)
 
 
 class Screen:
@@ -134,29 +131,6 @@ def search(text):
     time.sleep(1.5)
 
 
-def main_window():
-    out = subprocess.run(["xdotool", "search", "--sync", "--name", "^ParaView"],
-                         stdout=subprocess.PIPE, text=True, timeout=180).stdout.split()
-    best = None
-    for window in out:
-        geometry = subprocess.run(["xdotool", "getwindowgeometry", window],
-                                  stdout=subprocess.PIPE, text=True).stdout
-        w, h = [int(v) for v in geometry.split("Geometry:")[1].split()[0].split("x")]
-        if best is None or w * h > best[1]:
-            best = (window, w * h)
-    return best[0]
-
-
-def view_rectangle(png):
-    """(x, y, w, h) of the render view: inside the active view's blue frame."""
-    a = np.asarray(Image.open(png).convert("RGB")).astype(int)
-    blue = (a[:, :, 0] == 0) & (a[:, :, 1] == 0) & (a[:, :, 2] == 255)
-    rows = np.where(blue.sum(axis=1) > 300)[0]
-    cols = np.where(blue.sum(axis=0) > 300)[0]
-    top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
-    return int(left + 3), int(top + 3), int(right - left - 5), int(bottom - top - 5)
-
-
 def view_pixels(png):
     x, y, w, h = view_rectangle(png)
     return np.asarray(Image.open(png).convert("L"))[y:y + h, x:x + w].astype(float)
@@ -170,17 +144,8 @@ def crop(png, box, out):
 
 def run(args):
     output = os.path.abspath(args.output_dir)
-    home = os.path.join(output, "home")
-    shutil.rmtree(home, ignore_errors=True)
-    os.makedirs(home)
-    setup = os.path.join(output, "setup.py")
-    with open(setup, "w") as stream:
-        stream.write(SETUP)
-    env = dict(os.environ, HOME=home, PV_PLUGIN_PATH=os.path.abspath(args.plugin_dir),
-               PYTHONPATH=args.python_path)
-    log = open(os.path.join(output, "paraview.log"), "w")
-    paraview = subprocess.Popen([args.paraview, "--dr", "--script=" + setup], env=env,
-                                stdout=log, stderr=subprocess.STDOUT)
+    paraview = start_paraview(args.paraview, SETUP, output, "home", args.plugin_dir,
+                              args.python_path, os.path.join(output, "paraview.log"))
     screen = Screen(output)
     failures = []
     try:
@@ -274,11 +239,7 @@ def run(args):
         click(158, 211, 6.0)
         screen.shot("light-inspector-closed")
     finally:
-        paraview.terminate()
-        try:
-            paraview.wait(10)
-        except subprocess.TimeoutExpired:
-            paraview.kill()
+        stop_paraview(paraview)
     return failures
 
 
