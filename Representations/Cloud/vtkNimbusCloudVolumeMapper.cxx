@@ -1779,8 +1779,6 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     };
   }
 
-  this->AddViewLightsToSolve(frame, zMiddle, lighting);
-
   const nimbus::SceneAtmosphere& air = settings.Air;
   request.Key = { static_cast<double>(method), static_cast<double>(options.Orders),
     static_cast<double>(options.NumberOfDirections), options.SkyLight ? 1.0 : 0.0,
@@ -1792,13 +1790,7 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     settings.Sun.TemperatureKelvin, frame.Atmosphere ? 1.0 : 0.0, frame.Ground ? 1.0 : 0.0,
     air.SceneAltitudeMetres, air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG,
     settings.GroundAlbedo, settings.GroundHeight };
-  if (!lighting.PointLights.empty())
-  {
-    // The lights' part of the answer does not scale with the sun's illuminance: with
-    // lights, a new illuminance is a new solve.
-    request.Key.push_back(settings.Sun.Illuminance);
-    request.Key.insert(request.Key.end(), frame.LightsKey.begin(), frame.LightsKey.end());
-  }
+  this->AddViewLightsToSolve(frame, zMiddle, request.Lighting, request.Key);
   if (method == MultipleScatteringReferencePatterns)
   {
     request.Key.insert(request.Key.end(),
@@ -2948,11 +2940,20 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
 // The view's lights as point lights of the multiple-scattering solve (their orders >= 2
 // in the cloud; the march draws their single scattering): metres in the up frame, each
 // dimmed by the clear air between it and the cloud's middle height (the solve sees no
-// air). The opaque scene's shadows are not in the solve.
-void vtkNimbusCloudVolumeMapper::AddViewLightsToSolve(
-  const FrameState& frame, double cloudMiddleZ, nimbus::CloudLighting& lighting)
+// air), and what they are in the solve's key. The opaque scene's shadows are not in the
+// solve.
+void vtkNimbusCloudVolumeMapper::AddViewLightsToSolve(const FrameState& frame, double cloudMiddleZ,
+  nimbus::CloudLighting& lighting, std::vector<double>& key)
 {
   const Internals& in = *this->Internal;
+  if (frame.Lights.empty())
+  {
+    return;
+  }
+  // The lights' part of the answer does not scale with the sun's illuminance: with
+  // lights, a new illuminance is a new solve.
+  key.push_back(frame.Settings.Sun.Illuminance);
+  key.insert(key.end(), frame.LightsKey.begin(), frame.LightsKey.end());
   const double metres = frame.Settings.MetresPerUnit;
   for (const nimbus::ViewLight& light : frame.Lights)
   {

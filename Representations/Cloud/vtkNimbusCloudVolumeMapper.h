@@ -847,8 +847,8 @@ private:
   bool ShaftsApart(const FrameState& frame) const;
   void RenderLightShafts(const FrameState& frame);
   void SetViewLightUniforms(vtkShaderProgram* program, const FrameState& frame);
-  void AddViewLightsToSolve(
-    const FrameState& frame, double cloudMiddleZ, nimbus::CloudLighting& lighting);
+  void AddViewLightsToSolve(const FrameState& frame, double cloudMiddleZ,
+    nimbus::CloudLighting& lighting, std::vector<double>& key);
   void RenderVirtualPlanes(const FrameState& frame);
   void SetCloudLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
