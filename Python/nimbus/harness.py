@@ -664,7 +664,10 @@ class SvsRenderer:
     (LightShadowMapSize; 0: no shadows of the occluders), light_cloud_steps
     (LightCloudSteps; 0: the cloud casts no shadow in the beams) and shaft_downsampling
     (LightShaftDownsampling: the ray-marched shafts on 1 / n of the pixels per side),
-    each the mapper's default when a row leaves it out, set on every row.
+    each the mapper's default when a row leaves it out, set on every row. supersample n
+    (default 1, any scene): the frame drawn at n x n times the pixels and averaged over
+    each n x n block, the pixel's area as the path tracer integrates it (its time is the
+    larger frame's).
     """
 
     def __init__(self, scene_path):
@@ -722,11 +725,20 @@ class SvsRenderer:
         self.window = vtkRenderWindow()
         self.window.SetOffScreenRendering(1)
         self.window.SetMultiSamples(0)
-        self.window.SetSize(camera_description["width"], camera_description["height"])
+        self.size = (camera_description["width"], camera_description["height"])
+        self.window.SetSize(*self.size)
         self.window.AddRenderer(self.renderer)
         self.capture_class = vtkWindowToImageFilter
 
     def render(self, settings):
+        # supersample n: drawn at n x n times the pixels and averaged over each n x n
+        # block, as the path tracer integrates over each pixel's area (it samples the
+        # whole pixel; the mapper its centre). Float capture only.
+        supersample = int(settings.get("supersample", 1))
+        if supersample < 1 or (supersample > 1 and not self.float_capture):
+            raise ValueError(f"svs: supersample {supersample}: a positive integer, and above "
+                             "1 only for the float capture (black or atmosphere background)")
+        self.window.SetSize(self.size[0] * supersample, self.size[1] * supersample)
         method = settings.get("method", "slices")
         if self.lights and method != "march":
             raise ValueError(f"svs: setting {setting_label(settings)}: the scene has lights, "
@@ -775,7 +787,11 @@ class SvsRenderer:
             radiance = self.mapper.GetRadianceImage()
             width, height, _ = radiance.GetDimensions()
             rgba = vtk_to_numpy(radiance.GetPointData().GetScalars()).reshape(height, width, 4)
-            return rgba[..., :3].astype(np.float32).copy()
+            image = rgba[..., :3].astype(np.float32)
+            if supersample > 1:
+                image = image.reshape(height // supersample, supersample,
+                                      width // supersample, supersample, 3).mean(axis=(1, 3))
+            return image.copy()
         return read_framebuffer(self.window, self.capture_class, 3) / VTK_SCALE
 
     def close(self):
