@@ -1254,6 +1254,36 @@ class SceneReferences:
         return self.images[(name, sky)]
 
 
+def compare_references(scene_paths, names, args):
+    """Reference names[0] against reference names[1] on each scene (from the cache, or
+    rendered into it): the metrics with both references' noise taken off, and the ratio
+    of their mean radiances. Writes OUTPUT_DIR/reference-pairs.csv."""
+    cache_dir = args.cache_dir or os.path.join(args.output_dir, "reference-cache")
+    rows = []
+    for scene_path in scene_paths:
+        scene_path = os.path.abspath(scene_path)
+        scene_name = os.path.splitext(os.path.basename(scene_path))[0]
+        references = SceneReferences(scene_path, scene_name, cache_dir, args.output_dir,
+                                     args.reference_seconds, args.display_exposure)
+        image, image_error, image_label = references.get(names[0])
+        reference, reference_error, reference_label = references.get(names[1])
+        row = {"scene": scene_name, "image": image_label, "reference": reference_label}
+        row.update(error_metrics(image, reference, reference_error, image_error))
+        row["mean_ratio"] = float(image.mean() / max(reference.mean(), 1e-30))
+        rows.append(row)
+        print(f"{scene_name}: {image_label} against {reference_label}: RMSE {row['rmse']:.4g}, "
+              f"PSNR {row['psnr_db']:.1f} dB (p99.9 {row['psnr_p999_db']:.1f} dB), rel. L1 "
+              f"{row['relative_l1']:.3f}, mean radiance ratio {row['mean_ratio']:.3f}",
+              flush=True)
+    path = os.path.join(args.output_dir, "reference-pairs.csv")
+    with open(path, "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(path)
+    return rows
+
+
 def run(arguments):
     parser = argparse.ArgumentParser(prog="python3 -m nimbus.harness", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -1288,20 +1318,29 @@ def run(arguments):
     parser.add_argument("--path-convergence", type=int, metavar="SPP",
                         help="instead: measure the path tracer at SPP samples per pixel on each "
                              "scene and extrapolate its time to 1%% relative RMSE")
+    parser.add_argument("--compare-references", nargs=2, metavar=("IMAGE", "REFERENCE"),
+                        choices=sorted(REFERENCE_SETTINGS),
+                        help="instead: measure reference IMAGE against reference REFERENCE on "
+                             "each scene (both noise-corrected), e.g. path-single path: what "
+                             "multiple scattering adds")
     args = parser.parse_args(arguments)
+    if not (args.reference_seconds > 0 and math.isfinite(args.reference_seconds)):
+        parser.error("--reference-seconds must be a positive number of seconds")
+    if not (args.display_exposure > 0 and math.isfinite(args.display_exposure)):
+        parser.error("--display-exposure must be a positive number")
     if args.path_convergence:
         os.makedirs(args.output_dir, exist_ok=True)
         path_convergence(args.scenes, args.path_convergence, args.output_dir)
+        return 0
+    if args.compare_references:
+        os.makedirs(args.output_dir, exist_ok=True)
+        compare_references(args.scenes, args.compare_references, args)
         return 0
     renderers = args.renderer or ["vtk-gpu"]
     if args.settings and len(renderers) != 1:
         parser.error("--settings needs exactly one --renderer")
     if args.repeats < 1:
         parser.error("--repeats must be >= 1")
-    if not (args.display_exposure > 0 and math.isfinite(args.display_exposure)):
-        parser.error("--display-exposure must be a positive number")
-    if not (args.reference_seconds > 0 and math.isfinite(args.reference_seconds)):
-        parser.error("--reference-seconds must be a positive number of seconds")
     cache_dir = args.cache_dir or os.path.join(args.output_dir, "reference-cache")
     os.makedirs(args.output_dir, exist_ok=True)
 

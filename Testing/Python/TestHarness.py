@@ -357,6 +357,17 @@ class HarnessTest(unittest.TestCase):
             # 44.9 dB supersampled: the rest is mostly the pixel's area, which the path
             # tracer integrates and the mapper samples at its centre.
             self.assertGreater(float(row["psnr_db"]), 30.0, row)
+        # Multiple scattering's share: the path tracer stopped at the first scattering
+        # against the full one (the fog's higher orders add light: the ratio is below 1).
+        self.assertEqual(harness.run([path, "--compare-references", "path-single", "path",
+                                      "--reference-seconds", "4", "--output-dir",
+                                      self.output]), 0)
+        with open(os.path.join(self.output, "reference-pairs.csv")) as stream:
+            (pair,) = list(csv.DictReader(stream))
+        self.assertRegex(pair["image"], r"^path-single \(")
+        self.assertRegex(pair["reference"], r"^path \(")
+        self.assertLess(float(pair["mean_ratio"]), 1.0)
+        self.assertGreater(float(pair["mean_ratio"]), 0.5)
         # Reference, image and difference side by side, 2 pixels apart.
         from vtkmodules.vtkIOImage import vtkPNGReader
         reader = vtkPNGReader()
