@@ -1,0 +1,489 @@
+// The first scattering of point sources on the medium's grid (see FirstScattering.h).
+#include "FirstScattering.h"
+
+#include "ParallelFor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace nimbus
+{
+namespace
+{
+// Optical depth beyond which a source's light is dropped (T < 4e-18).
+constexpr double kOpaque = 40.0;
+// Directions of the cell average of 1/r^2 next to a source.
+constexpr int kCellAverageDirections = 1024;
+
+const std::vector<Vector3>& CellAverageDirections()
+{
+  static const std::vector<Vector3> directions = FibonacciDirections(kCellAverageDirections);
+  return directions;
+}
+
+// Sources merged to one grid point: their total intensity and intensity-weighted centre.
+struct MergedSource
+{
+  std::array<int, 3> Point{ { 0, 0, 0 } }; // grid indices (may lie outside the grid)
+  Vector3 Centre{ { 0, 0, 0 } };           // world [m]
+  double Intensity = 0.0;
+};
+
+Vector3 IndexCoordinates(const ExtinctionGrid& grid, const Vector3& world)
+{
+  const Vector3 rel{ { world[0] - grid.Origin[0], world[1] - grid.Origin[1],
+    world[2] - grid.Origin[2] } };
+  return { { Dot(rel, grid.Axes[0]) / grid.Spacing[0], Dot(rel, grid.Axes[1]) / grid.Spacing[1],
+    Dot(rel, grid.Axes[2]) / grid.Spacing[2] } };
+}
+
+std::vector<MergedSource> MergeByGridPoint(
+  const ExtinctionGrid& grid, const std::vector<ScalarPointSource>& sources)
+{
+  std::map<std::array<int, 3>, MergedSource> merged;
+  for (const ScalarPointSource& s : sources)
+  {
+    if (!(s.Intensity > 0.0))
+    {
+      continue;
+    }
+    const Vector3 index = IndexCoordinates(grid, s.Position);
+    std::array<int, 3> point;
+    for (int a = 0; a < 3; ++a)
+    {
+      // Far outside the grid the point only needs to be outside: clamp to keep ints sane.
+      point[a] = static_cast<int>(std::lround(std::clamp(index[a], -1e6, 1e6)));
+    }
+    MergedSource& m = merged[point];
+    m.Point = point;
+    m.Intensity += s.Intensity;
+    for (int c = 0; c < 3; ++c)
+    {
+      m.Centre[c] += s.Intensity * s.Position[c];
+    }
+  }
+  std::vector<MergedSource> out;
+  out.reserve(merged.size());
+  for (auto& entry : merged)
+  {
+    MergedSource m = entry.second;
+    for (int c = 0; c < 3; ++c)
+    {
+      m.Centre[c] /= m.Intensity;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+// One source's pass: tau carried outward shell by shell, E and F added to `sum`.
+class SourcePass
+{
+public:
+  SourcePass(
+    const ExtinctionGrid& grid, std::vector<float>& meanExtinction, std::vector<double>& sum)
+    : Grid(grid)
+    , MeanExtinction(meanExtinction)
+    , Sum(sum)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Dims[a] = grid.Dimensions[a];
+    }
+  }
+
+  void Run(const MergedSource& source)
+  {
+    this->Source = &source;
+    const std::array<int, 3>& s = source.Point;
+    // The shells that meet the grid: Chebyshev distances from s to the grid's box.
+    int nMin = 0, nMax = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const int below = std::max(0, s[a] - (this->Dims[a] - 1));
+      const int above = std::max(0, -s[a]);
+      nMin = std::max(nMin, std::max(below, above));
+      nMax = std::max(nMax, std::max(std::abs(s[a]), std::abs(s[a] - (this->Dims[a] - 1))));
+    }
+    for (int n = nMin; n <= nMax; ++n)
+    {
+      this->Shell(n);
+    }
+  }
+
+private:
+  bool Inside(int i, int j, int k) const
+  {
+    return i >= 0 && j >= 0 && k >= 0 && i < this->Dims[0] && j < this->Dims[1] &&
+      k < this->Dims[2];
+  }
+
+  // Every grid point at Chebyshev distance n from the source's point.
+  void Shell(int n)
+  {
+    const std::array<int, 3>& s = this->Source->Point;
+    const int k0 = std::max(0, s[2] - n), k1 = std::min(this->Dims[2] - 1, s[2] + n);
+    const int j0 = std::max(0, s[1] - n), j1 = std::min(this->Dims[1] - 1, s[1] + n);
+    const int i0 = std::max(0, s[0] - n), i1 = std::min(this->Dims[0] - 1, s[0] + n);
+    for (int k = k0; k <= k1; ++k)
+    {
+      if (std::abs(k - s[2]) == n)
+      {
+        for (int j = j0; j <= j1; ++j)
+        {
+          for (int i = i0; i <= i1; ++i)
+          {
+            this->Visit(i, j, k, n);
+          }
+        }
+        continue;
+      }
+      for (int j = j0; j <= j1; ++j)
+      {
+        if (std::abs(j - s[1]) == n)
+        {
+          for (int i = i0; i <= i1; ++i)
+          {
+            this->Visit(i, j, k, n);
+          }
+        }
+        else
+        {
+          if (this->Inside(s[0] - n, j, k))
+          {
+            this->Visit(s[0] - n, j, k, n);
+          }
+          if (n > 0 && this->Inside(s[0] + n, j, k))
+          {
+            this->Visit(s[0] + n, j, k, n);
+          }
+        }
+      }
+    }
+  }
+
+  std::size_t Index(int i, int j, int k) const
+  {
+    return (static_cast<std::size_t>(k) * this->Dims[1] + j) * this->Dims[0] + i;
+  }
+
+  // The mean extinction from the source and sigma at the fractional point p of a layer
+  // (one coordinate integer): bilinear in the other two. False when p is outside the
+  // grid's box. (The mean extinction tau / r, not tau, is interpolated: it is constant in
+  // a homogeneous medium, where tau's growth with r would bend between the samples.)
+  bool Layer(const double p[3], double& mean, double& sigma) const
+  {
+    int base[3];
+    double frac[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      if (p[a] < -1e-9 || p[a] > this->Dims[a] - 1 + 1e-9)
+      {
+        return false;
+      }
+      const double c = std::clamp(p[a], 0.0, static_cast<double>(this->Dims[a] - 1));
+      base[a] = std::min(static_cast<int>(c), std::max(0, this->Dims[a] - 2));
+      frac[a] = this->Dims[a] > 1 ? c - base[a] : 0.0;
+    }
+    mean = 0.0;
+    sigma = 0.0;
+    for (int corner = 0; corner < 8; ++corner)
+    {
+      double w = 1.0;
+      int q[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        const int up = (corner >> a) & 1;
+        w *= up ? frac[a] : 1.0 - frac[a];
+        q[a] = base[a] + up;
+      }
+      if (w <= 0.0)
+      {
+        continue; // also keeps q inside the grid on its last layer
+      }
+      const std::size_t index = this->Index(q[0], q[1], q[2]);
+      mean += w * this->MeanExtinction[index];
+      sigma += w * this->Grid.Extinction[index];
+    }
+    return true;
+  }
+
+  void Visit(int i, int j, int k, int n)
+  {
+    const std::size_t index = this->Index(i, j, k);
+    const std::array<int, 3>& s = this->Source->Point;
+    const int d[3] = { s[0] - i, s[1] - j, s[2] - k };
+    double tau = 0.0;
+    if (n > 0)
+    {
+      // One step toward the source along the dominant axis (|d| = n there): the
+      // predecessor lies in shell n - 1.
+      const double p[3] = { i + d[0] / static_cast<double>(n), j + d[1] / static_cast<double>(n),
+        k + d[2] / static_cast<double>(n) };
+      double meanBefore = 0.0, sigmaBefore = 0.0;
+      this->Layer(p, meanBefore, sigmaBefore); // outside the box: 0 and 0
+      double metres2 = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double m = d[a] / static_cast<double>(n) * this->Grid.Spacing[a];
+        metres2 += m * m;
+      }
+      const double step = std::sqrt(metres2); // [m]; the predecessor is (n - 1) steps away
+      tau = meanBefore * (n - 1) * step + 0.5 * (sigmaBefore + this->Grid.Extinction[index]) * step;
+      this->MeanExtinction[index] = static_cast<float>(tau / (n * step));
+    }
+    else
+    {
+      this->MeanExtinction[index] = 0.0f;
+    }
+    if (tau < kOpaque)
+    {
+      this->Add(index, i, j, k, n, std::exp(-tau));
+    }
+  }
+
+  // E and F of this source at point (i, j, k) with transmittance t.
+  void Add(std::size_t index, int i, int j, int k, int n, double t)
+  {
+    double inverse2 = 0.0; // 1/r^2 [1/m^2]
+    Vector3 flux{ { 0, 0, 0 } };
+    if (n <= 1)
+    {
+      // The cell touches the source's: the average over it, transmittance included.
+      this->CellAverage(i, j, k, this->Grid.Extinction[index], inverse2, flux);
+      t = 1.0;
+    }
+    else
+    {
+      this->AccumulateInverseSquare(this->Grid.Position(i, j, k), inverse2, flux);
+    }
+    const double e = this->Source->Intensity * t;
+    double* out = &this->Sum[4 * index];
+    out[0] += e * inverse2;
+    out[1] += e * flux[0];
+    out[2] += e * flux[1];
+    out[3] += e * flux[2];
+  }
+
+  // The average over the point's cell (a box of one spacing per axis about it) of T/r^2
+  // and of T w/r^2 from the source: in spherical coordinates about the source
+  // dV = r^2 dr dw, so integral T/r^2 dV = integral over directions of the integral of
+  // exp(-sigma r) along the chord the ray from the source cuts through the box (w times it
+  // for the flux), summed over a Fibonacci set; sigma the point's extinction, taken as
+  // constant from the source to the cell (the cells are the source's and its neighbours).
+  void CellAverage(int i, int j, int k, double sigma, double& inverse2, Vector3& flux) const
+  {
+    const Vector3 centre = this->Grid.Position(i, j, k);
+    const Vector3& c = this->Source->Centre;
+    const Vector3 world{ { c[0] - centre[0], c[1] - centre[1], c[2] - centre[2] } };
+    double origin[3], half[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      origin[a] = Dot(world, this->Grid.Axes[a]); // the source in the cell's frame [m]
+      half[a] = 0.5 * this->Grid.Spacing[a];
+    }
+    const std::vector<Vector3>& directions = CellAverageDirections();
+    double chords = 0.0;
+    Vector3 local{ { 0, 0, 0 } };
+    for (const Vector3& w : directions)
+    {
+      double tNear = 0.0, tFar = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3 && tNear < tFar; ++a)
+      {
+        if (w[a] == 0.0)
+        {
+          tFar = std::abs(origin[a]) <= half[a] ? tFar : -1.0;
+          continue;
+        }
+        double t0 = (-half[a] - origin[a]) / w[a], t1 = (half[a] - origin[a]) / w[a];
+        if (t0 > t1)
+        {
+          std::swap(t0, t1);
+        }
+        tNear = std::max(tNear, t0);
+        tFar = std::min(tFar, t1);
+      }
+      // integral over the chord of exp(-sigma r) dr: the cell's transmittance from the
+      // source, the extinction taken as the point's (the chord itself when sigma r << 1).
+      const double chord = tFar > tNear
+        ? (sigma * (tFar - tNear) > 1e-6
+              ? (std::exp(-sigma * tNear) - std::exp(-sigma * tFar)) / sigma
+              : (tFar - tNear) * std::exp(-sigma * tNear))
+        : 0.0;
+      chords += chord;
+      for (int a = 0; a < 3; ++a)
+      {
+        local[a] += chord * w[a];
+      }
+    }
+    const double scale = 4.0 * kPi / directions.size() /
+      (this->Grid.Spacing[0] * this->Grid.Spacing[1] * this->Grid.Spacing[2]);
+    inverse2 = chords * scale;
+    for (int c2 = 0; c2 < 3; ++c2)
+    {
+      flux[c2] = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        flux[c2] += local[a] * scale * this->Grid.Axes[a][c2];
+      }
+    }
+  }
+
+  void AccumulateInverseSquare(const Vector3& x, double& inverse2, Vector3& flux) const
+  {
+    const Vector3& c = this->Source->Centre;
+    const Vector3 d{ { x[0] - c[0], x[1] - c[1], x[2] - c[2] } };
+    // A sub-point on the source itself: a floor of a hundredth of the smallest spacing.
+    const double floor =
+      1e-4 * std::min({ this->Grid.Spacing[0], this->Grid.Spacing[1], this->Grid.Spacing[2] });
+    const double r2 = std::max(Dot(d, d), floor * floor);
+    const double r = std::sqrt(r2);
+    inverse2 += 1.0 / r2;
+    for (int a = 0; a < 3; ++a)
+    {
+      flux[a] += d[a] / (r * r2);
+    }
+  }
+
+  const ExtinctionGrid& Grid;
+  std::vector<float>& MeanExtinction; // tau / r from the source's grid point [1/m]
+  std::vector<double>& Sum;
+  int Dims[3] = { 0, 0, 0 };
+  const MergedSource* Source = nullptr;
+};
+} // namespace
+
+std::string CheckFirstScatteringInput(
+  const ExtinctionGrid& grid, const std::vector<ScalarPointSource>& sources)
+{
+  CloudLighting none;
+  none.HasSun = false;
+  const std::string gridProblem =
+    CheckMultipleScatteringInput(grid, CloudOptics(), none, MultipleScatteringOptions());
+  if (!gridProblem.empty())
+  {
+    return gridProblem;
+  }
+  for (std::size_t k = 0; k < sources.size(); ++k)
+  {
+    if (!IsFinite(sources[k].Position) || !std::isfinite(sources[k].Intensity) ||
+      sources[k].Intensity < 0.0)
+    {
+      std::ostringstream message;
+      message << "point source " << k
+              << " has a non-finite position or a negative or non-finite intensity";
+      return message.str();
+    }
+  }
+  return "";
+}
+
+FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
+  const std::vector<ScalarPointSource>& sources, int threads,
+  const std::function<void(double)>& progress)
+{
+  const std::string problem = CheckFirstScatteringInput(grid, sources);
+  if (!problem.empty())
+  {
+    throw std::invalid_argument("nimbus::ComputeFirstScattering: " + problem);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<MergedSource> merged = MergeByGridPoint(grid, sources);
+  const std::size_t n = grid.NumberOfPoints();
+  FirstScatteringField field;
+  field.Dimensions = grid.Dimensions;
+  field.MergedSources = static_cast<int>(merged.size());
+
+  // Each worker sums its share of the sources in its own buffer; batches of sources
+  // between progress reports (on this thread, where the caller may stop the work).
+  const std::size_t workers =
+    std::max<std::size_t>(1, std::min<std::size_t>(ResolveThreadCount(threads), merged.size()));
+  std::vector<std::vector<double>> sums(workers, std::vector<double>(4 * n, 0.0));
+  std::vector<std::vector<float>> taus(workers, std::vector<float>(n, 0.0f));
+  const std::size_t batch = 4 * workers;
+  for (std::size_t first = 0; first < merged.size(); first += batch)
+  {
+    const std::size_t last = std::min(merged.size(), first + batch);
+    ParallelFor(workers, 1, static_cast<int>(workers),
+      [&](std::size_t begin, std::size_t end)
+      {
+        for (std::size_t w = begin; w < end; ++w)
+        {
+          SourcePass pass(grid, taus[w], sums[w]);
+          for (std::size_t s = first + w; s < last; s += workers)
+          {
+            pass.Run(merged[s]);
+          }
+        }
+      });
+    if (progress)
+    {
+      progress(static_cast<double>(last) / merged.size());
+    }
+  }
+  field.Values.assign(4 * n, 0.0f);
+  for (std::size_t i = 0; i < 4 * n; ++i)
+  {
+    double total = 0.0;
+    for (const std::vector<double>& sum : sums)
+    {
+      total += sum[i];
+    }
+    field.Values[i] = static_cast<float>(total);
+  }
+  field.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return field;
+}
+
+FirstScatteringField CombineFirstScattering(
+  const std::vector<const FirstScatteringField*>& fields, const std::vector<double>& weights)
+{
+  if (fields.size() != weights.size())
+  {
+    throw std::invalid_argument("nimbus::CombineFirstScattering: one weight per field");
+  }
+  FirstScatteringField out;
+  if (fields.empty())
+  {
+    return out;
+  }
+  out.Dimensions = fields.front()->Dimensions;
+  out.Values.assign(fields.front()->Values.size(), 0.0f);
+  for (std::size_t f = 0; f < fields.size(); ++f)
+  {
+    if (fields[f]->Values.size() != out.Values.size() || fields[f]->Dimensions != out.Dimensions)
+    {
+      throw std::invalid_argument("nimbus::CombineFirstScattering: fields of different sizes");
+    }
+    const float w = static_cast<float>(weights[f]);
+    for (std::size_t i = 0; i < out.Values.size(); ++i)
+    {
+      out.Values[i] += w * fields[f]->Values[i];
+    }
+    out.MergedSources += fields[f]->MergedSources;
+    out.Seconds += fields[f]->Seconds;
+  }
+  return out;
+}
+
+double EvaluateFirstScattering(
+  const float* values, const Vector3& w, const std::function<double(double)>& phase)
+{
+  const double e = std::max(0.0, static_cast<double>(values[0]));
+  const Vector3 f{ { values[1], values[2], values[3] } };
+  const double directed = std::min(e, Length(f));
+  const double isotropic = (e - directed) / (4.0 * kPi);
+  if (!(directed > 0.0))
+  {
+    return isotropic;
+  }
+  return directed * phase(Dot(f, w) / Length(f)) + isotropic;
+}
+
+} // namespace nimbus

@@ -1,0 +1,96 @@
+// The first scattering of point sources inside a medium, on the medium's own grid: for a
+// lightning channel's sources (003 §3's point sources) the light that the cloud scatters
+// once, computed where the density is sampled rather than on the multiple-scattering
+// solver's coarse grid. A source inside a cloud lights a few mean free paths around it
+// (50 m in a cumulus), which a solver grid of 60-90 m cells holds at half a cell and
+// spreads; here every grid point gets its own transmittance and 1/r^2, and the points
+// next to a source the cell average of 1/r^2. Plain C++, no VTK.
+//
+// What is computed. At grid point x, the unscattered irradiance from all sources and its
+// direction-weighted sum (the net flux of the sources' light):
+//     E(x) = sum_k I_k T(x, s_k) / r_k^2                          [intensity units / m^2]
+//     F(x) = sum_k I_k T(x, s_k) / r_k^2 w_k,  w_k = (x - s_k) / r_k (direction of travel)
+// so that the in-scattered radiance per unit scattering coefficient of the first order is
+//     J1(x, w) = sum_k E_k p(w . w_k)                               (003 Eq. 1's first term)
+// which a renderer rebuilds as a lobe: J1(w) ~ |F| p(w . F/|F|) + (E - |F|) / (4 pi), exact
+// for one source and for sources seen in one direction, isotropic where their light
+// arrives from all around (a point on the channel). The cloud's scattering coefficient
+// sigma_s multiplies it where it is drawn.
+//
+// Transmittance T(x, s) = exp(-tau): tau is carried outward from the source shell by
+// shell (Chebyshev distance in grid steps from the grid point nearest the source): a
+// point's tau is its predecessor's, one grid step toward the source along the dominant
+// axis, plus the trapezoid of the extinction between them. The predecessor's tau is its
+// mean extinction tau / r bilinearly interpolated in its layer, times its distance (the
+// mean, unlike tau, is constant in a homogeneous medium, so there the result is exact).
+// The predecessor always lies in an earlier shell, so one pass per source costs
+// O(points), with the smoothing of one bilinear interpolation per step. A predecessor
+// outside the grid's box adds nothing: the box is convex, so the rest of the way
+// to the source is outside the medium. Sources in the same grid cell share the pass
+// (merged by grid point, their intensities summed): the source's own cell is the grid's
+// resolution. The points whose cell touches a source take the cell average of 1/r^2 (4^3
+// sub-points) so that the scattered power near the source is kept.
+//
+// Cost: sources (merged per grid point) x grid points, each a few loads and an exp;
+// memory: 4 floats per grid point plus one float per point per thread.
+#ifndef nimbus_FirstScattering_h
+#define nimbus_FirstScattering_h
+
+#include "NimbusPhysicsExport.h" // for export macro
+
+#include "MultipleScattering.h" // ExtinctionGrid
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace nimbus
+{
+
+/// A point source of one colour: world position [m] and radiant intensity (any units; the
+/// field is in the same units per m^2).
+struct NIMBUSPHYSICS_EXPORT ScalarPointSource
+{
+  Vector3 Position{ { 0, 0, 0 } };
+  double Intensity = 0.0;
+};
+
+/// The sources' unscattered irradiance on the grid (see the file comment).
+struct NIMBUSPHYSICS_EXPORT FirstScatteringField
+{
+  std::array<int, 3> Dimensions{ { 0, 0, 0 } };
+  /// 4 floats per grid point (x fastest): E, then F's world x, y, z.
+  std::vector<float> Values;
+  /// Distinct grid points the sources were merged to (one propagation pass each).
+  int MergedSources = 0;
+  double Seconds = 0.0;
+};
+
+/// "" or what is wrong: a bad grid (the solver's checks), sources with non-finite
+/// positions or negative or non-finite intensity.
+NIMBUSPHYSICS_EXPORT std::string CheckFirstScatteringInput(
+  const ExtinctionGrid& grid, const std::vector<ScalarPointSource>& sources);
+
+/// Computes the field. Throws std::invalid_argument with CheckFirstScatteringInput's
+/// message. `progress(fraction)` is called on the calling thread; it may throw to stop.
+/// Threads: 0 for the hardware's; the result does not depend on it (each thread sums
+/// its sources in its own buffer, then the buffers are added in a fixed order: results
+/// agree to float rounding across thread counts).
+NIMBUSPHYSICS_EXPORT FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
+  const std::vector<ScalarPointSource>& sources, int threads = 0,
+  const std::function<void(double)>& progress = nullptr);
+
+/// Sum of the fields' values weighted per field (same dimensions; an empty list gives an
+/// empty field). Throws std::invalid_argument when the sizes differ.
+NIMBUSPHYSICS_EXPORT FirstScatteringField CombineFirstScattering(
+  const std::vector<const FirstScatteringField*>& fields, const std::vector<double>& weights);
+
+/// J1(w) for one point's 4 values (the lobe of the file comment) with a normalised phase
+/// function p(mu) of the cosine between the direction of travel of the sources' light and
+/// w (a direction of propagation).
+NIMBUSPHYSICS_EXPORT double EvaluateFirstScattering(
+  const float* values, const Vector3& w, const std::function<double(double)>& phase);
+
+} // namespace nimbus
+
+#endif
