@@ -361,6 +361,7 @@ struct PathState
   std::vector<double> SavedWeight;        // the path's throughput during a sun-peak flight
   std::vector<double> LightTransmittance; // air transmittance toward a light
   std::vector<double> ViewTransmittance;  // air transmittance along a segment (equi-angular)
+  std::vector<double> LineWeights;        // cumulative line-light weights at a vertex
   // The segment being flown, for the equi-angular strategy's balance heuristic at its
   // collisions (Integrator::EquiAngularWeight): origin, direction, end, the proxy's
   // extinction at the origin, and the collision's distance along it.
@@ -523,6 +524,43 @@ public:
       this->LightTotal += light.Intensity;
       this->LightCdf.push_back(this->LightTotal);
     }
+    // The polyline segments, for their own choice at a vertex (LineNextEvent): a segment is
+    // drawn there with probability LineTotal / LightTotal (the sum of the segments'
+    // intensities over all the lights', as before), then among the segments by its
+    // estimated contribution at the vertex.
+    if (settings.AngularLineLightSampling)
+    {
+      const std::vector<LightElement>& elements = context.GetLightElements();
+      for (std::size_t k = 0; k < elements.size(); ++k)
+      {
+        const LightElement& light = elements[k];
+        if (!light.IsSegment || !(light.Intensity > 0.0))
+        {
+          continue;
+        }
+        const Vector3 axis{ { light.B[0] - light.A[0], light.B[1] - light.A[1],
+          light.B[2] - light.A[2] } };
+        const double length = std::sqrt(Dot(axis, axis));
+        if (!(length > 0.0) || !std::isfinite(length))
+        {
+          continue;
+        }
+        LineLight line;
+        line.A = light.A;
+        line.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
+        line.Length = length;
+        line.PerMetre = light.Intensity / length;
+        line.Element = k;
+        this->Lines.push_back(line);
+        this->LineTotal += light.Intensity;
+        for (int a = 0; a < 3; ++a)
+        {
+          this->LineA[a].push_back(light.A[a]);
+          this->LineB[a].push_back(light.B[a]);
+        }
+        this->LineWeightScale.push_back(std::sqrt(2.0) * light.Intensity);
+      }
+    }
   }
 
   int GetWavelengths() const { return this->Wavelengths; }
@@ -583,9 +621,17 @@ private:
   double CloudTransmittance(const Vector3& p, const Vector3& direction, PathRandom& rng,
     PathState& state, double tMax = kInfinity) const;
   /// Adds one light's contribution at p (next-event estimation to a light element
-  /// chosen in proportion to its intensity; a point along a segment, uniformly).
+  /// chosen in proportion to its intensity; where that is a polyline segment, SampleLine's
+  /// segment and point, or without AngularLineLightSampling a point along it, uniformly).
   void LightNextEvent(const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng,
     PathState& state) const;
+  /// AngularLineLightSampling at vertex p, once a polyline segment is to be sampled (with
+  /// probability LineTotal / LightTotal): one segment by its estimated unoccluded
+  /// contribution at p and a point y on it uniform in the angle it subtends at p. Returns
+  /// the segment's element and sets y and `intensity`, what multiplies f T S(lambda) in the
+  /// estimate (Y/(sr m^2)); null where p lies on the chosen segment's line.
+  const LightElement* SampleLine(
+    const Vector3& p, PathRandom& rng, PathState& state, Vector3& y, double& intensity) const;
   /// Equi-angular strategy (EquiAngularLightSampling): on the segment from ray.Origin to
   /// tEnd, one light element and a point on it as LightNextEvent chooses them, a distance t
   /// with density h / ((theta_b - theta_a)(h^2 + (t - t0)^2)) over the part of the segment
@@ -670,6 +716,22 @@ private:
   double CloudPhasePeak = 1.0;
   std::vector<double> LightCdf; // cumulative intensities of the light elements, Y/sr
   double LightTotal = 0.0;
+  /// A polyline segment for LineNextEvent: first end A (m), unit axis toward B, length (m),
+  /// intensity per metre (Y/(sr m)) and its index in the context's light elements.
+  struct LineLight
+  {
+    Vector3 A;
+    Vector3 Axis;
+    double Length;
+    double PerMetre;
+    std::size_t Element;
+  };
+  std::vector<LineLight> Lines; // empty without AngularLineLightSampling
+  /// The segments' ends by coordinate (structure of arrays for the weights' loop), m, and
+  /// sqrt(2) times each segment's intensity I_k = I_l L, Y/sr.
+  std::array<std::vector<double>, 3> LineA, LineB;
+  std::vector<double> LineWeightScale;
+  double LineTotal = 0.0; // the sum of the segments' intensities, Y/sr
   MajorantGrid Macro;
   std::vector<double> Majorant; // sigma_bar per block of Macro, 1/m
   double MinCellSize = 1.0;
@@ -1415,8 +1477,10 @@ int Integrator::ChooseScatteringMedium(const Vector3& p, PathRandom& rng) const
 void Integrator::LightNextEvent(
   const Vector3& p, const Vector3& d, Scatterer scatterer, PathRandom& rng, PathState& state) const
 {
-  // One light element k with probability P_k = I_k / I_total, and on a segment a point
-  // y uniform in length (pdf 1 / length): for intensity per metre I_l = I_k / length,
+  // One light element k with probability P_k = I_k / I_total. Where k is a polyline
+  // segment, SampleLine draws the segment and its point instead (what follows then holds
+  // with its factor in place of I_total / r^2); without AngularLineLightSampling, a point
+  // y uniform in length on segment k (pdf 1 / length): for intensity per metre I_l = I_k / length,
   // the estimate of sum_k int f T I_l / r^2 dl is f T I_total / r^2 (a point: the
   // same with y its position). Radiance toward -d:
   //   L = f(omega) I_total T_cloud(p, y) T_air(p, y, lambda) S_k(lambda) / r^2,
@@ -1426,21 +1490,37 @@ void Integrator::LightNextEvent(
   const std::size_t k = std::min(this->LightCdf.size() - 1,
     static_cast<std::size_t>(
       std::upper_bound(this->LightCdf.begin(), this->LightCdf.end(), u) - this->LightCdf.begin()));
-  const LightElement& light = this->Context.GetLightElements()[k];
-  Vector3 y = light.A;
-  if (light.IsSegment)
+  const LightElement* chosen = &this->Context.GetLightElements()[k];
+  Vector3 y = chosen->A;
+  // What multiplies f T S(lambda) in the estimate, Y/(sr m^2): I_total / r^2 for a point
+  // or a segment's uniform point (set once r is known), else LineNextEvent's factor.
+  double intensity = -1.0;
+  if (chosen->IsSegment && !this->Lines.empty())
+  {
+    chosen = this->SampleLine(p, rng, state, y, intensity);
+    if (!chosen)
+    {
+      return;
+    }
+  }
+  else if (chosen->IsSegment)
   {
     const double v = rng.Uniform();
     for (int a = 0; a < 3; ++a)
     {
-      y[a] = light.A[a] + v * (light.B[a] - light.A[a]);
+      y[a] = chosen->A[a] + v * (chosen->B[a] - chosen->A[a]);
     }
   }
+  const LightElement& light = *chosen;
   Vector3 omega;
   double r2, r, beam;
   if (!TowardLight(light, p, y, omega, r2, r, beam))
   {
     return;
+  }
+  if (intensity < 0.0)
+  {
+    intensity = this->LightTotal / r2;
   }
   // At a collision of a segment the equi-angular strategy also sampled: the balance
   // heuristic's share of this (collision) strategy, q / (q + p_ea). Not for polyline
@@ -1507,7 +1587,7 @@ void Integrator::LightNextEvent(
   {
     return;
   }
-  const double k0 = f * cloud * this->LightTotal / r2;
+  const double k0 = f * cloud * intensity;
   const std::vector<double>& spectrum = this->Context.GetLightSpectra()[light.Light];
   if (this->Air)
   {
@@ -1524,6 +1604,76 @@ void Integrator::LightNextEvent(
       state.Radiance[i] += state.Weight[i] * k0 * spectrum[i];
     }
   }
+}
+
+const LightElement* Integrator::SampleLine(
+  const Vector3& p, PathRandom& rng, PathState& state, Vector3& y, double& intensity) const
+{
+  // The segments' light at p: sum_j int_0^{L_j} f T S_j I_j' / r^2 ds (I_j' = I_j / L_j,
+  // Y/(sr m); r = |p - y(s)|). On the line of segment j, at distance h from p, with
+  // theta(s) = atan((s - s0) / h) (s0 the foot of p), d theta = h / r^2 ds: a point drawn
+  // uniformly in theta over the angle Delta theta_j that the segment subtends at p has the
+  // density h / (Delta theta_j r^2) in s, and the estimate f T S_j I_j' Delta theta_j / h,
+  // bounded by pi I_j' / h where the uniform point's I_j / r^2 is not (Kulla & Fajardo,
+  // "Importance Sampling Techniques for Path Tracing in Participating Media", EGSR 2012,
+  // their equi-angular sampling with the roles of the line and the point swapped).
+  //
+  // The segment: with probability w_j / W, W = sum_j w_j, where w_j estimates its
+  // unoccluded contribution I_j' Delta theta_j / h by the chord of the angle in place of
+  // the angle, w_j = I_j' 2 sin(Delta theta_j / 2) / h = sqrt(2) I_j / sqrt(q (q + a.b)),
+  // a = A_j - p, b = B_j - p, q = |a| |b| (with h = |a x b| / L_j and the half-angle
+  // formula): no trigonometry, 2 square roots per segment, finite off the segment's own
+  // points, and Delta theta / (2 sin(Delta theta / 2)) in [1, pi / 2], so the ratio of a
+  // segment's estimate to its probability stays within pi / 2 of W. Any positive w_j keeps
+  // the estimate unbiased.
+  const std::size_t n = this->Lines.size();
+  std::vector<double>& cdf = state.LineWeights;
+  cdf.resize(n);
+  const double* ax = this->LineA[0].data();
+  const double* ay = this->LineA[1].data();
+  const double* az = this->LineA[2].data();
+  const double* bx = this->LineB[0].data();
+  const double* by = this->LineB[1].data();
+  const double* bz = this->LineB[2].data();
+  const double* scale = this->LineWeightScale.data();
+  const double px = p[0], py = p[1], pz = p[2];
+  // LineLightWeight on the structure of arrays (the same operations, so the same values).
+  auto weight = [=](std::size_t i)
+  {
+    const double a0 = ax[i] - px, a1 = ay[i] - py, a2 = az[i] - pz;
+    const double b0 = bx[i] - px, b1 = by[i] - py, b2 = bz[i] - pz;
+    const double aa = a0 * a0 + a1 * a1 + a2 * a2, bb = b0 * b0 + b1 * b1 + b2 * b2;
+    const double ab = a0 * b0 + a1 * b1 + a2 * b2;
+    const double q = std::sqrt(aa * bb);
+    // 1e-300 m^4: p on the segment itself (a set of zero measure) still gets a finite weight.
+    return scale[i] / std::sqrt(std::max(q * (q + ab), 1e-300));
+  };
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    total += weight(i);
+    cdf[i] = total;
+  }
+  if (!(total > 0.0) || !std::isfinite(total))
+  {
+    return nullptr;
+  }
+  const std::size_t j = std::min(n - 1,
+    static_cast<std::size_t>(
+      std::upper_bound(cdf.begin(), cdf.end(), rng.Uniform() * total) - cdf.begin()));
+  const double wj = weight(j);
+  const LineLight& line = this->Lines[j];
+  SegmentAngleSample sample;
+  if (!(wj > 0.0) ||
+    !SampleSegmentByAngle(p, line.A, line.Axis, line.Length, rng.Uniform(), sample))
+  {
+    return nullptr; // p on the segment's line: a set of zero measure
+  }
+  y = sample.Point;
+  // I_j' Delta theta / h over the probability (LineTotal / LightTotal) (w_j / W).
+  intensity =
+    line.PerMetre * sample.AngleOverDistance * (total / wj) * (this->LightTotal / this->LineTotal);
+  return &this->Context.GetLightElements()[line.Element];
 }
 
 double Integrator::ExtinctionBound(const Vector3& x) const
@@ -1648,10 +1798,12 @@ void Integrator::EquiAngularLightEstimate(
   const LightElement& light = this->Context.GetLightElements()[k];
   if (light.IsSegment)
   {
-    // A polyline's point y is drawn uniformly along it, so near the channel the distance
-    // between y and the segment's line has no small-value cutoff and 1/h (what remains of
-    // 1/d^2 after the equi-angular sampling) would have infinite variance: lightning
-    // channels are left to the collisions (their weight there is 1).
+    // A polyline's point y is drawn at the collision (LightNextEvent) and so not known
+    // here; drawn uniformly along the channel instead, the distance between y and the
+    // segment's line would have no small-value cutoff and 1/h (what remains of 1/d^2 after
+    // the equi-angular sampling) infinite variance: lightning channels are left to the
+    // collisions (their weight there is 1), whose SampleLine bounds the estimate by
+    // pi I_l / h.
     return;
   }
   const Vector3 y = light.A;
@@ -2649,6 +2801,68 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     progress(1.0);
   }
   return result;
+}
+
+bool SampleSegmentByAngle(const Vector3& p, const Vector3& a, const Vector3& axis, double length,
+  double u, SegmentAngleSample& sample)
+{
+  // The triangle p, A = a, y: the angle phi at p (from A - p toward the segment), alpha at
+  // A (between p - A and the axis), so by the law of sines |y - A| = |A - p| sin(phi) /
+  // sin(alpha + phi), with alpha + Delta theta < pi. Delta theta = atan2(|v x w|, v.w),
+  // v = A - p, w = B - p, |v x w| = L h.
+  const Vector3 v{ { a[0] - p[0], a[1] - p[1], a[2] - p[2] } };
+  const Vector3 cross = Cross(v, axis);
+  const double h = std::sqrt(Dot(cross, cross)); // p's distance to the line, m
+  const double ra = std::sqrt(Dot(v, v));
+  const double along = Dot(v, axis);
+  const double dtheta = std::atan2(length * h, Dot(v, v) + length * along);
+  if (!(h > 0.0) || !(ra > 0.0) || !(length > 0.0) || !(dtheta > 0.0) || !std::isfinite(dtheta))
+  {
+    return false;
+  }
+  const double phi = u * dtheta;
+  const double sinAlpha = h / ra, cosAlpha = -along / ra;
+  const double denominator = sinAlpha * std::cos(phi) + cosAlpha * std::sin(phi);
+  if (!(denominator > 0.0))
+  {
+    return false;
+  }
+  sample.Along = std::clamp(ra * std::sin(phi) / denominator, 0.0, length);
+  sample.Point = Along(a, axis, sample.Along);
+  sample.AngleOverDistance = dtheta / h;
+  return true;
+}
+
+double SegmentAngleDensity(
+  const Vector3& p, const Vector3& a, const Vector3& axis, double length, double s)
+{
+  if (!(s >= 0.0 && s <= length))
+  {
+    return 0.0;
+  }
+  const Vector3 v{ { a[0] - p[0], a[1] - p[1], a[2] - p[2] } };
+  const Vector3 cross = Cross(v, axis);
+  const double h = std::sqrt(Dot(cross, cross));
+  const double dtheta = std::atan2(length * h, Dot(v, v) + length * Dot(v, axis));
+  const Vector3 y = Along(a, axis, s);
+  const Vector3 r{ { y[0] - p[0], y[1] - p[1], y[2] - p[2] } };
+  const double r2 = Dot(r, r);
+  if (!(h > 0.0) || !(dtheta > 0.0) || !(r2 > 0.0))
+  {
+    return 0.0;
+  }
+  return h / (dtheta * r2);
+}
+
+double LineLightWeight(const Vector3& p, const Vector3& a, const Vector3& b, double intensity)
+{
+  const double a0 = a[0] - p[0], a1 = a[1] - p[1], a2 = a[2] - p[2];
+  const double b0 = b[0] - p[0], b1 = b[1] - p[1], b2 = b[2] - p[2];
+  const double aa = a0 * a0 + a1 * a1 + a2 * a2, bb = b0 * b0 + b1 * b1 + b2 * b2;
+  const double ab = a0 * b0 + a1 * b1 + a2 * b2;
+  const double q = std::sqrt(aa * bb);
+  // 1e-300 m^4: p on the segment itself (a set of zero measure) still gets a finite weight.
+  return std::sqrt(2.0) * intensity / std::sqrt(std::max(q * (q + ab), 1e-300));
 }
 
 } // namespace nimbus

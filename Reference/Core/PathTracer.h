@@ -10,13 +10,14 @@
 // estimators:
 //
 //  - Version 3 (docs/ground-truth.md, "Lights, emission and several media"): lights by
-//    next-event estimation at every vertex (one element chosen by intensity, a point
-//    uniform along a segment; ratio tracking to a finite distance, the air's exact
-//    transmittance); emission by the collision estimator w eta / sigma_bar_c at each
-//    tentative collision charged to the cloud (blocks that emit get a majorant of at
-//    least 1 / block edge); several media through the summed extinction grid, the
-//    scattering medium chosen with probability a_i sigma_t,i / sigma_s and its phase used
-//    at that vertex. None of it runs, or draws a random number, in scenes without it.
+//    next-event estimation at every vertex (one element chosen by intensity; a polyline
+//    segment among the segments by its estimated contribution at the vertex and a point
+//    on it uniform in the angle it subtends there, SampleSegmentByAngle; ratio tracking to
+//    a finite distance, the air's exact transmittance); emission by the collision estimator w eta /
+//    sigma_bar_c at each tentative collision charged to the cloud (blocks that emit get a majorant
+//    of at least 1 / block edge); several media through the summed extinction grid, the scattering
+//    medium chosen with probability a_i sigma_t,i / sigma_s and its phase used at that vertex. None
+//    of it runs, or draws a random number, in scenes without it.
 //
 //  - Version 4 (docs/ground-truth.md, "Spot lights and occluders"): a spot is a light
 //    element whose estimate is multiplied by SpotFactor x its light map toward the vertex
@@ -154,6 +155,14 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   /// way; without it a point light's estimate near the light has infinite variance (the
   /// second moment of 1/d^2 over a volume diverges). Runs only in scenes with lights.
   bool EquiAngularLightSampling = true;
+  /// Next-event estimation to polyline segments (lightning channels): true = the segment
+  /// chosen by an estimate of its unoccluded contribution at the vertex and the point on it
+  /// uniform in the angle it subtends there (the estimate is bounded by pi I_l / h, h the
+  /// vertex's distance to the segment's line, I_l the intensity per metre); false = the
+  /// segment chosen in proportion to its intensity and the point uniform in length (the
+  /// estimate ~ 1/|x - y|^2, whose second moment diverges at vertices near a segment).
+  /// Both are unbiased; points and spots are sampled alike either way.
+  bool AngularLineLightSampling = true;
   /// The atmosphere's transmittance toward the sun at air and ground points from a
   /// table checked cell by cell against the exact integral (error in ln T <= 1e-4 where
   /// used, exact elsewhere); false = the exact integral at every point. The table
@@ -261,6 +270,38 @@ NIMBUSREFERENCE_EXPORT PathTracingEstimate EstimatePathTracingTime(const RenderC
 /// and std::range_error when the image has a NaN or infinite pixel component.
 NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
+
+/// Line lights (AngularLineLightSampling). A point y(s) = a + s axis of the segment from a
+/// along the unit axis, s in [0, length] (m), seen from p: drawn uniformly in the angle
+/// theta the segment subtends at p (u in [0, 1)), so with the density in s
+///   pdf(s) = h / (Delta theta r(s)^2),  1/m,
+/// h the distance from p to the segment's line, r(s) = |y(s) - p| (Kulla & Fajardo,
+/// "Importance Sampling Techniques for Path Tracing in Participating Media", EGSR 2012:
+/// their equi-angular density with the light and the path's line swapped). An estimate
+/// I_l f T / r^2 / pdf of the line's light at p is then I_l f T Delta theta / h.
+struct NIMBUSREFERENCE_EXPORT SegmentAngleSample
+{
+  Vector3 Point{ { 0.0, 0.0, 0.0 } }; // y, m
+  double Along = 0.0;                 // s, m
+  /// Delta theta / h = 1 / (r(s)^2 pdf(s)) for every s, 1/m.
+  double AngleOverDistance = 0.0;
+};
+/// False where p lies on the segment's line (a set of zero measure) or the segment is
+/// degenerate. Exact also near the line's extension (Delta theta = atan2(L h, a.b)).
+NIMBUSREFERENCE_EXPORT bool SampleSegmentByAngle(const Vector3& p, const Vector3& a,
+  const Vector3& axis, double length, double u, SegmentAngleSample& sample);
+/// The density pdf(s) of SampleSegmentByAngle, 1/m (0 outside [0, length]).
+NIMBUSREFERENCE_EXPORT double SegmentAngleDensity(
+  const Vector3& p, const Vector3& a, const Vector3& axis, double length, double s);
+/// The weight by which the path tracer chooses among line segments at a vertex p: the
+/// segment [a, b] of total intensity I (Y/sr, I_l = I / L per metre) gets
+///   w = I_l 2 sin(Delta theta / 2) / h = sqrt(2) I / sqrt(q (q + (a - p).(b - p))),
+/// q = |a - p| |b - p|, Y/(sr m^2): the chord of the subtended angle in place of the angle
+/// in the segment's unoccluded I_l Delta theta / h, so that
+/// 1 <= (I_l Delta theta / h) / w <= pi / 2. Two square roots, no trigonometry; finite
+/// off the segment's own points.
+NIMBUSREFERENCE_EXPORT double LineLightWeight(
+  const Vector3& p, const Vector3& a, const Vector3& b, double intensity);
 
 } // namespace nimbus
 
