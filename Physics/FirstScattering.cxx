@@ -82,13 +82,38 @@ std::vector<MergedSource> MergeByGridPoint(
   return out;
 }
 
+// The points whose field can be drawn: those with extinction and their 26 neighbours (a
+// renderer interpolates between them); the others only carry tau.
+std::vector<char> WantedPoints(const ExtinctionGrid& grid)
+{
+  const int nx = grid.Dimensions[0], ny = grid.Dimensions[1], nz = grid.Dimensions[2];
+  std::vector<char> wanted(grid.NumberOfPoints(), 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+      {
+        if (!(grid.Extinction[grid.Index(i, j, k)] > 0.0f))
+        {
+          continue;
+        }
+        for (int c = std::max(0, k - 1); c <= std::min(nz - 1, k + 1); ++c)
+          for (int b = std::max(0, j - 1); b <= std::min(ny - 1, j + 1); ++b)
+            for (int a = std::max(0, i - 1); a <= std::min(nx - 1, i + 1); ++a)
+            {
+              wanted[grid.Index(a, b, c)] = 1;
+            }
+      }
+  return wanted;
+}
+
 // One source's pass: tau carried outward shell by shell, E and F added to `sum`.
 class SourcePass
 {
 public:
-  SourcePass(
-    const ExtinctionGrid& grid, std::vector<float>& meanExtinction, std::vector<double>& sum)
+  SourcePass(const ExtinctionGrid& grid, const std::vector<char>& wanted,
+    std::vector<float>& meanExtinction, std::vector<double>& sum)
     : Grid(grid)
+    , Wanted(wanted)
     , MeanExtinction(meanExtinction)
     , Sum(sum)
   {
@@ -101,151 +126,120 @@ public:
   void Run(const MergedSource& source)
   {
     this->Source = &source;
-    const std::array<int, 3>& s = source.Point;
-    // The shells that meet the grid: Chebyshev distances from s to the grid's box.
-    int nMin = 0, nMax = 0;
-    for (int a = 0; a < 3; ++a)
+    this->CentreIndex = IndexCoordinates(this->Grid, source.Centre);
+    // The eight octants about the source's point, each swept in raster order away from
+    // it (a point's predecessor is at most one step closer on every axis, so it comes
+    // earlier), the points on the source's planes in the octants on their + side, which
+    // come first (every sign + before -).
+    for (int octant = 0; octant < 8; ++octant)
     {
-      const int below = std::max(0, s[a] - (this->Dims[a] - 1));
-      const int above = std::max(0, -s[a]);
-      nMin = std::max(nMin, std::max(below, above));
-      nMax = std::max(nMax, std::max(std::abs(s[a]), std::abs(s[a] - (this->Dims[a] - 1))));
-    }
-    for (int n = nMin; n <= nMax; ++n)
-    {
-      this->Shell(n);
+      int first[3], last[3], step[3];
+      bool empty = false;
+      for (int a = 0; a < 3; ++a)
+      {
+        const bool plus = ((octant >> (2 - a)) & 1) == 0; // z slowest: order (z, y, x)
+        const int n = this->Dims[a];
+        const int s = source.Point[a];
+        first[a] = plus ? std::max(s, 0) : std::min(s - 1, n - 1);
+        last[a] = plus ? n - 1 : 0;
+        step[a] = plus ? 1 : -1;
+        empty = empty || (plus ? first[a] > last[a] : first[a] < last[a]);
+      }
+      if (empty)
+      {
+        continue;
+      }
+      for (int k = first[2]; k != last[2] + step[2]; k += step[2])
+      {
+        for (int j = first[1]; j != last[1] + step[1]; j += step[1])
+        {
+          for (int i = first[0]; i != last[0] + step[0]; i += step[0])
+          {
+            this->Visit(i, j, k);
+          }
+        }
+      }
     }
   }
 
 private:
-  bool Inside(int i, int j, int k) const
-  {
-    return i >= 0 && j >= 0 && k >= 0 && i < this->Dims[0] && j < this->Dims[1] &&
-      k < this->Dims[2];
-  }
-
-  // Every grid point at Chebyshev distance n from the source's point.
-  void Shell(int n)
-  {
-    const std::array<int, 3>& s = this->Source->Point;
-    const int k0 = std::max(0, s[2] - n), k1 = std::min(this->Dims[2] - 1, s[2] + n);
-    const int j0 = std::max(0, s[1] - n), j1 = std::min(this->Dims[1] - 1, s[1] + n);
-    const int i0 = std::max(0, s[0] - n), i1 = std::min(this->Dims[0] - 1, s[0] + n);
-    for (int k = k0; k <= k1; ++k)
-    {
-      if (std::abs(k - s[2]) == n)
-      {
-        for (int j = j0; j <= j1; ++j)
-        {
-          for (int i = i0; i <= i1; ++i)
-          {
-            this->Visit(i, j, k, n);
-          }
-        }
-        continue;
-      }
-      for (int j = j0; j <= j1; ++j)
-      {
-        if (std::abs(j - s[1]) == n)
-        {
-          for (int i = i0; i <= i1; ++i)
-          {
-            this->Visit(i, j, k, n);
-          }
-        }
-        else
-        {
-          if (this->Inside(s[0] - n, j, k))
-          {
-            this->Visit(s[0] - n, j, k, n);
-          }
-          if (n > 0 && this->Inside(s[0] + n, j, k))
-          {
-            this->Visit(s[0] + n, j, k, n);
-          }
-        }
-      }
-    }
-  }
-
   std::size_t Index(int i, int j, int k) const
   {
     return (static_cast<std::size_t>(k) * this->Dims[1] + j) * this->Dims[0] + i;
   }
 
-  // The mean extinction from the source and sigma at the fractional point p of a layer
-  // (one coordinate integer): bilinear in the other two. False when p is outside the
-  // grid's box. (The mean extinction tau / r, not tau, is interpolated: it is constant in
-  // a homogeneous medium, where tau's growth with r would bend between the samples.)
-  bool Layer(const double p[3], double& mean, double& sigma) const
+  // The mean extinction from the source and sigma at the point one step toward the source
+  // from (i, j, k): on the layer `axis` +- 1, bilinear in the other two axes at the
+  // fractional coordinates u, v. False when that point is outside the grid's box. (The mean
+  // extinction tau / r, not tau, is interpolated: it is constant in a homogeneous medium,
+  // where tau's growth with r would bend between the samples.)
+  bool Layer(int axis, int layer, double u, double v, double& mean, double& sigma) const
   {
-    int base[3];
-    double frac[3];
-    for (int a = 0; a < 3; ++a)
+    const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+    if (layer < 0 || layer >= this->Dims[axis] || u < -1e-9 || v < -1e-9 ||
+      u > this->Dims[b] - 1 + 1e-9 || v > this->Dims[c] - 1 + 1e-9)
     {
-      if (p[a] < -1e-9 || p[a] > this->Dims[a] - 1 + 1e-9)
-      {
-        return false;
-      }
-      const double c = std::clamp(p[a], 0.0, static_cast<double>(this->Dims[a] - 1));
-      base[a] = std::min(static_cast<int>(c), std::max(0, this->Dims[a] - 2));
-      frac[a] = this->Dims[a] > 1 ? c - base[a] : 0.0;
+      return false;
     }
-    mean = 0.0;
-    sigma = 0.0;
-    for (int corner = 0; corner < 8; ++corner)
-    {
-      double w = 1.0;
-      int q[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        const int up = (corner >> a) & 1;
-        w *= up ? frac[a] : 1.0 - frac[a];
-        q[a] = base[a] + up;
-      }
-      if (w <= 0.0)
-      {
-        continue; // also keeps q inside the grid on its last layer
-      }
-      const std::size_t index = this->Index(q[0], q[1], q[2]);
-      mean += w * this->MeanExtinction[index];
-      sigma += w * this->Grid.Extinction[index];
-    }
+    u = std::clamp(u, 0.0, static_cast<double>(this->Dims[b] - 1));
+    v = std::clamp(v, 0.0, static_cast<double>(this->Dims[c] - 1));
+    const int u0 = std::min(static_cast<int>(u), std::max(0, this->Dims[b] - 2));
+    const int v0 = std::min(static_cast<int>(v), std::max(0, this->Dims[c] - 2));
+    const double fu = this->Dims[b] > 1 ? u - u0 : 0.0, fv = this->Dims[c] > 1 ? v - v0 : 0.0;
+    std::array<int, 3> q;
+    q[axis] = layer;
+    const std::size_t strides[3] = { 1, static_cast<std::size_t>(this->Dims[0]),
+      static_cast<std::size_t>(this->Dims[0]) * this->Dims[1] };
+    q[b] = u0;
+    q[c] = v0;
+    const std::size_t i00 = q[0] * strides[0] + q[1] * strides[1] + q[2] * strides[2];
+    const std::size_t du = fu > 0.0 ? strides[b] : 0, dv = fv > 0.0 ? strides[c] : 0;
+    const float* m = this->MeanExtinction.data();
+    const float* e = this->Grid.Extinction.data();
+    const double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
+    mean = w00 * m[i00] + w10 * m[i00 + du] + w01 * m[i00 + dv] + w11 * m[i00 + du + dv];
+    sigma = w00 * e[i00] + w10 * e[i00 + du] + w01 * e[i00 + dv] + w11 * e[i00 + du + dv];
     return true;
   }
 
-  void Visit(int i, int j, int k, int n)
+  void Visit(int i, int j, int k)
   {
     const std::size_t index = this->Index(i, j, k);
     const std::array<int, 3>& s = this->Source->Point;
     const int d[3] = { s[0] - i, s[1] - j, s[2] - k };
+    const int n = std::max({ std::abs(d[0]), std::abs(d[1]), std::abs(d[2]) });
     double tau = 0.0;
     if (n > 0)
     {
       // One step toward the source along the dominant axis (|d| = n there): the
       // predecessor lies in shell n - 1.
-      const double p[3] = { i + d[0] / static_cast<double>(n), j + d[1] / static_cast<double>(n),
-        k + d[2] / static_cast<double>(n) };
-      double meanBefore = 0.0, sigmaBefore = 0.0;
-      this->Layer(p, meanBefore, sigmaBefore); // outside the box: 0 and 0
-      double metres2 = 0.0;
-      for (int a = 0; a < 3; ++a)
-      {
-        const double m = d[a] / static_cast<double>(n) * this->Grid.Spacing[a];
-        metres2 += m * m;
-      }
-      const double step = std::sqrt(metres2); // [m]; the predecessor is (n - 1) steps away
+      const int axis = std::abs(d[0]) == n ? 0 : (std::abs(d[1]) == n ? 1 : 2);
+      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      const int here[3] = { i, j, k };
+      const double inverse = 1.0 / n;
+      double meanBefore = 0.0, sigmaBefore = 0.0; // outside the box: 0 and 0
+      this->Layer(axis, here[axis] + (d[axis] > 0 ? 1 : -1), here[b] + d[b] * inverse,
+        here[c] + d[c] * inverse, meanBefore, sigmaBefore);
+      const double step = this->StepLength(d, inverse); // [m]; the predecessor is n - 1 away
       tau = meanBefore * (n - 1) * step + 0.5 * (sigmaBefore + this->Grid.Extinction[index]) * step;
-      this->MeanExtinction[index] = static_cast<float>(tau / (n * step));
+      this->MeanExtinction[index] = static_cast<float>(tau * inverse / step);
     }
     else
     {
       this->MeanExtinction[index] = 0.0f;
     }
-    if (tau < kOpaque)
+    if (tau < kOpaque && this->Wanted[index])
     {
       this->Add(index, i, j, k, n, std::exp(-tau));
     }
+  }
+
+  double StepLength(const int d[3], double inverse) const
+  {
+    const double x = d[0] * inverse * this->Grid.Spacing[0];
+    const double y = d[1] * inverse * this->Grid.Spacing[1];
+    const double z = d[2] * inverse * this->Grid.Spacing[2];
+    return std::sqrt(x * x + y * y + z * z);
   }
 
   // E and F of this source at point (i, j, k) with transmittance t.
@@ -261,7 +255,15 @@ private:
     }
     else
     {
-      this->AccumulateInverseSquare(this->Grid.Position(i, j, k), inverse2, flux);
+      // In the grid's frame (its axes are orthonormal), F turned to world axes at the end.
+      const double x = (i - this->CentreIndex[0]) * this->Grid.Spacing[0];
+      const double y = (j - this->CentreIndex[1]) * this->Grid.Spacing[1];
+      const double z = (k - this->CentreIndex[2]) * this->Grid.Spacing[2];
+      const double r2 = x * x + y * y + z * z;
+      inverse2 = 1.0 / r2;
+      const double r3 = inverse2 / std::sqrt(r2);
+      flux = { { x * r3, y * r3, z * r3 } };
+      flux = this->ToWorld(flux);
     }
     const double e = this->Source->Intensity * t;
     double* out = &this->Sum[4 * index];
@@ -335,24 +337,23 @@ private:
     }
   }
 
-  void AccumulateInverseSquare(const Vector3& x, double& inverse2, Vector3& flux) const
+  Vector3 ToWorld(const Vector3& local) const
   {
-    const Vector3& c = this->Source->Centre;
-    const Vector3 d{ { x[0] - c[0], x[1] - c[1], x[2] - c[2] } };
-    // A sub-point on the source itself: a floor of a hundredth of the smallest spacing.
-    const double floor =
-      1e-4 * std::min({ this->Grid.Spacing[0], this->Grid.Spacing[1], this->Grid.Spacing[2] });
-    const double r2 = std::max(Dot(d, d), floor * floor);
-    const double r = std::sqrt(r2);
-    inverse2 += 1.0 / r2;
+    Vector3 world{ { 0, 0, 0 } };
     for (int a = 0; a < 3; ++a)
     {
-      flux[a] += d[a] / (r * r2);
+      for (int c = 0; c < 3; ++c)
+      {
+        world[c] += local[a] * this->Grid.Axes[a][c];
+      }
     }
+    return world;
   }
 
   const ExtinctionGrid& Grid;
+  const std::vector<char>& Wanted;    // points whose E a renderer can use
   std::vector<float>& MeanExtinction; // tau / r from the source's grid point [1/m]
+  Vector3 CentreIndex{ { 0, 0, 0 } }; // the source's centre in grid coordinates
   std::vector<double>& Sum;
   int Dims[3] = { 0, 0, 0 };
   const MergedSource* Source = nullptr;
@@ -402,6 +403,7 @@ FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
 
   // Each worker sums its share of the sources in its own buffer; batches of sources
   // between progress reports (on this thread, where the caller may stop the work).
+  const std::vector<char> wanted = WantedPoints(grid);
   const std::size_t workers =
     std::max<std::size_t>(1, std::min<std::size_t>(ResolveThreadCount(threads), merged.size()));
   std::vector<std::vector<double>> sums(workers, std::vector<double>(4 * n, 0.0));
@@ -415,7 +417,7 @@ FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
       {
         for (std::size_t w = begin; w < end; ++w)
         {
-          SourcePass pass(grid, taus[w], sums[w]);
+          SourcePass pass(grid, wanted, taus[w], sums[w]);
           for (std::size_t s = first + w; s < last; s += workers)
           {
             pass.Run(merged[s]);

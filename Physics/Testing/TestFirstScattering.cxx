@@ -40,7 +40,9 @@ double E(const ExtinctionGrid& g, const FirstScatteringField& f, int i, int j, i
 
 TEST(FirstScattering, InverseSquareInVacuumAndItsDirection)
 {
-  const ExtinctionGrid grid = Cube(21, 10.0, 0.0);
+  // "Vacuum": 1e-12 /m, so that the field is computed everywhere (it is only where the
+  // medium scatters) with a transmittance of 1 - 1e-10.
+  const ExtinctionGrid grid = Cube(21, 10.0, 1e-12);
   const FirstScatteringField f =
     nimbus::ComputeFirstScattering(grid, { { { { 0, 0, 0 } }, 1000.0 } }, 1);
   double worst = 0.0;
@@ -155,7 +157,7 @@ TEST(FirstScattering, OpaqueWallCastsAShadowAndSourcesOutsideTheGrid)
 {
   // A wall at x = 0 (optical depth 50 across one step) between a source at x = -95 m and
   // the half x > 0; vacuum elsewhere.
-  ExtinctionGrid grid = Cube(21, 10.0, 0.0);
+  ExtinctionGrid grid = Cube(21, 10.0, 1e-12);
   for (int k = 0; k < 21; ++k)
     for (int j = 0; j < 21; ++j)
     {
@@ -168,7 +170,7 @@ TEST(FirstScattering, OpaqueWallCastsAShadowAndSourcesOutsideTheGrid)
 
   // A source 1 km below the grid: the bottom face sees 1/r^2 unattenuated, the points above
   // the same through the vacuum of the grid; a lower grid point's light is its own.
-  const ExtinctionGrid empty = Cube(21, 10.0, 0.0);
+  const ExtinctionGrid empty = Cube(21, 10.0, 1e-12);
   const FirstScatteringField below =
     nimbus::ComputeFirstScattering(empty, { { { { 30, -20, -1000 } }, 1e6 } }, 2);
   double worst = 0.0;
@@ -185,7 +187,7 @@ TEST(FirstScattering, OpaqueWallCastsAShadowAndSourcesOutsideTheGrid)
 
 TEST(FirstScattering, MergesSourcesOfOneCellAndThreadsAgree)
 {
-  ExtinctionGrid grid = Cube(24, 10.0, 0.0);
+  ExtinctionGrid grid = Cube(24, 10.0, 1e-12);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (float& s : grid.Extinction)

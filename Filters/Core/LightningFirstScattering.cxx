@@ -1,0 +1,199 @@
+// The first scattering of a flash, grouped by brightness and kept (see the header).
+#include "LightningFirstScattering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+namespace nimbus
+{
+namespace
+{
+constexpr std::uint64_t kFnvOffset = 1469598103934665603ull;
+constexpr std::uint64_t kFnvPrime = 1099511628211ull;
+
+void HashBytes(std::uint64_t& h, const void* data, std::size_t bytes)
+{
+  const unsigned char* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i)
+  {
+    h = (h ^ p[i]) * kFnvPrime;
+  }
+}
+
+// Relative intensities (the largest 1) and that largest as the scale.
+LightningSourceGroup Normalised(std::vector<ScalarPointSource> sources, double scale)
+{
+  double largest = 0.0;
+  for (const ScalarPointSource& s : sources)
+  {
+    largest = std::max(largest, s.Intensity);
+  }
+  LightningSourceGroup group;
+  if (!(largest > 0.0))
+  {
+    return group;
+  }
+  for (ScalarPointSource& s : sources)
+  {
+    s.Intensity /= largest;
+  }
+  group.Sources = std::move(sources);
+  group.Scale = scale * largest;
+  return group;
+}
+
+std::uint64_t GroupKey(std::uint64_t gridHash, const LightningSourceGroup& group)
+{
+  std::uint64_t h = gridHash;
+  for (const ScalarPointSource& s : group.Sources)
+  {
+    HashBytes(h, s.Position.data(), sizeof(double) * 3);
+    HashBytes(h, &s.Intensity, sizeof(double));
+  }
+  return h;
+}
+} // namespace
+
+std::uint64_t HashExtinctionGrid(const ExtinctionGrid& grid)
+{
+  std::uint64_t h = kFnvOffset;
+  HashBytes(h, grid.Dimensions.data(), sizeof(int) * 3);
+  HashBytes(h, grid.Origin.data(), sizeof(double) * 3);
+  HashBytes(h, grid.Spacing.data(), sizeof(double) * 3);
+  for (const Vector3& axis : grid.Axes)
+  {
+    HashBytes(h, axis.data(), sizeof(double) * 3);
+  }
+  HashBytes(h, grid.Extinction.data(), sizeof(float) * grid.Extinction.size());
+  return h;
+}
+
+std::vector<LightningSourceGroup> GroupLightningSegments(
+  const std::vector<LightningSegment>& segments, const std::vector<double>& peaks, double spacing)
+{
+  // Brightness relative to the peak -> the segments at their peak intensity. The
+  // brightness of one class of segments is computed alike for all of them, but the
+  // strokes' float arrays round intensity and peak apart: classes are told apart at 1e-5.
+  struct Class
+  {
+    double BrightnessSum = 0.0;
+    std::vector<LightningSegment> Segments;
+  };
+  std::map<long long, Class> classes;
+  for (std::size_t s = 0; s < segments.size(); ++s)
+  {
+    if (!(segments[s].Intensity > 0.0))
+    {
+      continue;
+    }
+    const bool peaked = s < peaks.size() && peaks[s] > 0.0;
+    const double brightness = peaked ? segments[s].Intensity / peaks[s] : 1.0;
+    LightningSegment atPeak = segments[s];
+    atPeak.Intensity = peaked ? peaks[s] : segments[s].Intensity;
+    Class& c = classes[std::llround(std::log(brightness) * 1e5)];
+    c.BrightnessSum += brightness;
+    c.Segments.push_back(atPeak);
+  }
+  std::vector<LightningSourceGroup> groups;
+  for (const auto& entry : classes)
+  {
+    std::vector<ScalarPointSource> sources;
+    for (const PointLight& light : LightningPointSources(entry.second.Segments, spacing))
+    {
+      sources.push_back({ light.Position, light.Intensity[0] });
+    }
+    LightningSourceGroup group =
+      Normalised(std::move(sources), entry.second.BrightnessSum / entry.second.Segments.size());
+    if (group.Scale > 0.0)
+    {
+      groups.push_back(std::move(group));
+    }
+  }
+  return groups;
+}
+
+std::vector<LightningSourceGroup> GroupPointSources(const std::vector<ScalarPointSource>& sources)
+{
+  LightningSourceGroup group = Normalised(sources, 1.0);
+  if (group.Scale > 0.0)
+  {
+    return { group };
+  }
+  return {};
+}
+
+FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGrid& grid,
+  const std::vector<LightningSourceGroup>& groups, int threads,
+  const std::function<void(double)>& progress)
+{
+  this->LastComputeSeconds = 0.0;
+  const std::uint64_t gridHash = HashExtinctionGrid(grid);
+  std::vector<const FirstScatteringField*> fields;
+  std::vector<double> scales;
+  std::vector<std::uint64_t> keys;
+  for (const LightningSourceGroup& group : groups)
+  {
+    keys.push_back(GroupKey(gridHash, group));
+  }
+  // Keep the fields of this frame's groups at the front, so that computing one does not
+  // push out another.
+  std::size_t done = 0;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    auto found = std::find_if(
+      this->Entries.begin(), this->Entries.end(), [&](const Entry& e) { return e.Key == keys[g]; });
+    if (found != this->Entries.end())
+    {
+      ++this->Hits;
+      Entry entry = std::move(*found);
+      this->Entries.erase(found);
+      this->Entries.push_front(std::move(entry));
+      continue;
+    }
+    ++this->Misses;
+    Entry entry;
+    entry.Key = keys[g];
+    entry.Field = ComputeFirstScattering(grid, groups[g].Sources, threads,
+      [&](double fraction)
+      {
+        if (progress)
+        {
+          progress((done + fraction) / groups.size());
+        }
+      });
+    this->LastComputeSeconds += entry.Field.Seconds;
+    this->Entries.push_front(std::move(entry));
+    ++done;
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    for (const Entry& e : this->Entries)
+    {
+      if (e.Key == keys[g])
+      {
+        fields.push_back(&e.Field);
+        scales.push_back(groups[g].Scale);
+        break;
+      }
+    }
+  }
+  FirstScatteringField sum;
+  if (fields.empty())
+  {
+    sum.Dimensions = grid.Dimensions;
+    sum.Values.assign(4 * grid.NumberOfPoints(), 0.0f);
+  }
+  else
+  {
+    sum = CombineFirstScattering(fields, scales);
+  }
+  while (this->Entries.size() > std::max(Capacity, groups.size()))
+  {
+    this->Entries.pop_back();
+  }
+  return sum;
+}
+
+} // namespace nimbus

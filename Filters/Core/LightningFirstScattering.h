@@ -1,0 +1,83 @@
+// The first scattering of a flash's point sources on the cloud's own grid, frame after
+// frame (nimbus::ComputeFirstScattering, Physics/FirstScattering.h), without redoing it
+// for every time step. Plain C++, no VTK.
+//
+// The first scattering is linear in the sources' intensities. A flash changes its
+// segments' brightness in a few classes (LightningFlashBrightness, Physics/Lightning.h):
+// every segment by the same factor during a stroke's decay, the main channel and the
+// branches by two factors during subsequent strokes, the segments the leader has reached
+// by one. So the sources are grouped by their brightness relative to their peak; a
+// group's field at unit scale is computed once and kept (the last few, keyed by the
+// grid and the group's positions and relative intensities), and a frame is the sum of its
+// groups' fields times their scales: a frame of a decaying stroke costs a weighted sum, a
+// frame of the leader (whose reached set grows) a new computation.
+#ifndef nimbus_LightningFirstScattering_h
+#define nimbus_LightningFirstScattering_h
+
+#include "FirstScattering.h"
+#include "Lightning.h"
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace nimbus
+{
+
+/// Sources whose intensities change together: Sources at relative intensity (the largest
+/// 1), each lit by Scale times that.
+struct LightningSourceGroup
+{
+  std::vector<ScalarPointSource> Sources;
+  double Scale = 0.0;
+};
+
+/// Groups of a flash's segments by brightness: segment s shines at segments[s].Intensity,
+/// its peak is peaks[s] (empty: one group of all). Point sources every `spacing` metres
+/// (LightningPointSources). Segments with zero intensity are left out.
+std::vector<LightningSourceGroup> GroupLightningSegments(
+  const std::vector<LightningSegment>& segments, const std::vector<double>& peaks, double spacing);
+
+/// One group of point sources (its intensities relative to the largest).
+std::vector<LightningSourceGroup> GroupPointSources(const std::vector<ScalarPointSource>& sources);
+
+/// The groups' fields, computed once per grid and group and kept (see the file comment).
+class LightningFirstScatteringCache
+{
+public:
+  /// The sum over the groups of Scale x the group's field on `grid`. `progress` as for
+  /// ComputeFirstScattering (fractions of the groups computed anew).
+  FirstScatteringField Evaluate(const ExtinctionGrid& grid,
+    const std::vector<LightningSourceGroup>& groups, int threads,
+    const std::function<void(double)>& progress = nullptr);
+
+  /// Groups found in the cache and computed, since construction.
+  int GetHits() const { return this->Hits; }
+  int GetMisses() const { return this->Misses; }
+  /// Seconds spent computing in the last Evaluate (0 when every group was kept).
+  double GetLastComputeSeconds() const { return this->LastComputeSeconds; }
+  void Clear() { this->Entries.clear(); }
+
+  /// Fields kept at most.
+  static constexpr std::size_t Capacity = 6;
+
+private:
+  struct Entry
+  {
+    std::uint64_t Key = 0;
+    FirstScatteringField Field;
+  };
+  std::deque<Entry> Entries; // most recently used first
+  int Hits = 0;
+  int Misses = 0;
+  double LastComputeSeconds = 0.0;
+};
+
+/// A 64-bit FNV-1a hash of the grid (dimensions, placement, extinction).
+std::uint64_t HashExtinctionGrid(const ExtinctionGrid& grid);
+
+} // namespace nimbus
+
+#endif
