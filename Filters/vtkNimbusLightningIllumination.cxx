@@ -1,6 +1,7 @@
 #include "vtkNimbusLightningIllumination.h"
 
 #include "LightningBasis.h"
+#include "LightningFirstScattering.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -32,6 +33,8 @@ vtkStandardNewMacro(vtkNimbusLightningIllumination);
 namespace
 {
 constexpr int kAutomaticGridSide = 16; // points along the longest side when automatic
+// The first scattering's grid: the density's, in blocks when it has more samples than this.
+constexpr double kFirstScatteringPoints = 64.0 * 64.0 * 64.0;
 struct Aborted
 {
 };
@@ -47,6 +50,11 @@ struct vtkNimbusLightningIllumination::vtkInternals
   bool FromDisk = false;
   double RelightSeconds = 0.0;
   int SourcesOutside = 0;
+  // The first scattering on the density's grid: the sources grouped by brightness, and
+  // each group's field kept across time steps.
+  std::vector<nimbus::LightningSourceGroup> FirstScatteringGroups;
+  nimbus::LightningFirstScatteringCache FirstScattering;
+  double FirstScatteringSeconds = 0.0;
 };
 
 vtkNimbusLightningIllumination::vtkNimbusLightningIllumination()
@@ -245,7 +253,8 @@ int vtkNimbusLightningIllumination::RequestData(
     fieldData->ShallowCopy(cloud->GetFieldData());
   }
   for (const char* name :
-    { "nimbus_lightning_in_scattering", "nimbus_lightning_grid", "nimbus_lightning_optics" })
+    { "nimbus_lightning_in_scattering", "nimbus_lightning_grid", "nimbus_lightning_optics",
+      "nimbus_lightning_first_scattering", "nimbus_lightning_first_scattering_grid" })
   {
     fieldData->RemoveArray(name);
   }
@@ -288,6 +297,7 @@ int vtkNimbusLightningIllumination::RequestData(
 
   // The point sources at this time.
   std::vector<nimbus::PointLight> sources;
+  this->Internals->FirstScatteringGroups.clear();
   vtkDataArray* pointIntensity = lightning->GetPointData()->GetArray("intensity");
   vtkDataArray* cellIntensity = lightning->GetCellData()->GetArray("intensity");
   if (lightning->GetNumberOfLines() > 0)
@@ -299,6 +309,8 @@ int vtkNimbusLightningIllumination::RequestData(
       return 1;
     }
     std::vector<nimbus::LightningSegment> segments;
+    std::vector<double> peaks; // each segment's peak intensity, when the strokes say
+    vtkDataArray* peakIntensity = lightning->GetCellData()->GetArray("peak_intensity");
     vtkCellArray* lines = lightning->GetLines();
     const vtkIdType offset = lightning->GetNumberOfVerts();
     vtkIdType npts = 0;
@@ -320,6 +332,10 @@ int vtkNimbusLightningIllumination::RequestData(
         }
         s.Intensity = intensity;
         segments.push_back(s);
+        if (peakIntensity)
+        {
+          peaks.push_back(peakIntensity->GetComponent(offset + cell, 0));
+        }
       }
     }
     try
@@ -332,6 +348,15 @@ int vtkNimbusLightningIllumination::RequestData(
         }
       }
       sources = nimbus::LightningPointSources(segments, this->PointSourceSpacing);
+      if (this->FirstScatteringOnDensityGrid)
+      {
+        for (double& peak : peaks)
+        {
+          peak = std::isfinite(peak) ? peak : 0.0; // a bad peak: its segment alone
+        }
+        this->Internals->FirstScatteringGroups =
+          nimbus::GroupLightningSegments(segments, peaks, this->PointSourceSpacing);
+      }
     }
     catch (const std::exception& problem)
     {
@@ -359,6 +384,18 @@ int vtkNimbusLightningIllumination::RequestData(
         sources[i].Position[k] = x[k] * this->MetresPerUnit;
         sources[i].Intensity[k] = intensity;
       }
+    }
+    if (this->FirstScatteringOnDensityGrid)
+    {
+      std::vector<nimbus::ScalarPointSource> scalar;
+      for (const nimbus::PointLight& s : sources)
+      {
+        if (nimbus::IsFinite(s.Position) && std::isfinite(s.Intensity[0]) && s.Intensity[0] >= 0)
+        {
+          scalar.push_back({ s.Position, s.Intensity[0] });
+        }
+      }
+      this->Internals->FirstScatteringGroups = nimbus::GroupPointSources(scalar);
     }
   }
   for (nimbus::PointLight& s : sources)
@@ -449,6 +486,8 @@ int vtkNimbusLightningIllumination::RequestData(
   options.Threshold = this->Threshold;
   options.Threads = this->NumberOfThreads;
   options.MemoryBudgetBytes = this->MemoryBudgetMiB * 1048576.0;
+  // The first scattering on the density's grid replaces the basis's own (003's b_il).
+  options.IncludeFirstScattering = !this->FirstScatteringOnDensityGrid;
   const std::string fingerprint = nimbus::LightningBasisFingerprint(grid, optics, lights, options);
 
   vtkInternals& in = *this->Internals;
@@ -466,7 +505,7 @@ int vtkNimbusLightningIllumination::RequestData(
       solver.NumberOfDirections = this->NumberOfDirections;
       solver.Orders = this->Orders;
       solver.SkyLight = false;
-      solver.PointLightFirstScattering = true;
+      solver.PointLightFirstScattering = !this->FirstScatteringOnDensityGrid;
       solver.Threads = this->NumberOfThreads;
       if (sources.empty())
       {
@@ -500,6 +539,7 @@ int vtkNimbusLightningIllumination::RequestData(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     in.Factors = factors;
     this->AddLightningArrays(fieldData, field, cellData);
+    this->AddFirstScattering(fieldData, cloud, scalars, cellData);
     this->UpdateProgress(1.0);
     return 1;
   }
@@ -622,10 +662,85 @@ int vtkNimbusLightningIllumination::RequestData(
   }
   in.RelightSeconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  this->UpdateProgress(1.0);
-
   this->AddLightningArrays(fieldData, field, cellData);
+  this->AddFirstScattering(fieldData, cloud, scalars, cellData);
+  this->UpdateProgress(1.0);
   return 1;
+}
+
+void vtkNimbusLightningIllumination::AddFirstScattering(
+  vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars, bool cellData)
+{
+  vtkInternals& in = *this->Internals;
+  in.FirstScatteringSeconds = 0.0;
+  if (!this->FirstScatteringOnDensityGrid)
+  {
+    return;
+  }
+  // The density's grid, in blocks when it has more than kFirstScatteringPoints samples.
+  int dims[3];
+  cloud->GetDimensions(dims);
+  double samples = 1.0;
+  for (int k = 0; k < 3; ++k)
+  {
+    samples *= cellData ? std::max(dims[k] - 1, 1) : dims[k];
+  }
+  int blocks = this->FirstScatteringDownsampling;
+  if (blocks <= 0)
+  {
+    blocks = 1;
+    while (samples / (blocks * blocks * blocks) > kFirstScatteringPoints)
+    {
+      ++blocks;
+    }
+  }
+  nimbus::ExtinctionGrid grid;
+  std::array<int, 3> factors{ { 1, 1, 1 } };
+  const std::string problem = BuildCloudGrid(cloud, scalars, cellData, blocks,
+    this->ExtinctionPerDensity, this->MetresPerUnit, grid, factors);
+  if (!problem.empty())
+  {
+    return; // the same grid refused above already
+  }
+  const auto start = std::chrono::steady_clock::now();
+  nimbus::FirstScatteringField field;
+  try
+  {
+    field = in.FirstScattering.Evaluate(grid, in.FirstScatteringGroups, this->NumberOfThreads,
+      [this](double fraction)
+      {
+        if (this->CheckAbort())
+        {
+          throw Aborted();
+        }
+        this->UpdateProgress(0.95 + 0.05 * fraction);
+      });
+  }
+  catch (const Aborted&)
+  {
+    return;
+  }
+  in.FirstScatteringSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  vtkNew<vtkFloatArray> values;
+  values->SetName("nimbus_lightning_first_scattering");
+  values->SetNumberOfComponents(4);
+  values->SetNumberOfTuples(static_cast<vtkIdType>(field.Values.size() / 4));
+  // E and F carry the lightning's colour: the grey sources' field times it, per channel
+  // in the mapper (the colour is in nimbus_lightning_first_scattering_grid).
+  std::copy(field.Values.begin(), field.Values.end(), values->GetPointer(0));
+  vtkNew<vtkDoubleArray> gridArray;
+  gridArray->SetName("nimbus_lightning_first_scattering_grid");
+  gridArray->SetNumberOfTuples(10);
+  for (int k = 0; k < 3; ++k)
+  {
+    gridArray->SetValue(k, field.Dimensions[k]);
+    gridArray->SetValue(3 + k, factors[k]);
+    gridArray->SetValue(7 + k, this->LightningColor[k]);
+  }
+  gridArray->SetValue(6, cellData ? 1 : 0);
+  fieldData->AddArray(values);
+  fieldData->AddArray(gridArray);
 }
 
 void vtkNimbusLightningIllumination::AddLightningArrays(
@@ -655,6 +770,21 @@ void vtkNimbusLightningIllumination::AddLightningArrays(
   fieldData->AddArray(inScattering);
   fieldData->AddArray(gridArray);
   fieldData->AddArray(opticsArray);
+}
+
+double vtkNimbusLightningIllumination::GetLastFirstScatteringSeconds() const
+{
+  return this->Internals->FirstScatteringSeconds;
+}
+
+int vtkNimbusLightningIllumination::GetFirstScatteringGroupsKept() const
+{
+  return this->Internals->FirstScattering.GetHits();
+}
+
+int vtkNimbusLightningIllumination::GetFirstScatteringGroupsComputed() const
+{
+  return this->Internals->FirstScattering.GetMisses();
 }
 
 double vtkNimbusLightningIllumination::GetLastPrecomputeSeconds() const
@@ -731,6 +861,8 @@ void vtkNimbusLightningIllumination::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LightningColor: " << this->LightningColor[0] << ", " << this->LightningColor[1]
      << ", " << this->LightningColor[2] << "\n";
   os << indent << "PointSourceSpacing: " << this->PointSourceSpacing << " m\n";
+  os << indent << "FirstScatteringOnDensityGrid: " << this->FirstScatteringOnDensityGrid << "\n";
+  os << indent << "FirstScatteringDownsampling: " << this->FirstScatteringDownsampling << "\n";
   os << indent << "Virtual lights: " << this->GetNumberOfVirtualLights() << "\n";
   os << indent << "Last precompute: " << this->GetLastPrecomputeSeconds() << " s"
      << (this->GetLastBasisFromDisk() ? " (read from the disk cache)" : "") << "\n";

@@ -61,7 +61,9 @@
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
 
+class vtkDataArray;
 class vtkFieldData;
+class vtkImageData;
 namespace nimbus
 {
 struct MultipleScatteringField;
@@ -156,6 +158,25 @@ public:
   vtkGetVector3Macro(LightningColor, double);
   vtkSetClampMacro(PointSourceSpacing, double, 1e-3, 1e9);
   vtkGetMacro(PointSourceSpacing, double);
+
+  /// The sources' first scattering computed on the density's own grid (exact
+  /// transmittance and the cell averages next to the channel; Physics/FirstScattering.h)
+  /// and handed to the mapper as "nimbus_lightning_first_scattering"; the basis and the
+  /// direct solve then hold the orders >= 2. Off: the first scattering on the illumination
+  /// grid with the rest, as 003 does (it loses light next to the channel: docs/lightning.md).
+  /// Default on.
+  vtkSetMacro(FirstScatteringOnDensityGrid, bool);
+  vtkGetMacro(FirstScatteringOnDensityGrid, bool);
+  vtkBooleanMacro(FirstScatteringOnDensityGrid, bool);
+  /// Blocks of density samples per first-scattering point (0, the default: 1, or the
+  /// fewest that keep the grid under 64^3 points).
+  vtkSetClampMacro(FirstScatteringDownsampling, int, 0, 4096);
+  vtkGetMacro(FirstScatteringDownsampling, int);
+  /// Seconds the last update spent on the first scattering (about 0 when its groups of
+  /// sources were kept from an earlier time step), and the groups kept and computed.
+  double GetLastFirstScatteringSeconds() const;
+  int GetFirstScatteringGroupsKept() const;
+  int GetFirstScatteringGroupsComputed() const;
   ///@}
 
   ///@{
@@ -206,6 +227,8 @@ protected:
   std::string CacheDirectory;
   double LightningColor[3] = { 0.85, 0.9, 1.0 };
   double PointSourceSpacing = 10.0;
+  bool FirstScatteringOnDensityGrid = true;
+  int FirstScatteringDownsampling = 0;
 
 private:
   vtkNimbusLightningIllumination(const vtkNimbusLightningIllumination&) = delete;
@@ -213,6 +236,8 @@ private:
 
   void AddLightningArrays(
     vtkFieldData* fieldData, const nimbus::MultipleScatteringField& field, bool cellData);
+  void AddFirstScattering(
+    vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars, bool cellData);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

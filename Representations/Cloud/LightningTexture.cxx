@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 namespace nimbus
 {
@@ -29,6 +30,11 @@ bool LightningTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image
   const std::array<int, 3>& textureDimensions, const std::array<int, 3>& textureFactors,
   std::string& error)
 {
+  if (!this->UpdateFirstScattering(
+        window, image, cellData, textureDimensions, textureFactors, error))
+  {
+    return false;
+  }
   vtkFieldData* fields = image->GetFieldData();
   vtkFloatArray* values = fields
     ? vtkFloatArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_in_scattering"))
@@ -123,13 +129,106 @@ bool LightningTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image
   return true;
 }
 
+bool LightningTexture::UpdateFirstScattering(vtkOpenGLRenderWindow* window, vtkImageData* image,
+  bool cellData, const std::array<int, 3>& textureDimensions,
+  const std::array<int, 3>& textureFactors, std::string& error)
+{
+  vtkFieldData* fields = image->GetFieldData();
+  vtkFloatArray* values = fields
+    ? vtkFloatArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_first_scattering"))
+    : nullptr;
+  vtkDoubleArray* layout = fields ? vtkDoubleArray::SafeDownCast(fields->GetAbstractArray(
+                                      "nimbus_lightning_first_scattering_grid"))
+                                  : nullptr;
+  if (!values || !layout || layout->GetNumberOfValues() != 10)
+  {
+    this->FirstScatteringTextured = false;
+    this->FirstScatteringArray = nullptr;
+    return true;
+  }
+  if (values == this->FirstScatteringArray && values->GetMTime() == this->FirstScatteringTime)
+  {
+    return true;
+  }
+  this->FirstScatteringTextured = false;
+  this->FirstScatteringArray = values;
+  this->FirstScatteringTime = values->GetMTime();
+  int pointDims[3];
+  image->GetDimensions(pointDims);
+  std::array<int, 3> grid{}, blocks{};
+  bool fits = values->GetNumberOfComponents() == 4 && (layout->GetValue(6) != 0) == cellData;
+  std::size_t points = 1;
+  for (int k = 0; fits && k < 3; ++k)
+  {
+    grid[k] = static_cast<int>(layout->GetValue(k));
+    blocks[k] = static_cast<int>(layout->GetValue(3 + k));
+    this->FirstScatteringColour[k] = layout->GetValue(7 + k);
+    const int samples = cellData ? std::max(pointDims[k] - 1, 1) : pointDims[k];
+    fits = grid[k] >= 1 && blocks[k] >= 1 && (samples + blocks[k] - 1) / blocks[k] == grid[k] &&
+      std::isfinite(this->FirstScatteringColour[k]) && this->FirstScatteringColour[k] >= 0.0;
+    points *= static_cast<std::size_t>(std::max(grid[k], 0));
+  }
+  if (!fits || static_cast<std::size_t>(values->GetNumberOfTuples()) != points)
+  {
+    error = "The lightning's first-scattering arrays do not fit this image; the cloud is drawn "
+            "without lightning. Re-run the Lightning Illumination filter on this cloud.";
+    return false;
+  }
+  // E in alpha, F in RGB: one texture fetch gives the lobe.
+  const float* data = values->GetPointer(0);
+  std::vector<float> texels(4 * points);
+  for (std::size_t i = 0; i < points; ++i)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      if (!std::isfinite(data[4 * i + c]))
+      {
+        error = "The lightning's first scattering holds NaN or infinite values; the cloud is "
+                "drawn without lightning.";
+        return false;
+      }
+    }
+    texels[4 * i] = data[4 * i + 1];
+    texels[4 * i + 1] = data[4 * i + 2];
+    texels[4 * i + 2] = data[4 * i + 3];
+    texels[4 * i + 3] = data[4 * i];
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    this->FirstScatteringScale[k] = static_cast<double>(textureDimensions[k]) * textureFactors[k] /
+      (static_cast<double>(grid[k]) * blocks[k]);
+  }
+  vtkTextureObject* texture = this->FirstScattering;
+  texture->SetContext(window);
+  texture->ReleaseGraphicsResources(window);
+  texture->SetWrapS(vtkTextureObject::ClampToEdge);
+  texture->SetWrapT(vtkTextureObject::ClampToEdge);
+  texture->SetWrapR(vtkTextureObject::ClampToEdge);
+  texture->SetMinificationFilter(vtkTextureObject::Linear);
+  texture->SetMagnificationFilter(vtkTextureObject::Linear);
+  if (!texture->Create3DFromRaw(grid[0], grid[1], grid[2], 4, VTK_FLOAT, texels.data()))
+  {
+    std::ostringstream message;
+    message << "Could not upload the lightning's first scattering (" << 16.0 * points / 1048576.0
+            << " MiB; GL out of memory?); the cloud is drawn without lightning.";
+    error = message.str();
+    return false;
+  }
+  this->FirstScatteringTextured = true;
+  ++this->Uploads;
+  return true;
+}
+
 void LightningTexture::Release(vtkWindow* window)
 {
   for (auto& t : this->Textures)
   {
     t->ReleaseGraphicsResources(window);
   }
+  this->FirstScattering->ReleaseGraphicsResources(window);
   this->Textured = false;
   this->UploadedArray = nullptr;
+  this->FirstScatteringTextured = false;
+  this->FirstScatteringArray = nullptr;
 }
 } // namespace nimbus

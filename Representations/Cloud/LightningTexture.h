@@ -1,10 +1,13 @@
 // nimbus::LightningTexture — the lightning's in-scattered radiance for
-// vtkNimbusCloudVolumeMapper (issue 16): vtkNimbusLightningIllumination leaves J(x, w) of
-// the cloud lit by the strokes in the image's field data ("nimbus_lightning_in_scattering",
-// 12 floats per point of a grid of blocks of input samples, "nimbus_lightning_grid");
-// this uploads it as three RGBA float 3-D textures (the layout of the multiple-scattering
-// texture, UploadShCoefficients) when the array changes, and says how to read them with
-// the density texture's coordinates.
+// vtkNimbusCloudVolumeMapper: vtkNimbusLightningIllumination leaves J(x, w) of the cloud lit
+// by the strokes in the image's field data ("nimbus_lightning_in_scattering", 12 floats
+// per point of a grid of blocks of input samples, "nimbus_lightning_grid"); this uploads it
+// as three RGBA float 3-D textures (the layout of the multiple-scattering texture,
+// UploadShCoefficients) when the array changes, and says how to read them with the
+// density texture's coordinates. When the filter computed the first scattering on the
+// density's grid ("nimbus_lightning_first_scattering": E and the flux F per point,
+// Physics/FirstScattering.h; "nimbus_lightning_first_scattering_grid": its blocks and the
+// lightning's colour) that is a fourth, RGBA float texture (E in alpha, F in RGB).
 #ifndef nimbus_LightningTexture_h
 #define nimbus_LightningTexture_h
 
@@ -50,10 +53,33 @@ public:
   /// Uploads so far (a new lightning field each).
   int GetNumberOfUploads() const { return this->Uploads; }
 
+  /// The first scattering on the density's grid (F in RGB, E in alpha), its coordinates
+  /// from the density texture's and the lightning's colour.
+  bool HasFirstScattering() const { return this->FirstScatteringTextured; }
+  vtkTextureObject* GetFirstScatteringTexture() const { return this->FirstScattering; }
+  const std::array<double, 3>& GetFirstScatteringScale() const
+  {
+    return this->FirstScatteringScale;
+  }
+  const std::array<double, 3>& GetFirstScatteringColour() const
+  {
+    return this->FirstScatteringColour;
+  }
+
   void Release(vtkWindow* window);
 
 private:
+  bool UpdateFirstScattering(vtkOpenGLRenderWindow* window, vtkImageData* image, bool cellData,
+    const std::array<int, 3>& textureDimensions, const std::array<int, 3>& textureFactors,
+    std::string& error);
+
   vtkNew<vtkTextureObject> Textures[3];
+  vtkNew<vtkTextureObject> FirstScattering;
+  vtkDataArray* FirstScatteringArray = nullptr; // identity only, never dereferenced
+  unsigned long FirstScatteringTime = 0;
+  std::array<double, 3> FirstScatteringScale{ { 1, 1, 1 } };
+  std::array<double, 3> FirstScatteringColour{ { 1, 1, 1 } };
+  bool FirstScatteringTextured = false;
   vtkDataArray* UploadedArray = nullptr; // identity only, never dereferenced
   unsigned long UploadedTime = 0;
   std::array<int, 6> UploadedLayout{};

@@ -340,9 +340,10 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   double ScatteringScale = 1.0; // this frame's illuminance / the solve's
   int Octaves = 1;
 
-  // Lightning (issue 16): the in-scattered radiance vtkNimbusLightningIllumination left
-  // in the image's field data, uploaded.
+  // Lightning: the in-scattered radiance vtkNimbusLightningIllumination left in the
+  // image's field data, uploaded; its first scattering on the density's grid, when there.
   bool LightningTexture = false;
+  bool LightningFirstScattering = false;
 
   // Temperature emission (issue 17; EmissionTexture.h): uploaded and glowing.
   bool EmissionTexture = false;
@@ -1569,6 +1570,10 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
       in.Lightning.GetTexture(c)->Activate();
     }
   }
+  if (frame.LightningFirstScattering)
+  {
+    in.Lightning.GetFirstScatteringTexture()->Activate();
+  }
   if (frame.EmissionTexture)
   {
     in.Emission.GetTexture()->Activate();
@@ -1624,6 +1629,10 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
     {
       in.Lightning.GetTexture(c)->Deactivate();
     }
+  }
+  if (frame.LightningFirstScattering)
+  {
+    in.Lightning.GetFirstScatteringTexture()->Deactivate();
   }
   if (frame.EmissionTexture)
   {
@@ -1870,6 +1879,7 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
 {
   Internals& in = *this->Internal;
   frame.LightningTexture = false;
+  frame.LightningFirstScattering = false;
   if (this->Unlit)
   {
     return;
@@ -1891,7 +1901,8 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
     return;
   }
   frame.LightningTexture = in.Lightning.HasTexture();
-  if (!frame.LightningTexture)
+  frame.LightningFirstScattering = in.Lightning.HasFirstScattering();
+  if (!frame.LightningTexture && !frame.LightningFirstScattering)
   {
     return;
   }
@@ -2379,6 +2390,19 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
   const float lightningTextureScale[3] = { static_cast<float>(lightningScale[0]),
     static_cast<float>(lightningScale[1]), static_cast<float>(lightningScale[2]) };
   program->SetUniform3f("lightningTextureScale", lightningTextureScale);
+  program->SetUniformi("lightningFirstOn", frame.LightningFirstScattering ? 1 : 0);
+  program->SetUniformi("lightningFirst",
+    (frame.LightningFirstScattering ? in.Lightning.GetFirstScatteringTexture()
+                                    : in.Density.GetTexture())
+      ->GetTextureUnit());
+  const auto& firstScale = in.Lightning.GetFirstScatteringScale();
+  const auto& colour = in.Lightning.GetFirstScatteringColour();
+  const float lightningFirstScale[3] = { static_cast<float>(firstScale[0]),
+    static_cast<float>(firstScale[1]), static_cast<float>(firstScale[2]) };
+  const float lightningColour[3] = { static_cast<float>(colour[0]), static_cast<float>(colour[1]),
+    static_cast<float>(colour[2]) };
+  program->SetUniform3f("lightningFirstScale", lightningFirstScale);
+  program->SetUniform3f("lightningColour", lightningColour);
   // Temperature emission: the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
   // E [Y/(sr m)] scales them.
   program->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);

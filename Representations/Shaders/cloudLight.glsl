@@ -21,6 +21,13 @@ uniform sampler3D lightningRed;
 uniform sampler3D lightningGreen;
 uniform sampler3D lightningBlue;
 uniform vec3 lightningTextureScale;   // density texture coordinates -> these textures'
+// Its first scattering on the density's grid (Physics/FirstScattering.h), when the filter
+// computed it there (then the textures above hold the orders >= 2): the sources'
+// unscattered irradiance E (alpha) and its net flux F (rgb), grey, times the colour.
+uniform int lightningFirstOn;
+uniform sampler3D lightningFirst;
+uniform vec3 lightningFirstScale;     // density texture coordinates -> this texture's
+uniform vec3 lightningColour;
 // Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
 // [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
 uniform int emissionOn;
@@ -46,6 +53,22 @@ vec3 LightningInScattering(vec3 p, vec3 w)
   vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
   return max(vec3(dot(texture(lightningRed, tc), y), dot(texture(lightningGreen, tc), y),
                dot(texture(lightningBlue, tc), y)), vec3(0.0));
+}
+
+// J1(p, w) of the lightning's first scattering: the lobe |F| p(w . F/|F|) for the light
+// that arrives from one side and (E - |F|) / (4 pi) for the rest (exact for one source).
+vec3 LightningFirstScattering(vec3 p, vec3 w)
+{
+  vec4 v = texture(lightningFirst, (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale);
+  float e = max(v.a, 0.0);
+  float f = length(v.rgb);
+  float directed = min(e, f);
+  float j = (e - directed) / (4.0 * kPi);
+  if (directed > 0.0)
+  {
+    j += directed * CornetteShanks(dot(v.rgb, w) / f, cloudG);
+  }
+  return lightningColour * j;
 }
 
 // The sun's light scattered more than once that the mapper evaluates per sample,
@@ -89,6 +112,10 @@ vec3 CloudOtherSources(vec3 p, vec3 direction, float sigma)
   if (lightningTextureOn != 0)
   {
     source += cloudAlbedo * sigma * LightningInScattering(p, -direction);
+  }
+  if (lightningFirstOn != 0)
+  {
+    source += cloudAlbedo * sigma * LightningFirstScattering(p, -direction);
   }
   if (emissionOn != 0)
   {
