@@ -11,6 +11,7 @@
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
+#include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -184,6 +185,68 @@ TEST(LightningIllumination, LinearAndStrokesAsSources)
   const std::vector<float> fromStrokes = Values(Field(f));
   ASSERT_EQ(fromStrokes.size(), twice.size());
   EXPECT_NEAR(SumOfC00(fromStrokes), SumOfC00(twice), 1e-4 * SumOfC00(twice));
+}
+
+// The first scattering on the density's grid: its arrays (E and F per point of the
+// density's grid, the layout and the colour), zero before the flash; from the strokes it is
+// computed once per class of brightness and kept across the time steps that only scale
+// it (a stroke's decay), and it follows their scale; off, the arrays are gone and the
+// basis's field gains the first scattering back.
+TEST(LightningIllumination, FirstScatteringOnTheDensityGrid)
+{
+  auto cloud = SmallCloud();
+  vtkNew<vtkNimbusLightningSource> lightning;
+  auto f = Filter(cloud, lightning, "");
+  f->SetInputConnection(1, lightning->GetOutputPort(0)); // the strokes: grouped by brightness
+  MessageCatcher messages(f);
+  const double peak = lightning->GetFlashStartTime() + lightning->GetLeaderDuration();
+  f->UpdateTimeStep(peak);
+  const auto first = [&f]()
+  {
+    return vtkFloatArray::SafeDownCast(
+      f->GetOutput()->GetFieldData()->GetAbstractArray("nimbus_lightning_first_scattering"));
+  };
+  ASSERT_NE(first(), nullptr) << messages.AllErrors();
+  EXPECT_EQ(first()->GetNumberOfComponents(), 4);
+  EXPECT_EQ(first()->GetNumberOfTuples(), 24 * 24 * 16); // the density's own grid
+  auto* layout = vtkDoubleArray::SafeDownCast(
+    f->GetOutput()->GetFieldData()->GetAbstractArray("nimbus_lightning_first_scattering_grid"));
+  ASSERT_NE(layout, nullptr);
+  ASSERT_EQ(layout->GetNumberOfValues(), 10);
+  EXPECT_EQ(layout->GetValue(0), 24);
+  EXPECT_EQ(layout->GetValue(3), 1);
+  EXPECT_EQ(layout->GetValue(7), 0.85); // the default colour
+  const std::vector<float> atPeak = Values(first());
+  EXPECT_TRUE(AllFinite(atPeak));
+  double e = 0.0;
+  for (std::size_t i = 0; i < atPeak.size(); i += 4)
+  {
+    EXPECT_GE(atPeak[i], 0.0f);
+    // |F| <= E: a net flux cannot exceed the light arriving.
+    EXPECT_LE(
+      std::hypot(atPeak[i + 1], atPeak[i + 2], atPeak[i + 3]), atPeak[i] * 1.0001f + 1e-30f);
+    e += atPeak[i];
+  }
+  EXPECT_GT(e, 0.0);
+  const int computed = f->GetFirstScatteringGroupsComputed();
+  EXPECT_GE(computed, 1);
+  // 4 ms later the return stroke has decayed by exp(-4/15): the same field, scaled.
+  f->UpdateTimeStep(peak + 0.004);
+  EXPECT_EQ(f->GetFirstScatteringGroupsComputed(), computed) << "kept, not computed again";
+  const std::vector<float> later = Values(first());
+  double eLater = 0.0;
+  for (std::size_t i = 0; i < later.size(); i += 4)
+  {
+    eLater += later[i];
+  }
+  EXPECT_NEAR(eLater / e, std::exp(-0.004 / lightning->GetStrokeDecaySeconds()), 1e-4);
+  // Off: no first-scattering arrays; the basis holds the first scattering again.
+  const double withoutFirst = SumOfC00(Values(Field(f)));
+  f->FirstScatteringOnDensityGridOff();
+  f->UpdateTimeStep(peak + 0.004);
+  EXPECT_EQ(first(), nullptr);
+  EXPECT_GT(SumOfC00(Values(Field(f))), withoutFirst);
+  EXPECT_TRUE(messages.Errors.empty()) << messages.AllErrors();
 }
 
 // The disk cache: a second filter reads the first one's basis (same field), other
