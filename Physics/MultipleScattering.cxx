@@ -24,6 +24,37 @@ std::array<double, 4> ShBasis(const Vector3& w)
   return { { kY00, kY1 * w[1], kY1 * w[2], kY1 * w[0] } };
 }
 
+// CheckMultipleScatteringInput's part for CloudLighting::Emission.
+std::string CheckEmission(const ExtinctionGrid& grid, const CloudLighting& lighting,
+  const MultipleScatteringOptions& options)
+{
+  if (lighting.Emission.empty())
+  {
+    return "";
+  }
+  std::ostringstream message;
+  if (lighting.Emission.size() != 3 * grid.NumberOfPoints())
+  {
+    message << "the emission has " << lighting.Emission.size() << " values for "
+            << grid.NumberOfPoints() << " points (3 per point: R, G, B)";
+    return message.str();
+  }
+  for (float e : lighting.Emission)
+  {
+    if (!(e >= 0.0f) || !std::isfinite(e))
+    {
+      message << "emission must be finite and >= 0 radiance per metre (found " << e << ")";
+      return message.str();
+    }
+  }
+  if (options.Method == MultipleScatteringMethod::Octaves ||
+    options.Method == MultipleScatteringMethod::ReferencePatterns)
+  {
+    return "the medium's emission is a source of the discrete-direction method only";
+  }
+  return "";
+}
+
 // World vector -> the grid's frame (components along Axes).
 Vector3 ToGridFrame(const ExtinctionGrid& grid, const Vector3& v)
 {
@@ -360,16 +391,74 @@ public:
     // a' = a (1 - f) / (1 - f a).
     const double scale = 1.0 - phase.F * albedo;
     const double albedoScaled = scale > 0.0 ? albedo * (1.0 - phase.F) / scale : 0.0;
-    std::vector<float> extinction(this->Grid.Extinction);
-    for (float& e : extinction)
+    ExtinctionGrid scaledGrid = this->Grid;
+    for (float& e : scaledGrid.Extinction)
     {
       e = static_cast<float>(e * scale);
     }
-    ExtinctionGrid scaledGrid = this->Grid;
-    scaledGrid.Extinction = extinction;
+    const std::vector<double> matrix = this->PhaseMatrix(phase);
 
-    // The phase matrix between directions, rows normalised to 1 so that a
-    // scattering neither makes nor loses light: P[m][m'] = p'(s_m . s_m') dw / norm.
+    // The first scattering of the sun and the point lights, as a source function
+    // per direction: S1(x, m) = a' J'(x, s_m) (per unit sigma_t'); a spotlight's
+    // irradiance carries its factor SpotFactor(Spot, d) (SpotLight.h).
+    std::vector<float> firstSource(nd * 3 * n, 0.0f);
+    if (this->Lighting.HasSun)
+    {
+      this->AddSunFirstSource(scaledGrid, phase, albedoScaled, firstSource);
+    }
+    this->AddPointLightFirstSource(scaledGrid, phase, albedoScaled, firstSource);
+    Report(this->Progress, 0.05);
+
+    std::vector<float> order(nd * 3 * n, 0.0f);  // L_k(x, s_m)
+    std::vector<float> total(nd * 3 * n, 0.0f);  // sum of the orders so far
+    std::vector<float> source(nd * 3 * n, 0.0f); // S_k(x, s_m)
+    this->OrderZero(scaledGrid, order, total, source);
+    // Every order sweeps the same segments: their optical depths and the linear-source
+    // weights (Transport) once per direction, not once per order and direction.
+    std::vector<float> factors(nd * 4 * n);
+    ParallelFor(nd, 1, this->Options.Threads,
+      [&](std::size_t begin, std::size_t end)
+      {
+        for (std::size_t m = begin; m < end; ++m)
+        {
+          this->TransportFactors(scaledGrid, m, &factors[m * 4 * n]);
+        }
+      });
+    const OrderEnergies energies = this->ScatterOrders(
+      scaledGrid, matrix, albedoScaled, firstSource, factors, order, total, source);
+    field.OrdersComputed = energies.Computed;
+    this->ExtrapolateTail(energies, order, total, field);
+    // J(x, w) = integral p(w . s) L(x, s) ds with the cloud's own phase function:
+    // in SH, degree l scaled by k_l.
+    const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
+    for (std::size_t m = 0; m < nd; ++m)
+    {
+      this->Project(std::vector<float>(total.begin() + m * 3 * n, total.begin() + (m + 1) * 3 * n),
+        this->Directions[m], 1.0, k1, coefficients);
+    }
+    if (this->Options.PointLightFirstScattering)
+    {
+      this->AddPointLightFirstScattering(k1, coefficients);
+    }
+    return phase.F;
+  }
+
+private:
+  // The energies (sums over the grid and the directions, per channel) of the orders
+  // ScatterOrders computed: the last, the one before and all of them.
+  struct OrderEnergies
+  {
+    Rgb Previous{ { 0, 0, 0 } };
+    Rgb Last{ { 0, 0, 0 } };
+    Rgb Sum{ { 0, 0, 0 } };
+    int Computed = 0;
+  };
+
+  // The phase matrix between directions, rows normalised to 1 so that a
+  // scattering neither makes nor loses light: P[m][m'] = p'(s_m . s_m') dw / norm.
+  std::vector<double> PhaseMatrix(const TruncatedPhase& phase) const
+  {
+    const std::size_t nd = this->Directions.size();
     std::vector<double> matrix(nd * nd);
     for (std::size_t m = 0; m < nd; ++m)
     {
@@ -385,12 +474,16 @@ public:
         matrix[m * nd + q] /= sum;
       }
     }
+    return matrix;
+  }
 
-    // The first scattering of the sun and the point lights, as a source function
-    // per direction: S1(x, m) = a' J'(x, s_m) (per unit sigma_t'); a spotlight's
-    // irradiance carries its factor SpotFactor(Spot, d) (SpotLight.h).
-    std::vector<float> firstSource(nd * 3 * n, 0.0f);
-    if (this->Lighting.HasSun)
+  // The sun's first scattering as a source function per direction (AllOrders).
+  void AddSunFirstSource(const ExtinctionGrid& scaledGrid, const TruncatedPhase& phase,
+    double albedoScaled, std::vector<float>& firstSource) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nd = this->Directions.size();
+    const std::vector<float>& extinction = scaledGrid.Extinction;
     {
       const Vector3& toSun = this->Lighting.Sun.ToLight;
       const Vector3 travel{ { -toSun[0], -toSun[1], -toSun[2] } };
@@ -440,6 +533,15 @@ public:
           }
         });
     }
+  }
+
+  // The point lights' first scattering as a source function per direction (AllOrders).
+  void AddPointLightFirstSource(const ExtinctionGrid& scaledGrid, const TruncatedPhase& phase,
+    double albedoScaled, std::vector<float>& firstSource) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nd = this->Directions.size();
+    const std::vector<float>& extinction = scaledGrid.Extinction;
     for (const PointLight& light : this->Lighting.PointLights)
     {
       const Vector3 lightIndex = GridCoordinates(this->Grid, light.Position);
@@ -490,40 +592,66 @@ public:
           }
         });
     }
-    Report(this->Progress, 0.05);
+  }
 
-    // Order 0 of the sky: its light through the cloud, unscattered.
-    std::vector<float> order(nd * 3 * n, 0.0f);  // L_k(x, s_m)
-    std::vector<float> total(nd * 3 * n, 0.0f);  // sum of the orders so far
-    std::vector<float> source(nd * 3 * n, 0.0f); // S_k(x, s_m)
-    if (this->Options.SkyLight && this->Lighting.Sky)
+  // Order 0, the light no particle has scattered yet: the sky's light through the
+  // cloud and the medium's own emission (CloudLighting::Emission), both attenuated
+  // on their way. Into `order` and `total`; `source` is scratch (its first 3 n floats
+  // hold the emission's source function eta / sigma_t', the same in every direction;
+  // the orders overwrite it).
+  void OrderZero(const ExtinctionGrid& scaledGrid, std::vector<float>& order,
+    std::vector<float>& total, std::vector<float>& source) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nd = this->Directions.size();
+    const bool sky = this->Options.SkyLight && this->Lighting.Sky;
+    const bool emission = !this->Lighting.Emission.empty();
+    if (!sky && !emission)
     {
-      std::vector<Rgb> sky(nd);
-      for (std::size_t m = 0; m < nd; ++m)
-      {
-        sky[m] = this->SkyToward(this->Directions[m]); // on this thread: Sky may not be thread-safe
-      }
-      ParallelFor(nd, 1, this->Options.Threads,
-        [&](std::size_t begin, std::size_t end)
-        {
-          for (std::size_t m = begin; m < end; ++m)
-          {
-            this->Transport(scaledGrid, m, sky[m], nullptr, &order[m * 3 * n], nullptr);
-          }
-        });
-      total = order;
+      return;
     }
-    // Every order sweeps the same segments: their optical depths and the linear-source
-    // weights (Transport) once per direction, not once per order and direction.
-    std::vector<float> factors(nd * 4 * n);
+    std::vector<Rgb> boundary(nd, Rgb{ { 0, 0, 0 } });
+    for (std::size_t m = 0; sky && m < nd; ++m)
+    {
+      boundary[m] =
+        this->SkyToward(this->Directions[m]); // on this thread: Sky may not be thread-safe
+    }
+    if (emission)
+    {
+      // The source function of the emission per unit (scaled) extinction: Transport's
+      // segments add sigma_t' S ds = eta ds. Points without extinction cannot hold it
+      // (their emission is not transported; CloudLighting::Emission).
+      const std::vector<float>& sigma = scaledGrid.Extinction;
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          source[3 * i + c] =
+            sigma[i] > 0.0f ? this->Lighting.Emission[3 * i + c] / sigma[i] : 0.0f;
+        }
+      }
+    }
+    const float* emitted = emission ? source.data() : nullptr;
     ParallelFor(nd, 1, this->Options.Threads,
       [&](std::size_t begin, std::size_t end)
       {
         for (std::size_t m = begin; m < end; ++m)
         {
-          this->TransportFactors(scaledGrid, m, &factors[m * 4 * n]);
+          this->Transport(scaledGrid, m, boundary[m], emitted, &order[m * 3 * n], nullptr);
         }
       });
+    total = order;
+  }
+
+  // Orders 1 .. Options.Orders (or until an order carries < 1e-5 of the total):
+  // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1),
+  // transported; each order added to `total`.
+  OrderEnergies ScatterOrders(const ExtinctionGrid& scaledGrid, const std::vector<double>& matrix,
+    double albedoScaled, const std::vector<float>& firstSource, const std::vector<float>& factors,
+    std::vector<float>& order, std::vector<float>& total, std::vector<float>& source) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const std::size_t nd = this->Directions.size();
     const int maximumOrder = std::max(2, this->Options.Orders);
     Rgb previousEnergy{ { 0, 0, 0 } }, energy{ { 0, 0, 0 } }, sumEnergy{ { 0, 0, 0 } };
     int computed = 0;
@@ -609,13 +737,21 @@ public:
         break;
       }
     }
-    field.OrdersComputed = computed;
-    // The orders beyond the last computed (at Orders, or where the criterion stopped
-    // it: in a thick conservative cloud each order carries almost as much as the one
-    // before, so 1e-5 of the total per order still leaves a remainder of about 2 %):
-    // a geometric series with the ratio of the last two orders' energies, the
-    // spectral radius of the scattering operator once its dominant mode has taken
-    // over (Aitken's extrapolation).
+    return { previousEnergy, energy, sumEnergy, computed };
+  }
+
+  // The orders beyond the last computed (at Orders, or where the criterion stopped
+  // it: in a thick conservative cloud each order carries almost as much as the one
+  // before, so 1e-5 of the total per order still leaves a remainder of about 2 %):
+  // a geometric series with the ratio of the last two orders' energies, the
+  // spectral radius of the scattering operator once its dominant mode has taken
+  // over (Aitken's extrapolation).
+  void ExtrapolateTail(const OrderEnergies& energies, const std::vector<float>& order,
+    std::vector<float>& total, MultipleScatteringField& field) const
+  {
+    const Rgb& previousEnergy = energies.Previous;
+    const Rgb& energy = energies.Last;
+    const Rgb& sumEnergy = energies.Sum;
     for (int c = 0; c < 3; ++c)
     {
       const double ratio = previousEnergy[c] > 0.0 ? energy[c] / previousEnergy[c] : 0.0;
@@ -637,22 +773,7 @@ public:
         total[q] += static_cast<float>(factor[q % 3] * order[q]);
       }
     }
-    // J(x, w) = integral p(w . s) L(x, s) ds with the cloud's own phase function:
-    // in SH, degree l scaled by k_l.
-    const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
-    for (std::size_t m = 0; m < nd; ++m)
-    {
-      this->Project(std::vector<float>(total.begin() + m * 3 * n, total.begin() + (m + 1) * 3 * n),
-        this->Directions[m], 1.0, k1, coefficients);
-    }
-    if (this->Options.PointLightFirstScattering)
-    {
-      this->AddPointLightFirstScattering(k1, coefficients);
-    }
-    return phase.F;
   }
-
-private:
   // The radiance arriving from the sky that travels along s (looking toward -s).
   Rgb SkyToward(const Vector3& s) const
   {
@@ -1113,6 +1234,10 @@ std::string CheckMultipleScatteringInput(const ExtinctionGrid& grid, const Cloud
     {
       return "a spotlight's axis must be a finite unit vector";
     }
+  }
+  if (const std::string emission = CheckEmission(grid, lighting, options); !emission.empty())
+  {
+    return emission;
   }
   if (options.Method == MultipleScatteringMethod::ReferencePatterns &&
     !lighting.PointLights.empty())

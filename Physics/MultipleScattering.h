@@ -1,7 +1,8 @@
 // Multiple scattering in a cloud as a precompute for the GPU mapper: from a grid of
 // extinction, the cloud's optics, the sun (or point lights), the sky and the ground,
 // the radiance that the cloud's particles scatter at every grid point of orders >= 2
-// (and of order 1 for the sky and the ground), as low-order spherical harmonics.
+// (and of order 1 for the sky, the ground and the medium's own emission), as low-order
+// spherical harmonics.
 // The mapper adds it to its exact single scattering of the sun (000 Eq. 8).
 //
 // What is computed. At grid point x, for light leaving in direction w (the direction
@@ -32,6 +33,8 @@
 //    coefficient; g^2 for Henyey-Greenstein) is kept in the direction of travel, which
 //    makes a few dozen directions enough; the light the peak carries along the sun's
 //    direction is returned to the mapper as ForwardPeakFraction (see there).
+//    The medium's own emission (CloudLighting::Emission, hot smoke and fire) is a
+//    source of this method only: its light of every order enters J.
 //
 // Units: lengths in metres, extinction in 1/m, radiance and irradiance in the
 // caller's units (the mapper's: relative to the sun, linear sRGB).
@@ -138,6 +141,22 @@ struct NIMBUSPHYSICS_EXPORT CloudLighting
   DirectionalLight Sun;
   std::vector<PointLight> PointLights;
   std::function<Rgb(const Vector3& lookingToward)> Sky;
+  /// Light the medium itself emits (hot smoke, fire): the emission coefficient eta
+  /// [radiance units per metre] at every grid point, 3 floats (R, G, B) per point in
+  /// the grid's order, the same in every direction; empty: none. It enters the
+  /// radiative transfer equation as the source term:
+  ///     dL/ds = -sigma_t L + sigma_s J + eta,
+  /// so a homogeneous medium glowing everywhere holds L = eta / (sigma_t (1 - albedo))
+  /// deep inside. DiscreteDirections takes it as order 0, like the sky's light: the
+  /// emitted radiance travels (attenuated), is scattered and scattered again, and J
+  /// holds its scattered light of orders >= 1 (J = integral p L over the emitted
+  /// radiance of every order; the unscattered emission itself is the caller's to draw,
+  /// as the mapper does). Where a point has no extinction its emission is not carried
+  /// (the transport holds a source per unit extinction, eta / sigma_t). The delta-M
+  /// forward peak of the emitted light stays in the radiance the solver carries (it is
+  /// not returned apart, as the sun's is). Octaves and ReferencePatterns refuse it;
+  /// None ignores it.
+  std::vector<float> Emission;
 };
 
 struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
@@ -206,7 +225,9 @@ NIMBUSPHYSICS_EXPORT double EstimateMultipleScatteringBytes(
 
 /// The first message describing what is wrong with the input, or "" (dimensions
 /// < 1, sizes that do not match, NaN, infinite or negative extinction or spacing,
-/// axes not orthonormal, albedo outside [0, 1], NaN lighting, options out of range).
+/// axes not orthonormal, albedo outside [0, 1], NaN lighting, emission of the wrong
+/// size, NaN, infinite or negative, or given to a method that does not take it,
+/// options out of range).
 NIMBUSPHYSICS_EXPORT std::string CheckMultipleScatteringInput(const ExtinctionGrid& grid,
   const CloudOptics& optics, const CloudLighting& lighting,
   const MultipleScatteringOptions& options);

@@ -17,10 +17,13 @@ cells), written as .vti files beside their version-3 scene files:
 The reference is the path tracer (vtkNimbusReferenceRenderer, all orders of scattering,
 cached in the output directory); Nimbus renders the same view with
 vtkNimbusCloudVolumeMapper (its default multiple scattering: the discrete-direction
-solve; 512 slices). The script prints, per scene, the mean over the medium's pixels
-(image / reference, with the reference's standard error) and the RMSE of 8x8-pixel block
-means over the medium corrected for the reference's noise, relative to the mean, with
-the times; it writes reference | Nimbus strips as smoke-vs-path-tracer-<scene>.png.
+solve, which with Temperature Emission also scatters the glow; 512 slices). The script
+prints, per scene, the mean over the medium's pixels (image / reference, with the
+reference's standard error) and the RMSE of 8x8-pixel block means over the medium
+corrected for the reference's noise, relative to the mean, with the reference's own RMS
+block noise on the same scale; the times (the first frame, which includes the
+multiple-scattering solve, and the solve alone) and the solver's estimated memory; it
+writes reference | Nimbus strips as smoke-vs-path-tracer-<scene>.png.
 """
 import argparse
 import json
@@ -44,6 +47,17 @@ parser.add_argument("--scenes", nargs="+", default=["smoke", "fire"])
 parser.add_argument("--albedo", type=float, default=0.6,
                     help="the smoke's single-scattering albedo (default 0.6; 0 isolates "
                          "the emission from its scattering)")
+parser.add_argument("--downsampling", type=int, default=0,
+                    help="the multiple-scattering grid's downsampling of the density texture "
+                         "(0: the mapper's automatic choice)")
+parser.add_argument("--figure", metavar="PNG",
+                    help="also write the fire's flame, 2x, as four panels: the reference, "
+                         "Nimbus without multiple scattering (the glow not scattered), "
+                         "Nimbus, and Nimbus with the solve on the density's own grid "
+                         "(downsampling 1)")
+parser.add_argument("--gain", type=float, default=1.0,
+                    help="brightness of the written strips (default 1: the reference's 99th "
+                         "percentile at half scale)")
 args = parser.parse_args()
 os.makedirs(args.output_dir, exist_ok=True)
 
@@ -102,7 +116,7 @@ def scene_for(name, vti):
     return path
 
 
-def render_nimbus(name, image_data):
+def render_nimbus(name, image_data, method=None, downsampling=None):
     config = SCENES[name]
     mapper = nimbus.vtkNimbusCloudVolumeMapper()
     mapper.SetInputData(image_data)
@@ -118,8 +132,13 @@ def render_nimbus(name, image_data):
     mapper.SetEmissionRadiancePerMetre(EMISSION["radiance_per_metre"])
     mapper.SetEmissionReferenceTemperatureKelvin(EMISSION["reference_kelvin"])
     mapper.SetNumberOfSlices(512)
+    mapper.SetMultipleScatteringDownsampling(
+        args.downsampling if downsampling is None else downsampling)
+    if method is not None:
+        mapper.SetMultipleScatteringMethod(method)
     mapper.SetExposure(harness.VTK_SCALE)
-    return harness.render_mapper_radiance(mapper, CAMERA, args.size, (0.1, 1e4))
+    image, seconds = harness.render_mapper_radiance(mapper, CAMERA, args.size, (0.1, 1e4))
+    return image, seconds, mapper
 
 
 def blocks(image):
@@ -130,8 +149,8 @@ def block_errors(error):
     return harness.block_standard_errors(error, BLOCK)
 
 
-print(f"{'scene':<6} {'Nimbus s':>9} {'mean / reference':>20} {'block RMSE / mean':>18} "
-      f"{'reference':>10}")
+print(f"{'scene':<6} {'Nimbus s':>9} {'solve s':>8} {'solve MiB':>9} {'mean / reference':>20} "
+      f"{'block RMSE / mean':>18} {'ref. noise':>10} {'reference':>10}")
 for name in args.scenes:
     image_data, vti = simulate(name)
     scene_path = scene_for(name, vti)
@@ -146,7 +165,9 @@ for name in args.scenes:
         return image, harness.standard_error_of(output)
 
     reference, reference_error, cached = harness.cached_image(args.output_dir, key, path_trace)
-    image, seconds = render_nimbus(name, image_data)
+    image, seconds, mapper = render_nimbus(name, image_data)
+    dims = [0, 0, 0]
+    mapper.GetMultipleScatteringGridDimensions(dims)
     luminance = reference.mean(axis=2)
     medium = luminance > 0.01 * luminance.max()
     count = int(medium.sum())
@@ -157,9 +178,25 @@ for name in args.scenes:
     metrics = harness.error_metrics(blocks(image)[medium_blocks],
                                     blocks(reference)[medium_blocks],
                                     block_errors(reference_error)[medium_blocks])
-    print(f"{name:<6} {seconds:9.2f} {ratio:12.3f} +- {ratio * mean_error / mean_reference:.3f} "
-          f"{metrics['rmse'] / float(blocks(reference)[medium_blocks].mean()):18.3f} "
+    block_mean = float(blocks(reference)[medium_blocks].mean())
+    print(f"{name:<6} {seconds:9.2f} {mapper.GetLastMultipleScatteringSeconds():8.2f} "
+          f"{mapper.GetLastMultipleScatteringBytes() / 2 ** 20:9.1f} "
+          f"{ratio:12.3f} +- {ratio * mean_error / mean_reference:.3f} "
+          f"{metrics['rmse'] / block_mean:18.3f} {metrics['reference_noise'] / block_mean:10.4f} "
           f"{'cached' if cached else 'rendered':>10}")
-    scale = 0.5 / max(float(np.percentile(reference[medium], 99)), 1e-30)
+    print(f"{name}: multiple-scattering grid {dims[0]} x {dims[1]} x {dims[2]}", file=sys.stderr)
+    np.save(os.path.join(args.output_dir, f"nimbus-{name}.npy"), image)
+    scale = args.gain * 0.5 / max(float(np.percentile(reference[medium], 99)), 1e-30)
     strip = np.concatenate([reference, image], axis=1) * scale / harness.DISPLAY_EXPOSURE
     harness.write_png(strip, os.path.join(args.output_dir, f"smoke-vs-path-tracer-{name}.png"))
+    if args.figure and name == "fire":
+        panels = [reference, render_nimbus(name, image_data, method=0)[0], image,
+                  render_nimbus(name, image_data, downsampling=1)[0]]
+        for label, panel in zip(("no multiple scattering", "downsampling 1"),
+                                (panels[1], panels[3])):
+            print(f"fire, {label}: mean / reference "
+                  f"{float(panel[medium].mean()) / mean_reference:.3f}", file=sys.stderr)
+        # Rows from the bottom: the flame and the column above it.
+        flame = np.concatenate([p[15:135, 30:130] for p in panels], axis=1)
+        flame = np.repeat(np.repeat(flame, 2, axis=0), 2, axis=1)
+        harness.write_png(flame * scale / harness.DISPLAY_EXPOSURE, args.figure)

@@ -499,4 +499,254 @@ TEST(MultipleScattering, SpotlightLightsItsConeLikeThePointLight)
   EXPECT_LT(worstInside, 0.02);
   EXPECT_LT(largestOutside, 0.05);
 }
+// --- The medium's own emission (CloudLighting::Emission) ------------------------------
+
+CloudLighting Glowing(const ExtinctionGrid& grid, const nimbus::Rgb& eta)
+{
+  CloudLighting lighting;
+  lighting.HasSun = false;
+  lighting.Emission.resize(3 * grid.NumberOfPoints());
+  for (std::size_t i = 0; i < grid.NumberOfPoints(); ++i)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      lighting.Emission[3 * i + c] = grid.Extinction[i] > 0.0f ? static_cast<float>(eta[c]) : 0.0f;
+    }
+  }
+  return lighting;
+}
+
+// Deep inside a large homogeneous glowing box the radiance is the equilibrium of the
+// RTE, dL/ds = -sigma_t L + sigma_s J + eta = 0 with J = L: L = eta / (sigma_t (1 - a)),
+// whatever the phase function; J (the emitted light of every order, scattered) is
+// that radiance, isotropic.
+TEST(MultipleScatteringEmission, DeepInsideAGlowingBoxTheRadianceIsTheEquilibrium)
+{
+  const double sigma = 2.0; // 1/m; the centre lies 20 optical depths from every face
+  const ExtinctionGrid grid = UniformCube(25, 20.0, sigma);
+  const nimbus::Rgb eta{ { 1.0, 0.5, 0.25 } };
+  const std::size_t centre = grid.Index(12, 12, 12);
+  for (double albedo : { 0.0, 0.6, 0.9 })
+  {
+    CloudOptics optics{ albedo, PhaseFunctionKind::HenyeyGreenstein, 0.3 };
+    MultipleScatteringOptions options;
+    options.Orders = 200;
+    const auto field = nimbus::SolveMultipleScattering(grid, optics, Glowing(grid, eta), options);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double expected = eta[c] / (sigma * (1.0 - albedo));
+      const double got = MeanInScattering(field, centre, c);
+      // Measured: ratio 1.000000 (albedo 0), 0.999999 (0.6), 0.99856 (0.9: the orders'
+      // tail); the degree-1 part is not exactly 0 (the 26 Fibonacci directions do not
+      // sum to exactly 0, FibonacciDirectionsAreUnitAndBalanced).
+      EXPECT_NEAR(got / expected, 1.0, 2e-3) << albedo << " " << c;
+      for (int b = 1; b < 4; ++b)
+      {
+        const double ratio = std::abs(field.Coefficients[12 * centre + 4 * c + b]) / (got / kY00);
+        std::cout << (b == 1 && c == 0 ? "albedo " + std::to_string(albedo) + ": J / closed form " +
+              std::to_string(got / expected) + "\n"
+                                       : "");
+        EXPECT_LT(ratio, 0.01) << albedo << " " << c << " " << b;
+      }
+    }
+  }
+}
+
+// The first scattering at the centre of a glowing sphere that absorbs only: the emitted
+// radiance arriving from every direction is (eta / sigma)(1 - exp(-sigma R)), and with
+// albedo 0 nothing is scattered again (J holds the first scattering alone: the same
+// with 2 orders as with 200).
+TEST(MultipleScatteringEmission, CentreOfAnAbsorbingGlowingSphere)
+{
+  const double radius = 8.0, sigma = 1.0 / radius; // sigma R = 1
+  ExtinctionGrid grid = UniformCube(41, 20.0, sigma);
+  for (int k = 0; k < 41; ++k)
+  {
+    for (int j = 0; j < 41; ++j)
+    {
+      for (int i = 0; i < 41; ++i)
+      {
+        const Vector3 p = grid.Position(i, j, k);
+        grid.Extinction[grid.Index(i, j, k)] =
+          nimbus::Length(p) <= radius ? static_cast<float>(sigma) : 0.0f;
+      }
+    }
+  }
+  const CloudLighting lighting = Glowing(grid, { { 1.0, 1.0, 1.0 } });
+  CloudOptics optics{ 0.0, PhaseFunctionKind::CornetteShanks, 0.3 };
+  MultipleScatteringOptions options;
+  options.Orders = 200;
+  const auto many = nimbus::SolveMultipleScattering(grid, optics, lighting, options);
+  options.Orders = 2;
+  const auto two = nimbus::SolveMultipleScattering(grid, optics, lighting, options);
+  EXPECT_EQ(many.Coefficients, two.Coefficients);
+  const double expected = (1.0 - std::exp(-sigma * radius)) / sigma;
+  const double got = MeanInScattering(many, grid.Index(20, 20, 20), 0);
+  std::cout << "glowing sphere's centre: J " << got << ", closed form " << expected << "\n";
+  // Measured: ratio 0.995 (the sphere's trilinear edge on a grid of 0.5 m).
+  EXPECT_NEAR(got / expected, 1.0, 0.02);
+}
+
+// J is linear in the sources: twice the emission gives twice J (exactly: a power of 2),
+// the sun and the glow together give the sum of each alone, and an emission of zeros
+// changes nothing (bit-identical).
+TEST(MultipleScatteringEmission, JIsLinearInTheSources)
+{
+  ExtinctionGrid grid = UniformCube(11, 20.0, 0.5);
+  for (std::size_t i = 0; i < grid.Extinction.size(); ++i)
+  {
+    grid.Extinction[i] *= static_cast<float>(0.5 + 0.5 * std::sin(0.37 * i));
+  }
+  CloudOptics optics{ 0.6, PhaseFunctionKind::CornetteShanks, 0.3 };
+  MultipleScatteringOptions options;
+  options.Orders = 400;
+  options.ExtrapolateHigherOrders = false;
+  CloudLighting glow = Glowing(grid, { { 0.3, 0.2, 0.1 } });
+  for (std::size_t i = 0; i < grid.NumberOfPoints(); ++i)
+  {
+    glow.Emission[3 * i] *= static_cast<float>(1.0 + std::cos(0.11 * i));
+  }
+  CloudLighting twice = glow;
+  for (float& e : twice.Emission)
+  {
+    e *= 2.0f;
+  }
+  CloudLighting sun = UniformSky(0.2);
+  sun.HasSun = true;
+  sun.Sun.ToLight = nimbus::Normalized({ { 0.3, -0.2, 0.8 } });
+  CloudLighting both = sun;
+  both.Emission = glow.Emission;
+  CloudLighting zeros = sun;
+  zeros.Emission.assign(glow.Emission.size(), 0.0f);
+  const auto g = nimbus::SolveMultipleScattering(grid, optics, glow, options);
+  const auto g2 = nimbus::SolveMultipleScattering(grid, optics, twice, options);
+  const auto s = nimbus::SolveMultipleScattering(grid, optics, sun, options);
+  const auto b = nimbus::SolveMultipleScattering(grid, optics, both, options);
+  const auto z = nimbus::SolveMultipleScattering(grid, optics, zeros, options);
+  EXPECT_EQ(s.Coefficients, z.Coefficients);
+  double largest = 0.0, worstSum = 0.0;
+  for (float c : b.Coefficients)
+  {
+    largest = std::max(largest, static_cast<double>(std::abs(c)));
+  }
+  for (std::size_t q = 0; q < g.Coefficients.size(); ++q)
+  {
+    EXPECT_EQ(g2.Coefficients[q], 2.0f * g.Coefficients[q]);
+    worstSum = std::max(worstSum,
+      std::abs(static_cast<double>(b.Coefficients[q]) - s.Coefficients[q] - g.Coefficients[q]));
+  }
+  std::cout << "sun + glow against each alone: " << worstSum / largest << " of the largest\n";
+  // Measured: 2.4e-7 (float sums; each solve stops on its own order).
+  EXPECT_LT(worstSum, 1e-5 * largest);
+}
+
+// Energy balance of a small glowing box in a larger empty grid: the power emitted,
+// 4 pi sum eta dV, leaves as the power absorbed, 4 pi sum sigma_a <L> dV (<L> = c_00
+// Y_00 the mean radiance), plus the power through the grid's faces, sum F . n dA (the
+// flux F = integral L w dw from J's degree-1 coefficients: F = c_1 / (k_1 Y_1)).
+TEST(MultipleScatteringEmission, EnergyBalanceOfASmallBox)
+{
+  const int n = 21;
+  ExtinctionGrid grid = UniformCube(n, 10.0, 0.0); // 0.5 m spacing
+  for (int k = 6; k <= 14; ++k)
+  {
+    for (int j = 6; j <= 14; ++j)
+    {
+      for (int i = 6; i <= 14; ++i)
+      {
+        grid.Extinction[grid.Index(i, j, k)] = 0.4f; // 1/m: 1.6 optical depths across
+      }
+    }
+  }
+  const double albedo = 0.6, g = 0.5;
+  CloudOptics optics{ albedo, PhaseFunctionKind::HenyeyGreenstein, g };
+  const CloudLighting lighting = Glowing(grid, { { 1.0, 1.0, 1.0 } });
+  MultipleScatteringOptions options;
+  options.Orders = 200;
+  options.NumberOfDirections = 100;
+  const auto field = nimbus::SolveMultipleScattering(grid, optics, lighting, options);
+  const double h = grid.Spacing[0], cell = h * h * h;
+  double emitted = 0.0, absorbed = 0.0, escaped = 0.0;
+  for (std::size_t i = 0; i < grid.NumberOfPoints(); ++i)
+  {
+    emitted += 4.0 * nimbus::kPi * lighting.Emission[3 * i] * cell;
+    absorbed += 4.0 * nimbus::kPi * (1.0 - albedo) * grid.Extinction[i] *
+      MeanInScattering(field, i, 0) * cell;
+  }
+  constexpr double kY1 = 0.4886025119029199;
+  // c_1-1, c_10, c_11 hold w_y, w_z, w_x.
+  const int component[3] = { 3, 1, 2 };
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    for (int side = 0; side < 2; ++side)
+    {
+      for (int v = 0; v < n; ++v)
+      {
+        for (int u = 0; u < n; ++u)
+        {
+          int idx[3];
+          idx[axis] = side ? n - 1 : 0;
+          idx[(axis + 1) % 3] = u;
+          idx[(axis + 2) % 3] = v;
+          const double weight =
+            (u == 0 || u == n - 1 ? 0.5 : 1.0) * (v == 0 || v == n - 1 ? 0.5 : 1.0);
+          const double f =
+            field.Coefficients[12 * grid.Index(idx[0], idx[1], idx[2]) + component[axis]] /
+            (g * kY1);
+          escaped += (side ? f : -f) * weight * h * h;
+        }
+      }
+    }
+  }
+  std::cout << "glowing box: emitted " << emitted << ", absorbed " << absorbed << ", escaped "
+            << escaped << ": balance " << (absorbed + escaped) / emitted << "\n";
+  // Measured: 0.952 (absorbed 0.271, escaped 0.681 of the emitted power); the 4.8 %
+  // missing were not split between the solver and this measure of the flux (a
+  // trapezoid over the faces' grid points, the flux from degree-1 harmonics).
+  EXPECT_NEAR((absorbed + escaped) / emitted, 1.0, 0.06);
+}
+
+TEST(MultipleScatteringEmission, BadEmissionIsRefused)
+{
+  const ExtinctionGrid grid = UniformCube(3, 100.0, 0.01);
+  const CloudOptics optics;
+  const MultipleScatteringOptions options;
+  EXPECT_EQ(
+    nimbus::CheckMultipleScatteringInput(grid, optics, Glowing(grid, { { 1, 1, 1 } }), options),
+    "");
+  auto expectRefused =
+    [&](const CloudLighting& lighting, const MultipleScatteringOptions& opt, const char* words)
+  {
+    const std::string message = nimbus::CheckMultipleScatteringInput(grid, optics, lighting, opt);
+    EXPECT_NE(message.find(words), std::string::npos) << message;
+    EXPECT_THROW(
+      nimbus::SolveMultipleScattering(grid, optics, lighting, opt), std::invalid_argument);
+  };
+  CloudLighting shortEmission = Glowing(grid, { { 1, 1, 1 } });
+  shortEmission.Emission.pop_back();
+  expectRefused(shortEmission, options, "3 per point");
+  for (float bad :
+    { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -1.0f })
+  {
+    CloudLighting lighting = Glowing(grid, { { 1, 1, 1 } });
+    lighting.Emission[7] = bad;
+    expectRefused(lighting, options, "emission must be finite");
+  }
+  for (auto method :
+    { MultipleScatteringMethod::Octaves, MultipleScatteringMethod::ReferencePatterns })
+  {
+    MultipleScatteringOptions other = options;
+    other.Method = method;
+    expectRefused(Glowing(grid, { { 1, 1, 1 } }), other, "discrete-direction method only");
+  }
+  // None computes nothing and ignores it.
+  MultipleScatteringOptions none = options;
+  none.Method = MultipleScatteringMethod::None;
+  const auto field =
+    nimbus::SolveMultipleScattering(grid, optics, Glowing(grid, { { 1, 1, 1 } }), none);
+  for (float c : field.Coefficients)
+  {
+    EXPECT_EQ(c, 0.0f);
+  }
+}
 } // namespace

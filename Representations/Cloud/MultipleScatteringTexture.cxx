@@ -1,7 +1,10 @@
 #include "MultipleScatteringTexture.h"
 
+#include "BlackbodyEmission.h"
 #include "CloudDensityTexture.h"
+#include "EmissionTexture.h"
 #include "MemoryBudget.h"
+#include "SpectralColor.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -10,9 +13,11 @@
 #include "vtkTextureObject.h"
 #include "vtk_glew.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace nimbus
 {
@@ -153,6 +158,48 @@ bool MultipleScatteringTexture::BuildGrid(vtkImageData* image, vtkDataArray* sca
   return true;
 }
 
+bool MultipleScatteringTexture::BuildEmission(vtkDataArray* scalars,
+  const DensityResamplePlan& plan, const Request& request, std::vector<float>& emission,
+  std::string& error)
+{
+  vtkDataArray* temperature = request.EmissionTemperature;
+  const std::size_t samples = static_cast<std::size_t>(plan.InputDimensions[0]) *
+    plan.InputDimensions[1] * plan.InputDimensions[2];
+  if (!scalars || scalars->GetNumberOfComponents() != 1 ||
+    temperature->GetNumberOfComponents() != 1 ||
+    static_cast<std::size_t>(temperature->GetNumberOfTuples()) != samples ||
+    static_cast<std::size_t>(scalars->GetNumberOfTuples()) != samples)
+  {
+    error = "the temperature array does not fit the density";
+    return false;
+  }
+  std::vector<float> rho(samples), kelvin(samples);
+  for (std::size_t i = 0; i < samples; ++i)
+  {
+    rho[i] = static_cast<float>(scalars->GetComponent(static_cast<vtkIdType>(i), 0));
+    kelvin[i] = static_cast<float>(temperature->GetComponent(static_cast<vtkIdType>(i), 0));
+  }
+  try
+  {
+    static const SpectralSamples spectrum;
+    const BlackbodyEmission blackbody(spectrum, request.EmissionReferenceKelvin);
+    emission = ComputeEmissionTexels(rho.data(), kelvin.data(), plan.InputDimensions, plan.Factors,
+      plan.OutputDimensions, blackbody);
+  }
+  catch (const std::invalid_argument& problem)
+  {
+    error = problem.what();
+    return false;
+  }
+  // Linear sRGB of a red blackbody has negative channels; the shader clamps its texels
+  // at 0 as well.
+  for (float& e : emission)
+  {
+    e = static_cast<float>(std::min(request.EmissionRadiancePerMetre * std::max(e, 0.0f), 3.0e38));
+  }
+  return true;
+}
+
 bool MultipleScatteringTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
   vtkDataArray* scalars, bool cellData, vtkMatrix4x4* dataToWorld, double densityVersion,
   const Request& request, const std::function<void(double)>& progress, std::string& error)
@@ -203,8 +250,15 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
     shape.Dimensions = PlanGrid(image, cellData, request).OutputDimensions;
     const double points =
       static_cast<double>(shape.Dimensions[0]) * shape.Dimensions[1] * shape.Dimensions[2];
+    // The grid's extinction, and with a glow its emission (3 floats per point) and the
+    // density and temperature as floats while it is built.
     this->LastEstimatedBytes =
       EstimateMultipleScatteringBytes(shape, request.Options) + 4.0 * points;
+    if (request.EmissionTemperature)
+    {
+      this->LastEstimatedBytes +=
+        12.0 * points + 8.0 * static_cast<double>(request.EmissionTemperature->GetNumberOfTuples());
+    }
     if (request.BudgetBytes > 0.0 && this->LastEstimatedBytes > request.BudgetBytes)
     {
       std::ostringstream message;
@@ -222,10 +276,17 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
     error = "Multiple scattering: " + error + "; the cloud is drawn without it.";
     return false;
   }
+  CloudLighting lighting = request.Lighting;
+  if (request.EmissionTemperature &&
+    !BuildEmission(scalars, PlanGrid(image, cellData, request), request, lighting.Emission, error))
+  {
+    error = "Multiple scattering of the glow: " + error + "; the cloud is drawn without it.";
+    return false;
+  }
   try
   {
     this->Field =
-      SolveMultipleScattering(grid, request.Optics, request.Lighting, request.Options, progress);
+      SolveMultipleScattering(grid, request.Optics, lighting, request.Options, progress);
   }
   catch (const std::exception& problem)
   {

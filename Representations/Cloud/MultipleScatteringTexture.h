@@ -57,6 +57,16 @@ public:
     double MetresPerUnit = 1.0;
     double BudgetBytes = 0.0;
     CloudLighting Lighting;
+    /// The medium's glow (Physics/BlackbodyEmission.h), a source of the solve
+    /// (CloudLighting::Emission, DiscreteDirections only): the temperatures [K] of the
+    /// density's samples (one component, as many tuples as the density; null: no glow),
+    /// E [radiance per metre per unit density at T_ref] and T_ref [K]. On the solver's
+    /// grid eta = E times the block's mean of rho B(T) / Y[B(T_ref)] (linear sRGB),
+    /// the blocks of the extinction's (ComputeEmissionTexels): the same emission as the
+    /// mapper's EmissionTexture, which the shader adds as E times its texel.
+    vtkDataArray* EmissionTemperature = nullptr;
+    double EmissionRadiancePerMetre = 0.0;
+    double EmissionReferenceKelvin = 1500.0;
     /// Everything the answer depends on but the density values (compared with the
     /// last solve's); the density's identity is `densityVersion`.
     std::vector<double> Key;
@@ -100,6 +110,8 @@ public:
   void Release(vtkWindow* window);
 
 private:
+  static bool BuildEmission(vtkDataArray* scalars, const DensityResamplePlan& plan,
+    const Request& request, std::vector<float>& emission, std::string& error);
   bool Solve(vtkOpenGLRenderWindow* window, vtkImageData* image, vtkDataArray* scalars,
     bool cellData, vtkMatrix4x4* dataToWorld, const Request& request,
     const std::vector<double>& key, const std::function<void(double)>& progress,

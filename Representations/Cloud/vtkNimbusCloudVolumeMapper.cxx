@@ -42,6 +42,7 @@
 #include "vtkNimbusSkyBackground.h"
 
 #include "vtkCamera.h"
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -1649,6 +1650,47 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   }
 }
 
+namespace
+{
+// World -> the multiple-scattering textures' coordinates: the density texture's times
+// the solve's TextureScale, or (`coarse`: the whole cloud's coarse copy, in world
+// coordinates) its point grid's, texel centres at (index + 0.5) / dimensions.
+std::array<float, 16> WorldToScatteringTexture(vtkImageData* coarse, const int textureDims[3],
+  const std::array<float, 16>& worldToTexture, const std::array<double, 3>& textureScale)
+{
+  vtkNew<vtkMatrix4x4> worldToScattering;
+  if (coarse)
+  {
+    const double* origin = coarse->GetOrigin();
+    const double* spacing = coarse->GetSpacing();
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = std::max(textureDims[a], 1);
+      worldToScattering->SetElement(a, a, 1.0 / (spacing[a] * d));
+      worldToScattering->SetElement(a, 3, (-origin[a] / spacing[a] + 0.5) / d);
+    }
+  }
+  else
+  {
+    for (int r = 0; r < 4; ++r)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        worldToScattering->SetElement(r, c, worldToTexture[4 * c + r]);
+      }
+    }
+  }
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      worldToScattering->SetElement(r, c, worldToScattering->GetElement(r, c) * textureScale[r]);
+    }
+  }
+  return ColumnMajor(worldToScattering);
+}
+} // namespace
+
 //------------------------------------------------------------------------------
 // Multiple scattering (issue 14): the solver's term, re-solved only when the
 // density, the sun, the air, the ground, the optics or the method's knobs change.
@@ -1800,6 +1842,12 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     air.SceneAltitudeMetres, air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG,
     settings.GroundAlbedo, settings.GroundHeight };
   this->AddViewLightsToSolve(frame, zMiddle, request.Lighting, request.Key);
+  if (method == MultipleScatteringDiscreteDirections && !wholeCloud)
+  {
+    request.EmissionTemperature = this->EmissionForSolve(frame, request.Key);
+    request.EmissionRadiancePerMetre = this->EmissionRadiancePerMetre;
+    request.EmissionReferenceKelvin = this->EmissionReferenceTemperatureKelvin;
+  }
   if (method == MultipleScatteringReferencePatterns)
   {
     request.Key.insert(request.Key.end(),
@@ -1834,42 +1882,49 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     vtkDebugMacro(<< "multiple scattering: " << in.LastPrecomputeSeconds << " s");
   }
   frame.ScatteringTexture = in.Scattering.HasTexture();
-  // World -> the textures: (density texture coordinates) * TextureScale.
-  vtkNew<vtkMatrix4x4> worldToScattering;
-  if (wholeCloud)
-  {
-    // Point data: texel centres at (index + 0.5) / dimensions.
-    const double* origin = solveImage->GetOrigin();
-    const double* spacing = solveImage->GetSpacing();
-    for (int a = 0; a < 3; ++a)
-    {
-      const double d = std::max(textureDims[a], 1);
-      worldToScattering->SetElement(a, a, 1.0 / (spacing[a] * d));
-      worldToScattering->SetElement(a, 3, (-origin[a] / spacing[a] + 0.5) / d);
-    }
-  }
-  else
-  {
-    for (int r = 0; r < 4; ++r)
-    {
-      for (int c = 0; c < 4; ++c)
-      {
-        worldToScattering->SetElement(r, c, frame.WorldToTexture[4 * c + r]);
-      }
-    }
-  }
-  const auto& textureScale = in.Scattering.GetTextureScale();
-  for (int r = 0; r < 3; ++r)
-  {
-    for (int c = 0; c < 4; ++c)
-    {
-      worldToScattering->SetElement(r, c, worldToScattering->GetElement(r, c) * textureScale[r]);
-    }
-  }
-  frame.WorldToScattering = ColumnMajor(worldToScattering);
+  frame.WorldToScattering = WorldToScatteringTexture(wholeCloud ? solveImage : nullptr, textureDims,
+    frame.WorldToTexture, in.Scattering.GetTextureScale());
   frame.ScatteringScale =
     in.SolvedIlluminance > 0.0 ? settings.Sun.Illuminance / in.SolvedIlluminance : 1.0;
   frame.ForwardPeakFraction = in.Scattering.GetForwardPeakFraction();
+}
+
+//------------------------------------------------------------------------------
+// The glow as a source of the discrete-direction solve (CloudLighting::Emission): the
+// temperature array when Temperature Emission is on (the same conditions as
+// UpdateEmission; its errors are reported there), null otherwise. The key gains what
+// the emission depends on besides the density: the array and its modification time,
+// E and T_ref, and the sun's illuminance itself: the shader scales the solve's J by
+// the sun's illuminance now / at the solve (scatteringScale), right for the sun's
+// light but not for the glow's, so with a glow a new illuminance solves again (the
+// scale is then 1).
+vtkDataArray* vtkNimbusCloudVolumeMapper::EmissionForSolve(
+  const FrameState& frame, std::vector<double>& key) const
+{
+  vtkDataArray* temperature = nullptr;
+  if (!this->Unlit && this->TemperatureEmission && this->EmissionRadiancePerMetre > 0.0 &&
+    frame.Image && frame.Scalars)
+  {
+    const char* name = this->EmissionTemperatureArray.c_str();
+    temperature = frame.CellData ? frame.Image->GetCellData()->GetArray(name)
+                                 : frame.Image->GetPointData()->GetArray(name);
+    if (temperature &&
+      (temperature->GetNumberOfComponents() != 1 || frame.Scalars->GetNumberOfComponents() != 1 ||
+        temperature->GetNumberOfTuples() != frame.Scalars->GetNumberOfTuples()))
+    {
+      temperature = nullptr;
+    }
+  }
+  if (!temperature)
+  {
+    key.push_back(0.0);
+    return nullptr;
+  }
+  key.insert(key.end(),
+    { 1.0, static_cast<double>(reinterpret_cast<std::uintptr_t>(temperature)),
+      static_cast<double>(temperature->GetMTime()), this->EmissionRadiancePerMetre,
+      this->EmissionReferenceTemperatureKelvin, frame.Settings.Sun.Illuminance });
+  return temperature;
 }
 
 //------------------------------------------------------------------------------

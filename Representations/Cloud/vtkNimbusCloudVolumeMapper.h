@@ -137,9 +137,11 @@ public:
   /// writes): at the reference temperature a unit density emits EmissionRadiancePerMetre
   /// of luminance per metre (default 1); hotter is brighter and bluer (2000 K: 60x at a
   /// 1500 K reference), cooler dimmer and redder (1000 K: 3.5e-4x; smoke at 600 K: 1e-10x,
-  /// nothing). The emitted light is attenuated on its way to the eye but not scattered
-  /// again (the reference path tracer scatters it: the difference is measured in
-  /// docs/smoke.md).
+  /// nothing). The emitted light is attenuated on its way to the eye; with the
+  /// discrete-direction multiple scattering (the default) the medium also scatters it,
+  /// all orders (a source of the solve, Physics/MultipleScattering.h); with the other
+  /// methods it is not scattered again (docs/smoke.md measures both against the path
+  /// tracer).
   vtkSetMacro(TemperatureEmission, bool);
   vtkGetMacro(TemperatureEmission, bool);
   vtkBooleanMacro(TemperatureEmission, bool);
@@ -849,6 +851,7 @@ private:
   void SetViewLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void AddViewLightsToSolve(const FrameState& frame, double cloudMiddleZ,
     nimbus::CloudLighting& lighting, std::vector<double>& key);
+  vtkDataArray* EmissionForSolve(const FrameState& frame, std::vector<double>& key) const;
   void RenderVirtualPlanes(const FrameState& frame);
   void SetCloudLightUniforms(vtkShaderProgram* program, const FrameState& frame);
   void CaptureRadianceImage(const FrameState& frame);
