@@ -11,34 +11,37 @@
  * LightningGlowRadiance: isotropic scattering, the air's extinction over the glow
  * neglected). The mapper draws one camera-facing quad of radius GlowRadiusMetres per
  * source, the profile L(b) x Exposure x Color in its fragments, cut off smoothly at the
- * radius (x (1 - (b/R)^2)^2) and held at the channel's radius near the centre, added to
- * the frame (emissive blending). Along a channel the quads sum to the glow of a line
- * source, about (sigma_s I' / 2) ln(2R / d) at distance d for I' per metre (tested), the
- * paper's texture-mapped quads along the strokes with the texture computed per fragment.
+ * radius (x (1 - (b/R)^2)^2) and held at the channel's radius near the centre. Along a
+ * channel the quads sum to the glow of a line source, about (sigma_s I' / 2) ln(2R / d) at
+ * distance d for I' per metre (tested), the paper's texture-mapped quads along the strokes
+ * with the texture computed per fragment.
+ *
+ * The quads are summed in a 32-bit float RGBA target of the renderer's size (each source's
+ * intensity a float too), depth-tested against a copy of the depth the scene has when the
+ * glow is drawn (opaque geometry drawn before it hides it; the glow itself writes no
+ * depth), and the sum is added to the frame once (one rounding to its colour): many faint
+ * splats, each below the frame's 8-bit step, add up. Drawn in the opaque pass, as an
+ * emissive prop (after the actors added before it); not drawn for selection (picking).
+ * A multisampled frame's depth cannot be copied: there the glow is not hidden by opaque
+ * geometry (a warning, once). GLSL: Shaders/lightningGlow{SplatVS,SplatFS,CompositeFS}.glsl.
  *
  * AirScatteringPerMetre defaults to 1e-3 /m: air in rain and haze (a visibility of about
  * 4 km), as under a thunderstorm; clear air (about 3e-5 /m) makes a glow 30 times fainter,
- * invisible at night beside the channel. The frame's 8-bit colour rounds each splat's
- * addition, so the faintest part of the tail (below about 1/500 of white per splat) is
- * lost.
+ * invisible at night beside the channel.
  */
 #ifndef vtkNimbusLightningGlowMapper_h
 #define vtkNimbusLightningGlowMapper_h
 
 #include "NimbusRepresentationsModule.h" // for export macro
-#include "vtkNew.h"                      // for vtkNew
-#include "vtkOpenGLPointGaussianMapper.h"
+#include "vtkPolyDataMapper.h"
 
-#include <string> // for std::string
+#include <memory> // for std::unique_ptr
 
-class vtkLookupTable;
-
-class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusLightningGlowMapper
-  : public vtkOpenGLPointGaussianMapper
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusLightningGlowMapper : public vtkPolyDataMapper
 {
 public:
   static vtkNimbusLightningGlowMapper* New();
-  vtkTypeMacro(vtkNimbusLightningGlowMapper, vtkOpenGLPointGaussianMapper);
+  vtkTypeMacro(vtkNimbusLightningGlowMapper, vtkPolyDataMapper);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
@@ -68,6 +71,9 @@ public:
   ///@}
 
   void Render(vtkRenderer* renderer, vtkActor* actor) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+  /// Emissive: drawn in the opaque pass (as VTK's emissive point Gaussians).
+  bool HasTranslucentPolygonalGeometry() override { return false; }
 
 protected:
   vtkNimbusLightningGlowMapper();
@@ -84,8 +90,8 @@ private:
   vtkNimbusLightningGlowMapper(const vtkNimbusLightningGlowMapper&) = delete;
   void operator=(const vtkNimbusLightningGlowMapper&) = delete;
 
-  vtkNew<vtkLookupTable> Colors;
-  std::string LastShaderCode;
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
 };
 
 #endif
