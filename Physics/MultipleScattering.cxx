@@ -618,18 +618,7 @@ private:
     }
     if (emission)
     {
-      // The source function of the emission per unit (scaled) extinction: Transport's
-      // segments add sigma_t' S ds = eta ds. Points without extinction cannot hold it
-      // (their emission is not transported; CloudLighting::Emission).
-      const std::vector<float>& sigma = scaledGrid.Extinction;
-      for (std::size_t i = 0; i < n; ++i)
-      {
-        for (int c = 0; c < 3; ++c)
-        {
-          source[3 * i + c] =
-            sigma[i] > 0.0f ? this->Lighting.Emission[3 * i + c] / sigma[i] : 0.0f;
-        }
-      }
+      this->EmissionSource(scaledGrid, source);
     }
     const float* emitted = emission ? source.data() : nullptr;
     ParallelFor(nd, 1, this->Options.Threads,
@@ -641,8 +630,67 @@ private:
         }
       });
     total = order;
+    if (emission && this->Options.EmissionFirstScatteringApart)
+    {
+      // J without the emission's first scattering: its order 0 seeds order 1 but stays
+      // out of the total (the sky's order 0 alone there).
+      std::fill(total.begin(), total.end(), 0.0f);
+      if (sky)
+      {
+        ParallelFor(nd, 1, this->Options.Threads,
+          [&](std::size_t begin, std::size_t end)
+          {
+            for (std::size_t m = begin; m < end; ++m)
+            {
+              this->Transport(scaledGrid, m, boundary[m], nullptr, &total[m * 3 * n], nullptr);
+            }
+          });
+      }
+    }
   }
 
+  // The source function of the emission per unit (scaled) extinction into the first
+  // 3 n floats of `source`: Transport's segments add sigma_t' S ds = eta ds. Points
+  // without extinction cannot hold it (their emission is not transported;
+  // CloudLighting::Emission).
+  void EmissionSource(const ExtinctionGrid& scaledGrid, std::vector<float>& source) const
+  {
+    const std::vector<float>& sigma = scaledGrid.Extinction;
+    for (std::size_t i = 0; i < sigma.size(); ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        source[3 * i + c] = sigma[i] > 0.0f ? this->Lighting.Emission[3 * i + c] / sigma[i] : 0.0f;
+      }
+    }
+  }
+
+public:
+  // The emission's first scattering alone (EmissionFirstScattering): J1 = integral
+  // p(w . s) L0(x, s) ds, L0 the emitted radiance through the delta-M scaled extinction
+  // (as AllOrders carries it), one direction after another.
+  void EmissionFirstOrder(std::vector<float>& coefficients) const
+  {
+    const std::size_t n = this->Grid.NumberOfPoints();
+    const TruncatedPhase phase = Truncate(this->Optics);
+    const double scale = 1.0 - phase.F * this->Optics.Albedo;
+    ExtinctionGrid scaledGrid = this->Grid;
+    for (float& e : scaledGrid.Extinction)
+    {
+      e = static_cast<float>(e * scale);
+    }
+    std::vector<float> source(3 * n), radiance(3 * n);
+    this->EmissionSource(scaledGrid, source);
+    const double k1 = PhaseLegendreCoefficient(this->Optics, 1);
+    for (std::size_t m = 0; m < this->Directions.size(); ++m)
+    {
+      this->Transport(scaledGrid, m, Rgb{ { 0, 0, 0 } }, source.data(), radiance.data(), nullptr);
+      this->Project(radiance, this->Directions[m], 1.0, k1, coefficients);
+      Report(this->Progress, static_cast<double>(m + 1) / this->Directions.size());
+    }
+  }
+
+private:
   // Orders 1 .. Options.Orders (or until an order carries < 1e-5 of the total):
   // S_k = a' sum_m' P[m][m'] L_{k-1}(m') (+ the lights' first scattering at k = 1),
   // transported; each order added to `total`.
@@ -1281,6 +1329,38 @@ std::string CheckMultipleScatteringInput(const ExtinctionGrid& grid, const Cloud
     return message.str();
   }
   return "";
+}
+
+std::vector<float> EmissionFirstScattering(const ExtinctionGrid& grid, const CloudOptics& optics,
+  const std::vector<float>& emission, const MultipleScatteringOptions& options,
+  const std::function<void(double fraction)>& progress)
+{
+  CloudLighting lighting;
+  lighting.HasSun = false;
+  lighting.Emission = emission;
+  std::string problem = CheckMultipleScatteringInput(grid, optics, lighting, options);
+  if (problem.empty() && options.Method != MultipleScatteringMethod::DiscreteDirections)
+  {
+    problem = "the emission's first scattering is a step of the discrete-direction method";
+  }
+  if (!problem.empty())
+  {
+    throw std::invalid_argument("multiple scattering: " + problem);
+  }
+  std::vector<float> coefficients(grid.NumberOfPoints() * kCoefficients, 0.0f);
+  if (!emission.empty())
+  {
+    DiscreteDirectionSolver(grid, optics, lighting, options, progress)
+      .EmissionFirstOrder(coefficients);
+  }
+  for (float c : coefficients)
+  {
+    if (!std::isfinite(c))
+    {
+      throw std::range_error("multiple scattering: the solver produced a non-finite value");
+    }
+  }
+  return coefficients;
 }
 
 MultipleScatteringField SolveMultipleScattering(const ExtinctionGrid& grid,

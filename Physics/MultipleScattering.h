@@ -193,6 +193,11 @@ struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
   /// renderer computes otherwise; DiscreteDirections only). Default off: J holds the
   /// orders the mapper does not compute (for the sun, orders >= 2).
   bool PointLightFirstScattering = false;
+  /// Leave the emission's first scattering out of J (DiscreteDirections; the emission's
+  /// light still seeds the higher orders): J then holds the glow's orders >= 2, for a
+  /// caller that computes the first on a finer grid (EmissionFirstScattering) and adds
+  /// it. Default off: J holds every order of the glow's scattered light.
+  bool EmissionFirstScatteringApart = false;
   /// Threads (0: hardware concurrency). Results do not depend on it.
   int Threads = 0;
 };
@@ -237,6 +242,21 @@ NIMBUSPHYSICS_EXPORT std::string CheckMultipleScatteringInput(const ExtinctionGr
 /// may throw to stop the solve (the exception propagates).
 NIMBUSPHYSICS_EXPORT MultipleScatteringField SolveMultipleScattering(const ExtinctionGrid& grid,
   const CloudOptics& optics, const CloudLighting& lighting,
+  const MultipleScatteringOptions& options,
+  const std::function<void(double fraction)>& progress = nullptr);
+
+/// The first scattering of the medium's emission alone (CloudLighting::Emission, 3
+/// floats per point): J1(x, w) = integral p(w . s) L0(x, s) ds, L0 the emitted radiance
+/// attenuated on its way (through the delta-M scaled extinction, as the discrete-
+/// direction solve carries it), as 12 SH coefficients per point like
+/// MultipleScatteringField::Coefficients. With EmissionFirstScatteringApart, the solve's
+/// J plus this is the solve's J without it (to float rounding), so the first scattering,
+/// which holds most of the glow's scattered light next to a small hot source, can be
+/// computed on a finer grid than the rest. Needs options.Method DiscreteDirections
+/// (only NumberOfDirections counts). Throws std::invalid_argument as
+/// SolveMultipleScattering.
+NIMBUSPHYSICS_EXPORT std::vector<float> EmissionFirstScattering(const ExtinctionGrid& grid,
+  const CloudOptics& optics, const std::vector<float>& emission,
   const MultipleScatteringOptions& options,
   const std::function<void(double fraction)>& progress = nullptr);
 

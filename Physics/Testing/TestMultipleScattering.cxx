@@ -749,4 +749,42 @@ TEST(MultipleScatteringEmission, BadEmissionIsRefused)
     EXPECT_EQ(c, 0.0f);
   }
 }
+// The glow's first scattering apart (EmissionFirstScattering, EmissionFirstScatteringApart):
+// the solve without it plus it is the whole solve; with albedo 0 it is the whole J.
+TEST(MultipleScatteringEmission, FirstScatteringApartAddsUpToTheWhole)
+{
+  ExtinctionGrid grid = UniformCube(11, 20.0, 0.5);
+  for (std::size_t i = 0; i < grid.Extinction.size(); ++i)
+  {
+    grid.Extinction[i] *= static_cast<float>(0.5 + 0.5 * std::sin(0.37 * i));
+  }
+  CloudLighting lighting = Glowing(grid, { { 0.3, 0.2, 0.1 } });
+  lighting.Sky = [](const Vector3&) { return nimbus::Rgb{ { 0.1, 0.1, 0.1 } }; };
+  for (double albedo : { 0.0, 0.6 })
+  {
+    CloudOptics optics{ albedo, PhaseFunctionKind::CornetteShanks, 0.3 };
+    MultipleScatteringOptions options;
+    options.Orders = 400;
+    options.ExtrapolateHigherOrders = false;
+    const auto whole = nimbus::SolveMultipleScattering(grid, optics, lighting, options);
+    options.EmissionFirstScatteringApart = true;
+    const auto rest = nimbus::SolveMultipleScattering(grid, optics, lighting, options);
+    const auto first = nimbus::EmissionFirstScattering(grid, optics, lighting.Emission, options);
+    double largest = 0.0, worst = 0.0;
+    for (std::size_t q = 0; q < whole.Coefficients.size(); ++q)
+    {
+      largest = std::max(largest, static_cast<double>(std::abs(whole.Coefficients[q])));
+      worst = std::max(worst,
+        std::abs(static_cast<double>(whole.Coefficients[q]) - rest.Coefficients[q] - first[q]));
+    }
+    std::cout << "albedo " << albedo << ": whole - (rest + first) " << worst / largest
+              << " of the largest\n";
+    // Measured: 1e-7 (float sums).
+    EXPECT_LT(worst, 1e-5 * largest) << albedo;
+  }
+  MultipleScatteringOptions octaves;
+  octaves.Method = MultipleScatteringMethod::Octaves;
+  EXPECT_THROW(nimbus::EmissionFirstScattering(grid, CloudOptics(), lighting.Emission, octaves),
+    std::invalid_argument);
+}
 } // namespace

@@ -200,6 +200,107 @@ bool MultipleScatteringTexture::BuildEmission(vtkDataArray* scalars,
   return true;
 }
 
+bool MultipleScatteringTexture::FinerFirstScattering(const Request& request)
+{
+  return request.EmissionTemperature &&
+    request.Options.Method == MultipleScatteringMethod::DiscreteDirections &&
+    request.EmissionFirstScatteringDownsampling >= 1 &&
+    request.EmissionFirstScatteringDownsampling < request.Downsampling;
+}
+
+namespace
+{
+// The 12 coefficients per point of `coarse` (grid points at input sample positions
+// D i + (D - 1)/2 per axis, D = coarseFactors) interpolated trilinearly at the points
+// of a grid of `fineDimensions` with factors `fineFactors` (clamped at the edges).
+std::vector<float> Upsample(const std::vector<float>& coarse,
+  const std::array<int, 3>& coarseDimensions, const std::array<int, 3>& coarseFactors,
+  const std::array<int, 3>& fineDimensions, const std::array<int, 3>& fineFactors)
+{
+  std::array<std::vector<int>, 3> lower;
+  std::array<std::vector<float>, 3> weight;
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int i = 0; i < fineDimensions[a]; ++i)
+    {
+      const double position = fineFactors[a] * i + 0.5 * (fineFactors[a] - 1);
+      double u = (position - 0.5 * (coarseFactors[a] - 1)) / coarseFactors[a];
+      u = std::min(std::max(u, 0.0), static_cast<double>(coarseDimensions[a] - 1));
+      const int i0 = std::min(static_cast<int>(u), std::max(coarseDimensions[a] - 2, 0));
+      lower[a].push_back(i0);
+      weight[a].push_back(coarseDimensions[a] > 1 ? static_cast<float>(u - i0) : 0.0f);
+    }
+  }
+  const std::size_t nx = coarseDimensions[0], ny = coarseDimensions[1];
+  std::vector<float> fine(
+    12 * static_cast<std::size_t>(fineDimensions[0]) * fineDimensions[1] * fineDimensions[2], 0.0f);
+  std::size_t point = 0;
+  for (int k = 0; k < fineDimensions[2]; ++k)
+  {
+    for (int j = 0; j < fineDimensions[1]; ++j)
+    {
+      for (int i = 0; i < fineDimensions[0]; ++i, ++point)
+      {
+        for (int corner = 0; corner < 8; ++corner)
+        {
+          const int bit[3] = { corner & 1, (corner >> 1) & 1, (corner >> 2) & 1 };
+          const int idx[3] = { i, j, k };
+          float w = 1.0f;
+          std::size_t c[3];
+          for (int a = 0; a < 3; ++a)
+          {
+            const float f = weight[a][idx[a]];
+            w *= bit[a] ? f : 1.0f - f;
+            c[a] = static_cast<std::size_t>(
+              std::min(lower[a][idx[a]] + bit[a], coarseDimensions[a] - 1));
+          }
+          if (w == 0.0f)
+          {
+            continue;
+          }
+          const float* in = &coarse[12 * ((c[2] * ny + c[1]) * nx + c[0])];
+          for (int q = 0; q < 12; ++q)
+          {
+            fine[12 * point + q] += w * in[q];
+          }
+        }
+      }
+    }
+  }
+  return fine;
+}
+} // namespace
+
+bool MultipleScatteringTexture::AddFinerFirstScattering(vtkImageData* image, vtkDataArray* scalars,
+  bool cellData, vtkMatrix4x4* dataToWorld, const Request& request,
+  const std::array<int, 3>& coarseFactors, ExtinctionGrid& grid, std::array<int, 3>& factors,
+  std::string& error)
+{
+  Request fineRequest = request;
+  fineRequest.Downsampling = request.EmissionFirstScatteringDownsampling;
+  ExtinctionGrid fine;
+  std::array<int, 3> fineFactors{ { 1, 1, 1 } };
+  std::vector<float> emission;
+  if (!BuildGrid(image, scalars, cellData, dataToWorld, fineRequest, fine, fineFactors, error) ||
+    !BuildEmission(scalars, PlanGrid(image, cellData, fineRequest), fineRequest, emission, error))
+  {
+    return false;
+  }
+  std::vector<float> coefficients = Upsample(
+    this->Field.Coefficients, grid.Dimensions, coarseFactors, fine.Dimensions, fineFactors);
+  const std::vector<float> first =
+    EmissionFirstScattering(fine, request.Optics, emission, request.Options);
+  for (std::size_t q = 0; q < coefficients.size(); ++q)
+  {
+    coefficients[q] += first[q];
+  }
+  this->Field.Coefficients = std::move(coefficients);
+  this->Field.Dimensions = fine.Dimensions;
+  grid = std::move(fine);
+  factors = fineFactors;
+  return true;
+}
+
 bool MultipleScatteringTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
   vtkDataArray* scalars, bool cellData, vtkMatrix4x4* dataToWorld, double densityVersion,
   const Request& request, const std::function<void(double)>& progress, std::string& error)
@@ -259,6 +360,16 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
       this->LastEstimatedBytes +=
         12.0 * points + 8.0 * static_cast<double>(request.EmissionTemperature->GetNumberOfTuples());
     }
+    if (FinerFirstScattering(request))
+    {
+      // The finer grid's extinction, emission, first scattering, the solve's J on it,
+      // a source and a radiance (RGB each).
+      Request fine = request;
+      fine.Downsampling = request.EmissionFirstScatteringDownsampling;
+      const auto d = PlanGrid(image, cellData, fine).OutputDimensions;
+      this->LastEstimatedBytes +=
+        (4.0 + 12.0 + 48.0 + 48.0 + 24.0) * static_cast<double>(d[0]) * d[1] * d[2];
+    }
     if (request.BudgetBytes > 0.0 && this->LastEstimatedBytes > request.BudgetBytes)
     {
       std::ostringstream message;
@@ -283,10 +394,18 @@ bool MultipleScatteringTexture::Solve(vtkOpenGLRenderWindow* window, vtkImageDat
     error = "Multiple scattering of the glow: " + error + "; the cloud is drawn without it.";
     return false;
   }
+  MultipleScatteringOptions options = request.Options;
+  options.EmissionFirstScatteringApart = FinerFirstScattering(request);
   try
   {
-    this->Field =
-      SolveMultipleScattering(grid, request.Optics, lighting, request.Options, progress);
+    this->Field = SolveMultipleScattering(grid, request.Optics, lighting, options, progress);
+    if (options.EmissionFirstScatteringApart &&
+      !this->AddFinerFirstScattering(
+        image, scalars, cellData, dataToWorld, request, factors, grid, factors, error))
+    {
+      error = "Multiple scattering of the glow: " + error + "; the cloud is drawn without it.";
+      return false;
+    }
   }
   catch (const std::exception& problem)
   {

@@ -67,6 +67,14 @@ public:
     vtkDataArray* EmissionTemperature = nullptr;
     double EmissionRadiancePerMetre = 0.0;
     double EmissionReferenceKelvin = 1500.0;
+    /// The glow's first scattering on a finer grid, downsampled this much from the
+    /// density texture (1 ... Downsampling - 1; 0 or >= Downsampling: on the solve's
+    /// grid): next to a hot core a few density cells across, the coarse grid's first
+    /// scattering loses light (docs/smoke.md). Then the solve leaves it out
+    /// (EmissionFirstScatteringApart), EmissionFirstScattering computes it on the finer
+    /// grid, and the texture is uploaded at that grid's resolution: the solve's J
+    /// interpolated trilinearly onto it plus the first scattering.
+    int EmissionFirstScatteringDownsampling = 0;
     /// Everything the answer depends on but the density values (compared with the
     /// last solve's); the density's identity is `densityVersion`.
     std::vector<double> Key;
@@ -112,6 +120,10 @@ public:
 private:
   static bool BuildEmission(vtkDataArray* scalars, const DensityResamplePlan& plan,
     const Request& request, std::vector<float>& emission, std::string& error);
+  static bool FinerFirstScattering(const Request& request);
+  bool AddFinerFirstScattering(vtkImageData* image, vtkDataArray* scalars, bool cellData,
+    vtkMatrix4x4* dataToWorld, const Request& request, const std::array<int, 3>& coarseFactors,
+    ExtinctionGrid& grid, std::array<int, 3>& factors, std::string& error);
   bool Solve(vtkOpenGLRenderWindow* window, vtkImageData* image, vtkDataArray* scalars,
     bool cellData, vtkMatrix4x4* dataToWorld, const Request& request,
     const std::vector<double>& key, const std::function<void(double)>& progress,

@@ -1847,6 +1847,8 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
     request.EmissionTemperature = this->EmissionForSolve(frame, request.Key);
     request.EmissionRadiancePerMetre = this->EmissionRadiancePerMetre;
     request.EmissionReferenceKelvin = this->EmissionReferenceTemperatureKelvin;
+    // Its first scattering on a grid twice as fine (docs/smoke.md: the grid's effect).
+    request.EmissionFirstScatteringDownsampling = std::max(1, request.Downsampling / 2);
   }
   if (method == MultipleScatteringReferencePatterns)
   {
