@@ -524,7 +524,7 @@ public:
       this->LightTotal += light.Intensity;
       this->LightCdf.push_back(this->LightTotal);
     }
-    // The polyline segments, for their own choice at a vertex (LineNextEvent): a segment is
+    // The polyline segments, for their own choice at a vertex (SampleLine): a segment is
     // drawn there with probability LineTotal / LightTotal (the sum of the segments'
     // intensities over all the lights', as before), then among the segments by its
     // estimated contribution at the vertex.
@@ -553,12 +553,92 @@ public:
         line.Element = k;
         this->Lines.push_back(line);
         this->LineTotal += light.Intensity;
+      }
+      // In the Morton (Z-order) of their midpoints over the segments' bounding box (10 bits
+      // an axis), so that consecutive segments lie close together.
+      Vector3 lo{ { kInfinity, kInfinity, kInfinity } },
+        hi{ { -kInfinity, -kInfinity, -kInfinity } };
+      for (const LineLight& line : this->Lines)
+      {
+        for (int a = 0; a < 3; ++a)
+        {
+          const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
+          lo[a] = std::min(lo[a], mid);
+          hi[a] = std::max(hi[a], mid);
+        }
+      }
+      auto morton = [&lo, &hi](const LineLight& line)
+      {
+        std::uint64_t code = 0;
+        std::uint64_t cell[3];
+        for (int a = 0; a < 3; ++a)
+        {
+          const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
+          const double u = hi[a] > lo[a] ? (mid - lo[a]) / (hi[a] - lo[a]) : 0.0;
+          cell[a] = static_cast<std::uint64_t>(std::clamp(u * 1023.0, 0.0, 1023.0));
+        }
+        for (int bit = 9; bit >= 0; --bit)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            code = (code << 1) | ((cell[a] >> bit) & 1u);
+          }
+        }
+        return code;
+      };
+      std::stable_sort(this->Lines.begin(), this->Lines.end(),
+        [&morton](const LineLight& x, const LineLight& y) { return morton(x) < morton(y); });
+      for (const LineLight& line : this->Lines)
+      {
+        const LightElement& light = elements[line.Element];
         for (int a = 0; a < 3; ++a)
         {
           this->LineA[a].push_back(light.A[a]);
           this->LineB[a].push_back(light.B[a]);
         }
         this->LineWeightScale.push_back(std::sqrt(2.0) * light.Intensity);
+      }
+      // Clusters of ceil(sqrt(n)) consecutive segments in that order: their bounding
+      // spheres and intensities, for the first of SampleLine's two choices.
+      const std::size_t n = this->Lines.size();
+      const std::size_t size =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(std::sqrt(double(n)))));
+      for (std::size_t begin = 0; begin < n; begin += size)
+      {
+        const std::size_t end = std::min(n, begin + size);
+        Vector3 lo{ { kInfinity, kInfinity, kInfinity } },
+          hi{ { -kInfinity, -kInfinity, -kInfinity } };
+        double intensity = 0.0;
+        for (std::size_t i = begin; i < end; ++i)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            lo[a] = std::min({ lo[a], this->LineA[a][i], this->LineB[a][i] });
+            hi[a] = std::max({ hi[a], this->LineA[a][i], this->LineB[a][i] });
+          }
+          intensity += this->LineWeightScale[i] / std::sqrt(2.0);
+        }
+        LineCluster cluster;
+        cluster.Begin = begin;
+        cluster.End = end;
+        cluster.Intensity = intensity;
+        for (int a = 0; a < 3; ++a)
+        {
+          cluster.Centre[a] = 0.5 * (lo[a] + hi[a]);
+        }
+        for (std::size_t i = begin; i < end; ++i)
+        {
+          double da = 0.0, db = 0.0;
+          for (int a = 0; a < 3; ++a)
+          {
+            da += (this->LineA[a][i] - cluster.Centre[a]) * (this->LineA[a][i] - cluster.Centre[a]);
+            db += (this->LineB[a][i] - cluster.Centre[a]) * (this->LineB[a][i] - cluster.Centre[a]);
+          }
+          cluster.Radius2 = std::max({ cluster.Radius2, da, db });
+        }
+        // A cluster of one point-like segment still gets a finite weight at its centre.
+        cluster.Radius2 = std::max(cluster.Radius2, 1e-12);
+        this->LineClusters.push_back(cluster);
       }
     }
   }
@@ -716,7 +796,7 @@ private:
   double CloudPhasePeak = 1.0;
   std::vector<double> LightCdf; // cumulative intensities of the light elements, Y/sr
   double LightTotal = 0.0;
-  /// A polyline segment for LineNextEvent: first end A (m), unit axis toward B, length (m),
+  /// A polyline segment for SampleLine: first end A (m), unit axis toward B, length (m),
   /// intensity per metre (Y/(sr m)) and its index in the context's light elements.
   struct LineLight
   {
@@ -732,6 +812,17 @@ private:
   std::array<std::vector<double>, 3> LineA, LineB;
   std::vector<double> LineWeightScale;
   double LineTotal = 0.0; // the sum of the segments' intensities, Y/sr
+  /// Consecutive segments [Begin, End) of Lines: the bounding sphere of their ends (centre,
+  /// squared radius, m^2) and their intensities' sum (Y/sr).
+  struct LineCluster
+  {
+    Vector3 Centre{ { 0.0, 0.0, 0.0 } };
+    double Radius2 = 0.0;
+    double Intensity = 0.0;
+    std::size_t Begin = 0;
+    std::size_t End = 0;
+  };
+  std::vector<LineCluster> LineClusters;
   MajorantGrid Macro;
   std::vector<double> Majorant; // sigma_bar per block of Macro, 1/m
   double MinCellSize = 1.0;
@@ -1493,7 +1584,7 @@ void Integrator::LightNextEvent(
   const LightElement* chosen = &this->Context.GetLightElements()[k];
   Vector3 y = chosen->A;
   // What multiplies f T S(lambda) in the estimate, Y/(sr m^2): I_total / r^2 for a point
-  // or a segment's uniform point (set once r is known), else LineNextEvent's factor.
+  // or a segment's uniform point (set once r is known), else SampleLine's factor.
   double intensity = -1.0;
   if (chosen->IsSegment && !this->Lines.empty())
   {
@@ -1618,27 +1709,53 @@ const LightElement* Integrator::SampleLine(
   // "Importance Sampling Techniques for Path Tracing in Participating Media", EGSR 2012,
   // their equi-angular sampling with the roles of the line and the point swapped).
   //
-  // The segment: with probability w_j / W, W = sum_j w_j, where w_j estimates its
-  // unoccluded contribution I_j' Delta theta_j / h by the chord of the angle in place of
-  // the angle, w_j = I_j' 2 sin(Delta theta_j / 2) / h = sqrt(2) I_j / sqrt(q (q + a.b)),
+  // The segment, in two draws of ~sqrt(n) evaluations each (n the number of segments):
+  // first a cluster c of consecutive segments with probability u_c / U, U = sum_c u_c,
+  // u_c = I_c / max(|p - centre_c|^2, R_c^2) (its intensity over its squared distance,
+  // capped inside its bounding sphere); then a segment j of it with probability w_j / W_c,
+  // W_c = sum over the cluster, where w_j estimates its unoccluded contribution
+  // I_j' Delta theta_j / h by the chord of the angle in place of the angle,
+  // w_j = I_j' 2 sin(Delta theta_j / 2) / h = sqrt(2) I_j / sqrt(q (q + a.b)),
   // a = A_j - p, b = B_j - p, q = |a| |b| (with h = |a x b| / L_j and the half-angle
   // formula): no trigonometry, 2 square roots per segment, finite off the segment's own
   // points, and Delta theta / (2 sin(Delta theta / 2)) in [1, pi / 2], so the ratio of a
-  // segment's estimate to its probability stays within pi / 2 of W. Any positive w_j keeps
-  // the estimate unbiased.
-  const std::size_t n = this->Lines.size();
+  // segment's estimate to its probability stays within pi / 2 of W_c U / u_c. Any positive
+  // u_c and w_j keep the estimate unbiased.
+  const std::size_t clusters = this->LineClusters.size();
   std::vector<double>& cdf = state.LineWeights;
-  cdf.resize(n);
-  const double* ax = this->LineA[0].data();
-  const double* ay = this->LineA[1].data();
-  const double* az = this->LineA[2].data();
-  const double* bx = this->LineB[0].data();
-  const double* by = this->LineB[1].data();
-  const double* bz = this->LineB[2].data();
-  const double* scale = this->LineWeightScale.data();
+  cdf.resize(std::max(clusters, this->LineClusters.front().End));
+  double clusterTotal = 0.0;
+  for (std::size_t c = 0; c < clusters; ++c)
+  {
+    const LineCluster& cluster = this->LineClusters[c];
+    const double d0 = cluster.Centre[0] - p[0], d1 = cluster.Centre[1] - p[1],
+                 d2 = cluster.Centre[2] - p[2];
+    clusterTotal += cluster.Intensity / std::max(d0 * d0 + d1 * d1 + d2 * d2, cluster.Radius2);
+    cdf[c] = clusterTotal;
+  }
+  if (!(clusterTotal > 0.0) || !std::isfinite(clusterTotal))
+  {
+    return nullptr;
+  }
+  const std::size_t c = std::min(clusters - 1,
+    static_cast<std::size_t>(
+      std::upper_bound(cdf.begin(), cdf.begin() + clusters, rng.Uniform() * clusterTotal) -
+      cdf.begin()));
+  const double uc = cdf[c] - (c > 0 ? cdf[c - 1] : 0.0);
+  const LineCluster& cluster = this->LineClusters[c];
+  const std::size_t n = cluster.End - cluster.Begin;
+  cdf.resize(std::max(cdf.size(), n));
+  const double* ax = this->LineA[0].data() + cluster.Begin;
+  const double* ay = this->LineA[1].data() + cluster.Begin;
+  const double* az = this->LineA[2].data() + cluster.Begin;
+  const double* bx = this->LineB[0].data() + cluster.Begin;
+  const double* by = this->LineB[1].data() + cluster.Begin;
+  const double* bz = this->LineB[2].data() + cluster.Begin;
+  const double* scale = this->LineWeightScale.data() + cluster.Begin;
   const double px = p[0], py = p[1], pz = p[2];
   // LineLightWeight on the structure of arrays (the same operations, so the same values).
-  auto weight = [=](std::size_t i)
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
   {
     const double a0 = ax[i] - px, a1 = ay[i] - py, a2 = az[i] - pz;
     const double b0 = bx[i] - px, b1 = by[i] - py, b2 = bz[i] - pz;
@@ -1646,22 +1763,19 @@ const LightElement* Integrator::SampleLine(
     const double ab = a0 * b0 + a1 * b1 + a2 * b2;
     const double q = std::sqrt(aa * bb);
     // 1e-300 m^4: p on the segment itself (a set of zero measure) still gets a finite weight.
-    return scale[i] / std::sqrt(std::max(q * (q + ab), 1e-300));
-  };
-  double total = 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    total += weight(i);
+    total += scale[i] / std::sqrt(std::max(q * (q + ab), 1e-300));
     cdf[i] = total;
   }
   if (!(total > 0.0) || !std::isfinite(total))
   {
     return nullptr;
   }
-  const std::size_t j = std::min(n - 1,
+  const std::size_t k = std::min(n - 1,
     static_cast<std::size_t>(
-      std::upper_bound(cdf.begin(), cdf.end(), rng.Uniform() * total) - cdf.begin()));
-  const double wj = weight(j);
+      std::upper_bound(cdf.begin(), cdf.begin() + n, rng.Uniform() * total) - cdf.begin()));
+  // The probabilities as the draws realise them: differences of the cumulative sums.
+  const double wj = cdf[k] - (k > 0 ? cdf[k - 1] : 0.0);
+  const std::size_t j = cluster.Begin + k;
   const LineLight& line = this->Lines[j];
   SegmentAngleSample sample;
   if (!(wj > 0.0) ||
@@ -1671,8 +1785,8 @@ const LightElement* Integrator::SampleLine(
   }
   y = sample.Point;
   // I_j' Delta theta / h over the probability (LineTotal / LightTotal) (w_j / W).
-  intensity =
-    line.PerMetre * sample.AngleOverDistance * (total / wj) * (this->LightTotal / this->LineTotal);
+  intensity = line.PerMetre * sample.AngleOverDistance * (clusterTotal / uc) * (total / wj) *
+    (this->LightTotal / this->LineTotal);
   return &this->Context.GetLightElements()[line.Element];
 }
 
