@@ -544,18 +544,17 @@ void pqNimbusFirstApplyBehavior::onRepresentationAdded(pqRepresentation* represe
   if (IsLightningIllumination(data->getInput()))
   {
     // A flash is seen at night: the cloud's own sun below the horizon (a Nimbus Sky in
-    // the view still sets the sun for both), and the frame at the return stroke.
-    AfterApply(this, data,
-      [](pqDataRepresentation* lit)
-      {
-        vtkSMProxy* proxy = lit->getProxy();
-        if (proxy->GetProperty("SunElevationDegrees"))
-        {
-          vtkSMPropertyHelper(proxy, "SunElevationDegrees").Set(kNightSunElevationDegrees);
-          proxy->UpdateVTKObjects();
-        }
-        ShowLightningPeak(lit);
-      });
+    // the view still sets the sun for both), and the frame at the return stroke. The sun
+    // is set now, before anything renders the new representation: set after Apply (as
+    // the time is), a render of Apply's or a script's own would first draw the cloud
+    // in daylight.
+    vtkSMProxy* proxy = data->getProxy();
+    if (proxy->GetProperty("SunElevationDegrees"))
+    {
+      vtkSMPropertyHelper(proxy, "SunElevationDegrees").Set(kNightSunElevationDegrees);
+      proxy->UpdateVTKObjects();
+    }
+    AfterApply(this, data, [](pqDataRepresentation* lit) { ShowLightningPeak(lit); });
   }
 
   // The camera: only for the first data in the view (a sky background does not count).

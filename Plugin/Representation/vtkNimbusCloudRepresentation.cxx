@@ -587,6 +587,29 @@ NIMBUS_FORWARD(MaximumLights, int)
 
 // The units' conversion depends on the frame: the mixing ratio's standard
 // atmosphere (altitudes) and the estimate (column lengths in metres).
+// The mapper draws a frame as interactive when the render window's desired update rate
+// is at least its InteractiveUpdateRate (ParaView's still renders ask about 0.002 frames/s):
+// at its least, 1e-6 frames/s, every frame is. Only the mapper changes (no Modified() here:
+// the representation's data is not prepared again).
+void vtkNimbusCloudRepresentation::SetPlaybackInteractive(bool value)
+{
+  if (value == this->PlaybackInteractive)
+  {
+    return;
+  }
+  this->PlaybackInteractive = value;
+  vtkNimbusCloudVolumeMapper* mapper = this->CloudMapper;
+  if (value)
+  {
+    this->StillInteractiveUpdateRate = mapper->GetInteractiveUpdateRate();
+    mapper->SetInteractiveUpdateRate(mapper->GetInteractiveUpdateRateMinValue());
+  }
+  else
+  {
+    mapper->SetInteractiveUpdateRate(this->StillInteractiveUpdateRate);
+  }
+}
+
 bool vtkNimbusCloudRepresentation::UnitsDependOnFrame() const
 {
   return (this->DensityUnits == static_cast<int>(nimbus::DensityUnits::LiquidWaterMixingRatio) &&

@@ -256,6 +256,12 @@ public:
   double GetFrameBudgetMilliseconds();
   void SetQuality(double value);
   double GetQuality();
+  /// While on, every frame is drawn as an interactive one (the frame budget's reduced
+  /// work), also ParaView's still renders: the GUI turns it on while an animation plays
+  /// (a flash relit at every time step) and off when it stops, then renders once at full
+  /// quality. Not saved in state files. Off by default.
+  void SetPlaybackInteractive(bool value);
+  bool GetPlaybackInteractive() const { return this->PlaybackInteractive; }
   ///@}
 
   ///@{
@@ -387,6 +393,8 @@ protected:
   double Turbidity = 2.0;
   double MieScatteringOverride = -1.0;
   double FogVisibilityMetres = 0.0;
+  bool PlaybackInteractive = false;
+  double StillInteractiveUpdateRate = 1.0; // the mapper's, kept while PlaybackInteractive
 
   /// The light map's file name (the mapper holds the image read from it).
   std::string LightMapFile;
