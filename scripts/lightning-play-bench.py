@@ -109,6 +109,9 @@ def main():
                         metavar=("PROPERTY", "VALUE"),
                         help="a property of the illumination filter (a number), e.g. "
                         "FirstScatteringOnDensityGrid 0")
+    parser.add_argument("--strokes", action="store_true",
+                        help="the lightning's strokes (port 0) as the filter's Lightning input, "
+                        "not its point sources (port 1)")
     parser.add_argument("--json")
     arguments = parser.parse_args()
     cache = arguments.cache_dir or tempfile.mkdtemp(prefix="nimbus-play-bench-")
@@ -125,7 +128,8 @@ def main():
 
     cloud = globals()["NimbusMetaballCloud"]()
     bolt = globals()["NimbusLightning"]()
-    lit = globals()["NimbusLightningIllumination"](Input=cloud, Lightning=OutputPort(bolt, 1),
+    port = 0 if arguments.strokes else 1
+    lit = globals()["NimbusLightningIllumination"](Input=cloud, Lightning=OutputPort(bolt, port),
                                                    CacheDirectory=cache)
     for name, value in arguments.filter_set:
         setattr(lit, name, float(value) if "." in value else int(value))

@@ -2,7 +2,7 @@
 
     /usr/bin/python3 scripts/lightning-play-gui.py \
         --plugin-dir build/lib/paraview-5.11/plugins/Nimbus --output-dir DIR \
-        [--cache-dir DIR] [--play X Y]
+        [--cache-dir DIR] [--play X Y] [--strokes]
 
 Without a DISPLAY the script starts its own Xvfb (1920x1200) and stops it at the end. A fresh
 `paraview` (fresh settings folder, --dr) runs a start-up script that builds what a user builds
@@ -39,7 +39,7 @@ view = GetActiveViewOrCreate("RenderView")
 view.OrientationAxesVisibility = 0
 cloud = NimbusMetaballCloud()
 bolt = NimbusLightning()
-lit = NimbusLightningIllumination(Input=cloud, Lightning=OutputPort(bolt, 1),
+lit = NimbusLightningIllumination(Input=cloud, Lightning=OutputPort(bolt, %(port)d),
                                   CacheDirectory=%(cache)r)
 Show(bolt, view)
 display = Show(lit, view)
@@ -137,6 +137,7 @@ def run(args):
     if os.path.exists(log):
         os.remove(log)
     setup = SETUP % {"log": log, "cache": os.path.abspath(args.cache_dir),
+                     "port": 0 if args.strokes else 1,
                      "plugin": os.path.join(os.path.abspath(args.plugin_dir), "Nimbus.so")}
     paraview = start_paraview(args.paraview, setup, output, "home", args.plugin_dir,
                               args.python_path, os.path.join(output, "paraview.log"))
@@ -202,6 +203,9 @@ def main():
                      "site-packages")))
     parser.add_argument("--play", type=int, nargs=2, default=[592, 41],
                         help="where the VCR toolbar's Play button is (screen pixels)")
+    parser.add_argument("--strokes", action="store_true",
+                        help="the lightning's strokes (port 0) as the filter's Lightning input, "
+                        "not its point sources (port 1)")
     args = parser.parse_args()
     os.makedirs(args.output_dir, exist_ok=True)
     if os.environ.get("DISPLAY"):

@@ -111,10 +111,10 @@ void pqNimbusPlaybackBehavior::onEndPlay(vtkObject*, unsigned long, void*, void*
     }
   }
   this->Interactive.clear();
-  // The frame the play stopped at, at full quality, now (not at the next idle moment: a
-  // script that plays and then saves a screenshot gets it).
+  // The frame the play stopped at, at full quality: one render once the event loop runs
+  // (the property's change above asks the views for one too; the two are one render).
   for (pqView* view : views)
   {
-    view->forceRender();
+    view->render();
   }
 }
