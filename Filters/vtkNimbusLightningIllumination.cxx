@@ -387,15 +387,21 @@ int vtkNimbusLightningIllumination::RequestData(
     }
     if (this->FirstScatteringOnDensityGrid)
     {
+      // Grouped by brightness when the sources say their peak (the lightning source does).
+      vtkDataArray* peakIntensity = lightning->GetPointData()->GetArray("peak_intensity");
       std::vector<nimbus::ScalarPointSource> scalar;
-      for (const nimbus::PointLight& s : sources)
+      std::vector<double> peaks;
+      for (vtkIdType i = 0; i < lightning->GetNumberOfPoints(); ++i)
       {
+        const nimbus::PointLight& s = sources[i];
         if (nimbus::IsFinite(s.Position) && std::isfinite(s.Intensity[0]) && s.Intensity[0] >= 0)
         {
           scalar.push_back({ s.Position, s.Intensity[0] });
+          const double peak = peakIntensity ? peakIntensity->GetComponent(i, 0) : 0.0;
+          peaks.push_back(std::isfinite(peak) ? peak : 0.0);
         }
       }
-      this->Internals->FirstScatteringGroups = nimbus::GroupPointSources(scalar);
+      this->Internals->FirstScatteringGroups = nimbus::GroupPointSources(scalar, peaks);
     }
   }
   for (nimbus::PointLight& s : sources)

@@ -211,20 +211,36 @@ int vtkNimbusLightningSource::RequestData(
 
   const std::vector<nimbus::PointLight> lights =
     nimbus::LightningPointSources(lit, this->PointSourceSpacing);
+  // The same sources at their segments' peak (the segments lit now, unscaled): the
+  // brightness of each source is intensity / peak_intensity, as on the strokes.
+  std::vector<nimbus::LightningSegment> litAtPeak;
+  for (std::size_t i = 0; i < segments.size(); ++i)
+  {
+    if (lit[i].Intensity != 0.0)
+    {
+      litAtPeak.push_back(segments[i]);
+    }
+  }
+  const std::vector<nimbus::PointLight> peaks =
+    nimbus::LightningPointSources(litAtPeak, this->PointSourceSpacing);
   vtkNew<vtkPoints> sourcePoints;
   sourcePoints->SetDataTypeToDouble();
   vtkNew<vtkCellArray> vertices;
-  vtkNew<vtkDoubleArray> sourceIntensity;
+  vtkNew<vtkDoubleArray> sourceIntensity, sourcePeak;
   sourceIntensity->SetName("intensity");
-  for (const nimbus::PointLight& light : lights)
+  sourcePeak->SetName("peak_intensity");
+  const bool aligned = peaks.size() == lights.size();
+  for (std::size_t i = 0; i < lights.size(); ++i)
   {
-    const vtkIdType id = sourcePoints->InsertNextPoint(light.Position.data());
+    const vtkIdType id = sourcePoints->InsertNextPoint(lights[i].Position.data());
     vertices->InsertNextCell(1, &id);
-    sourceIntensity->InsertNextValue(light.Intensity[0]);
+    sourceIntensity->InsertNextValue(lights[i].Intensity[0]);
+    sourcePeak->InsertNextValue(aligned ? peaks[i].Intensity[0] : lights[i].Intensity[0]);
   }
   sources->SetPoints(sourcePoints);
   sources->SetVerts(vertices);
   sources->GetPointData()->AddArray(sourceIntensity);
+  sources->GetPointData()->AddArray(sourcePeak);
   sources->GetPointData()->SetActiveScalars("intensity");
   this->UpdateProgress(1.0);
   return 1;

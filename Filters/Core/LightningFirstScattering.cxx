@@ -44,13 +44,23 @@ LightningSourceGroup Normalised(std::vector<ScalarPointSource> sources, double s
   return group;
 }
 
+// Brightness classes: one class's brightness is computed alike for all of its segments,
+// but float arrays round intensity and peak apart, so classes are told apart at 1e-5.
+long long BrightnessClass(double brightness)
+{
+  return std::llround(std::log(brightness) * 1e5);
+}
+
+// The group's positions and relative intensities, the latter to 1e-6 (float rounding of
+// an intensity scaled by the same factor must not make a new group).
 std::uint64_t GroupKey(std::uint64_t gridHash, const LightningSourceGroup& group)
 {
   std::uint64_t h = gridHash;
   for (const ScalarPointSource& s : group.Sources)
   {
     HashBytes(h, s.Position.data(), sizeof(double) * 3);
-    HashBytes(h, &s.Intensity, sizeof(double));
+    const long long relative = std::llround(s.Intensity * 1e6);
+    HashBytes(h, &relative, sizeof(relative));
   }
   return h;
 }
@@ -73,9 +83,7 @@ std::uint64_t HashExtinctionGrid(const ExtinctionGrid& grid)
 std::vector<LightningSourceGroup> GroupLightningSegments(
   const std::vector<LightningSegment>& segments, const std::vector<double>& peaks, double spacing)
 {
-  // Brightness relative to the peak -> the segments at their peak intensity. The
-  // brightness of one class of segments is computed alike for all of them, but the
-  // strokes' float arrays round intensity and peak apart: classes are told apart at 1e-5.
+  // Brightness relative to the peak -> the segments at their peak intensity.
   struct Class
   {
     double BrightnessSum = 0.0;
@@ -92,7 +100,7 @@ std::vector<LightningSourceGroup> GroupLightningSegments(
     const double brightness = peaked ? segments[s].Intensity / peaks[s] : 1.0;
     LightningSegment atPeak = segments[s];
     atPeak.Intensity = peaked ? peaks[s] : segments[s].Intensity;
-    Class& c = classes[std::llround(std::log(brightness) * 1e5)];
+    Class& c = classes[BrightnessClass(brightness)];
     c.BrightnessSum += brightness;
     c.Segments.push_back(atPeak);
   }
@@ -114,14 +122,35 @@ std::vector<LightningSourceGroup> GroupLightningSegments(
   return groups;
 }
 
-std::vector<LightningSourceGroup> GroupPointSources(const std::vector<ScalarPointSource>& sources)
+std::vector<LightningSourceGroup> GroupPointSources(
+  const std::vector<ScalarPointSource>& sources, const std::vector<double>& peaks)
 {
-  LightningSourceGroup group = Normalised(sources, 1.0);
-  if (group.Scale > 0.0)
+  std::map<long long, std::pair<double, std::vector<ScalarPointSource>>> classes;
+  for (std::size_t k = 0; k < sources.size(); ++k)
   {
-    return { group };
+    if (!(sources[k].Intensity > 0.0))
+    {
+      continue;
+    }
+    const bool peaked = k < peaks.size() && peaks[k] > 0.0;
+    const double brightness = peaked ? sources[k].Intensity / peaks[k] : 1.0;
+    ScalarPointSource atPeak = sources[k];
+    atPeak.Intensity = peaked ? peaks[k] : sources[k].Intensity;
+    auto& c = classes[BrightnessClass(brightness)];
+    c.first += brightness;
+    c.second.push_back(atPeak);
   }
-  return {};
+  std::vector<LightningSourceGroup> groups;
+  for (auto& entry : classes)
+  {
+    const double brightness = entry.second.first / entry.second.second.size();
+    LightningSourceGroup group = Normalised(std::move(entry.second.second), brightness);
+    if (group.Scale > 0.0)
+    {
+      groups.push_back(std::move(group));
+    }
+  }
+  return groups;
 }
 
 FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGrid& grid,

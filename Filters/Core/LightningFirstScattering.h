@@ -40,8 +40,10 @@ struct LightningSourceGroup
 std::vector<LightningSourceGroup> GroupLightningSegments(
   const std::vector<LightningSegment>& segments, const std::vector<double>& peaks, double spacing);
 
-/// One group of point sources (its intensities relative to the largest).
-std::vector<LightningSourceGroup> GroupPointSources(const std::vector<ScalarPointSource>& sources);
+/// Groups of point sources by brightness: source k shines at sources[k].Intensity, its
+/// peak is peaks[k] (empty: one group of all, its intensities relative to the largest).
+std::vector<LightningSourceGroup> GroupPointSources(
+  const std::vector<ScalarPointSource>& sources, const std::vector<double>& peaks);
 
 /// The groups' fields, computed once per grid and group and kept (see the file comment).
 class LightningFirstScatteringCache
