@@ -23,7 +23,8 @@ and the median of each pixel's standard error over its value. --reference-only s
 there (no Nimbus render); --reference-seconds is --time-limit; --threads sets the path
 tracer's threads. The path tracer samples each channel segment uniformly in the angle it
 subtends at a vertex (docs/ground-truth.md, "Line lights"): a 900 s reference on 2 cores
-reaches ~5 % (RMS standard error / mean) on this scene.
+(--time-limit 900) has an RMS standard error of 0.40 of the mean and a median per-pixel
+relative standard error of 0.17 on this scene.
 """
 import argparse
 import json

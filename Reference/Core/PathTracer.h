@@ -293,7 +293,8 @@ NIMBUSREFERENCE_EXPORT bool SampleSegmentByAngle(const Vector3& p, const Vector3
 /// The density pdf(s) of SampleSegmentByAngle, 1/m (0 outside [0, length]).
 NIMBUSREFERENCE_EXPORT double SegmentAngleDensity(
   const Vector3& p, const Vector3& a, const Vector3& axis, double length, double s);
-/// The weight by which the path tracer chooses among line segments at a vertex p: the
+/// The weight by which the path tracer chooses among the line segments of a cluster (after
+/// choosing the cluster by its intensity over its squared distance) at a vertex p: the
 /// segment [a, b] of total intensity I (Y/sr, I_l = I / L per metre) gets
 ///   w = I_l 2 sin(Delta theta / 2) / h = sqrt(2) I / sqrt(q (q + (a - p).(b - p))),
 /// q = |a - p| |b - p|, Y/(sr m^2): the chord of the subtended angle in place of the angle
