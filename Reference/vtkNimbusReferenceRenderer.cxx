@@ -452,10 +452,12 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     settings.MemoryBudgetBytes = std::max(1.0, renderBudget);
     settings.TimeLimitSeconds = this->TimeLimitSeconds;
     settings.TargetImageRelativeError = this->TargetImageRelativeError;
+    settings.LightTracing = this->LightTracing;
+    settings.LightPathsPerBatch = static_cast<std::uint64_t>(this->LightPathsPerBatch);
     this->CurrentImageRelativeError = 0.0;
     this->CurrentSamplesPerPixel = 0.0;
     this->EstimatedSecondsToTarget = 0.0;
-    if (this->TargetImageRelativeError > 0.0)
+    if (this->TargetImageRelativeError > 0.0 && !this->LightTracing)
     {
       // Before the render, a pilot's forecast of the time to the target; said when it
       // is over the time limit (or over an hour without one).
@@ -558,6 +560,8 @@ void vtkNimbusReferenceRenderer::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TimeLimitSeconds: " << this->TimeLimitSeconds << "\n";
   os << indent << "TargetImageRelativeError: " << this->TargetImageRelativeError << "\n";
   os << indent << "EstimatedSecondsToTarget: " << this->EstimatedSecondsToTarget << "\n";
+  os << indent << "LightTracing: " << this->LightTracing << "\n";
+  os << indent << "LightPathsPerBatch: " << this->LightPathsPerBatch << "\n";
   os << indent << "MaxScatteringOrder: " << this->MaxScatteringOrder << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";

@@ -109,6 +109,20 @@ public:
   ///@}
 
   ///@{
+  /// Path tracing by light tracing (nimbus::PathTracingSettings::LightTracing): paths from
+  /// the lights connected to the camera at every scattering vertex, in batches whose spread
+  /// gives the standard error; Min/MaxSamplesPerPixel then count light paths per pixel
+  /// (LightPathsPerBatch a batch, 0: max(1024, pixels)). For scenes lit only by point, spot
+  /// and polyline lights in the cloud's media (no sun, background radiance, atmosphere,
+  /// ground, occluders or emission; others are an error that says so). Default off.
+  vtkSetMacro(LightTracing, bool);
+  vtkGetMacro(LightTracing, bool);
+  vtkBooleanMacro(LightTracing, bool);
+  vtkSetClampMacro(LightPathsPerBatch, int, 0, 1 << 30);
+  vtkGetMacro(LightPathsPerBatch, int);
+  ///@}
+
+  ///@{
   /// Path tracing: stop after the first round of samples that ends past
   /// TimeLimitSeconds (s), or whose image-wide relative error (RMS standard error
   /// over RMS radiance) is at or below TargetImageRelativeError; 0 = no such stop.
@@ -170,6 +184,8 @@ protected:
   int MaxScatteringOrder = 0;
   int Seed = 1;
   double TimeLimitSeconds = 0.0;
+  bool LightTracing = false;
+  int LightPathsPerBatch = 0;
   double TargetImageRelativeError = 0.0;
   double EstimatedSecondsToTarget = 0.0;
   double CurrentImageRelativeError = 0.0;

@@ -271,7 +271,12 @@ def configure_reference_renderer(renderer, settings, threads=0):
         renderer.SetRelativeTolerance(settings.get("tolerance", 1e-3))
         renderer.SetMaxRefinements(settings.get("max_refinements", 6))
     else:
+        # "path": camera paths; "light": light tracing (paths from the lights connected to
+        # the camera; min_spp / max_spp count light paths per pixel, light_paths_per_batch
+        # a batch, 0 = max(1024, pixels); only scenes lit by point, spot and polyline lights).
         renderer.SetModeToPathTracing()
+        renderer.SetLightTracing(mode == "light")
+        renderer.SetLightPathsPerBatch(settings.get("light_paths_per_batch", 0))
         renderer.SetMinSamplesPerPixel(settings.get("min_spp", 16))
         renderer.SetMaxSamplesPerPixel(settings.get("max_spp", 256))
         renderer.SetTargetRelativeError(settings.get("target_error", 0.0))

@@ -380,6 +380,46 @@ struct PathState
   bool Truncated = false;
 };
 
+/// The pinhole camera as light tracing projects onto it: position, unit forward, right and
+/// up, the tangents of the half angles across the image's width and height, the image's
+/// size, and the importance's constant 1 / s^2, s = 2 tan(half height angle) / height the
+/// side of a pixel on the image plane at distance 1.
+struct LightCamera
+{
+  Vector3 Position{ { 0.0, 0.0, 0.0 } };
+  Vector3 Forward{ { 0.0, 0.0, 1.0 } }, Right{ { 1.0, 0.0, 0.0 } }, Up{ { 0.0, 1.0, 0.0 } };
+  double TanX = 1.0, TanY = 1.0;
+  int Width = 1, Height = 1;
+  double InversePixelArea = 1.0;
+
+  explicit LightCamera(const Camera& camera)
+    : Position(camera.GetPosition())
+    , Width(camera.GetWidth())
+    , Height(camera.GetHeight())
+  {
+    // Camera keeps its frame to itself; RayDirection(x, y) is the unit vector of
+    // F + sx R + sy U with sx = (2x/W - 1) TanX and sy = (2y/H - 1) TanY.
+    const double w = this->Width, h = this->Height;
+    this->Forward = camera.RayDirection(0.5 * w, 0.5 * h);
+    auto axis = [this](const Vector3& d, Vector3& unit, double& tangent)
+    {
+      const double c = Dot(d, this->Forward);
+      Vector3 v{ { d[0] / c - this->Forward[0], d[1] / c - this->Forward[1],
+        d[2] / c - this->Forward[2] } };
+      tangent = std::sqrt(Dot(v, v));
+      for (double& x : v)
+      {
+        x /= tangent;
+      }
+      unit = v;
+    };
+    axis(camera.RayDirection(w, 0.5 * h), this->Right, this->TanX);
+    axis(camera.RayDirection(0.5 * w, h), this->Up, this->TanY);
+    const double side = 2.0 * this->TanY / h;
+    this->InversePixelArea = 1.0 / (side * side);
+  }
+};
+
 class Integrator
 {
 public:
@@ -666,6 +706,11 @@ public:
   /// One camera path through image point (x, y); the spectral estimate goes to
   /// state.Radiance, its linear sRGB to rgb.
   void TracePath(double x, double y, PathRandom& rng, PathState& state, double rgb[3]) const;
+  /// Light tracing (PathTracingSettings::LightTracing): one path from the lights, its
+  /// connections to the camera added to `image` (linear sRGB, 3 values a pixel, row 0 at the
+  /// bottom; the sum over a batch's paths divided by their number is the image's estimate).
+  void TraceLightPath(
+    const LightCamera& camera, PathRandom& rng, PathState& state, std::vector<double>& image) const;
 
 private:
   Ray MakeRay(const Vector3& origin, const Vector3& direction) const
@@ -740,6 +785,11 @@ private:
   /// the densities where the segment's altitude spans at most two of the smaller scale
   /// height (see the definition), else by that exact integral.
   void LightAirTransmittance(const Vector3& p, const Vector3& y, std::vector<double>& out) const;
+  /// Light tracing: the connection of a cloud scattering event at p (the light arriving
+  /// along `incoming`) to the camera; state.SavedWeight holds the light's emitted spectrum
+  /// over its sampling density, state.Weight the path's throughput since.
+  void ConnectToCamera(const LightCamera& camera, const Vector3& p, const Vector3& incoming,
+    PathRandom& rng, PathState& state, std::vector<double>& image) const;
   /// Adds the media's emission at a tentative collision charged to the cloud.
   void AddEmission(const Vector3& p, double cloudMajorant, PathState& state) const;
   /// Which medium scattered at a real cloud scattering event at p.
@@ -2420,6 +2470,170 @@ void Integrator::TracePath(
   }
 }
 
+void Integrator::TraceLightPath(
+  const LightCamera& camera, PathRandom& rng, PathState& state, std::vector<double>& image) const
+{
+  const int n = this->Wavelengths;
+  state.Weight.assign(n, 1.0);
+  state.Steps = 0;
+  state.Truncated = false;
+  state.Medium = 0;
+  state.EquiAngular = false;
+  // The light element k with probability P_k = I_k / I_total, a point y uniform on it
+  // (density 1 / length on a segment), a direction w uniform on the sphere (1 / 4 pi) or in
+  // a spot's cone (1 / (2 pi (1 - cos cone))): the path starts with the element's emitted
+  // intensity toward w per unit length, I_k beam(w) / length, over the density of (k, y, w),
+  //   I_total beam(w) / p(w),
+  // times the light's spectrum (luminance 1), the light-tracing counterpart of
+  // LightNextEvent's I_total / r^2.
+  const double u = rng.Uniform() * this->LightTotal;
+  const std::size_t k = std::min(this->LightCdf.size() - 1,
+    static_cast<std::size_t>(
+      std::upper_bound(this->LightCdf.begin(), this->LightCdf.end(), u) - this->LightCdf.begin()));
+  const LightElement& light = this->Context.GetLightElements()[k];
+  Vector3 origin = light.A;
+  if (light.IsSegment)
+  {
+    const double v = rng.Uniform();
+    for (int a = 0; a < 3; ++a)
+    {
+      origin[a] = light.A[a] + v * (light.B[a] - light.A[a]);
+    }
+  }
+  Vector3 direction;
+  double scale;
+  if (light.IsSpot)
+  {
+    const double cosCone = std::cos(light.Spot.ConeHalfAngleDegrees * kPi / 180.0);
+    const double mu = cosCone + (1.0 - cosCone) * rng.Uniform();
+    direction = DirectionFromCosine(light.Spot.Axis, mu, rng.Uniform());
+    scale = this->LightTotal * LightElementFactor(light, direction) * 2.0 * kPi * (1.0 - cosCone);
+  }
+  else
+  {
+    const double mu = 2.0 * rng.Uniform() - 1.0;
+    direction = DirectionFromCosine({ { 0.0, 0.0, 1.0 } }, mu, rng.Uniform());
+    scale = 4.0 * kPi * this->LightTotal;
+  }
+  if (!(scale > 0.0))
+  {
+    return;
+  }
+  const std::vector<double>& spectrum = this->Context.GetLightSpectra()[light.Light];
+  state.SavedWeight.resize(n);
+  for (int i = 0; i < n; ++i)
+  {
+    state.SavedWeight[i] = scale * spectrum[i];
+  }
+  const int maxOrder = this->Settings.MaxScatteringOrder;
+  const int rouletteOrder = this->Settings.RussianRouletteOrder;
+  auto uniform = [&rng]() { return rng.Uniform(); };
+  Ray ray = this->MakeRay(origin, direction);
+  for (int order = 0;;)
+  {
+    // No air, ground or occluders (LightTracingUnsupported): outside the cloud's box the
+    // path has left the scene.
+    if (!ray.CrossesCloud)
+    {
+      break;
+    }
+    double t;
+    Scatterer scatterer = Scatterer::None;
+    const FlightEnd end = this->FreeFlight(ray, ray.CloudFar, rng, state, t, scatterer);
+    if (end != FlightEnd::Collision || scatterer != Scatterer::Cloud)
+    {
+      break;
+    }
+    const Vector3 p = Along(ray.Origin, ray.Direction, t);
+    ++order;
+    this->ConnectToCamera(camera, p, ray.Direction, rng, state, image);
+    if (state.Truncated || (maxOrder > 0 && order >= maxOrder))
+    {
+      break;
+    }
+    const PhaseFunctionMixture& phase = this->CloudPhaseAt(state);
+    direction = DirectionFromCosine(ray.Direction, phase.Sample(uniform), rng.Uniform());
+    // Russian roulette on the largest spectral throughput, as camera paths.
+    if (rouletteOrder >= 0 && order >= rouletteOrder)
+    {
+      const double survive =
+        std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
+      if (!(survive > 0.0) || rng.Uniform() >= survive)
+      {
+        break;
+      }
+      for (int i = 0; i < n; ++i)
+      {
+        state.Weight[i] /= survive;
+      }
+    }
+    ray = this->MakeRay(p, direction);
+  }
+}
+
+void Integrator::ConnectToCamera(const LightCamera& camera, const Vector3& p,
+  const Vector3& incoming, PathRandom& rng, PathState& state, std::vector<double>& image) const
+{
+  // The pixel value is the radiance averaged over the pixel's square on the image plane,
+  // I = int L(w) W(w) dw with W = dA_pixel / dw = 1 / (s^2 cos^3 theta) (s the pixel's
+  // side at distance 1, theta between w and the forward axis) inside the pixel. A vertex
+  // at distance d from the camera seen along w (dw dt = dV / d^2) contributes
+  //   throughput x f(incoming . w_c) x T(p, camera) x W(w) / d^2,
+  // w_c = -w the direction toward the camera (the light arrives along `incoming`).
+  Vector3 toCamera{ { camera.Position[0] - p[0], camera.Position[1] - p[1],
+    camera.Position[2] - p[2] } };
+  const double d2 = Dot(toCamera, toCamera);
+  const double d = std::sqrt(d2);
+  if (!(d > 0.0) || !std::isfinite(d))
+  {
+    return;
+  }
+  for (double& c : toCamera)
+  {
+    c /= d;
+  }
+  const double cosine = -Dot(toCamera, camera.Forward);
+  if (!(cosine > 0.0))
+  {
+    return;
+  }
+  const double sx = -Dot(toCamera, camera.Right) / cosine;
+  const double sy = -Dot(toCamera, camera.Up) / cosine;
+  const double px = 0.5 * camera.Width * (sx / camera.TanX + 1.0);
+  const double py = 0.5 * camera.Height * (sy / camera.TanY + 1.0);
+  if (!(px >= 0.0 && px < camera.Width && py >= 0.0 && py < camera.Height))
+  {
+    return;
+  }
+  const double f = this->CloudPhaseAt(state).Evaluate(Dot(incoming, toCamera));
+  const double unoccluded = f * camera.InversePixelArea / (cosine * cosine * cosine * d2);
+  if (!(unoccluded > 0.0))
+  {
+    return;
+  }
+  // Ratio tracking to the camera, with its Russian roulette below a transmittance of 0.1:
+  // through a thick cloud most connections end after a few steps.
+  const double cloud = this->CloudTransmittance(p, toCamera, rng, state, d);
+  if (!(cloud > 0.0))
+  {
+    return;
+  }
+  const int i = std::min(camera.Width - 1, static_cast<int>(px));
+  const int j = std::min(camera.Height - 1, static_cast<int>(py));
+  double* out = &image[3 * (static_cast<std::size_t>(j) * camera.Width + i)];
+  const int n = this->Wavelengths;
+  const double k0 = unoccluded * cloud;
+  for (int c = 0; c < 3; ++c)
+  {
+    double sum = 0.0;
+    for (int w = 0; w < n; ++w)
+    {
+      sum += this->ToRgb[c * n + w] * state.Weight[w] * state.SavedWeight[w];
+    }
+    out[c] += k0 * sum;
+  }
+}
+
 /// Running mean and M2 (Welford 1962) of the three channels and their mean.
 struct PixelStatistics
 {
@@ -2480,6 +2694,200 @@ double ImageRelativeError(const std::vector<PixelStatistics>& statistics)
     }
   }
   return sumValue > 0.0 ? std::sqrt(sumError / sumValue) : 0.0;
+}
+
+/// Light tracing (PathTracingSettings::LightTracing): batches of light paths, each batch
+/// one sample of the whole image traced by one thread into its own buffer; the batches'
+/// images enter the pixels' running statistics in batch order, so the result does not
+/// depend on the thread count. Rounds of batches until MaxSamplesPerPixel light paths per
+/// pixel, the time limit or the image target.
+PathTracingResult RenderLightTraced(const RenderContext& context,
+  const PathTracingSettings& settings, const std::function<void(double)>& progress)
+{
+  const std::string unsupported = LightTracingUnsupported(context);
+  if (!unsupported.empty())
+  {
+    throw std::invalid_argument(unsupported);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const LightCamera camera(context.GetCamera());
+  const std::size_t pixels = static_cast<std::size_t>(camera.Width) * camera.Height;
+  const std::uint64_t perBatch = settings.LightPathsPerBatch > 0
+    ? settings.LightPathsPerBatch
+    : std::max<std::uint64_t>(1024, pixels);
+  auto batchesFor = [&](int samplesPerPixel)
+  {
+    const double paths = static_cast<double>(samplesPerPixel) * static_cast<double>(pixels);
+    return std::max<std::uint64_t>(
+      2, static_cast<std::uint64_t>(std::ceil(paths / static_cast<double>(perBatch))));
+  };
+  const std::uint64_t maxBatches = batchesFor(settings.MaxSamplesPerPixel);
+  const int threads = ResolveThreadCount(settings.Threads);
+  // A round holds at most this many batch images (3 doubles a pixel each).
+  const std::uint64_t roundCap =
+    std::max<std::uint64_t>(2, 4 * static_cast<std::uint64_t>(threads));
+  {
+    const double bytes = static_cast<double>(pixels) *
+      (static_cast<double>(sizeof(PixelStatistics)) + 2 * 3 * sizeof(float) +
+        static_cast<double>(roundCap) * 3 * sizeof(double));
+    const double budget = settings.MemoryBudgetBytes > 0.0
+      ? settings.MemoryBudgetBytes
+      : static_cast<double>(DefaultMemoryBudgetBytes());
+    const std::string message =
+      OverBudgetMessage("the light tracer's per-pixel buffers", bytes, budget);
+    if (!message.empty())
+    {
+      throw std::length_error(message);
+    }
+  }
+  const Integrator integrator(context, settings);
+  std::vector<PixelStatistics> statistics(pixels);
+  std::atomic<std::uint64_t> paths{ 0 }, truncated{ 0 };
+  std::atomic<bool> stop{ false };
+  const std::thread::id caller = std::this_thread::get_id();
+  const double totalPaths = static_cast<double>(maxBatches) * static_cast<double>(perBatch);
+  auto report = [&]()
+  {
+    if (progress)
+    {
+      progress(std::min(1.0, static_cast<double>(paths.load()) / totalPaths));
+    }
+  };
+  // Light paths use the generator's pixel slot 2^42 + batch (camera paths: the pixel).
+  constexpr std::uint64_t kLightStreams = std::uint64_t(1) << 42;
+  std::uint64_t done = 0;
+  std::uint64_t target = std::min(maxBatches, batchesFor(settings.MinSamplesPerPixel));
+  int rounds = 0;
+  bool stoppedAtTimeLimit = false, reachedImageTarget = false;
+  double roundStart = 0.0;
+  std::vector<std::vector<double>> images;
+  while (done < maxBatches)
+  {
+    const std::uint64_t count = std::min(target - done, roundCap);
+    images.assign(count, std::vector<double>());
+    ParallelFor(count, 1, threads,
+      [&](std::size_t begin, std::size_t end)
+      {
+        PathState state;
+        const bool reporter = progress && std::this_thread::get_id() == caller;
+        for (std::size_t b = begin; b < end; ++b)
+        {
+          std::vector<double> image(3 * pixels, 0.0);
+          std::uint64_t localTruncated = 0;
+          for (std::uint64_t path = 0; path < perBatch; ++path)
+          {
+            PathRandom rng(settings.Seed, kLightStreams + done + b, path);
+            integrator.TraceLightPath(camera, rng, state, image);
+            localTruncated += state.Truncated ? 1 : 0;
+            if ((path & 255u) == 255u)
+            {
+              paths += 256;
+              if (stop.load(std::memory_order_relaxed))
+              {
+                return;
+              }
+              if (reporter)
+              {
+                try
+                {
+                  report();
+                }
+                catch (...)
+                {
+                  stop = true;
+                  throw;
+                }
+              }
+            }
+          }
+          paths += perBatch & 255u;
+          truncated += localTruncated;
+          images[b] = std::move(image);
+        }
+      });
+    const double inverse = 1.0 / static_cast<double>(perBatch);
+    for (const std::vector<double>& image : images)
+    {
+      for (std::size_t k = 0; k < pixels; ++k)
+      {
+        const double rgb[3] = { image[3 * k] * inverse, image[3 * k + 1] * inverse,
+          image[3 * k + 2] * inverse };
+        statistics[k].Add(rgb);
+      }
+    }
+    done += count;
+    ++rounds;
+    report();
+    const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double imageError = ImageRelativeError(statistics);
+    if (settings.OnRound)
+    {
+      PathTracingRound round;
+      round.Round = rounds;
+      round.MeanSamplesPerPixel = static_cast<double>(paths.load()) / static_cast<double>(pixels);
+      round.Seconds = elapsed;
+      round.ImageRelativeError = imageError;
+      round.Pixels = pixels;
+      round.ActivePixels = done < maxBatches ? pixels : 0;
+      settings.OnRound(round);
+    }
+    if (settings.TargetImageRelativeError > 0.0 && imageError <= settings.TargetImageRelativeError)
+    {
+      reachedImageTarget = true;
+      break;
+    }
+    if (settings.TimeLimitSeconds > 0.0 && elapsed >= settings.TimeLimitSeconds)
+    {
+      stoppedAtTimeLimit = true;
+      break;
+    }
+    // The next round: up to twice the batches so far; with a time limit, the batches that
+    // fit in the time left at this round's cost (a multiple of the threads, at least one
+    // a thread).
+    std::uint64_t next = std::max(target, std::min(maxBatches, 2 * done));
+    if (settings.TimeLimitSeconds > 0.0)
+    {
+      const double perBatchSeconds = (elapsed - roundStart) / static_cast<double>(count);
+      const double fit = (settings.TimeLimitSeconds - elapsed) / std::max(perBatchSeconds, 1e-9);
+      std::uint64_t add = static_cast<std::uint64_t>(std::max(0.0, fit)) /
+        static_cast<std::uint64_t>(threads) * static_cast<std::uint64_t>(threads);
+      add = std::max<std::uint64_t>(add, static_cast<std::uint64_t>(threads));
+      next = std::min(next, done + add);
+    }
+    target = std::min(maxBatches, std::max(next, done + 1));
+    roundStart = elapsed;
+  }
+
+  PathTracingResult result;
+  result.Image = FloatImage(camera.Width, camera.Height);
+  result.StandardError = FloatImage(camera.Width, camera.Height);
+  for (std::size_t k = 0; k < pixels; ++k)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      result.Image.Pixels[3 * k + c] = static_cast<float>(statistics[k].Mean[c]);
+      result.StandardError.Pixels[3 * k + c] = static_cast<float>(statistics[k].StandardError(c));
+    }
+  }
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error("RenderPathTraced (light tracing): the image has " + nonFinite);
+  }
+  result.Paths = paths.load();
+  result.TruncatedPaths = truncated.load();
+  result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
+  result.ImageRelativeError = ImageRelativeError(result.Image, result.StandardError);
+  result.StoppedAtTimeLimit = stoppedAtTimeLimit;
+  result.ReachedImageTarget = reachedImageTarget;
+  result.Rounds = rounds;
+  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return result;
 }
 } // namespace
 
@@ -2686,6 +3094,10 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   {
     throw std::invalid_argument(
       "RenderPathTraced: TimeLimitSeconds and TargetImageRelativeError must be >= 0");
+  }
+  if (settings.LightTracing)
+  {
+    return RenderLightTraced(context, settings, progress);
   }
   const auto start = std::chrono::steady_clock::now();
   const Camera& camera = context.GetCamera();
@@ -2915,6 +3327,58 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     progress(1.0);
   }
   return result;
+}
+
+std::string LightTracingUnsupported(const RenderContext& context)
+{
+  std::vector<std::string> reasons;
+  double lights = 0.0;
+  for (const LightElement& light : context.GetLightElements())
+  {
+    lights += light.Intensity;
+  }
+  if (!(lights > 0.0))
+  {
+    reasons.push_back("no light of positive intensity");
+  }
+  auto positive = [](const std::vector<double>& v)
+  { return std::any_of(v.begin(), v.end(), [](double x) { return x > 0.0; }); };
+  if (positive(context.GetSunIrradiance()))
+  {
+    reasons.push_back("a sun of illuminance > 0");
+  }
+  if (positive(context.GetBackgroundRadiance()))
+  {
+    reasons.push_back("a background radiance > 0");
+  }
+  if (context.HasAtmosphere())
+  {
+    reasons.push_back("the atmosphere enabled");
+  }
+  if (context.HasGround())
+  {
+    reasons.push_back("the ground enabled");
+  }
+  if (!context.GetOccluders().IsEmpty())
+  {
+    reasons.push_back("occluders");
+  }
+  if (context.HasEmission())
+  {
+    reasons.push_back("emitting media");
+  }
+  if (reasons.empty())
+  {
+    return std::string();
+  }
+  std::string message = "light tracing renders only scenes lit by point, spot and polyline "
+                        "lights in the cloud's media (no sun, background radiance, atmosphere, "
+                        "ground, occluders or emission); this scene has ";
+  for (std::size_t i = 0; i < reasons.size(); ++i)
+  {
+    message += (i == 0 ? "" : (i + 1 == reasons.size() ? " and " : ", ")) + reasons[i];
+  }
+  return message + ": render it with camera paths (LightTracing off)";
 }
 
 bool SampleSegmentByAngle(const Vector3& p, const Vector3& a, const Vector3& axis, double length,

@@ -27,6 +27,11 @@
 //    normal, weight x albedo; albedo 0 ends the path) and block the shadow rays of the sun
 //    and of every light. Neither runs, or draws a random number, in scenes without it.
 //
+//  - Light tracing (PathTracingSettings::LightTracing; docs/ground-truth.md, "Light
+//    tracing"): for scenes lit only by point, spot and polyline lights, paths start at the
+//    lights and connect to the pinhole camera at every scattering vertex (RenderLightTraced);
+//    the standard error comes from batches of light paths.
+//
 //  - Free flights: delta tracking against a piecewise-constant majorant
 //    sigma_bar(t) = cloud block majorant (max density of a 4^3-voxel block of the
 //    MajorantGrid x ExtinctionPerDensity, the blocks visited by an incremental 3-D DDA,
@@ -108,6 +113,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 
 namespace nimbus
 {
@@ -194,6 +200,24 @@ struct NIMBUSREFERENCE_EXPORT PathTracingSettings
   double TargetImageRelativeError = 0.0;
   /// Called on the calling thread after each round (for a progress display).
   std::function<void(const PathTracingRound&)> OnRound;
+  /// Light tracing instead of camera paths (docs/ground-truth.md, "Light tracing"): paths
+  /// start at the lights (an element chosen by intensity, a point uniform on a segment, a
+  /// direction uniform on the sphere or in a spot's cone) and at every scattering vertex
+  /// connect to the pinhole camera (ratio tracking to it, with its Russian roulette below
+  /// a transmittance of 0.1), adding to the pixel the connection passes through. The
+  /// camera's importance is normalised so that the image is the box-filtered radiance of
+  /// the camera path tracer with PixelJitter. Paths come in batches of LightPathsPerBatch;
+  /// each batch is one sample of the whole image, and a pixel's standard error is that of
+  /// the mean over the batches. MinSamplesPerPixel and MaxSamplesPerPixel then count light
+  /// paths per pixel (at least 2 batches); TargetRelativeError and AdaptiveSampling do not
+  /// apply. Only for scenes lit by point, spot and polyline lights in the cloud's media:
+  /// RenderPathTraced throws std::invalid_argument (LightTracingUnsupported's message) for a
+  /// sun of illuminance > 0, a background radiance > 0, the atmosphere, the ground,
+  /// occluders, emitting media or no light. Deterministic for a Seed and any thread count
+  /// (each batch is traced by one thread; batches are summed in order).
+  bool LightTracing = false;
+  /// Light tracing: light paths per batch (0 = max(1024, pixels)).
+  std::uint64_t LightPathsPerBatch = 0;
 };
 
 /// The state after one round of samples.
@@ -270,6 +294,10 @@ NIMBUSREFERENCE_EXPORT PathTracingEstimate EstimatePathTracingTime(const RenderC
 /// and std::range_error when the image has a NaN or infinite pixel component.
 NIMBUSREFERENCE_EXPORT PathTracingResult RenderPathTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress = {});
+
+/// Why light tracing (PathTracingSettings::LightTracing) cannot render the context's scene,
+/// or "" when it can.
+NIMBUSREFERENCE_EXPORT std::string LightTracingUnsupported(const RenderContext& context);
 
 /// Line lights (AngularLineLightSampling). A point y(s) = a + s axis of the segment from a
 /// along the unit axis, s in [0, length] (m), seen from p: drawn uniformly in the angle

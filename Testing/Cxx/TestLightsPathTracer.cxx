@@ -848,3 +848,203 @@ TEST(LightsPathTracer, LineLightSamplersAgreeInAThickMedium)
   EXPECT_LE(agreement.Outliers, 1);
   EXPECT_LT(std::abs(agreement.ImageSumZ), 4.0);
 }
+
+//------------------------------------------------------------------------------
+// Light tracing (PathTracingSettings::LightTracing): paths from the lights connected to the
+// camera at every scattering vertex, against the camera path tracer on the same scene,
+// pixel by pixel and image sum within their combined standard errors.
+namespace
+{
+/// The light tracer on `context`: `batches` batches of `perBatch` light paths.
+PathTracingResult LightTraced(
+  const RenderContext& context, int batches, int perBatch, std::uint64_t seed, int threads = 2)
+{
+  const int pixels = context.GetCamera().GetWidth() * context.GetCamera().GetHeight();
+  PathTracingSettings settings;
+  settings.LightTracing = true;
+  settings.LightPathsPerBatch = static_cast<std::uint64_t>(perBatch);
+  settings.MinSamplesPerPixel = batches * perBatch / pixels;
+  settings.MaxSamplesPerPixel = settings.MinSamplesPerPixel;
+  settings.Seed = seed;
+  settings.Threads = threads;
+  return nimbus::RenderPathTraced(context, settings);
+}
+
+void ExpectAgreement(const PathTracingResult& light, const PathTracingResult& camera,
+  int pixelChannels, const char* what)
+{
+  const nimbus_test::ImageAgreement agreement = nimbus_test::CompareMonteCarloImages(light, camera);
+  std::printf("%s, light vs camera paths: RMS z %.3f over %d pixel channels, %d beyond 4 "
+              "sigma; image sum z %.2f (its relative se %.2f %%); %.2f s vs %.2f s\n",
+    what, agreement.RmsZ, agreement.Count, agreement.Outliers, agreement.ImageSumZ,
+    100.0 * agreement.ImageSumRelativeError, light.Seconds, camera.Seconds);
+  EXPECT_TRUE(agreement.Finite) << what;
+  EXPECT_EQ(agreement.Count, pixelChannels) << what;
+  EXPECT_LE(agreement.Outliers, 1) << what;
+  EXPECT_LT(agreement.RmsZ, 1.5) << what;
+  EXPECT_LT(std::abs(agreement.ImageSumZ), 4.0) << what;
+  EXPECT_LT(agreement.ImageSumRelativeError, 0.05) << what;
+}
+} // namespace
+
+// A point light off-centre in a homogeneous scattering box (tau 1 across, albedo 0.9,
+// Henyey-Greenstein g = 0.5, so the phase function's direction convention matters), seen
+// from outside on 6 x 6 pixels.
+TEST(LightsPathTracer, LightTracingAgreesWithCameraPathsPointLight)
+{
+  const V lo{ { -50.0, -50.0, -50.0 } }, hi{ { 50.0, 50.0, 50.0 } };
+  SceneDescription scene = DarkScene({ { 30.0, -300.0, 20.0 } }, { { 0.0, 0.0, 0.0 } }, 6);
+  scene.Camera.ViewAngle = 26.0;
+  scene.Medium.ExtinctionPerDensity = 0.01;
+  scene.Medium.SingleScatteringAlbedo = 0.9;
+  scene.Medium.Phase = { { "henyey_greenstein", 0.5, 1.0 } };
+  scene.Lights = { PointLight({ { 15.0, 10.0, -20.0 } }, 5000.0, 4000.0) };
+  const RenderContext context(scene, DensityGrid::Constant(lo, hi, 1.0f));
+  PathTracingSettings settings = Samples(32768, 71, 0);
+  settings.PixelJitter = true;
+  const PathTracingResult camera = nimbus::RenderPathTraced(context, settings);
+  const PathTracingResult light = LightTraced(context, 512, 4096, 72);
+  ExpectAgreement(light, camera, 3 * 36, "point light in a scattering box");
+  // Per seed, whatever the thread count.
+  const PathTracingResult one = LightTraced(context, 4, 1024, 73, 1);
+  const PathTracingResult two = LightTraced(context, 4, 1024, 73, 3);
+  EXPECT_EQ(one.Image.Pixels, two.Image.Pixels);
+  EXPECT_EQ(one.StandardError.Pixels, two.StandardError.Pixels);
+  EXPECT_DOUBLE_EQ(one.MeanSamplesPerPixel, 4.0 * 1024.0 / 36.0);
+}
+
+// A spot light (cone 40 degrees, soft edge 10 degrees) in the same box: the light paths'
+// directions drawn in the cone, weighted by the beam's profile.
+TEST(LightsPathTracer, LightTracingAgreesWithCameraPathsSpotLight)
+{
+  const V lo{ { -50.0, -50.0, -50.0 } }, hi{ { 50.0, 50.0, 50.0 } };
+  SceneDescription scene = DarkScene({ { 30.0, -300.0, 20.0 } }, { { 0.0, 0.0, 0.0 } }, 4);
+  scene.Camera.ViewAngle = 26.0;
+  scene.Medium.ExtinctionPerDensity = 0.01;
+  scene.Medium.SingleScatteringAlbedo = 0.9;
+  scene.Medium.Phase = { { "henyey_greenstein", 0.5, 1.0 } };
+  LightDescription spot = PointLight({ { 15.0, 10.0, -20.0 } }, 5000.0, 4000.0);
+  spot.Type = "spot";
+  spot.Direction = { { -0.3, -1.0, 0.5 } };
+  spot.ConeAngleDegrees = 40.0;
+  spot.EdgeDegrees = 10.0;
+  scene.Lights = { spot };
+  const RenderContext context(scene, DensityGrid::Constant(lo, hi, 1.0f));
+  PathTracingSettings settings = Samples(16384, 75, 0);
+  settings.PixelJitter = true;
+  const PathTracingResult camera = nimbus::RenderPathTraced(context, settings);
+  const PathTracingResult light = LightTraced(context, 256, 4096, 76);
+  ExpectAgreement(light, camera, 3 * 16, "spot light in a scattering box");
+}
+
+// A polyline light of two segments in an optically thick box (tau 8 across, albedo 0.99,
+// Cornette-Shanks g = 0.85): multiple scattering of high orders, the camera connections'
+// ratio tracking through the thick medium with its roulette. The medium keeps 10 m clear
+// of the channel (a grid of 5 m spacing, 0 at its points within 10 m) so that the camera
+// paths' estimate of the light stays bounded and their standard error can be trusted.
+TEST(LightsPathTracer, LightTracingAgreesWithCameraPathsSegmentInThickBox)
+{
+  const V lo{ { -50.0, -50.0, -50.0 } }, hi{ { 50.0, 50.0, 50.0 } };
+  SceneDescription scene = DarkScene({ { 0.0, -300.0, 0.0 } }, { { 0.0, 0.0, 0.0 } }, 4);
+  scene.Camera.ViewAngle = 24.0;
+  scene.Medium.ExtinctionPerDensity = 0.08;
+  scene.Medium.SingleScatteringAlbedo = 0.99;
+  scene.Medium.Phase = { { "cornette_shanks", 0.85, 1.0 } };
+  const std::vector<V> channel{ { { -20.0, 5.0, 30.0 } }, { { 0.0, -10.0, 0.0 } },
+    { { 15.0, 0.0, -35.0 } } };
+  scene.Lights = { Polyline(channel, 40.0) };
+  auto toChannel = [&channel](const V& x)
+  {
+    double nearest = 1e300;
+    for (std::size_t k = 0; k + 1 < channel.size(); ++k)
+    {
+      const V& a = channel[k];
+      const V ab{ { channel[k + 1][0] - a[0], channel[k + 1][1] - a[1],
+        channel[k + 1][2] - a[2] } };
+      const V ax{ { x[0] - a[0], x[1] - a[1], x[2] - a[2] } };
+      const double s = std::clamp(nimbus::Dot(ax, ab) / nimbus::Dot(ab, ab), 0.0, 1.0);
+      nearest = std::min(
+        nearest, Distance(x, { { a[0] + s * ab[0], a[1] + s * ab[1], a[2] + s * ab[2] } }));
+    }
+    return nearest;
+  };
+  std::vector<float> density;
+  for (int k = 0; k <= 20; ++k)
+    for (int j = 0; j <= 20; ++j)
+      for (int i = 0; i <= 20; ++i)
+      {
+        const V x{ { -50.0 + 5.0 * i, -50.0 + 5.0 * j, -50.0 + 5.0 * k } };
+        density.push_back(toChannel(x) < 10.0 ? 0.0f : 1.0f);
+      }
+  const RenderContext context(
+    scene, DensityGrid({ { 21, 21, 21 } }, lo, { { 5.0, 5.0, 5.0 } }, density));
+  PathTracingSettings settings = Samples(16384, 81, 0);
+  settings.PixelJitter = true;
+  const PathTracingResult camera = nimbus::RenderPathTraced(context, settings);
+  const PathTracingResult light = LightTraced(context, 256, 4096, 82);
+  ExpectAgreement(light, camera, 3 * 16, "segment light in a thick box");
+}
+
+// What light tracing does not render is refused with a message that names it.
+TEST(LightsPathTracer, LightTracingRefusesWhatItDoesNotRender)
+{
+  const V lo{ { -50.0, -50.0, -50.0 } }, hi{ { 50.0, 50.0, 50.0 } };
+  SceneDescription base = DarkScene({ { 0.0, -300.0, 0.0 } }, { { 0.0, 0.0, 0.0 } }, 2);
+  base.Medium.ExtinctionPerDensity = 0.01;
+  base.Lights = { PointLight({ { 0.0, 0.0, 0.0 } }, 100.0) };
+  auto refusal = [&](const SceneDescription& scene) -> std::string
+  {
+    const RenderContext context(scene, DensityGrid::Constant(lo, hi, 1.0f));
+    EXPECT_EQ(nimbus::LightTracingUnsupported(context).empty(), false);
+    try
+    {
+      LightTraced(context, 2, 64, 1);
+    }
+    catch (const std::invalid_argument& error)
+    {
+      return error.what();
+    }
+    return "(no error)";
+  };
+  {
+    const RenderContext context(base, DensityGrid::Constant(lo, hi, 1.0f));
+    EXPECT_EQ(nimbus::LightTracingUnsupported(context), "");
+  }
+  SceneDescription sun = base;
+  sun.Sun.Illuminance = 1.0;
+  EXPECT_NE(refusal(sun).find("a sun of illuminance > 0"), std::string::npos);
+  SceneDescription background = base;
+  background.Background.Type = "constant";
+  background.Background.Radiance = 0.5;
+  EXPECT_NE(refusal(background).find("a background radiance > 0"), std::string::npos);
+  SceneDescription ground = base;
+  ground.Ground.Enabled = true;
+  ground.Ground.Height = -100.0;
+  EXPECT_NE(refusal(ground).find("the ground"), std::string::npos);
+  SceneDescription air = base;
+  air.Atmosphere.Enabled = true;
+  air.Background.Type = "black";
+  EXPECT_NE(refusal(air).find("the atmosphere"), std::string::npos);
+  SceneDescription occluded = base;
+  nimbus::OccluderDescription box;
+  box.Min = { { 60.0, 60.0, 60.0 } };
+  box.Max = { { 70.0, 70.0, 70.0 } };
+  box.Albedo = 0.5;
+  occluded.Occluders = { box };
+  EXPECT_NE(refusal(occluded).find("occluders"), std::string::npos);
+  SceneDescription emitting = base;
+  emitting.Medium.Emission.Enabled = true;
+  emitting.Medium.Emission.RadiancePerMetre = 1.0;
+  EXPECT_NE(refusal(emitting).find("emitting media"), std::string::npos);
+  SceneDescription dark = base;
+  dark.Lights.clear();
+  const std::string both = [&]
+  {
+    SceneDescription s = dark;
+    s.Ground.Enabled = true;
+    s.Ground.Height = -100.0;
+    return refusal(s);
+  }();
+  std::printf("light tracing's refusal: %s\n", both.c_str());
+  EXPECT_NE(both.find("no light of positive intensity and the ground"), std::string::npos);
+}
