@@ -674,6 +674,22 @@ int vtkNimbusLightningIllumination::RequestData(
   return 1;
 }
 
+// The forward peak the solver folds into the beam (delta-M: f = k_2 of the cloud's phase
+// function, as MultipleScattering.cxx's truncation takes it), which the first scattering
+// must give back (FirstScatteringForwardPeak).
+nimbus::FirstScatteringForwardPeak vtkNimbusLightningIllumination::ForwardPeak() const
+{
+  nimbus::CloudOptics optics;
+  optics.Albedo = this->Albedo;
+  optics.G = this->CloudG;
+  const double k1 = nimbus::PhaseLegendreCoefficient(optics, 1);
+  const double k2 = nimbus::PhaseLegendreCoefficient(optics, 2);
+  nimbus::FirstScatteringForwardPeak peak;
+  peak.Fraction = (k2 > 0.0 && k1 > k2 && k2 < 0.999) ? k2 : 0.0;
+  peak.Albedo = this->Albedo;
+  return peak;
+}
+
 void vtkNimbusLightningIllumination::AddFirstScattering(
   vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars, bool cellData)
 {
@@ -712,7 +728,8 @@ void vtkNimbusLightningIllumination::AddFirstScattering(
   nimbus::FirstScatteringField field;
   try
   {
-    field = in.FirstScattering.Evaluate(grid, in.FirstScatteringGroups, this->NumberOfThreads,
+    field = in.FirstScattering.Evaluate(grid, in.FirstScatteringGroups, this->ForwardPeak(),
+      this->NumberOfThreads,
       [this](double fraction)
       {
         if (this->CheckAbort())

@@ -67,6 +67,7 @@ class vtkImageData;
 namespace nimbus
 {
 struct MultipleScatteringField;
+struct FirstScatteringForwardPeak;
 }
 
 class NIMBUSFILTERS_EXPORT vtkNimbusLightningIllumination : public vtkImageAlgorithm
@@ -238,6 +239,7 @@ private:
     vtkFieldData* fieldData, const nimbus::MultipleScatteringField& field, bool cellData);
   void AddFirstScattering(
     vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars, bool cellData);
+  nimbus::FirstScatteringForwardPeak ForwardPeak() const;
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

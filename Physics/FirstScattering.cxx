@@ -110,9 +110,11 @@ std::vector<char> WantedPoints(const ExtinctionGrid& grid)
 class SourcePass
 {
 public:
-  SourcePass(const ExtinctionGrid& grid, const std::vector<char>& wanted,
-    std::vector<float>& meanExtinction, std::vector<double>& sum)
+  SourcePass(const ExtinctionGrid& grid, const FirstScatteringForwardPeak& peak,
+    const std::vector<char>& wanted, std::vector<float>& meanExtinction, std::vector<double>& sum)
     : Grid(grid)
+    , Peak(peak.Fraction)
+    , Reduced(1.0 - peak.Fraction * peak.Albedo)
     , Wanted(wanted)
     , MeanExtinction(meanExtinction)
     , Sum(sum)
@@ -228,10 +230,30 @@ private:
     {
       this->MeanExtinction[index] = 0.0f;
     }
-    if (tau < kOpaque && this->Wanted[index])
+    if (this->Reduced * tau < kOpaque && this->Wanted[index])
     {
-      this->Add(index, i, j, k, n, std::exp(-tau));
+      this->Add(index, i, j, k, n, this->Transmittance(tau));
     }
+  }
+
+  // T' = f exp(-tau) + (1 - f) exp(-(1 - f albedo) tau) (FirstScatteringForwardPeak).
+  double Transmittance(double tau) const
+  {
+    const double plain = std::exp(-tau);
+    return this->Peak > 0.0
+      ? this->Peak * plain + (1.0 - this->Peak) * std::exp(-this->Reduced * tau)
+      : plain;
+  }
+
+  // integral over [t0, t1] of exp(-sigma r) dr (the chord itself when sigma r << 1).
+  static double ChordTransmittance(double sigma, double t0, double t1)
+  {
+    if (!(t1 > t0))
+    {
+      return 0.0;
+    }
+    return sigma * (t1 - t0) > 1e-6 ? (std::exp(-sigma * t0) - std::exp(-sigma * t1)) / sigma
+                                    : (t1 - t0) * std::exp(-sigma * t0);
   }
 
   double StepLength(const int d[3], double inverse) const
@@ -311,13 +333,11 @@ private:
         tNear = std::max(tNear, t0);
         tFar = std::min(tFar, t1);
       }
-      // integral over the chord of exp(-sigma r) dr: the cell's transmittance from the
-      // source, the extinction taken as the point's (the chord itself when sigma r << 1).
-      const double chord = tFar > tNear
-        ? (sigma * (tFar - tNear) > 1e-6
-              ? (std::exp(-sigma * tNear) - std::exp(-sigma * tFar)) / sigma
-              : (tFar - tNear) * std::exp(-sigma * tNear))
-        : 0.0;
+      // integral over the chord of T'(sigma r) dr: the cell's transmittance from the
+      // source, the extinction taken as the point's.
+      const double chord = this->Peak > 0.0 ? this->Peak * ChordTransmittance(sigma, tNear, tFar) +
+          (1.0 - this->Peak) * ChordTransmittance(this->Reduced * sigma, tNear, tFar)
+                                            : ChordTransmittance(sigma, tNear, tFar);
       chords += chord;
       for (int a = 0; a < 3; ++a)
       {
@@ -351,6 +371,8 @@ private:
   }
 
   const ExtinctionGrid& Grid;
+  const double Peak;                  // f
+  const double Reduced;               // 1 - f albedo
   const std::vector<char>& Wanted;    // points whose E a renderer can use
   std::vector<float>& MeanExtinction; // tau / r from the source's grid point [1/m]
   Vector3 CentreIndex{ { 0, 0, 0 } }; // the source's centre in grid coordinates
@@ -360,9 +382,13 @@ private:
 };
 } // namespace
 
-std::string CheckFirstScatteringInput(
-  const ExtinctionGrid& grid, const std::vector<ScalarPointSource>& sources)
+std::string CheckFirstScatteringInput(const ExtinctionGrid& grid,
+  const std::vector<ScalarPointSource>& sources, const FirstScatteringForwardPeak& peak)
 {
+  if (!(peak.Fraction >= 0.0 && peak.Fraction < 1.0) || !(peak.Albedo >= 0.0 && peak.Albedo <= 1.0))
+  {
+    return "the forward peak's fraction must be in [0, 1) and the albedo in [0, 1]";
+  }
   CloudLighting none;
   none.HasSun = false;
   const std::string gridProblem =
@@ -387,9 +413,9 @@ std::string CheckFirstScatteringInput(
 
 FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
   const std::vector<ScalarPointSource>& sources, int threads,
-  const std::function<void(double)>& progress)
+  const std::function<void(double)>& progress, const FirstScatteringForwardPeak& peak)
 {
-  const std::string problem = CheckFirstScatteringInput(grid, sources);
+  const std::string problem = CheckFirstScatteringInput(grid, sources, peak);
   if (!problem.empty())
   {
     throw std::invalid_argument("nimbus::ComputeFirstScattering: " + problem);
@@ -417,7 +443,7 @@ FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
       {
         for (std::size_t w = begin; w < end; ++w)
         {
-          SourcePass pass(grid, wanted, taus[w], sums[w]);
+          SourcePass pass(grid, peak, wanted, taus[w], sums[w]);
           for (std::size_t s = first + w; s < last; s += workers)
           {
             pass.Run(merged[s]);
@@ -474,18 +500,11 @@ FirstScatteringField CombineFirstScattering(
   return out;
 }
 
-double EvaluateFirstScattering(
-  const float* values, const Vector3& w, const std::function<double(double)>& phase)
+double EvaluateFirstScattering(const float* values, const Vector3& w, double k1)
 {
-  const double e = std::max(0.0, static_cast<double>(values[0]));
-  const Vector3 f{ { values[1], values[2], values[3] } };
-  const double directed = std::min(e, Length(f));
-  const double isotropic = (e - directed) / (4.0 * kPi);
-  if (!(directed > 0.0))
-  {
-    return isotropic;
-  }
-  return directed * phase(Dot(f, w) / Length(f)) + isotropic;
+  const double e = values[0];
+  const double f = values[1] * w[0] + values[2] * w[1] + values[3] * w[2];
+  return std::max(0.0, (e + 3.0 * k1 * f) / (4.0 * kPi));
 }
 
 } // namespace nimbus

@@ -10,12 +10,14 @@
 // direction-weighted sum (the net flux of the sources' light):
 //     E(x) = sum_k I_k T(x, s_k) / r_k^2                          [intensity units / m^2]
 //     F(x) = sum_k I_k T(x, s_k) / r_k^2 w_k,  w_k = (x - s_k) / r_k (direction of travel)
-// so that the in-scattered radiance per unit scattering coefficient of the first order is
+// so that the in-scattered radiance per unit scattering coefficient of the first order,
 //     J1(x, w) = sum_k E_k p(w . w_k)                               (003 Eq. 1's first term)
-// which a renderer rebuilds as a lobe: J1(w) ~ |F| p(w . F/|F|) + (E - |F|) / (4 pi), exact
-// for one source and for sources seen in one direction, isotropic where their light
-// arrives from all around (a point on the channel). The cloud's scattering coefficient
-// sigma_s multiplies it where it is drawn.
+// is, in degree-1 spherical harmonics as the solver keeps J (MultipleScattering.h),
+//     J1(w) = (E + 3 k_1 F . w) / (4 pi),  k_1 the phase function's mean cosine.
+// (A lobe |F| p(w . F/|F|) + (E - |F|) / (4 pi), exact for one point source, was measured
+// darker than the path tracer next to a lightning channel, whose light arrives in a fan of
+// directions: docs/lightning.md.) The cloud's scattering coefficient sigma_s multiplies
+// it where it is drawn.
 //
 // Transmittance T(x, s) = exp(-tau): tau is carried outward from the grid point nearest
 // the source: a point's tau is its predecessor's, one grid step toward the source along
@@ -61,6 +63,21 @@ struct NIMBUSPHYSICS_EXPORT ScalarPointSource
   double Intensity = 0.0;
 };
 
+/// The forward peak the multiple-scattering solver folds into the direction of travel
+/// (delta-M, Wiscombe 1977; MultipleScatteringField::ForwardPeakFraction): a fraction f of
+/// the scattering stays in the beam, so the solver's orders >= 2 start from the beam
+/// through the reduced extinction (1 - f albedo) sigma_t. The first scattering that goes
+/// with them is then the one the mapper draws for the sun (cloudLight.glsl,
+/// SunMultipleScattering): sigma_s p(mu) E with the transmittance
+///     T' = f exp(-tau) + (1 - f) exp(-(1 - f albedo) tau)
+/// in place of exp(-tau), the light scattered once into the peak and then out of the beam
+/// (f = 0: the plain first scattering).
+struct NIMBUSPHYSICS_EXPORT FirstScatteringForwardPeak
+{
+  double Fraction = 0.0; // f in [0, 1)
+  double Albedo = 1.0;   // the medium's single-scattering albedo
+};
+
 /// The sources' unscattered irradiance on the grid (see the file comment).
 struct NIMBUSPHYSICS_EXPORT FirstScatteringField
 {
@@ -73,9 +90,11 @@ struct NIMBUSPHYSICS_EXPORT FirstScatteringField
 };
 
 /// "" or what is wrong: a bad grid (the solver's checks), sources with non-finite
-/// positions or negative or non-finite intensity.
-NIMBUSPHYSICS_EXPORT std::string CheckFirstScatteringInput(
-  const ExtinctionGrid& grid, const std::vector<ScalarPointSource>& sources);
+/// positions or negative or non-finite intensity, a forward peak outside [0, 1) or an
+/// albedo outside [0, 1].
+NIMBUSPHYSICS_EXPORT std::string CheckFirstScatteringInput(const ExtinctionGrid& grid,
+  const std::vector<ScalarPointSource>& sources,
+  const FirstScatteringForwardPeak& peak = FirstScatteringForwardPeak());
 
 /// Computes the field. Throws std::invalid_argument with CheckFirstScatteringInput's
 /// message. `progress(fraction)` is called on the calling thread; it may throw to stop.
@@ -84,18 +103,18 @@ NIMBUSPHYSICS_EXPORT std::string CheckFirstScatteringInput(
 /// agree to float rounding across thread counts).
 NIMBUSPHYSICS_EXPORT FirstScatteringField ComputeFirstScattering(const ExtinctionGrid& grid,
   const std::vector<ScalarPointSource>& sources, int threads = 0,
-  const std::function<void(double)>& progress = nullptr);
+  const std::function<void(double)>& progress = nullptr,
+  const FirstScatteringForwardPeak& peak = FirstScatteringForwardPeak());
 
 /// Sum of the fields' values weighted per field (same dimensions; an empty list gives an
 /// empty field). Throws std::invalid_argument when the sizes differ.
 NIMBUSPHYSICS_EXPORT FirstScatteringField CombineFirstScattering(
   const std::vector<const FirstScatteringField*>& fields, const std::vector<double>& weights);
 
-/// J1(w) for one point's 4 values (the lobe of the file comment) with a normalised phase
-/// function p(mu) of the cosine between the direction of travel of the sources' light and
-/// w (a direction of propagation).
+/// J1(w) for one point's 4 values in degree-1 spherical harmonics (the file comment), w a
+/// direction of propagation, k1 the phase function's mean cosine; clamped at 0.
 NIMBUSPHYSICS_EXPORT double EvaluateFirstScattering(
-  const float* values, const Vector3& w, const std::function<double(double)>& phase);
+  const float* values, const Vector3& w, double k1);
 
 } // namespace nimbus
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Lightning inside a cloud: Nimbus against the path tracer (issue 16).
+"""Lightning inside a cloud: Nimbus against the path tracer.
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
         scripts/lightning-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
@@ -10,12 +10,13 @@ stroke's peak (a 3.5 km channel from 2 km high inside the cloud down to the grou
 branches). The reference is the path tracer (vtkNimbusReferenceRenderer) on a version-3
 scene file whose lights are the flash's segments as polyline lights of their intensity
 per metre (grey, 6500 K); it is cached in the output directory. Nimbus renders the
-same view with vtkNimbusCloudVolumeMapper over vtkNimbusLightningIllumination, once with
-the precomputed basis and once with its direct solve, and the script prints their error
+same view with vtkNimbusCloudVolumeMapper over vtkNimbusLightningIllumination in each of
+--variants (the precomputed basis or the direct solve; the first scattering on the
+density's grid or on the illumination grid), and the script prints their error
 against the reference on aggregates that the path tracer's fireflies do not swamp (the
 mean over the cloud's pixels, with its standard error; the RMSE of 10x10-pixel block
 means corrected for the reference's noise) with the times, and writes
-reference | basis | direct as lightning-vs-path-tracer.png.
+reference | the variants as lightning-vs-path-tracer.png.
 
 The reference's own noise is printed over its lit pixels (those whose 5x5 mean exceeds 1 %
 of that mean's 99.5th percentile): the RMS of the pixels' standard errors over their mean
@@ -56,6 +57,16 @@ parser.add_argument("--reference-mode", choices=("path", "light"), default="path
 parser.add_argument("--size", type=int, nargs=2, default=(200, 150))
 parser.add_argument("--downsampling", type=int, default=3,
                     help="the illumination grid's blocks of density samples (default 3)")
+parser.add_argument("--orders", type=int, default=0,
+                    help="scattering orders of the illumination before the geometric tail "
+                         "(0: the filter's default)")
+parser.add_argument("--cache-dir", default="",
+                    help="the illumination filter's basis cache (default: its own)")
+parser.add_argument("--variants", nargs="+",
+                    default=["basis", "direct", "basis-fine1", "basis-coarse", "direct-coarse"],
+                    help="Nimbus variants: basis or direct, with the first scattering on the "
+                         "density's grid (automatic blocks; -fineN: N blocks) or on the "
+                         "illumination grid (-coarse, as before)")
 args = parser.parse_args()
 os.makedirs(args.output_dir, exist_ok=True)
 
@@ -167,12 +178,21 @@ cloud.SetBounds(*CLOUD["Bounds"])
 cloud.SetSeed(CLOUD["Seed"])
 
 
-def render(method):
+def render(variant):
+    """One Nimbus variant (see --variants): the image, the filter's update seconds, the filter."""
+    method = 1 if variant.startswith("direct") else 0
     illumination = nimbus.vtkNimbusLightningIllumination()
     illumination.SetInputConnection(0, cloud.GetOutputPort(0))
     illumination.SetInputConnection(1, lightning.GetOutputPort(0))  # the strokes
     illumination.SetMethod(method)
     illumination.SetDownsampling(args.downsampling)
+    illumination.SetFirstScatteringOnDensityGrid(not variant.endswith("-coarse"))
+    if "-fine" in variant:
+        illumination.SetFirstScatteringDownsampling(int(variant.split("-fine")[1]))
+    if args.cache_dir:
+        illumination.SetCacheDirectory(args.cache_dir)
+    if args.orders > 0:
+        illumination.SetOrders(args.orders)
     illumination.SetLightningColor(1, 1, 1)  # grey, as the reference's 6500 K
     illumination.SetAlbedo(0.99)
     # The basis of this grid (96 x 96 x 64 in blocks of 3) may need ~2.3 GiB: more than
@@ -210,8 +230,8 @@ def block_errors(error):
     return harness.block_standard_errors(error, BLOCK)
 
 
-rendered = {method: render(method) for method in (0, 1)}
-lit = rendered[1][0].mean(axis=2)
+rendered = {variant: render(variant) for variant in args.variants}
+lit = rendered[args.variants[0]][0].mean(axis=2)
 cloud_pixels = lit > 0.01 * lit.max()
 count = int(cloud_pixels.sum())
 mean_cloud = float(reference[cloud_pixels].mean())
@@ -221,20 +241,21 @@ cloud_blocks = blocks(np.repeat(cloud_pixels[..., None], 3, axis=2).astype(np.fl
 print(f"cloud: {count} pixels, reference mean {mean_cloud:.4g} +- {mean_error:.2g} "
       f"(standard error); {int(cloud_blocks[..., 0].sum())} blocks of {BLOCK}x{BLOCK}")
 images = [reference]
-print(f"{'method':<22} {'update s':>9} {'per frame ms':>13} {'mean / reference':>17} "
-      f"{'block RMSE / mean':>18}")
-for method, name in ((0, "precomputed basis"), (1, "direct solve")):
-    image, update, illumination = rendered[method]
+print(f"{'variant':<22} {'update s':>9} {'relight ms':>11} {'first s':>8} "
+      f"{'mean / reference':>17} {'block RMSE / mean':>18}")
+for name in args.variants:
+    image, update, illumination = rendered[name]
     ratio = float(image[cloud_pixels].mean()) / mean_cloud
     block_metrics = harness.error_metrics(blocks(image)[cloud_blocks],
                                           reference_blocks[cloud_blocks],
                                           reference_block_errors[cloud_blocks])
-    print(f"{name:<22} {update:9.1f} {1000 * illumination.GetLastRelightSeconds():13.1f} "
+    print(f"{name:<22} {update:9.1f} {1000 * illumination.GetLastRelightSeconds():11.1f} "
+          f"{illumination.GetLastFirstScatteringSeconds():8.2f} "
           f"{ratio:11.3f} +- {ratio * mean_error / mean_cloud:.3f} "
           f"{block_metrics['rmse'] / float(reference_blocks[cloud_blocks].mean()):18.3f}")
     images.append(image)
 strip = np.concatenate(images, axis=1)
-scale = 0.5 / max(float(np.percentile(rendered[1][0][cloud_pixels], 99)), 1e-30)
+scale = 0.5 / max(float(np.percentile(rendered[args.variants[0]][0][cloud_pixels], 99)), 1e-30)
 path = os.path.join(args.output_dir, "lightning-vs-path-tracer.png")
 harness.write_png(strip * scale / harness.DISPLAY_EXPOSURE, path)
 print(path)

@@ -154,11 +154,13 @@ std::vector<LightningSourceGroup> GroupPointSources(
 }
 
 FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGrid& grid,
-  const std::vector<LightningSourceGroup>& groups, int threads,
-  const std::function<void(double)>& progress)
+  const std::vector<LightningSourceGroup>& groups, const FirstScatteringForwardPeak& peak,
+  int threads, const std::function<void(double)>& progress)
 {
   this->LastComputeSeconds = 0.0;
-  const std::uint64_t gridHash = HashExtinctionGrid(grid);
+  std::uint64_t gridHash = HashExtinctionGrid(grid);
+  HashBytes(gridHash, &peak.Fraction, sizeof(double));
+  HashBytes(gridHash, &peak.Albedo, sizeof(double));
   std::vector<const FirstScatteringField*> fields;
   std::vector<double> scales;
   std::vector<std::uint64_t> keys;
@@ -184,14 +186,16 @@ FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGri
     ++this->Misses;
     Entry entry;
     entry.Key = keys[g];
-    entry.Field = ComputeFirstScattering(grid, groups[g].Sources, threads,
+    entry.Field = ComputeFirstScattering(
+      grid, groups[g].Sources, threads,
       [&](double fraction)
       {
         if (progress)
         {
           progress((done + fraction) / groups.size());
         }
-      });
+      },
+      peak);
     this->LastComputeSeconds += entry.Field.Seconds;
     this->Entries.push_front(std::move(entry));
     ++done;

@@ -49,11 +49,12 @@ std::vector<LightningSourceGroup> GroupPointSources(
 class LightningFirstScatteringCache
 {
 public:
-  /// The sum over the groups of Scale x the group's field on `grid`. `progress` as for
-  /// ComputeFirstScattering (fractions of the groups computed anew).
+  /// The sum over the groups of Scale x the group's field on `grid` (with the solver's
+  /// forward peak, ComputeFirstScattering). `progress` as for ComputeFirstScattering
+  /// (fractions of the groups computed anew).
   FirstScatteringField Evaluate(const ExtinctionGrid& grid,
-    const std::vector<LightningSourceGroup>& groups, int threads,
-    const std::function<void(double)>& progress = nullptr);
+    const std::vector<LightningSourceGroup>& groups, const FirstScatteringForwardPeak& peak,
+    int threads, const std::function<void(double)>& progress = nullptr);
 
   /// Groups found in the cache and computed, since construction.
   int GetHits() const { return this->Hits; }

@@ -229,19 +229,31 @@ TEST(FirstScattering, MergesSourcesOfOneCellAndThreadsAgree)
   EXPECT_LT(worst, 1e-5);
 }
 
-TEST(FirstScattering, LobeIsExactForOneSourceAndIsotropicBetweenTwo)
+TEST(FirstScattering, DegreeOneHarmonicsAndTheForwardPeak)
 {
-  const auto hg = [](double mu)
+  // J1 = (E + 3 k1 F . w) / (4 pi): the Funk-Hecke form of one source's E p(w . w0).
+  const float up[4] = { 2.0f, 0.0f, 0.0f, 2.0f };
+  EXPECT_NEAR(nimbus::EvaluateFirstScattering(up, { { 0, 0, 1 } }, 0.3),
+    2.0 * (1 + 0.9) / (4 * nimbus::kPi), 1e-7);
+  EXPECT_EQ(nimbus::EvaluateFirstScattering(up, { { 0, 0, -1 } }, 0.9), 0.0); // clamped
+  // The forward peak: T' = f exp(-tau) + (1 - f) exp(-(1 - f a) tau) along an axis of a
+  // homogeneous medium (there the propagation is exact).
+  const double sigma = 0.02, f = 0.6, a = 0.99;
+  const ExtinctionGrid grid = Cube(31, 10.0, sigma);
+  nimbus::FirstScatteringForwardPeak peak;
+  peak.Fraction = f;
+  peak.Albedo = a;
+  const FirstScatteringField field =
+    nimbus::ComputeFirstScattering(grid, { { { { 0, 0, 0 } }, 1.0 } }, 2, nullptr, peak);
+  for (int i = 17; i < 31; i += 3)
   {
-    const double g = 0.8;
-    return (1 - g * g) / (4 * nimbus::kPi * std::pow(1 + g * g - 2 * g * mu, 1.5));
-  };
-  const float one[4] = { 2.0f, 0.0f, 0.0f, 2.0f }; // all its light travelling up
-  EXPECT_NEAR(nimbus::EvaluateFirstScattering(one, { { 0, 0, 1 } }, hg), 2.0 * hg(1.0), 1e-9);
-  EXPECT_NEAR(nimbus::EvaluateFirstScattering(one, { { 1, 0, 0 } }, hg), 2.0 * hg(0.0), 1e-9);
-  const float opposed[4] = { 2.0f, 0.0f, 0.0f, 0.0f }; // equal light up and down
-  EXPECT_NEAR(
-    nimbus::EvaluateFirstScattering(opposed, { { 0, 1, 0 } }, hg), 2.0 / (4 * nimbus::kPi), 1e-9);
+    const double r = (i - 15) * 10.0, tau = sigma * r;
+    const double expected = (f * std::exp(-tau) + (1 - f) * std::exp(-(1 - f * a) * tau)) / (r * r);
+    EXPECT_NEAR(E(grid, field, i, 15, 15) / expected, 1.0, 1e-5) << "r " << r;
+  }
+  peak.Fraction = 1.0;
+  EXPECT_THROW(nimbus::ComputeFirstScattering(grid, { { { { 0, 0, 0 } }, 1.0 } }, 1, nullptr, peak),
+    std::invalid_argument);
 }
 
 TEST(FirstScattering, RefusesBadInputAndHandlesExtremes)

@@ -2460,6 +2460,10 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
     static_cast<float>(colour[2]) };
   program->SetUniform3f("lightningFirstScale", lightningFirstScale);
   program->SetUniform3f("lightningColour", lightningColour);
+  nimbus::CloudOptics lightningOptics;
+  lightningOptics.G = this->CloudG;
+  program->SetUniformf(
+    "lightningFirstK1", static_cast<float>(nimbus::PhaseLegendreCoefficient(lightningOptics, 1)));
   // Temperature emission: the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
   // E [Y/(sr m)] scales them.
   program->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);

@@ -28,6 +28,7 @@ uniform int lightningFirstOn;
 uniform sampler3D lightningFirst;
 uniform vec3 lightningFirstScale;     // density texture coordinates -> this texture's
 uniform vec3 lightningColour;
+uniform float lightningFirstK1;       // the cloud's phase function's mean cosine
 // Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
 // [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
 uniform int emissionOn;
@@ -55,20 +56,15 @@ vec3 LightningInScattering(vec3 p, vec3 w)
                dot(texture(lightningBlue, tc), y)), vec3(0.0));
 }
 
-// J1(p, w) of the lightning's first scattering: the lobe |F| p(w . F/|F|) for the light
-// that arrives from one side and (E - |F|) / (4 pi) for the rest (exact for one source).
+// J1(p, w) of the lightning's first scattering in degree-1 spherical harmonics, as the
+// solver's J: (E + 3 k_1 F . w) / (4 pi), k_1 the phase function's mean cosine. (A lobe
+// p(w . F/|F|) around the net flux, exact for one point source, was measured darker than
+// the path tracer next to a channel: a line's light arrives in a fan of directions, which
+// the lobe folds into one: docs/lightning.md.)
 vec3 LightningFirstScattering(vec3 p, vec3 w)
 {
   vec4 v = texture(lightningFirst, (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale);
-  float e = max(v.a, 0.0);
-  float f = length(v.rgb);
-  float directed = min(e, f);
-  float j = (e - directed) / (4.0 * kPi);
-  if (directed > 0.0)
-  {
-    j += directed * CornetteShanks(dot(v.rgb, w) / f, cloudG);
-  }
-  return lightningColour * j;
+  return lightningColour * max((v.a + 3.0 * lightningFirstK1 * dot(v.rgb, w)) / (4.0 * kPi), 0.0);
 }
 
 // The sun's light scattered more than once that the mapper evaluates per sample,
