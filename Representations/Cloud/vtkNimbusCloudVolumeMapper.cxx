@@ -373,7 +373,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // (a sky model of the mapper's own air, built only when the sky light needs it).
   nimbus::MultipleScatteringTexture Scattering;
   std::string LastScatteringError;
-  // Lightning (issue 16; LightningTexture.h).
+  // Lightning (LightningTexture.h).
   nimbus::LightningTexture Lightning;
   std::string LastLightningError;
   // Temperature emission (issue 17; EmissionTexture.h).
@@ -1930,7 +1930,7 @@ vtkDataArray* vtkNimbusCloudVolumeMapper::EmissionForSolve(
 }
 
 //------------------------------------------------------------------------------
-// Lightning (issue 16): the field vtkNimbusLightningIllumination computed, uploaded
+// Lightning: the field vtkNimbusLightningIllumination computed, uploaded
 // when it changes (every time step of a flash).
 void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
 {

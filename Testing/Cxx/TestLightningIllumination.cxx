@@ -1,4 +1,4 @@
-// vtkNimbusLightningIllumination (issue 16): the lightning's in-scattered radiance in the
+// vtkNimbusLightningIllumination: the lightning's in-scattered radiance in the
 // cloud's field data, over time, linear in the sources, the disk cache (hit, miss,
 // damaged file), the extremes (one-voxel cloud, a stroke outside the cloud, zero
 // intensity, xi = 0 and xi = 1), and bad input of every kind refused with a message and
