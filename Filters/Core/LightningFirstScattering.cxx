@@ -51,6 +51,31 @@ long long BrightnessClass(double brightness)
   return std::llround(std::log(brightness) * 1e5);
 }
 
+// Sources at their peak, each shining at `brightness` times it -> one group per class of
+// brightness, its scale the class's mean brightness.
+std::vector<LightningSourceGroup> GroupByBrightness(
+  std::vector<ScalarPointSource> atPeak, const std::vector<double>& brightness)
+{
+  std::map<long long, std::pair<double, std::vector<ScalarPointSource>>> classes;
+  for (std::size_t k = 0; k < atPeak.size(); ++k)
+  {
+    auto& c = classes[BrightnessClass(brightness[k])];
+    c.first += brightness[k];
+    c.second.push_back(atPeak[k]);
+  }
+  std::vector<LightningSourceGroup> groups;
+  for (auto& entry : classes)
+  {
+    const double mean = entry.second.first / entry.second.second.size();
+    LightningSourceGroup group = Normalised(std::move(entry.second.second), mean);
+    if (group.Scale > 0.0)
+    {
+      groups.push_back(std::move(group));
+    }
+  }
+  return groups;
+}
+
 // The group's positions and relative intensities, the latter to 1e-6 (float rounding of
 // an intensity scaled by the same factor must not make a new group).
 std::uint64_t GroupKey(std::uint64_t gridHash, const LightningSourceGroup& group)
@@ -83,13 +108,9 @@ std::uint64_t HashExtinctionGrid(const ExtinctionGrid& grid)
 std::vector<LightningSourceGroup> GroupLightningSegments(
   const std::vector<LightningSegment>& segments, const std::vector<double>& peaks, double spacing)
 {
-  // Brightness relative to the peak -> the segments at their peak intensity.
-  struct Class
-  {
-    double BrightnessSum = 0.0;
-    std::vector<LightningSegment> Segments;
-  };
-  std::map<long long, Class> classes;
+  // Each lit segment's point sources at its peak, with the segment's brightness.
+  std::vector<ScalarPointSource> atPeak;
+  std::vector<double> brightness;
   for (std::size_t s = 0; s < segments.size(); ++s)
   {
     if (!(segments[s].Intensity > 0.0))
@@ -97,35 +118,22 @@ std::vector<LightningSourceGroup> GroupLightningSegments(
       continue;
     }
     const bool peaked = s < peaks.size() && peaks[s] > 0.0;
-    const double brightness = peaked ? segments[s].Intensity / peaks[s] : 1.0;
-    LightningSegment atPeak = segments[s];
-    atPeak.Intensity = peaked ? peaks[s] : segments[s].Intensity;
-    Class& c = classes[BrightnessClass(brightness)];
-    c.BrightnessSum += brightness;
-    c.Segments.push_back(atPeak);
-  }
-  std::vector<LightningSourceGroup> groups;
-  for (const auto& entry : classes)
-  {
-    std::vector<ScalarPointSource> sources;
-    for (const PointLight& light : LightningPointSources(entry.second.Segments, spacing))
+    LightningSegment segment = segments[s];
+    segment.Intensity = peaked ? peaks[s] : segments[s].Intensity;
+    for (const PointLight& light : LightningPointSources({ segment }, spacing))
     {
-      sources.push_back({ light.Position, light.Intensity[0] });
-    }
-    LightningSourceGroup group =
-      Normalised(std::move(sources), entry.second.BrightnessSum / entry.second.Segments.size());
-    if (group.Scale > 0.0)
-    {
-      groups.push_back(std::move(group));
+      atPeak.push_back({ light.Position, light.Intensity[0] });
+      brightness.push_back(peaked ? segments[s].Intensity / peaks[s] : 1.0);
     }
   }
-  return groups;
+  return GroupByBrightness(std::move(atPeak), brightness);
 }
 
 std::vector<LightningSourceGroup> GroupPointSources(
   const std::vector<ScalarPointSource>& sources, const std::vector<double>& peaks)
 {
-  std::map<long long, std::pair<double, std::vector<ScalarPointSource>>> classes;
+  std::vector<ScalarPointSource> atPeak;
+  std::vector<double> brightness;
   for (std::size_t k = 0; k < sources.size(); ++k)
   {
     if (!(sources[k].Intensity > 0.0))
@@ -133,24 +141,10 @@ std::vector<LightningSourceGroup> GroupPointSources(
       continue;
     }
     const bool peaked = k < peaks.size() && peaks[k] > 0.0;
-    const double brightness = peaked ? sources[k].Intensity / peaks[k] : 1.0;
-    ScalarPointSource atPeak = sources[k];
-    atPeak.Intensity = peaked ? peaks[k] : sources[k].Intensity;
-    auto& c = classes[BrightnessClass(brightness)];
-    c.first += brightness;
-    c.second.push_back(atPeak);
+    atPeak.push_back({ sources[k].Position, peaked ? peaks[k] : sources[k].Intensity });
+    brightness.push_back(peaked ? sources[k].Intensity / peaks[k] : 1.0);
   }
-  std::vector<LightningSourceGroup> groups;
-  for (auto& entry : classes)
-  {
-    const double brightness = entry.second.first / entry.second.second.size();
-    LightningSourceGroup group = Normalised(std::move(entry.second.second), brightness);
-    if (group.Scale > 0.0)
-    {
-      groups.push_back(std::move(group));
-    }
-  }
-  return groups;
+  return GroupByBrightness(std::move(atPeak), brightness);
 }
 
 FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGrid& grid,

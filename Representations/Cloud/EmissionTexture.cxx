@@ -1,6 +1,7 @@
 #include "EmissionTexture.h"
 
 #include "BlackbodyEmission.h"
+#include "MultipleScatteringTexture.h"
 #include "SpectralColor.h"
 
 #include "vtkCellData.h"
@@ -164,23 +165,9 @@ bool EmissionTexture::Update(vtkOpenGLRenderWindow* window, vtkImageData* image,
   {
     return true; // nothing glows: no texture, no cost in the shader
   }
-  vtkTextureObject* texture = this->Texture;
-  texture->SetContext(window);
-  texture->ReleaseGraphicsResources(window);
-  texture->SetWrapS(vtkTextureObject::ClampToEdge);
-  texture->SetWrapT(vtkTextureObject::ClampToEdge);
-  texture->SetWrapR(vtkTextureObject::ClampToEdge);
-  texture->SetMinificationFilter(vtkTextureObject::Linear);
-  texture->SetMagnificationFilter(vtkTextureObject::Linear);
-  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
+  if (!UploadFloatTexture3D(window, this->Texture,
+        { { textureDimensions[0], textureDimensions[1], textureDimensions[2] } }, 3, texels.data()))
   {
-    // errors of earlier GL calls are not this upload's
-  }
-  if (!texture->Create3DFromRaw(textureDimensions[0], textureDimensions[1], textureDimensions[2], 3,
-        VTK_FLOAT, const_cast<float*>(texels.data())) ||
-    glGetError() == GL_OUT_OF_MEMORY)
-  {
-    texture->ReleaseGraphicsResources(window);
     this->UploadedKey.clear();
     std::ostringstream message;
     message << "Could not upload the emission texture (" << 12.0 * texels.size() / 3 / 1048576.0

@@ -198,15 +198,7 @@ bool LightningTexture::UpdateFirstScattering(vtkOpenGLRenderWindow* window, vtkI
     this->FirstScatteringScale[k] = static_cast<double>(textureDimensions[k]) * textureFactors[k] /
       (static_cast<double>(grid[k]) * blocks[k]);
   }
-  vtkTextureObject* texture = this->FirstScattering;
-  texture->SetContext(window);
-  texture->ReleaseGraphicsResources(window);
-  texture->SetWrapS(vtkTextureObject::ClampToEdge);
-  texture->SetWrapT(vtkTextureObject::ClampToEdge);
-  texture->SetWrapR(vtkTextureObject::ClampToEdge);
-  texture->SetMinificationFilter(vtkTextureObject::Linear);
-  texture->SetMagnificationFilter(vtkTextureObject::Linear);
-  if (!texture->Create3DFromRaw(grid[0], grid[1], grid[2], 4, VTK_FLOAT, texels.data()))
+  if (!UploadFloatTexture3D(window, this->FirstScattering, grid, 4, texels.data()))
   {
     std::ostringstream message;
     message << "Could not upload the lightning's first scattering (" << 16.0 * points / 1048576.0

@@ -21,6 +21,30 @@
 
 namespace nimbus
 {
+bool UploadFloatTexture3D(vtkOpenGLRenderWindow* window, vtkTextureObject* texture,
+  const std::array<int, 3>& dimensions, int components, const float* texels)
+{
+  texture->SetContext(window);
+  texture->ReleaseGraphicsResources(window);
+  texture->SetWrapS(vtkTextureObject::ClampToEdge);
+  texture->SetWrapT(vtkTextureObject::ClampToEdge);
+  texture->SetWrapR(vtkTextureObject::ClampToEdge);
+  texture->SetMinificationFilter(vtkTextureObject::Linear);
+  texture->SetMagnificationFilter(vtkTextureObject::Linear);
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
+  {
+    // errors of earlier GL calls are not this upload's
+  }
+  if (!texture->Create3DFromRaw(dimensions[0], dimensions[1], dimensions[2], components, VTK_FLOAT,
+        const_cast<float*>(texels)) ||
+    glGetError() == GL_OUT_OF_MEMORY)
+  {
+    texture->ReleaseGraphicsResources(window);
+    return false;
+  }
+  return true;
+}
+
 bool UploadShCoefficients(vtkOpenGLRenderWindow* window, vtkTextureObject* const textures[3],
   const std::array<int, 3>& dimensions, const float* coefficients)
 {
@@ -36,21 +60,7 @@ bool UploadShCoefficients(vtkOpenGLRenderWindow* window, vtkTextureObject* const
         channel[4 * i + b] = coefficients[12 * i + 4 * c + b];
       }
     }
-    vtkTextureObject* texture = textures[c];
-    texture->SetContext(window);
-    texture->ReleaseGraphicsResources(window);
-    texture->SetWrapS(vtkTextureObject::ClampToEdge);
-    texture->SetWrapT(vtkTextureObject::ClampToEdge);
-    texture->SetWrapR(vtkTextureObject::ClampToEdge);
-    texture->SetMinificationFilter(vtkTextureObject::Linear);
-    texture->SetMagnificationFilter(vtkTextureObject::Linear);
-    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i)
-    {
-      // errors of earlier GL calls are not this upload's
-    }
-    if (!texture->Create3DFromRaw(
-          dimensions[0], dimensions[1], dimensions[2], 4, VTK_FLOAT, channel.data()) ||
-      glGetError() == GL_OUT_OF_MEMORY)
+    if (!UploadFloatTexture3D(window, textures[c], dimensions, 4, channel.data()))
     {
       for (int t = 0; t < 3; ++t)
       {

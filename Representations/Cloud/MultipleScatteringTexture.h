@@ -30,6 +30,13 @@ class vtkWindow;
 
 namespace nimbus
 {
+/// Uploads `components` floats per texel (x fastest) as a float 3-D texture, linear
+/// filtering, clamped at the edges. False (the texture released) when GL refuses it or
+/// runs out of memory.
+NIMBUSREPRESENTATIONS_EXPORT bool UploadFloatTexture3D(vtkOpenGLRenderWindow* window,
+  vtkTextureObject* texture, const std::array<int, 3>& dimensions, int components,
+  const float* texels);
+
 /// Uploads 12 floats per point (SH c_00, c_1-1, c_10, c_11 of R, G, B; x fastest) as
 /// three RGBA float 3-D textures, linear filtering, clamped at the edges. False (the
 /// textures released) when GL refuses them.
