@@ -60,6 +60,8 @@ parser.add_argument("--downsampling", type=int, default=3,
 parser.add_argument("--orders", type=int, default=0,
                     help="scattering orders of the illumination before the geometric tail "
                          "(0: the filter's default)")
+parser.add_argument("--directions", type=int, default=0,
+                    help="discrete directions of the illumination's solve (0: the filter's 26)")
 parser.add_argument("--cache-dir", default="",
                     help="the illumination filter's basis cache (default: its own)")
 parser.add_argument("--variants", nargs="+",
@@ -193,6 +195,8 @@ def render(variant):
         illumination.SetCacheDirectory(args.cache_dir)
     if args.orders > 0:
         illumination.SetOrders(args.orders)
+    if args.directions > 0:
+        illumination.SetNumberOfDirections(args.directions)
     illumination.SetLightningColor(1, 1, 1)  # grey, as the reference's 6500 K
     illumination.SetAlbedo(0.99)
     # The basis of this grid (96 x 96 x 64 in blocks of 3) may need ~2.3 GiB: more than
