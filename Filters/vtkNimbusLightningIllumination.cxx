@@ -295,191 +295,18 @@ int vtkNimbusLightningIllumination::RequestData(
     }
   }
 
-  // The point sources at this time.
   std::vector<nimbus::PointLight> sources;
-  this->Internals->FirstScatteringGroups.clear();
-  vtkDataArray* pointIntensity = lightning->GetPointData()->GetArray("intensity");
-  vtkDataArray* cellIntensity = lightning->GetCellData()->GetArray("intensity");
-  if (lightning->GetNumberOfLines() > 0)
+  if (!this->ReadLightningSources(lightning, colour, sources))
   {
-    if (!cellIntensity)
-    {
-      vtkErrorMacro("Lightning illumination: the strokes have no cell array \"intensity\" "
-                    "(radiant intensity per metre); the cloud passes through unlit.");
-      return 1;
-    }
-    std::vector<nimbus::LightningSegment> segments;
-    std::vector<double> peaks; // each segment's peak intensity, when the strokes say
-    vtkDataArray* peakIntensity = lightning->GetCellData()->GetArray("peak_intensity");
-    vtkCellArray* lines = lightning->GetLines();
-    const vtkIdType offset = lightning->GetNumberOfVerts();
-    vtkIdType npts = 0;
-    const vtkIdType* ids = nullptr;
-    vtkIdType cell = 0;
-    for (lines->InitTraversal(); lines->GetNextCell(npts, ids); ++cell)
-    {
-      const double intensity = cellIntensity->GetComponent(offset + cell, 0);
-      for (vtkIdType p = 0; p + 1 < npts; ++p)
-      {
-        nimbus::LightningSegment s;
-        double a[3], b[3];
-        lightning->GetPoint(ids[p], a);
-        lightning->GetPoint(ids[p + 1], b);
-        for (int k = 0; k < 3; ++k)
-        {
-          s.A[k] = a[k] * this->MetresPerUnit;
-          s.B[k] = b[k] * this->MetresPerUnit;
-        }
-        s.Intensity = intensity;
-        segments.push_back(s);
-        if (peakIntensity)
-        {
-          peaks.push_back(peakIntensity->GetComponent(offset + cell, 0));
-        }
-      }
-    }
-    try
-    {
-      for (const nimbus::LightningSegment& s : segments)
-      {
-        if (!std::isfinite(s.Intensity) || s.Intensity < 0.0 || !std::isfinite(s.Length()))
-        {
-          throw std::invalid_argument("a stroke is not finite or has a negative intensity");
-        }
-      }
-      sources = nimbus::LightningPointSources(segments, this->PointSourceSpacing);
-      if (this->FirstScatteringOnDensityGrid)
-      {
-        for (double& peak : peaks)
-        {
-          peak = std::isfinite(peak) ? peak : 0.0; // a bad peak: its segment alone
-        }
-        this->Internals->FirstScatteringGroups =
-          nimbus::GroupLightningSegments(segments, peaks, this->PointSourceSpacing);
-      }
-    }
-    catch (const std::exception& problem)
-    {
-      vtkErrorMacro(
-        "Lightning illumination: " << problem.what() << "; the cloud passes through unlit.");
-      return 1;
-    }
-  }
-  else if (lightning->GetNumberOfPoints() > 0)
-  {
-    if (!pointIntensity)
-    {
-      vtkErrorMacro("Lightning illumination: the point sources have no point array "
-                    "\"intensity\"; the cloud passes through unlit.");
-      return 1;
-    }
-    sources.resize(static_cast<std::size_t>(lightning->GetNumberOfPoints()));
-    for (vtkIdType i = 0; i < lightning->GetNumberOfPoints(); ++i)
-    {
-      double x[3];
-      lightning->GetPoint(i, x);
-      const double intensity = pointIntensity->GetComponent(i, 0);
-      for (int k = 0; k < 3; ++k)
-      {
-        sources[i].Position[k] = x[k] * this->MetresPerUnit;
-        sources[i].Intensity[k] = intensity;
-      }
-    }
-    if (this->FirstScatteringOnDensityGrid)
-    {
-      // Grouped by brightness when the sources say their peak (the lightning source does).
-      vtkDataArray* peakIntensity = lightning->GetPointData()->GetArray("peak_intensity");
-      std::vector<nimbus::ScalarPointSource> scalar;
-      std::vector<double> peaks;
-      for (vtkIdType i = 0; i < lightning->GetNumberOfPoints(); ++i)
-      {
-        const nimbus::PointLight& s = sources[i];
-        if (nimbus::IsFinite(s.Position) && std::isfinite(s.Intensity[0]) && s.Intensity[0] >= 0)
-        {
-          scalar.push_back({ s.Position, s.Intensity[0] });
-          const double peak = peakIntensity ? peakIntensity->GetComponent(i, 0) : 0.0;
-          peaks.push_back(std::isfinite(peak) ? peak : 0.0);
-        }
-      }
-      this->Internals->FirstScatteringGroups = nimbus::GroupPointSources(scalar, peaks);
-    }
-  }
-  for (nimbus::PointLight& s : sources)
-  {
-    for (int k = 0; k < 3; ++k)
-    {
-      s.Intensity[k] *= colour[k];
-      if (!std::isfinite(s.Position[k]) || !std::isfinite(s.Intensity[k]) || s.Intensity[k] < 0.0)
-      {
-        vtkErrorMacro("Lightning illumination: a lightning source's position or intensity "
-                      "is not finite or is negative; the cloud passes through unlit.");
-        return 1;
-      }
-    }
-  }
-
-  // The cloud grid and the virtual lights.
-  nimbus::ExtinctionGrid grid;
-  std::array<int, 3> factors{ { 1, 1, 1 } };
-  const std::string gridProblem = BuildCloudGrid(cloud, scalars, cellData, this->Downsampling,
-    this->ExtinctionPerDensity, this->MetresPerUnit, grid, factors);
-  if (!gridProblem.empty())
-  {
-    vtkErrorMacro("Lightning illumination: " << gridProblem << "; the cloud passes through unlit.");
     return 1;
   }
-  double low[3], high[3];
-  for (int k = 0; k < 3; ++k)
-  {
-    const double a = grid.Origin[k];
-    const double b = grid.Origin[k] + grid.Axes[k][k] * grid.Spacing[k] * (grid.Dimensions[k] - 1);
-    low[k] = std::min(a, b);
-    high[k] = std::max(a, b);
-  }
-  // The cloud bottom z_cld: the lowest layer holding density.
-  double cloudBottom = high[2];
-  for (int k = 0; k < grid.Dimensions[2] && cloudBottom == high[2]; ++k)
-  {
-    for (int j = 0; j < grid.Dimensions[1]; ++j)
-    {
-      for (int i = 0; i < grid.Dimensions[0]; ++i)
-      {
-        if (grid.Extinction[grid.Index(i, j, k)] > 0.0f)
-        {
-          cloudBottom = grid.Position(i, j, k)[2];
-        }
-      }
-    }
-  }
-  nimbus::VirtualLightGridParameters lightParameters;
-  const double side = std::max(high[0] - low[0], high[1] - low[1]);
-  lightParameters.BaseInterval = this->LightSpacingMetres > 0.0
-    ? this->LightSpacingMetres
-    : std::max(side / 12.0, std::max(grid.Spacing[0], grid.Spacing[1]));
-  const double bottom = std::isfinite(this->SimulationBottomMetres)
-    ? std::min(this->SimulationBottomMetres, cloudBottom)
-    : cloudBottom;
-  lightParameters.Low = { { low[0], low[1], bottom } };
-  lightParameters.High = { { high[0], high[1], std::max(high[2], bottom + 1.0) } };
-  for (int k = 0; k < 2; ++k)
-  {
-    if (!(lightParameters.High[k] > lightParameters.Low[k]))
-    {
-      // A cloud one sample wide: a box one light spacing wide around it.
-      lightParameters.Low[k] -= 0.5 * lightParameters.BaseInterval;
-      lightParameters.High[k] += 0.5 * lightParameters.BaseInterval;
-    }
-  }
-  lightParameters.CloudBottom = std::min(cloudBottom, lightParameters.High[2]);
+
+  nimbus::ExtinctionGrid grid;
+  std::array<int, 3> factors{ { 1, 1, 1 } };
   nimbus::VirtualLightGrid lights;
-  try
+  double low[3], high[3];
+  if (!this->BuildIlluminationGrids(cloud, scalars, cellData, grid, factors, lights, low, high))
   {
-    lights = nimbus::MakeVirtualLightGrid(lightParameters);
-  }
-  catch (const std::exception& problem)
-  {
-    vtkErrorMacro("Lightning illumination: the virtual lights: "
-      << problem.what() << "; the cloud passes through unlit.");
     return 1;
   }
 
@@ -496,126 +323,15 @@ int vtkNimbusLightningIllumination::RequestData(
   options.IncludeFirstScattering = !this->FirstScatteringOnDensityGrid;
   const std::string fingerprint = nimbus::LightningBasisFingerprint(grid, optics, lights, options);
 
-  vtkInternals& in = *this->Internals;
   if (this->Method == DirectSolve)
   {
-    // The reference: the solver with the actual point sources, every time step.
-    const auto start = std::chrono::steady_clock::now();
-    nimbus::MultipleScatteringField field;
-    try
-    {
-      nimbus::CloudLighting lighting;
-      lighting.HasSun = false;
-      lighting.PointLights = sources;
-      nimbus::MultipleScatteringOptions solver;
-      solver.NumberOfDirections = this->NumberOfDirections;
-      solver.Orders = this->Orders;
-      solver.SkyLight = false;
-      solver.PointLightFirstScattering = !this->FirstScatteringOnDensityGrid;
-      solver.Threads = this->NumberOfThreads;
-      if (sources.empty())
-      {
-        field.Dimensions = grid.Dimensions;
-        field.Coefficients.assign(12 * grid.NumberOfPoints(), 0.0f);
-      }
-      else
-      {
-        field = nimbus::SolveMultipleScattering(grid, optics, lighting, solver,
-          [this](double fraction)
-          {
-            this->UpdateProgress(0.95 * fraction);
-            if (this->CheckAbort())
-            {
-              throw Aborted();
-            }
-          });
-      }
-    }
-    catch (const Aborted&)
-    {
-      return 1;
-    }
-    catch (const std::exception& problem)
-    {
-      vtkErrorMacro("Lightning illumination: the direct solve refused: "
-        << problem.what() << ". The cloud passes through unlit.");
-      return 1;
-    }
-    in.RelightSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    in.Factors = factors;
-    this->AddLightningArrays(fieldData, field, cellData);
-    this->AddFirstScattering(fieldData, cloud, scalars, cellData);
-    this->UpdateProgress(1.0);
+    return this->SolveDirectly(fieldData, cloud, scalars, cellData, grid, optics, sources, factors);
+  }
+  if (!this->EnsureBasis(grid, optics, lights, options, fingerprint, factors))
+  {
     return 1;
   }
-  if (fingerprint != in.Fingerprint)
-  {
-    in.Fingerprint.clear();
-    in.Basis = nimbus::LightningBasis();
-    in.PrecomputeSeconds = 0.0;
-    in.FromDisk = false;
-    in.CacheFile.clear();
-    const std::string directory =
-      ExpandUser(this->CacheDirectory.empty() ? DefaultCacheDirectory() : this->CacheDirectory);
-    if (this->UseDiskCache && !directory.empty())
-    {
-      in.CacheFile = directory + "/lightning-basis-" + fingerprint + ".bin";
-      std::string why;
-      if (nimbus::ReadLightningBasis(in.CacheFile, fingerprint, in.Basis, why))
-      {
-        in.FromDisk = true;
-        in.Fingerprint = fingerprint;
-      }
-    }
-    if (!in.FromDisk)
-    {
-      try
-      {
-        in.Basis = nimbus::PrecomputeLightningBasis(grid, optics, lights, options,
-          [this](double fraction)
-          {
-            this->UpdateProgress(0.95 * fraction);
-            if (this->CheckAbort())
-            {
-              throw Aborted();
-            }
-          });
-      }
-      catch (const Aborted&)
-      {
-        in.Basis = nimbus::LightningBasis();
-        return 1; // stopped by the user: the cloud unlit
-      }
-      catch (const std::exception& problem)
-      {
-        in.Basis = nimbus::LightningBasis();
-        vtkErrorMacro("Lightning illumination: the precompute refused: "
-          << problem.what() << ". The cloud passes through unlit.");
-        return 1;
-      }
-      in.PrecomputeSeconds = in.Basis.Seconds;
-      in.Fingerprint = fingerprint;
-      if (!in.CacheFile.empty())
-      {
-        try
-        {
-          std::filesystem::create_directories(std::filesystem::path(in.CacheFile).parent_path());
-          nimbus::WriteLightningBasis(in.Basis, fingerprint, in.CacheFile);
-        }
-        catch (const std::exception& problem)
-        {
-          vtkWarningMacro("Lightning illumination: the basis could not be cached on disk ("
-            << problem.what() << "); it is kept in memory.");
-        }
-      }
-    }
-    in.Factors = factors;
-  }
-  else
-  {
-    in.PrecomputeSeconds = 0.0; // from memory
-  }
+  vtkInternals& in = *this->Internals;
 
   // Sources outside the virtual lights' box would be moved onto it (Eq. 6's cells end
   // there), closer to the cloud than they are: their intensity is dimmed by the inverse
@@ -688,6 +404,339 @@ nimbus::FirstScatteringForwardPeak vtkNimbusLightningIllumination::ForwardPeak()
   peak.Fraction = (k2 > 0.0 && k1 > k2 && k2 < 0.999) ? k2 : 0.0;
   peak.Albedo = this->Albedo;
   return peak;
+}
+
+// The point sources at this time (strokes split every PointSourceSpacing metres, or the
+// given points), times the colour; the first scattering's groups by brightness. False,
+// with an error, when they are malformed.
+bool vtkNimbusLightningIllumination::ReadLightningSources(
+  vtkPolyData* lightning, const double colour[3], std::vector<nimbus::PointLight>& sources)
+{
+  this->Internals->FirstScatteringGroups.clear();
+  vtkDataArray* pointIntensity = lightning->GetPointData()->GetArray("intensity");
+  vtkDataArray* cellIntensity = lightning->GetCellData()->GetArray("intensity");
+  if (lightning->GetNumberOfLines() > 0)
+  {
+    if (!cellIntensity)
+    {
+      vtkErrorMacro("Lightning illumination: the strokes have no cell array \"intensity\" "
+                    "(radiant intensity per metre); the cloud passes through unlit.");
+      return false;
+    }
+    std::vector<nimbus::LightningSegment> segments;
+    std::vector<double> peaks; // each segment's peak intensity, when the strokes say
+    vtkDataArray* peakIntensity = lightning->GetCellData()->GetArray("peak_intensity");
+    vtkCellArray* lines = lightning->GetLines();
+    const vtkIdType offset = lightning->GetNumberOfVerts();
+    vtkIdType npts = 0;
+    const vtkIdType* ids = nullptr;
+    vtkIdType cell = 0;
+    for (lines->InitTraversal(); lines->GetNextCell(npts, ids); ++cell)
+    {
+      const double intensity = cellIntensity->GetComponent(offset + cell, 0);
+      for (vtkIdType p = 0; p + 1 < npts; ++p)
+      {
+        nimbus::LightningSegment s;
+        double a[3], b[3];
+        lightning->GetPoint(ids[p], a);
+        lightning->GetPoint(ids[p + 1], b);
+        for (int k = 0; k < 3; ++k)
+        {
+          s.A[k] = a[k] * this->MetresPerUnit;
+          s.B[k] = b[k] * this->MetresPerUnit;
+        }
+        s.Intensity = intensity;
+        segments.push_back(s);
+        if (peakIntensity)
+        {
+          peaks.push_back(peakIntensity->GetComponent(offset + cell, 0));
+        }
+      }
+    }
+    try
+    {
+      for (const nimbus::LightningSegment& s : segments)
+      {
+        if (!std::isfinite(s.Intensity) || s.Intensity < 0.0 || !std::isfinite(s.Length()))
+        {
+          throw std::invalid_argument("a stroke is not finite or has a negative intensity");
+        }
+      }
+      sources = nimbus::LightningPointSources(segments, this->PointSourceSpacing);
+      if (this->FirstScatteringOnDensityGrid)
+      {
+        for (double& peak : peaks)
+        {
+          peak = std::isfinite(peak) ? peak : 0.0; // a bad peak: its segment alone
+        }
+        this->Internals->FirstScatteringGroups =
+          nimbus::GroupLightningSegments(segments, peaks, this->PointSourceSpacing);
+      }
+    }
+    catch (const std::exception& problem)
+    {
+      vtkErrorMacro(
+        "Lightning illumination: " << problem.what() << "; the cloud passes through unlit.");
+      return false;
+    }
+  }
+  else if (lightning->GetNumberOfPoints() > 0)
+  {
+    if (!pointIntensity)
+    {
+      vtkErrorMacro("Lightning illumination: the point sources have no point array "
+                    "\"intensity\"; the cloud passes through unlit.");
+      return false;
+    }
+    sources.resize(static_cast<std::size_t>(lightning->GetNumberOfPoints()));
+    for (vtkIdType i = 0; i < lightning->GetNumberOfPoints(); ++i)
+    {
+      double x[3];
+      lightning->GetPoint(i, x);
+      const double intensity = pointIntensity->GetComponent(i, 0);
+      for (int k = 0; k < 3; ++k)
+      {
+        sources[i].Position[k] = x[k] * this->MetresPerUnit;
+        sources[i].Intensity[k] = intensity;
+      }
+    }
+    if (this->FirstScatteringOnDensityGrid)
+    {
+      // Grouped by brightness when the sources say their peak (the lightning source does).
+      vtkDataArray* peakIntensity = lightning->GetPointData()->GetArray("peak_intensity");
+      std::vector<nimbus::ScalarPointSource> scalar;
+      std::vector<double> peaks;
+      for (vtkIdType i = 0; i < lightning->GetNumberOfPoints(); ++i)
+      {
+        const nimbus::PointLight& s = sources[i];
+        if (nimbus::IsFinite(s.Position) && std::isfinite(s.Intensity[0]) && s.Intensity[0] >= 0)
+        {
+          scalar.push_back({ s.Position, s.Intensity[0] });
+          const double peak = peakIntensity ? peakIntensity->GetComponent(i, 0) : 0.0;
+          peaks.push_back(std::isfinite(peak) ? peak : 0.0);
+        }
+      }
+      this->Internals->FirstScatteringGroups = nimbus::GroupPointSources(scalar, peaks);
+    }
+  }
+  for (nimbus::PointLight& s : sources)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      s.Intensity[k] *= colour[k];
+      if (!std::isfinite(s.Position[k]) || !std::isfinite(s.Intensity[k]) || s.Intensity[k] < 0.0)
+      {
+        vtkErrorMacro("Lightning illumination: a lightning source's position or intensity "
+                      "is not finite or is negative; the cloud passes through unlit.");
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The cloud's extinction grid (blocks of Downsampling samples) and the virtual lights
+// over it (003 Eq. 4); low and high: the grid's box. False, with an error, when refused.
+bool vtkNimbusLightningIllumination::BuildIlluminationGrids(vtkImageData* cloud,
+  vtkDataArray* scalars, bool cellData, nimbus::ExtinctionGrid& grid, std::array<int, 3>& factors,
+  nimbus::VirtualLightGrid& lights, double low[3], double high[3])
+{
+  const std::string gridProblem = BuildCloudGrid(cloud, scalars, cellData, this->Downsampling,
+    this->ExtinctionPerDensity, this->MetresPerUnit, grid, factors);
+  if (!gridProblem.empty())
+  {
+    vtkErrorMacro("Lightning illumination: " << gridProblem << "; the cloud passes through unlit.");
+    return false;
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    const double a = grid.Origin[k];
+    const double b = grid.Origin[k] + grid.Axes[k][k] * grid.Spacing[k] * (grid.Dimensions[k] - 1);
+    low[k] = std::min(a, b);
+    high[k] = std::max(a, b);
+  }
+  // The cloud bottom z_cld: the lowest layer holding density.
+  double cloudBottom = high[2];
+  for (int k = 0; k < grid.Dimensions[2] && cloudBottom == high[2]; ++k)
+  {
+    for (int j = 0; j < grid.Dimensions[1]; ++j)
+    {
+      for (int i = 0; i < grid.Dimensions[0]; ++i)
+      {
+        if (grid.Extinction[grid.Index(i, j, k)] > 0.0f)
+        {
+          cloudBottom = grid.Position(i, j, k)[2];
+        }
+      }
+    }
+  }
+  nimbus::VirtualLightGridParameters lightParameters;
+  const double side = std::max(high[0] - low[0], high[1] - low[1]);
+  lightParameters.BaseInterval = this->LightSpacingMetres > 0.0
+    ? this->LightSpacingMetres
+    : std::max(side / 12.0, std::max(grid.Spacing[0], grid.Spacing[1]));
+  const double bottom = std::isfinite(this->SimulationBottomMetres)
+    ? std::min(this->SimulationBottomMetres, cloudBottom)
+    : cloudBottom;
+  lightParameters.Low = { { low[0], low[1], bottom } };
+  lightParameters.High = { { high[0], high[1], std::max(high[2], bottom + 1.0) } };
+  for (int k = 0; k < 2; ++k)
+  {
+    if (!(lightParameters.High[k] > lightParameters.Low[k]))
+    {
+      // A cloud one sample wide: a box one light spacing wide around it.
+      lightParameters.Low[k] -= 0.5 * lightParameters.BaseInterval;
+      lightParameters.High[k] += 0.5 * lightParameters.BaseInterval;
+    }
+  }
+  lightParameters.CloudBottom = std::min(cloudBottom, lightParameters.High[2]);
+  try
+  {
+    lights = nimbus::MakeVirtualLightGrid(lightParameters);
+  }
+  catch (const std::exception& problem)
+  {
+    vtkErrorMacro("Lightning illumination: the virtual lights: "
+      << problem.what() << "; the cloud passes through unlit.");
+    return false;
+  }
+  return true;
+}
+
+// The reference method: the solver with the actual point sources, every time step.
+int vtkNimbusLightningIllumination::SolveDirectly(vtkFieldData* fieldData, vtkImageData* cloud,
+  vtkDataArray* scalars, bool cellData, const nimbus::ExtinctionGrid& grid,
+  const nimbus::CloudOptics& optics, const std::vector<nimbus::PointLight>& sources,
+  const std::array<int, 3>& factors)
+{
+  vtkInternals& in = *this->Internals;
+  // The reference: the solver with the actual point sources, every time step.
+  const auto start = std::chrono::steady_clock::now();
+  nimbus::MultipleScatteringField field;
+  try
+  {
+    nimbus::CloudLighting lighting;
+    lighting.HasSun = false;
+    lighting.PointLights = sources;
+    nimbus::MultipleScatteringOptions solver;
+    solver.NumberOfDirections = this->NumberOfDirections;
+    solver.Orders = this->Orders;
+    solver.SkyLight = false;
+    solver.PointLightFirstScattering = !this->FirstScatteringOnDensityGrid;
+    solver.Threads = this->NumberOfThreads;
+    if (sources.empty())
+    {
+      field.Dimensions = grid.Dimensions;
+      field.Coefficients.assign(12 * grid.NumberOfPoints(), 0.0f);
+    }
+    else
+    {
+      field = nimbus::SolveMultipleScattering(grid, optics, lighting, solver,
+        [this](double fraction)
+        {
+          this->UpdateProgress(0.95 * fraction);
+          if (this->CheckAbort())
+          {
+            throw Aborted();
+          }
+        });
+    }
+  }
+  catch (const Aborted&)
+  {
+    return 1;
+  }
+  catch (const std::exception& problem)
+  {
+    vtkErrorMacro("Lightning illumination: the direct solve refused: "
+      << problem.what() << ". The cloud passes through unlit.");
+    return 1;
+  }
+  in.RelightSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  in.Factors = factors;
+  this->AddLightningArrays(fieldData, field, cellData);
+  this->AddFirstScattering(fieldData, cloud, scalars, cellData);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+// The basis for this grid, optics, lights and options: kept in memory, read from the
+// disk cache, or precomputed (and cached). False when stopped or refused (with an error).
+bool vtkNimbusLightningIllumination::EnsureBasis(const nimbus::ExtinctionGrid& grid,
+  const nimbus::CloudOptics& optics, const nimbus::VirtualLightGrid& lights,
+  const nimbus::LightningBasisOptions& options, const std::string& fingerprint,
+  const std::array<int, 3>& factors)
+{
+  vtkInternals& in = *this->Internals;
+  if (fingerprint != in.Fingerprint)
+  {
+    in.Fingerprint.clear();
+    in.Basis = nimbus::LightningBasis();
+    in.PrecomputeSeconds = 0.0;
+    in.FromDisk = false;
+    in.CacheFile.clear();
+    const std::string directory =
+      ExpandUser(this->CacheDirectory.empty() ? DefaultCacheDirectory() : this->CacheDirectory);
+    if (this->UseDiskCache && !directory.empty())
+    {
+      in.CacheFile = directory + "/lightning-basis-" + fingerprint + ".bin";
+      std::string why;
+      if (nimbus::ReadLightningBasis(in.CacheFile, fingerprint, in.Basis, why))
+      {
+        in.FromDisk = true;
+        in.Fingerprint = fingerprint;
+      }
+    }
+    if (!in.FromDisk)
+    {
+      try
+      {
+        in.Basis = nimbus::PrecomputeLightningBasis(grid, optics, lights, options,
+          [this](double fraction)
+          {
+            this->UpdateProgress(0.95 * fraction);
+            if (this->CheckAbort())
+            {
+              throw Aborted();
+            }
+          });
+      }
+      catch (const Aborted&)
+      {
+        in.Basis = nimbus::LightningBasis();
+        return false; // stopped by the user: the cloud unlit
+      }
+      catch (const std::exception& problem)
+      {
+        in.Basis = nimbus::LightningBasis();
+        vtkErrorMacro("Lightning illumination: the precompute refused: "
+          << problem.what() << ". The cloud passes through unlit.");
+        return false;
+      }
+      in.PrecomputeSeconds = in.Basis.Seconds;
+      in.Fingerprint = fingerprint;
+      if (!in.CacheFile.empty())
+      {
+        try
+        {
+          std::filesystem::create_directories(std::filesystem::path(in.CacheFile).parent_path());
+          nimbus::WriteLightningBasis(in.Basis, fingerprint, in.CacheFile);
+        }
+        catch (const std::exception& problem)
+        {
+          vtkWarningMacro("Lightning illumination: the basis could not be cached on disk ("
+            << problem.what() << "); it is kept in memory.");
+        }
+      }
+    }
+    in.Factors = factors;
+  }
+  else
+  {
+    in.PrecomputeSeconds = 0.0; // from memory
+  }
+  return true;
 }
 
 void vtkNimbusLightningIllumination::AddFirstScattering(

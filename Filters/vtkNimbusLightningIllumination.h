@@ -58,16 +58,24 @@
 #include "NimbusFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
+#include <array>  // for std::array
 #include <memory> // for std::unique_ptr
 #include <string> // for std::string
+#include <vector> // for std::vector
 
 class vtkDataArray;
 class vtkFieldData;
 class vtkImageData;
+class vtkPolyData;
 namespace nimbus
 {
 struct MultipleScatteringField;
 struct FirstScatteringForwardPeak;
+struct ExtinctionGrid;
+struct PointLight;
+struct VirtualLightGrid;
+struct CloudOptics;
+struct LightningBasisOptions;
 }
 
 class NIMBUSFILTERS_EXPORT vtkNimbusLightningIllumination : public vtkImageAlgorithm
@@ -240,6 +248,17 @@ private:
   void AddFirstScattering(
     vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars, bool cellData);
   nimbus::FirstScatteringForwardPeak ForwardPeak() const;
+  bool ReadLightningSources(
+    vtkPolyData* lightning, const double colour[3], std::vector<nimbus::PointLight>& sources);
+  bool BuildIlluminationGrids(vtkImageData* cloud, vtkDataArray* scalars, bool cellData,
+    nimbus::ExtinctionGrid& grid, std::array<int, 3>& factors, nimbus::VirtualLightGrid& lights,
+    double low[3], double high[3]);
+  int SolveDirectly(vtkFieldData* fieldData, vtkImageData* cloud, vtkDataArray* scalars,
+    bool cellData, const nimbus::ExtinctionGrid& grid, const nimbus::CloudOptics& optics,
+    const std::vector<nimbus::PointLight>& sources, const std::array<int, 3>& factors);
+  bool EnsureBasis(const nimbus::ExtinctionGrid& grid, const nimbus::CloudOptics& optics,
+    const nimbus::VirtualLightGrid& lights, const nimbus::LightningBasisOptions& options,
+    const std::string& fingerprint, const std::array<int, 3>& factors);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
