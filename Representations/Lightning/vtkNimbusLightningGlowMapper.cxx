@@ -148,37 +148,7 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
   }
   in.Window = window;
 
-  // The splats' vertices, uploaded again when the input or the mapper changed.
-  const vtkMTimeType time = std::max(input->GetMTime(), this->GetMTime());
-  if (time != in.VerticesTime || !in.Vertices->GetHandle())
-  {
-    static const float corners[6][2] = { { -1, -1 }, { 1, -1 }, { 1, 1 }, { -1, -1 }, { 1, 1 },
-      { -1, 1 } };
-    std::vector<float> vertices;
-    vertices.reserve(static_cast<std::size_t>(input->GetNumberOfPoints()) * 36);
-    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
-    {
-      const double value = intensity->GetComponent(i, 0);
-      if (!(value > 0.0) || !std::isfinite(value))
-      {
-        continue; // dark (or invalid) sources add nothing
-      }
-      double p[3];
-      input->GetPoint(i, p);
-      for (const auto& corner : corners)
-      {
-        vertices.insert(vertices.end(),
-          { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]),
-            static_cast<float>(value), corner[0], corner[1] });
-      }
-    }
-    in.VertexCount = static_cast<int>(vertices.size() / 6);
-    if (in.VertexCount > 0)
-    {
-      in.Vertices->Upload(vertices, vtkOpenGLBufferObject::ArrayBuffer);
-    }
-    in.VerticesTime = time;
-  }
+  this->UpdateSplatVertices(input, intensity);
   if (in.VertexCount == 0)
   {
     return;
@@ -253,6 +223,74 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
   state->vtkglEnable(GL_BLEND);
   state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
 
+  this->DrawSplats(renderer, actor, window);
+  in.Framebuffer->RemoveDepthAttachment();
+
+  // The sum added to the frame once.
+  state->PopFramebufferBindings();
+  state->vtkglViewport(x0, y0, width, height);
+  state->vtkglDisable(GL_DEPTH_TEST);
+  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  if (!in.Composite)
+  {
+    in.Composite =
+      std::make_unique<vtkOpenGLQuadHelper>(window, nullptr, lightningGlowCompositeFS, "");
+  }
+  else
+  {
+    window->GetShaderCache()->ReadyShaderProgram(in.Composite->Program);
+  }
+  if (in.Composite->Program)
+  {
+    in.Sum->Activate();
+    in.Composite->Program->SetUniformi("glowSum", in.Sum->GetTextureUnit());
+    in.Composite->Render();
+    in.Sum->Deactivate();
+  }
+}
+
+// The splats' vertices (six corners per lit source: position, intensity, corner),
+// uploaded again when the input or the mapper changed.
+void vtkNimbusLightningGlowMapper::UpdateSplatVertices(vtkPolyData* input, vtkDataArray* intensity)
+{
+  Internals& in = *this->Internal;
+  const vtkMTimeType time = std::max(input->GetMTime(), this->GetMTime());
+  if (time != in.VerticesTime || !in.Vertices->GetHandle())
+  {
+    static const float corners[6][2] = { { -1, -1 }, { 1, -1 }, { 1, 1 }, { -1, -1 }, { 1, 1 },
+      { -1, 1 } };
+    std::vector<float> vertices;
+    vertices.reserve(static_cast<std::size_t>(input->GetNumberOfPoints()) * 36);
+    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
+    {
+      const double value = intensity->GetComponent(i, 0);
+      if (!(value > 0.0) || !std::isfinite(value))
+      {
+        continue; // dark (or invalid) sources add nothing
+      }
+      double p[3];
+      input->GetPoint(i, p);
+      for (const auto& corner : corners)
+      {
+        vertices.insert(vertices.end(),
+          { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]),
+            static_cast<float>(value), corner[0], corner[1] });
+      }
+    }
+    in.VertexCount = static_cast<int>(vertices.size() / 6);
+    if (in.VertexCount > 0)
+    {
+      in.Vertices->Upload(vertices, vtkOpenGLBufferObject::ArrayBuffer);
+    }
+    in.VerticesTime = time;
+  }
+}
+
+// The splats into the bound float target: L(b) = sigma_s I / (4 b) per source.
+void vtkNimbusLightningGlowMapper::DrawSplats(
+  vtkRenderer* renderer, vtkActor* actor, vtkOpenGLRenderWindow* window)
+{
+  Internals& in = *this->Internal;
   in.SplatProgram =
     window->GetShaderCache()->ReadyShaderProgram(lightningGlowSplatVS, lightningGlowSplatFS, "");
   vtkShaderProgram* program = in.SplatProgram;
@@ -308,29 +346,6 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
     program->SetUniform3f("glowColor", color);
     glDrawArrays(GL_TRIANGLES, 0, in.VertexCount);
     in.Layout->Release();
-  }
-  in.Framebuffer->RemoveDepthAttachment();
-
-  // The sum added to the frame once.
-  state->PopFramebufferBindings();
-  state->vtkglViewport(x0, y0, width, height);
-  state->vtkglDisable(GL_DEPTH_TEST);
-  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  if (!in.Composite)
-  {
-    in.Composite =
-      std::make_unique<vtkOpenGLQuadHelper>(window, nullptr, lightningGlowCompositeFS, "");
-  }
-  else
-  {
-    window->GetShaderCache()->ReadyShaderProgram(in.Composite->Program);
-  }
-  if (in.Composite->Program)
-  {
-    in.Sum->Activate();
-    in.Composite->Program->SetUniformi("glowSum", in.Sum->GetTextureUnit());
-    in.Composite->Render();
-    in.Sum->Deactivate();
   }
 }
 

@@ -37,6 +37,9 @@
 
 #include <memory> // for std::unique_ptr
 
+class vtkDataArray;
+class vtkOpenGLRenderWindow;
+
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusLightningGlowMapper : public vtkPolyDataMapper
 {
 public:
@@ -89,6 +92,9 @@ protected:
 private:
   vtkNimbusLightningGlowMapper(const vtkNimbusLightningGlowMapper&) = delete;
   void operator=(const vtkNimbusLightningGlowMapper&) = delete;
+
+  void UpdateSplatVertices(vtkPolyData* input, vtkDataArray* intensity);
+  void DrawSplats(vtkRenderer* renderer, vtkActor* actor, vtkOpenGLRenderWindow* window);
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
