@@ -4,13 +4,14 @@
 // solver's coarse grid. A source inside a cloud lights a few mean free paths around it
 // (50 m in a cumulus), which a solver grid of 60-90 m cells holds at half a cell and
 // spreads; here every grid point gets its own transmittance and 1/r^2, and the points
-// next to a source the cell average of 1/r^2. Plain C++, no VTK.
+// next to a source the cell average of T/r^2. Plain C++, no VTK.
 //
 // What is computed. At grid point x, the unscattered irradiance from all sources and its
 // direction-weighted sum (the net flux of the sources' light):
 //     E(x) = sum_k I_k T(x, s_k) / r_k^2                          [intensity units / m^2]
 //     F(x) = sum_k I_k T(x, s_k) / r_k^2 w_k,  w_k = (x - s_k) / r_k (direction of travel)
-// so that the in-scattered radiance per unit scattering coefficient of the first order,
+// (T with the solver's forward peak given back: FirstScatteringForwardPeak below), so
+// that the in-scattered radiance per unit scattering coefficient of the first order,
 //     J1(x, w) = sum_k E_k p(w . w_k)                               (003 Eq. 1's first term)
 // is, in degree-1 spherical harmonics as the solver keeps J (MultipleScattering.h),
 //     J1(w) = (E + 3 k_1 F . w) / (4 pi),  k_1 the phase function's mean cosine.
@@ -39,8 +40,9 @@
 // E and F are computed where the medium has extinction and at the points next to it (a
 // renderer interpolates between them); elsewhere they are 0 (tau is still carried there).
 //
-// Cost: sources (merged per grid point) x grid points, each a few loads and an exp;
-// memory: 4 floats per grid point plus one float per point per thread.
+// Cost: sources (merged per grid point) x grid points, each a few loads and an exp (0.3 s
+// for a 3.5 km flash on 48 x 48 x 32 points, 4.7 s on 96 x 96 x 64, 2 cores); memory: 4
+// doubles and a float per grid point per thread, and the 4 floats per point returned.
 #ifndef nimbus_FirstScattering_h
 #define nimbus_FirstScattering_h
 
