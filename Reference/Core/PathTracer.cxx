@@ -2701,6 +2701,42 @@ double ImageRelativeError(const std::vector<PixelStatistics>& statistics)
 /// images enter the pixels' running statistics in batch order, so the result does not
 /// depend on the thread count. Rounds of batches until MaxSamplesPerPixel light paths per
 /// pixel, the time limit or the image target.
+// How a render went, for its result's totals.
+struct RenderTotals
+{
+  std::uint64_t Paths = 0;
+  std::uint64_t TruncatedPaths = 0;
+  std::size_t Pixels = 1;
+  int Rounds = 0;
+  bool StoppedAtTimeLimit = false;
+  bool ReachedImageTarget = false;
+};
+
+// The result's totals once its pixels are filled (camera or light paths alike); throws
+// std::range_error, naming `who`, for a pixel that is not finite.
+void FinishResult(PathTracingResult& result, const char* who, const RenderTotals& totals,
+  std::chrono::steady_clock::time_point start, const std::function<void(double)>& progress)
+{
+  const std::string nonFinite = NonFiniteMessage(result.Image);
+  if (!nonFinite.empty())
+  {
+    throw std::range_error(std::string(who) + ": the image has " + nonFinite);
+  }
+  result.Paths = totals.Paths;
+  result.TruncatedPaths = totals.TruncatedPaths;
+  result.MeanSamplesPerPixel =
+    static_cast<double>(result.Paths) / static_cast<double>(totals.Pixels);
+  result.ImageRelativeError = ImageRelativeError(result.Image, result.StandardError);
+  result.StoppedAtTimeLimit = totals.StoppedAtTimeLimit;
+  result.ReachedImageTarget = totals.ReachedImageTarget;
+  result.Rounds = totals.Rounds;
+  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress)
+  {
+    progress(1.0);
+  }
+}
+
 PathTracingResult RenderLightTraced(const RenderContext& context,
   const PathTracingSettings& settings, const std::function<void(double)>& progress)
 {
@@ -2870,23 +2906,9 @@ PathTracingResult RenderLightTraced(const RenderContext& context,
       result.StandardError.Pixels[3 * k + c] = static_cast<float>(statistics[k].StandardError(c));
     }
   }
-  const std::string nonFinite = NonFiniteMessage(result.Image);
-  if (!nonFinite.empty())
-  {
-    throw std::range_error("RenderPathTraced (light tracing): the image has " + nonFinite);
-  }
-  result.Paths = paths.load();
-  result.TruncatedPaths = truncated.load();
-  result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
-  result.ImageRelativeError = ImageRelativeError(result.Image, result.StandardError);
-  result.StoppedAtTimeLimit = stoppedAtTimeLimit;
-  result.ReachedImageTarget = reachedImageTarget;
-  result.Rounds = rounds;
-  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (progress)
-  {
-    progress(1.0);
-  }
+  FinishResult(result, "RenderPathTraced (light tracing)",
+    { paths.load(), truncated.load(), pixels, rounds, stoppedAtTimeLimit, reachedImageTarget },
+    start, progress);
   return result;
 }
 } // namespace
@@ -3309,23 +3331,9 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     }
   }
   // Never a silent NaN or infinity (a scene the reader accepts should not make one).
-  const std::string nonFinite = NonFiniteMessage(result.Image);
-  if (!nonFinite.empty())
-  {
-    throw std::range_error("RenderPathTraced: the image has " + nonFinite);
-  }
-  result.Paths = paths.load();
-  result.TruncatedPaths = truncated.load();
-  result.MeanSamplesPerPixel = static_cast<double>(result.Paths) / static_cast<double>(pixels);
-  result.ImageRelativeError = ImageRelativeError(result.Image, result.StandardError);
-  result.StoppedAtTimeLimit = stoppedAtTimeLimit;
-  result.ReachedImageTarget = reachedImageTarget;
-  result.Rounds = rounds;
-  result.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (progress)
-  {
-    progress(1.0);
-  }
+  FinishResult(result, "RenderPathTraced",
+    { paths.load(), truncated.load(), pixels, rounds, stoppedAtTimeLimit, reachedImageTarget },
+    start, progress);
   return result;
 }
 
