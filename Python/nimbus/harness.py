@@ -1168,6 +1168,15 @@ def write_side_by_side(reference, image, path, exposure=None):
     write_png(np.concatenate([reference, gap, image, gap, difference], axis=1), path, exposure)
 
 
+def write_rows_csv(path, rows):
+    """Rows (dicts with the same keys) as a CSV file with a header; prints the path."""
+    with open(path, "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(path)
+
+
 def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
     """Time to `target` relative RMSE of the path tracer, per scene.
 
@@ -1193,12 +1202,7 @@ def path_convergence(scene_paths, samples_per_pixel, output_dir, target=0.01):
         print(f"{scene_name}: path tracing {samples_per_pixel} spp in {seconds:.1f} s, relative "
               f"error {error:.3f} -> {target:.0%} needs ~{row['samples_per_pixel_for_target']:.3g}"
               f" spp, ~{row['seconds_for_target'] / 3600:.2g} h", flush=True)
-    path = os.path.join(output_dir, "path-convergence.csv")
-    with open(path, "w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    print(path)
+    write_rows_csv(os.path.join(output_dir, "path-convergence.csv"), rows)
     return rows
 
 
@@ -1280,12 +1284,7 @@ def compare_references(scene_paths, names, args):
               f"PSNR {row['psnr_db']:.1f} dB (p99.9 {row['psnr_p999_db']:.1f} dB), rel. L1 "
               f"{row['relative_l1']:.3f}, mean radiance ratio {row['mean_ratio']:.3f}",
               flush=True)
-    path = os.path.join(args.output_dir, "reference-pairs.csv")
-    with open(path, "w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    print(path)
+    write_rows_csv(os.path.join(args.output_dir, "reference-pairs.csv"), rows)
     return rows
 
 
