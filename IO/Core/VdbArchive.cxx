@@ -6,6 +6,7 @@
 #include <openvdb/Metadata.h>
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <climits>
@@ -258,6 +259,104 @@ SpanBuf::pos_type SpanBuf::seekoff(
 }
 
 SpanBuf::pos_type SpanBuf::seekpos(pos_type pos, std::ios_base::openmode which)
+{
+  return this->seekoff(off_type(pos), std::ios_base::beg, which);
+}
+
+FileRangeBuf::FileRangeBuf(const std::string& path, int64_t begin, int64_t end, int64_t window)
+  : Begin(begin)
+  , End(end)
+  , WindowStart(begin)
+  , Window(static_cast<size_t>(std::max<int64_t>(4096, window)))
+{
+  this->Descriptor = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (this->Descriptor < 0)
+  {
+    throw Error("cannot open " + Quote(path) + " for reading: " + std::strerror(errno));
+  }
+  this->setg(this->Window.data(), this->Window.data(), this->Window.data());
+}
+
+FileRangeBuf::~FileRangeBuf()
+{
+  if (this->Descriptor >= 0)
+  {
+    ::close(this->Descriptor);
+  }
+}
+
+FileRangeBuf::int_type FileRangeBuf::underflow()
+{
+  if (this->gptr() < this->egptr())
+  {
+    return traits_type::to_int_type(*this->gptr());
+  }
+  const int64_t at = this->Position();
+  const int64_t n = std::min<int64_t>(this->End - at, static_cast<int64_t>(this->Window.size()));
+  if (n <= 0)
+  {
+    return traits_type::eof();
+  }
+  int64_t got = 0;
+  while (got < n)
+  {
+    const ssize_t r = ::pread(this->Descriptor, this->Window.data() + got,
+      static_cast<size_t>(n - got), static_cast<off_t>(at + got));
+    if (r < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (r <= 0)
+    {
+      break; // the file ended early (it shrank): the stream's read fails
+    }
+    got += r;
+  }
+  this->Read += got;
+  this->WindowStart = at;
+  this->setg(this->Window.data(), this->Window.data(), this->Window.data() + got);
+  return got > 0 ? traits_type::to_int_type(*this->gptr()) : traits_type::eof();
+}
+
+FileRangeBuf::pos_type FileRangeBuf::seekoff(
+  off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which)
+{
+  if (!(which & std::ios_base::in))
+  {
+    return pos_type(off_type(-1));
+  }
+  int64_t at = 0;
+  if (dir == std::ios_base::beg)
+  {
+    at = off;
+  }
+  else if (dir == std::ios_base::cur)
+  {
+    at = this->Position() + off;
+  }
+  else
+  {
+    at = this->End + off;
+  }
+  if (at < this->Begin || at > this->End)
+  {
+    return pos_type(off_type(-1));
+  }
+  const int64_t loaded = this->egptr() - this->eback();
+  if (at >= this->WindowStart && at <= this->WindowStart + loaded)
+  {
+    this->setg(this->eback(), this->eback() + (at - this->WindowStart), this->egptr());
+  }
+  else
+  {
+    // Outside the window: nothing read until the next read.
+    this->WindowStart = at;
+    this->setg(this->Window.data(), this->Window.data(), this->Window.data());
+  }
+  return pos_type(at);
+}
+
+FileRangeBuf::pos_type FileRangeBuf::seekpos(pos_type pos, std::ios_base::openmode which)
 {
   return this->seekoff(off_type(pos), std::ios_base::beg, which);
 }

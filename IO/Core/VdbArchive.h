@@ -57,15 +57,23 @@ struct FileLayout
   std::map<std::string, std::string> FileStrings;
 };
 
+/// A stream buffer that knows how many bytes are left before the end of its range (the
+/// chunk-size checks of VdbCompressionGuard.cxx ask).
+class BoundedBuf : public std::streambuf
+{
+public:
+  virtual int64_t Remaining() const = 0;
+};
+
 /// A stream buffer over bytes [base, base + size) of a file held in memory: reads and seeks
 /// outside that range fail (with the stream's exceptions on: throw), so OpenVDB cannot read
 /// past a grid's end, or past the end of a truncated file, without noticing. Remaining()
 /// tells the chunk-size checks of VdbCompressionGuard.cxx how many bytes are left.
-class SpanBuf : public std::streambuf
+class SpanBuf : public BoundedBuf
 {
 public:
   SpanBuf(std::vector<char>& bytes, int64_t base);
-  int64_t Remaining() const { return this->egptr() - this->gptr(); }
+  int64_t Remaining() const override { return this->egptr() - this->gptr(); }
 
 protected:
   pos_type seekoff(
@@ -74,6 +82,37 @@ protected:
 
 private:
   int64_t Base;
+};
+
+/// The same bounds over bytes [begin, end) of a file read as they are asked for, through a
+/// window of at most `window` bytes: seeking over bytes does not read them, so a grid's
+/// clipped read (OpenVDB skips the buffers of the leaves outside its box) reads from the
+/// file only the leaves it keeps. A file that ends before `end` (it shrank since ScanFile)
+/// makes the read fail.
+class FileRangeBuf : public BoundedBuf
+{
+public:
+  FileRangeBuf(const std::string& path, int64_t begin, int64_t end, int64_t window = 1 << 20);
+  ~FileRangeBuf() override;
+  FileRangeBuf(const FileRangeBuf&) = delete;
+  FileRangeBuf& operator=(const FileRangeBuf&) = delete;
+  int64_t Remaining() const override { return this->End - this->Position(); }
+  /// Bytes read from the file so far.
+  int64_t BytesRead() const { return this->Read; }
+
+protected:
+  int_type underflow() override;
+  pos_type seekoff(
+    off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override;
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override;
+
+private:
+  int64_t Position() const { return this->WindowStart + (this->gptr() - this->eback()); }
+  int Descriptor = -1;
+  int64_t Begin, End;
+  int64_t WindowStart;
+  int64_t Read = 0;
+  std::vector<char> Window;
 };
 
 /// Checks the layout of `path` (see above). Throws Error with a message that says what is

@@ -89,10 +89,11 @@ bool nimbus::vdb::CompressionGuardInEffect()
 
 namespace
 {
-/// Bytes left in the stream when it reads a grid held in memory (SpanBuf); -1 otherwise.
+/// Bytes left in the stream when it reads a grid's own bytes (SpanBuf, FileRangeBuf); -1
+/// otherwise.
 int64_t Remaining(std::istream& is)
 {
-  const auto* span = dynamic_cast<const nimbus::vdb::SpanBuf*>(is.rdbuf());
+  const auto* span = dynamic_cast<const nimbus::vdb::BoundedBuf*>(is.rdbuf());
   return span ? span->Remaining() : -1;
 }
 

@@ -408,10 +408,13 @@ typename GridT::Ptr BuildGrid(const FieldToWrite& field)
   return grid;
 }
 
-/// OpenVDB's own grid reading (Archive::readGrid), fed one grid at a time from memory
-/// through a SpanBuf, after ScanFile has checked the layout. OpenVDB's File reads from an
-/// ifstream whose failed reads it does not check, which is how a truncated file gave
-/// uninitialised values and a corrupt count unbounded allocations.
+/// OpenVDB's own grid reading (Archive::readGrid), fed one grid at a time from the grid's own
+/// bytes through a FileRangeBuf (reads outside them fail), after ScanFile has checked the
+/// layout. OpenVDB's File reads from an ifstream whose failed reads it does not check, which
+/// is how a truncated file gave uninitialised values and a corrupt count unbounded
+/// allocations. With a clip box, OpenVDB reads the whole topology (the node masks) but only
+/// the voxel buffers of the leaves that touch the box, seeking over the others, and drops
+/// the rest of the tree as it goes: a piece's read holds and reads only the piece's voxels.
 class ArchiveReader : public openvdb::io::Archive
 {
 public:
@@ -433,13 +436,15 @@ public:
     throw Error("ArchiveReader cannot write");
   }
 
-  /// Grid `i` of the layout: metadata and transform only, or the whole grid.
-  openvdb::GridBase::Ptr Read(size_t i, bool metadataOnly, int depth = 0)
+  /// Grid `i` of the layout: metadata and transform only, or the whole grid, or (with
+  /// `clip`) the grid's voxels in that index box and nothing outside it.
+  openvdb::GridBase::Ptr Read(
+    size_t i, bool metadataOnly, int depth = 0, const openvdb::CoordBBox* clip = nullptr)
   {
     const GridLayout& g = this->Layout.Grids[i];
-    std::vector<char> bytes;
-    this->Load(g.DescriptorPos, (metadataOnly ? g.BlockPos : g.EndPos) - g.DescriptorPos, bytes);
-    SpanBuf buf(bytes, g.DescriptorPos);
+    FileRangeBuf buf(this->Path, g.DescriptorPos, metadataOnly ? g.BlockPos : g.EndPos,
+      metadataOnly ? 64 << 10 : 1 << 20);
+    buf.pubseekpos(g.DescriptorPos, std::ios_base::in);
     std::istream is(&buf);
     is.exceptions(std::ios::failbit | std::ios::badbit);
     auto meta = std::make_shared<openvdb::io::StreamMetadata>();
@@ -463,7 +468,14 @@ public:
       grid->readTransform(is);
       return grid;
     }
-    Archive::readGrid(grid, gd, is);
+    if (clip)
+    {
+      Archive::readGrid(grid, gd, is, *clip);
+    }
+    else
+    {
+      Archive::readGrid(grid, gd, is);
+    }
     if (gd.isInstance())
     {
       size_t parent = this->Layout.Grids.size();
@@ -479,7 +491,7 @@ public:
         throw Error("grid " + Quote(this->Layout.DistinctNames[i]) +
           " is an instance of a grid that is missing or itself an instance");
       }
-      grid->setTree(this->Read(parent, false, depth + 1)->baseTreePtr());
+      grid->setTree(this->Read(parent, false, depth + 1, clip)->baseTreePtr());
     }
     return grid;
   }
@@ -534,6 +546,59 @@ std::string ReadFailure(const std::string& path, const std::string& grid, const 
   }
   return "cannot read grid " + Quote(grid) + " of OpenVDB file " + Quote(path) +
     " (truncated or corrupt?): " + e.what();
+}
+
+/// The index box of grid `index` to read for `box` of the reference's index space: the box
+/// itself when the grid has the reference's transform (its voxels are copied), the box's
+/// corners in the grid's index space grown by 2 voxels when it is resampled (trilinear
+/// sampling reads the 8 voxels around each point). False (read the whole grid) for files older
+/// than grid instancing, whose metadata cannot be read apart, and for non-linear transforms,
+/// whose linearisation depends on the whole grid's active box.
+bool ClipBox(ArchiveReader& archive, const FileLayout& layout, size_t index,
+  const TransformInfo& reference, const IndexBox& box, openvdb::CoordBBox& clip)
+{
+  if (layout.FormatVersion < openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING || !reference.Linear ||
+    box.Empty())
+  {
+    return false;
+  }
+  const auto meta = archive.Read(index, /*metadataOnly=*/true);
+  const openvdb::math::Transform& transform = meta->transform();
+  if (!transform.isLinear())
+  {
+    return false;
+  }
+  if (AnalyseTransform(transform, openvdb::Vec3d(0.0)).SameAs(reference))
+  {
+    clip = ToCoordBox(box);
+    return true;
+  }
+  openvdb::Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    std::array<double, 3> ijk{};
+    for (int c = 0; c < 3; ++c)
+    {
+      ijk[c] = double((corner >> c) & 1 ? box.Max[c] : box.Min[c]);
+    }
+    const auto w = IndexToWorld(reference, ijk);
+    const openvdb::Vec3d g = transform.worldToIndex(openvdb::Vec3d(w[0], w[1], w[2]));
+    lo = openvdb::math::minComponent(lo, g);
+    hi = openvdb::math::maxComponent(hi, g);
+  }
+  const double limit = double(std::numeric_limits<int32_t>::max() / 2);
+  for (int c = 0; c < 3; ++c)
+  {
+    if (!(std::abs(lo[c]) < limit && std::abs(hi[c]) < limit))
+    {
+      return false;
+    }
+  }
+  clip = openvdb::CoordBBox(openvdb::Coord(int(std::floor(lo[0])) - 2, int(std::floor(lo[1])) - 2,
+                              int(std::floor(lo[2])) - 2),
+    openvdb::Coord(
+      int(std::ceil(hi[0])) + 2, int(std::ceil(hi[1])) + 2, int(std::ceil(hi[2])) + 2));
+  return true;
 }
 
 } // namespace
@@ -881,7 +946,10 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
       {
         throw Error("no grid named " + Quote(names[g]) + " in " + Quote(path));
       }
-      const auto base = archive.Read(size_t(found - layout.DistinctNames.begin()), false);
+      const size_t index = size_t(found - layout.DistinctNames.begin());
+      openvdb::CoordBBox clip;
+      const bool clipped = ClipBox(archive, layout, index, reference, box, clip);
+      const auto base = archive.Read(index, false, 0, clipped ? &clip : nullptr);
       const ValueKind kind = KindOf(*base);
       // Every value is set even if a copy stopped half-way: never uninitialised memory.
       std::fill(target[g], target[g] + box.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
