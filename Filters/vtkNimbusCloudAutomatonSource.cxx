@@ -16,6 +16,11 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+#include "vtkCommunicator.h"
+#include "vtkMultiProcessController.h"
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -39,6 +44,13 @@ struct vtkNimbusCloudAutomatonSource::vtkInternals
   std::unique_ptr<nimbus::CloudAutomaton> Automaton;
   std::map<std::int64_t, nimbus::CloudAutomatonState> Checkpoints;
   std::map<std::int64_t, std::vector<float>> Densities; // smoothed cld of recent steps
+  int DensityBox[6] = { 0, -1, 0, -1, 0, -1 };          // the cells Densities cover
+
+  // A distributed run (see the class description): this rank, the ranks, the layers it owns
+  // and holds. Ranks 1 and the whole grid otherwise.
+  bool Distributed = false;
+  int Rank = 0, Ranks = 1;
+  int Owned[2] = { 0, 0 }, Held[2] = { 0, 0 };
 
   void Clear()
   {
@@ -111,6 +123,200 @@ double AxisSpacing(int points, double low, double high)
   }
   return high > low ? high - low : 1.0;
 }
+
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+constexpr int HaloTag = 93017;
+using Field = nimbus::CloudAutomaton::Field;
+constexpr Field Fields[3] = { Field::Hum, Field::Act, Field::Cld };
+
+/// After a step: the owned layers next to each neighbour go to it (2 up, 1 down), the halo
+/// layers come from it. Even ranks send first, odd ranks receive first, so blocking sends
+/// never wait on each other. Returns the bytes this rank sent.
+std::uint64_t ExchangeHalo(vtkCommunicator* communicator, nimbus::CloudAutomaton& automaton,
+  int rank, int ranks, const int owned[2], const int held[2])
+{
+  const std::size_t layerWords = static_cast<std::size_t>(automaton.GetParameters().Dimensions[1]) *
+    static_cast<std::size_t>(automaton.WordsPerRow());
+  std::vector<std::uint64_t> buffer;
+  std::uint64_t sent = 0;
+  auto pack = [&](int z0, int z1)
+  {
+    buffer.clear();
+    for (const Field f : Fields)
+    {
+      for (int z = z0; z < z1; ++z)
+      {
+        const std::uint64_t* layer = automaton.Layer(f, z);
+        buffer.insert(buffer.end(), layer, layer + layerWords);
+      }
+    }
+  };
+  auto unpack = [&](int z0, int z1)
+  {
+    std::size_t at = 0;
+    for (const Field f : Fields)
+    {
+      for (int z = z0; z < z1; ++z, at += layerWords)
+      {
+        std::copy_n(buffer.data() + at, layerWords, automaton.Layer(f, z));
+      }
+    }
+  };
+  auto send = [&](int to, int z0, int z1)
+  {
+    pack(z0, z1);
+    communicator->Send(reinterpret_cast<const unsigned long*>(buffer.data()),
+      static_cast<vtkIdType>(buffer.size()), to, HaloTag);
+    sent += 8 * buffer.size();
+  };
+  auto receive = [&](int from, int z0, int z1)
+  {
+    buffer.resize(3 * layerWords * static_cast<std::size_t>(z1 - z0));
+    communicator->Receive(reinterpret_cast<unsigned long*>(buffer.data()),
+      static_cast<vtkIdType>(buffer.size()), from, HaloTag);
+    unpack(z0, z1);
+  };
+  const bool even = rank % 2 == 0;
+  const bool up = rank + 1 < ranks, down = rank > 0;
+  // Upward: my top owned layers become the halo below the next rank's slab.
+  for (int phase = 0; phase < 2; ++phase)
+  {
+    if ((phase == 0) == even && up)
+    {
+      send(rank + 1, owned[1] - nimbus::CloudHaloBelow, owned[1]);
+    }
+    if ((phase == 0) != even && down)
+    {
+      receive(rank - 1, held[0], owned[0]);
+    }
+  }
+  // Downward: my bottom owned layer becomes the halo above the previous rank's slab.
+  for (int phase = 0; phase < 2; ++phase)
+  {
+    if ((phase == 0) == even && down)
+    {
+      send(rank - 1, owned[0], owned[0] + nimbus::CloudHaloAbove);
+    }
+    if ((phase == 0) != even && up)
+    {
+      receive(rank + 1, owned[1], held[1]);
+    }
+  }
+  return sent;
+}
+
+/// The rows (y) within `halo` of a box's [y0, y1], in the grid (wrapped when periodic),
+/// distinct and ascending; none for an empty box.
+std::vector<int> RowsAround(const int box[6], int halo, int ny, bool periodic)
+{
+  std::vector<int> rows;
+  if (box[0] > box[1] || box[2] > box[3] || box[4] > box[5])
+  {
+    return rows;
+  }
+  std::vector<char> used(static_cast<std::size_t>(ny), 0);
+  for (int y = box[2] - halo; y <= box[3] + halo; ++y)
+  {
+    if (y >= 0 && y < ny)
+    {
+      used[y] = 1;
+    }
+    else if (periodic)
+    {
+      used[((y % ny) + ny) % ny] = 1;
+    }
+  }
+  for (int y = 0; y < ny; ++y)
+  {
+    if (used[y])
+    {
+      rows.push_back(y);
+    }
+  }
+  return rows;
+}
+
+/// The cld rows every rank needs for its box (its piece's cells, `halo` around in y and z),
+/// scattered by the ranks that own their layers (one ScatterV per rank). `table` receives,
+/// for each (y, z - zLow) of this rank's box, the row's words (nullptr where not needed).
+/// Returns the bytes received.
+std::uint64_t GatherRows(vtkCommunicator* communicator, nimbus::CloudAutomaton& automaton, int rank,
+  int ranks, const int box[6], int halo, std::vector<std::uint64_t>& storage,
+  std::vector<const std::uint64_t*>& table, int& zLow)
+{
+  const auto& p = automaton.GetParameters();
+  const int ny = p.Dimensions[1], nz = p.Dimensions[2];
+  const bool periodic = p.Boundary == nimbus::CloudBoundary::Periodic;
+  const std::size_t W = static_cast<std::size_t>(automaton.WordsPerRow());
+  std::vector<int> boxes(static_cast<std::size_t>(6 * ranks));
+  communicator->AllGather(box, boxes.data(), 6);
+  // Layers [lo, hi] of rank r's box within the grid; rows of its box.
+  std::vector<std::vector<int>> rows(static_cast<std::size_t>(ranks));
+  std::vector<int> lo(static_cast<std::size_t>(ranks)), hi(static_cast<std::size_t>(ranks));
+  for (int r = 0; r < ranks; ++r)
+  {
+    const int* b = boxes.data() + 6 * r;
+    rows[r] = RowsAround(b, halo, ny, periodic);
+    lo[r] = std::max(0, b[4] - halo);
+    hi[r] = rows[r].empty() ? lo[r] - 1 : std::min(nz - 1, b[5] + halo);
+  }
+  zLow = lo[rank];
+  const int layers = std::max(0, hi[rank] - lo[rank] + 1);
+  table.assign(static_cast<std::size_t>(ny) * layers, nullptr);
+  storage.assign(rows[rank].size() * static_cast<std::size_t>(layers) * W, 0);
+  std::size_t received = 0;
+  std::vector<std::uint64_t> sendBuffer;
+  std::vector<vtkIdType> lengths(static_cast<std::size_t>(ranks)),
+    offsets(static_cast<std::size_t>(ranks));
+  for (int root = 0; root < ranks; ++root)
+  {
+    int owned[2], held[2];
+    nimbus::DistributedLayers(nz, root, ranks, owned, held);
+    // What `root` sends rank r: rows[r] of its owned layers within r's box, z then y.
+    auto range = [&](int r, int& z0, int& z1)
+    {
+      z0 = std::max(owned[0], lo[r]);
+      z1 = std::min(owned[1] - 1, hi[r]);
+    };
+    if (rank == root)
+    {
+      sendBuffer.clear();
+      for (int r = 0; r < ranks; ++r)
+      {
+        int z0, z1;
+        range(r, z0, z1);
+        offsets[r] = static_cast<vtkIdType>(sendBuffer.size());
+        for (int z = z0; z <= z1; ++z)
+        {
+          const std::uint64_t* layer = automaton.Layer(Field::Cld, z);
+          for (const int y : rows[r])
+          {
+            sendBuffer.insert(sendBuffer.end(), layer + y * W, layer + (y + 1) * W);
+          }
+        }
+        lengths[r] = static_cast<vtkIdType>(sendBuffer.size()) - offsets[r];
+      }
+    }
+    int z0, z1;
+    range(rank, z0, z1);
+    const std::size_t count = z1 >= z0 ? (z1 - z0 + 1) * rows[rank].size() * W : 0;
+    std::uint64_t* target = storage.data() + received;
+    communicator->ScatterV(reinterpret_cast<const unsigned long*>(sendBuffer.data()),
+      reinterpret_cast<unsigned long*>(target), lengths.data(), offsets.data(),
+      static_cast<vtkIdType>(count), root);
+    for (int z = z0; z <= z1; ++z)
+    {
+      for (const int y : rows[rank])
+      {
+        table[static_cast<std::size_t>(z - zLow) * ny + y] = target;
+        target += W;
+      }
+    }
+    received += count;
+  }
+  return 8 * received;
+}
+#endif
 }
 
 vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
@@ -385,6 +591,150 @@ int vtkNimbusCloudAutomatonSource::RequestData(
   return 1;
 }
 
+bool vtkNimbusCloudAutomatonSource::SetUpAutomaton(vtkImageData* input, const int held[2])
+{
+  auto& internals = *this->Internals;
+  const int* d = this->Dimensions;
+  nimbus::CloudAutomatonParameters p;
+  std::copy(d, d + 3, p.Dimensions);
+  p.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
+  p.Extinction = nimbus::ProbabilityField::Uniform(this->ExtinctionProbability);
+  p.HumiditySupply = nimbus::ProbabilityField::Uniform(this->HumidityProbability);
+  p.ActivationSupply = nimbus::ProbabilityField::Uniform(this->ActivationProbability);
+  p.InitialHumidity = this->InitialHumidity;
+  p.InitialActivation = this->InitialActivation;
+  // m/s -> cells per step; (m/s)/m -> cells per step per layer.
+  const double dz = AxisSpacing(d[2], this->Bounds[4], this->Bounds[5]);
+  for (int a = 0; a < 2; ++a)
+  {
+    const double spacing = AxisSpacing(d[a], this->Bounds[2 * a], this->Bounds[2 * a + 1]);
+    p.Wind[a] = this->Wind[a] * this->StepDuration / spacing;
+    p.Shear[a] = this->Shear[a] * dz * this->StepDuration / spacing;
+  }
+  p.Boundary =
+    this->PeriodicBoundary ? nimbus::CloudBoundary::Periodic : nimbus::CloudBoundary::Open;
+  p.NumberOfThreads = this->NumberOfThreads;
+  p.Layers[0] = held[0];
+  p.Layers[1] = held[1];
+  // Values per held layer (the whole grid unless distributed).
+  const std::size_t plane = static_cast<std::size_t>(d[0]) * d[1];
+  const std::size_t first = plane * held[0], last = plane * held[1];
+  if (this->NumberOfFormationRegions > 0)
+  {
+    // Regions in cells: the radii (metres) over the horizontal spacing, vertical semi-axes
+    // half the horizontal ones, centres at 30 % of the height.
+    const double sx = AxisSpacing(d[0], this->Bounds[0], this->Bounds[1]);
+    const double sy = AxisSpacing(d[1], this->Bounds[2], this->Bounds[3]);
+    const double radius[2] = { this->FormationRegionRadiusRange[0],
+      this->FormationRegionRadiusRange[1] };
+    const double cellRadius[2] = { radius[0] / sx, radius[1] / sx };
+    std::vector<nimbus::FormationRegion> regions =
+      nimbus::RandomFormationRegions(d, this->NumberOfFormationRegions, cellRadius, 1.0,
+        0.3 * (d[2] - 1), p.Seed, p.Boundary == nimbus::CloudBoundary::Open);
+    for (nimbus::FormationRegion& region : regions)
+    {
+      const double metres = region.Radius[0] * sx;
+      region.Radius[1] = metres / sy;
+      region.Radius[2] = 0.5 * metres / dz;
+    }
+    const std::vector<float> weights = nimbus::FormationRegionWeights(
+      d, regions, p.Boundary == nimbus::CloudBoundary::Periodic, held[0], held[1]);
+    std::vector<float> hum(weights.size()), act(weights.size());
+    for (std::size_t i = 0; i < weights.size(); ++i)
+    {
+      hum[i] = static_cast<float>(this->HumidityProbability * weights[i]);
+      act[i] = static_cast<float>(this->ActivationProbability * weights[i]);
+    }
+    p.HumiditySupply = nimbus::ProbabilityField::Volume(std::move(hum));
+    p.ActivationSupply = nimbus::ProbabilityField::Volume(std::move(act));
+  }
+
+  if (input)
+  {
+    int inDims[3];
+    input->GetDimensions(inDims);
+    const char* names[3] = { "p_ext", "p_hum", "p_act" };
+    nimbus::ProbabilityField* fields[3] = { &p.Extinction, &p.HumiditySupply, &p.ActivationSupply };
+    for (int f = 0; f < 3; ++f)
+    {
+      vtkDataArray* array = input->GetPointData()->GetArray(names[f]);
+      if (!array)
+      {
+        continue;
+      }
+      const bool volume = inDims[0] == d[0] && inDims[1] == d[1] && inDims[2] == d[2];
+      const bool plane = inDims[0] == d[0] && inDims[1] == d[1] && inDims[2] == 1;
+      if (!volume && !plane)
+      {
+        vtkErrorMacro(<< "The input probability image is " << inDims[0] << " x " << inDims[1]
+                      << " x " << inDims[2] << " points; it must match Dimensions (" << d[0]
+                      << " x " << d[1] << " x " << d[2] << ") or be a 2-D map of " << d[0] << " x "
+                      << d[1] << " x 1.");
+        return false;
+      }
+      if (array->GetNumberOfComponents() != 1)
+      {
+        vtkErrorMacro(<< "Input array \"" << names[f] << "\" must have one component, it has "
+                      << array->GetNumberOfComponents() << ".");
+        return false;
+      }
+      const vtkIdType expected = static_cast<vtkIdType>(inDims[0]) * inDims[1] * inDims[2];
+      if (array->GetNumberOfTuples() != expected)
+      {
+        vtkErrorMacro(<< "Input array \"" << names[f] << "\" has " << array->GetNumberOfTuples()
+                      << " values for " << expected << " points.");
+        return false;
+      }
+      std::vector<float> values(static_cast<std::size_t>(array->GetNumberOfTuples()));
+      std::size_t aboveOne = 0;
+      vtkIdType firstBad = -1;
+      for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
+      {
+        values[i] = static_cast<float>(array->GetComponent(i, 0));
+        aboveOne += values[i] > 1.0f && std::isfinite(values[i]) ? 1 : 0;
+        if (firstBad < 0 && !(values[i] >= 0.0f && values[i] <= 1.0f))
+        {
+          firstBad = i;
+        }
+      }
+      // Bad values where they enter, counted (the core names the first one).
+      const nimbus::ValueCensus census = nimbus::TakeCensus(values.data(), values.size());
+      if (!census.AllFiniteNonNegative() || aboveOne > 0)
+      {
+        std::string problems = nimbus::DescribeCensus(census);
+        if (aboveOne > 0)
+        {
+          problems +=
+            (problems.empty() ? "" : " and ") + std::to_string(aboveOne) + " values above 1";
+        }
+        const char* core[3] = { "Extinction", "HumiditySupply", "ActivationSupply" };
+        vtkErrorMacro(<< "Input array \"" << names[f] << "\" (" << core[f] << ") has " << problems
+                      << ", the first " << values[firstBad] << " at index " << firstBad
+                      << "; probabilities must be in [0, 1] (an 8-bit image needs scaling "
+                         "by 1/255 first).");
+        return false;
+      }
+      if (volume)
+      {
+        values = std::vector<float>(values.begin() + first, values.begin() + last);
+      }
+      *fields[f] = volume ? nimbus::ProbabilityField::Volume(std::move(values))
+                          : nimbus::ProbabilityField::Plane(std::move(values));
+    }
+  }
+  try
+  {
+    internals.Automaton = std::make_unique<nimbus::CloudAutomaton>(p);
+  }
+  catch (const std::exception& error)
+  {
+    vtkErrorMacro(<< "Cannot set up the cloud automaton: " << error.what()
+                  << " (input arrays p_ext, p_hum, p_act must hold probabilities in [0, 1]).");
+    return false;
+  }
+  return true;
+}
+
 int vtkNimbusCloudAutomatonSource::Generate(
   vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -395,6 +745,67 @@ int vtkNimbusCloudAutomatonSource::Generate(
     : nullptr;
   auto& internals = *this->Internals;
   const int* d = this->Dimensions;
+  // --- one piece per rank: the ranks share the automaton by layers -----------------------------
+  int extent[6];
+  const bool anyPoint = nimbus::RequestedExtent(outInfo, extent);
+  bool distributed = false;
+  int rank = 0, ranks = 1;
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  vtkCommunicator* communicator = controller ? controller->GetCommunicator() : nullptr;
+  if (communicator && controller->GetNumberOfProcesses() > 1)
+  {
+    using SDDP = vtkStreamingDemandDrivenPipeline;
+    const int pieces = outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
+      ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
+      : 1;
+    const int piece =
+      outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+    ranks = controller->GetNumberOfProcesses();
+    rank = controller->GetLocalProcessId();
+    distributed = pieces == ranks && piece == rank && d[2] >= 2 * ranks;
+  }
+#endif
+  if (!distributed)
+  {
+    rank = 0;
+    ranks = 1;
+  }
+  if (distributed != internals.Distributed || rank != internals.Rank || ranks != internals.Ranks)
+  {
+    internals.Clear();
+    internals.Distributed = distributed;
+    internals.Rank = rank;
+    internals.Ranks = ranks;
+  }
+  if (distributed)
+  {
+    nimbus::DistributedLayers(d[2], rank, ranks, internals.Owned, internals.Held);
+  }
+  else
+  {
+    internals.Owned[0] = internals.Held[0] = 0;
+    internals.Owned[1] = internals.Held[1] = d[2];
+  }
+  std::copy(internals.Owned, internals.Owned + 2, this->OwnedLayers);
+  // The cells the densities are smoothed on: the piece when distributed, else the whole grid.
+  int densityBox[6] = { 0, d[0] - 1, 0, d[1] - 1, 0, d[2] - 1 };
+  if (distributed)
+  {
+    std::copy(extent, extent + 6, densityBox);
+    if (!anyPoint)
+    {
+      densityBox[1] = densityBox[3] = densityBox[5] = -1;
+      densityBox[0] = densityBox[2] = densityBox[4] = 0;
+    }
+  }
+  if (!std::equal(densityBox, densityBox + 6, internals.DensityBox))
+  {
+    internals.Densities.clear();
+    std::copy(densityBox, densityBox + 6, internals.DensityBox);
+  }
+  this->HaloBytesPerStep = 0;
+  this->PieceGatherBytes = 0;
   // --- memory: states, checkpoints, cached densities, output and input maps ----------------
   std::uint64_t cells = 0;
   if (!nimbus::CheckedProduct({ static_cast<std::uint64_t>(d[0]), static_cast<std::uint64_t>(d[1]),
@@ -406,8 +817,16 @@ int vtkNimbusCloudAutomatonSource::Generate(
     return 1;
   }
   const double cellCount = static_cast<double>(cells);
+  // This rank's share: its held layers, and the cells of its densities.
+  const double heldLayers = static_cast<double>(internals.Held[1] - internals.Held[0]);
+  const double heldCells = cellCount / d[2] * heldLayers;
+  double densityCells = 1.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    densityCells *= std::max(0, densityBox[2 * a + 1] - densityBox[2 * a] + 1);
+  }
   // One state: three bit fields, rows padded to 64-bit words.
-  const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * d[2];
+  const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * heldLayers;
   const double lastStep =
     static_cast<double>(this->NumberOfTimeSteps) + static_cast<double>(this->SpinUpSteps);
   const double checkpoints = std::min(static_cast<double>(this->MaximumNumberOfCheckpoints),
@@ -415,8 +834,8 @@ int vtkNimbusCloudAutomatonSource::Generate(
   // Floats per cell: the cached densities (up to 2 more while a request runs), the
   // smoothing's two buffers and the output array; 8 bytes per cell per input map.
   const double bytes = stateBytes * (2.0 + checkpoints) +
-    4.0 * cellCount * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0) +
-    (this->NumberOfFormationRegions > 0 ? 12.0 * cellCount : 0.0);
+    4.0 * densityCells * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0) +
+    (this->NumberOfFormationRegions > 0 ? 12.0 * heldCells : 0.0);
   std::ostringstream what;
   what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
        << checkpoints << " checkpoints)";
@@ -436,133 +855,8 @@ int vtkNimbusCloudAutomatonSource::Generate(
     internals.InputTime != inputTime)
   {
     internals.Clear();
-    nimbus::CloudAutomatonParameters p;
-    std::copy(d, d + 3, p.Dimensions);
-    p.Seed = static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed));
-    p.Extinction = nimbus::ProbabilityField::Uniform(this->ExtinctionProbability);
-    p.HumiditySupply = nimbus::ProbabilityField::Uniform(this->HumidityProbability);
-    p.ActivationSupply = nimbus::ProbabilityField::Uniform(this->ActivationProbability);
-    p.InitialHumidity = this->InitialHumidity;
-    p.InitialActivation = this->InitialActivation;
-    // m/s -> cells per step; (m/s)/m -> cells per step per layer.
-    const double dz = AxisSpacing(d[2], this->Bounds[4], this->Bounds[5]);
-    for (int a = 0; a < 2; ++a)
+    if (!this->SetUpAutomaton(input, internals.Held))
     {
-      const double spacing = AxisSpacing(d[a], this->Bounds[2 * a], this->Bounds[2 * a + 1]);
-      p.Wind[a] = this->Wind[a] * this->StepDuration / spacing;
-      p.Shear[a] = this->Shear[a] * dz * this->StepDuration / spacing;
-    }
-    p.Boundary =
-      this->PeriodicBoundary ? nimbus::CloudBoundary::Periodic : nimbus::CloudBoundary::Open;
-    p.NumberOfThreads = this->NumberOfThreads;
-    if (this->NumberOfFormationRegions > 0)
-    {
-      // Regions in cells: the radii (metres) over the horizontal spacing, vertical semi-axes
-      // half the horizontal ones, centres at 30 % of the height.
-      const double sx = AxisSpacing(d[0], this->Bounds[0], this->Bounds[1]);
-      const double sy = AxisSpacing(d[1], this->Bounds[2], this->Bounds[3]);
-      const double radius[2] = { this->FormationRegionRadiusRange[0],
-        this->FormationRegionRadiusRange[1] };
-      const double cellRadius[2] = { radius[0] / sx, radius[1] / sx };
-      std::vector<nimbus::FormationRegion> regions =
-        nimbus::RandomFormationRegions(d, this->NumberOfFormationRegions, cellRadius, 1.0,
-          0.3 * (d[2] - 1), p.Seed, p.Boundary == nimbus::CloudBoundary::Open);
-      for (nimbus::FormationRegion& region : regions)
-      {
-        const double metres = region.Radius[0] * sx;
-        region.Radius[1] = metres / sy;
-        region.Radius[2] = 0.5 * metres / dz;
-      }
-      const std::vector<float> weights =
-        nimbus::FormationRegionWeights(d, regions, p.Boundary == nimbus::CloudBoundary::Periodic);
-      std::vector<float> hum(weights.size()), act(weights.size());
-      for (std::size_t i = 0; i < weights.size(); ++i)
-      {
-        hum[i] = static_cast<float>(this->HumidityProbability * weights[i]);
-        act[i] = static_cast<float>(this->ActivationProbability * weights[i]);
-      }
-      p.HumiditySupply = nimbus::ProbabilityField::Volume(std::move(hum));
-      p.ActivationSupply = nimbus::ProbabilityField::Volume(std::move(act));
-    }
-
-    if (input)
-    {
-      int inDims[3];
-      input->GetDimensions(inDims);
-      const char* names[3] = { "p_ext", "p_hum", "p_act" };
-      nimbus::ProbabilityField* fields[3] = { &p.Extinction, &p.HumiditySupply,
-        &p.ActivationSupply };
-      for (int f = 0; f < 3; ++f)
-      {
-        vtkDataArray* array = input->GetPointData()->GetArray(names[f]);
-        if (!array)
-        {
-          continue;
-        }
-        const bool volume = inDims[0] == d[0] && inDims[1] == d[1] && inDims[2] == d[2];
-        const bool plane = inDims[0] == d[0] && inDims[1] == d[1] && inDims[2] == 1;
-        if (!volume && !plane)
-        {
-          vtkErrorMacro(<< "The input probability image is " << inDims[0] << " x " << inDims[1]
-                        << " x " << inDims[2] << " points; it must match Dimensions (" << d[0]
-                        << " x " << d[1] << " x " << d[2] << ") or be a 2-D map of " << d[0]
-                        << " x " << d[1] << " x 1.");
-          return 1;
-        }
-        if (array->GetNumberOfComponents() != 1)
-        {
-          vtkErrorMacro(<< "Input array \"" << names[f] << "\" must have one component, it has "
-                        << array->GetNumberOfComponents() << ".");
-          return 1;
-        }
-        const vtkIdType expected = static_cast<vtkIdType>(inDims[0]) * inDims[1] * inDims[2];
-        if (array->GetNumberOfTuples() != expected)
-        {
-          vtkErrorMacro(<< "Input array \"" << names[f] << "\" has " << array->GetNumberOfTuples()
-                        << " values for " << expected << " points.");
-          return 1;
-        }
-        std::vector<float> values(static_cast<std::size_t>(array->GetNumberOfTuples()));
-        std::size_t aboveOne = 0;
-        vtkIdType firstBad = -1;
-        for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i)
-        {
-          values[i] = static_cast<float>(array->GetComponent(i, 0));
-          aboveOne += values[i] > 1.0f && std::isfinite(values[i]) ? 1 : 0;
-          if (firstBad < 0 && !(values[i] >= 0.0f && values[i] <= 1.0f))
-          {
-            firstBad = i;
-          }
-        }
-        // Bad values where they enter, counted (the core names the first one).
-        const nimbus::ValueCensus census = nimbus::TakeCensus(values.data(), values.size());
-        if (!census.AllFiniteNonNegative() || aboveOne > 0)
-        {
-          std::string problems = nimbus::DescribeCensus(census);
-          if (aboveOne > 0)
-          {
-            problems +=
-              (problems.empty() ? "" : " and ") + std::to_string(aboveOne) + " values above 1";
-          }
-          const char* core[3] = { "Extinction", "HumiditySupply", "ActivationSupply" };
-          vtkErrorMacro(<< "Input array \"" << names[f] << "\" (" << core[f] << ") has " << problems
-                        << ", the first " << values[firstBad] << " at index " << firstBad
-                        << "; probabilities must be in [0, 1] (an 8-bit image needs scaling "
-                           "by 1/255 first).");
-          return 1;
-        }
-        *fields[f] = volume ? nimbus::ProbabilityField::Volume(std::move(values))
-                            : nimbus::ProbabilityField::Plane(std::move(values));
-      }
-    }
-    try
-    {
-      internals.Automaton = std::make_unique<nimbus::CloudAutomaton>(p);
-    }
-    catch (const std::exception& error)
-    {
-      vtkErrorMacro(<< "Cannot set up the cloud automaton: " << error.what()
-                    << " (input arrays p_ext, p_hum, p_act must hold probabilities in [0, 1]).");
       internals.Clear();
       return 1;
     }
@@ -676,7 +970,29 @@ int vtkNimbusCloudAutomatonSource::Generate(
       if (s >= step && s <= lastNeeded && needs(s))
       {
         std::vector<float> density;
-        nimbus::SmoothCloud(automaton, internals.Smoothing, density);
+        if (!distributed)
+        {
+          nimbus::SmoothCloud(automaton, internals.Smoothing, density);
+        }
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+        else
+        {
+          // The cld rows around the piece, from the ranks that own them; then the piece's
+          // share of SmoothCloud, bit for bit.
+          std::vector<std::uint64_t> storage;
+          std::vector<const std::uint64_t*> table;
+          int zLow = 0;
+          this->PieceGatherBytes += static_cast<vtkIdType>(GatherRows(communicator, automaton, rank,
+            ranks, densityBox, nimbus::SmoothingHalo(internals.Smoothing), storage, table, zLow));
+          if (anyPoint)
+          {
+            nimbus::SmoothCloudBox(
+              automaton.GetParameters(), internals.Smoothing, densityBox,
+              [&](int y, int z) { return table[static_cast<std::size_t>(z - zLow) * d[1] + y]; },
+              density);
+          }
+        }
+#endif
         internals.Densities[s] = std::move(density);
       }
       if (s >= lastNeeded)
@@ -692,6 +1008,13 @@ int vtkNimbusCloudAutomatonSource::Generate(
         return 1;
       }
       automaton.Step();
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+      if (distributed)
+      {
+        this->HaloBytesPerStep = static_cast<vtkIdType>(
+          ExchangeHalo(communicator, automaton, rank, ranks, internals.Owned, internals.Held));
+      }
+#endif
       ++this->NumberOfStepsComputed;
     }
     // Keep only the densities nearest to the ones just used.
@@ -704,15 +1027,10 @@ int vtkNimbusCloudAutomatonSource::Generate(
   }
 
   // --- output: the requested extent ----------------------------------------------------------
-  // Pieces: a cell's state after n steps depends on cells up to n (2 + |wind shift|) cells
-  // away (f_act reaches 2 cells, the wind moves whole layers, periodic sides wrap), and the
-  // spin-up alone is SpinUpSteps steps, so a piece's dependency region is the whole grid
-  // for any useful setting. Every piece therefore runs the automaton and the smoothing on
-  // the whole grid (cached as before; memory and time are not divided between ranks) and
-  // outputs only its extent: exact, and cheap next to a renderer's work on the piece.
-  int extent[6];
+  // Pieces: distributed, the densities are this rank's piece (its slab stepped with the
+  // halo exchange, the piece smoothed from the gathered rows); otherwise the whole grid's,
+  // cropped to the requested extent. Either way bit-identical to the serial output there.
   double origin[3], spacing[3];
-  const bool anyPoint = nimbus::RequestedExtent(outInfo, extent);
   outInfo->Get(vtkDataObject::ORIGIN(), origin);
   outInfo->Get(vtkDataObject::SPACING(), spacing);
   const std::vector<float>& a = internals.Densities.at(step);
@@ -729,7 +1047,12 @@ int vtkNimbusCloudAutomatonSource::Generate(
   {
     for (int j = extent[2]; j <= extent[3]; ++j)
     {
-      const std::size_t first = (static_cast<std::size_t>(k) * d[1] + j) * d[0] + extent[0];
+      // The densities cover DensityBox (the whole grid, or this rank's piece).
+      const int* box = internals.DensityBox;
+      const std::size_t first =
+        (static_cast<std::size_t>(k - box[4]) * (box[3] - box[2] + 1) + (j - box[2])) *
+          (box[1] - box[0] + 1) +
+        (extent[0] - box[0]);
       for (std::size_t i = 0; i < rowLength; ++i, ++out)
       {
         const float va = a[first + i];

@@ -31,10 +31,19 @@
  * already has grown clouds; time t shows step SpinUpSteps + t / StepDuration.
  *
  * Pieces (data parallel): the output is the requested extent (a piece with its ghost layers
- * under MPI), bit-identical to the same points of the serial output. A cell's state after n
- * steps depends on cells up to n (2 + wind shift) cells away, and time 0 is already
- * SpinUpSteps steps in, so every piece runs the automaton and the smoothing on the whole grid
- * and crops: exact, but memory and time are not divided between ranks.
+ * under MPI), bit-identical to the same points of the serial output. When every rank of the
+ * global vtkMultiProcessController asks for its own piece (piece = rank, pieces = ranks, as
+ * pvbatch and pvserver do) and the grid has at least 2 layers per rank, the ranks share the
+ * automaton: rank r steps only its slab of layers (nimbus::DistributedLayers: nz / ranks
+ * layers, plus 2 below and 1 above, the reach of the rules in z; the wind moves only along x
+ * and y, and x and y stay whole, so the periodic sides wrap within the slab), and after each
+ * step sends its 2 top layers up and its bottom layer down (3 fields, ny rows of
+ * ceil(nx / 64) words each). Every random number is keyed by the global cell, so the slabs
+ * step exactly as the whole grid. The density of the rank's piece is then smoothed from the
+ * cld rows around it (nimbus::SmoothCloudBox), which the ranks that own them scatter to it.
+ * Otherwise (one process, or a request that is not one piece per rank) the whole grid is run
+ * and cropped, as before. GetHaloBytesPerStep() and GetPieceGatherBytes() say what a rank
+ * sent per step and received for its last piece.
  *
  * Optional input (port 0): vtkImageData whose point arrays "p_ext", "p_hum", "p_act"
  * (one component, values in [0, 1]) replace the scalar ExtinctionProbability,
@@ -222,6 +231,16 @@ public:
   /// Automaton steps run since the cache was last reset (for tests and timings).
   vtkGetMacro(NumberOfStepsComputed, vtkIdType);
 
+  ///@{
+  /// Distributed runs (see Pieces above): bytes this rank sends to its neighbours per automaton
+  /// step, and bytes of cld rows it received for the density of its last piece; 0 when the
+  /// whole grid runs here. The layers this rank owns, [first, end) (the whole grid when not
+  /// distributed).
+  vtkGetMacro(HaloBytesPerStep, vtkIdType);
+  vtkGetMacro(PieceGatherBytes, vtkIdType);
+  vtkGetVector2Macro(OwnedLayers, int);
+  ///@}
+
 protected:
   vtkNimbusCloudAutomatonSource();
   ~vtkNimbusCloudAutomatonSource() override;
@@ -258,6 +277,9 @@ protected:
   int CheckpointInterval;
   int MaximumNumberOfCheckpoints;
   vtkIdType NumberOfStepsComputed;
+  vtkIdType HaloBytesPerStep = 0;
+  vtkIdType PieceGatherBytes = 0;
+  int OwnedLayers[2] = { 0, 0 };
   double MemoryBudgetMiB;
   double MemoryBudgetRangeMiB[2];
 
@@ -267,6 +289,9 @@ private:
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
+  /// Sets up Internals' automaton for the held layers [held[0], held[1]) (input maps and
+  /// formation regions included); false (after vtkErrorMacro) when the input is unusable.
+  bool SetUpAutomaton(vtkImageData* input, const int held[2]);
 };
 
 #endif

@@ -231,6 +231,7 @@ struct EventSampler
   const std::vector<std::uint32_t>* Thresholds;
   Word Key;
   int Nx, Ny;
+  int ZOffset; // global layer of held layer 0: random numbers are keyed by the global cell
 
   Word operator()(Word candidates, Word wordIndex, int w, int y, int z) const
   {
@@ -247,7 +248,8 @@ struct EventSampler
     const std::size_t base = this->Field->Type == ProbabilityField::Kind::Plane
       ? planeIndex
       : planeIndex + static_cast<std::size_t>(z) * this->Nx * this->Ny;
-    const std::size_t cellBase = planeIndex + static_cast<std::size_t>(z) * this->Nx * this->Ny;
+    const std::size_t cellBase =
+      planeIndex + static_cast<std::size_t>(z + this->ZOffset) * this->Nx * this->Ny;
     Word events = 0;
     Word remaining = candidates;
     while (remaining)
@@ -314,17 +316,28 @@ void CloudAutomaton::ValidateAndPrepare()
   }
   CheckProbability(p.InitialHumidity, "InitialHumidity");
   CheckProbability(p.InitialActivation, "InitialActivation");
-  this->ExtinctionThresholds = MakeThresholds(p.Extinction, nx * ny, nx * ny * nz, "Extinction");
+  const int layerEnd = p.Layers[1] < 0 ? static_cast<int>(nz) : p.Layers[1];
+  if (p.Layers[0] < 0 || layerEnd > static_cast<int>(nz) || p.Layers[0] >= layerEnd)
+  {
+    std::ostringstream message;
+    message << "Layers must be a non-empty range within [0, " << nz << "), got [" << p.Layers[0]
+            << ", " << layerEnd << ").";
+    throw std::invalid_argument(message.str());
+  }
+  this->Z0 = p.Layers[0];
+  this->NZ = layerEnd - p.Layers[0];
+  const std::size_t held = static_cast<std::size_t>(this->NZ);
+  this->ExtinctionThresholds = MakeThresholds(p.Extinction, nx * ny, nx * ny * held, "Extinction");
   this->HumidityThresholds =
-    MakeThresholds(p.HumiditySupply, nx * ny, nx * ny * nz, "HumiditySupply");
+    MakeThresholds(p.HumiditySupply, nx * ny, nx * ny * held, "HumiditySupply");
   this->ActivationThresholds =
-    MakeThresholds(p.ActivationSupply, nx * ny, nx * ny * nz, "ActivationSupply");
+    MakeThresholds(p.ActivationSupply, nx * ny, nx * ny * held, "ActivationSupply");
 
   this->RowWords = static_cast<int>((nx + Bits - 1) / Bits);
   const int tailBits = static_cast<int>(nx % Bits);
   this->TailMask = tailBits == 0 ? ~Word(0) : ((Word(1) << tailBits) - 1);
   this->Threads = ResolveThreadCount(p.NumberOfThreads);
-  const std::size_t words = static_cast<std::size_t>(this->RowWords) * ny * nz;
+  const std::size_t words = static_cast<std::size_t>(this->RowWords) * ny * held;
   for (auto* state : { &this->Current, &this->Scratch })
   {
     state->Hum.assign(words, 0);
@@ -336,7 +349,9 @@ void CloudAutomaton::ValidateAndPrepare()
 void CloudAutomaton::InitialState()
 {
   const auto& p = this->Parameters;
-  const int ny = p.Dimensions[1], nz = p.Dimensions[2], W = this->RowWords;
+  const int ny = p.Dimensions[1], nz = this->NZ, W = this->RowWords;
+  // Global word index of held word i: random numbers are keyed by the global cell.
+  const std::size_t offset = static_cast<std::size_t>(this->Z0) * ny * W;
   const Word humKey = StreamKey(p.Seed, -1, StreamInitialHumidity);
   const Word actKey = StreamKey(p.Seed, -1, StreamInitialActivation);
   const std::uint32_t humThreshold = ToThreshold(p.InitialHumidity);
@@ -354,8 +369,8 @@ void CloudAutomaton::InitialState()
           {
             const std::size_t i = (static_cast<std::size_t>(z) * ny + y) * W + w;
             const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
-            s.Hum[i] = BernoulliWord(humKey, i, humThreshold) & tail;
-            s.Act[i] = BernoulliWord(actKey, i, actThreshold) & tail;
+            s.Hum[i] = BernoulliWord(humKey, i + offset, humThreshold) & tail;
+            s.Act[i] = BernoulliWord(actKey, i + offset, actThreshold) & tail;
             s.Cld[i] = 0;
           }
         }
@@ -378,19 +393,22 @@ void CloudAutomaton::Clear()
 void CloudAutomaton::Step()
 {
   const auto& p = this->Parameters;
-  const int nx = p.Dimensions[0], ny = p.Dimensions[1], nz = p.Dimensions[2];
+  // nz: the held layers (the whole grid unless Parameters.Layers says otherwise); z below is
+  // the held layer, layer0 + z the global one.
+  const int nx = p.Dimensions[0], ny = p.Dimensions[1], nz = this->NZ, layer0 = this->Z0;
   const int W = this->RowWords;
+  const std::size_t offset = static_cast<std::size_t>(layer0) * ny * W; // global word index - held
   const bool periodic = p.Boundary == CloudBoundary::Periodic;
   const std::int64_t n = this->Current.Step;
   const CloudAutomatonState& in = this->Current;
   CloudAutomatonState& out = this->Scratch;
 
   const EventSampler humidity{ &p.HumiditySupply, &this->HumidityThresholds,
-    StreamKey(p.Seed, n, StreamHumidity), nx, ny };
+    StreamKey(p.Seed, n, StreamHumidity), nx, ny, layer0 };
   const EventSampler activation{ &p.ActivationSupply, &this->ActivationThresholds,
-    StreamKey(p.Seed, n, StreamActivation), nx, ny };
+    StreamKey(p.Seed, n, StreamActivation), nx, ny, layer0 };
   const EventSampler extinction{ &p.Extinction, &this->ExtinctionThresholds,
-    StreamKey(p.Seed, n, StreamExtinction), nx, ny };
+    StreamKey(p.Seed, n, StreamExtinction), nx, ny, layer0 };
 
   // Row (y, z) of a field, nullptr outside the grid (open) -- y wraps when periodic.
   auto row = [&](const std::vector<Word>& field, int y, int z) -> const Word*
@@ -480,9 +498,9 @@ void CloudAutomaton::Step()
             Word newAct = ~a & h & f;
             // Extinction and supply.
             const Word tail = (w == W - 1) ? this->TailMask : ~Word(0);
-            cld &= ~extinction(cld & tail, i, w, y, z);
-            hum |= humidity(~hum & tail, i, w, y, z);
-            newAct |= activation(~newAct & tail, i, w, y, z);
+            cld &= ~extinction(cld & tail, i + offset, w, y, z);
+            hum |= humidity(~hum & tail, i + offset, w, y, z);
+            newAct |= activation(~newAct & tail, i + offset, w, y, z);
             out.Hum[i] = hum & tail;
             out.Act[i] = newAct & tail;
             out.Cld[i] = cld & tail;
@@ -495,8 +513,8 @@ void CloudAutomaton::Step()
   bool anyShift = false;
   for (int z = 0; z < nz && !anyShift; ++z)
   {
-    anyShift = WindShift(p.Wind[0] + z * p.Shear[0], n) != 0 ||
-      WindShift(p.Wind[1] + z * p.Shear[1], n) != 0;
+    anyShift = WindShift(p.Wind[0] + (layer0 + z) * p.Shear[0], n) != 0 ||
+      WindShift(p.Wind[1] + (layer0 + z) * p.Shear[1], n) != 0;
   }
   if (!anyShift)
   {
@@ -513,8 +531,8 @@ void CloudAutomaton::Step()
       {
         for (int z = z0; z < z1; ++z)
         {
-          const long long sx = WindShift(p.Wind[0] + z * p.Shear[0], n);
-          const long long sy = WindShift(p.Wind[1] + z * p.Shear[1], n);
+          const long long sx = WindShift(p.Wind[0] + (layer0 + z) * p.Shear[0], n);
+          const long long sy = WindShift(p.Wind[1] + (layer0 + z) * p.Shear[1], n);
           long long up = 0, down = 0; // shifts towards +x and -x combined by OR
           bool useUp = false, useDown = false;
           if (periodic)
@@ -629,25 +647,49 @@ const std::vector<std::uint64_t>& CloudAutomaton::Data(Field field) const
 bool CloudAutomaton::Get(Field field, int x, int y, int z) const
 {
   const int* d = this->Parameters.Dimensions;
-  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2])
+  if (x < 0 || y < 0 || z < this->Z0 || x >= d[0] || y >= d[1] || z >= this->Z0 + this->NZ)
   {
-    throw std::out_of_range("CloudAutomaton::Get: cell outside the grid.");
+    throw std::out_of_range("CloudAutomaton::Get: cell outside the grid (or its held layers).");
   }
-  const std::size_t i = (static_cast<std::size_t>(z) * d[1] + y) * this->RowWords + x / Bits;
+  const std::size_t i =
+    (static_cast<std::size_t>(z - this->Z0) * d[1] + y) * this->RowWords + x / Bits;
   return (this->Data(field)[i] >> (x % Bits)) & 1u;
 }
 
 void CloudAutomaton::Set(Field field, int x, int y, int z, bool value)
 {
   const int* d = this->Parameters.Dimensions;
-  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2])
+  if (x < 0 || y < 0 || z < this->Z0 || x >= d[0] || y >= d[1] || z >= this->Z0 + this->NZ)
   {
-    throw std::out_of_range("CloudAutomaton::Set: cell outside the grid.");
+    throw std::out_of_range("CloudAutomaton::Set: cell outside the grid (or its held layers).");
   }
-  const std::size_t i = (static_cast<std::size_t>(z) * d[1] + y) * this->RowWords + x / Bits;
+  const std::size_t i =
+    (static_cast<std::size_t>(z - this->Z0) * d[1] + y) * this->RowWords + x / Bits;
   const Word bit = Word(1) << (x % Bits);
   auto& data = this->Data(field);
   data[i] = value ? (data[i] | bit) : (data[i] & ~bit);
+}
+
+std::uint64_t* CloudAutomaton::Layer(Field field, int z)
+{
+  if (z < this->Z0 || z >= this->Z0 + this->NZ)
+  {
+    throw std::out_of_range("CloudAutomaton::Layer: layer outside the held layers.");
+  }
+  return this->Data(field).data() +
+    static_cast<std::size_t>(z - this->Z0) * this->Parameters.Dimensions[1] * this->RowWords;
+}
+
+void DistributedLayers(int nz, int rank, int ranks, int owned[2], int held[2])
+{
+  if (ranks < 1 || rank < 0 || rank >= ranks || nz < 2 * ranks)
+  {
+    throw std::invalid_argument("DistributedLayers: needs 0 <= rank < ranks and nz >= 2 ranks.");
+  }
+  owned[0] = static_cast<int>(static_cast<long long>(nz) * rank / ranks);
+  owned[1] = static_cast<int>(static_cast<long long>(nz) * (rank + 1) / ranks);
+  held[0] = std::max(0, owned[0] - CloudHaloBelow);
+  held[1] = std::min(nz, owned[1] + CloudHaloAbove);
 }
 
 std::size_t CloudAutomaton::Count(Field field) const
@@ -802,6 +844,168 @@ void SmoothCloud(const CloudAutomatonParameters& parameters, const CloudAutomato
   density.swap(scratch);
 }
 
+int SmoothingHalo(const CloudSmoothingParameters& smoothing)
+{
+  return static_cast<int>(std::ceil(std::max(1.0, smoothing.Radius))) - 1;
+}
+
+void SmoothCloudBox(const CloudAutomatonParameters& parameters,
+  const CloudSmoothingParameters& smoothing, const int box[6],
+  const std::function<const std::uint64_t*(int y, int z)>& row, std::vector<float>& density)
+{
+  const int* d = parameters.Dimensions;
+  const int nx = d[0], ny = d[1], nz = d[2];
+  for (int a = 0; a < 3; ++a)
+  {
+    if (box[2 * a] < 0 || box[2 * a + 1] >= d[a] || box[2 * a] > box[2 * a + 1])
+    {
+      throw std::invalid_argument("SmoothCloudBox: the box is empty or outside the grid.");
+    }
+  }
+  if (!std::isfinite(smoothing.Radius) || smoothing.Radius < 0.0 || smoothing.Radius > 64.0)
+  {
+    throw std::invalid_argument("SmoothCloudBox: Radius must be in [0, 64] cells.");
+  }
+  const bool periodic = parameters.Boundary == CloudBoundary::Periodic;
+  const int threads = ResolveThreadCount(smoothing.NumberOfThreads);
+  // The kernel exactly as SmoothCloud makes it.
+  const double R = std::max(1.0, smoothing.Radius);
+  const int K = SmoothingHalo(smoothing);
+  std::vector<float> weights(static_cast<std::size_t>(2 * K + 1));
+  double sum = 0.0;
+  for (int t = -K; t <= K; ++t)
+  {
+    sum += WyvillFalloff(static_cast<double>(t) * t, R * R);
+  }
+  for (int t = -K; t <= K; ++t)
+  {
+    weights[t + K] = static_cast<float>(WyvillFalloff(static_cast<double>(t) * t, R * R) / sum);
+  }
+  // Boxes: B (bits as floats) over x0-K..x1+K, y0-K..y1+K, the layers zl..zh; X (after the x
+  // pass) over x0..x1 and the same y and z; Y (after y) over y0..y1; the result over z0..z1.
+  // Cells outside the grid (open sides) are 0 in B: SmoothCloud skips them, and adding
+  // w * 0 to a sum of non-negative terms leaves it bit for bit.
+  const int x0 = box[0], y0 = box[2], z0 = box[4];
+  const int bx = box[1] - box[0] + 1, by = box[3] - box[2] + 1, bz = box[5] - box[4] + 1;
+  const int zl = std::max(0, z0 - K), zh = std::min(nz - 1, box[5] + K);
+  const int lz = zh - zl + 1, ey = by + 2 * K, ex = bx + 2 * K;
+  std::vector<float> X(static_cast<std::size_t>(bx) * ey * lz);
+  ForEachSlab(lz, threads,
+    [&](int k0, int k1)
+    {
+      std::vector<float> bits(static_cast<std::size_t>(ex));
+      for (int k = k0; k < k1; ++k)
+      {
+        for (int j = 0; j < ey; ++j)
+        {
+          int y = y0 - K + j;
+          const bool inside = y >= 0 && y < ny;
+          const Word* words = nullptr;
+          if (inside || periodic)
+          {
+            words = row(Wrap(y, ny), zl + k);
+          }
+          for (int i = 0; i < ex; ++i)
+          {
+            const int x = x0 - K + i;
+            float v = 0.0f;
+            if (words && ((x >= 0 && x < nx) || periodic))
+            {
+              v = GetBit(words, Wrap(x, nx)) ? 1.0f : 0.0f;
+            }
+            bits[i] = v;
+          }
+          float* out = X.data() + (static_cast<std::size_t>(k) * ey + j) * bx;
+          for (int i = 0; i < bx; ++i)
+          {
+            if (K == 0)
+            {
+              out[i] = bits[i];
+              continue;
+            }
+            float value = 0.0f;
+            for (int t = -K; t <= K; ++t)
+            {
+              const int x = x0 + i + t;
+              if (!periodic && (x < 0 || x >= nx))
+              {
+                continue; // as SmoothCloud
+              }
+              value += weights[t + K] * bits[i + K + t];
+            }
+            out[i] = value;
+          }
+        }
+      }
+    });
+  density.assign(static_cast<std::size_t>(bx) * by * bz, 0.0f);
+  if (K == 0)
+  {
+    for (int k = 0; k < bz; ++k)
+    {
+      for (int j = 0; j < by; ++j)
+      {
+        const float* in = X.data() + (static_cast<std::size_t>(k + z0 - zl) * ey + j) * bx;
+        std::copy(in, in + bx, density.data() + (static_cast<std::size_t>(k) * by + j) * bx);
+      }
+    }
+    return;
+  }
+  std::vector<float> Y(static_cast<std::size_t>(bx) * by * lz);
+  ForEachSlab(lz, threads,
+    [&](int k0, int k1)
+    {
+      for (int k = k0; k < k1; ++k)
+      {
+        for (int j = 0; j < by; ++j)
+        {
+          float* out = Y.data() + (static_cast<std::size_t>(k) * by + j) * bx;
+          std::fill(out, out + bx, 0.0f);
+          for (int t = -K; t <= K; ++t)
+          {
+            const int y = y0 + j + t;
+            if (!periodic && (y < 0 || y >= ny))
+            {
+              continue;
+            }
+            const float* in = X.data() + (static_cast<std::size_t>(k) * ey + j + K + t) * bx;
+            const float w = weights[t + K];
+            for (int i = 0; i < bx; ++i)
+            {
+              out[i] += w * in[i];
+            }
+          }
+        }
+      }
+    });
+  X = std::vector<float>();
+  ForEachSlab(bz, threads,
+    [&](int k0, int k1)
+    {
+      for (int k = k0; k < k1; ++k)
+      {
+        for (int j = 0; j < by; ++j)
+        {
+          float* out = density.data() + (static_cast<std::size_t>(k) * by + j) * bx;
+          for (int t = -K; t <= K; ++t)
+          {
+            const int z = z0 + k + t;
+            if (z < 0 || z >= nz)
+            {
+              continue;
+            }
+            const float* in = Y.data() + (static_cast<std::size_t>(z - zl) * by + j) * bx;
+            const float w = weights[t + K];
+            for (int i = 0; i < bx; ++i)
+            {
+              out[i] += w * in[i];
+            }
+          }
+        }
+      }
+    });
+}
+
 void InterpolateDensity(
   const std::vector<float>& a, const std::vector<float>& b, double t, std::vector<float>& out)
 {
@@ -821,10 +1025,13 @@ void InterpolateDensity(
   }
 }
 
-std::vector<float> FormationRegionWeights(
-  const int dimensions[3], const std::vector<FormationRegion>& regions, bool periodic)
+std::vector<float> FormationRegionWeights(const int dimensions[3],
+  const std::vector<FormationRegion>& regions, bool periodic, int zBegin, int zEnd)
 {
-  const int nx = dimensions[0], ny = dimensions[1], nz = dimensions[2];
+  const int nx = dimensions[0], ny = dimensions[1];
+  zBegin = std::clamp(zBegin, 0, dimensions[2]);
+  zEnd = zEnd < 0 ? dimensions[2] : std::clamp(zEnd, zBegin, dimensions[2]);
+  const int nz = zEnd - zBegin; // the layers computed
   std::vector<float> weights(static_cast<std::size_t>(nx) * ny * nz, 0.0f);
   constexpr double cutoff = 3.0; // semi-axes
   for (const FormationRegion& region : regions)
@@ -850,7 +1057,7 @@ std::vector<float> FormationRegionWeights(
         high[a] = std::min(high[a], n - 1);
       }
     }
-    for (int k = low[2]; k <= high[2]; ++k)
+    for (int k = std::max(low[2], zBegin); k <= std::min(high[2], zEnd - 1); ++k)
     {
       const double dz = (k - region.Center[2]) / region.Radius[2];
       for (int j = low[1]; j <= high[1]; ++j)
@@ -866,8 +1073,8 @@ std::vector<float> FormationRegionWeights(
             continue;
           }
           const int x = ((i % nx) + nx) % nx;
-          float& w =
-            weights[x + static_cast<std::size_t>(nx) * (y + static_cast<std::size_t>(ny) * k)];
+          float& w = weights[x +
+            static_cast<std::size_t>(nx) * (y + static_cast<std::size_t>(ny) * (k - zBegin))];
           w = std::max(w, static_cast<float>(std::exp(-0.5 * r2)));
         }
       }

@@ -85,7 +85,26 @@ struct CloudAutomatonParameters
   CloudBoundary Boundary = CloudBoundary::Periodic;
   /// Worker threads; 0 = std::thread::hardware_concurrency(). Results do not depend on it.
   int NumberOfThreads = 0;
+  /// The layers this automaton holds: z in [Layers[0], Layers[1]) of the grid's
+  /// Dimensions[2] (Layers[1] < 0: to the top; the default holds the whole grid). A slab of a
+  /// distributed run (DistributedLayers): its states hold only these layers, a Volume
+  /// probability field gives nx*ny values per held layer, and every random number, wind
+  /// shift and probability stays the one of the global cell (z = Layers[0] + local layer),
+  /// so the held layers equal the whole grid's as long as the layers just outside are
+  /// right: Step treats the layers beyond the slab as empty, and the caller replaces the
+  /// outermost held layers (the halo) with their owners' after every step.
+  int Layers[2] = { 0, -1 };
 };
+
+/// A distributed run's split of nz layers between `ranks`: rank r owns
+/// [nz r / ranks, nz (r + 1) / ranks) and holds 2 more layers below and 1 above (the reach
+/// of f_act in z; the wind moves only along x and y), within the grid. `owned` and `held`
+/// receive [begin, end). Needs nz >= 2 ranks (every rank owns 2 layers or more).
+NIMBUSFILTERS_EXPORT void DistributedLayers(int nz, int rank, int ranks, int owned[2], int held[2]);
+
+/// Layers below and above the owned ones that a distributed run refreshes after each step.
+constexpr int CloudHaloBelow = 2;
+constexpr int CloudHaloAbove = 1;
 
 /// The whole automaton state at one step (a checkpoint).
 struct CloudAutomatonState
@@ -131,6 +150,7 @@ public:
   /// Restores a state taken from an automaton with the same parameters (sizes checked).
   void SetState(const CloudAutomatonState& state);
 
+  /// Cell (x, y, z), z global (within the held layers).
   bool Get(Field field, int x, int y, int z) const;
   void Set(Field field, int x, int y, int z, bool value);
   /// Clears all three fields (for hand-built test states).
@@ -138,6 +158,12 @@ public:
   std::size_t Count(Field field) const;
 
   int WordsPerRow() const { return this->RowWords; }
+  /// The held layers [FirstLayer, FirstLayer + HeldLayers) (Parameters.Layers resolved).
+  int FirstLayer() const { return this->Z0; }
+  int HeldLayers() const { return this->NZ; }
+  /// Words of field `field` at global layer z (held), ny rows of WordsPerRow() words:
+  /// where a distributed run reads and replaces halo layers.
+  std::uint64_t* Layer(Field field, int z);
 
 private:
   void ValidateAndPrepare();
@@ -147,6 +173,7 @@ private:
 
   CloudAutomatonParameters Parameters;
   int RowWords = 1;
+  int Z0 = 0, NZ = 1; // held layers
   std::uint64_t TailMask = ~std::uint64_t(0);
   int Threads = 1;
   // Probability thresholds on a 24-bit uniform integer: event when r < threshold.
@@ -167,8 +194,9 @@ struct FormationRegion
 /// Per-cell weight in [0, 1] on the grid `dimensions` (x fastest): the largest
 /// exp(-r^2 / 2) over the regions, r the distance from a region's centre in units of its
 /// semi-axes, 0 where r > 3. With `periodic`, regions wrap around in x and y (nearest image).
-NIMBUSFILTERS_EXPORT std::vector<float> FormationRegionWeights(
-  const int dimensions[3], const std::vector<FormationRegion>& regions, bool periodic);
+/// Only layers [zBegin, zEnd) (zEnd < 0: to the top), the same values as the whole grid's.
+NIMBUSFILTERS_EXPORT std::vector<float> FormationRegionWeights(const int dimensions[3],
+  const std::vector<FormationRegion>& regions, bool periodic, int zBegin = 0, int zEnd = -1);
 
 /// `count` regions drawn from `seed` (the same on every platform): centres uniform over x
 /// and y at height `centerHeight`, horizontal semi-axes uniform in `horizontalRadius` (low,
@@ -202,6 +230,18 @@ NIMBUSFILTERS_EXPORT void SmoothCloud(const CloudAutomaton& automaton,
 NIMBUSFILTERS_EXPORT void SmoothCloud(const CloudAutomatonParameters& parameters,
   const CloudAutomatonState& state, const CloudSmoothingParameters& smoothing,
   std::vector<float>& density);
+
+/// Cells beyond a box that SmoothCloudBox reads on each side: ceil(max(1, Radius)) - 1.
+NIMBUSFILTERS_EXPORT int SmoothingHalo(const CloudSmoothingParameters& smoothing);
+
+/// SmoothCloud's values at the cells of `box` (x0, x1, y0, y1, z0, z1 inclusive, global), bit
+/// for bit, from the cld rows around it: `row(y, z)` returns the WordsPerRow() words of whole
+/// row (y, z) for y within SmoothingHalo() of the box (wrapped into the grid when periodic,
+/// else inside it) and z within it inside the grid. `density` is resized to the box's cells
+/// (x fastest). What a rank of a distributed run computes for its piece.
+NIMBUSFILTERS_EXPORT void SmoothCloudBox(const CloudAutomatonParameters& parameters,
+  const CloudSmoothingParameters& smoothing, const int box[6],
+  const std::function<const std::uint64_t*(int y, int z)>& row, std::vector<float>& density);
 
 /// Linear interpolation in time between the densities of two consecutive steps:
 /// out = (1 - t) a + t b, t in [0, 1] (002 §3: no flicker between steps).

@@ -65,6 +65,24 @@ def automaton():
     return s, 3.0  # between steps 1 and 2: the interpolation is tested too
 
 
+def automaton_periodic():
+    """Periodic sides (the slabs' rows wrap in x and y), wind and shear across the pieces,
+    a width that is no multiple of 64 cells, no formation regions (uniform probabilities)."""
+    s = nimbus.vtkNimbusCloudAutomatonSource()
+    s.SetDimensions(70, 19, 12)
+    s.SetPeriodicBoundary(True)
+    s.SetNumberOfFormationRegions(0)
+    s.SetInitialHumidity(0.3)
+    s.SetInitialActivation(0.01)
+    s.SetSpinUpSteps(9)
+    s.SetStepDuration(1.0)
+    s.SetNumberOfTimeSteps(3)
+    s.SetSeed(11)
+    s.SetWind(900.0, -450.0)  # m/s over 200 m cells: several cells per step
+    s.SetShear(2.0, 1.0)
+    return s, 1.5
+
+
 def synthetic_image():
     image = vtkImageData()
     image.SetDimensions(22, 17, 1)
@@ -199,6 +217,13 @@ def check_pieces(name, make, ghosts, errors):
     try:
         algorithm, time = make()
         piece_output = update(algorithm, time, RANK, SIZE, ghosts)
+        if hasattr(algorithm, "GetOwnedLayers") and SIZE > 1:
+            # The automaton's ranks share it by layers: this rank stepped only its slab.
+            owned = algorithm.GetOwnedLayers()
+            nz = algorithm.GetDimensions()[2]
+            if owned[1] - owned[0] >= nz or algorithm.GetHaloBytesPerStep() <= 0:
+                fail("rank %d ran the whole automaton (layers %s of %d, %d halo bytes per step)"
+                     % (RANK, list(owned), nz, algorithm.GetHaloBytesPerStep()))
     except Exception:  # still send, so that rank 0 does not wait forever
         fail("rank %d: %s" % (RANK, traceback.format_exc()))
         piece_output = vtkImageData()
@@ -321,6 +346,7 @@ def main():
     CONTROLLER.Barrier()
 
     cases = [("metaball cloud", metaballs), ("cloud automaton", automaton),
+             ("cloud automaton, periodic", automaton_periodic),
              ("image cloud", image_cloud), ("smoke", smoke),
              ("OpenVDB reader", vdb_reader(vdb_path)),
              ("OpenVDB reader, density's box", vdb_reader(vdb_path, "density"))]
