@@ -1,0 +1,51 @@
+// Billboard splatting of metaball clouds (002 §3.3), the view pass
+// (vtkNimbusCloudSplatMapper): one square per metaball facing the viewer, back to front,
+// drawn instanced (four corners per instance, from gl_VertexID). The ball's colour is its
+// single scattering: albedo x phase x the sun's colour x the sun's transmittance at the
+// centre, from the sun pass (the accumulation texture, or the value read back per ball).
+//VTK::System::Dec
+//NIMBUS::Library
+in vec4 ball;       // xyz: the centre (world), w: the radius R (world units)
+in vec2 ballOptics; // x: kappa = k d R, y: the sun's transmittance read back (read-back variant)
+uniform mat4 MCVCMatrix;
+uniform mat4 VCDCMatrix;
+uniform vec3 eyeWorld;
+uniform vec3 toSun;
+uniform vec3 sunAxisX;
+uniform vec3 sunAxisY;
+uniform vec4 sunRect;        // the sun texture's window (as cloudSplatSunVS)
+uniform vec2 sunDepthRange;  // (depth of layer 0, 1 / (depth of the last layer - that))
+//SPLAT::SunTexture (the mapper defines SUN_TEXTURE here for the accumulation texture)
+#ifdef SUN_TEXTURE
+uniform sampler3D sunDepth;  // the accumulated optical depth toward the sun, per layer
+#endif
+uniform vec3 sunColor;       // the sun's irradiance (linear sRGB) x exposure
+uniform float albedo;
+uniform float cloudG;
+out vec2 corner;
+out float kappa;
+out vec3 ballColor;
+
+void main()
+{
+  corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1)) * 2.0 - 1.0;
+  vec4 centre = MCVCMatrix * vec4(ball.xyz, 1.0);
+  centre.xy += corner * ball.w * centre.w;
+  gl_Position = VCDCMatrix * centre;
+  kappa = ballOptics.x;
+
+  float sunTransmittance = ballOptics.y;
+#ifdef SUN_TEXTURE
+  {
+    vec3 size = vec3(textureSize(sunDepth, 0));
+    vec3 s = vec3((vec2(dot(ball.xyz, sunAxisX), dot(ball.xyz, sunAxisY)) - sunRect.xy) *
+        sunRect.zw,
+      (-dot(ball.xyz, toSun) - sunDepthRange.x) * sunDepthRange.y);
+    s.z = (s.z * (size.z - 1.0) + 0.5) / size.z; // layers at texel centres
+    sunTransmittance = exp(-texture(sunDepth, s).r);
+  }
+#endif
+  // The scattering angle: the sunlight's direction (-toSun) against the way to the eye.
+  float mu = dot(-toSun, normalize(eyeWorld - ball.xyz));
+  ballColor = albedo * CornetteShanks(mu, cloudG) * sunColor * sunTransmittance;
+}

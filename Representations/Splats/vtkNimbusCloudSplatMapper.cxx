@@ -1,0 +1,705 @@
+#include "vtkNimbusCloudSplatMapper.h"
+
+#include "CloudSplats.h"
+#include "ShaderLibrary.h"
+#include "Sun.h"
+#include "SunAndAir.h"
+
+#include "cloudSplatSunFS.h"
+#include "cloudSplatSunVS.h"
+#include "cloudSplatViewFS.h"
+#include "cloudSplatViewVS.h"
+
+#include "vtkActor.h"
+#include "vtkAlgorithm.h"
+#include "vtkCamera.h"
+#include "vtkDataArray.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMatrix4x4.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLBufferObject.h"
+#include "vtkOpenGLCamera.h"
+#include "vtkOpenGLFramebufferObject.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLRenderer.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkOpenGLVertexArrayObject.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkShaderProgram.h"
+#include "vtkTextureObject.h"
+#include "vtkTimerLog.h"
+#include "vtk_glew.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+// The billboard texture's side and supersampling, and the partial-column table's sizes.
+constexpr int kBillboardSize = 64;
+constexpr int kBillboardSupersample = 4;
+constexpr int kTableU = 64;
+constexpr int kTableH = 128;
+// Six floats per ball instance: centre (3), radius, kappa, the sun's transmittance.
+constexpr int kInstanceFloats = 6;
+}
+
+struct vtkNimbusCloudSplatMapper::Internals
+{
+  // The balls in world coordinates, as read from the input (once per change).
+  std::vector<float> Centres; // 3 per ball
+  std::vector<float> Radii;
+  std::vector<float> Kappa;         // k d R (metres): the column's optical scale
+  std::vector<float> Transmittance; // the sun's, per ball (read-back variant)
+  vtkMTimeType BallsTime = 0;
+  std::vector<double> SunKey; // what the sun pass's result depends on
+
+  // The sun's frame: axes across the light, the window and the depth range.
+  std::array<std::array<double, 3>, 3> Frame{};
+  std::array<double, 4> Rect{};       // x min, y min, 1 / width, 1 / height
+  std::array<double, 2> DepthRange{}; // depth of the first layer, 1 / (last - first)
+
+  vtkNew<vtkOpenGLBufferObject> SunInstances;
+  vtkNew<vtkOpenGLBufferObject> ViewInstances;
+  vtkNew<vtkOpenGLVertexArrayObject> SunLayout;
+  vtkNew<vtkOpenGLVertexArrayObject> ViewLayout;
+  vtkShaderProgram* SunLayoutProgram = nullptr;
+  vtkShaderProgram* ViewLayoutProgram = nullptr;
+  std::vector<std::size_t> LayerCounts;
+  std::vector<std::uint32_t> SunOrder;
+
+  vtkNew<vtkTextureObject> SunDepth;    // 3-D: the accumulated optical depth
+  vtkNew<vtkTextureObject> SunReadBack; // 2-D: the read-back variant's framebuffer
+  vtkNew<vtkTextureObject> Billboard;   // C over the billboard
+  vtkNew<vtkTextureObject> Partial;     // P(u, h)
+  vtkNew<vtkOpenGLFramebufferObject> Framebuffer;
+  vtkOpenGLRenderWindow* Window = nullptr;
+  std::string ViewVertexSource[2]; // [1]: with the accumulation texture
+
+  double SunSeconds = 0.0;
+  double ViewSeconds = 0.0;
+  vtkIdType Balls = 0;
+  bool ReportedError = false;
+
+  void Release(vtkWindow* window)
+  {
+    if (window)
+    {
+      for (vtkTextureObject* texture : { this->SunDepth.Get(), this->SunReadBack.Get(),
+             this->Billboard.Get(), this->Partial.Get() })
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
+      this->Framebuffer->ReleaseGraphicsResources(window);
+    }
+    this->SunInstances->ReleaseGraphicsResources();
+    this->ViewInstances->ReleaseGraphicsResources();
+    this->SunLayout->ReleaseGraphicsResources();
+    this->ViewLayout->ReleaseGraphicsResources();
+    this->SunLayoutProgram = nullptr;
+    this->ViewLayoutProgram = nullptr;
+    this->SunKey.clear();
+    this->Window = nullptr;
+  }
+
+  // A linear-filtered, edge-clamped single-channel float texture from values.
+  static void Upload2D(
+    vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h, std::vector<float> data)
+  {
+    texture->SetContext(window);
+    if (texture->GetHandle())
+    {
+      return;
+    }
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Linear);
+    texture->SetMagnificationFilter(vtkTextureObject::Linear);
+    texture->Create2DFromRaw(w, h, 1, VTK_FLOAT, data.data());
+  }
+
+  // The instances of `order` (centre, radius, kappa, sun transmittance) into `buffer`.
+  void UploadInstances(vtkOpenGLBufferObject* buffer, const std::vector<std::uint32_t>& order)
+  {
+    std::vector<float> data(order.size() * kInstanceFloats);
+    for (std::size_t n = 0; n < order.size(); ++n)
+    {
+      const std::uint32_t i = order[n];
+      float* d = &data[n * kInstanceFloats];
+      d[0] = this->Centres[3 * i];
+      d[1] = this->Centres[3 * i + 1];
+      d[2] = this->Centres[3 * i + 2];
+      d[3] = this->Radii[i];
+      d[4] = this->Kappa[i];
+      d[5] = this->Transmittance.empty() ? 1.0f : this->Transmittance[i];
+    }
+    buffer->Upload(data, vtkOpenGLBufferObject::ArrayBuffer);
+  }
+
+  // Binds `layout` for `program` over `buffer`'s instances.
+  static void BindLayout(vtkOpenGLVertexArrayObject* layout, vtkShaderProgram*& layoutProgram,
+    vtkShaderProgram* program, vtkOpenGLBufferObject* buffer)
+  {
+    if (layoutProgram != program)
+    {
+      layout->ShaderProgramChanged();
+      layout->Bind();
+      const int stride = kInstanceFloats * sizeof(float);
+      layout->AddAttributeArrayWithDivisor(
+        program, buffer, "ball", 0, stride, VTK_FLOAT, 4, false, 1, false);
+      layout->AddAttributeArrayWithDivisor(
+        program, buffer, "ballOptics", 4 * sizeof(float), stride, VTK_FLOAT, 2, false, 1, false);
+      layoutProgram = program;
+    }
+    else
+    {
+      layout->Bind();
+    }
+  }
+
+  void SetSunFrameUniforms(vtkShaderProgram* program) const
+  {
+    float v[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        v[c] = static_cast<float>(this->Frame[axis][c]);
+      }
+      program->SetUniform3f(axis == 0 ? "sunAxisX" : (axis == 1 ? "sunAxisY" : "toSun"), v);
+    }
+    const float rect[4] = { static_cast<float>(this->Rect[0]), static_cast<float>(this->Rect[1]),
+      static_cast<float>(this->Rect[2]), static_cast<float>(this->Rect[3]) };
+    program->SetUniform4f("sunRect", rect);
+  }
+};
+
+vtkStandardNewMacro(vtkNimbusCloudSplatMapper);
+
+vtkNimbusCloudSplatMapper::vtkNimbusCloudSplatMapper()
+  : Internal(new Internals)
+{
+  this->SetRadiusArrayName("radius");
+  this->SetDensityArrayName("density");
+}
+
+vtkNimbusCloudSplatMapper::~vtkNimbusCloudSplatMapper()
+{
+  this->SetRadiusArrayName(nullptr);
+  this->SetDensityArrayName(nullptr);
+}
+
+double vtkNimbusCloudSplatMapper::GetLastSunPassSeconds() const
+{
+  return this->Internal->SunSeconds;
+}
+
+double vtkNimbusCloudSplatMapper::GetLastViewPassSeconds() const
+{
+  return this->Internal->ViewSeconds;
+}
+
+vtkIdType vtkNimbusCloudSplatMapper::GetLastNumberOfBalls() const
+{
+  return this->Internal->Balls;
+}
+
+void vtkNimbusCloudSplatMapper::ReleaseGraphicsResources(vtkWindow* window)
+{
+  this->Internal->Release(window);
+  this->Superclass::ReleaseGraphicsResources(window);
+}
+
+// The balls in world coordinates (the actor's matrix applied), their optical scales, when
+// the input, the mapper or the actor changed. False when there is nothing to draw.
+bool vtkNimbusCloudSplatMapper::UpdateBalls(vtkPolyData* input, vtkActor* actor)
+{
+  Internals& in = *this->Internal;
+  const vtkMTimeType time =
+    std::max({ input->GetMTime(), this->GetMTime(), actor->GetMatrix()->GetMTime() });
+  if (time == in.BallsTime)
+  {
+    return !in.Radii.empty();
+  }
+  in.BallsTime = time;
+  in.SunKey.clear();
+  in.Centres.clear();
+  in.Radii.clear();
+  in.Kappa.clear();
+  in.Transmittance.clear();
+  vtkDataArray* radii =
+    this->RadiusArrayName ? input->GetPointData()->GetArray(this->RadiusArrayName) : nullptr;
+  vtkDataArray* densities =
+    this->DensityArrayName ? input->GetPointData()->GetArray(this->DensityArrayName) : nullptr;
+  if (!radii || !densities)
+  {
+    vtkErrorMacro("The input has no point array \""
+      << (radii ? (this->DensityArrayName ? this->DensityArrayName : "")
+                : (this->RadiusArrayName ? this->RadiusArrayName : ""))
+      << "\" (RadiusArrayName, DensityArrayName): nothing drawn.");
+    return false;
+  }
+  vtkMatrix4x4* matrix = actor->GetMatrix();
+  const double scale = std::cbrt(std::abs(matrix->Determinant()));
+  const vtkIdType n = input->GetNumberOfPoints();
+  in.Centres.reserve(3 * n);
+  in.Radii.reserve(n);
+  in.Kappa.reserve(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    const double radius = radii->GetComponent(i, 0) * scale;
+    const double density = densities->GetComponent(i, 0);
+    double p[4] = { 0, 0, 0, 1 };
+    input->GetPoint(i, p);
+    matrix->MultiplyPoint(p, p);
+    // k d R (R in metres): tau through the column = kappa C(u) (CloudSplats.h).
+    const double kappa = this->ExtinctionPerDensity * density * radius * this->MetresPerUnit;
+    if (!(radius > 0.0) || !(density > 0.0) || !std::isfinite(radius) || !std::isfinite(kappa) ||
+      !std::isfinite(p[0] + p[1] + p[2]))
+    {
+      continue; // empty (or invalid) balls add nothing
+    }
+    in.Centres.insert(in.Centres.end(),
+      { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]) });
+    in.Radii.push_back(static_cast<float>(radius));
+    in.Kappa.push_back(static_cast<float>(kappa));
+  }
+  return !in.Radii.empty();
+}
+
+void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
+{
+  Internals& in = *this->Internal;
+  if (renderer->GetSelector() || renderer->GetRenderWindow()->CheckAbortStatus())
+  {
+    return; // light, not a surface to pick
+  }
+  int port = 0;
+  vtkAlgorithm* producer =
+    this->GetNumberOfInputConnections(0) ? this->GetInputAlgorithm(0, 0, port) : nullptr;
+  if (!this->Static && producer)
+  {
+    producer->Update(port);
+  }
+  vtkPolyData* input = this->GetInput();
+  auto* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
+  if (!input || !window || input->GetNumberOfPoints() == 0)
+  {
+    return;
+  }
+  if (in.Window && in.Window != window)
+  {
+    in.Release(in.Window);
+  }
+  in.Window = window;
+  try
+  {
+    if (!this->UpdateBalls(input, actor))
+    {
+      in.Balls = 0;
+      return;
+    }
+    in.Balls = static_cast<vtkIdType>(in.Radii.size());
+    Internals::Upload2D(in.Billboard, window, kBillboardSize, kBillboardSize,
+      nimbus::SplatColumnTexture(kBillboardSize, kBillboardSupersample));
+    Internals::Upload2D(
+      in.Partial, window, kTableU, kTableH, nimbus::SplatPartialColumnTable(kTableU, kTableH));
+
+    // The sun's pass, again only when the balls, the sun or its texture changed.
+    const nimbus::Vector3 toSun =
+      nimbus::SunDirection(this->SunElevationDegrees, this->SunAzimuthDegrees);
+    const std::vector<double> sunKey = { toSun[0], toSun[1], toSun[2],
+      static_cast<double>(this->SunLightMethod), static_cast<double>(this->SunTextureSize),
+      static_cast<double>(this->SunTextureLayers) };
+    vtkNew<vtkTimerLog> timer;
+    timer->StartTimer();
+    if (sunKey != in.SunKey)
+    {
+      in.Frame = nimbus::SplatFrame(toSun);
+      if (this->SunLightMethod == FramebufferReadBack)
+      {
+        this->SunPassReadBack(window);
+      }
+      else
+      {
+        this->SunPassTexture(window);
+      }
+      in.SunKey = sunKey;
+      if (this->TimePasses)
+      {
+        glFinish();
+      }
+    }
+    timer->StopTimer();
+    in.SunSeconds = timer->GetElapsedTime();
+    timer->StartTimer();
+    this->ViewPass(renderer, window);
+    if (this->TimePasses)
+    {
+      glFinish();
+    }
+    timer->StopTimer();
+    in.ViewSeconds = timer->GetElapsedTime();
+    in.ReportedError = false;
+  }
+  catch (const std::exception& error)
+  {
+    if (!in.ReportedError)
+    {
+      vtkErrorMacro("Cloud splats not drawn: " << error.what());
+      in.ReportedError = true;
+    }
+    in.SunKey.clear();
+  }
+}
+
+namespace
+{
+// The balls' window across the sun's light and their depth range along it (world units).
+void SunWindow(const std::vector<float>& centres, const std::vector<float>& radii,
+  const std::array<std::array<double, 3>, 3>& frame, std::array<double, 4>& rect,
+  std::array<double, 2>& depth, std::vector<float>& centreDepths)
+{
+  double lo[3] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+    std::numeric_limits<double>::max() };
+  double hi[3] = { -lo[0], -lo[1], -lo[2] };
+  centreDepths.resize(radii.size());
+  for (std::size_t i = 0; i < radii.size(); ++i)
+  {
+    const double p[3] = { centres[3 * i], centres[3 * i + 1], centres[3 * i + 2] };
+    for (int a = 0; a < 3; ++a)
+    {
+      double x = frame[a][0] * p[0] + frame[a][1] * p[1] + frame[a][2] * p[2];
+      if (a == 2)
+      {
+        x = -x; // depth grows away from the sun
+        centreDepths[i] = static_cast<float>(x);
+      }
+      lo[a] = std::min(lo[a], x - radii[i]);
+      hi[a] = std::max(hi[a], x + radii[i]);
+    }
+  }
+  const double width = std::max(hi[0] - lo[0], 1e-30);
+  const double height = std::max(hi[1] - lo[1], 1e-30);
+  rect = { lo[0], lo[1], 1.0 / width, 1.0 / height };
+  depth = { lo[2], 1.0 / std::max(hi[2] - lo[2], 1e-30) };
+}
+}
+
+// The GPU variant: the optical depth toward the sun accumulated in SunTextureLayers planes
+// of a 3-D float texture (002 §3.3's sun-facing billboards, summed instead of multiplied
+// and read back).
+void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
+{
+  Internals& in = *this->Internal;
+  std::vector<float> depths;
+  SunWindow(in.Centres, in.Radii, in.Frame, in.Rect, in.DepthRange, depths);
+  std::vector<float> fronts(depths.size());
+  for (std::size_t i = 0; i < depths.size(); ++i)
+  {
+    fronts[i] = depths[i] - in.Radii[i];
+  }
+  // Sorted by the front toward the sun: layer k draws the first LayerCounts[k] balls.
+  const std::array<double, 3> away = { -in.Frame[2][0], -in.Frame[2][1], -in.Frame[2][2] };
+  std::vector<float> offsets(in.Radii.size());
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+  {
+    offsets[i] = -in.Radii[i];
+  }
+  in.SunOrder = nimbus::SplatOrder(in.Centres, away, offsets);
+  std::vector<float> sortedFronts(fronts.size());
+  for (std::size_t n = 0; n < in.SunOrder.size(); ++n)
+  {
+    sortedFronts[n] = fronts[in.SunOrder[n]];
+  }
+  const int layers = this->SunTextureLayers;
+  const double zMin = in.DepthRange[0];
+  const double zMax = zMin + 1.0 / in.DepthRange[1];
+  in.LayerCounts = nimbus::SplatLayerCounts(sortedFronts, zMin, zMax, layers);
+  in.UploadInstances(in.SunInstances, in.SunOrder);
+
+  const int size = this->SunTextureSize;
+  vtkTextureObject* texture = in.SunDepth;
+  texture->SetContext(window);
+  if (!texture->GetHandle() || static_cast<int>(texture->GetWidth()) != size ||
+    static_cast<int>(texture->GetDepth()) != layers)
+  {
+    texture->ReleaseGraphicsResources(window);
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetWrapR(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Linear);
+    texture->SetMagnificationFilter(vtkTextureObject::Linear);
+    if (!texture->Allocate3D(size, size, layers, 1, VTK_FLOAT))
+    {
+      throw std::runtime_error("the sun's accumulation texture could not be allocated");
+    }
+  }
+  vtkShaderProgram* program =
+    window->GetShaderCache()->ReadyShaderProgram(cloudSplatSunVS, cloudSplatSunFS, "");
+  if (!program)
+  {
+    throw std::runtime_error("the sun pass's shaders did not compile");
+  }
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglViewport viewportSaver(state);
+  vtkOpenGLState::ScopedglEnableDisable scissorSaver(state, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable cullSaver(state, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
+  vtkOpenGLState::ScopedglClearColor clearSaver(state);
+  vtkOpenGLState::ScopedglColorMask maskSaver(state);
+  state->PushFramebufferBindings();
+  in.Framebuffer->SetContext(window);
+  in.Framebuffer->Bind(GL_FRAMEBUFFER);
+  state->vtkglViewport(0, 0, size, size);
+  state->vtkglDisable(GL_SCISSOR_TEST);
+  state->vtkglDisable(GL_DEPTH_TEST);
+  state->vtkglDisable(GL_CULL_FACE);
+  state->vtkglEnable(GL_BLEND);
+  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  Internals::BindLayout(in.SunLayout, in.SunLayoutProgram, program, in.SunInstances);
+  in.SetSunFrameUniforms(program);
+  in.Partial->Activate();
+  program->SetUniformi("partialColumn", in.Partial->GetTextureUnit());
+  program->SetUniformi("multiply", 0);
+  for (int k = 0; k < layers; ++k)
+  {
+    // One layer of the 3-D texture (this VTK's AddColorAttachment attaches slice 0 only).
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, k);
+    glDrawBuffer(GL_COLOR_ATTACHMENT0);
+    state->vtkglClear(GL_COLOR_BUFFER_BIT);
+    if (in.LayerCounts[k] > 0)
+    {
+      program->SetUniformf(
+        "planeDepth", static_cast<float>(zMin + (zMax - zMin) * k / (layers - 1)));
+      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(in.LayerCounts[k]));
+    }
+  }
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0);
+  in.Partial->Deactivate();
+  in.SunLayout->Release();
+  state->PopFramebufferBindings();
+}
+
+// 002 §3.3's read-back: the framebuffer facing the sun starts at 1; the balls, nearest to
+// the sun first, each read the pixel under their centre and then multiply in their
+// attenuation ratios.
+void vtkNimbusCloudSplatMapper::SunPassReadBack(vtkOpenGLRenderWindow* window)
+{
+  Internals& in = *this->Internal;
+  if (!glDrawArraysInstancedBaseInstance)
+  {
+    throw std::runtime_error("FramebufferReadBack needs OpenGL 4.2 (base instances)");
+  }
+  std::vector<float> depths;
+  SunWindow(in.Centres, in.Radii, in.Frame, in.Rect, in.DepthRange, depths);
+  const std::array<double, 3> away = { -in.Frame[2][0], -in.Frame[2][1], -in.Frame[2][2] };
+  in.SunOrder = nimbus::SplatOrder(in.Centres, away, {});
+  in.Transmittance.assign(in.Radii.size(), 1.0f);
+  in.UploadInstances(in.SunInstances, in.SunOrder);
+
+  const int size = this->SunTextureSize;
+  vtkTextureObject* texture = in.SunReadBack;
+  texture->SetContext(window);
+  if (!texture->GetHandle() || static_cast<int>(texture->GetWidth()) != size)
+  {
+    texture->ReleaseGraphicsResources(window);
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    if (!texture->Allocate2D(size, size, 1, VTK_FLOAT))
+    {
+      throw std::runtime_error("the read-back framebuffer could not be allocated");
+    }
+  }
+  vtkShaderProgram* program =
+    window->GetShaderCache()->ReadyShaderProgram(cloudSplatSunVS, cloudSplatSunFS, "");
+  if (!program)
+  {
+    throw std::runtime_error("the sun pass's shaders did not compile");
+  }
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglViewport viewportSaver(state);
+  vtkOpenGLState::ScopedglEnableDisable scissorSaver(state, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable cullSaver(state, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
+  vtkOpenGLState::ScopedglClearColor clearSaver(state);
+  vtkOpenGLState::ScopedglColorMask maskSaver(state);
+  state->PushFramebufferBindings();
+  in.Framebuffer->SetContext(window);
+  in.Framebuffer->Bind(GL_FRAMEBUFFER);
+  in.Framebuffer->AddColorAttachment(0, texture);
+  in.Framebuffer->ActivateDrawBuffer(0);
+  in.Framebuffer->ActivateReadBuffer(0);
+  state->vtkglViewport(0, 0, size, size);
+  state->vtkglDisable(GL_SCISSOR_TEST);
+  state->vtkglDisable(GL_DEPTH_TEST);
+  state->vtkglDisable(GL_CULL_FACE);
+  state->vtkglEnable(GL_BLEND);
+  state->vtkglBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_COLOR);
+  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  state->vtkglClearColor(1.0f, 1.0f, 1.0f, 1.0f);
+  state->vtkglClear(GL_COLOR_BUFFER_BIT);
+  Internals::BindLayout(in.SunLayout, in.SunLayoutProgram, program, in.SunInstances);
+  in.SetSunFrameUniforms(program);
+  in.Partial->Activate();
+  program->SetUniformi("partialColumn", in.Partial->GetTextureUnit());
+  program->SetUniformi("multiply", 1);
+  program->SetUniformf("planeDepth", 0.0f);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  const double halfColumn = nimbus::SplatPartialColumn(0.0, 0.0);
+  for (std::size_t n = 0; n < in.SunOrder.size(); ++n)
+  {
+    const std::uint32_t i = in.SunOrder[n];
+    const double p[3] = { in.Centres[3 * i], in.Centres[3 * i + 1], in.Centres[3 * i + 2] };
+    const double x =
+      (in.Frame[0][0] * p[0] + in.Frame[0][1] * p[1] + in.Frame[0][2] * p[2] - in.Rect[0]) *
+      in.Rect[2] * size;
+    const double y =
+      (in.Frame[1][0] * p[0] + in.Frame[1][1] * p[1] + in.Frame[1][2] * p[2] - in.Rect[1]) *
+      in.Rect[3] * size;
+    float value = 1.0f;
+    glReadPixels(std::clamp(static_cast<int>(x), 0, size - 1),
+      std::clamp(static_cast<int>(y), 0, size - 1), 1, 1, GL_RED, GL_FLOAT, &value);
+    in.Transmittance[i] = static_cast<float>(value * std::exp(-in.Kappa[i] * halfColumn));
+    glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, 4, 1, static_cast<GLuint>(n));
+  }
+  in.Framebuffer->RemoveColorAttachment(0);
+  in.Partial->Deactivate();
+  in.SunLayout->Release();
+  state->PopFramebufferBindings();
+}
+
+// The billboards facing the viewer, back to front, into the frame.
+void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderWindow* window)
+{
+  Internals& in = *this->Internal;
+  vtkCamera* camera = renderer->GetActiveCamera();
+  double eye[3];
+  camera->GetPosition(eye);
+  std::vector<std::uint32_t> order;
+  if (camera->GetParallelProjection())
+  {
+    double direction[3];
+    camera->GetDirectionOfProjection(direction);
+    order = nimbus::SplatOrder(in.Centres, { -direction[0], -direction[1], -direction[2] }, {});
+  }
+  else
+  {
+    order = nimbus::SplatOrderBackToFront(in.Centres, { eye[0], eye[1], eye[2] });
+  }
+  in.UploadInstances(in.ViewInstances, order);
+
+  const bool texture = this->SunLightMethod == AccumulationTexture;
+  std::string& source = in.ViewVertexSource[texture ? 1 : 0];
+  if (source.empty())
+  {
+    source = nimbus::WithShaderLibrary(cloudSplatViewVS);
+    if (texture)
+    {
+      vtkShaderProgram::Substitute(source, "//SPLAT::SunTexture", "#define SUN_TEXTURE");
+    }
+  }
+  vtkShaderProgram* program =
+    window->GetShaderCache()->ReadyShaderProgram(source.c_str(), cloudSplatViewFS, "");
+  if (!program)
+  {
+    throw std::runtime_error("the view pass's shaders did not compile");
+  }
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable cullSaver(state, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
+  vtkOpenGLState::ScopedglDepthMask depthMaskSaver(state);
+  vtkOpenGLState::ScopedglDepthFunc depthFuncSaver(state);
+  state->vtkglEnable(GL_DEPTH_TEST);
+  state->vtkglDepthFunc(GL_LEQUAL);
+  state->vtkglDepthMask(GL_FALSE);
+  state->vtkglDisable(GL_CULL_FACE);
+  state->vtkglEnable(GL_BLEND);
+  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+
+  Internals::BindLayout(in.ViewLayout, in.ViewLayoutProgram, program, in.ViewInstances);
+  vtkMatrix4x4* wcvc = nullptr;
+  vtkMatrix4x4* vcdc = nullptr;
+  vtkMatrix4x4* wcdc = nullptr;
+  vtkMatrix3x3* normals = nullptr;
+  static_cast<vtkOpenGLCamera*>(camera)->GetKeyMatrices(renderer, wcvc, normals, vcdc, wcdc);
+  program->SetUniformMatrix("MCVCMatrix", wcvc); // the balls are in world coordinates
+  program->SetUniformMatrix("VCDCMatrix", vcdc);
+  const float eyeWorld[3] = { static_cast<float>(eye[0]), static_cast<float>(eye[1]),
+    static_cast<float>(eye[2]) };
+  program->SetUniform3f("eyeWorld", eyeWorld);
+  in.SetSunFrameUniforms(program);
+  program->SetUniform2f("sunDepthRange",
+    std::array<float, 2>{
+      static_cast<float>(in.DepthRange[0]), static_cast<float>(in.DepthRange[1]) }
+      .data());
+  if (texture)
+  {
+    in.SunDepth->Activate();
+    program->SetUniformi("sunDepth", in.SunDepth->GetTextureUnit());
+  }
+  in.Billboard->Activate();
+  program->SetUniformi("billboard", in.Billboard->GetTextureUnit());
+
+  // The sun's colour above the air (linear sRGB of its blackbody spectrum) x exposure.
+  nimbus::SunParameters sun;
+  sun.AzimuthDegrees = this->SunAzimuthDegrees;
+  sun.ElevationDegrees = this->SunElevationDegrees;
+  sun.Illuminance = this->SunIlluminance;
+  sun.TemperatureKelvin = this->SunTemperatureKelvin;
+  nimbus::SceneAtmosphere air;
+  air.Enabled = false;
+  const nimbus::SunAndAir sunAndAir(sun, air, 16);
+  const std::array<double, 3> rgb = sunAndAir.ToLinearSrgb(sunAndAir.GetSunIrradiance());
+  const float color[3] = { static_cast<float>(std::max(rgb[0], 0.0) * this->Exposure),
+    static_cast<float>(std::max(rgb[1], 0.0) * this->Exposure),
+    static_cast<float>(std::max(rgb[2], 0.0) * this->Exposure) };
+  program->SetUniform3f("sunColor", color);
+  program->SetUniformf("albedo", static_cast<float>(this->Albedo));
+  program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(order.size()));
+  in.Billboard->Deactivate();
+  if (texture)
+  {
+    in.SunDepth->Deactivate();
+  }
+  in.ViewLayout->Release();
+}
+
+void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "RadiusArrayName: " << (this->RadiusArrayName ? this->RadiusArrayName : "(none)")
+     << "\n";
+  os << indent
+     << "DensityArrayName: " << (this->DensityArrayName ? this->DensityArrayName : "(none)")
+     << "\n";
+  os << indent << "SunAzimuthDegrees: " << this->SunAzimuthDegrees << "\n";
+  os << indent << "SunElevationDegrees: " << this->SunElevationDegrees << "\n";
+  os << indent << "SunIlluminance: " << this->SunIlluminance << "\n";
+  os << indent << "SunTemperatureKelvin: " << this->SunTemperatureKelvin << "\n";
+  os << indent << "ExtinctionPerDensity: " << this->ExtinctionPerDensity << " /m\n";
+  os << indent << "Albedo: " << this->Albedo << "\n";
+  os << indent << "CloudG: " << this->CloudG << "\n";
+  os << indent << "MetresPerUnit: " << this->MetresPerUnit << "\n";
+  os << indent << "Exposure: " << this->Exposure << "\n";
+  os << indent << "SunLightMethod: " << this->SunLightMethod << "\n";
+  os << indent << "SunTextureSize: " << this->SunTextureSize << "\n";
+  os << indent << "SunTextureLayers: " << this->SunTextureLayers << "\n";
+  os << indent << "TimePasses: " << this->TimePasses << "\n";
+}

@@ -1,0 +1,181 @@
+/**
+ * @class   vtkNimbusCloudSplatMapper
+ * @brief   Metaball clouds drawn by two-pass billboard splatting (002 §3.3).
+ *
+ * Input: points, one per metaball, with a point array of radii (RadiusArrayName,
+ * default "radius", world units) and one of centre densities (DensityArrayName,
+ * default "density", dimensionless): vtkNimbusMetaballCloudSource's second output
+ * (port 1). Each ball's density is d f(|x - c|^2 / R^2) with Nimbus's metaball
+ * kernel (CloudSplats.h), its extinction ExtinctionPerDensity x that (1/m).
+ *
+ * The frame, as 002 §3.3:
+ *  1. The sun's pass: the light from the sun at each ball. SunLightMethod chooses how:
+ *     - AccumulationTexture (default; the GPU variant, no read-back): squares facing
+ *       the sun, in a parallel projection along the sunlight, add their optical depth
+ *       into a 3-D float texture of SunTextureLayers planes across the cloud
+ *       (SunTextureSize^2 texels each): layer k holds the depth from the sun to its
+ *       plane, each ball adding the part of its column in front of the plane
+ *       (the precomputed partial-column table P(u, h)); the balls are sorted by their
+ *       front toward the sun and layer k draws only those that reach its plane. Each
+ *       ball then reads the texture at its centre (trilinear: between the two nearest
+ *       planes) in the view pass's vertex shader: exp(-tau).
+ *     - FramebufferReadBack (the paper's): a framebuffer cleared to 1; the balls,
+ *       sorted by distance from the sun, nearest first, each read the pixel under
+ *       its centre (glReadPixels: the sun's transmittance in front of it, times its
+ *       own half column exp(-kappa C(0) / 2)) and then multiply the framebuffer by
+ *       their attenuation ratio texture. One read per ball: slow (docs/splats.md).
+ *  2. The view pass: squares facing the viewer, sorted back to front, each
+ *     multiplying the framebuffer by its attenuation ratio a = exp(-kappa C(u)) (the
+ *     precomputed billboard texture of the cumulative density C) and adding its
+ *     colour Albedo x CornetteShanks(mu, CloudG) x the sun's colour x the sun's
+ *     transmittance x (1 - a) x Exposure.
+ * That is single scattering with the sun's light taken at each ball's centre; the
+ * light scattered more than once, the sky's light and the air are not drawn.
+ *
+ * Units: radii and points in world units, MetresPerUnit metres each; the sun
+ * (SunAzimuthDegrees from +y toward +x, SunElevationDegrees above the x-y plane: z is
+ * up; SunIlluminance, SunTemperatureKelvin) as vtkNimbusCloudVolumeMapper and the
+ * scene format, its colour the blackbody spectrum's linear sRGB above the air
+ * (Physics/SunAndAir); radiance relative to the sun, x Exposure in the framebuffer
+ * (linear, no sRGB encoding).
+ *
+ * Drawn in the opaque pass after the props before it, as an emissive prop: depth-tested
+ * against the scene's depth, writing none; opaque props drawn later are not hidden by
+ * it. The actor's matrix moves the balls (its scale's cube root scales the radii).
+ * GLSL: Shaders/cloudSplat{Sun,View}{VS,FS}.glsl. Needs OpenGL 4.2 for the read-back
+ * variant (base instances).
+ */
+#ifndef vtkNimbusCloudSplatMapper_h
+#define vtkNimbusCloudSplatMapper_h
+
+#include "NimbusRepresentationsModule.h" // for export macro
+#include "vtkPolyDataMapper.h"
+
+#include <memory> // for std::unique_ptr
+
+class vtkOpenGLRenderWindow;
+
+class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusCloudSplatMapper : public vtkPolyDataMapper
+{
+public:
+  static vtkNimbusCloudSplatMapper* New();
+  vtkTypeMacro(vtkNimbusCloudSplatMapper, vtkPolyDataMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The point arrays of the balls' radii (world units; default "radius") and centre
+  /// densities (dimensionless; default "density"), as vtkNimbusMetaballCloudSource's
+  /// port 1 writes them.
+  vtkSetStringMacro(RadiusArrayName);
+  vtkGetStringMacro(RadiusArrayName);
+  vtkSetStringMacro(DensityArrayName);
+  vtkGetStringMacro(DensityArrayName);
+  ///@}
+
+  ///@{
+  /// The sun, as vtkNimbusCloudVolumeMapper: azimuth from +y toward +x and elevation
+  /// (degrees), the luminance of its irradiance (relative; default 1) and its
+  /// blackbody temperature (K; default 5778).
+  vtkSetClampMacro(SunAzimuthDegrees, double, -1e9, 1e9);
+  vtkGetMacro(SunAzimuthDegrees, double);
+  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  vtkGetMacro(SunElevationDegrees, double);
+  vtkSetClampMacro(SunIlluminance, double, 0.0, 1e9);
+  vtkGetMacro(SunIlluminance, double);
+  vtkSetClampMacro(SunTemperatureKelvin, double, 1000.0, 40000.0);
+  vtkGetMacro(SunTemperatureKelvin, double);
+  ///@}
+
+  ///@{
+  /// Cloud optics, as vtkNimbusCloudVolumeMapper: sigma_t = ExtinctionPerDensity x
+  /// density (1/m; default 0.02), Albedo sigma_s / sigma_t (default 0.99), CloudG the
+  /// Cornette-Shanks asymmetry (default 0.85).
+  vtkSetClampMacro(ExtinctionPerDensity, double, 0.0, 1e6);
+  vtkGetMacro(ExtinctionPerDensity, double);
+  vtkSetClampMacro(Albedo, double, 0.0, 1.0);
+  vtkGetMacro(Albedo, double);
+  vtkSetClampMacro(CloudG, double, -0.999, 0.999);
+  vtkGetMacro(CloudG, double);
+  ///@}
+
+  ///@{
+  /// Metres per world unit (default 1) and the framebuffer's value per unit radiance
+  /// (default 1).
+  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  vtkGetMacro(MetresPerUnit, double);
+  vtkSetClampMacro(Exposure, double, 0.0, 1e9);
+  vtkGetMacro(Exposure, double);
+  ///@}
+
+  enum SunLightMethods
+  {
+    /// The GPU variant: a sun-facing 3-D texture of accumulated optical depth.
+    AccumulationTexture = 0,
+    /// 002 §3.3's framebuffer read-back, one pixel per ball.
+    FramebufferReadBack = 1
+  };
+  ///@{
+  /// How the sun's light reaches each ball (SunLightMethods; default AccumulationTexture).
+  vtkSetClampMacro(SunLightMethod, int, 0, 1);
+  vtkGetMacro(SunLightMethod, int);
+  void SetSunLightMethodToAccumulationTexture() { this->SetSunLightMethod(AccumulationTexture); }
+  void SetSunLightMethodToFramebufferReadBack() { this->SetSunLightMethod(FramebufferReadBack); }
+  ///@}
+
+  ///@{
+  /// The sun pass's texture: texels per side (default 512; the read-back's
+  /// framebuffer too) and planes along the light (AccumulationTexture; default 32).
+  vtkSetClampMacro(SunTextureSize, int, 16, 8192);
+  vtkGetMacro(SunTextureSize, int);
+  vtkSetClampMacro(SunTextureLayers, int, 2, 512);
+  vtkGetMacro(SunTextureLayers, int);
+  ///@}
+
+  /// Seconds of the last frame's sun pass and view pass (each ended by glFinish only
+  /// when TimePasses is on; default off).
+  vtkSetMacro(TimePasses, bool);
+  vtkGetMacro(TimePasses, bool);
+  double GetLastSunPassSeconds() const;
+  double GetLastViewPassSeconds() const;
+  /// The balls drawn by the last frame.
+  vtkIdType GetLastNumberOfBalls() const;
+
+  void Render(vtkRenderer* renderer, vtkActor* actor) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+  /// Drawn in the opaque pass (emissive, as the lightning glow).
+  bool HasTranslucentPolygonalGeometry() override { return false; }
+
+protected:
+  vtkNimbusCloudSplatMapper();
+  ~vtkNimbusCloudSplatMapper() override;
+
+  char* RadiusArrayName = nullptr;
+  char* DensityArrayName = nullptr;
+  double SunAzimuthDegrees = 135.0;
+  double SunElevationDegrees = 45.0;
+  double SunIlluminance = 1.0;
+  double SunTemperatureKelvin = 5778.0;
+  double ExtinctionPerDensity = 0.02;
+  double Albedo = 0.99;
+  double CloudG = 0.85;
+  double MetresPerUnit = 1.0;
+  double Exposure = 1.0;
+  int SunLightMethod = AccumulationTexture;
+  int SunTextureSize = 512;
+  int SunTextureLayers = 32;
+  bool TimePasses = false;
+
+private:
+  vtkNimbusCloudSplatMapper(const vtkNimbusCloudSplatMapper&) = delete;
+  void operator=(const vtkNimbusCloudSplatMapper&) = delete;
+
+  bool UpdateBalls(vtkPolyData* input, vtkActor* actor);
+  void SunPassTexture(vtkOpenGLRenderWindow* window);
+  void SunPassReadBack(vtkOpenGLRenderWindow* window);
+  void ViewPass(vtkRenderer* renderer, vtkOpenGLRenderWindow* window);
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif

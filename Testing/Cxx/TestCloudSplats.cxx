@@ -1,0 +1,177 @@
+// The numerics of billboard splatting (Representations/Splats/CloudSplats.h, 002 §3.3):
+// the kernel against the metaball cloud's, the closed-form columns against a numerical
+// integral of the kernel, the textures, the sorting and the sun pass's layer counts.
+#include "CloudSplats.h"
+#include "Metaballs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace
+{
+// The kernel integrated along the line at impact parameter u from t0 to t1 (units of R),
+// composite Simpson's rule on 2000 intervals (the kernel is a smooth polynomial inside).
+double NumericalColumn(double u, double t0, double t1)
+{
+  const int n = 2000;
+  const double h = (t1 - t0) / n;
+  double sum = 0.0;
+  for (int i = 0; i <= n; ++i)
+  {
+    const double t = t0 + i * h;
+    const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+    sum += w * nimbus::WyvillFalloff(u * u + t * t, 1.0);
+  }
+  return sum * h / 3.0;
+}
+}
+
+TEST(CloudSplats, KernelIsTheMetaballCloudsKernel)
+{
+  for (double q = 0.0; q <= 1.2; q += 0.01)
+  {
+    EXPECT_NEAR(nimbus::SplatKernel(q), nimbus::WyvillFalloff(q, 1.0), 1e-14) << "q " << q;
+  }
+}
+
+TEST(CloudSplats, ColumnAgainstNumericalIntegral)
+{
+  EXPECT_NEAR(nimbus::SplatColumn(0.0), 944.0 / 945.0, 1e-14);
+  for (double u = 0.0; u < 1.0; u += 0.037)
+  {
+    const double s = std::sqrt(1.0 - u * u);
+    EXPECT_NEAR(nimbus::SplatColumn(u), NumericalColumn(u, -s, s), 1e-10) << "u " << u;
+  }
+  EXPECT_EQ(nimbus::SplatColumn(1.0), 0.0);
+  EXPECT_EQ(nimbus::SplatColumn(1.5), 0.0);
+  EXPECT_NEAR(nimbus::SplatColumn(0.999), 0.0, 1e-6); // continuous at the rim
+}
+
+TEST(CloudSplats, PartialColumnAgainstNumericalIntegral)
+{
+  for (double u = 0.0; u < 1.0; u += 0.11)
+  {
+    const double s = std::sqrt(1.0 - u * u);
+    for (double h = -1.2; h <= 1.2; h += 0.1)
+    {
+      const double end = std::clamp(h, -s, s);
+      EXPECT_NEAR(nimbus::SplatPartialColumn(u, h), NumericalColumn(u, -s, end), 1e-10)
+        << "u " << u << " h " << h;
+    }
+    // Half of the column lies in front of the centre plane.
+    EXPECT_NEAR(nimbus::SplatPartialColumn(u, 0.0), 0.5 * nimbus::SplatColumn(u), 1e-14);
+  }
+}
+
+TEST(CloudSplats, BallMassFromColumns)
+{
+  // The integral of the column over the billboard's disc is the ball's mass:
+  // 4 pi integral_0^1 f(r^2) r^2 dr = 4 pi (1/3 - 22/45 + 17/63 - 4/81) = 4 pi 32/2835 ... x R^3.
+  const double exact = 4.0 * M_PI * (1.0 / 3.0 - 22.0 / 45.0 + 17.0 / 63.0 - 4.0 / 81.0);
+  const int n = 4000;
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i)
+  {
+    const double u = (i + 0.5) / n;
+    sum += 2.0 * M_PI * u * nimbus::SplatColumn(u) / n;
+  }
+  EXPECT_NEAR(sum, exact, 1e-6);
+}
+
+TEST(CloudSplats, Textures)
+{
+  const int size = 32;
+  const std::vector<float> texture = nimbus::SplatColumnTexture(size, 4);
+  ASSERT_EQ(texture.size(), static_cast<std::size_t>(size * size));
+  // The texels' mean x the square's area = the ball's mass (units of R^3), to the
+  // texel averages' supersampling.
+  double mass = 0.0;
+  for (float value : texture)
+  {
+    mass += value * (2.0 / size) * (2.0 / size);
+  }
+  const double exact = 4.0 * M_PI * (1.0 / 3.0 - 22.0 / 45.0 + 17.0 / 63.0 - 4.0 / 81.0);
+  EXPECT_NEAR(mass, exact, 2e-3 * exact);
+  // Symmetric, highest at the centre, 0 in the corners.
+  EXPECT_FLOAT_EQ(texture[0], 0.0f);
+  EXPECT_FLOAT_EQ(texture[5 * size + 7], texture[7 * size + 5]);
+  EXPECT_FLOAT_EQ(texture[5 * size + 7], texture[(size - 1 - 5) * size + (size - 1 - 7)]);
+  EXPECT_GT(texture[(size / 2) * size + size / 2], 0.95f);
+
+  const std::vector<float> table = nimbus::SplatPartialColumnTable(9, 5);
+  ASSERT_EQ(table.size(), 45u);
+  EXPECT_FLOAT_EQ(table[0], 0.0f);                               // u 0, h -1
+  EXPECT_NEAR(table[2 * 9], 0.5 * 944.0 / 945.0, 1e-7);          // u 0, h 0
+  EXPECT_NEAR(table[4 * 9 + 4], nimbus::SplatColumn(0.5), 1e-7); // u 0.5, h 1
+  EXPECT_THROW(nimbus::SplatPartialColumnTable(1, 5), std::invalid_argument);
+}
+
+TEST(CloudSplats, Sorting)
+{
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(-100.0f, 100.0f);
+  std::vector<float> centres(3 * 500);
+  for (float& c : centres)
+  {
+    c = uniform(random);
+  }
+  const std::array<double, 3> direction = { 0.6, 0.0, -0.8 };
+  std::vector<float> offsets(500);
+  for (float& o : offsets)
+  {
+    o = uniform(random);
+  }
+  const auto order = nimbus::SplatOrder(centres, direction, offsets);
+  ASSERT_EQ(order.size(), 500u);
+  auto key = [&](std::uint32_t i)
+  {
+    return direction[0] * centres[3 * i] + direction[1] * centres[3 * i + 1] +
+      direction[2] * centres[3 * i + 2] + offsets[i];
+  };
+  for (std::size_t n = 1; n < order.size(); ++n)
+  {
+    EXPECT_LE(key(order[n - 1]), key(order[n]));
+  }
+  const std::array<double, 3> eye = { 10.0, -300.0, 50.0 };
+  const auto backToFront = nimbus::SplatOrderBackToFront(centres, eye);
+  auto distance = [&](std::uint32_t i)
+  {
+    const double dx = centres[3 * i] - eye[0], dy = centres[3 * i + 1] - eye[1],
+                 dz = centres[3 * i + 2] - eye[2];
+    return dx * dx + dy * dy + dz * dz;
+  };
+  for (std::size_t n = 1; n < backToFront.size(); ++n)
+  {
+    EXPECT_GE(distance(backToFront[n - 1]), distance(backToFront[n]));
+  }
+  EXPECT_THROW(nimbus::SplatOrder(centres, direction, { 1.0f }), std::invalid_argument);
+}
+
+TEST(CloudSplats, FrameAndLayers)
+{
+  const std::array<double, 3> axis = { 0.48, -0.6, 0.64 };
+  const auto frame = nimbus::SplatFrame(axis);
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = 0; b < 3; ++b)
+    {
+      const double dot =
+        frame[a][0] * frame[b][0] + frame[a][1] * frame[b][1] + frame[a][2] * frame[b][2];
+      EXPECT_NEAR(dot, a == b ? 1.0 : 0.0, 1e-12);
+    }
+  }
+  // Fronts 0, 1, ..., 9; planes at 0, 3, 6, 9: strictly before each plane.
+  std::vector<float> fronts;
+  for (int i = 0; i < 10; ++i)
+  {
+    fronts.push_back(static_cast<float>(i));
+  }
+  const auto counts = nimbus::SplatLayerCounts(fronts, 0.0, 9.0, 4);
+  ASSERT_EQ(counts.size(), 4u);
+  EXPECT_EQ(counts[0], 0u);
+  EXPECT_EQ(counts[1], 3u);
+  EXPECT_EQ(counts[2], 6u);
+  EXPECT_EQ(counts[3], 9u);
+}
