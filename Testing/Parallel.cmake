@@ -55,3 +55,27 @@ add_test(NAME mpi.ParaViewPieces.2
 set_tests_properties(mpi.ParaViewPieces.2 PROPERTIES
   LABELS mpi TIMEOUT 300 PROCESSORS 2 RESOURCE_LOCK mpi
   ENVIRONMENT "PYTHONPATH=${python_dir};${nimbus_mpi_environment}")
+
+# What a rank holds: mpi.PieceMemory.4 (TestParallelVdbMemory.py): every rank reads its piece
+# of a 256^3 all-active .vdb (written by mpi.PieceMemory.Setup) and fails when its peak memory
+# grows by more than twice its piece plus a quarter of the whole grid (a whole read, which the
+# last rank also does as a check of the measurement, grows it by twice the whole grid). The
+# cloud automaton's ranks stepping only their slabs is checked by mpi.Pieces.* (its pieces
+# against the serial output, 2 and 4 ranks, open and periodic sides).
+if (NIMBUS_HAVE_OPENVDB)
+  set(nimbus_vdb_memory_file "${output_dir}/parallel_vdb_memory.vdb")
+  add_test(NAME mpi.PieceMemory.Setup
+    COMMAND "${Python3_EXECUTABLE}" "${CMAKE_CURRENT_SOURCE_DIR}/Python/TestParallelVdbMemory.py"
+      --write "${nimbus_vdb_memory_file}")
+  set_tests_properties(mpi.PieceMemory.Setup PROPERTIES
+    LABELS mpi TIMEOUT 60 FIXTURES_SETUP nimbus_vdb_memory
+    ENVIRONMENT "PYTHONPATH=${python_dir}")
+  add_test(NAME mpi.PieceMemory.4
+    COMMAND "${NIMBUS_MPIEXEC}" ${nimbus_mpiexec_flags} -n 4
+      "${NIMBUS_PVBATCH}" --symmetric --force-offscreen-rendering
+      "${CMAKE_CURRENT_SOURCE_DIR}/Python/TestParallelVdbMemory.py"
+      --read "${nimbus_vdb_memory_file}")
+  set_tests_properties(mpi.PieceMemory.4 PROPERTIES
+    LABELS mpi TIMEOUT 120 PROCESSORS 4 RESOURCE_LOCK mpi FIXTURES_REQUIRED nimbus_vdb_memory
+    ENVIRONMENT "PYTHONPATH=${python_dir};${nimbus_mpi_environment}")
+endif ()

@@ -273,6 +273,23 @@ struct EventSampler
 };
 } // namespace
 
+namespace
+{
+/// Whether the wind moves any of the layers [layer0, layer0 + nz) at step n.
+bool AnyLayerMoves(const CloudAutomatonParameters& p, int layer0, int nz, std::int64_t n)
+{
+  for (int z = layer0; z < layer0 + nz; ++z)
+  {
+    if (WindShift(p.Wind[0] + z * p.Shear[0], n) != 0 ||
+      WindShift(p.Wind[1] + z * p.Shear[1], n) != 0)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+}
+
 CloudAutomaton::CloudAutomaton(const CloudAutomatonParameters& parameters)
   : Parameters(parameters)
 {
@@ -393,11 +410,10 @@ void CloudAutomaton::Clear()
 void CloudAutomaton::Step()
 {
   const auto& p = this->Parameters;
-  // nz: the held layers (the whole grid unless Parameters.Layers says otherwise); z below is
-  // the held layer, layer0 + z the global one.
+  // nz: the held layers (Parameters.Layers); layer0 + z is held layer z's global index.
   const int nx = p.Dimensions[0], ny = p.Dimensions[1], nz = this->NZ, layer0 = this->Z0;
   const int W = this->RowWords;
-  const std::size_t offset = static_cast<std::size_t>(layer0) * ny * W; // global word index - held
+  const std::size_t offset = static_cast<std::size_t>(layer0) * ny * W; // global - held word
   const bool periodic = p.Boundary == CloudBoundary::Periodic;
   const std::int64_t n = this->Current.Step;
   const CloudAutomatonState& in = this->Current;
@@ -510,13 +526,7 @@ void CloudAutomaton::Step()
     });
 
   // 3. wind: out -> in (shifted), or just swap when no layer moves this step.
-  bool anyShift = false;
-  for (int z = 0; z < nz && !anyShift; ++z)
-  {
-    anyShift = WindShift(p.Wind[0] + (layer0 + z) * p.Shear[0], n) != 0 ||
-      WindShift(p.Wind[1] + (layer0 + z) * p.Shear[1], n) != 0;
-  }
-  if (!anyShift)
+  if (!AnyLayerMoves(p, layer0, nz, n))
   {
     std::swap(this->Current.Hum, this->Scratch.Hum);
     std::swap(this->Current.Act, this->Scratch.Act);
