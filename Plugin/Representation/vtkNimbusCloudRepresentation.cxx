@@ -127,7 +127,10 @@ void vtkNimbusCloudRepresentation::ForwardMapperProgress(vtkObject*, unsigned lo
   this->UpdateProgress(this->CloudMapper->GetProgress());
 }
 
-vtkNimbusCloudRepresentation::~vtkNimbusCloudRepresentation() = default;
+vtkNimbusCloudRepresentation::~vtkNimbusCloudRepresentation()
+{
+  this->StopObservingRenderer();
+}
 
 vtkNimbusCloudVolumeMapper* vtkNimbusCloudRepresentation::GetCloudMapper()
 {
@@ -415,18 +418,16 @@ void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
   vtkNimbusCloudVolumeMapper* mapper = this->CloudMapper;
   if (!this->CoarseDensity || !nimbus::IsOrderedCompositing(view))
   {
+    this->StopObservingRenderer();
     mapper->SetPieceCompositing(false);
     mapper->SetDrawOutsideRegions(true);
     mapper->SetExternalDensity(nullptr);
     const double none[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
     mapper->SetSlicingBounds(none);
+    mapper->SetViewCoverBounds(none);
     return;
   }
-  // The last rank in IceT's order (ParaView's own helper, same boxes, same camera)
-  // is the bottom layer: it draws the air and the ground.
-  const bool bottom = nimbus::IsLastInCompositingOrder(view);
   mapper->SetPieceCompositing(true);
-  mapper->SetDrawOutsideRegions(bottom);
   mapper->SetExternalDensity(this->CoarseDensity);
   mapper->SetSlicingBounds(this->WholeBounds);
   double background[3] = { 0.0, 0.0, 0.0 };
@@ -435,21 +436,87 @@ void vtkNimbusCloudRepresentation::ConfigurePiece(vtkPVRenderView* view)
     view->GetRenderer()->GetBackground(background);
   }
   mapper->SetPieceBackground(background);
+  // A first placement with this rank's camera now; the renderer's start places the layer
+  // again with the camera of the render, the same on every rank.
+  this->PlaceLayer(view);
+  this->ObserveRendererStart(view);
+}
+
+void vtkNimbusCloudRepresentation::ObserveRendererStart(vtkPVRenderView* view)
+{
+  vtkRenderer* renderer = view->GetRenderer();
+  this->LayerView = view;
+  if (renderer == this->ObservedRenderer && this->RendererStartTag != 0)
+  {
+    return;
+  }
+  this->StopObservingRenderer();
+  if (renderer)
+  {
+    // Below ParaView's synchronized renderers (priority 0), which give every rank rank
+    // 0's camera in their StartEvent observer.
+    constexpr float afterCameraSynchronization = -1.0f;
+    this->RendererStartTag = renderer->AddObserver(vtkCommand::StartEvent, this,
+      &vtkNimbusCloudRepresentation::OnRendererStart, afterCameraSynchronization);
+    this->ObservedRenderer = renderer;
+  }
+}
+
+void vtkNimbusCloudRepresentation::OnRendererStart(vtkObject*, unsigned long, void*)
+{
+  vtkPVRenderView* view = this->LayerView;
+  if (view && this->CloudMapper->GetPieceCompositing() && this->GetVisibility())
+  {
+    this->PlaceLayer(view);
+  }
+}
+
+void vtkNimbusCloudRepresentation::StopObservingRenderer()
+{
+  if (this->ObservedRenderer && this->RendererStartTag != 0)
+  {
+    this->ObservedRenderer->RemoveObserver(this->RendererStartTag);
+  }
+  this->ObservedRenderer = nullptr;
+  this->RendererStartTag = 0;
+}
+
+bool vtkNimbusCloudRepresentation::RemoveFromView(vtkView* view)
+{
+  if (vtkPVRenderView::SafeDownCast(view) == this->LayerView)
+  {
+    this->StopObservingRenderer();
+    this->LayerView = nullptr;
+  }
+  return this->Superclass::RemoveFromView(view);
+}
+
+void vtkNimbusCloudRepresentation::PlaceLayer(vtkPVRenderView* view)
+{
+  vtkNimbusCloudVolumeMapper* mapper = this->CloudMapper;
+  // The last rank in IceT's order (ParaView's own helper, same boxes, same camera)
+  // is the bottom layer: it draws the air and the ground.
+  const bool bottom = nimbus::IsLastInCompositingOrder(view);
+  mapper->SetDrawOutsideRegions(bottom);
   // The bottom piece's pixels are the whole view: its prop bounds must project onto
   // all of it (IceT composites only the pixels a rank's bounds cover), without
-  // containing the eye. The frustum's corner rays between the cloud's distance and
-  // twice it, widened by half for safety.
+  // containing the eye. The frustum's corner rays between a distance d and 2 d, widened
+  // by half for safety: d is the cloud's distance, kept inside the clipping range, and
+  // at least a thousandth of the cloud's size (a camera whose clipping range has
+  // collapsed, the cloud behind it, still gets a box apart from the eye).
   double cover[6] = { 1.0, -1.0, 1.0, -1.0, 1.0, -1.0 };
   vtkCamera* camera = view->GetActiveCamera();
   if (bottom && camera && view->GetRenderer())
   {
     vtkBoundingBox box;
     const double* eye = camera->GetPosition();
+    vtkBoundingBox whole(this->WholeBounds);
     double centre[3];
-    vtkBoundingBox(this->WholeBounds).GetCenter(centre);
+    whole.GetCenter(centre);
     const double distance = std::max(std::sqrt(vtkMath::Distance2BetweenPoints(eye, centre)), 1e-6);
     const double* range = camera->GetClippingRange();
-    const double nearest = std::max(range[0], std::min(distance, range[1]));
+    const double nearest =
+      std::max(1e-3 * whole.GetDiagonalLength(), std::max(range[0], std::min(distance, range[1])));
     int* size = view->GetRenderer()->GetSize();
     const double aspect = size && size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0;
     vtkMatrix4x4* toWorld = camera->GetCompositeProjectionTransformMatrix(aspect, -1.0, 1.0);

@@ -30,12 +30,14 @@
 #include "NimbusCloudRepresentationModule.h" // for export macro
 #include "vtkImageVolumeRepresentation.h"
 #include "vtkSmartPointer.h" // for vtkSmartPointer
+#include "vtkWeakPointer.h"  // for vtkWeakPointer
 
 #include <string> // for std::string
 
 class vtkImageData;
 class vtkNimbusCloudVolumeMapper;
 class vtkPVRenderView;
+class vtkRenderer;
 
 class NIMBUSCLOUDREPRESENTATION_EXPORT vtkNimbusCloudRepresentation
   : public vtkImageVolumeRepresentation
@@ -358,9 +360,27 @@ protected:
 
   /// Before a render under ordered compositing: this piece's settings on the mapper
   /// (premultiplied output, the whole cloud's slice planes, the other pieces'
-  /// shadow) and whether this rank, last in the compositing order for the view's
-  /// camera, draws the air and the ground; without ordered compositing, none.
+  /// shadow), and PlaceLayer() again at the start of the renderer's render (see there);
+  /// without ordered compositing, none.
   void ConfigurePiece(vtkPVRenderView* view);
+
+  /// Whether this rank, last in the compositing order for the view's camera, draws the
+  /// air and the ground, and the bounds that make its image cover the view. Run at the
+  /// start of each render of the view's renderer: only then does every rank hold the
+  /// camera of the render (ParaView's synchronized renderers copy rank 0's camera to
+  /// the other ranks when the renderer starts; a camera set from a script reaches them
+  /// only then). Every rank must agree on the bottom rank, or none draws the air.
+  void PlaceLayer(vtkPVRenderView* view);
+
+  /// The view's renderer's StartEvent, observed after ParaView's own observer (the
+  /// camera's synchronization, priority 0): PlaceLayer().
+  void ObserveRendererStart(vtkPVRenderView* view);
+  void OnRendererStart(vtkObject* caller, unsigned long event, void* data);
+  void StopObservingRenderer();
+  bool RemoveFromView(vtkView* view) override;
+  vtkWeakPointer<vtkRenderer> ObservedRenderer;
+  vtkWeakPointer<vtkPVRenderView> LayerView;
+  unsigned long RendererStartTag = 0;
 
   /// The union of all ranks' piece bounds (invalid: not distributed) and the coarse
   /// whole density from the last RequestData.
