@@ -38,6 +38,9 @@ packages=(
   xdotool imagemagick
   # no X at all: EGL (vtkNimbusOffscreenRenderWindow, NIMBUS_OFFSCREEN=egl)
   libegl-dev libegl-mesa0
+  # ... or OSMesa, Mesa on the CPU into memory (NIMBUS_OFFSCREEN=osmesa, and where no EGL
+  # display can be made); optional at configure time
+  libosmesa6-dev
 )
 
 # NIMBUS_OFFSCREEN=egl: no X at all (a cluster node, a container): Xvfb is neither

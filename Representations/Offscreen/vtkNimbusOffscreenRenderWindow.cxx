@@ -1,5 +1,7 @@
 #include "vtkNimbusOffscreenRenderWindow.h"
 
+#include "OffscreenOSMesa.h"
+
 #include "vtkGenericRenderWindowInteractor.h"
 #include "vtkObjectFactory.h"
 #include "vtkObjectFactoryCollection.h"
@@ -15,6 +17,7 @@
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -213,14 +216,15 @@ public:
   const char* GetVTKSourceVersion() override { return VTK_SOURCE_VERSION; }
   const char* GetDescription() override
   {
-    return "Nimbus: vtkRenderWindow on an EGL pbuffer (NIMBUS_OFFSCREEN=egl, --offscreen)";
+    return "Nimbus: vtkRenderWindow on an EGL pbuffer or OSMesa (NIMBUS_OFFSCREEN=egl|osmesa, "
+           "--offscreen)";
   }
 
 protected:
   vtkNimbusOffscreenFactory()
   {
     this->RegisterOverride("vtkRenderWindow", "vtkNimbusOffscreenRenderWindow",
-      "EGL pbuffer render window, no X server", 1, NewOffscreenWindow);
+      "EGL pbuffer or OSMesa render window, no X server", 1, NewOffscreenWindow);
     this->RegisterOverride("vtkRenderWindowInteractor", "vtkGenericRenderWindowInteractor",
       "an interactor that needs no X server", 1, NewGenericInteractor);
   }
@@ -232,11 +236,31 @@ private:
 
 std::mutex FactoryMutex;
 vtkObjectFactory* InstalledFactory = nullptr; // held by vtkObjectFactory's registry
+
+std::atomic<int> DefaultContextAPI{ vtkNimbusOffscreenRenderWindow::EGLThenOSMesa };
+std::once_flag OSMesaFallbackNotice;
+
+// Lets go of the EGL context current on this thread, whichever window made it.
+void ReleaseCurrentEGL()
+{
+  if (eglGetCurrentContext() != EGL_NO_CONTEXT)
+  {
+    eglMakeCurrent(eglGetCurrentDisplay(), EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  }
+}
 }
 
 //------------------------------------------------------------------------------
 struct vtkNimbusOffscreenRenderWindow::Internals
 {
+  enum class API
+  {
+    None,
+    EGL,
+    OSMesa
+  };
+  API Current = API::None;
+  nimbus::OffscreenOSMesa OSMesa;
   EGLDisplay Display = EGL_NO_DISPLAY;
   EGLConfig Config = nullptr;
   EGLContext Context = EGL_NO_CONTEXT;
@@ -250,12 +274,13 @@ vtkStandardNewMacro(vtkNimbusOffscreenRenderWindow);
 
 //------------------------------------------------------------------------------
 vtkNimbusOffscreenRenderWindow::vtkNimbusOffscreenRenderWindow()
-  : Internal(new Internals)
+  : RequestedContextAPI(DefaultContextAPI)
+  , Internal(new Internals)
 {
   // Our own context: VTK keeps its GL state between renders, as with an X window.
   this->OwnContext = 1;
   this->SetShowWindow(false);
-  this->SetWindowName("Nimbus (EGL offscreen)");
+  this->SetWindowName("Nimbus (offscreen)");
 }
 
 //------------------------------------------------------------------------------
@@ -332,6 +357,24 @@ const char* vtkNimbusOffscreenRenderWindow::GetEnvironmentVariableName()
 }
 
 //------------------------------------------------------------------------------
+void vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(int api)
+{
+  DefaultContextAPI = api < EGLThenOSMesa ? EGLThenOSMesa : (api > OSMesaOnly ? OSMesaOnly : api);
+}
+
+//------------------------------------------------------------------------------
+int vtkNimbusOffscreenRenderWindow::GetDefaultRequestedContextAPI()
+{
+  return DefaultContextAPI;
+}
+
+//------------------------------------------------------------------------------
+bool vtkNimbusOffscreenRenderWindow::HasOSMesa()
+{
+  return nimbus::OffscreenOSMesa::Available();
+}
+
+//------------------------------------------------------------------------------
 int vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested()
 {
   const char* value = std::getenv(OffscreenVariable);
@@ -341,13 +384,30 @@ int vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested()
   }
   if (std::strcmp(value, "egl") == 0 || std::strcmp(value, "EGL") == 0)
   {
+    vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(EGLThenOSMesa);
     vtkNimbusOffscreenRenderWindow::InstallFactory();
     return 1;
   }
+  const bool osmesa = std::strcmp(value, "osmesa") == 0 || std::strcmp(value, "OSMesa") == 0 ||
+    std::strcmp(value, "OSMESA") == 0;
+  if (osmesa && vtkNimbusOffscreenRenderWindow::HasOSMesa())
+  {
+    vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(OSMesaOnly);
+    vtkNimbusOffscreenRenderWindow::InstallFactory();
+    return 1;
+  }
+  if (osmesa)
+  {
+    std::cerr << "Error: " << OffscreenVariable << "=" << value
+              << ": this build of Nimbus has no OSMesa (configure found no GL/osmesa.h and "
+                 "libOSMesa; Debian: install libosmesa6-dev and configure again). Use "
+              << OffscreenVariable << "=egl, or an X display.\n";
+    return -1;
+  }
   std::cerr << "Error: " << OffscreenVariable << "=" << value << " is not understood: use "
+            << OffscreenVariable << "=egl to render without an X server (EGL, else OSMesa), "
             << OffscreenVariable
-            << "=egl to render without an X server (EGL), or leave it unset, empty or 0 for "
-               "an X display.\n";
+            << "=osmesa for OSMesa only, or leave it unset, empty or 0 for an X display.\n";
   return -1;
 }
 
@@ -390,13 +450,74 @@ int vtkNimbusOffscreenRenderWindow::InstallIfRequested(int& argc, char* argv[])
 bool vtkNimbusOffscreenRenderWindow::CreateContext()
 {
   Internals& in = *this->Internal;
-  if (in.Context != EGL_NO_CONTEXT)
+  if (in.Current != Internals::API::None)
   {
     return true;
   }
   const int width = this->Size[0] > 0 ? this->Size[0] : 300;
   const int height = this->Size[1] > 0 ? this->Size[1] : 300;
+  const int requested = this->RequestedContextAPI;
 
+  std::string eglTried;
+  if (requested != OSMesaOnly && this->CreateEGLContext(width, height, eglTried))
+  {
+    return true;
+  }
+  std::string osmesaError;
+  if (requested != EGLOnly && this->CreateOSMesaContext(width, height, osmesaError))
+  {
+    if (requested == EGLThenOSMesa)
+    {
+      // Once per process: every window takes the same way.
+      std::call_once(OSMesaFallbackNotice,
+        [&]
+        {
+          std::cerr << "Nimbus offscreen: no EGL display with an OpenGL 3.2 core context and a "
+                       "pbuffer (tried:"
+                    << eglTried << "); rendering with OSMesa ("
+                    << nimbus::OffscreenOSMesa::LibraryName() << ").\n";
+        });
+    }
+    return true;
+  }
+
+  std::ostringstream message;
+  message << "No offscreen OpenGL context could be made (asked for by " << OffscreenVariable
+          << " or " << OffscreenFlag << ").";
+  if (requested != OSMesaOnly)
+  {
+    message << "\nEGL: no display with a desktop OpenGL 3.2 core context and a pbuffer; tried:"
+            << eglTried;
+  }
+  if (requested != EGLOnly)
+  {
+    message << "\nOSMesa: " << osmesaError;
+  }
+  message << "\nInstall libEGL and a vendor library (Debian: libegl1 libegl-mesa0 for Mesa's "
+             "llvmpipe, or NVIDIA's driver) or OSMesa (Debian: libosmesa6), or unset "
+          << OffscreenVariable << " and render on an X display.";
+  vtkErrorMacro(<< message.str());
+  return false;
+}
+
+//------------------------------------------------------------------------------
+bool vtkNimbusOffscreenRenderWindow::CreateOSMesaContext(int width, int height, std::string& error)
+{
+  Internals& in = *this->Internal;
+  ReleaseCurrentEGL(); // libglvnd has one current API per thread
+  if (!in.OSMesa.Create(width, height, error))
+  {
+    return false;
+  }
+  in.Current = Internals::API::OSMesa;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkNimbusOffscreenRenderWindow::CreateEGLContext(int width, int height, std::string& attempts)
+{
+  Internals& in = *this->Internal;
+  nimbus::OffscreenOSMesa::ReleaseAnyCurrent(); // libglvnd has one current API per thread
   std::ostringstream tried;
   for (const DisplayCandidate& candidate : DisplayCandidates())
   {
@@ -457,16 +578,14 @@ bool vtkNimbusOffscreenRenderWindow::CreateContext()
     in.SurfaceSize[0] = width;
     in.SurfaceSize[1] = height;
     in.Platform = candidate.Platform;
+    in.Current = Internals::API::EGL;
     return true;
   }
-  const std::string attempts = tried.str();
-  vtkErrorMacro("No EGL display with a desktop OpenGL 3.2 core context and a pbuffer could be "
-                "made (asked for by "
-    << OffscreenVariable << "=egl or " << OffscreenFlag
-    << "); tried:" << (attempts.empty() ? std::string("\n  no EGL display at all") : attempts)
-    << "\nInstall libEGL and a vendor library (Debian: libegl1 libegl-mesa0 for Mesa's "
-       "llvmpipe, or NVIDIA's driver), or unset "
-    << OffscreenVariable << " and render on an X display.");
+  attempts = tried.str();
+  if (attempts.empty())
+  {
+    attempts = "\n  no EGL display at all";
+  }
   return false;
 }
 
@@ -474,6 +593,12 @@ bool vtkNimbusOffscreenRenderWindow::CreateContext()
 void vtkNimbusOffscreenRenderWindow::DestroyContext()
 {
   Internals& in = *this->Internal;
+  if (in.Current == Internals::API::OSMesa)
+  {
+    in.OSMesa.Destroy();
+    in.Current = Internals::API::None;
+    return;
+  }
   if (in.Display == EGL_NO_DISPLAY)
   {
     return;
@@ -497,12 +622,23 @@ void vtkNimbusOffscreenRenderWindow::DestroyContext()
   in.Surface = EGL_NO_SURFACE;
   in.SurfaceSize[0] = in.SurfaceSize[1] = 0;
   in.Platform.clear();
+  in.Current = Internals::API::None;
 }
 
 //------------------------------------------------------------------------------
 bool vtkNimbusOffscreenRenderWindow::ResizeSurface(int width, int height)
 {
   Internals& in = *this->Internal;
+  if (in.Current == Internals::API::OSMesa)
+  {
+    std::string error;
+    if (!in.OSMesa.Resize(width, height, error))
+    {
+      vtkErrorMacro("Could not make a " << width << "x" << height << " OSMesa buffer: " << error);
+      return false;
+    }
+    return true;
+  }
   if (in.Context == EGL_NO_CONTEXT || width < 1 || height < 1 ||
     (in.SurfaceSize[0] == width && in.SurfaceSize[1] == height))
   {
@@ -553,7 +689,7 @@ void vtkNimbusOffscreenRenderWindow::Initialize()
 //------------------------------------------------------------------------------
 void vtkNimbusOffscreenRenderWindow::Finalize()
 {
-  if (this->Internal->Context != EGL_NO_CONTEXT)
+  if (this->Internal->Current != Internals::API::None)
   {
     this->MakeCurrent();
     this->ReleaseGraphicsResources(this);
@@ -579,15 +715,17 @@ void vtkNimbusOffscreenRenderWindow::OpenGLInitContext()
     if (result != GLEW_OK && !glxStageOnly)
     {
       this->GlewInitValid = false;
-      vtkErrorMacro("GLEW could not be initialized on the EGL context: "
-        << reinterpret_cast<const char*>(glewGetErrorString(result)));
+      vtkErrorMacro("GLEW could not be initialized on the "
+        << this->GetContextAPI()
+        << " context: " << reinterpret_cast<const char*>(glewGetErrorString(result)));
       return;
     }
     if (!GLEW_VERSION_3_2)
     {
       this->GlewInitValid = false;
-      vtkErrorMacro("The EGL context does not offer OpenGL 3.2 (GL_VERSION "
-        << reinterpret_cast<const char*>(glGetString(GL_VERSION)) << ")");
+      vtkErrorMacro("The " << this->GetContextAPI()
+                           << " context does not offer OpenGL 3.2 (GL_VERSION "
+                           << reinterpret_cast<const char*>(glGetString(GL_VERSION)) << ")");
       return;
     }
     this->GlewInitValid = true;
@@ -626,8 +764,8 @@ void vtkNimbusOffscreenRenderWindow::Render()
 void vtkNimbusOffscreenRenderWindow::Frame()
 {
   this->MakeCurrent();
-  // Blits VTK's display framebuffer to the pbuffer (the "hardware" buffer). A pbuffer
-  // has a single buffer, so there is nothing to swap.
+  // Blits VTK's display framebuffer to the pbuffer or the OSMesa buffer (the "hardware"
+  // buffer). Both are single-buffered, so there is nothing to swap.
   this->vtkOpenGLRenderWindow::Frame();
 }
 
@@ -635,8 +773,22 @@ void vtkNimbusOffscreenRenderWindow::Frame()
 void vtkNimbusOffscreenRenderWindow::MakeCurrent()
 {
   Internals& in = *this->Internal;
+  if (in.Current == Internals::API::OSMesa)
+  {
+    if (!in.OSMesa.IsCurrent())
+    {
+      ReleaseCurrentEGL(); // another window's (libglvnd has one current API per thread)
+      std::string error;
+      if (!in.OSMesa.MakeCurrent(error))
+      {
+        vtkErrorMacro("Could not make the OSMesa context current: " << error);
+      }
+    }
+    return;
+  }
   if (in.Context != EGL_NO_CONTEXT && eglGetCurrentContext() != in.Context)
   {
+    nimbus::OffscreenOSMesa::ReleaseAnyCurrent(); // another window's
     if (!eglMakeCurrent(in.Display, in.Surface, in.Surface, in.Context))
     {
       vtkErrorMacro("eglMakeCurrent failed: " << ErrorName(eglGetError()));
@@ -648,6 +800,11 @@ void vtkNimbusOffscreenRenderWindow::MakeCurrent()
 void vtkNimbusOffscreenRenderWindow::ReleaseCurrent()
 {
   Internals& in = *this->Internal;
+  if (in.Current == Internals::API::OSMesa)
+  {
+    in.OSMesa.ReleaseCurrent();
+    return;
+  }
   if (in.Context != EGL_NO_CONTEXT && eglGetCurrentContext() == in.Context)
   {
     eglMakeCurrent(in.Display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -657,6 +814,10 @@ void vtkNimbusOffscreenRenderWindow::ReleaseCurrent()
 //------------------------------------------------------------------------------
 bool vtkNimbusOffscreenRenderWindow::IsCurrent()
 {
+  if (this->Internal->Current == Internals::API::OSMesa)
+  {
+    return this->Internal->OSMesa.IsCurrent();
+  }
   return this->Internal->Context != EGL_NO_CONTEXT &&
     eglGetCurrentContext() == this->Internal->Context;
 }
@@ -674,7 +835,7 @@ int vtkNimbusOffscreenRenderWindow::SupportsOpenGL()
 //------------------------------------------------------------------------------
 vtkTypeBool vtkNimbusOffscreenRenderWindow::IsDirect()
 {
-  return this->Internal->Context != EGL_NO_CONTEXT ? 1 : 0;
+  return this->Internal->Current != Internals::API::None ? 1 : 0;
 }
 
 //------------------------------------------------------------------------------
@@ -687,19 +848,36 @@ void vtkNimbusOffscreenRenderWindow::SetSize(int width, int height)
 //------------------------------------------------------------------------------
 void* vtkNimbusOffscreenRenderWindow::GetGenericContext()
 {
-  return this->Internal->Context;
+  Internals& in = *this->Internal;
+  return in.Current == Internals::API::OSMesa ? in.OSMesa.GetContext() : in.Context;
 }
 
 //------------------------------------------------------------------------------
 void* vtkNimbusOffscreenRenderWindow::GetGenericDisplayId()
 {
-  return this->Internal->Display;
+  Internals& in = *this->Internal;
+  return in.Current == Internals::API::OSMesa ? nullptr : in.Display;
 }
 
 //------------------------------------------------------------------------------
 void* vtkNimbusOffscreenRenderWindow::GetGenericDrawable()
 {
-  return this->Internal->Surface;
+  Internals& in = *this->Internal;
+  return in.Current == Internals::API::OSMesa ? in.OSMesa.GetBuffer() : in.Surface;
+}
+
+//------------------------------------------------------------------------------
+const char* vtkNimbusOffscreenRenderWindow::GetContextAPI()
+{
+  switch (this->Internal->Current)
+  {
+    case Internals::API::EGL:
+      return "EGL";
+    case Internals::API::OSMesa:
+      return "OSMesa";
+    default:
+      return "";
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -716,13 +894,23 @@ const char* vtkNimbusOffscreenRenderWindow::ReportCapabilities()
     this->Initialize();
   }
   Internals& in = *this->Internal;
-  if (in.Context == EGL_NO_CONTEXT)
+  if (in.Current == Internals::API::None)
   {
-    in.Capabilities = "EGL: no display or context could be made\n";
+    in.Capabilities = "Offscreen: no EGL or OSMesa context could be made\n";
     return in.Capabilities.c_str();
   }
   this->MakeCurrent();
   std::ostringstream report;
+  if (in.Current == Internals::API::OSMesa)
+  {
+    report << "OSMesa library: " << nimbus::OffscreenOSMesa::LibraryName() << "\n"
+           << "OSMesa GL dispatch: " << nimbus::OffscreenOSMesa::DispatchDescription() << "\n"
+           << "OSMesa buffer: " << in.OSMesa.GetWidth() << "x" << in.OSMesa.GetHeight() << "\n";
+    const char* opengl = this->Superclass::ReportCapabilities();
+    report << (opengl ? opengl : "");
+    in.Capabilities = report.str();
+    return in.Capabilities.c_str();
+  }
   const char* vendor = eglQueryString(in.Display, EGL_VENDOR);
   const char* version = eglQueryString(in.Display, EGL_VERSION);
   report << "EGL platform: " << in.Platform << "\n"
@@ -739,7 +927,13 @@ const char* vtkNimbusOffscreenRenderWindow::ReportCapabilities()
 void vtkNimbusOffscreenRenderWindow::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  const Internals& in = *this->Internal;
+  Internals& in = *this->Internal;
+  os << indent << "RequestedContextAPI: " << this->RequestedContextAPI << "\n";
+  os << indent
+     << "ContextAPI: " << (in.Current == Internals::API::None ? "(none)" : this->GetContextAPI())
+     << "\n";
+  os << indent << "OSMesaContext: " << in.OSMesa.GetContext() << " (" << in.OSMesa.GetWidth() << "x"
+     << in.OSMesa.GetHeight() << ")\n";
   os << indent << "EGLPlatform: " << (in.Platform.empty() ? "(none)" : in.Platform) << "\n";
   os << indent << "EGLDisplay: " << in.Display << "\n";
   os << indent << "EGLContext: " << in.Context << "\n";

@@ -1,6 +1,9 @@
 // vtkNimbusOffscreenRenderWindow: rendering with no X server (DISPLAY is removed first).
 // The run-time selection (--offscreen, NIMBUS_OFFSCREEN), the factory override, pixels
-// read back after a render and after a resize, two windows taking turns, and the report.
+// read back after a render and after a resize, two windows taking turns, and the report,
+// on EGL and on OSMesa (where the build has it); an EGL window and an OSMesa window taking
+// turns; OSMesa taken where no EGL context can be made (run with libglvnd's EGL vendors
+// hidden: offscreen.RenderWindow.no-egl).
 #include "vtkNimbusOffscreenRenderWindow.h"
 
 #include "vtkActor.h"
@@ -76,12 +79,30 @@ TEST(OffscreenRenderWindow, RequestParsing)
   ::setenv("NIMBUS_OFFSCREEN", "", 1);
   EXPECT_EQ(vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested(), 0);
   EXPECT_FALSE(vtkNimbusOffscreenRenderWindow::IsFactoryInstalled());
-  ::setenv("NIMBUS_OFFSCREEN", "osmesa", 1);
+  ::setenv("NIMBUS_OFFSCREEN", "glx", 1);
   EXPECT_EQ(vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested(), -1);
   EXPECT_FALSE(vtkNimbusOffscreenRenderWindow::IsFactoryInstalled());
+  ::setenv("NIMBUS_OFFSCREEN", "osmesa", 1);
+  if (vtkNimbusOffscreenRenderWindow::HasOSMesa())
+  {
+    EXPECT_EQ(vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested(), 1);
+    EXPECT_TRUE(vtkNimbusOffscreenRenderWindow::IsFactoryInstalled());
+    EXPECT_EQ(vtkNimbusOffscreenRenderWindow::GetDefaultRequestedContextAPI(),
+      vtkNimbusOffscreenRenderWindow::OSMesaOnly);
+    vtkNew<vtkNimbusOffscreenRenderWindow> window;
+    EXPECT_EQ(window->GetRequestedContextAPI(), vtkNimbusOffscreenRenderWindow::OSMesaOnly);
+    vtkNimbusOffscreenRenderWindow::RemoveFactory();
+  }
+  else
+  {
+    EXPECT_EQ(vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested(), -1);
+    EXPECT_FALSE(vtkNimbusOffscreenRenderWindow::IsFactoryInstalled());
+  }
   ::setenv("NIMBUS_OFFSCREEN", "egl", 1);
   EXPECT_EQ(vtkNimbusOffscreenRenderWindow::InstallFactoryIfRequested(), 1);
   EXPECT_TRUE(vtkNimbusOffscreenRenderWindow::IsFactoryInstalled());
+  EXPECT_EQ(vtkNimbusOffscreenRenderWindow::GetDefaultRequestedContextAPI(),
+    vtkNimbusOffscreenRenderWindow::EGLThenOSMesa);
   vtkNimbusOffscreenRenderWindow::RemoveFactory();
   ::unsetenv("NIMBUS_OFFSCREEN");
 
@@ -126,9 +147,30 @@ TEST(OffscreenRenderWindow, FactoryOverride)
   vtkNimbusOffscreenRenderWindow::InstallFactory();
 }
 
-TEST(OffscreenRenderWindow, RendersAndReadsBack)
+// The tests below on each API: EGL only, OSMesa only.
+class OffscreenAPI : public ::testing::TestWithParam<int>
 {
-  vtkNimbusOffscreenRenderWindow::InstallFactory();
+protected:
+  void SetUp() override
+  {
+    if (GetParam() == vtkNimbusOffscreenRenderWindow::OSMesaOnly &&
+      !vtkNimbusOffscreenRenderWindow::HasOSMesa())
+    {
+      GTEST_SKIP() << "this build has no OSMesa";
+    }
+    vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(GetParam());
+    vtkNimbusOffscreenRenderWindow::InstallFactory();
+  }
+  void TearDown() override
+  {
+    vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(
+      vtkNimbusOffscreenRenderWindow::EGLThenOSMesa);
+  }
+  bool OnOSMesa() const { return GetParam() == vtkNimbusOffscreenRenderWindow::OSMesaOnly; }
+};
+
+TEST_P(OffscreenAPI, RendersAndReadsBack)
+{
   Scene scene(64, 48, 1.0);
   scene.Window->Render();
   auto* window = vtkNimbusOffscreenRenderWindow::SafeDownCast(scene.Window);
@@ -136,12 +178,13 @@ TEST(OffscreenRenderWindow, RendersAndReadsBack)
   EXPECT_TRUE(window->IsCurrent());
   EXPECT_EQ(window->SupportsOpenGL(), 1);
   EXPECT_NE(window->GetGenericContext(), nullptr);
-  EXPECT_NE(std::string(window->GetEGLPlatform()), "");
+  EXPECT_EQ(std::string(window->GetContextAPI()), OnOSMesa() ? "OSMesa" : "EGL");
+  EXPECT_EQ(std::string(window->GetEGLPlatform()).empty(), OnOSMesa());
   ExpectNear(scene.Pixel(32, 24), 255, 0, 0);  // the sphere
   ExpectNear(scene.Pixel(1, 1), 64, 128, 191); // the background
   ExpectNear(scene.Pixel(62, 46), 64, 128, 191);
 
-  // A new size: a new pbuffer, the image follows.
+  // A new size: a new pbuffer (OSMesa buffer), the image follows.
   scene.Window->SetSize(100, 30);
   scene.Window->Render();
   EXPECT_EQ(scene.Window->GetSize()[0], 100);
@@ -150,16 +193,16 @@ TEST(OffscreenRenderWindow, RendersAndReadsBack)
   ExpectNear(scene.Pixel(2, 15), 64, 128, 191);
 
   const std::string report = scene.Window->ReportCapabilities();
-  EXPECT_NE(report.find("EGL platform: "), std::string::npos) << report;
+  EXPECT_NE(report.find(OnOSMesa() ? "OSMesa library: " : "EGL platform: "), std::string::npos)
+    << report;
   EXPECT_NE(report.find("OpenGL renderer string"), std::string::npos) << report;
-  // Which EGL display and GL renderer this machine gave (logged for the record).
+  // Which display (library) and GL renderer this machine gave (logged for the record).
   const std::size_t extensions = report.find("OpenGL extensions");
   std::cout << report.substr(0, extensions) << std::flush;
 }
 
-TEST(OffscreenRenderWindow, TwoWindowsTakeTurns)
+TEST_P(OffscreenAPI, TwoWindowsTakeTurns)
 {
-  vtkNimbusOffscreenRenderWindow::InstallFactory();
   Scene first(40, 40, 1.0);
   Scene second(50, 30, 0.5);
   for (int round = 0; round < 2; ++round)
@@ -176,9 +219,75 @@ TEST(OffscreenRenderWindow, TwoWindowsTakeTurns)
   ExpectNear(second.Pixel(25, 15), 128, 0, 0);
 }
 
+INSTANTIATE_TEST_SUITE_P(OffscreenRenderWindow, OffscreenAPI,
+  ::testing::Values(
+    vtkNimbusOffscreenRenderWindow::EGLOnly, vtkNimbusOffscreenRenderWindow::OSMesaOnly),
+  [](const ::testing::TestParamInfo<int>& info)
+  { return info.param == vtkNimbusOffscreenRenderWindow::OSMesaOnly ? "OSMesa" : "EGL"; });
+
+// libglvnd has one current API per thread: each window lets go of the other's.
+TEST(OffscreenRenderWindow, EGLAndOSMesaTakeTurns)
+{
+  if (!vtkNimbusOffscreenRenderWindow::HasOSMesa())
+  {
+    GTEST_SKIP() << "this build has no OSMesa";
+  }
+  vtkNimbusOffscreenRenderWindow::InstallFactory();
+  vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(
+    vtkNimbusOffscreenRenderWindow::EGLOnly);
+  Scene egl(40, 40, 1.0);
+  vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(
+    vtkNimbusOffscreenRenderWindow::OSMesaOnly);
+  Scene osmesa(50, 30, 0.5);
+  vtkNimbusOffscreenRenderWindow::SetDefaultRequestedContextAPI(
+    vtkNimbusOffscreenRenderWindow::EGLThenOSMesa);
+  for (int round = 0; round < 2; ++round)
+  {
+    egl.Window->Render();
+    osmesa.Window->Render();
+    ExpectNear(egl.Pixel(20, 20), 255, 0, 0);
+    ExpectNear(osmesa.Pixel(25, 15), 128, 0, 0);
+    ExpectNear(osmesa.Pixel(1, 1), 64, 128, 191);
+  }
+  EXPECT_EQ(
+    std::string(vtkNimbusOffscreenRenderWindow::SafeDownCast(egl.Window)->GetContextAPI()), "EGL");
+  EXPECT_EQ(
+    std::string(vtkNimbusOffscreenRenderWindow::SafeDownCast(osmesa.Window)->GetContextAPI()),
+    "OSMesa");
+}
+
+// Where no EGL context can be made, the default (NIMBUS_OFFSCREEN=egl, --offscreen) takes
+// OSMesa. Skipped where EGL works (every run but offscreen.RenderWindow.no-egl).
+TEST(OffscreenRenderWindow, FallsBackToOSMesa)
+{
+  vtkNimbusOffscreenRenderWindow::InstallFactory();
+  vtkNew<vtkNimbusOffscreenRenderWindow> probe;
+  probe->SetRequestedContextAPI(vtkNimbusOffscreenRenderWindow::EGLOnly);
+  probe->GlobalWarningDisplayOff(); // its error is expected here
+  probe->Initialize();
+  const bool eglWorks = std::string(probe->GetContextAPI()) == "EGL";
+  probe->GlobalWarningDisplayOn();
+  if (eglWorks)
+  {
+    GTEST_SKIP() << "EGL works here: nothing to fall back from";
+  }
+  if (!vtkNimbusOffscreenRenderWindow::HasOSMesa())
+  {
+    GTEST_SKIP() << "no EGL here and this build has no OSMesa";
+  }
+  Scene scene(64, 48, 1.0);
+  scene.Window->Render();
+  auto* window = vtkNimbusOffscreenRenderWindow::SafeDownCast(scene.Window);
+  ASSERT_NE(window, nullptr);
+  EXPECT_EQ(window->GetRequestedContextAPI(), vtkNimbusOffscreenRenderWindow::EGLThenOSMesa);
+  EXPECT_EQ(std::string(window->GetContextAPI()), "OSMesa");
+  ExpectNear(scene.Pixel(32, 24), 255, 0, 0);
+  ExpectNear(scene.Pixel(1, 1), 64, 128, 191);
+}
+
 int main(int argc, char* argv[])
 {
-  // No X: whatever this test renders comes through EGL.
+  // No X: whatever this test renders comes through EGL or OSMesa.
   ::unsetenv("DISPLAY");
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
