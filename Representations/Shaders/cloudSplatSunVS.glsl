@@ -10,9 +10,10 @@ uniform vec3 sunAxisY;
 uniform vec3 toSun;      // and the unit vector toward the sun
 uniform vec4 sunRect;    // (x min, y min, 1 / width, 1 / height) of the frame's window
 uniform float planeDepth; // the layer's plane: depth -dot(x, toSun) (world units)
+uniform float slabThickness; // from the previous layer's plane to this one (world units)
 out vec2 corner;     // the corner of the square, in units of R
 out float kappa;
-out float planeOffset; // (plane depth - centre depth) / R
+out vec2 planeOffsets; // (this plane's and the previous plane's depth - centre depth) / R
 
 void main()
 {
@@ -21,5 +22,9 @@ void main()
   vec2 window = (vec2(dot(p, sunAxisX), dot(p, sunAxisY)) - sunRect.xy) * sunRect.zw;
   gl_Position = vec4(window * 2.0 - 1.0, 0.0, 1.0);
   kappa = ballOptics.x;
-  planeOffset = (planeDepth + dot(ball.xyz, toSun)) / ball.w;
+  planeOffsets = (vec2(planeDepth, planeDepth - slabThickness) + dot(ball.xyz, toSun)) / ball.w;
+  if (planeOffsets.y >= 1.0)
+  {
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // the ball ends before the slab: no fragments
+  }
 }

@@ -159,22 +159,28 @@ std::array<std::array<double, 3>, 3> SplatFrame(const std::array<double, 3>& axi
   return { e1, e2, axis };
 }
 
-std::vector<std::size_t> SplatLayerCounts(
-  const std::vector<float>& sortedFronts, double zMin, double zMax, int layers)
+std::vector<std::array<std::size_t, 2>> SplatLayerRanges(
+  const std::vector<float>& sortedFronts, double zMin, double zMax, int layers, double maxDiameter)
 {
-  if (layers < 2 || !(zMax >= zMin))
+  if (layers < 2 || !(zMax >= zMin) || !(maxDiameter >= 0.0))
   {
-    throw std::invalid_argument("SplatLayerCounts: needs layers >= 2 and zMax >= zMin");
+    throw std::invalid_argument(
+      "SplatLayerRanges: needs layers >= 2, zMax >= zMin and maxDiameter >= 0");
   }
-  std::vector<std::size_t> counts(layers);
-  for (int k = 0; k < layers; ++k)
+  auto before = [&sortedFronts](double z)
+  {
+    return static_cast<std::size_t>(std::lower_bound(sortedFronts.begin(), sortedFronts.end(), z,
+                                      [](float front, double plane) { return front < plane; }) -
+      sortedFronts.begin());
+  };
+  std::vector<std::array<std::size_t, 2>> ranges(layers, { 0, 0 });
+  for (int k = 1; k < layers; ++k)
   {
     const double z = zMin + (zMax - zMin) * k / (layers - 1);
-    counts[k] =
-      static_cast<std::size_t>(std::lower_bound(sortedFronts.begin(), sortedFronts.end(), z,
-                                 [](float front, double plane) { return front < plane; }) -
-        sortedFronts.begin());
+    const double previous = zMin + (zMax - zMin) * (k - 1) / (layers - 1);
+    const std::size_t end = before(z);
+    ranges[k] = { std::min(before(previous - maxDiameter), end), end };
   }
-  return counts;
+  return ranges;
 }
 } // namespace nimbus

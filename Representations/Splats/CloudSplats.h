@@ -69,11 +69,15 @@ NIMBUSREPRESENTATIONS_EXPORT std::array<std::array<double, 3>, 3> SplatFrame(
   const std::array<double, 3>& axis);
 
 /// The sun pass's accumulation layers: planes at depths z_k = zMin + k (zMax - zMin) /
-/// (layers - 1), k = 0 .. layers - 1, along the sun's light (depth = -dot(x, toSun)). With
-/// the billboards sorted by their front depth (depth - R) ascending, layer k draws the
-/// first count_k of them: those whose front lies before z_k. Returns count_k per layer.
-NIMBUSREPRESENTATIONS_EXPORT std::vector<std::size_t> SplatLayerCounts(
-  const std::vector<float>& sortedFronts, double zMin, double zMax, int layers);
+/// (layers - 1), k = 0 .. layers - 1, along the sun's light (depth = -dot(x, toSun)). Layer
+/// k adds the balls' columns in the slab (z_{k-1}, z_k] to the running sum of the layers
+/// before it. With the billboards sorted by their front depth (depth - R) ascending, the
+/// balls that may cross slab k are the range [first_k, end_k): those whose front lies
+/// before z_k and, as no ball is deeper than maxDiameter, whose front lies after
+/// z_{k-1} - maxDiameter (the shader skips the few in the range that end before the slab).
+/// Returns (first_k, end_k) per layer; layer 0's range is empty.
+NIMBUSREPRESENTATIONS_EXPORT std::vector<std::array<std::size_t, 2>> SplatLayerRanges(
+  const std::vector<float>& sortedFronts, double zMin, double zMax, int layers, double maxDiameter);
 } // namespace nimbus
 
 #endif

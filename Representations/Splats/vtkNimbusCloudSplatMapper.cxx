@@ -72,7 +72,7 @@ struct vtkNimbusCloudSplatMapper::Internals
   vtkNew<vtkOpenGLVertexArrayObject> ViewLayout;
   vtkShaderProgram* SunLayoutProgram = nullptr;
   vtkShaderProgram* ViewLayoutProgram = nullptr;
-  std::vector<std::size_t> LayerCounts;
+  std::vector<std::array<std::size_t, 2>> LayerRanges;
   std::vector<std::uint32_t> SunOrder;
 
   vtkNew<vtkTextureObject> SunDepth;    // 3-D: the accumulated optical depth
@@ -395,34 +395,37 @@ void SunWindow(const std::vector<float>& centres, const std::vector<float>& radi
 
 // The GPU variant: the optical depth toward the sun accumulated in SunTextureLayers planes
 // of a 3-D float texture (002 §3.3's sun-facing billboards, summed instead of multiplied
-// and read back).
+// and read back): a 2-D running sum gains each slab's columns (only the balls that cross
+// the slab are drawn) and is copied into the slab's layer.
 void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
 {
   Internals& in = *this->Internal;
+  if (!glDrawArraysInstancedBaseInstance || !glCopyTexSubImage3D)
+  {
+    throw std::runtime_error("the accumulation texture needs OpenGL 4.2 (base instances)");
+  }
   std::vector<float> depths;
   SunWindow(in.Centres, in.Radii, in.Frame, in.Rect, in.DepthRange, depths);
-  std::vector<float> fronts(depths.size());
-  for (std::size_t i = 0; i < depths.size(); ++i)
-  {
-    fronts[i] = depths[i] - in.Radii[i];
-  }
-  // Sorted by the front toward the sun: layer k draws the first LayerCounts[k] balls.
+  // Sorted by the front toward the sun (depth - R): slab k draws the range LayerRanges[k].
   const std::array<double, 3> away = { -in.Frame[2][0], -in.Frame[2][1], -in.Frame[2][2] };
   std::vector<float> offsets(in.Radii.size());
+  float maxRadius = 0.0f;
   for (std::size_t i = 0; i < offsets.size(); ++i)
   {
     offsets[i] = -in.Radii[i];
+    maxRadius = std::max(maxRadius, in.Radii[i]);
   }
   in.SunOrder = nimbus::SplatOrder(in.Centres, away, offsets);
-  std::vector<float> sortedFronts(fronts.size());
+  std::vector<float> sortedFronts(depths.size());
   for (std::size_t n = 0; n < in.SunOrder.size(); ++n)
   {
-    sortedFronts[n] = fronts[in.SunOrder[n]];
+    sortedFronts[n] = depths[in.SunOrder[n]] - in.Radii[in.SunOrder[n]];
   }
   const int layers = this->SunTextureLayers;
   const double zMin = in.DepthRange[0];
   const double zMax = zMin + 1.0 / in.DepthRange[1];
-  in.LayerCounts = nimbus::SplatLayerCounts(sortedFronts, zMin, zMax, layers);
+  const double slab = (zMax - zMin) / (layers - 1);
+  in.LayerRanges = nimbus::SplatLayerRanges(sortedFronts, zMin, zMax, layers, 2.0 * maxRadius);
   in.UploadInstances(in.SunInstances, in.SunOrder);
 
   const int size = this->SunTextureSize;
@@ -440,6 +443,18 @@ void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
     if (!texture->Allocate3D(size, size, layers, 1, VTK_FLOAT))
     {
       throw std::runtime_error("the sun's accumulation texture could not be allocated");
+    }
+  }
+  vtkTextureObject* running = in.SunReadBack; // the running sum (the read-back's target)
+  running->SetContext(window);
+  if (!running->GetHandle() || static_cast<int>(running->GetWidth()) != size)
+  {
+    running->ReleaseGraphicsResources(window);
+    running->SetMinificationFilter(vtkTextureObject::Nearest);
+    running->SetMagnificationFilter(vtkTextureObject::Nearest);
+    if (!running->Allocate2D(size, size, 1, VTK_FLOAT))
+    {
+      throw std::runtime_error("the sun pass's running sum could not be allocated");
     }
   }
   vtkShaderProgram* program =
@@ -460,6 +475,9 @@ void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
   state->PushFramebufferBindings();
   in.Framebuffer->SetContext(window);
   in.Framebuffer->Bind(GL_FRAMEBUFFER);
+  in.Framebuffer->AddColorAttachment(0, running);
+  in.Framebuffer->ActivateDrawBuffer(0);
+  in.Framebuffer->ActivateReadBuffer(0);
   state->vtkglViewport(0, 0, size, size);
   state->vtkglDisable(GL_SCISSOR_TEST);
   state->vtkglDisable(GL_DEPTH_TEST);
@@ -468,25 +486,27 @@ void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
   state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
   state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  state->vtkglClear(GL_COLOR_BUFFER_BIT);
   Internals::BindLayout(in.SunLayout, in.SunLayoutProgram, program, in.SunInstances);
   in.SetSunFrameUniforms(program);
   in.Partial->Activate();
   program->SetUniformi("partialColumn", in.Partial->GetTextureUnit());
   program->SetUniformi("multiply", 0);
+  program->SetUniformf("slabThickness", static_cast<float>(slab));
+  texture->Activate(); // its unit active: glCopyTexSubImage3D writes into it
   for (int k = 0; k < layers; ++k)
   {
-    // One layer of the 3-D texture (this VTK's AddColorAttachment attaches slice 0 only).
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, k);
-    glDrawBuffer(GL_COLOR_ATTACHMENT0);
-    state->vtkglClear(GL_COLOR_BUFFER_BIT);
-    if (in.LayerCounts[k] > 0)
+    const auto& range = in.LayerRanges[k];
+    if (range[1] > range[0])
     {
-      program->SetUniformf(
-        "planeDepth", static_cast<float>(zMin + (zMax - zMin) * k / (layers - 1)));
-      glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(in.LayerCounts[k]));
+      program->SetUniformf("planeDepth", static_cast<float>(zMin + slab * k));
+      glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, 4,
+        static_cast<GLsizei>(range[1] - range[0]), static_cast<GLuint>(range[0]));
     }
+    glCopyTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, k, 0, 0, size, size);
   }
-  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0);
+  texture->Deactivate();
+  in.Framebuffer->RemoveColorAttachment(0);
   in.Partial->Deactivate();
   in.SunLayout->Release();
   state->PopFramebufferBindings();
@@ -558,6 +578,7 @@ void vtkNimbusCloudSplatMapper::SunPassReadBack(vtkOpenGLRenderWindow* window)
   program->SetUniformi("partialColumn", in.Partial->GetTextureUnit());
   program->SetUniformi("multiply", 1);
   program->SetUniformf("planeDepth", 0.0f);
+  program->SetUniformf("slabThickness", 1e30f); // whole columns: nothing culled
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   const double halfColumn = nimbus::SplatPartialColumn(0.0, 0.0);
   for (std::size_t n = 0; n < in.SunOrder.size(); ++n)

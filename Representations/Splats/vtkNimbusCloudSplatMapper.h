@@ -123,7 +123,7 @@ public:
   ///@}
 
   ///@{
-  /// The sun pass's texture: texels per side (default 512; the read-back's
+  /// The sun pass's texture: texels per side (default 256; the read-back's
   /// framebuffer too) and planes along the light (AccumulationTexture; default 32).
   vtkSetClampMacro(SunTextureSize, int, 16, 8192);
   vtkGetMacro(SunTextureSize, int);
@@ -161,7 +161,7 @@ protected:
   double MetresPerUnit = 1.0;
   double Exposure = 1.0;
   int SunLightMethod = AccumulationTexture;
-  int SunTextureSize = 512;
+  int SunTextureSize = 256;
   int SunTextureLayers = 32;
   bool TimePasses = false;
 

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -162,16 +163,48 @@ TEST(CloudSplats, FrameAndLayers)
       EXPECT_NEAR(dot, a == b ? 1.0 : 0.0, 1e-12);
     }
   }
-  // Fronts 0, 1, ..., 9; planes at 0, 3, 6, 9: strictly before each plane.
+  // Fronts 0, 1, ..., 9 (diameters at most 2); planes at 0, 3, 6, 9: slab k takes the
+  // fronts in [z_{k-1} - 2, z_k).
   std::vector<float> fronts;
   for (int i = 0; i < 10; ++i)
   {
     fronts.push_back(static_cast<float>(i));
   }
-  const auto counts = nimbus::SplatLayerCounts(fronts, 0.0, 9.0, 4);
-  ASSERT_EQ(counts.size(), 4u);
-  EXPECT_EQ(counts[0], 0u);
-  EXPECT_EQ(counts[1], 3u);
-  EXPECT_EQ(counts[2], 6u);
-  EXPECT_EQ(counts[3], 9u);
+  const auto ranges = nimbus::SplatLayerRanges(fronts, 0.0, 9.0, 4, 2.0);
+  ASSERT_EQ(ranges.size(), 4u);
+  EXPECT_EQ(ranges[0][0], ranges[0][1]); // the first plane: nothing before it
+  EXPECT_EQ(ranges[1][0], 0u);
+  EXPECT_EQ(ranges[1][1], 3u);
+  EXPECT_EQ(ranges[2][0], 1u);
+  EXPECT_EQ(ranges[2][1], 6u);
+  EXPECT_EQ(ranges[3][0], 4u);
+  EXPECT_EQ(ranges[3][1], 9u);
+  // Every ball crossing a slab lies in its range (random fronts and diameters).
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> uniform(0.0f, 100.0f), diameter(0.0f, 7.0f);
+  std::vector<std::pair<float, float>> balls(300);
+  for (auto& b : balls)
+  {
+    b = { uniform(random), diameter(random) };
+  }
+  std::sort(balls.begin(), balls.end());
+  std::vector<float> sorted;
+  for (const auto& b : balls)
+  {
+    sorted.push_back(b.first);
+  }
+  const int layers = 17;
+  const auto r = nimbus::SplatLayerRanges(sorted, 0.0, 110.0, layers, 7.0);
+  for (int k = 1; k < layers; ++k)
+  {
+    const double z = 110.0 * k / (layers - 1), previous = 110.0 * (k - 1) / (layers - 1);
+    for (std::size_t n = 0; n < balls.size(); ++n)
+    {
+      const bool crosses = balls[n].first < z && balls[n].first + balls[n].second > previous;
+      if (crosses)
+      {
+        EXPECT_TRUE(n >= r[k][0] && n < r[k][1]) << "layer " << k << " ball " << n;
+      }
+    }
+  }
 }
