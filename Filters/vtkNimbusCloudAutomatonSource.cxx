@@ -14,6 +14,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #if VTK_MODULE_ENABLE_VTK_ParallelCore
@@ -51,6 +52,28 @@ struct vtkNimbusCloudAutomatonSource::vtkInternals
   bool Distributed = false;
   int Rank = 0, Ranks = 1;
   int Owned[2] = { 0, 0 }, Held[2] = { 0, 0 };
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+  vtkCommunicator* Communicator = nullptr;
+#endif
+
+  // Whether the ranks share the automaton for this request (one piece per rank), this rank's
+  // layers, and the cells its densities cover (DensityBox); clears what no longer fits.
+  void ChooseRanks(vtkNimbusCloudAutomatonSource* self, vtkInformation* outInfo,
+    const int extent[6], bool anyPoint);
+  // The memory budget's message when this rank's share (its held layers, its densities'
+  // cells) would not fit; empty when it fits.
+  std::string OverBudget(
+    vtkNimbusCloudAutomatonSource* self, bool withInput, double cellCount) const;
+  // Keeps a copy of the automaton's state at step s when it is a checkpoint step.
+  void KeepCheckpoint(std::int64_t s, int interval, int maximum);
+  // The smoothed cld of the automaton's current step over DensityBox (the piece's rows
+  // gathered first when distributed). Returns the bytes of rows received.
+  std::uint64_t Smooth(std::vector<float>& density, int ny);
+  // After a step: the halo exchange when distributed. Returns the bytes sent.
+  std::uint64_t AfterStep();
+  // The density array of `extent` from the cached densities of `step` and `step + 1`.
+  vtkSmartPointer<vtkFloatArray> Crop(
+    std::int64_t step, double fraction, const int extent[6], bool anyPoint) const;
 
   void Clear()
   {
@@ -591,6 +614,204 @@ int vtkNimbusCloudAutomatonSource::RequestData(
   return 1;
 }
 
+void vtkNimbusCloudAutomatonSource::vtkInternals::ChooseRanks(
+  vtkNimbusCloudAutomatonSource* self, vtkInformation* outInfo, const int extent[6], bool anyPoint)
+{
+  const int* d = self->Dimensions;
+  bool distributed = false;
+  int rank = 0, ranks = 1;
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  this->Communicator = controller ? controller->GetCommunicator() : nullptr;
+  if (this->Communicator && controller->GetNumberOfProcesses() > 1)
+  {
+    using SDDP = vtkStreamingDemandDrivenPipeline;
+    const int pieces = outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
+      ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
+      : 1;
+    const int piece =
+      outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+    ranks = controller->GetNumberOfProcesses();
+    rank = controller->GetLocalProcessId();
+    // Every rank asks for its own piece (pvbatch, pvserver): they step together.
+    distributed = pieces == ranks && piece == rank && d[2] >= 2 * ranks;
+  }
+#else
+  (void)outInfo;
+#endif
+  if (!distributed)
+  {
+    rank = 0;
+    ranks = 1;
+  }
+  if (distributed != this->Distributed || rank != this->Rank || ranks != this->Ranks)
+  {
+    this->Clear();
+    this->Distributed = distributed;
+    this->Rank = rank;
+    this->Ranks = ranks;
+  }
+  if (distributed)
+  {
+    nimbus::DistributedLayers(d[2], rank, ranks, this->Owned, this->Held);
+  }
+  else
+  {
+    this->Owned[0] = this->Held[0] = 0;
+    this->Owned[1] = this->Held[1] = d[2];
+  }
+  std::copy(this->Owned, this->Owned + 2, self->OwnedLayers);
+  // The cells the densities are smoothed on: the piece when distributed, else the whole grid.
+  int box[6] = { 0, d[0] - 1, 0, d[1] - 1, 0, d[2] - 1 };
+  if (distributed)
+  {
+    std::copy(extent, extent + 6, box);
+    if (!anyPoint)
+    {
+      box[1] = box[3] = box[5] = -1;
+      box[0] = box[2] = box[4] = 0;
+    }
+  }
+  if (!std::equal(box, box + 6, this->DensityBox))
+  {
+    this->Densities.clear();
+    std::copy(box, box + 6, this->DensityBox);
+  }
+}
+
+std::string vtkNimbusCloudAutomatonSource::vtkInternals::OverBudget(
+  vtkNimbusCloudAutomatonSource* self, bool withInput, double cellCount) const
+{
+  const int* d = self->Dimensions;
+  const int* densityBox = this->DensityBox;
+  // This rank's share: its held layers, and the cells of its densities.
+  const double heldLayers = static_cast<double>(this->Held[1] - this->Held[0]);
+  const double heldCells = cellCount / d[2] * heldLayers;
+  double densityCells = 1.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    densityCells *= std::max(0, densityBox[2 * a + 1] - densityBox[2 * a] + 1);
+  }
+  // One state: three bit fields, rows padded to 64-bit words.
+  const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * heldLayers;
+  const double lastStep =
+    static_cast<double>(self->NumberOfTimeSteps) + static_cast<double>(self->SpinUpSteps);
+  const double checkpoints = std::min(static_cast<double>(self->MaximumNumberOfCheckpoints),
+    std::floor(lastStep / self->CheckpointInterval));
+  // Floats per cell: the cached densities (up to 2 more while a request runs), the
+  // smoothing's two buffers and the output array; 8 bytes per cell per input map.
+  const double bytes = stateBytes * (2.0 + checkpoints) +
+    4.0 * densityCells * (MaximumCachedDensities + 2 + 2 + 1) +
+    (withInput ? 24.0 * cellCount : 0.0) +
+    (self->NumberOfFormationRegions > 0 ? 12.0 * heldCells : 0.0);
+  std::ostringstream what;
+  what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
+       << checkpoints << " checkpoints)";
+  return nimbus::OverBudgetMessage(what.str(), bytes, self->MemoryBudgetMiB * MiB);
+}
+
+void vtkNimbusCloudAutomatonSource::vtkInternals::KeepCheckpoint(
+  std::int64_t s, int interval, int maximum)
+{
+  if (s % interval != 0 || s <= 0 || maximum <= 0 || this->Checkpoints.count(s) != 0)
+  {
+    return;
+  }
+  this->Checkpoints.emplace(s, this->Automaton->GetState());
+  // Over the limit: drop the checkpoint closest to its predecessor (keeps them spread).
+  while (static_cast<int>(this->Checkpoints.size()) > maximum)
+  {
+    auto victim = this->Checkpoints.begin();
+    std::int64_t smallestGap = victim->first;
+    for (auto it = std::next(this->Checkpoints.begin()); it != this->Checkpoints.end(); ++it)
+    {
+      const std::int64_t gap = it->first - std::prev(it)->first;
+      if (gap < smallestGap)
+      {
+        smallestGap = gap;
+        victim = it;
+      }
+    }
+    this->Checkpoints.erase(victim);
+  }
+}
+
+std::uint64_t vtkNimbusCloudAutomatonSource::vtkInternals::Smooth(
+  std::vector<float>& density, int ny)
+{
+  if (!this->Distributed)
+  {
+    nimbus::SmoothCloud(*this->Automaton, this->Smoothing, density);
+    return 0;
+  }
+  std::uint64_t received = 0;
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+  // The cld rows around the piece, from the ranks that own them; then the piece's share of
+  // SmoothCloud, bit for bit.
+  std::vector<std::uint64_t> storage;
+  std::vector<const std::uint64_t*> table;
+  int zLow = 0;
+  received = GatherRows(this->Communicator, *this->Automaton, this->Rank, this->Ranks,
+    this->DensityBox, nimbus::SmoothingHalo(this->Smoothing), storage, table, zLow);
+  const int* box = this->DensityBox;
+  if (box[0] <= box[1] && box[2] <= box[3] && box[4] <= box[5])
+  {
+    nimbus::SmoothCloudBox(
+      this->Automaton->GetParameters(), this->Smoothing, box,
+      [&](int y, int z) { return table[static_cast<std::size_t>(z - zLow) * ny + y]; }, density);
+  }
+#else
+  (void)ny;
+#endif
+  return received;
+}
+
+std::uint64_t vtkNimbusCloudAutomatonSource::vtkInternals::AfterStep()
+{
+#if VTK_MODULE_ENABLE_VTK_ParallelCore
+  if (this->Distributed)
+  {
+    return ExchangeHalo(
+      this->Communicator, *this->Automaton, this->Rank, this->Ranks, this->Owned, this->Held);
+  }
+#endif
+  return 0;
+}
+
+vtkSmartPointer<vtkFloatArray> vtkNimbusCloudAutomatonSource::vtkInternals::Crop(
+  std::int64_t step, double fraction, const int extent[6], bool anyPoint) const
+{
+  const std::vector<float>& a = this->Densities.at(step);
+  const std::vector<float>* b = fraction > 0.0 ? &this->Densities.at(step + 1) : nullptr;
+  const std::size_t rowLength = anyPoint ? static_cast<std::size_t>(extent[1] - extent[0] + 1) : 0;
+  const std::size_t points =
+    anyPoint ? rowLength * (extent[3] - extent[2] + 1) * (extent[5] - extent[4] + 1) : 0;
+  auto density = vtkSmartPointer<vtkFloatArray>::New();
+  density->SetName("density");
+  density->SetNumberOfTuples(static_cast<vtkIdType>(points));
+  float* out = density->GetPointer(0);
+  const float t = static_cast<float>(fraction);
+  // The densities cover DensityBox (the whole grid, or this rank's piece).
+  const int* box = this->DensityBox;
+  for (int k = extent[4]; anyPoint && k <= extent[5]; ++k)
+  {
+    for (int j = extent[2]; j <= extent[3]; ++j)
+    {
+      const std::size_t first =
+        (static_cast<std::size_t>(k - box[4]) * (box[3] - box[2] + 1) + (j - box[2])) *
+          (box[1] - box[0] + 1) +
+        (extent[0] - box[0]);
+      for (std::size_t i = 0; i < rowLength; ++i, ++out)
+      {
+        const float va = a[first + i];
+        // Same as nimbus::InterpolateDensity.
+        *out = b ? va + t * ((*b)[first + i] - va) : va;
+      }
+    }
+  }
+  return density;
+}
+
 bool vtkNimbusCloudAutomatonSource::SetUpAutomaton(vtkImageData* input, const int held[2])
 {
   auto& internals = *this->Internals;
@@ -748,62 +969,7 @@ int vtkNimbusCloudAutomatonSource::Generate(
   // --- one piece per rank: the ranks share the automaton by layers -----------------------------
   int extent[6];
   const bool anyPoint = nimbus::RequestedExtent(outInfo, extent);
-  bool distributed = false;
-  int rank = 0, ranks = 1;
-#if VTK_MODULE_ENABLE_VTK_ParallelCore
-  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  vtkCommunicator* communicator = controller ? controller->GetCommunicator() : nullptr;
-  if (communicator && controller->GetNumberOfProcesses() > 1)
-  {
-    using SDDP = vtkStreamingDemandDrivenPipeline;
-    const int pieces = outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
-      ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
-      : 1;
-    const int piece =
-      outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
-    ranks = controller->GetNumberOfProcesses();
-    rank = controller->GetLocalProcessId();
-    distributed = pieces == ranks && piece == rank && d[2] >= 2 * ranks;
-  }
-#endif
-  if (!distributed)
-  {
-    rank = 0;
-    ranks = 1;
-  }
-  if (distributed != internals.Distributed || rank != internals.Rank || ranks != internals.Ranks)
-  {
-    internals.Clear();
-    internals.Distributed = distributed;
-    internals.Rank = rank;
-    internals.Ranks = ranks;
-  }
-  if (distributed)
-  {
-    nimbus::DistributedLayers(d[2], rank, ranks, internals.Owned, internals.Held);
-  }
-  else
-  {
-    internals.Owned[0] = internals.Held[0] = 0;
-    internals.Owned[1] = internals.Held[1] = d[2];
-  }
-  std::copy(internals.Owned, internals.Owned + 2, this->OwnedLayers);
-  // The cells the densities are smoothed on: the piece when distributed, else the whole grid.
-  int densityBox[6] = { 0, d[0] - 1, 0, d[1] - 1, 0, d[2] - 1 };
-  if (distributed)
-  {
-    std::copy(extent, extent + 6, densityBox);
-    if (!anyPoint)
-    {
-      densityBox[1] = densityBox[3] = densityBox[5] = -1;
-      densityBox[0] = densityBox[2] = densityBox[4] = 0;
-    }
-  }
-  if (!std::equal(densityBox, densityBox + 6, internals.DensityBox))
-  {
-    internals.Densities.clear();
-    std::copy(densityBox, densityBox + 6, internals.DensityBox);
-  }
+  internals.ChooseRanks(this, outInfo, extent, anyPoint);
   this->HaloBytesPerStep = 0;
   this->PieceGatherBytes = 0;
   // --- memory: states, checkpoints, cached densities, output and input maps ----------------
@@ -817,30 +983,7 @@ int vtkNimbusCloudAutomatonSource::Generate(
     return 1;
   }
   const double cellCount = static_cast<double>(cells);
-  // This rank's share: its held layers, and the cells of its densities.
-  const double heldLayers = static_cast<double>(internals.Held[1] - internals.Held[0]);
-  const double heldCells = cellCount / d[2] * heldLayers;
-  double densityCells = 1.0;
-  for (int a = 0; a < 3; ++a)
-  {
-    densityCells *= std::max(0, densityBox[2 * a + 1] - densityBox[2 * a] + 1);
-  }
-  // One state: three bit fields, rows padded to 64-bit words.
-  const double stateBytes = 3.0 * 8.0 * std::ceil(d[0] / 64.0) * d[1] * heldLayers;
-  const double lastStep =
-    static_cast<double>(this->NumberOfTimeSteps) + static_cast<double>(this->SpinUpSteps);
-  const double checkpoints = std::min(static_cast<double>(this->MaximumNumberOfCheckpoints),
-    std::floor(lastStep / this->CheckpointInterval));
-  // Floats per cell: the cached densities (up to 2 more while a request runs), the
-  // smoothing's two buffers and the output array; 8 bytes per cell per input map.
-  const double bytes = stateBytes * (2.0 + checkpoints) +
-    4.0 * densityCells * (MaximumCachedDensities + 2 + 2 + 1) + (input ? 24.0 * cellCount : 0.0) +
-    (this->NumberOfFormationRegions > 0 ? 12.0 * heldCells : 0.0);
-  std::ostringstream what;
-  what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
-       << checkpoints << " checkpoints)";
-  const std::string overBudget =
-    nimbus::OverBudgetMessage(what.str(), bytes, this->MemoryBudgetMiB * MiB);
+  const std::string overBudget = internals.OverBudget(this, input != nullptr, cellCount);
   if (!overBudget.empty())
   {
     vtkErrorMacro(<< overBudget
@@ -945,54 +1088,11 @@ int vtkNimbusCloudAutomatonSource::Generate(
     for (;;)
     {
       const std::int64_t s = automaton.GetStep();
-      if (s % this->CheckpointInterval == 0 && s > 0 && this->MaximumNumberOfCheckpoints > 0 &&
-        internals.Checkpoints.count(s) == 0)
-      {
-        internals.Checkpoints.emplace(s, automaton.GetState());
-        // Over the limit: drop the checkpoint closest to its predecessor (keeps them spread).
-        while (static_cast<int>(internals.Checkpoints.size()) > this->MaximumNumberOfCheckpoints)
-        {
-          auto victim = internals.Checkpoints.begin();
-          std::int64_t smallestGap = victim->first;
-          for (auto it = std::next(internals.Checkpoints.begin());
-               it != internals.Checkpoints.end(); ++it)
-          {
-            const std::int64_t gap = it->first - std::prev(it)->first;
-            if (gap < smallestGap)
-            {
-              smallestGap = gap;
-              victim = it;
-            }
-          }
-          internals.Checkpoints.erase(victim);
-        }
-      }
+      internals.KeepCheckpoint(s, this->CheckpointInterval, this->MaximumNumberOfCheckpoints);
       if (s >= step && s <= lastNeeded && needs(s))
       {
         std::vector<float> density;
-        if (!distributed)
-        {
-          nimbus::SmoothCloud(automaton, internals.Smoothing, density);
-        }
-#if VTK_MODULE_ENABLE_VTK_ParallelCore
-        else
-        {
-          // The cld rows around the piece, from the ranks that own them; then the piece's
-          // share of SmoothCloud, bit for bit.
-          std::vector<std::uint64_t> storage;
-          std::vector<const std::uint64_t*> table;
-          int zLow = 0;
-          this->PieceGatherBytes += static_cast<vtkIdType>(GatherRows(communicator, automaton, rank,
-            ranks, densityBox, nimbus::SmoothingHalo(internals.Smoothing), storage, table, zLow));
-          if (anyPoint)
-          {
-            nimbus::SmoothCloudBox(
-              automaton.GetParameters(), internals.Smoothing, densityBox,
-              [&](int y, int z) { return table[static_cast<std::size_t>(z - zLow) * d[1] + y]; },
-              density);
-          }
-        }
-#endif
+        this->PieceGatherBytes += static_cast<vtkIdType>(internals.Smooth(density, d[1]));
         internals.Densities[s] = std::move(density);
       }
       if (s >= lastNeeded)
@@ -1008,13 +1108,7 @@ int vtkNimbusCloudAutomatonSource::Generate(
         return 1;
       }
       automaton.Step();
-#if VTK_MODULE_ENABLE_VTK_ParallelCore
-      if (distributed)
-      {
-        this->HaloBytesPerStep = static_cast<vtkIdType>(
-          ExchangeHalo(communicator, automaton, rank, ranks, internals.Owned, internals.Held));
-      }
-#endif
+      this->HaloBytesPerStep = static_cast<vtkIdType>(internals.AfterStep());
       ++this->NumberOfStepsComputed;
     }
     // Keep only the densities nearest to the ones just used.
@@ -1033,35 +1127,8 @@ int vtkNimbusCloudAutomatonSource::Generate(
   double origin[3], spacing[3];
   outInfo->Get(vtkDataObject::ORIGIN(), origin);
   outInfo->Get(vtkDataObject::SPACING(), spacing);
-  const std::vector<float>& a = internals.Densities.at(step);
-  const std::vector<float>* b = fraction > 0.0 ? &internals.Densities.at(step + 1) : nullptr;
-  const std::size_t rowLength = anyPoint ? static_cast<std::size_t>(extent[1] - extent[0] + 1) : 0;
-  const std::size_t points =
-    anyPoint ? rowLength * (extent[3] - extent[2] + 1) * (extent[5] - extent[4] + 1) : 0;
-  vtkNew<vtkFloatArray> density;
-  density->SetName("density");
-  density->SetNumberOfTuples(static_cast<vtkIdType>(points));
-  float* out = density->GetPointer(0);
-  const float t = static_cast<float>(fraction);
-  for (int k = extent[4]; anyPoint && k <= extent[5]; ++k)
-  {
-    for (int j = extent[2]; j <= extent[3]; ++j)
-    {
-      // The densities cover DensityBox (the whole grid, or this rank's piece).
-      const int* box = internals.DensityBox;
-      const std::size_t first =
-        (static_cast<std::size_t>(k - box[4]) * (box[3] - box[2] + 1) + (j - box[2])) *
-          (box[1] - box[0] + 1) +
-        (extent[0] - box[0]);
-      for (std::size_t i = 0; i < rowLength; ++i, ++out)
-      {
-        const float va = a[first + i];
-        // Same as nimbus::InterpolateDensity.
-        *out = b ? va + t * ((*b)[first + i] - va) : va;
-      }
-    }
-  }
-  out = density->GetPointer(0);
+  vtkSmartPointer<vtkFloatArray> density = internals.Crop(step, fraction, extent, anyPoint);
+  const float* out = density->GetPointer(0);
   if (!anyPoint)
   {
     std::fill(extent, extent + 6, 0);

@@ -688,7 +688,7 @@ int vtkNimbusOpenVDBReader::ReadImage(vtkImageData* output)
   // The image is the file's, turned into the up frame (nothing changes for +Z). Pieces are
   // pieces of the turned image: only the piece's part of the plan's box is read into the
   // image (each voxel's value does not depend on the box, so a piece equals the whole image's
-  // crop bit for bit). OpenVDB still reads each selected grid's whole tree from the file.
+  // crop bit for bit). ReadDense reads only the leaves that touch the box (clipped reads).
   const vdb::UpAxisChoice& up = internal.ChooseUp(this->UpAxis);
   const vdb::UpTurn turn(up.Axis, plan.Reference->Transform);
   const vdb::IndexBox turnedBox = internal.PieceBox(turn.TurnBox(plan.Box));

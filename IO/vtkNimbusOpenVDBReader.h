@@ -26,9 +26,12 @@
  * UPDATE_NUMBER_OF_GHOST_LEVELS) the output is VTK's block of the image for that piece grown
  * by the ghost levels (the executive's UPDATE_EXTENT, computed from this file's box so that a
  * file series whose boxes differ stays right), bit-identical to the same points of the whole
- * image; only that part is copied into the image, and the limits below count its points.
- * OpenVDB still reads each selected grid's whole tree from the file. A one-piece request
- * gets the whole image, as before.
+ * image; only that part is read: OpenVDB reads each selected grid's topology (its node masks)
+ * and only the voxel buffers of the leaves that touch the piece (a clipped read; a resampled
+ * grid's box grown by 2 voxels), seeking over the others in the file, and the limits below
+ * count the piece's points. Whole grids are still read for files older than OpenVDB's grid
+ * instancing and for non-linear (frustum) transforms. A one-piece request gets the whole
+ * image, as before.
  *
  * Up axis: the output is in Nimbus's z-up frame (x east, y north, z up). UpAxis says which
  * axis of the file points up: -1 Auto (default: the file's metadata "up_axis" if it has one,

@@ -58,8 +58,8 @@ set_tests_properties(mpi.ParaViewPieces.2 PROPERTIES
 
 # What a rank holds: mpi.PieceMemory.4 (TestParallelVdbMemory.py): every rank reads its piece
 # of a 256^3 all-active .vdb (written by mpi.PieceMemory.Setup) and fails when its peak memory
-# grows by more than twice its piece plus a quarter of the whole grid (a whole read, which the
-# last rank also does as a check of the measurement, grows it by twice the whole grid). The
+# grows by more than its piece plus half the whole grid (a whole read, which the last rank also
+# does as a check of the measurement and of its piece's values, grows it by the whole grid). The
 # cloud automaton's ranks stepping only their slabs is checked by mpi.Pieces.* (its pieces
 # against the serial output, 2 and 4 ranks, open and periodic sides).
 if (NIMBUS_HAVE_OPENVDB)

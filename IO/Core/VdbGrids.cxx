@@ -548,6 +548,9 @@ std::string ReadFailure(const std::string& path, const std::string& grid, const 
     " (truncated or corrupt?): " + e.what();
 }
 
+/// Values of one clipped read in ReadDense (a slab of the box): 32 MiB.
+constexpr int64_t SlabBytes = int64_t(32) << 20;
+
 /// The index box of grid `index` to read for `box` of the reference's index space: the box
 /// itself when the grid has the reference's transform (its voxels are copied), the box's
 /// corners in the grid's index space grown by 2 voxels when it is resampled (trilinear
@@ -947,33 +950,55 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
         throw Error("no grid named " + Quote(names[g]) + " in " + Quote(path));
       }
       const size_t index = size_t(found - layout.DistinctNames.begin());
-      openvdb::CoordBBox clip;
-      const bool clipped = ClipBox(archive, layout, index, reference, box, clip);
-      const auto base = archive.Read(index, false, 0, clipped ? &clip : nullptr);
-      const ValueKind kind = KindOf(*base);
-      // Every value is set even if a copy stopped half-way: never uninitialised memory.
-      std::fill(target[g], target[g] + box.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
       bool wasResampled = false;
       TransformInfo own;
-      switch (kind)
+      // Slabs of whole leaves along z (multiples of 8 voxels, about SlabBytes of values each):
+      // the tree held at once is one slab's leaves, not the box's. One read of the whole
+      // grid where a clipped read is not possible (ClipBox).
+      openvdb::CoordBBox clip;
+      const bool clipped = ClipBox(archive, layout, index, reference, box, clip);
+      const int64_t nx = box.Max[0] - box.Min[0] + 1, ny = box.Max[1] - box.Min[1] + 1;
+      const int64_t thickness =
+        std::max<int64_t>(8, SlabBytes / std::max<int64_t>(1, 12 * nx * ny) / 8 * 8);
+      for (int64_t z0 = box.Min[2]; z0 <= box.Max[2];)
       {
-        case ValueKind::Float:
-          Extract<openvdb::FloatGrid, float>(base, reference, box, target[g], wasResampled, own);
-          break;
-        case ValueKind::Double:
-          Extract<openvdb::DoubleGrid, float>(base, reference, box, target[g], wasResampled, own);
-          break;
-        case ValueKind::Vec3Float:
-          Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(
-            base, reference, box, target[g], wasResampled, own);
-          break;
-        case ValueKind::Vec3Double:
-          Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(
-            base, reference, box, target[g], wasResampled, own);
-          break;
-        default:
-          throw Error(
-            "grid " + Quote(names[g]) + " has unsupported value type " + Quote(base->valueType()));
+        IndexBox slab = box;
+        if (clipped)
+        {
+          const int64_t end = z0 + thickness;
+          slab.Min[2] = z0;
+          slab.Max[2] = std::min(box.Max[2], end - (((end % 8) + 8) % 8) - 1);
+          ClipBox(archive, layout, index, reference, slab, clip);
+        }
+        const auto base = archive.Read(index, false, 0, clipped ? &clip : nullptr);
+        const ValueKind kind = KindOf(*base);
+        float* slabTarget =
+          target[g] + uint64_t(slab.Min[2] - box.Min[2]) * nx * ny * uint64_t(ComponentsOf(kind));
+        // Every value is set even if a copy stopped half-way: never uninitialised memory.
+        std::fill(slabTarget, slabTarget + slab.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
+        switch (kind)
+        {
+          case ValueKind::Float:
+            Extract<openvdb::FloatGrid, float>(
+              base, reference, slab, slabTarget, wasResampled, own);
+            break;
+          case ValueKind::Double:
+            Extract<openvdb::DoubleGrid, float>(
+              base, reference, slab, slabTarget, wasResampled, own);
+            break;
+          case ValueKind::Vec3Float:
+            Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(
+              base, reference, slab, slabTarget, wasResampled, own);
+            break;
+          case ValueKind::Vec3Double:
+            Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(
+              base, reference, slab, slabTarget, wasResampled, own);
+            break;
+          default:
+            throw Error("grid " + Quote(names[g]) + " has unsupported value type " +
+              Quote(base->valueType()));
+        }
+        z0 = slab.Max[2] + 1;
       }
       if (wasResampled && resampled)
       {

@@ -134,8 +134,11 @@ using Progress = std::function<void(double)>;
 
 /// Reads the named grids (GridInfo::Name, the distinct names) into dense arrays over `box`
 /// of the reference grid's index space. Each grid's bytes are checked (ScanFile) and read
-/// from memory through a stream that fails, instead of returning garbage, on any read
-/// outside the grid's own bytes; every target value is set (filled with 0 first). `target` points
+/// from the file through a stream that fails, instead of returning garbage, on any read
+/// outside the grid's own bytes; only the leaves that touch `box` (grown by 2 voxels for a
+/// resampled grid) are read and held, the others skipped in the file (OpenVDB's clipped read;
+/// the whole grid for files older than grid instancing and non-linear transforms). Every
+/// target value is set (filled with 0 first). `target` points
 /// at caller-allocated storage of box.VoxelCount()*components floats per grid (the VTK array's
 /// buffer), in the order of `names`. Grids whose transform differs from `reference` are resampled
 /// trilinearly at the reference's voxel positions (`resampled` receives their names). `exact`

@@ -8,15 +8,17 @@ voxel active (noise in [0.1, 1): the tree is dense and Blosc hardly compresses i
 vtkNimbusOpenVDBWriter. --read: every rank resets its peak resident memory (5 into
 /proc/self/clear_refs), reads its piece with 1 ghost level (UpdatePiece(rank, N, 1)) and takes
 the growth of VmHWM over the resident memory before the read. With W = 4 S^3 bytes (the whole
-grid as floats) and P the piece's bytes, a piece read costs its output array and its leaves
-(about 2 P) and the whole tree's node masks (about W / 64); a rank that read the whole file
-held the file's bytes (about W) and the whole tree (W) as well. The test fails when a rank's
-growth exceeds
+grid as floats) and P the piece's bytes, a piece read costs its output array (P), the leaves of
+one slab of it at a time (at most 32 MiB) and the whole tree's node masks (about W / 20); a
+rank that read the whole file (as the reader did before clipped reads) held the whole tree (W)
+and the file's bytes (about W here) besides its piece. The test fails when a rank's growth
+exceeds
 
-    limit = 2 P + W / 4 + 16 MiB
+    limit = P + W / 2 + 8 MiB
 
 and, as a check of the measurement itself, when a whole read (piece 0 of 1, by the last rank
-after its piece) does not exceed the limit. Every rank prints its figures; every rank exits
+after its piece) does not exceed the limit; that rank's piece must also equal the whole read's
+crop bit for bit (the reads go in slabs of whole leaves, different ones for the two boxes). Every rank prints its figures; every rank exits
 non-zero when a check failed on any rank.
 """
 import argparse
@@ -86,7 +88,7 @@ def read(path, size):
 
     try:
         reader, peak, piece_bytes = growth(rank, ranks, 1)
-        limit = 2.0 * piece_bytes + whole / 4.0 + 16.0 * MiB
+        limit = piece_bytes + whole / 2.0 + 8.0 * MiB
         print("rank %d of %d: piece %.1f MiB (whole %.1f MiB), peak growth %.1f MiB, limit %.1f MiB"
               % (rank, ranks, piece_bytes / MiB, whole / MiB, peak / MiB, limit / MiB),
               flush=True)
@@ -98,8 +100,22 @@ def read(path, size):
                           "than %.1f MiB: it read more than its piece (the whole file?)"
                           % (rank, peak / MiB, limit / MiB))
         if rank == ranks - 1:
-            del reader
-            _, whole_peak, _ = growth(0, 1, 0)
+            piece = reader.GetOutput()
+            whole_reader, whole_peak, _ = growth(0, 1, 0)
+            # The piece (leaves read in slabs of the piece's box) equals the whole read's
+            # crop (other slabs) bit for bit.
+            import numpy as np
+            from vtkmodules.util.numpy_support import vtk_to_numpy
+            full = whole_reader.GetOutput()
+            e, w = piece.GetExtent(), full.GetExtent()
+            dims = [w[2 * a + 1] - w[2 * a] + 1 for a in range(3)]
+            cube = vtk_to_numpy(full.GetPointData().GetArray("density")).reshape(dims[::-1])
+            crop = cube[e[4] - w[4]:e[5] - w[4] + 1, e[2] - w[2]:e[3] - w[2] + 1,
+                        e[0] - w[0]:e[1] - w[0] + 1]
+            mine = vtk_to_numpy(piece.GetPointData().GetArray("density")).reshape(crop.shape)
+            if not np.array_equal(mine, crop):
+                errors.append("rank %d: its piece differs from the whole read's crop in %d values"
+                              % (rank, int(np.sum(mine != crop))))
             print("rank %d: a whole read grew the peak by %.1f MiB (must exceed %.1f MiB)"
                   % (rank, whole_peak / MiB, limit / MiB), flush=True)
             if whole_peak <= limit:
