@@ -952,14 +952,16 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
       const size_t index = size_t(found - layout.DistinctNames.begin());
       bool wasResampled = false;
       TransformInfo own;
-      // Slabs of whole leaves along z (multiples of 8 voxels, about SlabBytes of values each):
-      // the tree held at once is one slab's leaves, not the box's. One read of the whole
-      // grid where a clipped read is not possible (ClipBox).
+      // Slabs of whole leaves along z (multiples of 8 voxels, about SlabBytes of values each,
+      // at most 4 slabs: each read parses the grid's whole topology again): the tree held at
+      // once is one slab's leaves, not the box's. One read of the whole grid where a clipped
+      // read is not possible (ClipBox).
       openvdb::CoordBBox clip;
       const bool clipped = ClipBox(archive, layout, index, reference, box, clip);
       const int64_t nx = box.Max[0] - box.Min[0] + 1, ny = box.Max[1] - box.Min[1] + 1;
-      const int64_t thickness =
-        std::max<int64_t>(8, SlabBytes / std::max<int64_t>(1, 12 * nx * ny) / 8 * 8);
+      const int64_t nz = box.Max[2] - box.Min[2] + 1;
+      const int64_t thickness = std::max<int64_t>(
+        { 8, SlabBytes / std::max<int64_t>(1, 12 * nx * ny) / 8 * 8, (nz + 31) / 32 * 8 });
       for (int64_t z0 = box.Min[2]; z0 <= box.Max[2];)
       {
         IndexBox slab = box;
