@@ -945,7 +945,7 @@ bool vtkNimbusCloudAutomatonSource::SetUpAutomaton(vtkImageData* input, const in
   }
   try
   {
-    internals.Automaton = std::make_unique<nimbus::CloudAutomaton>(p);
+    internals.Automaton = std::make_unique<nimbus::CloudAutomaton>(std::move(p));
   }
   catch (const std::exception& error)
   {

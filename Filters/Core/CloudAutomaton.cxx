@@ -297,6 +297,13 @@ CloudAutomaton::CloudAutomaton(const CloudAutomatonParameters& parameters)
   this->InitialState();
 }
 
+CloudAutomaton::CloudAutomaton(CloudAutomatonParameters&& parameters)
+  : Parameters(std::move(parameters))
+{
+  this->ValidateAndPrepare();
+  this->InitialState();
+}
+
 void CloudAutomaton::ValidateAndPrepare()
 {
   const auto& p = this->Parameters;
@@ -349,6 +356,12 @@ void CloudAutomaton::ValidateAndPrepare()
     MakeThresholds(p.HumiditySupply, nx * ny, nx * ny * held, "HumiditySupply");
   this->ActivationThresholds =
     MakeThresholds(p.ActivationSupply, nx * ny, nx * ny * held, "ActivationSupply");
+  // The thresholds replace the values (see GetParameters).
+  for (ProbabilityField* field : { &this->Parameters.Extinction, &this->Parameters.HumiditySupply,
+         &this->Parameters.ActivationSupply })
+  {
+    field->Values = std::vector<float>();
+  }
 
   this->RowWords = static_cast<int>((nx + Bits - 1) / Bits);
   const int tailBits = static_cast<int>(nx % Bits);

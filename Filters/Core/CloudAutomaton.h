@@ -131,7 +131,12 @@ public:
   /// Validates the parameters (throws std::invalid_argument with a message naming
   /// the parameter) and sets up step 0.
   explicit CloudAutomaton(const CloudAutomatonParameters& parameters);
+  /// The same, taking the parameters' arrays over (no copy of the probability fields).
+  explicit CloudAutomaton(CloudAutomatonParameters&& parameters);
 
+  /// The parameters; the values of Plane and Volume probability fields are dropped once they
+  /// are turned into the per-cell thresholds the steps use (ProbabilityField::Values is empty
+  /// then, its Type kept), which would otherwise double their memory.
   const CloudAutomatonParameters& GetParameters() const { return this->Parameters; }
   std::int64_t GetStep() const { return this->Current.Step; }
 
