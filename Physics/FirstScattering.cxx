@@ -1,6 +1,7 @@
 // The first scattering of point sources on the medium's grid (see FirstScattering.h).
 #include "FirstScattering.h"
 
+#include "CellAverage.h"
 #include "ParallelFor.h"
 
 #include <algorithm>
@@ -18,15 +19,6 @@ namespace
 {
 // Optical depth beyond which a source's light is dropped (T < 4e-18).
 constexpr double kOpaque = 40.0;
-// Directions of the cell average of 1/r^2 next to a source.
-constexpr int kCellAverageDirections = 1024;
-
-const std::vector<Vector3>& CellAverageDirections()
-{
-  static const std::vector<Vector3> directions = FibonacciDirections(kCellAverageDirections);
-  return directions;
-}
-
 // Sources merged to one grid point: their total intensity and intensity-weighted centre.
 struct MergedSource
 {
@@ -245,17 +237,6 @@ private:
       : plain;
   }
 
-  // integral over [t0, t1] of exp(-sigma r) dr (the chord itself when sigma r << 1).
-  static double ChordTransmittance(double sigma, double t0, double t1)
-  {
-    if (!(t1 > t0))
-    {
-      return 0.0;
-    }
-    return sigma * (t1 - t0) > 1e-6 ? (std::exp(-sigma * t0) - std::exp(-sigma * t1)) / sigma
-                                    : (t1 - t0) * std::exp(-sigma * t0);
-  }
-
   double StepLength(const int d[3], double inverse) const
   {
     const double x = d[0] * inverse * this->Grid.Spacing[0];
@@ -296,65 +277,26 @@ private:
   }
 
   // The average over the point's cell (a box of one spacing per axis about it) of T/r^2
-  // and of T w/r^2 from the source: in spherical coordinates about the source
-  // dV = r^2 dr dw, so integral T/r^2 dV = integral over directions of the integral of
-  // exp(-sigma r) along the chord the ray from the source cuts through the box (w times it
-  // for the flux), summed over a Fibonacci set; sigma the point's extinction, taken as
+  // and of T w/r^2 from the source (CellAverage.h), the extinction taken as the point's,
   // constant from the source to the cell (the cells are the source's and its neighbours).
   void CellAverage(int i, int j, int k, double sigma, double& inverse2, Vector3& flux) const
   {
     const Vector3 centre = this->Grid.Position(i, j, k);
     const Vector3& c = this->Source->Centre;
     const Vector3 world{ { c[0] - centre[0], c[1] - centre[1], c[2] - centre[2] } };
-    double origin[3], half[3];
+    Vector3 origin, half;
     for (int a = 0; a < 3; ++a)
     {
       origin[a] = Dot(world, this->Grid.Axes[a]); // the source in the cell's frame [m]
       half[a] = 0.5 * this->Grid.Spacing[a];
     }
-    const std::vector<Vector3>& directions = CellAverageDirections();
-    double chords = 0.0;
-    Vector3 local{ { 0, 0, 0 } };
-    for (const Vector3& w : directions)
-    {
-      double tNear = 0.0, tFar = std::numeric_limits<double>::infinity();
-      for (int a = 0; a < 3 && tNear < tFar; ++a)
-      {
-        if (w[a] == 0.0)
-        {
-          tFar = std::abs(origin[a]) <= half[a] ? tFar : -1.0;
-          continue;
-        }
-        double t0 = (-half[a] - origin[a]) / w[a], t1 = (half[a] - origin[a]) / w[a];
-        if (t0 > t1)
-        {
-          std::swap(t0, t1);
-        }
-        tNear = std::max(tNear, t0);
-        tFar = std::min(tFar, t1);
-      }
-      // integral over the chord of T'(sigma r) dr: the cell's transmittance from the
-      // source, the extinction taken as the point's.
-      const double chord = this->Peak > 0.0 ? this->Peak * ChordTransmittance(sigma, tNear, tFar) +
-          (1.0 - this->Peak) * ChordTransmittance(this->Reduced * sigma, tNear, tFar)
-                                            : ChordTransmittance(sigma, tNear, tFar);
-      chords += chord;
-      for (int a = 0; a < 3; ++a)
-      {
-        local[a] += chord * w[a];
-      }
-    }
-    const double scale = 4.0 * kPi / directions.size() /
-      (this->Grid.Spacing[0] * this->Grid.Spacing[1] * this->Grid.Spacing[2]);
-    inverse2 = chords * scale;
-    for (int c2 = 0; c2 < 3; ++c2)
-    {
-      flux[c2] = 0.0;
-      for (int a = 0; a < 3; ++a)
-      {
-        flux[c2] += local[a] * scale * this->Grid.Axes[a][c2];
-      }
-    }
+    BeamTransmittance beam;
+    beam.Sigma = sigma;
+    beam.PeakFraction = this->Peak;
+    beam.Reduced = this->Reduced;
+    const CellAverageOfSource average = AverageSourceOverCell(origin, half, beam);
+    inverse2 = average.InverseSquare;
+    flux = this->ToWorld(average.Flux);
   }
 
   Vector3 ToWorld(const Vector3& local) const

@@ -66,6 +66,10 @@ public:
 
 constexpr char kMagic[8] = { 'N', 'I', 'M', 'B', 'L', 'B', 'A', 'S' };
 constexpr std::uint32_t kFormatVersion = 1;
+// The solver's revision, in the fingerprint so that a basis the solver would now compute
+// differently is not taken from the disk cache (2: point lights' first source averaged
+// over the cells next to them, MultipleScattering.cxx ArrivalAt).
+constexpr std::uint32_t kSolverRevision = 2;
 
 template <typename T>
 void Put(std::ostream& out, const T& value)
@@ -89,6 +93,7 @@ std::string LightningBasisFingerprint(const ExtinctionGrid& cloud, const CloudOp
   {
     Fnv1a f(bases[h]);
     f.Value(kFormatVersion);
+    f.Value(kSolverRevision);
     f.Value(cloud.Dimensions);
     f.Value(cloud.Origin);
     f.Value(cloud.Spacing);
