@@ -31,6 +31,7 @@ namespace
 constexpr double MaximumWork = 1.0e11; // cell steps in one request (minutes)
 constexpr int MaximumCells = 8192;     // a side
 constexpr double RippleNoiseMetres = 0.001;
+constexpr double MinimumShownSandMetres = 1.0e-6;
 }
 
 struct vtkNimbusDunesSource::vtkInternals
@@ -283,7 +284,8 @@ void FillSurface(
     for (int i = 0; i < px; ++i)
     {
       const vtkIdType id = static_cast<vtkIdType>(i) + static_cast<vtkIdType>(px) * j;
-      const double z = at(i, j);
+      // Sand thinner than a micrometre (what the hops leave on bare rock) is shown as rock.
+      const double z = at(i, j) < MinimumShownSandMetres ? 0.0 : at(i, j);
       const double x = x0 + i * dx;
       const double y = y0 + j * dx;
       points->SetPoint(id, x, y, z);

@@ -14,7 +14,8 @@
  *
  * Output 0 (vtkPolyData): the dune surface, (nx + 1) x (ny + 1) points (the first row and
  * column repeated at the far side, so copies shifted by the field's size meet exactly)
- * centred on the origin, z up, quads; point arrays "Height" (m of sand), "Normals",
+ * centred on the origin, z up, quads; point arrays "Height" (m of sand; under 1 micrometre
+ * shown as 0, bare rock), "Normals",
  * "TextureCoordinates" (x and y divided by the ripple tile's size: one repeat per tile)
  * and "Tangents" (the surface's x direction, for normal mapping).
  * Output 1 (vtkImageData): the ripple tile, RippleResolution^2 points of RippleCellSizeMetres;
