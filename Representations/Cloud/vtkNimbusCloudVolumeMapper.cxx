@@ -15,6 +15,7 @@
 #include "PassTimer.h"
 #include "SliceGeometry.h"
 #include "SpectralColor.h"
+#include "Sun.h"
 #include "SunAndAir.h"
 #include "SunDepthVolume.h"
 #include "UpAxis.h"
@@ -564,6 +565,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
 vtkNimbusCloudVolumeMapper::vtkNimbusCloudVolumeMapper()
   : Internal(new Internals)
 {
+  const nimbus::SunParameters sun;
+  this->SunAzimuthDegrees = sun.AzimuthDegrees;
+  this->SunElevationDegrees = sun.ElevationDegrees;
 }
 
 vtkNimbusCloudVolumeMapper::~vtkNimbusCloudVolumeMapper()

@@ -741,8 +741,9 @@ protected:
   double PatternContribution = 0.8;
   double PatternSelection = 0.25;
   double MultipleScatteringMemoryBudgetMiB = 0.0;
-  double SunAzimuthDegrees = 135.0;
-  double SunElevationDegrees = 45.0;
+  // The sun's defaults are nimbus::SunParameters' (Physics/Sun.h), set in the constructor.
+  double SunAzimuthDegrees = 0.0;
+  double SunElevationDegrees = 0.0;
   double SunIlluminance = 1.0;
   double SunTemperatureKelvin = 5778.0;
   bool Atmosphere = true;

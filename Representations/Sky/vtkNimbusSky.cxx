@@ -1,6 +1,7 @@
 #include "vtkNimbusSky.h"
 
 #include "Sky.h"
+#include "Sun.h"
 #include "UpAxis.h"
 
 #include "FiniteSetters.h"
@@ -63,6 +64,9 @@ struct vtkNimbusSky::Internals
 vtkNimbusSky::vtkNimbusSky()
   : Internal(new Internals)
 {
+  const nimbus::SunParameters sun;
+  this->SunElevationDegrees = sun.ElevationDegrees;
+  this->SunAzimuthDegrees = sun.AzimuthDegrees;
   this->Turbidity = nimbus::kDefaultTurbidity;
   this->MieScatteringPerMetre = nimbus::MieScatteringFromTurbidity(
     this->Turbidity, nimbus::ClearSkyAtmosphere(this->Turbidity));

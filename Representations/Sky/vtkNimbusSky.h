@@ -205,8 +205,9 @@ protected:
   vtkNimbusSky();
   ~vtkNimbusSky() override;
 
-  double SunElevationDegrees = 45.0;
-  double SunAzimuthDegrees = 135.0;
+  // The sun's defaults are nimbus::SunParameters' (Physics/Sun.h), set in the constructor.
+  double SunElevationDegrees = 0.0;
+  double SunAzimuthDegrees = 0.0;
   double Turbidity = 2.0;                  // nimbus::kDefaultTurbidity
   double MieScatteringPerMetre = 1.875e-5; // of Turbidity (set in the constructor)
   double GroundAlbedo = 0.3;

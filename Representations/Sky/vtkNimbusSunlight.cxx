@@ -26,7 +26,12 @@ namespace
 constexpr double SunTemperatureK = 5778.0; // effective temperature of the solar photosphere
 }
 
-vtkNimbusSunlight::vtkNimbusSunlight() = default;
+vtkNimbusSunlight::vtkNimbusSunlight()
+{
+  const nimbus::SunParameters sun;
+  this->SunElevationDegrees = sun.ElevationDegrees;
+  this->SunAzimuthDegrees = sun.AzimuthDegrees;
+}
 
 void vtkNimbusSunlight::GetDirection(double direction[3])
 {

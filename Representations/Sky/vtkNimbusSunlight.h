@@ -83,8 +83,9 @@ protected:
   vtkNimbusSunlight();
   ~vtkNimbusSunlight() override = default;
 
-  double SunElevationDegrees = 45.0;
-  double SunAzimuthDegrees = 135.0;
+  // The sun's defaults are nimbus::SunParameters' (Physics/Sun.h), set in the constructor.
+  double SunElevationDegrees = 0.0;
+  double SunAzimuthDegrees = 0.0;
   double SceneAltitudeMetres = 1500.0;
   bool WhiteBalance = true;
 
