@@ -1,4 +1,4 @@
-// Pieces of an image source's output (issue 18, data parallel): the extent the pipeline asks
+// Pieces of an image source's output (data parallel, under MPI): the extent the pipeline asks
 // for, and the crop of a whole-grid result to it. Private to Nimbus::Filters.
 //
 // With CAN_PRODUCE_SUB_EXTENT set in RequestInformation, VTK's streaming executive turns a

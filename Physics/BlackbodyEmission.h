@@ -1,4 +1,4 @@
-// The light hot smoke and fire emit (issue 17): a blackbody source term in the
+// The light hot smoke and fire emit (Planck's law): a blackbody source term in the
 // radiative transfer equation, shared by the GPU Cloud representation and the reference
 // path tracer so that both draw the same medium.
 //

@@ -1,4 +1,4 @@
-# Data-parallel tests (issue 18), label mpi: the field sources and the OpenVDB reader under
+# Data-parallel tests (docs/parallel.md), label mpi: the field sources and the OpenVDB reader under
 # MPI. Included at the end of Testing/CMakeLists.txt.
 #
 # mpi.Pieces.<N>: `mpiexec -n N pvbatch --symmetric TestParallelPieces.py`: every rank

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Relight against the direct solve, in the picture (issue 16).
+"""Relight against the direct solve, in the picture (003; docs/lightning.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
         scripts/lightning-relight-vs-direct.py [--spacing M ...] [--threshold XI ...]

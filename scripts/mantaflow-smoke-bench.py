@@ -1,4 +1,4 @@
-"""Blender 3.4's Mantaflow smoke on the scene of build/bin/BenchSmoke (issue 17): time per
+"""Blender 3.4's Mantaflow smoke on the scene of build/bin/BenchSmoke (docs/smoke.md): time per
 frame and per Mantaflow step, and the last frame's density as OpenVDB for
 scripts/smoke-side-by-side.py.
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Side-by-side images of multiple scattering in the SVS mapper (issue 14).
+"""Side-by-side images of multiple scattering in the SVS mapper (003, 004).
 
 For each scene: the SVS mapper with single scattering only (k_multi 0, 256 slices, single
 scattering in the air too: paper 000), the same with the mapper's default multiple

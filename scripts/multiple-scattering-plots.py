@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""One Pareto plot per scene from several harness CSVs (issue 14: every multiple-scattering
+"""One Pareto plot per scene from several harness CSVs (docs/multiple-scattering.md: every multiple-scattering
 method of the SVS mapper, VTK's mapper and SVS with k_multi in one plot).
 
     PYTHONPATH=build/lib/python3.11/site-packages /usr/bin/python3 \

@@ -1,4 +1,4 @@
-"""Generation time and peak memory per rank of the Nimbus field sources in pieces (issue 18).
+"""Generation time and peak memory per rank of the Nimbus field sources in pieces (docs/parallel.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages \
         mpiexec -n N pvbatch --symmetric scripts/parallel-generation-bench.py \

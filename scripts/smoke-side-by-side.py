@@ -1,5 +1,5 @@
 """Nimbus's smoke and Blender's Mantaflow smoke of the same scene, rendered side by side
-with the same renderer, optics, sun and camera (issue 17).
+with the same renderer, optics, sun and camera (docs/smoke.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
         scripts/smoke-side-by-side.py --nimbus A --mantaflow B --out C.png

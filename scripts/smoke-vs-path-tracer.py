@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Smoke and fire: the Cloud representation against the path tracer (issue 17).
+"""Smoke and fire: the Cloud representation against the path tracer (docs/smoke.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
         scripts/smoke-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]

@@ -1,5 +1,5 @@
 // nimbus-lightning-storm: a cumulus at night lit from inside by a lightning flash
-// (issue 16), to a PNG. The C++ twin of Examples/Python/lightning_storm_vtk.py.
+// (003's precomputed lightning), to a PNG. The C++ twin of Examples/Python/lightning_storm_vtk.py.
 //
 //   nimbus-lightning-storm [--output storm.png] [--time SECONDS] [--size W H]
 //

@@ -1,4 +1,4 @@
-"""VTK Python example: a cloud at night lit from inside by a lightning flash (issue 16).
+"""VTK Python example: a cloud at night lit from inside by a lightning flash (paper 003).
 
     PYTHONPATH=build/lib/python3.11/site-packages /usr/bin/python3 \
         Examples/Python/lightning_storm_vtk.py [output.png] [--time SECONDS] [--size W H]

@@ -1,4 +1,4 @@
-"""VTK Python example: smoke rising around an obstacle into the sky (issue 17).
+"""VTK Python example: smoke rising around an obstacle into the sky (002 §4).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
         Examples/Python/smoke_obstacle_vtk.py [output.png] [--seconds S] [--size W H]

@@ -1,4 +1,4 @@
-// Solid cells from a closed triangulated surface (issue 17: smoke obstacles given as
+// Solid cells from a closed triangulated surface (the smoke solver's obstacles given as
 // polydata). Plain C++, no VTK.
 //
 // A cell is solid when its centre lies inside the surface: the parity of the surface's

@@ -1,4 +1,4 @@
-// BlackbodyEmission (issue 17): the emission of hot smoke, relative to a reference
+// BlackbodyEmission (hot smoke and fire): the emission of hot smoke, relative to a reference
 // temperature. Luminance 1 at the reference, the physics of Planck's law (Wien's
 // approximation for the luminance ratios), colours from red to blue, the table against the
 // exact values, and the extremes (0 K, NaN, infinite, absurd references).

@@ -1,4 +1,4 @@
-// Where this rank's image goes in ParaView's ordered compositing (issue 18).
+// Where this rank's image goes in ParaView's ordered compositing (under MPI).
 //
 // Under MPI with ordered compositing (volumes present), IceT composites the ranks'
 // images with "over" in the order vtkOrderedCompositingHelper computes from the view's

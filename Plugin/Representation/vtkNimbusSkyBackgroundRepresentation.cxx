@@ -105,7 +105,7 @@ int vtkNimbusSkyBackgroundRepresentation::ProcessViewRequest(
       this->InputExposure = this->Background->GetSky()->GetExposure();
     }
     // Under MPI with ordered compositing (a Cloud in the view), the sky is the bottom
-    // layer of the composite: only the rank last in IceT's order draws it (issue 18).
+    // layer of the composite: only the rank last in IceT's order draws it.
     auto* renderView = vtkPVRenderView::SafeDownCast(this->GetView());
     this->Background->SetDrawSky(nimbus::IsLastInCompositingOrder(renderView));
     // The input's Exposure is now on the sky; lower it if this view needs it.

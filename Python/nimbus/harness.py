@@ -101,7 +101,7 @@ DEFAULT_SETTINGS = {
         {"shading": "volumetric", "sample_distance": 0.25, "reach": 1.0},
     ],
     # SVS: single scattering over slices (ms "none", the scene's k_multi), then the
-    # multiple-scattering methods (issue 14) at 256 slices over their knobs.
+    # multiple-scattering methods (003, 004) at 256 slices over their knobs.
     "svs": [{"slices": n} for n in (8, 16, 32, 64, 128, 256, 512)]
     + [{"slices": 256, "k_multi": k} for k in (2, 4, 8)]
     + [{"ms": "octaves", "octaves": n} for n in (2, 4, 8)]
@@ -650,7 +650,7 @@ class SvsRenderer:
     atmosphere_steps, jitter (SliceJitter, default on), unlit (the unlit
     compositing floor, for timing only), k_multi
     (000 Eq. 1's multiple-scattering constant; default the scene's), and the
-    multiple-scattering term (issue 14): ms (none, the default here, octaves,
+    multiple-scattering term (003, 004): ms (none, the default here, octaves,
     patterns or directions), orders, downsampling (0: the mapper's automatic
     choice), directions, sky_light (bool),
     octaves, pattern_radius, pattern_selection; air_ms (bool, default true: the

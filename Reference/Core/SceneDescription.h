@@ -57,7 +57,7 @@ struct DensitySourceDescription
 /// blackbody spectrum of TemperatureKelvin normalised to luminance 1 (as the sun's).
 /// The field is the medium's density ("from_density") or another point-data array
 /// of the medium's .vti ("array"; only for "file" densities), on the density's grid.
-/// "blackbody" (issue 17, hot smoke and fire; Physics/BlackbodyEmission.h): the array is
+/// "blackbody" (hot smoke and fire, Planck's law; Physics/BlackbodyEmission.h): the array is
 /// a temperature T [K] and each voxel emits eta_i(lambda) = RadiancePerMetre density_i
 /// B(lambda, T_i) / Y[B(TemperatureKelvin)] (hotter: brighter and bluer), trilinear
 /// between voxels as the density is; TemperatureKelvin is then the reference temperature

@@ -1,5 +1,5 @@
 // nimbus::EmissionTexture — the glow of hot smoke and fire for vtkNimbusCloudVolumeMapper
-// (issue 17). Per texel of the density texture, the mean over its block of input samples
+// (Planck's law). Per texel of the density texture, the mean over its block of input samples
 // of rho B(T) / Y[B(T_ref)] in linear sRGB (Physics/BlackbodyEmission.h): the emission
 // coefficient without its scale E, which the shader applies. Uploaded as one RGB float
 // 3-D texture with the density texture's dimensions (the same texture coordinates) when

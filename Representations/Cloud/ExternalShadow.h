@@ -1,4 +1,4 @@
-// Sun shadows across the pieces of a distributed cloud (issue 18).
+// Sun shadows across the pieces of a distributed cloud (under MPI).
 //
 // Under MPI each rank renders only its piece of the density (a box), but the sun
 // reaches that piece through the other ranks' pieces. Every rank holds a coarse copy

@@ -1,5 +1,5 @@
 // nimbus::MultipleScatteringTexture — the multiple-scattering term of
-// vtkNimbusCloudVolumeMapper (issue 14): the solver's in-scattered radiance
+// vtkNimbusCloudVolumeMapper (003, 004): the solver's in-scattered radiance
 // J(x, w) (Physics/MultipleScattering.h) on a grid downsampled from the density, as
 // three RGBA float 3-D textures (the SH coefficients c_00, c_1-1, c_10, c_11 of R, of
 // G, of B), re-solved only when what it depends on changes (the key).

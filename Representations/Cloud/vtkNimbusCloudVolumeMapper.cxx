@@ -347,7 +347,7 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   bool LightningTexture = false;
   bool LightningFirstScattering = false;
 
-  // Temperature emission (issue 17; EmissionTexture.h): uploaded and glowing.
+  // Temperature emission (EmissionTexture.h): uploaded and glowing.
   bool EmissionTexture = false;
 
   // A hash of the opaque scene's depth in the viewport (0 without one).
@@ -370,14 +370,14 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // Density volume (000: the "volume texture").
   nimbus::CloudDensityTexture Density;
 
-  // Multiple scattering (issue 14): the solver's texture, and the sky it sees
+  // Multiple scattering (003, 004): the solver's texture, and the sky it sees
   // (a sky model of the mapper's own air, built only when the sky light needs it).
   nimbus::MultipleScatteringTexture Scattering;
   std::string LastScatteringError;
   // Lightning (LightningTexture.h).
   nimbus::LightningTexture Lightning;
   std::string LastLightningError;
-  // Temperature emission (issue 17; EmissionTexture.h).
+  // Temperature emission (EmissionTexture.h).
   nimbus::EmissionTexture Emission;
   std::string LastEmissionError;
   double LastPrecomputeSeconds = 0.0;
@@ -413,7 +413,7 @@ struct vtkNimbusCloudVolumeMapper::Internals
   vtkNew<vtkOpenGLFramebufferObject> RayEndsFramebuffer;
   vtkNew<vtkImageData> Radiance; // float copy of the last accumulation (CaptureRadiance)
 
-  // The other pieces' optical depth toward the sun (issue 18; ExternalShadow.h): the
+  // The other pieces' optical depth toward the sun (ExternalShadow.h): the
   // coarse whole density, its map facing the sun (keyed by what it depends on) and
   // the map as a 2-channel float texture.
   vtkSmartPointer<vtkImageData> ExternalDensity;
@@ -1696,7 +1696,7 @@ std::array<float, 16> WorldToScatteringTexture(vtkImageData* coarse, const int t
 } // namespace
 
 //------------------------------------------------------------------------------
-// Multiple scattering (issue 14): the solver's term, re-solved only when the
+// Multiple scattering (003, 004): the solver's term, re-solved only when the
 // density, the sun, the air, the ground, the optics or the method's knobs change.
 void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
 {
@@ -1726,7 +1726,7 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
   options.Threads = vtkSMPTools::GetEstimatedNumberOfThreads();
   request.Optics = { this->Albedo, nimbus::PhaseFunctionKind::CornetteShanks, this->CloudG };
   request.ExtinctionPerDensity = this->ExtinctionPerDensity;
-  // One piece of a distributed cloud (issue 18): the solve runs on the whole cloud's
+  // One piece of a distributed cloud (under MPI): the solve runs on the whole cloud's
   // coarse copy, the same on every rank, so that light crosses the pieces' faces as in
   // one renderer (each piece's own solve would lose it there: dark seams, measured).
   const bool wholeCloud = frame.ExternalShadow && this->PieceCompositing;
@@ -1996,7 +1996,7 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
 }
 
 //------------------------------------------------------------------------------
-// Temperature emission (issue 17): rho B(T) / Y[B(T_ref)] per texel, uploaded when the
+// Temperature emission (Planck's law): rho B(T) / Y[B(T_ref)] per texel, uploaded when the
 // density, the temperature or the reference temperature change.
 void vtkNimbusCloudVolumeMapper::UpdateEmission(FrameState& frame)
 {
@@ -2160,7 +2160,7 @@ vtkImageData* vtkNimbusCloudVolumeMapper::GetExternalDensity()
 }
 
 //------------------------------------------------------------------------------
-// The other pieces' shadow (issue 18, ExternalShadow.h): the coarse whole density
+// The other pieces' shadow (ExternalShadow.h): the coarse whole density
 // converted when it changes, its map rebuilt when the sun, the piece, the optics or
 // the grid change (not with the camera), uploaded as a (Beyond, Whole) texture.
 void vtkNimbusCloudVolumeMapper::UpdateExternalShadow(FrameState& frame)
@@ -2364,7 +2364,7 @@ void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
 // sky).
 void vtkNimbusCloudVolumeMapper::RenderOutsideRegion(const FrameState& frame, bool behindBox)
 {
-  // A piece whose image goes over the one that draws the air (issue 18): only the
+  // A piece whose image goes over the one that draws the air (under MPI): only the
   // air in front of its box, weighted by its opacity 1 - T_i (and none in its box).
   // The bottom image has all the air in front of its own box, which compositing
   // multiplies by the transmittances of the pieces in front; each piece adds back

@@ -19,7 +19,7 @@
  *    atmosphere, the background attenuated by g_view.
  *  - A ground plane lit by the attenuated sun and shadowed through the shadow
  *    surface, and shafts of light in the atmosphere beyond the cloud box.
- *  - Multiple scattering (issue 14; MultipleScatteringMethod, default discrete
+ *  - Multiple scattering (003, 004; MultipleScatteringMethod, default discrete
  *    directions): the light the cloud scatters more than once and the sky's and the
  *    ground's light on it, solved on a downsampled grid (Physics/MultipleScattering.h)
  *    only when the density, sun, air, ground, optics or knobs change, and added per
@@ -128,7 +128,7 @@ public:
   ///@}
 
   ///@{
-  /// Temperature emission (issue 17): hot smoke and fire glow. Off by default. When on,
+  /// Temperature emission (Planck's law): hot smoke and fire glow. Off by default. When on,
   /// every sample adds the emission coefficient (the source term of the radiative
   /// transfer equation, Physics/BlackbodyEmission.h)
   ///     eta = EmissionRadiancePerMetre rho B(T) / Y[B(EmissionReferenceTemperatureKelvin)]
@@ -157,7 +157,7 @@ public:
   vtkGetMacro(EmissionReferenceTemperatureKelvin, double);
   ///@}
 
-  /// How the light scattered more than once is computed (issue 14; see
+  /// How the light scattered more than once is computed (003, 004; see
   /// Physics/MultipleScattering.h and docs/multiple-scattering.md). The single
   /// scattering of the sun stays exact per sample (the slices); these add the rest:
   enum MultipleScatteringMethods
@@ -643,7 +643,7 @@ public:
   ///@}
 
   ///@{
-  /// One piece of a distributed cloud (issue 18; docs/parallel.md). Under MPI each
+  /// One piece of a distributed cloud (docs/parallel.md). Under MPI each
   /// rank renders its piece and ParaView composites the ranks' images in visibility
   /// order with the premultiplied "over" operator (IceT). ParaView's Cloud
   /// representation sets these; a VTK program composing its own images may too.

@@ -24,7 +24,7 @@ uniform sampler2D sceneColor;
 uniform vec3 displayScale;
 uniform int encodeSrgb;
 uniform int skyBackground;
-// One piece of a distributed cloud (issue 18, docs/parallel.md). premultipliedPiece:
+// One piece of a distributed cloud (docs/parallel.md). premultipliedPiece:
 // this piece's cloud alone, premultiplied (radiance, 1 - T_cl) over a transparent
 // framebuffer, for IceT's "over" in visibility order. usePieceBackground: the rank
 // that draws the air and the ground, last in that order, composites them over the

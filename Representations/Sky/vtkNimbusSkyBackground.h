@@ -60,7 +60,7 @@ public:
   /// Whether this prop draws the sky (default on). Off, it stays visible as the
   /// view's sky (a cloud mapper still follows its sun, air and display settings) but
   /// draws nothing: under MPI the sky is the bottom layer of the composite, drawn by
-  /// one rank only (issue 18; ParaView's Sky Background representation sets it).
+  /// one rank only (ParaView's Sky Background representation sets it).
   vtkSetMacro(DrawSky, bool);
   vtkGetMacro(DrawSky, bool);
   vtkBooleanMacro(DrawSky, bool);

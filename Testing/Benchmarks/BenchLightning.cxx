@@ -1,4 +1,4 @@
-// Benchmark (not a test) of precomputed lightning (issue 16, 003 §4-§7): the seed's case
+// Benchmark (not a test) of precomputed lightning (003 §4-§7): the seed's case
 // (a cloud grid of 32x32x4 points 200 m apart, as if downsampled 4x from 128x128x16;
 // virtual lights 20x20x6 by 003 Eq. 4; n_dir 26) precomputed, its memory against xi, the
 // relight of a stroke against the direct multiple-scattering solve with the same point

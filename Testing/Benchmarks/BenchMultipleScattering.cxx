@@ -1,4 +1,4 @@
-// Benchmark (not a test) of multiple scattering (issue 14): the solver's cost against
+// Benchmark (not a test) of multiple scattering (003, 004): the solver's cost against
 // its grid, directions and orders, per method, and in the mapper the precompute when
 // the sun moves and the frame time against SVS single scattering.
 //

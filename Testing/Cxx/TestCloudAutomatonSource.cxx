@@ -523,7 +523,7 @@ Cover MeasureCover(const std::vector<float>& density, int nx, int ny, int nz, do
 
 TEST(CloudAutomatonSource, DefaultsGiveSeparateCumulusThatDrift)
 {
-  // The first Apply in ParaView: time 0 of the defaults. Before issue 15 the defaults (uniform
+  // The first Apply in ParaView: time 0 of the defaults. The earlier defaults (uniform
   // vapour 0.3, no regions, no wind) filled the whole box: every column cloudy, one group.
   vtkNew<vtkNimbusCloudAutomatonSource> source;
   const std::vector<float> first = DensityAt(source, 0.0);

@@ -208,7 +208,7 @@ bool FacingSun(const Context& c)
     c.CompareWithBaseline();
 }
 
-// Multiple scattering (issue 14), the default method (discrete directions): the lit
+// Multiple scattering (003, 004), the default method (discrete directions): the lit
 // side at noon is bright inside, not grey; backlit, the cloud glows through instead
 // of going black. Octaves and reference patterns at noon.
 bool MultipleScatteringNoon(const Context& c)
@@ -294,7 +294,7 @@ bool MultipleScatteringResolvesOnlyOnChange(const Context&)
   return ok;
 }
 
-// Automatic quality (issue 15): still frames at Quality, interactive frames (the
+// Automatic quality (the frame budget): still frames at Quality, interactive frames (the
 // window's DesiredUpdateRate >= InteractiveUpdateRate) at the level the cost model
 // fits into FrameBudgetMilliseconds; an unchanged frame reuses the cloud's image;
 // anything the cloud depends on (camera, a setting, opaque geometry) does not.
@@ -376,7 +376,7 @@ bool FrameBudgetAndReuse(const Context&)
 
 // Progress and abort: a still frame that takes more than a second reports progress
 // every 16 slices and stops when asked (here by an observer of its progress).
-// --- lightning (issue 16) --------------------------------------------------------------
+// --- lightning (003) ------------------------------------------------------------------
 // The cumulus at night lit by a flash from inside (vtkNimbusLightningIllumination, cheap
 // settings: 14 directions, lights 750 m apart), the filter driven to time `seconds`.
 struct LightningScene
@@ -489,7 +489,7 @@ bool LightningFollowsTime(const Context&)
   return ok;
 }
 
-// Temperature emission (issue 17): a uniform, purely absorbing box (albedo 0) of density
+// Temperature emission (Planck's law): a uniform, purely absorbing box (albedo 0) of density
 // rho at temperature T seen head on through D = 200 m, no sun, no air, no ground:
 //   L = (eta / sigma_a)(1 - exp(-sigma_a D)),  eta = E rho B(T) / Y[B(T_ref)] (linear sRGB),
 // the closed form of the reference's TestLightsPathTracer.BlackbodyEmittingBox. Off, cold
@@ -957,7 +957,7 @@ bool DataLayouts(const Context&)
   // box clips the cloud; the cloud's rim has density ~0 there. Measured 0.026
   // (quantisation to 1/1000) and 0.054 (the rim) with the slices over the whole
   // screen; 0.106 (0.096 without SliceJitter) since the air outside the box is
-  // marched and inside it sliced (issue 15): the larger box moves that border,
+  // marched and inside it sliced (svsMarchFS.glsl): the larger box moves that border,
   // and the slices' planes and jitter with it (a few pixels off by 1 of 255).
   return Check(typedRmse < 0.1,
            "unsigned short x1000 vs float: RMSE " + std::to_string(typedRmse) + " < 0.1") &&

@@ -410,7 +410,7 @@ TEST(DensityResample, CensusAndTooLargeValues)
   EXPECT_FLOAT_EQ(clamped.Data()[1], static_cast<float>(nimbus::kMaximumDensity));
 }
 
-// The emission texels (issue 17): per texel the mean over its block of rho B(T) / Y[B(T_ref)],
+// The emission texels (hot smoke): per texel the mean over its block of rho B(T) / Y[B(T_ref)],
 // blocks at the upper edges partial; NaN or negative densities and NaN temperatures emit
 // nothing.
 TEST(EmissionTexels, BlockMeansOfDensityTimesBlackbody)

@@ -1,5 +1,5 @@
 // The other pieces' shadow of a distributed cloud (Representations/Cloud/ExternalShadow.h,
-// issue 18) against closed forms: a uniform slab cut into two pieces, the sun
+// under MPI) against closed forms: a uniform slab cut into two pieces, the sun
 // overhead and oblique, lines that miss the piece, the trilinear lattice, and bad
 // input (NaN, negative, an empty grid) giving finite zeros.
 #include "ExternalShadow.h"

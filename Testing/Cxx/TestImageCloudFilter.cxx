@@ -245,7 +245,7 @@ TEST(ImageCloudFilter, SizeAndBudgetMessagesNameTheRealCause)
 TEST(ImageCloudFilter, DefaultsKeepTheDarkSeaClear)
 {
   // The first Apply: the sample image with the defaults (TwoStream, ClearIntensity 0.25).
-  // Before issue 15 the defaults (Linear, 0.1) made the sea (25 to 50 of 255) a cloud of
+  // The earlier defaults (Linear, 0.1) made the sea (25 to 50 of 255) a cloud of
   // optical depth up to 3: a solid square.
   vtkNew<vtkPNGReader> reader;
   reader->SetFileName(NIMBUS_SAMPLE_IMAGE);

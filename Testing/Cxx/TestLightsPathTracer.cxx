@@ -290,7 +290,7 @@ TEST(LightsPathTracer, EmittingAbsorbingBox)
 }
 
 //------------------------------------------------------------------------------
-// "blackbody" emission (issue 17, hot smoke): the same absorbing box with a temperature
+// "blackbody" emission (hot smoke, Planck's law): the same absorbing box with a temperature
 // field T; eta(lambda) = s rho B(lambda, T) / Y[B(T_ref)] (Physics/BlackbodyEmission.h),
 // so L = (eta / sigma_a)(1 - exp(-sigma_a D)) with the spectrum of B(T) scaled by its
 // luminance ratio: at T = T_ref the luminance is that of "from_density" at T_ref, at

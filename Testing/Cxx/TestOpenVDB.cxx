@@ -1278,7 +1278,7 @@ TEST(ReadChecks, UnknownGridTypeIsSkippedNotFatal)
   EXPECT_TRUE(Contains(warnings, "'alien' (unknown type 'Tree_floet_5_4_3')")) << warnings;
 }
 
-// Issue 17: the smoke source's output (density, temperature, velocity and the obstacle
+// Smoke in OpenVDB: the smoke source's output (density, temperature, velocity and the obstacle
 // mask of a voxelised sphere) goes out as .vdb through the writer and comes back
 // identical: FloatGrids, a Vec3SGrid, the cell centres' positions.
 TEST(RoundTrip, SmokeOut)

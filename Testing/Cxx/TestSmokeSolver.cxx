@@ -1,4 +1,4 @@
-// The smoke solver (Filters/Core/SmokeSolver.h, issue 17): the projection leaves the
+// The smoke solver (Filters/Core/SmokeSolver.h, 002 §4): the projection leaves the
 // velocity divergence-free, nothing flows through obstacles, a hot plume rises and
 // spreads, the advection's mass change is stated and bounded, a large time step is
 // sub-stepped (and too large a one refused), threads do not change the result, bad

@@ -1,4 +1,4 @@
-// vtkNimbusSmokeSource (issue 17): the arrays and time steps, the same frame whatever the
+// vtkNimbusSmokeSource (002 §4): the arrays and time steps, the same frame whatever the
 // order of the requests (checkpoints), obstacles from an input image or a closed surface,
 // wind blowing the smoke through open sides, bad input refused with a message and an
 // empty output.

@@ -1,5 +1,5 @@
 """Renders a metaball cloud as the "Cloud" representation in pvbatch, on as many
-ranks as pvbatch runs with (issue 18), and saves the picture and the timings.
+ranks as pvbatch runs with (docs/parallel.md), and saves the picture and the timings.
 
     mpiexec -n N pvbatch --force-offscreen-rendering ParallelCloudRender.py \
         --plugin Nimbus.so --output image.png [--size 320 240] [--grid 96]

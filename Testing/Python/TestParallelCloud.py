@@ -1,4 +1,4 @@
-"""The Cloud representation rendered by 2-4 pvbatch ranks against one rank (issue 18).
+"""The Cloud representation rendered by 2-4 pvbatch ranks against one rank (docs/parallel.md).
 
     python3 TestParallelCloud.py --mpiexec mpiexec --pvbatch pvbatch --plugin Nimbus.so \
         --ranks 2 --output-dir DIR [--max-rmse 2.0] [--max-p99 12]

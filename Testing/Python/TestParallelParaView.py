@@ -1,4 +1,4 @@
-"""MPI test (issue 18): the plugin's metaball cloud through plain ParaView on 2 ranks.
+"""MPI test (docs/parallel.md): the plugin's metaball cloud through plain ParaView on 2 ranks.
 
     mpiexec -n 2 pvbatch --force-offscreen-rendering TestParallelParaView.py --plugin Nimbus.so
 

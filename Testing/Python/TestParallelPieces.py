@@ -1,4 +1,4 @@
-"""MPI test (issue 18, data parallel): the pieces of every Nimbus field source, assembled,
+"""MPI test (data parallel, docs/parallel.md): the pieces of every Nimbus field source, assembled,
 equal the serial output bit for bit.
 
     mpiexec -n N pvbatch --symmetric --force-offscreen-rendering TestParallelPieces.py \

@@ -1,4 +1,4 @@
-"""pvpython test: what the first Apply shows for each Nimbus source and filter (issue 15).
+"""pvpython test: what the first Apply shows for each Nimbus source and filter (docs/paraview.md).
 
     pvpython TestPluginFirstApply.py --plugin Nimbus.so --image Data/SatelliteClouds.png \
         [--output-dir DIR]

@@ -1,4 +1,4 @@
-"""pvpython test of "one sun per view" and of the panels' words (issue 15).
+"""pvpython test of "one sun per view" and of the panels' words (docs/paraview.md).
 
     pvpython TestPluginOneSun.py --plugin Nimbus.so --output-dir DIR
 
