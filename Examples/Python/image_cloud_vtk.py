@@ -21,7 +21,7 @@ import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401
 from vtkmodules.vtkRenderingVolume import vtkGPUVolumeRayCastMapper
 
-# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (README, Without a display).
+# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (docs/offscreen.md).
 nimbus.offscreen_if_requested()
 
 SIZE = 300

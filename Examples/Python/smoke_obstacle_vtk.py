@@ -25,7 +25,7 @@ from vtkmodules.vtkRenderingCore import (vtkActor, vtkPolyDataMapper, vtkRendere
                                          vtkRenderWindow, vtkVolume, vtkWindowToImageFilter)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
-# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (README, Without a display).
+# NIMBUS_OFFSCREEN=egl: render on an EGL pbuffer, no X server (docs/offscreen.md).
 nimbus.offscreen_if_requested()
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -476,7 +476,7 @@ void CloudAutomaton::Step()
         for (int y = 0; y < ny; ++y)
         {
           const Word* act = row(in.Act, y, z);
-          // f_act's neighbourhood (README): y +-1, +-2 and z +1, -1, -2 ...
+          // f_act's neighbourhood (shared/papers/README.md): y +-1, +-2 and z +1, -1, -2 ...
           const Word* others[7] = { row(in.Act, y - 1, z), row(in.Act, y + 1, z),
             row(in.Act, y - 2, z), row(in.Act, y + 2, z), row(in.Act, y, z + 1),
             row(in.Act, y, z - 1), row(in.Act, y, z - 2) };
@@ -521,7 +521,7 @@ void CloudAutomaton::Step()
             }
             const Word h = in.Hum[i];
             const Word c = in.Cld[i];
-            // 002 §3 (README): growth.
+            // 002 §3 (shared/papers/README.md): growth.
             Word hum = h & ~a;
             Word cld = c | a;
             Word newAct = ~a & h & f;

@@ -4,7 +4,7 @@
 // Three boolean fields live on an nx x ny x nz grid of cells (x fastest, z up):
 //   hum  water vapour,  act  phase-transition factor,  cld  cloud.
 // One step n -> n+1 is, in this order:
-//   1. growth (002 §3, README):
+//   1. growth (002 §3, shared/papers/README.md):
 //        hum' = hum AND NOT act
 //        cld' = cld OR act
 //        act' = NOT act AND hum AND f_act
@@ -224,7 +224,7 @@ struct CloudSmoothingParameters
   int NumberOfThreads = 0;
 };
 
-/// Density in [0, 1]: the cld field smoothed by the kernel above (002 §3, README:
+/// Density in [0, 1]: the cld field smoothed by the kernel above (002 §3, papers README:
 /// "the boolean cld field smoothed over a small 3-D neighbourhood with a smooth
 /// kernel"). x/y boundaries follow the automaton's, z is open. `density` is
 /// resized to nx*ny*nz (x fastest).

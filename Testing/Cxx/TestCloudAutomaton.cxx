@@ -123,7 +123,7 @@ TEST(CloudAutomatonRules, ActNeedsHumidityAndIsNotSelfSustaining)
   EXPECT_TRUE(ca.Get(Field::Cld, 3, 3, 3));
 }
 
-// Every offset of the f_act neighbourhood triggers, nothing else does (README's list:
+// Every offset of the f_act neighbourhood triggers, nothing else does (the papers README's list:
 // (+-1,0,0), (+-2,0,0), (0,+-1,0), (0,+-2,0), (0,0,+1), (0,0,-1), (0,0,-2)).
 TEST(CloudAutomatonRules, ActivationNeighbourhood)
 {
