@@ -125,7 +125,7 @@ def render_window(size):
     return window, renderer
 
 
-def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE):
+def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE, samples=8):
     from vtkmodules.vtkRenderingCore import vtkActor, vtkWindowToImageFilter
     mapper = nimbus.vtkNimbusCloudSplatMapper()
     mapper.SetInputData(poly)
@@ -138,6 +138,7 @@ def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE):
     mapper.SetSunLightMethod(method)
     mapper.SetSunTextureSize(sun_size)
     mapper.SetSunTextureLayers(layers)
+    mapper.SetSunLightSamples(samples)
     mapper.SetTimePasses(True)
     actor = vtkActor()
     actor.SetMapper(mapper)
@@ -206,7 +207,11 @@ def main():
     parser.add_argument("--sun-size", type=int, default=256)
     parser.add_argument("--layers", type=int, default=32)
     parser.add_argument("--path-seconds", type=float, default=60.0)
+    parser.add_argument("--samples", type=int, default=8,
+                        help="SunLightSamples of the splat-texture rows (splat-texture-centre: 0)")
     parser.add_argument("--no-references", action="store_true")
+    parser.add_argument("--reuse-references", action="store_true",
+                        help="load the references an earlier run saved in --output")
     parser.add_argument("--output", default="build/splats")
     args = parser.parse_args()
     os.makedirs(args.output, exist_ok=True)
@@ -226,7 +231,13 @@ def main():
         scene = write_scene(directory, "density.vti")
         reference_seconds = {}
         references = {}
-        if not args.no_references:
+        seconds_path = os.path.join(directory, "reference-seconds.json")
+        if args.reuse_references and os.path.exists(seconds_path):
+            with open(seconds_path) as stream:
+                reference_seconds = json.load(stream)
+            for name in reference_seconds:
+                references[name] = np.load(os.path.join(directory, f"{name}.npy"))
+        elif not args.no_references:
             for name, settings in (
                     ("single", harness.REFERENCE_SETTINGS["single"]),
                     ("path", dict(harness.REFERENCE_SETTINGS["path"],
@@ -236,6 +247,8 @@ def main():
                 reference_seconds[name] = time.perf_counter() - start
                 references[name] = image
                 np.save(os.path.join(directory, f"{name}.npy"), image)
+            with open(seconds_path, "w") as stream:
+                json.dump(reference_seconds, stream)
         images = {}
         seconds = {}
         # The 8-bit framebuffer's exposure: the single-scattering reference's brightest
@@ -243,10 +256,12 @@ def main():
         exposure = (0.9 / float(references["single"].max()) if "single" in references
                     else VTK_SCALE)
         images["splat-texture"], seconds["splat-texture"], sun_texture = render_splats(
-            poly, 0, args.repeats, args.sun_size, args.layers, exposure)
+            poly, 0, args.repeats, args.sun_size, args.layers, exposure, args.samples)
+        images["splat-texture-centre"], seconds["splat-texture-centre"], centre_sun = \
+            render_splats(poly, 0, args.repeats, args.sun_size, args.layers, exposure, 0)
         if count <= args.readback_max:
             images["splat-readback"], seconds["splat-readback"], _ = render_splats(
-                poly, 1, 1, args.sun_size, args.layers, exposure)
+                poly, 1, 1, args.sun_size, args.layers, exposure, 0)
         images["svs"], seconds["svs"] = render_svs(grid, args.repeats)
         mask = None
         if "single" in references:
@@ -257,7 +272,8 @@ def main():
             harness.write_png(image, os.path.join(directory, f"{name}.png"), exposure=exposure)
             row = {"balls": count, "radius_m": radius, "renderer": name,
                    "seconds": seconds[name],
-                   "sun_pass_seconds": sun_texture if name == "splat-texture" else "",
+                   "sun_pass_seconds": {"splat-texture": sun_texture,
+                                        "splat-texture-centre": centre_sun}.get(name, ""),
                    "voxelise_seconds": voxel_seconds, "exposure": exposure}
             for reference_name, reference in references.items():
                 for key, value in errors(image, reference, mask).items():

@@ -4,11 +4,53 @@
 // single scattering with the sun's light at its centre: the integral of
 // sigma exp(-tau to the exit) along the column). Blended (GL_ONE, GL_ONE_MINUS_SRC_ALPHA):
 // the framebuffer is multiplied by a and the colour added (002 §3.3).
+// With SUN_SAMPLES (SunLightSamples > 0, accumulation texture): the light along the
+// fragment's own view ray through the ball, at SUN_SAMPLES midpoints x_j of its chord:
+//   L = albedo p(mu) E_sun sum_j kappa f(x_j) dh T_sun(x_j) exp(-kappa P(u, h_j)),
+// T_sun from the sun's accumulation texture at x_j (all balls, this one included),
+// exp(-kappa P) this ball's own column between x_j and the eye (P: the partial-column
+// table), u the ray's distance from the centre and h along it, both in units of R.
 //VTK::System::Dec
+// (the mapper defines SUN_SAMPLES, the number of points, on the next line)
+//SPLAT::SunSamples
+#ifdef SUN_SAMPLES
+//NIMBUS::Library
+#endif
 in vec2 corner;
 in float kappa;
 in vec3 ballColor;
+in vec3 billboardPoint;
+flat in vec4 ballWorld;
 uniform sampler2D billboard;
+#ifdef SUN_SAMPLES
+uniform sampler3D sunDepth;
+uniform sampler2D partialColumn;
+uniform vec3 eyeWorld;
+uniform vec3 toSun;
+uniform vec3 sunAxisX;
+uniform vec3 sunAxisY;
+uniform vec4 sunRect;
+uniform vec2 sunDepthRange;
+uniform vec3 sunColor;
+uniform float albedo;
+uniform float cloudG;
+
+float SunOpticalDepth(vec3 x)
+{
+  vec3 size = vec3(textureSize(sunDepth, 0));
+  vec3 s = vec3((vec2(dot(x, sunAxisX), dot(x, sunAxisY)) - sunRect.xy) * sunRect.zw,
+    (-dot(x, toSun) - sunDepthRange.x) * sunDepthRange.y);
+  s.z = (s.z * (size.z - 1.0) + 0.5) / size.z;
+  return texture(sunDepth, s).r;
+}
+
+float PartialColumn(float u, float h)
+{
+  vec2 size = vec2(textureSize(partialColumn, 0));
+  vec2 uv = (vec2(u, clamp(h, -1.0, 1.0) * 0.5 + 0.5) * (size - 1.0) + 0.5) / size;
+  return texture(partialColumn, uv).r;
+}
+#endif
 //VTK::Output::Dec
 
 void main()
@@ -19,5 +61,28 @@ void main()
   }
   float column = texture(billboard, corner * 0.5 + 0.5).r;
   float opacity = 1.0 - exp(-kappa * column);
-  gl_FragData[0] = vec4(ballColor * opacity, opacity);
+  vec3 color = ballColor * opacity;
+#ifdef SUN_SAMPLES
+  {
+    vec3 d = normalize(billboardPoint - eyeWorld);
+    float R = ballWorld.w;
+    float tc = dot(ballWorld.xyz - eyeWorld, d);
+    vec3 closest = eyeWorld + tc * d;
+    float u = min(length(closest - ballWorld.xyz) / R, 1.0);
+    float chord = sqrt(max(1.0 - u * u, 0.0));
+    float dh = 2.0 * chord / float(SUN_SAMPLES);
+    float sum = 0.0;
+    for (int j = 0; j < SUN_SAMPLES; ++j)
+    {
+      float h = -chord + (float(j) + 0.5) * dh; // from the eye's side
+      vec3 x = closest + h * R * d;
+      float q = u * u + h * h;
+      float f = 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * 4.0 / 9.0));
+      sum += kappa * f * dh * exp(-SunOpticalDepth(x) - kappa * PartialColumn(u, h));
+    }
+    // mu: the sunlight's direction (-toSun) against the way to the eye (-d).
+    color = albedo * CornetteShanks(dot(toSun, d), cloudG) * sunColor * sum;
+  }
+#endif
+  gl_FragData[0] = vec4(color, opacity);
 }

@@ -3,6 +3,9 @@
 // drawn instanced (four corners per instance, from gl_VertexID). The ball's colour is its
 // single scattering: albedo x phase x the sun's colour x the sun's transmittance at the
 // centre, from the sun pass (the accumulation texture, or the value read back per ball).
+// With SUN_SAMPLES (the accumulation texture and SunLightSamples > 0) the fragment shader
+// integrates the light along its own column instead (cloudSplatViewFS.glsl); this shader
+// then hands it the billboard's point and the ball.
 //VTK::System::Dec
 //NIMBUS::Library
 in vec4 ball;       // xyz: the centre (world), w: the radius R (world units)
@@ -15,16 +18,21 @@ uniform vec3 sunAxisX;
 uniform vec3 sunAxisY;
 uniform vec4 sunRect;        // the sun texture's window (as cloudSplatSunVS)
 uniform vec2 sunDepthRange;  // (depth of layer 0, 1 / (depth of the last layer - that))
-//SPLAT::SunTexture (the mapper defines SUN_TEXTURE here for the accumulation texture)
+// (the mapper defines SUN_TEXTURE on the next line for the accumulation texture)
+//SPLAT::SunTexture
 #ifdef SUN_TEXTURE
 uniform sampler3D sunDepth;  // the accumulated optical depth toward the sun, per layer
 #endif
 uniform vec3 sunColor;       // the sun's irradiance (linear sRGB) x exposure
 uniform float albedo;
 uniform float cloudG;
+uniform vec3 viewRight; // the camera's axes in world coordinates (the billboard's plane)
+uniform vec3 viewUp;
 out vec2 corner;
 out float kappa;
 out vec3 ballColor;
+out vec3 billboardPoint; // world
+flat out vec4 ballWorld;
 
 void main()
 {
@@ -33,6 +41,8 @@ void main()
   centre.xy += corner * ball.w * centre.w;
   gl_Position = VCDCMatrix * centre;
   kappa = ballOptics.x;
+  billboardPoint = ball.xyz + (viewRight * corner.x + viewUp * corner.y) * ball.w;
+  ballWorld = ball;
 
   float sunTransmittance = ballOptics.y;
 #ifdef SUN_TEXTURE

@@ -633,8 +633,16 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
       vtkShaderProgram::Substitute(source, "//SPLAT::SunTexture", "#define SUN_TEXTURE");
     }
   }
+  const int samples = texture ? this->SunLightSamples : 0;
+  std::string fragment = cloudSplatViewFS;
+  if (samples > 0)
+  {
+    vtkShaderProgram::Substitute(
+      fragment, "//SPLAT::SunSamples", "#define SUN_SAMPLES " + std::to_string(samples));
+    fragment = nimbus::WithShaderLibrary(fragment);
+  }
   vtkShaderProgram* program =
-    window->GetShaderCache()->ReadyShaderProgram(source.c_str(), cloudSplatViewFS, "");
+    window->GetShaderCache()->ReadyShaderProgram(source.c_str(), fragment.c_str(), "");
   if (!program)
   {
     throw std::runtime_error("the view pass's shaders did not compile");
@@ -676,6 +684,19 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   }
   in.Billboard->Activate();
   program->SetUniformi("billboard", in.Billboard->GetTextureUnit());
+  if (samples > 0)
+  {
+    in.Partial->Activate();
+    program->SetUniformi("partialColumn", in.Partial->GetTextureUnit());
+  }
+  // The camera's axes in world coordinates: the rows of the view transform.
+  vtkMatrix4x4* view = camera->GetViewTransformMatrix();
+  const float right[3] = { static_cast<float>(view->GetElement(0, 0)),
+    static_cast<float>(view->GetElement(0, 1)), static_cast<float>(view->GetElement(0, 2)) };
+  const float up[3] = { static_cast<float>(view->GetElement(1, 0)),
+    static_cast<float>(view->GetElement(1, 1)), static_cast<float>(view->GetElement(1, 2)) };
+  program->SetUniform3f("viewRight", right);
+  program->SetUniform3f("viewUp", up);
 
   // The sun's colour above the air (linear sRGB of its blackbody spectrum) x exposure.
   nimbus::SunParameters sun;
@@ -695,6 +716,10 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(order.size()));
   in.Billboard->Deactivate();
+  if (samples > 0)
+  {
+    in.Partial->Deactivate();
+  }
   if (texture)
   {
     in.SunDepth->Deactivate();
@@ -722,5 +747,6 @@ void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SunLightMethod: " << this->SunLightMethod << "\n";
   os << indent << "SunTextureSize: " << this->SunTextureSize << "\n";
   os << indent << "SunTextureLayers: " << this->SunTextureLayers << "\n";
+  os << indent << "SunLightSamples: " << this->SunLightSamples << "\n";
   os << indent << "TimePasses: " << this->TimePasses << "\n";
 }

@@ -123,6 +123,15 @@ public:
   ///@}
 
   ///@{
+  /// With the accumulation texture: the sun's light is integrated along each fragment's
+  /// own ray through its ball at this many points (the texture read at each, this ball's
+  /// own column toward the eye from the partial-column table) instead of taken at the
+  /// ball's centre; 0: at the centre (002 §3.3's per-ball colour). Default 8.
+  vtkSetClampMacro(SunLightSamples, int, 0, 64);
+  vtkGetMacro(SunLightSamples, int);
+  ///@}
+
+  ///@{
   /// The sun pass's texture: texels per side (default 256; the read-back's
   /// framebuffer too) and planes along the light (AccumulationTexture; default 32).
   vtkSetClampMacro(SunTextureSize, int, 16, 8192);
@@ -163,6 +172,7 @@ protected:
   int SunLightMethod = AccumulationTexture;
   int SunTextureSize = 256;
   int SunTextureLayers = 32;
+  int SunLightSamples = 8;
   bool TimePasses = false;
 
 private:
