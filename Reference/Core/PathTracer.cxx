@@ -443,102 +443,16 @@ public:
     }
     if (this->HasCloud)
     {
-      // Coarse majorant grid of the cloud: sigma_bar per block of 4^3 voxels, the
-      // maximum over the block's grid points dilated by one point on every side, times
-      // the extinction per density. Trilinear interpolation never exceeds the corner
-      // values, so the value bounds sigma_t over the block and over one voxel around it
-      // (margin for pieces whose end points round across a block face).
-      this->Macro = settings.BlockTraversal
-        ? MajorantGrid(this->Grid, 0, settings.MajorantBlockVoxels)
-        : MajorantGrid(this->Grid, 1);
-      const double extinctionPerDensity = context.GetExtinctionScale();
-      const std::array<int, 3>& blocks = this->Macro.GetBlocks();
-      this->Majorant.resize(static_cast<std::size_t>(blocks[0]) * blocks[1] * blocks[2]);
-      for (std::size_t i = 0; i < this->Majorant.size(); ++i)
-      {
-        this->Majorant[i] = extinctionPerDensity * this->Macro.GetMaximum(i);
-      }
-      const Vector3& size = this->Macro.GetBlockSize();
-      this->MinCellSize = std::min({ size[0], size[1], size[2] });
-      if (this->Emission)
-      {
-        // Emission is collected at tentative collisions (FreeFlight), so the majorant
-        // must be positive wherever eta is, also where the medium does not attenuate
-        // (an "array" field, or extinction_per_density 0): such blocks get at least
-        // one tentative collision per block edge on average. Any majorant >= sigma_t
-        // is unbiased; this only sets how finely the emission is sampled there.
-        const double floor = 1.0 / this->MinCellSize;
-        for (const MediumComponent& m : this->Media)
-        {
-          if (!m.Emits)
-          {
-            continue;
-          }
-          const MajorantGrid emitting = settings.BlockTraversal
-            ? MajorantGrid(*m.EmissionField, 0, settings.MajorantBlockVoxels)
-            : MajorantGrid(*m.EmissionField, 1);
-          for (std::size_t i = 0; i < this->Majorant.size(); ++i)
-          {
-            if (!emitting.IsEmpty(i))
-            {
-              this->Majorant[i] = std::max(this->Majorant[i], floor);
-            }
-          }
-        }
-      }
+      this->BuildCloudMajorant(settings);
     }
     this->CloudAlbedo = context.GetCloudAlbedo();
-    if (this->Air)
-    {
-      const AtmosphereParameters& a = this->Air->GetParameters();
-      this->EarthRadius = a.EarthRadiusMetres;
-      this->ScaleHeightR = a.RayleighScaleHeightMetres;
-      this->ScaleHeightM = a.MieScaleHeightMetres;
-      this->MieG = a.MieG;
-      this->BetaR = context.GetRayleighScatteringSeaLevel();
-      this->BetaRMax = *std::max_element(this->BetaR.begin(), this->BetaR.end());
-      this->BetaMs = context.GetMieScatteringSeaLevel();
-      this->BetaMt = context.GetMieExtinctionSeaLevel();
-      if (this->HasCloud)
-      {
-        // Lowest altitude of the box: distance from the earth centre to the box.
-        // The earth centre in the scene frame is -EarthCentred(0).
-        const Vector3 origin = this->Context.EarthCentred({ { 0.0, 0.0, 0.0 } });
-        double r2 = 0.0;
-        for (int a = 0; a < 3; ++a)
-        {
-          const double c = -origin[a];
-          const double nearest =
-            std::min(this->Grid.GetUpper()[a], std::max(this->Grid.GetLower()[a], c));
-          r2 += (nearest - c) * (nearest - c);
-        }
-        this->CloudBoxMinRadius = std::sqrt(r2);
-        this->AirMajorantInCloudBox =
-          this->AirMajorantAt(this->CloudBoxMinRadius - this->EarthRadius);
-      }
-    }
-    else
-    {
-      this->BetaR.assign(this->Wavelengths, 0.0);
-    }
+    this->SetUpAir();
     this->Sun = context.GetSunDirection();
     this->SunIrradiance = context.GetSunIrradiance();
     this->SunOn = std::any_of(
       this->SunIrradiance.begin(), this->SunIrradiance.end(), [](double e) { return e > 0.0; });
     this->Background = context.GetBackgroundRadiance();
-    // ToLinearSrgb is linear in the spectrum: tabulate it once (3 x N matrix).
-    std::vector<double> unit(this->Wavelengths, 0.0);
-    this->ToRgb.resize(3 * static_cast<std::size_t>(this->Wavelengths));
-    for (int i = 0; i < this->Wavelengths; ++i)
-    {
-      unit.assign(this->Wavelengths, 0.0);
-      unit[i] = 1.0;
-      const std::array<double, 3> rgb = context.ToLinearSrgb(unit);
-      for (int c = 0; c < 3; ++c)
-      {
-        this->ToRgb[c * this->Wavelengths + i] = rgb[c];
-      }
-    }
+    this->BuildSpectrumToRgb();
     if (this->Air && this->HasCloud && this->SunOn)
     {
       this->BuildSunTable();
@@ -570,121 +484,18 @@ public:
     // estimated contribution at the vertex.
     if (settings.AngularLineLightSampling)
     {
-      const std::vector<LightElement>& elements = context.GetLightElements();
-      for (std::size_t k = 0; k < elements.size(); ++k)
-      {
-        const LightElement& light = elements[k];
-        if (!light.IsSegment || !(light.Intensity > 0.0))
-        {
-          continue;
-        }
-        const Vector3 axis{ { light.B[0] - light.A[0], light.B[1] - light.A[1],
-          light.B[2] - light.A[2] } };
-        const double length = std::sqrt(Dot(axis, axis));
-        if (!(length > 0.0) || !std::isfinite(length))
-        {
-          continue;
-        }
-        LineLight line;
-        line.A = light.A;
-        line.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
-        line.Length = length;
-        line.PerMetre = light.Intensity / length;
-        line.Element = k;
-        this->Lines.push_back(line);
-        this->LineTotal += light.Intensity;
-      }
-      // In the Morton (Z-order) of their midpoints over the segments' bounding box (10 bits
-      // an axis), so that consecutive segments lie close together.
-      Vector3 lo{ { kInfinity, kInfinity, kInfinity } },
-        hi{ { -kInfinity, -kInfinity, -kInfinity } };
-      for (const LineLight& line : this->Lines)
-      {
-        for (int a = 0; a < 3; ++a)
-        {
-          const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
-          lo[a] = std::min(lo[a], mid);
-          hi[a] = std::max(hi[a], mid);
-        }
-      }
-      auto morton = [&lo, &hi](const LineLight& line)
-      {
-        std::uint64_t code = 0;
-        std::uint64_t cell[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
-          const double u = hi[a] > lo[a] ? (mid - lo[a]) / (hi[a] - lo[a]) : 0.0;
-          cell[a] = static_cast<std::uint64_t>(std::clamp(u * 1023.0, 0.0, 1023.0));
-        }
-        for (int bit = 9; bit >= 0; --bit)
-        {
-          for (int a = 0; a < 3; ++a)
-          {
-            code = (code << 1) | ((cell[a] >> bit) & 1u);
-          }
-        }
-        return code;
-      };
-      std::stable_sort(this->Lines.begin(), this->Lines.end(),
-        [&morton](const LineLight& x, const LineLight& y) { return morton(x) < morton(y); });
-      for (const LineLight& line : this->Lines)
-      {
-        const LightElement& light = elements[line.Element];
-        for (int a = 0; a < 3; ++a)
-        {
-          this->LineA[a].push_back(light.A[a]);
-          this->LineB[a].push_back(light.B[a]);
-        }
-        this->LineWeightScale.push_back(std::sqrt(2.0) * light.Intensity);
-      }
-      // Clusters of ceil(sqrt(n)) consecutive segments in that order: their bounding
-      // spheres and intensities, for the first of SampleLine's two choices.
-      const std::size_t n = this->Lines.size();
-      const std::size_t size =
-        std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(std::sqrt(double(n)))));
-      for (std::size_t begin = 0; begin < n; begin += size)
-      {
-        const std::size_t end = std::min(n, begin + size);
-        Vector3 lo{ { kInfinity, kInfinity, kInfinity } },
-          hi{ { -kInfinity, -kInfinity, -kInfinity } };
-        double intensity = 0.0;
-        for (std::size_t i = begin; i < end; ++i)
-        {
-          for (int a = 0; a < 3; ++a)
-          {
-            lo[a] = std::min({ lo[a], this->LineA[a][i], this->LineB[a][i] });
-            hi[a] = std::max({ hi[a], this->LineA[a][i], this->LineB[a][i] });
-          }
-          intensity += this->LineWeightScale[i] / std::sqrt(2.0);
-        }
-        LineCluster cluster;
-        cluster.Begin = begin;
-        cluster.End = end;
-        cluster.Intensity = intensity;
-        for (int a = 0; a < 3; ++a)
-        {
-          cluster.Centre[a] = 0.5 * (lo[a] + hi[a]);
-        }
-        for (std::size_t i = begin; i < end; ++i)
-        {
-          double da = 0.0, db = 0.0;
-          for (int a = 0; a < 3; ++a)
-          {
-            da += (this->LineA[a][i] - cluster.Centre[a]) * (this->LineA[a][i] - cluster.Centre[a]);
-            db += (this->LineB[a][i] - cluster.Centre[a]) * (this->LineB[a][i] - cluster.Centre[a]);
-          }
-          cluster.Radius2 = std::max({ cluster.Radius2, da, db });
-        }
-        // A cluster of one point-like segment still gets a finite weight at its centre.
-        cluster.Radius2 = std::max(cluster.Radius2, 1e-12);
-        this->LineClusters.push_back(cluster);
-      }
+      this->BuildLineLights();
     }
   }
 
   int GetWavelengths() const { return this->Wavelengths; }
 
+  /// The constructor's steps: the cloud's majorant per block (sigma_bar), the air's
+  /// coefficients, the spectrum-to-RGB matrix, the polyline lights' tables.
+  void BuildCloudMajorant(const PathTracingSettings& settings);
+  void SetUpAir();
+  void BuildSpectrumToRgb();
+  void BuildLineLights();
   void BuildSunTable();
   /// Exact optical lengths L_R, L_M (m) toward the sun from radius r and sun cosine mu;
   /// false where the earth hides the sun.
@@ -892,6 +703,218 @@ private:
   std::vector<double> Background;
   std::vector<double> ToRgb;
 };
+
+void Integrator::BuildCloudMajorant(const PathTracingSettings& settings)
+{
+  // Coarse majorant grid of the cloud: sigma_bar per block of 4^3 voxels, the
+  // maximum over the block's grid points dilated by one point on every side, times
+  // the extinction per density. Trilinear interpolation never exceeds the corner
+  // values, so the value bounds sigma_t over the block and over one voxel around it
+  // (margin for pieces whose end points round across a block face).
+  this->Macro = settings.BlockTraversal ? MajorantGrid(this->Grid, 0, settings.MajorantBlockVoxels)
+                                        : MajorantGrid(this->Grid, 1);
+  const double extinctionPerDensity = this->Context.GetExtinctionScale();
+  const std::array<int, 3>& blocks = this->Macro.GetBlocks();
+  this->Majorant.resize(static_cast<std::size_t>(blocks[0]) * blocks[1] * blocks[2]);
+  for (std::size_t i = 0; i < this->Majorant.size(); ++i)
+  {
+    this->Majorant[i] = extinctionPerDensity * this->Macro.GetMaximum(i);
+  }
+  const Vector3& size = this->Macro.GetBlockSize();
+  this->MinCellSize = std::min({ size[0], size[1], size[2] });
+  if (this->Emission)
+  {
+    // Emission is collected at tentative collisions (FreeFlight), so the majorant
+    // must be positive wherever eta is, also where the medium does not attenuate
+    // (an "array" field, or extinction_per_density 0): such blocks get at least
+    // one tentative collision per block edge on average. Any majorant >= sigma_t
+    // is unbiased; this only sets how finely the emission is sampled there.
+    const double floor = 1.0 / this->MinCellSize;
+    for (const MediumComponent& m : this->Media)
+    {
+      if (!m.Emits)
+      {
+        continue;
+      }
+      const MajorantGrid emitting = settings.BlockTraversal
+        ? MajorantGrid(*m.EmissionField, 0, settings.MajorantBlockVoxels)
+        : MajorantGrid(*m.EmissionField, 1);
+      for (std::size_t i = 0; i < this->Majorant.size(); ++i)
+      {
+        if (!emitting.IsEmpty(i))
+        {
+          this->Majorant[i] = std::max(this->Majorant[i], floor);
+        }
+      }
+    }
+  }
+}
+
+void Integrator::SetUpAir()
+{
+  if (this->Air)
+  {
+    const AtmosphereParameters& a = this->Air->GetParameters();
+    this->EarthRadius = a.EarthRadiusMetres;
+    this->ScaleHeightR = a.RayleighScaleHeightMetres;
+    this->ScaleHeightM = a.MieScaleHeightMetres;
+    this->MieG = a.MieG;
+    this->BetaR = this->Context.GetRayleighScatteringSeaLevel();
+    this->BetaRMax = *std::max_element(this->BetaR.begin(), this->BetaR.end());
+    this->BetaMs = this->Context.GetMieScatteringSeaLevel();
+    this->BetaMt = this->Context.GetMieExtinctionSeaLevel();
+    if (this->HasCloud)
+    {
+      // Lowest altitude of the box: distance from the earth centre to the box.
+      // The earth centre in the scene frame is -EarthCentred(0).
+      const Vector3 origin = this->Context.EarthCentred({ { 0.0, 0.0, 0.0 } });
+      double r2 = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double c = -origin[a];
+        const double nearest =
+          std::min(this->Grid.GetUpper()[a], std::max(this->Grid.GetLower()[a], c));
+        r2 += (nearest - c) * (nearest - c);
+      }
+      this->CloudBoxMinRadius = std::sqrt(r2);
+      this->AirMajorantInCloudBox =
+        this->AirMajorantAt(this->CloudBoxMinRadius - this->EarthRadius);
+    }
+  }
+  else
+  {
+    this->BetaR.assign(this->Wavelengths, 0.0);
+  }
+}
+
+void Integrator::BuildSpectrumToRgb()
+{
+  // ToLinearSrgb is linear in the spectrum: tabulate it once (3 x N matrix).
+  std::vector<double> unit(this->Wavelengths, 0.0);
+  this->ToRgb.resize(3 * static_cast<std::size_t>(this->Wavelengths));
+  for (int i = 0; i < this->Wavelengths; ++i)
+  {
+    unit.assign(this->Wavelengths, 0.0);
+    unit[i] = 1.0;
+    const std::array<double, 3> rgb = this->Context.ToLinearSrgb(unit);
+    for (int c = 0; c < 3; ++c)
+    {
+      this->ToRgb[c * this->Wavelengths + i] = rgb[c];
+    }
+  }
+}
+
+void Integrator::BuildLineLights()
+{
+  const std::vector<LightElement>& elements = this->Context.GetLightElements();
+  for (std::size_t k = 0; k < elements.size(); ++k)
+  {
+    const LightElement& light = elements[k];
+    if (!light.IsSegment || !(light.Intensity > 0.0))
+    {
+      continue;
+    }
+    const Vector3 axis{ { light.B[0] - light.A[0], light.B[1] - light.A[1],
+      light.B[2] - light.A[2] } };
+    const double length = std::sqrt(Dot(axis, axis));
+    if (!(length > 0.0) || !std::isfinite(length))
+    {
+      continue;
+    }
+    LineLight line;
+    line.A = light.A;
+    line.Axis = { { axis[0] / length, axis[1] / length, axis[2] / length } };
+    line.Length = length;
+    line.PerMetre = light.Intensity / length;
+    line.Element = k;
+    this->Lines.push_back(line);
+    this->LineTotal += light.Intensity;
+  }
+  // In the Morton (Z-order) of their midpoints over the segments' bounding box (10 bits
+  // an axis), so that consecutive segments lie close together.
+  Vector3 lo{ { kInfinity, kInfinity, kInfinity } }, hi{ { -kInfinity, -kInfinity, -kInfinity } };
+  for (const LineLight& line : this->Lines)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
+      lo[a] = std::min(lo[a], mid);
+      hi[a] = std::max(hi[a], mid);
+    }
+  }
+  auto morton = [&lo, &hi](const LineLight& line)
+  {
+    std::uint64_t code = 0;
+    std::uint64_t cell[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const double mid = line.A[a] + 0.5 * line.Length * line.Axis[a];
+      const double u = hi[a] > lo[a] ? (mid - lo[a]) / (hi[a] - lo[a]) : 0.0;
+      cell[a] = static_cast<std::uint64_t>(std::clamp(u * 1023.0, 0.0, 1023.0));
+    }
+    for (int bit = 9; bit >= 0; --bit)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        code = (code << 1) | ((cell[a] >> bit) & 1u);
+      }
+    }
+    return code;
+  };
+  std::stable_sort(this->Lines.begin(), this->Lines.end(),
+    [&morton](const LineLight& x, const LineLight& y) { return morton(x) < morton(y); });
+  for (const LineLight& line : this->Lines)
+  {
+    const LightElement& light = elements[line.Element];
+    for (int a = 0; a < 3; ++a)
+    {
+      this->LineA[a].push_back(light.A[a]);
+      this->LineB[a].push_back(light.B[a]);
+    }
+    this->LineWeightScale.push_back(std::sqrt(2.0) * light.Intensity);
+  }
+  // Clusters of ceil(sqrt(n)) consecutive segments in that order: their bounding
+  // spheres and intensities, for the first of SampleLine's two choices.
+  const std::size_t n = this->Lines.size();
+  const std::size_t size =
+    std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(std::sqrt(double(n)))));
+  for (std::size_t begin = 0; begin < n; begin += size)
+  {
+    const std::size_t end = std::min(n, begin + size);
+    Vector3 lo{ { kInfinity, kInfinity, kInfinity } }, hi{ { -kInfinity, -kInfinity, -kInfinity } };
+    double intensity = 0.0;
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = std::min({ lo[a], this->LineA[a][i], this->LineB[a][i] });
+        hi[a] = std::max({ hi[a], this->LineA[a][i], this->LineB[a][i] });
+      }
+      intensity += this->LineWeightScale[i] / std::sqrt(2.0);
+    }
+    LineCluster cluster;
+    cluster.Begin = begin;
+    cluster.End = end;
+    cluster.Intensity = intensity;
+    for (int a = 0; a < 3; ++a)
+    {
+      cluster.Centre[a] = 0.5 * (lo[a] + hi[a]);
+    }
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      double da = 0.0, db = 0.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        da += (this->LineA[a][i] - cluster.Centre[a]) * (this->LineA[a][i] - cluster.Centre[a]);
+        db += (this->LineB[a][i] - cluster.Centre[a]) * (this->LineB[a][i] - cluster.Centre[a]);
+      }
+      cluster.Radius2 = std::max({ cluster.Radius2, da, db });
+    }
+    // A cluster of one point-like segment still gets a finite weight at its centre.
+    cluster.Radius2 = std::max(cluster.Radius2, 1e-12);
+    this->LineClusters.push_back(cluster);
+  }
+}
 
 bool Integrator::ExactSunLengths(double r, double mu, double& lR, double& lM) const
 {
