@@ -83,6 +83,22 @@ def automaton_periodic():
     return s, 1.5
 
 
+def automaton_maps():
+    """Probability maps as input (3-D p_hum and p_ext): each rank uses its layers of them."""
+    s, time = automaton()
+    maps = vtkImageData()
+    maps.SetDimensions(28, 22, 10)
+    for name, scale in (("p_hum", 0.2), ("p_ext", 0.1)):
+        values = vtkFloatArray()
+        values.SetName(name)
+        values.SetNumberOfTuples(28 * 22 * 10)
+        for i in range(28 * 22 * 10):
+            values.SetValue(i, scale * ((i * 37) % 11) / 10.0)
+        maps.GetPointData().AddArray(values)
+    s.SetInputData(maps)
+    return s, time
+
+
 def synthetic_image():
     image = vtkImageData()
     image.SetDimensions(22, 17, 1)
@@ -347,6 +363,7 @@ def main():
 
     cases = [("metaball cloud", metaballs), ("cloud automaton", automaton),
              ("cloud automaton, periodic", automaton_periodic),
+             ("cloud automaton, probability maps", automaton_maps),
              ("image cloud", image_cloud), ("smoke", smoke),
              ("OpenVDB reader", vdb_reader(vdb_path)),
              ("OpenVDB reader, density's box", vdb_reader(vdb_path, "density"))]
