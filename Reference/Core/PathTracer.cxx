@@ -496,6 +496,16 @@ public:
   void SetUpAir();
   void BuildSpectrumToRgb();
   void BuildLineLights();
+  /// TracePath's steps: the vertex where a flight reached its segment's end (false: the
+  /// path ends there), the next direction at a vertex (returns its pdf for the sun-peak
+  /// weight; 0 for the air and the surfaces), Russian roulette on the largest spectral
+  /// weight (false: the path ends), the spectrum to linear sRGB.
+  bool BoundaryVertex(const Ray& ray, double tEnd, SegmentEndKind endKind,
+    const OccluderHit& surface, PathState& state, Vector3& p, Scatterer& scatterer) const;
+  double SampleDirection(const Ray& ray, Scatterer scatterer, PathRandom& rng, PathState& state,
+    Vector3& direction) const;
+  bool SurvivesRoulette(PathRandom& rng, PathState& state) const;
+  void RadianceToRgb(const std::vector<double>& radiance, double rgb[3]) const;
   void BuildSunTable();
   /// Exact optical lengths L_R, L_M (m) toward the sun from radius r and sun cosine mu;
   /// false where the earth hides the sun.
@@ -2262,6 +2272,139 @@ void Integrator::SunPeakEstimate(const Vector3& p, const Vector3& incoming, Scat
   state.Medium = vertexMedium; // the path continues from p
 }
 
+bool Integrator::BoundaryVertex(const Ray& ray, double tEnd, SegmentEndKind endKind,
+  const OccluderHit& surface, PathState& state, Vector3& p, Scatterer& scatterer) const
+{
+  const int n = this->Wavelengths;
+  if (endKind == SegmentEndKind::Earth)
+  {
+    return false;
+  }
+  if (endKind == SegmentEndKind::Leaves)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      state.Radiance[i] += state.Weight[i] * this->Background[i];
+    }
+    return false;
+  }
+  if (++state.Steps > kMaxTrackingStepsPerPath)
+  {
+    state.Truncated = true;
+    return false;
+  }
+  if (endKind == SegmentEndKind::Surface)
+  {
+    // An occluder: a grey Lambertian surface; black ones end the path. The vertex
+    // moves off the surface (toward the side the path came from) so that the rays
+    // leaving it do not hit it again.
+    if (!(surface.Albedo > 0.0))
+    {
+      return false;
+    }
+    p = OffsetFromSurface(Along(ray.Origin, ray.Direction, tEnd), surface.Normal);
+    scatterer = Scatterer::Surface;
+    state.SurfaceNormal = surface.Normal;
+    state.SurfaceAlbedo = surface.Albedo;
+  }
+  else
+  {
+    p = Along(ray.Origin, ray.Direction, tEnd);
+    p[2] = this->Context.GetGroundHeight();
+    scatterer = Scatterer::Ground;
+  }
+  return true;
+}
+
+double Integrator::SampleDirection(
+  const Ray& ray, Scatterer scatterer, PathRandom& rng, PathState& state, Vector3& direction) const
+{
+  const int n = this->Wavelengths;
+  double pdf = 0.0;
+  auto uniform = [&rng]() { return rng.Uniform(); };
+  switch (scatterer)
+  {
+    case Scatterer::Ground:
+    {
+      // Cosine-weighted hemisphere about +z: pdf cos/pi, so the weight of the
+      // Lambertian BRDF albedo/pi times cos over the pdf is the albedo.
+      const double u1 = rng.Uniform(), u2 = rng.Uniform();
+      const double radius = std::sqrt(u1), phi = 2.0 * kPi * u2;
+      direction = { { radius * std::cos(phi), radius * std::sin(phi),
+        std::sqrt(std::max(0.0, 1.0 - u1)) } };
+      if (!(direction[2] > 0.0))
+      {
+        direction[2] = 1e-12;
+      }
+      pdf = direction[2] / kPi;
+      const double albedo = this->Context.GetGroundAlbedo();
+      for (int i = 0; i < n; ++i)
+      {
+        state.Weight[i] *= albedo;
+      }
+      break;
+    }
+    case Scatterer::Surface:
+    {
+      // Cosine-weighted about the surface's normal (the side the path came from): the
+      // weight of the Lambertian BRDF times cos over the pdf is the albedo.
+      const double mu = std::sqrt(rng.Uniform());
+      direction = DirectionFromCosine(state.SurfaceNormal, mu, rng.Uniform());
+      for (int i = 0; i < n; ++i)
+      {
+        state.Weight[i] *= state.SurfaceAlbedo;
+      }
+      break;
+    }
+    case Scatterer::Rayleigh:
+      direction = DirectionFromCosine(ray.Direction, SampleRayleigh(rng.Uniform()), rng.Uniform());
+      break;
+    case Scatterer::Mie:
+      direction = DirectionFromCosine(
+        ray.Direction, SampleCornetteShanks(this->MieG, uniform), rng.Uniform());
+      break;
+    case Scatterer::Cloud:
+    default:
+    {
+      const PhaseFunctionMixture& phase = this->CloudPhaseAt(state);
+      const double mu = phase.Sample(uniform);
+      direction = DirectionFromCosine(ray.Direction, mu, rng.Uniform());
+      pdf = phase.Evaluate(mu);
+      break;
+    }
+  }
+  return pdf;
+}
+
+bool Integrator::SurvivesRoulette(PathRandom& rng, PathState& state) const
+{
+  const int n = this->Wavelengths;
+  const double survive = std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
+  if (!(survive > 0.0) || rng.Uniform() >= survive)
+  {
+    return false;
+  }
+  for (int i = 0; i < n; ++i)
+  {
+    state.Weight[i] /= survive;
+  }
+  return true;
+}
+
+void Integrator::RadianceToRgb(const std::vector<double>& radiance, double rgb[3]) const
+{
+  const int n = this->Wavelengths;
+  for (int c = 0; c < 3; ++c)
+  {
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i)
+    {
+      sum += this->ToRgb[c * n + i] * radiance[i];
+    }
+    rgb[c] = sum;
+  }
+}
+
 void Integrator::TracePath(
   double x, double y, PathRandom& rng, PathState& state, double rgb[3]) const
 {
@@ -2323,42 +2466,9 @@ void Integrator::TracePath(
     Vector3 p;
     if (end == FlightEnd::Boundary)
     {
-      if (endKind == SegmentEndKind::Earth)
+      if (!this->BoundaryVertex(ray, tEnd, endKind, surface, state, p, scatterer))
       {
         break;
-      }
-      if (endKind == SegmentEndKind::Leaves)
-      {
-        for (int i = 0; i < n; ++i)
-        {
-          state.Radiance[i] += state.Weight[i] * this->Background[i];
-        }
-        break;
-      }
-      if (++state.Steps > kMaxTrackingStepsPerPath)
-      {
-        state.Truncated = true;
-        break;
-      }
-      if (endKind == SegmentEndKind::Surface)
-      {
-        // An occluder: a grey Lambertian surface; black ones end the path. The vertex
-        // moves off the surface (toward the side the path came from) so that the rays
-        // leaving it do not hit it again.
-        if (!(surface.Albedo > 0.0))
-        {
-          break;
-        }
-        p = OffsetFromSurface(Along(ray.Origin, ray.Direction, tEnd), surface.Normal);
-        scatterer = Scatterer::Surface;
-        state.SurfaceNormal = surface.Normal;
-        state.SurfaceAlbedo = surface.Albedo;
-      }
-      else
-      {
-        p = Along(ray.Origin, ray.Direction, tEnd);
-        p[2] = this->Context.GetGroundHeight();
-        scatterer = Scatterer::Ground;
       }
     }
     else
@@ -2411,86 +2521,16 @@ void Integrator::TracePath(
     }
     // Next direction, and its pdf for the sun-peak weight at the next vertex.
     Vector3 direction;
-    double pdf = 0.0;
-    auto uniform = [&rng]() { return rng.Uniform(); };
-    switch (scatterer)
-    {
-      case Scatterer::Ground:
-      {
-        // Cosine-weighted hemisphere about +z: pdf cos/pi, so the weight of the
-        // Lambertian BRDF albedo/pi times cos over the pdf is the albedo.
-        const double u1 = rng.Uniform(), u2 = rng.Uniform();
-        const double radius = std::sqrt(u1), phi = 2.0 * kPi * u2;
-        direction = { { radius * std::cos(phi), radius * std::sin(phi),
-          std::sqrt(std::max(0.0, 1.0 - u1)) } };
-        if (!(direction[2] > 0.0))
-        {
-          direction[2] = 1e-12;
-        }
-        pdf = direction[2] / kPi;
-        const double albedo = this->Context.GetGroundAlbedo();
-        for (int i = 0; i < n; ++i)
-        {
-          state.Weight[i] *= albedo;
-        }
-        break;
-      }
-      case Scatterer::Surface:
-      {
-        // Cosine-weighted about the surface's normal (the side the path came from): the
-        // weight of the Lambertian BRDF times cos over the pdf is the albedo.
-        const double mu = std::sqrt(rng.Uniform());
-        direction = DirectionFromCosine(state.SurfaceNormal, mu, rng.Uniform());
-        for (int i = 0; i < n; ++i)
-        {
-          state.Weight[i] *= state.SurfaceAlbedo;
-        }
-        break;
-      }
-      case Scatterer::Rayleigh:
-        direction =
-          DirectionFromCosine(ray.Direction, SampleRayleigh(rng.Uniform()), rng.Uniform());
-        break;
-      case Scatterer::Mie:
-        direction = DirectionFromCosine(
-          ray.Direction, SampleCornetteShanks(this->MieG, uniform), rng.Uniform());
-        break;
-      case Scatterer::Cloud:
-      default:
-      {
-        const PhaseFunctionMixture& phase = this->CloudPhaseAt(state);
-        const double mu = phase.Sample(uniform);
-        direction = DirectionFromCosine(ray.Direction, mu, rng.Uniform());
-        pdf = phase.Evaluate(mu);
-        break;
-      }
-    }
+    const double pdf = this->SampleDirection(ray, scatterer, rng, state, direction);
     previousPdf = usePeak ? pdf : 0.0;
     // Russian roulette on the largest spectral weight.
-    if (rouletteOrder >= 0 && order >= rouletteOrder)
+    if (rouletteOrder >= 0 && order >= rouletteOrder && !this->SurvivesRoulette(rng, state))
     {
-      const double survive =
-        std::min(1.0, *std::max_element(state.Weight.begin(), state.Weight.end()));
-      if (!(survive > 0.0) || rng.Uniform() >= survive)
-      {
-        break;
-      }
-      for (int i = 0; i < n; ++i)
-      {
-        state.Weight[i] /= survive;
-      }
+      break;
     }
     ray = this->MakeRay(p, direction);
   }
-  for (int c = 0; c < 3; ++c)
-  {
-    double sum = 0.0;
-    for (int i = 0; i < n; ++i)
-    {
-      sum += this->ToRgb[c * n + i] * state.Radiance[i];
-    }
-    rgb[c] = sum;
-  }
+  this->RadianceToRgb(state.Radiance, rgb);
 }
 
 void Integrator::TraceLightPath(
