@@ -28,9 +28,12 @@
  *     multiplying the framebuffer by its attenuation ratio a = exp(-kappa C(u)) (the
  *     precomputed billboard texture of the cumulative density C) and adding its
  *     colour Albedo x CornetteShanks(mu, CloudG) x the sun's colour x the sun's
- *     transmittance x (1 - a) x Exposure.
- * That is single scattering with the sun's light taken at each ball's centre; the
- * light scattered more than once, the sky's light and the air are not drawn.
+ *     transmittance x (1 - a) x Exposure: single scattering with the sun's light taken
+ *     at each ball's centre. With the accumulation texture and SunLightSamples > 0
+ *     (default 8) each fragment instead integrates the light along its own ray through
+ *     its ball, reading the texture at that many points (docs/splats.md: the light at
+ *     the centre makes overlapping balls far too dark).
+ * The light scattered more than once, the sky's light and the air are not drawn.
  *
  * Units: radii and points in world units, MetresPerUnit metres each; the sun
  * (SunAzimuthDegrees from +y toward +x, SunElevationDegrees above the x-y plane: z is
