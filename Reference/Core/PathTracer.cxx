@@ -3160,12 +3160,10 @@ std::uint64_t NextRoundTarget(
   return std::max(std::min(next, maxSamples), std::min(target + 1, maxSamples));
 }
 
-PathTracingResult RenderPathTraced(const RenderContext& context,
-  const PathTracingSettings& settings, const std::function<void(double)>& progress)
+namespace
 {
-  // Paths the calling thread traces between progress reports within a pixel (a few
-  // milliseconds: ~15 us a path in a thick cloud).
-  constexpr std::uint64_t kPathsPerProgressCheck = 1024;
+void CheckPathTracingSettings(const PathTracingSettings& settings)
+{
   if (settings.MinSamplesPerPixel < 1 || settings.MaxSamplesPerPixel < settings.MinSamplesPerPixel)
   {
     throw std::invalid_argument(
@@ -3180,6 +3178,86 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     throw std::invalid_argument(
       "RenderPathTraced: TimeLimitSeconds and TargetImageRelativeError must be >= 0");
   }
+}
+
+/// Per pixel: running statistics, a slot in the list of active pixels and the two result
+/// images (3 floats each); checked before anything is allocated.
+void CheckPixelBuffersFit(const PathTracingSettings& settings, int width, int height)
+{
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  const double bytesPerPixel = static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) +
+    2 * 3 * sizeof(float) + (settings.AdaptiveSampling ? 40 : 0));
+  const double budget = settings.MemoryBudgetBytes > 0.0
+    ? settings.MemoryBudgetBytes
+    : static_cast<double>(DefaultMemoryBudgetBytes());
+  const std::string message = OverBudgetMessage("the path tracer's per-pixel buffers (" +
+      std::to_string(width) + "x" + std::to_string(height) + " pixels, " +
+      std::to_string(static_cast<int>(bytesPerPixel)) + " bytes each)",
+    bytesPerPixel * static_cast<double>(pixels), budget);
+  if (!message.empty())
+  {
+    throw std::length_error(message);
+  }
+}
+
+/// The pixels still short of their samples or their error target.
+std::vector<std::size_t> ActivePixels(const std::vector<PixelStatistics>& statistics)
+{
+  std::vector<std::size_t> active;
+  for (std::size_t k = 0; k < statistics.size(); ++k)
+  {
+    if (!statistics[k].Done)
+    {
+      active.push_back(k);
+    }
+  }
+  return active;
+}
+
+PathTracingRound RoundReport(int rounds, std::uint64_t paths, double elapsed, double imageError,
+  const std::vector<PixelStatistics>& statistics)
+{
+  const std::size_t pixels = statistics.size();
+  PathTracingRound round;
+  round.Round = rounds;
+  round.MeanSamplesPerPixel =
+    static_cast<double>(paths) / static_cast<double>(std::max<std::size_t>(1, pixels));
+  round.Seconds = elapsed;
+  round.ImageRelativeError = imageError;
+  round.Pixels = pixels;
+  for (const PixelStatistics& stats : statistics)
+  {
+    round.ActivePixels += stats.Done ? 0 : 1;
+  }
+  return round;
+}
+
+void FillImages(
+  const std::vector<PixelStatistics>& statistics, int width, int height, PathTracingResult& result)
+{
+  const std::size_t pixels = statistics.size();
+  result.Image = FloatImage(width, height);
+  result.StandardError = FloatImage(width, height);
+  for (std::size_t k = 0; k < pixels; ++k)
+  {
+    const int i = static_cast<int>(k % static_cast<std::size_t>(width));
+    const int j = static_cast<int>(k / static_cast<std::size_t>(width));
+    for (int c = 0; c < 3; ++c)
+    {
+      result.Image.At(i, j)[c] = static_cast<float>(statistics[k].Mean[c]);
+      result.StandardError.At(i, j)[c] = static_cast<float>(statistics[k].StandardError(c));
+    }
+  }
+}
+} // namespace
+
+PathTracingResult RenderPathTraced(const RenderContext& context,
+  const PathTracingSettings& settings, const std::function<void(double)>& progress)
+{
+  // Paths the calling thread traces between progress reports within a pixel (a few
+  // milliseconds: ~15 us a path in a thick cloud).
+  constexpr std::uint64_t kPathsPerProgressCheck = 1024;
+  CheckPathTracingSettings(settings);
   if (settings.LightTracing)
   {
     return RenderLightTraced(context, settings, progress);
@@ -3188,23 +3266,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   const Camera& camera = context.GetCamera();
   const int width = camera.GetWidth(), height = camera.GetHeight();
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  {
-    // Per pixel: running statistics, a slot in the list of active pixels and the
-    // two result images (3 floats each); checked before anything is allocated.
-    const double bytesPerPixel = static_cast<double>(sizeof(PixelStatistics) + sizeof(std::size_t) +
-      2 * 3 * sizeof(float) + (settings.AdaptiveSampling ? 40 : 0));
-    const double budget = settings.MemoryBudgetBytes > 0.0
-      ? settings.MemoryBudgetBytes
-      : static_cast<double>(DefaultMemoryBudgetBytes());
-    const std::string message = OverBudgetMessage("the path tracer's per-pixel buffers (" +
-        std::to_string(width) + "x" + std::to_string(height) + " pixels, " +
-        std::to_string(static_cast<int>(bytesPerPixel)) + " bytes each)",
-      bytesPerPixel * static_cast<double>(pixels), budget);
-    if (!message.empty())
-    {
-      throw std::length_error(message);
-    }
-  }
+  CheckPixelBuffersFit(settings, width, height);
   const Integrator integrator(context, settings);
   std::vector<PixelStatistics> statistics(pixels);
   const int threads = ResolveThreadCount(settings.Threads);
@@ -3234,14 +3296,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (;;)
   {
-    std::vector<std::size_t> active;
-    for (std::size_t k = 0; k < pixels; ++k)
-    {
-      if (!statistics[k].Done)
-      {
-        active.push_back(k);
-      }
-    }
+    const std::vector<std::size_t> active = ActivePixels(statistics);
     if (active.empty())
     {
       break;
@@ -3342,18 +3397,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
     const double imageError = ImageRelativeError(statistics);
     if (settings.OnRound)
     {
-      PathTracingRound round;
-      round.Round = rounds;
-      round.MeanSamplesPerPixel =
-        static_cast<double>(paths.load()) / static_cast<double>(std::max<std::size_t>(1, pixels));
-      round.Seconds = elapsed;
-      round.ImageRelativeError = imageError;
-      round.Pixels = pixels;
-      for (const PixelStatistics& stats : statistics)
-      {
-        round.ActivePixels += stats.Done ? 0 : 1;
-      }
-      settings.OnRound(round);
+      settings.OnRound(RoundReport(rounds, paths.load(), elapsed, imageError, statistics));
     }
     if (settings.TargetImageRelativeError > 0.0 && imageError <= settings.TargetImageRelativeError)
     {
@@ -3381,18 +3425,7 @@ PathTracingResult RenderPathTraced(const RenderContext& context,
   }
 
   PathTracingResult result;
-  result.Image = FloatImage(width, height);
-  result.StandardError = FloatImage(width, height);
-  for (std::size_t k = 0; k < pixels; ++k)
-  {
-    const int i = static_cast<int>(k % static_cast<std::size_t>(width));
-    const int j = static_cast<int>(k / static_cast<std::size_t>(width));
-    for (int c = 0; c < 3; ++c)
-    {
-      result.Image.At(i, j)[c] = static_cast<float>(statistics[k].Mean[c]);
-      result.StandardError.At(i, j)[c] = static_cast<float>(statistics[k].StandardError(c));
-    }
-  }
+  FillImages(statistics, width, height, result);
   // Never a silent NaN or infinity (a scene the reader accepts should not make one).
   FinishResult(result, "RenderPathTraced",
     { paths.load(), truncated.load(), pixels, rounds, stoppedAtTimeLimit, reachedImageTarget },
