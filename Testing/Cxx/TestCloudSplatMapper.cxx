@@ -4,7 +4,8 @@
 // compared with a baseline PNG (criteria: ImageComparison.h); the same frame with the
 // sun's light read back per ball (the paper's variant) must agree with the texture's
 // per-ball light (SunLightSamples 0) to an RMSE of 6 (8-bit), and a frame that moves
-// only the camera must not redo the sun pass's work.
+// only the camera must not redo the sun pass's work; bad balls are skipped and a missing
+// array named.
 //
 //   TestCloudSplatMapper <baseline.png> <output dir>
 #include "vtkNimbusCloudSplatMapper.h"
@@ -13,16 +14,20 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkWindowToImageFilter.h"
 
 #include "ImageComparison.h"
+#include "MessageCatcher.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -149,6 +154,48 @@ int main(int argc, char* argv[])
     std::cerr << "the sun pass ran again for a camera move (" << mapper->GetLastSunPassSeconds()
               << " s)\n";
     ok = false;
+  }
+
+  // Bad input: a missing array is named once and nothing is drawn; balls with NaN,
+  // infinite, zero or negative radii or densities are skipped (the others drawn).
+  {
+    vtkNew<vtkPolyData> balls;
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkFloatArray> radius;
+    vtkNew<vtkFloatArray> density;
+    radius->SetName("radius");
+    density->SetName("density");
+    const float nan = std::nanf("");
+    const float values[5][2] = { { 300.0f, 1.0f }, { nan, 1.0f }, { 300.0f, INFINITY },
+      { -5.0f, 1.0f }, { 200.0f, 0.0f } };
+    for (int i = 0; i < 5; ++i)
+    {
+      points->InsertNextPoint(300.0 * i - 600.0, 0.0, 1600.0);
+      radius->InsertNextValue(values[i][0]);
+      density->InsertNextValue(values[i][1]);
+    }
+    balls->SetPoints(points);
+    balls->GetPointData()->AddArray(radius);
+    balls->GetPointData()->AddArray(density);
+    mapper->SetInputData(balls);
+    nimbus::testing::MessageCatcher catcher(mapper);
+    window->Render();
+    if (mapper->GetLastNumberOfBalls() != 1 || !catcher.Errors.empty())
+    {
+      std::cerr << "bad balls: drew " << mapper->GetLastNumberOfBalls()
+                << " (expected 1), errors: " << catcher.AllErrors() << "\n";
+      ok = false;
+    }
+    mapper->SetDensityArrayName("no such array");
+    window->Render();
+    window->Render();
+    if (mapper->GetLastNumberOfBalls() != 0 || catcher.Errors.size() != 1 ||
+      catcher.Errors[0].find("no such array") == std::string::npos)
+    {
+      std::cerr << "missing array: drew " << mapper->GetLastNumberOfBalls()
+                << ", errors: " << catcher.AllErrors() << "\n";
+      ok = false;
+    }
   }
   return ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }
