@@ -296,6 +296,110 @@ ReferencePattern BuildReferencePattern(const ExtinctionGrid& grid, const CloudOp
   }
   return pattern;
 }
+
+/// The order-1 source without its phase: E_sun(z_j) exp(-tau_sun(j)) [irradiance], 3 per
+/// point, at the points with extinction (0 elsewhere).
+std::vector<float> SunLightAtPoints(
+  const ExtinctionGrid& grid, const DirectionalLight& sun, const std::vector<float>& sunDepth)
+{
+  const std::size_t count = grid.NumberOfPoints();
+  const std::array<int, 3>& n = grid.Dimensions;
+  const std::vector<float>& sigmaT = grid.Extinction; // [1/m]
+  std::vector<float> sunLight(3 * count, 0.0f);
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const std::size_t index = grid.Index(i, j, k);
+        if (sigmaT[index] > 0.0f)
+        {
+          const Rgb irradiance = sun.IrradianceAt(grid.Position(i, j, k)[2]);
+          const double transmittance = std::exp(-static_cast<double>(sunDepth[index]));
+          for (int c = 0; c < 3; ++c)
+          {
+            sunLight[3 * index + c] = static_cast<float>(irradiance[c] * transmittance);
+          }
+        }
+      }
+    }
+  }
+  return sunLight;
+}
+
+/// The points whose J the mapper can use: some extinction in their 3x3x3 block.
+std::vector<unsigned char> NeededPoints(const ExtinctionGrid& grid)
+{
+  const std::size_t count = grid.NumberOfPoints();
+  const std::array<int, 3>& n = grid.Dimensions;
+  const std::vector<float>& sigmaT = grid.Extinction; // [1/m]
+  std::vector<unsigned char> needed(count, 0);
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        if (sigmaT[grid.Index(i, j, k)] > 0.0f)
+        {
+          for (int dk = std::max(0, k - 1); dk <= std::min(n[2] - 1, k + 1); ++dk)
+          {
+            for (int dj = std::max(0, j - 1); dj <= std::min(n[1] - 1, j + 1); ++dj)
+            {
+              for (int di = std::max(0, i - 1); di <= std::min(n[0] - 1, i + 1); ++di)
+              {
+                needed[grid.Index(di, dj, dk)] = 1;
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  return needed;
+}
+
+/// 004 §3.4: n1 of the pattern's n2 kept offsets for one point, as (kept offset, its
+/// factor W / (n1 w_i)): all of them (factor 1) when n1 = n2, else by systematic sampling
+/// proportional to the weights from the point's own random state (seed, order, point).
+void DrawOffsets(const ReferencePattern& pattern, std::size_t n1, std::uint64_t seed, int order,
+  std::size_t p, std::vector<std::pair<std::uint32_t, double>>& drawn)
+{
+  const std::size_t n2 = pattern.Kept.size();
+  const double keptWeight = n2 > 0 ? pattern.Cumulative.back() : 0.0; // W
+  drawn.clear();
+  if (n1 == n2)
+  {
+    for (std::size_t i = 0; i < n2; ++i)
+    {
+      drawn.emplace_back(static_cast<std::uint32_t>(i), 1.0);
+    }
+  }
+  else // systematic sampling proportional to the weights
+  {
+    const std::uint64_t state = Mix(Mix(Mix(seed) ^ static_cast<std::uint64_t>(order)) ^ p);
+    const double u0 = static_cast<double>(state >> 11) * 0x1.0p-53; // [0, 1)
+    std::size_t i = 0;
+    for (std::size_t m = 0; m < n1; ++m)
+    {
+      const double target = (u0 + static_cast<double>(m)) * keptWeight / n1;
+      while (i + 1 < n2 && pattern.Cumulative[i] <= target)
+      {
+        ++i;
+      }
+      const double factor = keptWeight / (n1 * pattern.Kept[i].Weight);
+      if (!drawn.empty() && drawn.back().first == i)
+      {
+        drawn.back().second += factor;
+      }
+      else
+      {
+        drawn.emplace_back(static_cast<std::uint32_t>(i), factor);
+      }
+    }
+  }
+}
 } // namespace
 
 void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& optics,
@@ -329,54 +433,11 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
   const double sigmaMean = sigmaSum / static_cast<double>(cloudPoints); // [1/m]
   const Vector3 toLight = Normalized(sun.ToLight);
 
-  // The order-1 source without its phase: E_sun(z_j) exp(-tau_sun(j)) [irradiance],
-  // at the points with extinction (the calling thread: sun.Irradiance need not be
-  // thread-safe).
-  std::vector<float> sunLight(3 * count, 0.0f);
-  for (int k = 0; k < n[2]; ++k)
-  {
-    for (int j = 0; j < n[1]; ++j)
-    {
-      for (int i = 0; i < n[0]; ++i)
-      {
-        const std::size_t index = grid.Index(i, j, k);
-        if (sigmaT[index] > 0.0f)
-        {
-          const Rgb irradiance = sun.IrradianceAt(grid.Position(i, j, k)[2]);
-          const double transmittance = std::exp(-static_cast<double>(sunDepth[index]));
-          for (int c = 0; c < 3; ++c)
-          {
-            sunLight[3 * index + c] = static_cast<float>(irradiance[c] * transmittance);
-          }
-        }
-      }
-    }
-  }
+  // The order-1 source without its phase (the calling thread: sun.Irradiance need not
+  // be thread-safe).
+  const std::vector<float> sunLight = SunLightAtPoints(grid, sun, sunDepth);
 
-  // The points whose J the mapper can use: some extinction in their 3x3x3 block.
-  std::vector<unsigned char> needed(count, 0);
-  for (int k = 0; k < n[2]; ++k)
-  {
-    for (int j = 0; j < n[1]; ++j)
-    {
-      for (int i = 0; i < n[0]; ++i)
-      {
-        if (sigmaT[grid.Index(i, j, k)] > 0.0f)
-        {
-          for (int dk = std::max(0, k - 1); dk <= std::min(n[2] - 1, k + 1); ++dk)
-          {
-            for (int dj = std::max(0, j - 1); dj <= std::min(n[1] - 1, j + 1); ++dj)
-            {
-              for (int di = std::max(0, i - 1); di <= std::min(n[0] - 1, i + 1); ++di)
-              {
-                needed[grid.Index(di, dj, dk)] = 1;
-              }
-            }
-          }
-        }
-      }
-    }
-  }
+  const std::vector<unsigned char> needed = NeededPoints(grid);
 
   const ReferencePattern sunPattern =
     BuildReferencePattern(grid, optics, toLight, options, sigmaMean, true);
@@ -406,7 +467,6 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
           std::ceil(options.PatternSelection * static_cast<double>(n2) - 1e-9))));
     // 004 §3.4: the estimate of the kept offsets' sum / r, see the file comment.
     const double scale = n2 > 0 ? 1.0 / pattern.CoveredShare : 0.0;
-    const double keptWeight = n2 > 0 ? pattern.Cumulative.back() : 0.0; // W
     const bool fromSun = order == 2;
 
     const auto body = [&](std::size_t begin, std::size_t end)
@@ -424,38 +484,7 @@ void AddReferencePatternOrders(const ExtinctionGrid& grid, const CloudOptics& op
         const int pi = static_cast<int>(p % n[0]);
         const int pj = static_cast<int>((p / n[0]) % n[1]);
         const int pk = static_cast<int>(p / (static_cast<std::size_t>(n[0]) * n[1]));
-        drawn.clear();
-        if (n1 == n2)
-        {
-          for (std::size_t i = 0; i < n2; ++i)
-          {
-            drawn.emplace_back(static_cast<std::uint32_t>(i), 1.0);
-          }
-        }
-        else // systematic sampling proportional to the weights
-        {
-          const std::uint64_t state =
-            Mix(Mix(Mix(options.Seed) ^ static_cast<std::uint64_t>(order)) ^ p);
-          const double u0 = static_cast<double>(state >> 11) * 0x1.0p-53; // [0, 1)
-          std::size_t i = 0;
-          for (std::size_t m = 0; m < n1; ++m)
-          {
-            const double target = (u0 + static_cast<double>(m)) * keptWeight / n1;
-            while (i + 1 < n2 && pattern.Cumulative[i] <= target)
-            {
-              ++i;
-            }
-            const double factor = keptWeight / (n1 * pattern.Kept[i].Weight);
-            if (!drawn.empty() && drawn.back().first == i)
-            {
-              drawn.back().second += factor;
-            }
-            else
-            {
-              drawn.emplace_back(static_cast<std::uint32_t>(i), factor);
-            }
-          }
-        }
+        DrawOffsets(pattern, n1, options.Seed, order, p, drawn);
         const double sigmaP = sigmaT[p];
         double c[3][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
         for (const std::pair<std::uint32_t, double>& draw : drawn)
