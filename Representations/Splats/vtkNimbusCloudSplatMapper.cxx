@@ -1,6 +1,7 @@
 #include "vtkNimbusCloudSplatMapper.h"
 
 #include "CloudSplats.h"
+#include "FiniteSetters.h"
 #include "ShaderLibrary.h"
 #include "Sun.h"
 #include "SunAndAir.h"
@@ -182,6 +183,15 @@ struct vtkNimbusCloudSplatMapper::Internals
 };
 
 vtkStandardNewMacro(vtkNimbusCloudSplatMapper);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, SunAzimuthDegrees);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, SunElevationDegrees);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, SunIlluminance);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, SunTemperatureKelvin);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, ExtinctionPerDensity);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, Albedo);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, CloudG);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, MetresPerUnit);
+nimbusDefineFiniteSetter(vtkNimbusCloudSplatMapper, Exposure);
 
 vtkNimbusCloudSplatMapper::vtkNimbusCloudSplatMapper()
   : Internal(new Internals)

@@ -42,6 +42,9 @@
  * (Physics/SunAndAir); radiance relative to the sun, x Exposure in the framebuffer
  * (linear, no sRGB encoding).
  *
+ * The numeric setters refuse NaN and infinity (an error; the value is kept) and clamp
+ * finite values to their ranges (Cloud/FiniteSetters.h).
+ *
  * Drawn in the opaque pass after the props before it, as an emissive prop: depth-tested
  * against the scene's depth, writing none; opaque props drawn later are not hidden by
  * it. The actor's matrix moves the balls (its scale's cube root scales the radii).
@@ -79,13 +82,21 @@ public:
   /// The sun, as vtkNimbusCloudVolumeMapper: azimuth from +y toward +x and elevation
   /// (degrees), the luminance of its irradiance (relative; default 1) and its
   /// blackbody temperature (K; default 5778).
-  vtkSetClampMacro(SunAzimuthDegrees, double, -1e9, 1e9);
+  virtual void SetSunAzimuthDegrees(double value);
+  virtual double GetSunAzimuthDegreesMinValue() { return -1e9; }
+  virtual double GetSunAzimuthDegreesMaxValue() { return 1e9; }
   vtkGetMacro(SunAzimuthDegrees, double);
-  vtkSetClampMacro(SunElevationDegrees, double, -90.0, 90.0);
+  virtual void SetSunElevationDegrees(double value);
+  virtual double GetSunElevationDegreesMinValue() { return -90.0; }
+  virtual double GetSunElevationDegreesMaxValue() { return 90.0; }
   vtkGetMacro(SunElevationDegrees, double);
-  vtkSetClampMacro(SunIlluminance, double, 0.0, 1e9);
+  virtual void SetSunIlluminance(double value);
+  virtual double GetSunIlluminanceMinValue() { return 0.0; }
+  virtual double GetSunIlluminanceMaxValue() { return 1e9; }
   vtkGetMacro(SunIlluminance, double);
-  vtkSetClampMacro(SunTemperatureKelvin, double, 1000.0, 40000.0);
+  virtual void SetSunTemperatureKelvin(double value);
+  virtual double GetSunTemperatureKelvinMinValue() { return 1000.0; }
+  virtual double GetSunTemperatureKelvinMaxValue() { return 40000.0; }
   vtkGetMacro(SunTemperatureKelvin, double);
   ///@}
 
@@ -93,20 +104,30 @@ public:
   /// Cloud optics, as vtkNimbusCloudVolumeMapper: sigma_t = ExtinctionPerDensity x
   /// density (1/m; default 0.02), Albedo sigma_s / sigma_t (default 0.99), CloudG the
   /// Cornette-Shanks asymmetry (default 0.85).
-  vtkSetClampMacro(ExtinctionPerDensity, double, 0.0, 1e6);
+  virtual void SetExtinctionPerDensity(double value);
+  virtual double GetExtinctionPerDensityMinValue() { return 0.0; }
+  virtual double GetExtinctionPerDensityMaxValue() { return 1e6; }
   vtkGetMacro(ExtinctionPerDensity, double);
-  vtkSetClampMacro(Albedo, double, 0.0, 1.0);
+  virtual void SetAlbedo(double value);
+  virtual double GetAlbedoMinValue() { return 0.0; }
+  virtual double GetAlbedoMaxValue() { return 1.0; }
   vtkGetMacro(Albedo, double);
-  vtkSetClampMacro(CloudG, double, -0.999, 0.999);
+  virtual void SetCloudG(double value);
+  virtual double GetCloudGMinValue() { return -0.999; }
+  virtual double GetCloudGMaxValue() { return 0.999; }
   vtkGetMacro(CloudG, double);
   ///@}
 
   ///@{
   /// Metres per world unit (default 1) and the framebuffer's value per unit radiance
   /// (default 1).
-  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  virtual void SetMetresPerUnit(double value);
+  virtual double GetMetresPerUnitMinValue() { return 1e-9; }
+  virtual double GetMetresPerUnitMaxValue() { return 1e9; }
   vtkGetMacro(MetresPerUnit, double);
-  vtkSetClampMacro(Exposure, double, 0.0, 1e9);
+  virtual void SetExposure(double value);
+  virtual double GetExposureMinValue() { return 0.0; }
+  virtual double GetExposureMaxValue() { return 1e9; }
   vtkGetMacro(Exposure, double);
   ///@}
 

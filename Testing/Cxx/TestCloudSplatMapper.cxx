@@ -186,6 +186,15 @@ int main(int argc, char* argv[])
                 << " (expected 1), errors: " << catcher.AllErrors() << "\n";
       ok = false;
     }
+    mapper->SetSunElevationDegrees(std::nan(""));
+    mapper->SetExtinctionPerDensity(INFINITY);
+    if (catcher.Errors.size() != 2 || mapper->GetSunElevationDegrees() != 25.0 ||
+      mapper->GetExtinctionPerDensity() != 0.004)
+    {
+      std::cerr << "non-finite settings not refused: " << catcher.AllErrors() << "\n";
+      ok = false;
+    }
+    catcher.Errors.clear();
     mapper->SetDensityArrayName("no such array");
     window->Render();
     window->Render();
