@@ -349,35 +349,13 @@ std::vector<float> SkyModel::GetMultipleScatteringTableRgb() const
   return rgb;
 }
 
-//------------------------------------------------------------------------------
-SkySpectra SkyModel::March(
-  const Vector3& x0, const Vector3& w, const Vector3& s, const MarchOptions& o) const
+namespace
 {
-  const int n = static_cast<int>(this->BetaRayleigh.size());
-  const AtmosphereParameters& a = this->Parameters.Atmosphere;
-  const double R = a.EarthRadiusMetres, top = a.TopRadiusMetres;
-  SkySpectra out;
-  out.Rayleigh.assign(n, 0.0);
-  out.Mie.assign(n, 0.0);
-  out.Isotropic.assign(n, 0.0);
-  out.Transmittance.assign(n, 1.0);
-  auto record = [&](std::size_t count)
-  {
-    if (o.Records)
-    {
-      while (o.Records->size() < count)
-      {
-        o.Records->push_back(out);
-      }
-    }
-  };
-
-  Vector3 x = x0;
-  double r = std::sqrt(Dot(x, x));
-  if (!std::isfinite(r) || !std::isfinite(Dot(w, w)) || !std::isfinite(Dot(s, s)))
-  {
-    throw std::invalid_argument("nimbus::Sky: non-finite ray or sun direction");
-  }
+/// Moves the start of a march x (earth-centred, radius r) into the atmosphere: from below
+/// the ground radially onto it, from above the top along w to where the ray enters
+/// (offset: the distance skipped, m). False when the ray misses the atmosphere.
+bool EnterAtmosphere(const Vector3& w, double R, double top, Vector3& x, double& r, double& offset)
+{
   if (r < R)
   {
     // Below the ground: radially onto it (as Atmosphere::OpticalLengthsToTop).
@@ -385,52 +363,33 @@ SkySpectra SkyModel::March(
     x = r > 0.0 ? Vector3{ { x[0] * k, x[1] * k, x[2] * k } } : Vector3{ { 0.0, 0.0, R } };
     r = R;
   }
-  double offset = 0.0; // distance skipped outside the atmosphere
   if (r > top)
   {
     const double b = Dot(x, w);
     const double disc = b * b - (r - top) * (r + top);
     if (b >= 0.0 || disc <= 0.0)
     {
-      record(o.RecordAt ? o.RecordAt->size() : 0);
-      return out; // misses the atmosphere
+      return false; // misses the atmosphere
     }
     offset = -b - std::sqrt(disc);
     x = { { x[0] + offset * w[0], x[1] + offset * w[1], x[2] + offset * w[2] } };
     r = top;
   }
-  const double mu = Clamp(Dot(x, w) / r, -1.0, 1.0);
-  bool hits = this->RayHitsGround(r, mu);
-  if (o.Ground == GroundMode::Hit)
-  {
-    hits = true;
-  }
-  else if (o.Ground == GroundMode::Miss)
-  {
-    hits = false;
-  }
-  double D = hits ? this->DistanceToGround(r, mu) : this->DistanceToTop(r, mu);
-  bool groundTerm = hits;
-  if (o.RecordAt && !o.RecordAt->empty())
-  {
-    D = std::max(0.0, o.RecordAt->back() - offset);
-    groundTerm = false;
-  }
-  else if (o.MaxDistance >= 0.0 && o.MaxDistance - offset < D)
-  {
-    D = std::max(0.0, o.MaxDistance - offset);
-    groundTerm = false;
-  }
+  return true;
+}
 
-  // Step nodes.
+/// The march's step nodes along the ray (m from x, the entry point) up to D: steps per
+/// interval between the distances recordAt (from the ray's origin, offset before x) when
+/// given, with recordNode the node reached at each; else quadratically spaced.
+std::vector<double> MarchNodes(const Vector3& x, const Vector3& w, double D, double offset,
+  int steps, const std::vector<double>* recordAt, std::vector<std::size_t>& recordNode)
+{
   std::vector<double> nodes;
-  const int steps = o.Steps > 0 ? o.Steps : this->Parameters.ViewSteps;
-  std::vector<std::size_t> recordNode; // node index reached at each record
-  if (o.RecordAt)
+  if (recordAt)
   {
     nodes.push_back(0.0);
     double previous = 0.0;
-    for (double target : *o.RecordAt)
+    for (double target : *recordAt)
     {
       const double t1 = Clamp(target - offset, 0.0, D);
       if (t1 > previous)
@@ -473,6 +432,72 @@ SkySpectra SkyModel::March(
       }
     }
   }
+  return nodes;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+SkySpectra SkyModel::March(
+  const Vector3& x0, const Vector3& w, const Vector3& s, const MarchOptions& o) const
+{
+  const int n = static_cast<int>(this->BetaRayleigh.size());
+  const AtmosphereParameters& a = this->Parameters.Atmosphere;
+  const double R = a.EarthRadiusMetres, top = a.TopRadiusMetres;
+  SkySpectra out;
+  out.Rayleigh.assign(n, 0.0);
+  out.Mie.assign(n, 0.0);
+  out.Isotropic.assign(n, 0.0);
+  out.Transmittance.assign(n, 1.0);
+  auto record = [&](std::size_t count)
+  {
+    if (o.Records)
+    {
+      while (o.Records->size() < count)
+      {
+        o.Records->push_back(out);
+      }
+    }
+  };
+
+  Vector3 x = x0;
+  double r = std::sqrt(Dot(x, x));
+  if (!std::isfinite(r) || !std::isfinite(Dot(w, w)) || !std::isfinite(Dot(s, s)))
+  {
+    throw std::invalid_argument("nimbus::Sky: non-finite ray or sun direction");
+  }
+  double offset = 0.0; // distance skipped outside the atmosphere
+  if (!EnterAtmosphere(w, R, top, x, r, offset))
+  {
+    record(o.RecordAt ? o.RecordAt->size() : 0);
+    return out; // misses the atmosphere
+  }
+  const double mu = Clamp(Dot(x, w) / r, -1.0, 1.0);
+  bool hits = this->RayHitsGround(r, mu);
+  if (o.Ground == GroundMode::Hit)
+  {
+    hits = true;
+  }
+  else if (o.Ground == GroundMode::Miss)
+  {
+    hits = false;
+  }
+  double D = hits ? this->DistanceToGround(r, mu) : this->DistanceToTop(r, mu);
+  bool groundTerm = hits;
+  if (o.RecordAt && !o.RecordAt->empty())
+  {
+    D = std::max(0.0, o.RecordAt->back() - offset);
+    groundTerm = false;
+  }
+  else if (o.MaxDistance >= 0.0 && o.MaxDistance - offset < D)
+  {
+    D = std::max(0.0, o.MaxDistance - offset);
+    groundTerm = false;
+  }
+
+  // Step nodes.
+  const int steps = o.Steps > 0 ? o.Steps : this->Parameters.ViewSteps;
+  std::vector<std::size_t> recordNode; // node index reached at each record
+  const std::vector<double> nodes = MarchNodes(x, w, D, offset, steps, o.RecordAt, recordNode);
 
   std::vector<double> Tsun(n), source(n, 0.0);
   std::vector<double>& T = out.Transmittance;
