@@ -309,6 +309,79 @@ nimbus::SceneFields SceneFieldsOf(
   }
   return fields;
 }
+
+/// The scene's own density (vtkNimbusSceneDensitySource), when no image is connected.
+vtkSmartPointer<vtkImageData> SceneDensity(
+  const std::string& sceneFileName, double budgetMiB, std::string& densityErrors)
+{
+  vtkNew<vtkNimbusSceneDensitySource> sceneDensity;
+  sceneDensity->SetSceneFileName(sceneFileName.c_str());
+  sceneDensity->SetMemoryBudgetMiB(budgetMiB);
+  // Its errors become part of this algorithm's one error (observers of this
+  // algorithm see why), its warnings are passed on as they come.
+  vtkNew<vtkCallbackCommand> relay;
+  relay->SetClientData(&densityErrors);
+  relay->SetCallback(
+    [](vtkObject*, unsigned long, void* clientData, void* callData)
+    {
+      auto* text = static_cast<std::string*>(clientData);
+      std::string message = static_cast<const char*>(callData);
+      const std::size_t object = message.find("): "); // "vtkClass (0x...): "
+      message = object == std::string::npos ? message : message.substr(object + 3);
+      while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
+      {
+        message.pop_back();
+      }
+      *text += (text->empty() ? "" : "; ") + message;
+    });
+  sceneDensity->AddObserver(vtkCommand::ErrorEvent, relay);
+  sceneDensity->Update();
+  return sceneDensity->GetOutput();
+}
+
+/// The renderers' context: the density as a float grid (its errors name the array) and the
+/// scene's fields.
+std::unique_ptr<nimbus::RenderContext> MakeRenderContext(const nimbus::SceneDescription& scene,
+  vtkImageData* volume, vtkDataArray* values, const std::string& arrayName,
+  const std::string& sceneFileName, double budgetMiB)
+{
+  nimbus::DensityGrid grid;
+  try
+  {
+    grid = nimbus::DensityGridFromImage(volume, values);
+  }
+  catch (const std::invalid_argument& error)
+  {
+    throw std::invalid_argument("density array '" + arrayName + "': " + error.what());
+  }
+  return std::make_unique<nimbus::RenderContext>(
+    scene, std::move(grid), SceneFieldsOf(scene, sceneFileName, budgetMiB));
+}
+
+/// The warning when a pilot forecasts more time to the target image error than the time
+/// limit (or over an hour without one), else empty.
+std::string PilotForecast(const std::string& sceneFileName,
+  const nimbus::PathTracingEstimate& estimate, double target, double limit)
+{
+  if ((limit > 0.0 && estimate.SecondsToTarget > limit) ||
+    (limit == 0.0 && estimate.SecondsToTarget > 3600.0))
+  {
+    std::ostringstream message;
+    message.precision(2);
+    message << sceneFileName << ": a pilot (" << estimate.PilotPixels << " pixels x "
+            << estimate.PilotSamplesPerPixel << " samples, " << estimate.PilotSeconds
+            << " s) forecasts about " << FormatDuration(estimate.SecondsToTarget)
+            << " to reach an image error of " << 100.0 * target << " %";
+    if (limit > 0.0)
+    {
+      const double reachable = target * std::sqrt(estimate.SecondsToTarget / std::max(limit, 1e-9));
+      message << "; the time limit of " << FormatDuration(limit)
+              << " will end the render first, at about " << 100.0 * reachable << " %";
+    }
+    return message.str();
+  }
+  return std::string();
+}
 } // namespace
 
 int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkImageData* output)
@@ -337,30 +410,8 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
   std::string arrayName = this->DensityArrayName;
   if (!volume)
   {
-    vtkNew<vtkNimbusSceneDensitySource> sceneDensity;
-    sceneDensity->SetSceneFileName(this->SceneFileName.c_str());
-    sceneDensity->SetMemoryBudgetMiB(budget / 1048576.0);
-    // Its errors become part of this algorithm's one error (observers of this
-    // algorithm see why), its warnings are passed on as they come.
     std::string densityErrors;
-    vtkNew<vtkCallbackCommand> relay;
-    relay->SetClientData(&densityErrors);
-    relay->SetCallback(
-      [](vtkObject*, unsigned long, void* clientData, void* callData)
-      {
-        auto* text = static_cast<std::string*>(clientData);
-        std::string message = static_cast<const char*>(callData);
-        const std::size_t object = message.find("): "); // "vtkClass (0x...): "
-        message = object == std::string::npos ? message : message.substr(object + 3);
-        while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
-        {
-          message.pop_back();
-        }
-        *text += (text->empty() ? "" : "; ") + message;
-      });
-    sceneDensity->AddObserver(vtkCommand::ErrorEvent, relay);
-    sceneDensity->Update();
-    volume = sceneDensity->GetOutput();
+    volume = SceneDensity(this->SceneFileName, budget / 1048576.0, densityErrors);
     arrayName = "density";
     if (volume->GetNumberOfPoints() == 0)
     {
@@ -391,20 +442,8 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
     return 0;
   }
 
-  std::unique_ptr<nimbus::RenderContext> context;
-  {
-    nimbus::DensityGrid grid;
-    try
-    {
-      grid = nimbus::DensityGridFromImage(volume, values);
-    }
-    catch (const std::invalid_argument& error)
-    {
-      throw std::invalid_argument("density array '" + arrayName + "': " + error.what());
-    }
-    context = std::make_unique<nimbus::RenderContext>(
-      scene, std::move(grid), SceneFieldsOf(scene, this->SceneFileName, budget / 1048576.0));
-  }
+  const std::unique_ptr<nimbus::RenderContext> context =
+    MakeRenderContext(scene, volume, values, arrayName, this->SceneFileName, budget / 1048576.0);
   const double renderBudget =
     budget - static_cast<double>(values->GetNumberOfTuples()) * sizeof(float) - outputBytes;
 
@@ -464,24 +503,11 @@ int vtkNimbusReferenceRenderer::Render(vtkInformationVector** inputVector, vtkIm
       const nimbus::PathTracingEstimate estimate =
         nimbus::EstimatePathTracingTime(*context, settings, this->TargetImageRelativeError);
       this->EstimatedSecondsToTarget = estimate.SecondsToTarget;
-      const double limit = this->TimeLimitSeconds;
-      if ((limit > 0.0 && estimate.SecondsToTarget > limit) ||
-        (limit == 0.0 && estimate.SecondsToTarget > 3600.0))
+      const std::string forecast = PilotForecast(
+        this->SceneFileName, estimate, this->TargetImageRelativeError, this->TimeLimitSeconds);
+      if (!forecast.empty())
       {
-        std::ostringstream message;
-        message.precision(2);
-        message << this->SceneFileName << ": a pilot (" << estimate.PilotPixels << " pixels x "
-                << estimate.PilotSamplesPerPixel << " samples, " << estimate.PilotSeconds
-                << " s) forecasts about " << FormatDuration(estimate.SecondsToTarget)
-                << " to reach an image error of " << 100.0 * this->TargetImageRelativeError << " %";
-        if (limit > 0.0)
-        {
-          const double reachable = this->TargetImageRelativeError *
-            std::sqrt(estimate.SecondsToTarget / std::max(limit, 1e-9));
-          message << "; the time limit of " << FormatDuration(limit)
-                  << " will end the render first, at about " << 100.0 * reachable << " %";
-        }
-        vtkWarningMacro(<< message.str() << ".");
+        vtkWarningMacro(<< forecast << ".");
       }
     }
     settings.OnRound = [this](const nimbus::PathTracingRound& round)
