@@ -246,6 +246,17 @@ int vtkNimbusImageCloudFilter::RequestData(
   vtkImageData* map = vtkImageData::GetData(outputVector, 1);
   output->Initialize();
   map->Initialize();
+  static bool warnedRanks = false; // once per process
+  const int pieces = outputVector->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+  if (pieces > 1 && !warnedRanks)
+  {
+    warnedRanks = true;
+    vtkWarningMacro(<< "Image cloud on " << pieces
+                    << " ranks (pieces): every rank builds the whole cloud (each column's fit "
+                       "depends on its neighbours and on the map's maximum) and keeps its "
+                       "piece; more ranks make it neither faster nor smaller per rank.");
+  }
   try
   {
     return this->Generate(inputVector, outputVector);

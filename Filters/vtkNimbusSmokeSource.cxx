@@ -172,6 +172,17 @@ int vtkNimbusSmokeSource::RequestData(
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   output->Initialize();
   vtkInternals& in = *this->Internals;
+  static bool warnedRanks = false; // once per process
+  const int pieces = outputVector->GetInformationObject(0)->Get(
+    vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+  if (pieces > 1 && !warnedRanks)
+  {
+    warnedRanks = true;
+    vtkWarningMacro("Smoke on " << pieces
+                                << " ranks (pieces): every rank simulates the whole "
+                                   "domain (the pressure solve is global) and keeps its piece; "
+                                   "more ranks make it neither faster nor smaller per rank.");
+  }
 
   nimbus::SmokeParameters p;
   for (int k = 0; k < 3; ++k)
