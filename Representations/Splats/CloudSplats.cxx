@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace nimbus
 {
@@ -182,5 +183,139 @@ std::vector<std::array<std::size_t, 2>> SplatLayerRanges(
     ranges[k] = { std::min(before(previous - maxDiameter), end), end };
   }
   return ranges;
+}
+double SplatBallVolume()
+{
+  // 4 pi integral_0^1 f(r^2) r^2 dr, f the metaball kernel (004 §4).
+  return 4.0 * M_PI * (1.0 / 3.0 - 22.0 / 45.0 + 17.0 / 63.0 - 4.0 / 81.0);
+}
+
+namespace
+{
+// The ball's mass on the 8 grid points around `x` (grid coordinates), trilinearly.
+void DepositCloudInCell(SplatDensityGrid& grid, const double x[3], double mass)
+{
+  int i0[3];
+  double w[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const double u = std::min(std::max(x[a], 0.0), grid.Dimensions[a] - 1.000001);
+    i0[a] = static_cast<int>(u);
+    w[a] = u - i0[a];
+  }
+  const double perPoint = mass / (grid.Spacing * grid.Spacing * grid.Spacing);
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double weight = 1.0;
+    int idx[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const int bit = (corner >> a) & 1;
+      weight *= bit ? w[a] : 1.0 - w[a];
+      idx[a] = i0[a] + bit;
+    }
+    const std::size_t n =
+      (static_cast<std::size_t>(idx[2]) * grid.Dimensions[1] + idx[1]) * grid.Dimensions[0] +
+      idx[0];
+    grid.Density[n] += static_cast<float>(weight * perPoint);
+  }
+}
+} // namespace
+
+// The balls' density on a grid for the multiple-scattering solve (docs/splats.md).
+SplatDensityGrid SplatBallsOntoGrid(const std::vector<float>& centres,
+  const std::vector<float>& radii, const std::vector<float>& densities, int longestSide)
+{
+  const std::size_t balls = radii.size();
+  if (longestSide < 4 || centres.size() != 3 * balls || densities.size() != balls)
+  {
+    throw std::invalid_argument("SplatBallsOntoGrid: needs longestSide >= 4 and 3 centre "
+                                "coordinates and one density per radius");
+  }
+  SplatDensityGrid grid;
+  if (balls == 0)
+  {
+    return grid;
+  }
+  double lo[3] = { 1e300, 1e300, 1e300 }, hi[3] = { -1e300, -1e300, -1e300 };
+  for (std::size_t b = 0; b < balls; ++b)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      lo[a] = std::min(lo[a], static_cast<double>(centres[3 * b + a]) - radii[b]);
+      hi[a] = std::max(hi[a], static_cast<double>(centres[3 * b + a]) + radii[b]);
+    }
+  }
+  const double longest = std::max({ hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30 });
+  // longestSide points including one padding point at each end.
+  grid.Spacing = longest / (longestSide - 3);
+  for (int a = 0; a < 3; ++a)
+  {
+    grid.Dimensions[a] =
+      std::max(static_cast<int>(std::ceil((hi[a] - lo[a]) / grid.Spacing - 1e-9)) + 3, 4);
+    const double extent = (grid.Dimensions[a] - 1) * grid.Spacing;
+    grid.Origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * extent;
+  }
+  grid.Density.assign(
+    static_cast<std::size_t>(grid.Dimensions[0]) * grid.Dimensions[1] * grid.Dimensions[2], 0.0f);
+  const double h = grid.Spacing;
+  const double cell = h * h * h;
+  std::vector<std::pair<std::size_t, float>> samples;
+  for (std::size_t b = 0; b < balls; ++b)
+  {
+    const double radius = radii[b];
+    const double mass =
+      static_cast<double>(densities[b]) * radius * radius * radius * SplatBallVolume();
+    const double x[3] = { (centres[3 * b] - grid.Origin[0]) / h,
+      (centres[3 * b + 1] - grid.Origin[1]) / h, (centres[3 * b + 2] - grid.Origin[2]) / h };
+    if (!(mass > 0.0) || !std::isfinite(mass))
+    {
+      continue;
+    }
+    samples.clear();
+    double sum = 0.0;
+    if (radius >= h)
+    {
+      const double r = radius / h;
+      int first[3], last[3];
+      for (int a = 0; a < 3; ++a)
+      {
+        first[a] = std::max(static_cast<int>(std::ceil(x[a] - r)), 0);
+        last[a] = std::min(static_cast<int>(std::floor(x[a] + r)), grid.Dimensions[a] - 1);
+      }
+      for (int k = first[2]; k <= last[2]; ++k)
+      {
+        for (int j = first[1]; j <= last[1]; ++j)
+        {
+          for (int i = first[0]; i <= last[0]; ++i)
+          {
+            const double q =
+              ((i - x[0]) * (i - x[0]) + (j - x[1]) * (j - x[1]) + (k - x[2]) * (k - x[2])) /
+              (r * r);
+            const double f = SplatKernel(q);
+            if (f > 0.0)
+            {
+              const std::size_t n =
+                (static_cast<std::size_t>(k) * grid.Dimensions[1] + j) * grid.Dimensions[0] + i;
+              samples.emplace_back(n, static_cast<float>(f));
+              sum += f;
+            }
+          }
+        }
+      }
+    }
+    if (sum <= 0.0)
+    {
+      DepositCloudInCell(grid, x, mass);
+      continue;
+    }
+    // Each point's share of the mass: d f(q) rescaled to the ball's exact mass.
+    const double scale = mass / (sum * cell);
+    for (const auto& sample : samples)
+    {
+      grid.Density[sample.first] += static_cast<float>(scale * sample.second);
+    }
+  }
+  return grid;
 }
 } // namespace nimbus

@@ -78,6 +78,32 @@ NIMBUSREPRESENTATIONS_EXPORT std::array<std::array<double, 3>, 3> SplatFrame(
 /// Returns (first_k, end_k) per layer; layer 0's range is empty.
 NIMBUSREPRESENTATIONS_EXPORT std::vector<std::array<std::size_t, 2>> SplatLayerRanges(
   const std::vector<float>& sortedFronts, double zMin, double zMax, int layers, double maxDiameter);
+/// The mass of a ball of centre density 1 and radius 1: the kernel integrated over the
+/// unit ball, 4 pi (1/3 - 22/45 + 17/63 - 4/81) = 0.81559 (a ball's mass is d R^3 times
+/// this).
+NIMBUSREPRESENTATIONS_EXPORT double SplatBallVolume();
+
+/// The balls' density on a regular grid (for the multiple-scattering solve,
+/// Physics/MultipleScattering.h): points Origin + (i, j, k) Spacing, x fastest, over the
+/// balls' bounds (centre +- R) padded by one spacing on every side, `longestSide` points
+/// (>= 4) on the longest axis, the same spacing on every axis.
+struct NIMBUSREPRESENTATIONS_EXPORT SplatDensityGrid
+{
+  std::array<int, 3> Dimensions{ { 0, 0, 0 } };
+  std::array<double, 3> Origin{ { 0, 0, 0 } }; // world units
+  double Spacing = 1.0;                        // world units
+  std::vector<float> Density;                  // dimensionless (as the balls' d)
+};
+
+/// Splats the balls (centres: 3 per ball; radii in world units; centre densities) onto a
+/// SplatDensityGrid. A ball at least one spacing in radius adds d f(|x - c|^2 / R^2) at
+/// the grid points inside it, scaled so that its points' sum times Spacing^3 is its mass
+/// d R^3 SplatBallVolume() (the point samples alone miss the mass by the kernel's
+/// discretisation error: TestCloudSplats measures it); a smaller ball (or one that hits
+/// no point) puts its mass on the 8 points around its centre, trilinearly (cloud in
+/// cell). The grid's total mass is the balls' to float rounding. Empty input: an empty grid.
+NIMBUSREPRESENTATIONS_EXPORT SplatDensityGrid SplatBallsOntoGrid(const std::vector<float>& centres,
+  const std::vector<float>& radii, const std::vector<float>& densities, int longestSide);
 } // namespace nimbus
 
 #endif
