@@ -351,17 +351,16 @@ void CloudAutomaton::ValidateAndPrepare()
   this->Z0 = p.Layers[0];
   this->NZ = layerEnd - p.Layers[0];
   const std::size_t held = static_cast<std::size_t>(this->NZ);
-  this->ExtinctionThresholds = MakeThresholds(p.Extinction, nx * ny, nx * ny * held, "Extinction");
-  this->HumidityThresholds =
-    MakeThresholds(p.HumiditySupply, nx * ny, nx * ny * held, "HumiditySupply");
-  this->ActivationThresholds =
-    MakeThresholds(p.ActivationSupply, nx * ny, nx * ny * held, "ActivationSupply");
-  // The thresholds replace the values (see GetParameters).
-  for (ProbabilityField* field : { &this->Parameters.Extinction, &this->Parameters.HumiditySupply,
-         &this->Parameters.ActivationSupply })
+  // The thresholds replace the values, each field's as soon as they are made (GetParameters).
+  auto thresholds = [&](ProbabilityField& field, const char* name)
   {
-    field->Values = std::vector<float>();
-  }
+    std::vector<std::uint32_t> t = MakeThresholds(field, nx * ny, nx * ny * held, name);
+    field.Values = std::vector<float>();
+    return t;
+  };
+  this->ExtinctionThresholds = thresholds(this->Parameters.Extinction, "Extinction");
+  this->HumidityThresholds = thresholds(this->Parameters.HumiditySupply, "HumiditySupply");
+  this->ActivationThresholds = thresholds(this->Parameters.ActivationSupply, "ActivationSupply");
 
   this->RowWords = static_cast<int>((nx + Bits - 1) / Bits);
   const int tailBits = static_cast<int>(nx % Bits);
