@@ -1,0 +1,96 @@
+"""pvpython test of the plugin's "Cloud Splats" representation
+(vtkNimbusCloudSplatRepresentation, vtkNimbusCloudSplatMapper).
+
+    pvpython --force-offscreen-rendering TestPluginCloudSplats.py --plugin Nimbus.so \
+        --output-dir DIR
+
+Checks, through paraview.simple only:
+  1. "Cloud Splats" is offered for the Nimbus Metaball Cloud's second output (Metaballs)
+     and its radius and density arrays are chosen by default ("radius", "density");
+  2. shown as "Cloud Splats" with the XML defaults, the image is not empty: many cloud
+     pixels differ from the background, and the sunlit ones are brighter than it;
+  3. the sun reaches the mapper: a sun below the balls' side (elevation -60) changes the
+     image.
+"""
+import argparse
+import os
+import sys
+
+from paraview.simple import (CreateRenderView, Delete, LoadPlugin, OutputPort, Render, SaveScreenshot,
+                             Show)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from image_compare import read_png  # noqa: E402
+
+SIZE = [320, 240]
+BACKGROUND = [0.1, 0.1, 0.15]  # a dark blue-grey: cloud pixels are brighter
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--plugin", required=True)
+    parser.add_argument("--output-dir", required=True)
+    args = parser.parse_args()
+    LoadPlugin(args.plugin, ns=globals())
+    failures = []
+
+    cloud = NimbusMetaballCloud()  # noqa: F821 (from the plugin)
+    view = CreateRenderView()
+    view.ViewSize = SIZE
+    view.OrientationAxesVisibility = 0
+    view.UseColorPaletteForBackground = 0
+    view.Background = BACKGROUND
+    display = Show(OutputPort(cloud, 1), view)
+
+    types = list(display.Representation.Available)
+    if "Cloud Splats" not in types:
+        failures.append("'Cloud Splats' not offered for the metaballs: %s" % types)
+    display.SetRepresentationType("Cloud Splats")
+    print("radius array:", display.SplatRadiusArray, "density array:", display.SplatDensityArray)
+    if display.SplatRadiusArray != "radius" or display.SplatDensityArray != "density":
+        failures.append("default arrays %r, %r (expected radius, density)" %
+                        (display.SplatRadiusArray, display.SplatDensityArray))
+
+    # The GUI's first look at Nimbus data: looking north, 11 degrees down; the sun (the
+    # defaults: azimuth 135, south-east, 45 degrees up) behind the camera's right shoulder.
+    view.CameraPosition = [0.0, -9817.0, 3408.0]
+    view.CameraFocalPoint = [0.0, 0.0, 1500.0]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    image_path = os.path.join(args.output_dir, "TestPluginCloudSplats.png")
+    SaveScreenshot(image_path, view, ImageResolution=SIZE)
+    pixels = read_png(image_path)
+    background = [255.0 * c for c in BACKGROUND]
+    difference = abs(pixels - background).max(axis=2)
+    cloud_pixels = difference > 8.0
+    brighter = pixels.mean(axis=2) > sum(background) / 3.0 + 40.0
+    share = cloud_pixels.mean()
+    bright_share = brighter.mean()
+    print("cloud pixels: %.3f of the image; brighter than the background by 40+: %.3f; "
+          "brightest %.0f" % (share, bright_share, pixels.max()))
+    if share < 0.05:
+        failures.append("only %.3f of the pixels differ from the background" % share)
+    if bright_share < 0.02:
+        failures.append("only %.3f of the pixels are brighter than the background" % bright_share)
+
+    display.SunElevationDegrees = -60.0
+    Render(view)
+    low_path = os.path.join(args.output_dir, "TestPluginCloudSplats-sun-below.png")
+    SaveScreenshot(low_path, view, ImageResolution=SIZE)
+    change = abs(read_png(low_path) - pixels).mean()
+    print("mean change with the sun below: %.2f" % change)
+    if change < 1.0:
+        failures.append("the sun's elevation does not change the image (%.2f)" % change)
+
+    # The view goes before the interpreter exits: pvpython tearing it down during
+    # sys.exit makes a destroyed GLX context current under Xvfb (an X error, exit 1).
+    Delete(view)
+    del view
+    for failure in failures:
+        print("FAIL:", failure)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
