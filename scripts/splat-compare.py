@@ -13,6 +13,15 @@ that every count fills the same volume with the same mean density) is
       - the reference renderer: converged single scattering ("single", the same physics
         as splatting) and the path tracer (multiple scattering, --path-seconds).
 
+With --multiple-scattering, two more rows per count draw the splats with the mapper's
+MultipleScattering option (the balls splatted onto a --ms-grid-size grid, the sun's light
+of all orders solved there and added per sample): "splat-texture-ms" (SunLightSamples
+--samples) and "splat-texture-centre-ms" (0: at each ball's centre), their frame exposed
+by the path tracer's brightest pixel (the single reference's would saturate the 8-bit
+frame); their seconds per frame include a solve (every frame marks the balls modified),
+given apart as ms_solve_seconds; and unless --splats-only, "svs-ms": the SVS mapper with
+its own multiple scattering (DiscreteDirections, its automatic grid) on the voxelised grid. --splats-only leaves out the read-back and the SVS rows.
+
 Errors over the cloud (pixels where the single-scattering reference exceeds 1e-3 of its
 99th percentile): the ratio of means (image / reference) and the RMSE (in the sun's
 relative radiance units), each renderer against each reference. One CSV row per
@@ -125,7 +134,8 @@ def render_window(size):
     return window, renderer
 
 
-def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE, samples=8):
+def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE, samples=8,
+                  multiple_scattering=False, ms_grid_size=32):
     from vtkmodules.vtkRenderingCore import vtkActor, vtkWindowToImageFilter
     mapper = nimbus.vtkNimbusCloudSplatMapper()
     mapper.SetInputData(poly)
@@ -140,31 +150,39 @@ def render_splats(poly, method, repeats, sun_size, layers, exposure=VTK_SCALE, s
     mapper.SetSunTextureLayers(layers)
     mapper.SetSunLightSamples(samples)
     mapper.SetTimePasses(True)
+    mapper.SetMultipleScattering(multiple_scattering)
+    mapper.SetMultipleScatteringGridSize(ms_grid_size)
     actor = vtkActor()
     actor.SetMapper(mapper)
     window, renderer = render_window((CAMERA["width"], CAMERA["height"]))
     renderer.AddActor(actor)
     window.Render()  # first frame: shaders, textures, uploads
-    times, suns = [], []
+    times, suns, solves, views = [], [], [], []
     for _ in range(repeats):
         mapper.Modified()  # the balls again: the sun pass and the sort are redone
         start = time.perf_counter()
         window.Render()
         times.append(time.perf_counter() - start)
         suns.append(mapper.GetLastSunPassSeconds())
+        solves.append(mapper.GetLastMultipleScatteringSeconds() if multiple_scattering else 0.0)
+        views.append(mapper.GetLastViewPassSeconds())
     image = harness.read_framebuffer(window, vtkWindowToImageFilter, 3) / exposure
     window.Finalize()
+    render_splats.extra = {"ms_solve_seconds": statistics.median(solves),
+                           "view_pass_seconds": statistics.median(views),
+                           "solves": mapper.GetNumberOfMultipleScatteringSolves()}
     return image, statistics.median(times), statistics.median(suns)
 
 
-def render_svs(grid, repeats):
+def render_svs(grid, repeats, multiple_scattering=False):
     mapper = nimbus.vtkNimbusCloudVolumeMapper()
     mapper.SetInputData(grid)
     mapper.SetExtinctionPerDensity(EXTINCTION)
     mapper.SetAlbedo(ALBEDO)
     mapper.SetCloudG(G)
     mapper.SetMultipleScattering(0.0)
-    mapper.SetMultipleScatteringMethod(0)
+    # 3: DiscreteDirections, the solver the splats' option uses (the mapper's own grid).
+    mapper.SetMultipleScatteringMethod(3 if multiple_scattering else 0)
     mapper.SetAtmosphere(False)
     mapper.SetAirMultipleScattering(False)
     mapper.SetGround(False)
@@ -209,6 +227,12 @@ def main():
     parser.add_argument("--path-seconds", type=float, default=60.0)
     parser.add_argument("--samples", type=int, default=8,
                         help="SunLightSamples of the splat-texture rows (splat-texture-centre: 0)")
+    parser.add_argument("--multiple-scattering", action="store_true",
+                        help="add the rows drawn with the mapper's MultipleScattering option")
+    parser.add_argument("--ms-grid-size", type=int, default=32,
+                        help="MultipleScatteringGridSize of those rows")
+    parser.add_argument("--splats-only", action="store_true",
+                        help="leave out the read-back and the SVS rows")
     parser.add_argument("--no-references", action="store_true")
     parser.add_argument("--reuse-references", action="store_true",
                         help="load the references an earlier run saved in --output")
@@ -251,30 +275,49 @@ def main():
                 json.dump(reference_seconds, stream)
         images = {}
         seconds = {}
+        suns = {}
+        extras = {}
+        exposures = {}
         # The 8-bit framebuffer's exposure: the single-scattering reference's brightest
         # pixel near white (a step of 1/255 of it), else VTK_SCALE.
         exposure = (0.9 / float(references["single"].max()) if "single" in references
                     else VTK_SCALE)
-        images["splat-texture"], seconds["splat-texture"], sun_texture = render_splats(
-            poly, 0, args.repeats, args.sun_size, args.layers, exposure, args.samples)
-        images["splat-texture-centre"], seconds["splat-texture-centre"], centre_sun = \
-            render_splats(poly, 0, args.repeats, args.sun_size, args.layers, exposure, 0)
-        if count <= args.readback_max:
+        # With multiple scattering the cloud is about 5 times brighter: exposed by the
+        # path tracer's brightest pixel.
+        ms_exposure = (0.9 / float(references["path"].max()) if "path" in references
+                       else exposure / 8.0)
+        runs = [("splat-texture", args.samples, False, exposure),
+                ("splat-texture-centre", 0, False, exposure)]
+        if args.multiple_scattering:
+            runs += [("splat-texture-ms", args.samples, True, ms_exposure),
+                     ("splat-texture-centre-ms", 0, True, ms_exposure)]
+        for name, samples, ms, run_exposure in runs:
+            images[name], seconds[name], suns[name] = render_splats(
+                poly, 0, args.repeats, args.sun_size, args.layers, run_exposure, samples,
+                ms, args.ms_grid_size)
+            extras[name] = render_splats.extra
+            exposures[name] = run_exposure
+        if count <= args.readback_max and not args.splats_only:
             images["splat-readback"], seconds["splat-readback"], _ = render_splats(
                 poly, 1, 1, args.sun_size, args.layers, exposure, 0)
-        images["svs"], seconds["svs"] = render_svs(grid, args.repeats)
+        if not args.splats_only:
+            images["svs"], seconds["svs"] = render_svs(grid, args.repeats)
+            if args.multiple_scattering:
+                images["svs-ms"], seconds["svs-ms"] = render_svs(grid, args.repeats, True)
         mask = None
         if "single" in references:
             luminance = references["single"].mean(axis=2)
             mask = luminance > 1e-3 * np.percentile(luminance, 99)
         for name, image in images.items():
             np.save(os.path.join(directory, f"{name}.npy"), image)
-            harness.write_png(image, os.path.join(directory, f"{name}.png"), exposure=exposure)
+            row_exposure = exposures.get(name, exposure)
+            harness.write_png(image, os.path.join(directory, f"{name}.png"),
+                              exposure=row_exposure)
             row = {"balls": count, "radius_m": radius, "renderer": name,
                    "seconds": seconds[name],
-                   "sun_pass_seconds": {"splat-texture": sun_texture,
-                                        "splat-texture-centre": centre_sun}.get(name, ""),
-                   "voxelise_seconds": voxel_seconds, "exposure": exposure}
+                   "sun_pass_seconds": suns.get(name, ""),
+                   "voxelise_seconds": voxel_seconds, "exposure": row_exposure}
+            row.update(extras.get(name, {}))
             for reference_name, reference in references.items():
                 for key, value in errors(image, reference, mask).items():
                     row[f"{reference_name}_{key}"] = value

@@ -10,9 +10,15 @@
 // T_sun from the sun's accumulation texture at x_j (all balls, this one included),
 // exp(-kappa P) this ball's own column between x_j and the eye (P: the partial-column
 // table), u the ray's distance from the centre and h along it, both in units of R.
+// With MULTIPLE_SCATTERING (MultipleScattering on) each point adds the light scattered
+// more than once, as the cloud mapper's cloudLight.glsl: albedo kappa f(x_j) dh
+// exp(-kappa P) times J(x_j, toward the eye) (the solver's in-scattered radiance, SH
+// textures) plus the delta-M forward peak's part of the sun's light,
+// (1 - f) p(mu) E_sun (exp(-(1 - f albedo) tau_sun) - exp(-tau_sun)).
 //VTK::System::Dec
 // (the mapper defines SUN_SAMPLES, the number of points, on the next line)
 //SPLAT::SunSamples
+//SPLAT::MultipleScattering
 #ifdef SUN_SAMPLES
 //NIMBUS::Library
 #endif
@@ -34,6 +40,24 @@ uniform vec2 sunDepthRange;
 uniform vec3 sunColor;
 uniform float albedo;
 uniform float cloudG;
+#ifdef MULTIPLE_SCATTERING
+uniform sampler3D scatteringRed; // J's SH c_00, c_1-1, c_10, c_11 per colour
+uniform sampler3D scatteringGreen;
+uniform sampler3D scatteringBlue;
+uniform vec3 scatteringScale; // texture coordinate = x scatteringScale + scatteringOffset
+uniform vec3 scatteringOffset;
+uniform float scatteringExposure;
+uniform float forwardPeakFraction;
+
+// J(x, w) toward w (direction of travel), per unit scattering coefficient.
+vec3 SplatInScattering(vec3 x, vec3 w)
+{
+  vec3 tc = x * scatteringScale + scatteringOffset;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return max(vec3(dot(texture(scatteringRed, tc), y), dot(texture(scatteringGreen, tc), y),
+               dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+}
+#endif
 
 float SunOpticalDepth(vec3 x)
 {
@@ -72,16 +96,29 @@ void main()
     float chord = sqrt(max(1.0 - u * u, 0.0));
     float dh = 2.0 * chord / float(SUN_SAMPLES);
     float sum = 0.0;
+    float peakSum = 0.0;
+    vec3 scatteredSum = vec3(0.0);
     for (int j = 0; j < SUN_SAMPLES; ++j)
     {
       float h = -chord + (float(j) + 0.5) * dh; // from the eye's side
       vec3 x = closest + h * R * d;
       float q = u * u + h * h;
       float f = 1.0 + q * (-22.0 / 9.0 + q * (17.0 / 9.0 - q * 4.0 / 9.0));
-      sum += kappa * f * dh * exp(-SunOpticalDepth(x) - kappa * PartialColumn(u, h));
+      float tau = SunOpticalDepth(x);
+      float weight = kappa * f * dh * exp(-kappa * PartialColumn(u, h));
+      sum += weight * exp(-tau);
+#ifdef MULTIPLE_SCATTERING
+      peakSum += weight * (exp(-(1.0 - forwardPeakFraction * albedo) * tau) - exp(-tau));
+      scatteredSum += weight * SplatInScattering(x, -d);
+#endif
     }
     // mu: the sunlight's direction (-toSun) against the way to the eye (-d).
     color = albedo * CornetteShanks(dot(toSun, d), cloudG) * sunColor * sum;
+#ifdef MULTIPLE_SCATTERING
+    color += albedo * (CornetteShanks(dot(toSun, d), cloudG) * sunColor *
+                        (1.0 - forwardPeakFraction) * peakSum +
+                      scatteringExposure * scatteredSum);
+#endif
   }
 #endif
   gl_FragData[0] = vec4(color, opacity);

@@ -6,6 +6,9 @@
 // With SUN_SAMPLES (the accumulation texture and SunLightSamples > 0) the fragment shader
 // integrates the light along its own column instead (cloudSplatViewFS.glsl); this shader
 // then hands it the billboard's point and the ball.
+// With MULTIPLE_SCATTERING (MultipleScattering on, the light at the centre) the ball's
+// colour adds the sun's light scattered more than once, read at its centre: the solver's
+// in-scattered radiance J(centre, toward the eye) and the delta-M forward peak's part.
 //VTK::System::Dec
 //NIMBUS::Library
 in vec4 ball;       // xyz: the centre (world), w: the radius R (world units)
@@ -26,6 +29,27 @@ uniform sampler3D sunDepth;  // the accumulated optical depth toward the sun, pe
 uniform vec3 sunColor;       // the sun's irradiance (linear sRGB) x exposure
 uniform float albedo;
 uniform float cloudG;
+// (the mapper defines MULTIPLE_SCATTERING on the next line)
+//SPLAT::MultipleScattering
+#ifdef MULTIPLE_SCATTERING
+uniform sampler3D scatteringRed; // J's SH c_00, c_1-1, c_10, c_11 per colour
+uniform sampler3D scatteringGreen;
+uniform sampler3D scatteringBlue;
+uniform vec3 scatteringScale; // texture coordinate = x scatteringScale + scatteringOffset
+uniform vec3 scatteringOffset;
+uniform float scatteringExposure;
+uniform float forwardPeakFraction; // f, the delta-M forward fraction of the solve
+
+// J(x, w): the radiance the cloud's particles scatter toward w (direction of travel) per
+// unit scattering coefficient, orders >= 2 of the sun (Physics/MultipleScattering.h).
+vec3 SplatInScattering(vec3 x, vec3 w)
+{
+  vec3 tc = x * scatteringScale + scatteringOffset;
+  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  return max(vec3(dot(texture(scatteringRed, tc), y), dot(texture(scatteringGreen, tc), y),
+               dot(texture(scatteringBlue, tc), y)), vec3(0.0));
+}
+#endif
 uniform vec3 viewRight; // the camera's axes in world coordinates (the billboard's plane)
 uniform vec3 viewUp;
 out vec2 corner;
@@ -58,4 +82,15 @@ void main()
   // The scattering angle: the sunlight's direction (-toSun) against the way to the eye.
   float mu = dot(-toSun, normalize(eyeWorld - ball.xyz));
   ballColor = albedo * CornetteShanks(mu, cloudG) * sunColor * sunTransmittance;
+#ifdef MULTIPLE_SCATTERING
+  {
+    // The forward peak the delta-M solve left on the sun's direction (as the cloud
+    // mapper's SunMultipleScattering) and J toward the eye.
+    float tau = -log(max(sunTransmittance, 1e-30));
+    float peak = (1.0 - forwardPeakFraction) *
+      (exp(-(1.0 - forwardPeakFraction * albedo) * tau) - sunTransmittance);
+    ballColor += albedo * (CornetteShanks(mu, cloudG) * sunColor * peak +
+                   scatteringExposure * SplatInScattering(ball.xyz, normalize(eyeWorld - ball.xyz)));
+  }
+#endif
 }

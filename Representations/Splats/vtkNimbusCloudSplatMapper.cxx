@@ -2,6 +2,8 @@
 
 #include "CloudSplats.h"
 #include "FiniteSetters.h"
+#include "MultipleScattering.h"
+#include "MultipleScatteringTexture.h"
 #include "ShaderLibrary.h"
 #include "Sun.h"
 #include "SunAndAir.h"
@@ -35,6 +37,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -58,6 +61,7 @@ struct vtkNimbusCloudSplatMapper::Internals
   std::vector<float> Centres; // 3 per ball
   std::vector<float> Radii;
   std::vector<float> Kappa;         // k d R (metres): the column's optical scale
+  std::vector<float> Densities;     // d, the centre densities
   std::vector<float> Transmittance; // the sun's, per ball (read-back variant)
   vtkMTimeType BallsTime = 0;
   std::vector<double> SunKey; // what the sun pass's result depends on
@@ -82,7 +86,18 @@ struct vtkNimbusCloudSplatMapper::Internals
   vtkNew<vtkTextureObject> Partial;     // P(u, h)
   vtkNew<vtkOpenGLFramebufferObject> Framebuffer;
   vtkOpenGLRenderWindow* Window = nullptr;
-  std::string ViewVertexSource[2]; // [1]: with the accumulation texture
+  // [1]: with the accumulation texture, [2]: with multiple scattering at the centre.
+  std::string ViewVertexSource[4];
+
+  // Multiple scattering: J's SH coefficients (R, G, B) on the splatted grid.
+  vtkNew<vtkTextureObject> Scattering[3];
+  std::vector<double> ScatteringKey;      // what the last solve depends on
+  bool ScatteringOn = false;              // the textures hold a solve
+  std::array<float, 3> ScatteringScale{}; // texture coordinate = x scale + offset (world)
+  std::array<float, 3> ScatteringOffset{};
+  float ForwardPeakFraction = 0.0f;
+  double ScatteringSeconds = 0.0;
+  int ScatteringSolves = 0;
 
   double SunSeconds = 0.0;
   double ViewSeconds = 0.0;
@@ -99,7 +114,13 @@ struct vtkNimbusCloudSplatMapper::Internals
         texture->ReleaseGraphicsResources(window);
       }
       this->Framebuffer->ReleaseGraphicsResources(window);
+      for (auto& texture : this->Scattering)
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
     }
+    this->ScatteringKey.clear();
+    this->ScatteringOn = false;
     this->SunInstances->ReleaseGraphicsResources();
     this->ViewInstances->ReleaseGraphicsResources();
     this->SunLayout->ReleaseGraphicsResources();
@@ -216,6 +237,16 @@ double vtkNimbusCloudSplatMapper::GetLastViewPassSeconds() const
   return this->Internal->ViewSeconds;
 }
 
+double vtkNimbusCloudSplatMapper::GetLastMultipleScatteringSeconds() const
+{
+  return this->Internal->ScatteringSeconds;
+}
+
+int vtkNimbusCloudSplatMapper::GetNumberOfMultipleScatteringSolves() const
+{
+  return this->Internal->ScatteringSolves;
+}
+
 vtkIdType vtkNimbusCloudSplatMapper::GetLastNumberOfBalls() const
 {
   return this->Internal->Balls;
@@ -243,6 +274,7 @@ bool vtkNimbusCloudSplatMapper::UpdateBalls(vtkPolyData* input, vtkActor* actor)
   in.Centres.clear();
   in.Radii.clear();
   in.Kappa.clear();
+  in.Densities.clear();
   in.Transmittance.clear();
   vtkDataArray* radii =
     this->RadiusArrayName ? input->GetPointData()->GetArray(this->RadiusArrayName) : nullptr;
@@ -280,6 +312,7 @@ bool vtkNimbusCloudSplatMapper::UpdateBalls(vtkPolyData* input, vtkActor* actor)
       { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]) });
     in.Radii.push_back(static_cast<float>(radius));
     in.Kappa.push_back(static_cast<float>(kappa));
+    in.Densities.push_back(static_cast<float>(density));
   }
   return !in.Radii.empty();
 }
@@ -349,6 +382,10 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
     }
     timer->StopTimer();
     in.SunSeconds = timer->GetElapsedTime();
+    if (this->MultipleScattering)
+    {
+      this->UpdateMultipleScattering(window, toSun.data());
+    }
     timer->StartTimer();
     this->ViewPass(renderer, window);
     if (this->TimePasses)
@@ -372,6 +409,22 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
 
 namespace
 {
+// The sun's irradiance above the air, linear sRGB of its blackbody spectrum (relative).
+std::array<double, 3> SunIrradianceRgb(
+  double azimuth, double elevation, double illuminance, double kelvin)
+{
+  nimbus::SunParameters sun;
+  sun.AzimuthDegrees = azimuth;
+  sun.ElevationDegrees = elevation;
+  sun.Illuminance = illuminance;
+  sun.TemperatureKelvin = kelvin;
+  nimbus::SceneAtmosphere air;
+  air.Enabled = false;
+  const nimbus::SunAndAir sunAndAir(sun, air, 16);
+  const std::array<double, 3> rgb = sunAndAir.ToLinearSrgb(sunAndAir.GetSunIrradiance());
+  return { std::max(rgb[0], 0.0), std::max(rgb[1], 0.0), std::max(rgb[2], 0.0) };
+}
+
 // The balls' window across the sun's light and their depth range along it (world units).
 void SunWindow(const std::vector<float>& centres, const std::vector<float>& radii,
   const std::array<std::array<double, 3>, 3>& frame, std::array<double, 4>& rect,
@@ -634,21 +687,35 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   in.UploadInstances(in.ViewInstances, order);
 
   const bool texture = this->SunLightMethod == AccumulationTexture;
-  std::string& source = in.ViewVertexSource[texture ? 1 : 0];
+  const int samples = texture ? this->SunLightSamples : 0;
+  const bool scattering = this->MultipleScattering && in.ScatteringOn;
+  // Multiple scattering at the ball's centre (vertex shader) or along the fragment's ray.
+  const bool centreScattering = scattering && samples == 0;
+  std::string& source = in.ViewVertexSource[(texture ? 1 : 0) + (centreScattering ? 2 : 0)];
   if (source.empty())
   {
-    source = nimbus::WithShaderLibrary(cloudSplatViewVS);
+    source = cloudSplatViewVS;
     if (texture)
     {
       vtkShaderProgram::Substitute(source, "//SPLAT::SunTexture", "#define SUN_TEXTURE");
     }
+    if (centreScattering)
+    {
+      vtkShaderProgram::Substitute(
+        source, "//SPLAT::MultipleScattering", "#define MULTIPLE_SCATTERING");
+    }
+    source = nimbus::WithShaderLibrary(source);
   }
-  const int samples = texture ? this->SunLightSamples : 0;
   std::string fragment = cloudSplatViewFS;
   if (samples > 0)
   {
     vtkShaderProgram::Substitute(
       fragment, "//SPLAT::SunSamples", "#define SUN_SAMPLES " + std::to_string(samples));
+    if (scattering)
+    {
+      vtkShaderProgram::Substitute(
+        fragment, "//SPLAT::MultipleScattering", "#define MULTIPLE_SCATTERING");
+    }
     fragment = nimbus::WithShaderLibrary(fragment);
   }
   vtkShaderProgram* program =
@@ -709,22 +776,25 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   program->SetUniform3f("viewUp", up);
 
   // The sun's colour above the air (linear sRGB of its blackbody spectrum) x exposure.
-  nimbus::SunParameters sun;
-  sun.AzimuthDegrees = this->SunAzimuthDegrees;
-  sun.ElevationDegrees = this->SunElevationDegrees;
-  sun.Illuminance = this->SunIlluminance;
-  sun.TemperatureKelvin = this->SunTemperatureKelvin;
-  nimbus::SceneAtmosphere air;
-  air.Enabled = false;
-  const nimbus::SunAndAir sunAndAir(sun, air, 16);
-  const std::array<double, 3> rgb = sunAndAir.ToLinearSrgb(sunAndAir.GetSunIrradiance());
-  const float color[3] = { static_cast<float>(std::max(rgb[0], 0.0) * this->Exposure),
-    static_cast<float>(std::max(rgb[1], 0.0) * this->Exposure),
-    static_cast<float>(std::max(rgb[2], 0.0) * this->Exposure) };
+  const std::array<double, 3> rgb = SunIrradianceRgb(this->SunAzimuthDegrees,
+    this->SunElevationDegrees, this->SunIlluminance, this->SunTemperatureKelvin);
+  const float color[3] = { static_cast<float>(rgb[0] * this->Exposure),
+    static_cast<float>(rgb[1] * this->Exposure), static_cast<float>(rgb[2] * this->Exposure) };
   program->SetUniform3f("sunColor", color);
   program->SetUniformf("albedo", static_cast<float>(this->Albedo));
   program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
+  if (scattering)
+  {
+    this->SetMultipleScatteringUniforms(program);
+  }
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(order.size()));
+  if (scattering)
+  {
+    for (auto& t : in.Scattering)
+    {
+      t->Deactivate();
+    }
+  }
   in.Billboard->Deactivate();
   if (samples > 0)
   {
@@ -735,6 +805,93 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
     in.SunDepth->Deactivate();
   }
   in.ViewLayout->Release();
+}
+
+// The sun's light scattered more than once (003 Eq. 1, iterated: Physics/MultipleScattering.h,
+// DiscreteDirections): the balls' density splatted onto a coarse grid, the solve's J(x, w)
+// uploaded as three RGBA 3-D textures (SH c_00, c_1-1, c_10, c_11 of R, G, B). Again only
+// when the balls (or the mapper's settings) or the sun change, not on camera moves.
+void vtkNimbusCloudSplatMapper::UpdateMultipleScattering(
+  vtkOpenGLRenderWindow* window, const double toSun[3])
+{
+  Internals& in = *this->Internal;
+  const std::vector<double> key = { static_cast<double>(in.BallsTime), toSun[0], toSun[1], toSun[2],
+    static_cast<double>(this->MultipleScatteringGridSize) };
+  if (key == in.ScatteringKey)
+  {
+    return;
+  }
+  in.ScatteringKey = key; // a failed solve is not tried again until something changes
+  in.ScatteringOn = false;
+  const auto start = std::chrono::steady_clock::now();
+  const nimbus::SplatDensityGrid splat = nimbus::SplatBallsOntoGrid(
+    in.Centres, in.Radii, in.Densities, this->MultipleScatteringGridSize);
+  nimbus::ExtinctionGrid grid;
+  grid.Dimensions = splat.Dimensions;
+  const double metres = this->MetresPerUnit;
+  for (int a = 0; a < 3; ++a)
+  {
+    grid.Origin[a] = splat.Origin[a] * metres;
+    grid.Spacing[a] = splat.Spacing * metres;
+    in.ScatteringScale[a] = static_cast<float>(1.0 / (splat.Spacing * splat.Dimensions[a]));
+    in.ScatteringOffset[a] = static_cast<float>(
+      (0.5 - splat.Origin[a] / splat.Spacing) / splat.Dimensions[a]); // texel centres
+  }
+  grid.Extinction.resize(splat.Density.size());
+  for (std::size_t n = 0; n < splat.Density.size(); ++n)
+  {
+    grid.Extinction[n] = static_cast<float>(this->ExtinctionPerDensity * splat.Density[n]);
+  }
+  nimbus::CloudOptics optics;
+  optics.Albedo = this->Albedo;
+  optics.Phase = nimbus::PhaseFunctionKind::CornetteShanks;
+  optics.G = this->CloudG;
+  nimbus::CloudLighting lighting;
+  lighting.HasSun = true;
+  lighting.Sun.ToLight = { { toSun[0], toSun[1], toSun[2] } };
+  const std::array<double, 3> rgb = SunIrradianceRgb(this->SunAzimuthDegrees,
+    this->SunElevationDegrees, this->SunIlluminance, this->SunTemperatureKelvin);
+  lighting.Sun.ConstantIrradiance = { { rgb[0], rgb[1], rgb[2] } };
+  nimbus::MultipleScatteringOptions options;
+  options.Method = nimbus::MultipleScatteringMethod::DiscreteDirections;
+  options.SkyLight = false; // no sky here: the sun's light only
+  nimbus::MultipleScatteringField field;
+  try
+  {
+    field = nimbus::SolveMultipleScattering(
+      grid, optics, lighting, options, [this](double fraction) { this->UpdateProgress(fraction); });
+  }
+  catch (const std::exception& problem)
+  {
+    vtkErrorMacro("Multiple scattering not drawn: " << problem.what());
+    return;
+  }
+  vtkTextureObject* const textures[3] = { in.Scattering[0], in.Scattering[1], in.Scattering[2] };
+  if (!nimbus::UploadShCoefficients(window, textures, grid.Dimensions, field.Coefficients.data()))
+  {
+    vtkErrorMacro("Multiple scattering not drawn: its textures could not be uploaded.");
+    return;
+  }
+  in.ForwardPeakFraction = static_cast<float>(field.ForwardPeakFraction);
+  in.ScatteringOn = true;
+  ++in.ScatteringSolves;
+  in.ScatteringSeconds =
+    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void vtkNimbusCloudSplatMapper::SetMultipleScatteringUniforms(vtkShaderProgram* program)
+{
+  Internals& in = *this->Internal;
+  const char* names[3] = { "scatteringRed", "scatteringGreen", "scatteringBlue" };
+  for (int c = 0; c < 3; ++c)
+  {
+    in.Scattering[c]->Activate();
+    program->SetUniformi(names[c], in.Scattering[c]->GetTextureUnit());
+  }
+  program->SetUniform3f("scatteringScale", in.ScatteringScale.data());
+  program->SetUniform3f("scatteringOffset", in.ScatteringOffset.data());
+  program->SetUniformf("scatteringExposure", static_cast<float>(this->Exposure));
+  program->SetUniformf("forwardPeakFraction", in.ForwardPeakFraction);
 }
 
 void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
@@ -759,4 +916,6 @@ void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SunTextureLayers: " << this->SunTextureLayers << "\n";
   os << indent << "SunLightSamples: " << this->SunLightSamples << "\n";
   os << indent << "TimePasses: " << this->TimePasses << "\n";
+  os << indent << "MultipleScattering: " << this->MultipleScattering << "\n";
+  os << indent << "MultipleScatteringGridSize: " << this->MultipleScatteringGridSize << "\n";
 }

@@ -33,7 +33,14 @@
  *     (default 8) each fragment instead integrates the light along its own ray through
  *     its ball, reading the texture at that many points (docs/splats.md: the light at
  *     the centre makes overlapping balls far too dark).
- * The light scattered more than once, the sky's light and the air are not drawn.
+ * With MultipleScattering on (default off) the light scattered more than once is added:
+ * the balls' density splatted onto a grid of MultipleScatteringGridSize points on its
+ * longest side (CloudSplats.h SplatBallsOntoGrid), the sun's light of all orders solved
+ * there (Physics/MultipleScattering.h, DiscreteDirections, no sky) and the in-scattered
+ * radiance J(x, w) read from three 3-D textures at the fragment's samples (or at the
+ * ball's centre), with the delta-M forward peak's part of the sun's light as the cloud
+ * mapper adds it. Solved again only when the balls or the sun change.
+ * The sky's light and the air are not drawn.
  *
  * Units: radii and points in world units, MetresPerUnit metres each; the sun
  * (SunAzimuthDegrees from +y toward +x, SunElevationDegrees above the x-y plane: z is
@@ -60,6 +67,7 @@
 #include <memory> // for std::unique_ptr
 
 class vtkOpenGLRenderWindow;
+class vtkShaderProgram;
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusCloudSplatMapper : public vtkPolyDataMapper
 {
@@ -164,6 +172,21 @@ public:
   vtkGetMacro(SunTextureLayers, int);
   ///@}
 
+  ///@{
+  /// Multiple scattering (default off): the sun's light scattered more than once, solved
+  /// on a grid over the balls with MultipleScatteringGridSize points on its longest side
+  /// (default 32; 4 to 256) and added to every fragment (docs/splats.md).
+  vtkSetMacro(MultipleScattering, bool);
+  vtkGetMacro(MultipleScattering, bool);
+  vtkBooleanMacro(MultipleScattering, bool);
+  vtkSetClampMacro(MultipleScatteringGridSize, int, 4, 256);
+  vtkGetMacro(MultipleScatteringGridSize, int);
+  /// Seconds of the last multiple-scattering solve (splatting, solver, upload) and the
+  /// number of solves so far.
+  double GetLastMultipleScatteringSeconds() const;
+  int GetNumberOfMultipleScatteringSolves() const;
+  ///@}
+
   /// Seconds of the last frame's sun pass and view pass (each ended by glFinish only
   /// when TimePasses is on; default off).
   vtkSetMacro(TimePasses, bool);
@@ -198,6 +221,8 @@ protected:
   int SunTextureLayers = 32;
   int SunLightSamples = 8;
   bool TimePasses = false;
+  bool MultipleScattering = false;
+  int MultipleScatteringGridSize = 32;
 
 private:
   vtkNimbusCloudSplatMapper(const vtkNimbusCloudSplatMapper&) = delete;
@@ -207,6 +232,8 @@ private:
   void SunPassTexture(vtkOpenGLRenderWindow* window);
   void SunPassReadBack(vtkOpenGLRenderWindow* window);
   void ViewPass(vtkRenderer* renderer, vtkOpenGLRenderWindow* window);
+  void UpdateMultipleScattering(vtkOpenGLRenderWindow* window, const double toSun[3]);
+  void SetMultipleScatteringUniforms(vtkShaderProgram* program);
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
