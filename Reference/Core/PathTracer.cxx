@@ -234,88 +234,6 @@ struct GlobalSunTable
   }
 };
 
-/// Incremental 3-D DDA over the blocks of a MajorantGrid along a ray (Amanatides & Woo,
-/// "A Fast Voxel Traversal Algorithm", Eurographics 1987): the block index and the
-/// distance at which the ray leaves it are updated by one comparison and one addition
-/// per block, instead of locating the block from the position at every piece. The
-/// block is always the one whose interval [entry, Exit) holds the caller's t, so a
-/// block's maximum bounds the density there without dilation (a point can lie outside
-/// the block only by rounding, ~1e-12 of the coordinates).
-struct BlockCursor
-{
-  bool Active = false;
-  int Cell[3] = { 0, 0, 0 };
-  int Step[3] = { 0, 0, 0 };
-  int Count[3] = { 1, 1, 1 };
-  double TMax[3] = { 0.0, 0.0, 0.0 };
-  double TDelta[3] = { 0.0, 0.0, 0.0 };
-  std::size_t Stride[3] = { 1, 1, 1 };
-  std::size_t Index = 0;
-
-  void Start(const MajorantGrid& grid, const Vector3& origin, const Vector3& direction, double t)
-  {
-    const Vector3 p = Along(origin, direction, t);
-    const std::array<int, 3>& blocks = grid.GetBlocks();
-    std::size_t stride = 1;
-    this->Index = 0;
-    for (int a = 0; a < 3; ++a)
-    {
-      const double size = grid.GetBlockSize()[a];
-      const double lower = grid.GetLower()[a];
-      this->Count[a] = blocks[a];
-      const double x = (p[a] - lower) / size;
-      // On a face, the block the ray enters.
-      int c = static_cast<int>(std::floor(x));
-      if (direction[a] < 0.0 && x == std::floor(x))
-      {
-        c -= 1;
-      }
-      c = std::min(blocks[a] - 1, std::max(0, c));
-      this->Cell[a] = c;
-      const double d = direction[a];
-      if (d > 0.0)
-      {
-        this->Step[a] = 1;
-        this->TMax[a] = (lower + (c + 1) * size - origin[a]) / d;
-        this->TDelta[a] = size / d;
-      }
-      else if (d < 0.0)
-      {
-        this->Step[a] = -1;
-        this->TMax[a] = (lower + c * size - origin[a]) / d;
-        this->TDelta[a] = -size / d;
-      }
-      else
-      {
-        this->Step[a] = 0;
-        this->TMax[a] = kInfinity;
-        this->TDelta[a] = kInfinity;
-      }
-      this->Stride[a] = stride;
-      this->Index += stride * static_cast<std::size_t>(c);
-      stride *= static_cast<std::size_t>(blocks[a]);
-    }
-    this->Active = true;
-  }
-  double Exit() const { return std::min({ this->TMax[0], this->TMax[1], this->TMax[2] }); }
-  /// To the next block; false when the ray leaves the grid.
-  bool Advance()
-  {
-    const int a = this->TMax[0] < this->TMax[1] ? (this->TMax[0] < this->TMax[2] ? 0 : 2)
-                                                : (this->TMax[1] < this->TMax[2] ? 1 : 2);
-    const int c = this->Cell[a] + this->Step[a];
-    if (c < 0 || c >= this->Count[a])
-    {
-      this->Active = false;
-      return false;
-    }
-    this->Cell[a] = c;
-    this->TMax[a] += this->TDelta[a];
-    this->Index = this->Step[a] > 0 ? this->Index + this->Stride[a] : this->Index - this->Stride[a];
-    return true;
-  }
-};
-
 /// A ray with what its majorant pieces need.
 struct Ray
 {
@@ -551,7 +469,7 @@ private:
   /// End of the majorant piece that starts at t (<= tEnd) and its majorant, 1/m
   /// (returned, and split into its cloud and atmosphere parts).
   double Piece(const Ray& ray, double t, double tEnd, bool withAir, double& tNext,
-    double& cloudMajorant, double& airMajorant, BlockCursor& cursor) const;
+    double& cloudMajorant, double& airMajorant, MajorantWalk& cursor) const;
   /// Largest atmosphere extinction over all wavelengths at an altitude, 1/m.
   double AirMajorantAt(double altitude) const
   {
@@ -1197,7 +1115,7 @@ void Integrator::BuildSunDepth()
 }
 
 double Integrator::Piece(const Ray& ray, double t, double tEnd, bool withAir, double& tNext,
-  double& cloudMajorant, double& airMajorant, BlockCursor& cursor) const
+  double& cloudMajorant, double& airMajorant, MajorantWalk& cursor) const
 {
   tNext = tEnd;
   cloudMajorant = airMajorant = 0.0;
@@ -1300,7 +1218,7 @@ FlightEnd Integrator::FreeFlight(const Ray& ray, double tEnd, PathRandom& rng, P
   const int n = this->Wavelengths;
   std::vector<double>& w = state.Weight;
   t = 0.0;
-  BlockCursor cursor;
+  MajorantWalk cursor;
   for (;;)
   {
     // Sample the optical distance tau ~ Exp(1) against the piecewise majorant.
@@ -1454,7 +1372,7 @@ double Integrator::CloudTransmittance(
   // over the tentative collisions x_i; Russian roulette below the threshold.
   double transmittance = 1.0;
   double t = ray.CloudNear;
-  BlockCursor cursor;
+  MajorantWalk cursor;
   for (;;)
   {
     double tau = -std::log(1.0 - rng.Uniform());

@@ -387,33 +387,20 @@ public:
   long long SkipEmpty(const Vector3& p, const Vector3& dir, double tm, double begin, double h,
     long long k, long long last) const
   {
-    int b[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      const double c = std::floor((p[a] - this->BlockLower[a]) / this->CellSize[a]);
-      const int cell = static_cast<int>(std::min<double>(this->Cells[a] - 1, std::max(0.0, c)));
-      b[a] = cell / kBlockCells;
-    }
-    if (!this->Blocks.IsEmpty(this->Blocks.GetIndex(b[0], b[1], b[2])))
+    // The block holding p (on a face, the one the ray enters) and where the ray leaves it.
+    MajorantWalk block;
+    block.Start(this->Blocks, p, dir, 0.0);
+    if (!this->Blocks.IsEmpty(block.Index))
     {
       return k;
     }
-    double exit = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a)
-    {
-      if (dir[a] == 0.0)
-      {
-        continue;
-      }
-      const double lo = this->BlockLower[a] + b[a] * kBlockCells * this->CellSize[a];
-      const double hi = this->BlockLower[a] +
-        std::min(this->Cells[a], (b[a] + 1) * kBlockCells) * this->CellSize[a];
-      exit = std::min(exit, ((dir[a] > 0.0 ? hi : lo) - p[a]) / dir[a]);
-    }
+    const double exit = block.Exit();
     // Midpoints strictly before tm + exit (less a rounding margin) are in the block.
     const double limit = tm + std::max(0.0, exit) - 1e-9 * (h + this->BlockDiagonal);
     const double first = std::ceil((limit - begin) / h - 0.5); // first midpoint >= limit
-    if (!(first - 1.0 > static_cast<double>(k)))
+    // The last block along an axis may end at the grid's box, before its Exit: the cap at
+    // last - 1 keeps the remainder step, and a step at or past it is never skipped back.
+    if (!(first - 1.0 > static_cast<double>(k)) || k >= last - 1)
     {
       return k;
     }
@@ -555,22 +542,19 @@ private:
   /// (MajorantGrid without dilation: maximum 0).
   void BuildEmptyBlocks()
   {
-    this->Cells = { { 1, 1, 1 } };
-    this->CellSize = { { 1.0, 1.0, 1.0 } };
-    this->BlockLower = { { 0.0, 0.0, 0.0 } };
     if (this->Grid.IsEmpty())
     {
       return;
     }
+    // A block's diagonal (kBlockCells cells an edge), m: the scale of SkipEmpty's
+    // rounding margin.
     const std::array<int, 3>& dims = this->Grid.GetDimensions();
     const Vector3 lower = this->Grid.GetLower(), upper = this->Grid.GetUpper();
     double diagonal2 = 0.0;
     for (int a = 0; a < 3; ++a)
     {
-      this->Cells[a] = std::max(1, dims[a] - 1);
-      this->CellSize[a] = (upper[a] - lower[a]) / this->Cells[a];
-      this->BlockLower[a] = lower[a];
-      diagonal2 += std::pow(kBlockCells * this->CellSize[a], 2);
+      const double cellSize = (upper[a] - lower[a]) / std::max(1, dims[a] - 1);
+      diagonal2 += std::pow(kBlockCells * cellSize, 2);
     }
     this->BlockDiagonal = std::sqrt(diagonal2);
     this->Blocks = MajorantGrid(this->Grid, 0);
@@ -779,8 +763,6 @@ private:
   double OffsetR = 1e-6, OffsetM = 1e-6; // m
   // Empty-space skipping: macro blocks of kBlockCells³ grid cells.
   MajorantGrid Blocks;
-  std::array<int, 3> Cells{ { 1, 1, 1 } };
-  Vector3 CellSize{ { 1.0, 1.0, 1.0 } }, BlockLower{ { 0.0, 0.0, 0.0 } };
   double BlockDiagonal = 0.0;
 };
 
