@@ -915,6 +915,8 @@ void vtkNimbusCloudRepresentation::PrintSelf(ostream& os, vtkIndent indent)
      << this->WholeBounds[1] << ", " << this->WholeBounds[2] << " .. " << this->WholeBounds[3]
      << ", " << this->WholeBounds[4] << " .. " << this->WholeBounds[5] << "\n";
   os << indent << "CoarseDensity: " << this->CoarseDensity.GetPointer() << "\n";
+  os << indent << "Bottom layer placed at the renderer's start: "
+     << (this->RendererStartTag != 0 ? "yes" : "no") << "\n";
   os << indent << "CloudMapper:\n";
   this->CloudMapper->PrintSelf(os, indent.GetNextIndent());
 }
