@@ -15,6 +15,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 
 #include <algorithm>
@@ -44,6 +45,35 @@ void GrowByRadii(vtkPolyData* balls, vtkDataArray* radii, double bounds[6])
       bounds[2 * axis] = std::min(bounds[2 * axis], point[axis] - radius);
       bounds[2 * axis + 1] = std::max(bounds[2 * axis + 1], point[axis] + radius);
     }
+  }
+}
+
+// The splats are drawn in the opaque pass and write no depth; the sky background,
+// also drawn there, fills every pixel still at the far plane: drawn after the splats it
+// would cover them. Props draw in the renderer's order, so the splats' actor is moved
+// behind the sky's when the sky was added after it (then it stays there).
+void KeepAfterSky(vtkRenderer* renderer, vtkActor* actor, vtkProp* sky)
+{
+  if (!sky)
+  {
+    return;
+  }
+  int index = 0;
+  int actorIndex = -1;
+  int skyIndex = -1;
+  vtkCollectionSimpleIterator iterator;
+  vtkPropCollection* props = renderer->GetViewProps();
+  props->InitTraversal(iterator);
+  while (vtkProp* prop = props->GetNextProp(iterator))
+  {
+    actorIndex = prop == actor ? index : actorIndex;
+    skyIndex = prop == sky ? index : skyIndex;
+    ++index;
+  }
+  if (actorIndex >= 0 && skyIndex > actorIndex)
+  {
+    renderer->RemoveActor(actor);
+    renderer->AddActor(actor);
   }
 }
 }
@@ -132,6 +162,7 @@ void vtkNimbusCloudSplatRepresentation::ApplySun()
       vtkNimbusSkyBackground::SafeDownCast(view->GetRenderer()->GetInformation()->Get(
         vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
     sky = background && background->GetVisibility() ? background->GetSky() : nullptr;
+    KeepAfterSky(view->GetRenderer(), this->Actor, background);
   }
   double temperature = this->SunTemperatureKelvin;
   if (sky)

@@ -10,7 +10,10 @@ Checks, through paraview.simple only:
   2. shown as "Cloud Splats" with the XML defaults, the image is not empty: many cloud
      pixels differ from the background, and the sunlit ones are brighter than it;
   3. the sun reaches the mapper: a sun below the balls' side (elevation -60) changes the
-     image.
+     image;
+  4. with a Nimbus Sky shown in the view ("Sky Background"), the balls are drawn over the
+     sky, lit by the sky's sun: the sky's sun elevation changes the image, the display's
+     own does not.
 """
 import argparse
 import os
@@ -24,6 +27,46 @@ from image_compare import read_png  # noqa: E402
 
 SIZE = [320, 240]
 BACKGROUND = [0.1, 0.1, 0.15]  # a dark blue-grey: cloud pixels are brighter
+
+
+def save(view, output_dir, name):
+    """Renders the view and returns its pixels, saved as name.png in output_dir."""
+    Render(view)
+    path = os.path.join(output_dir, name + ".png")
+    SaveScreenshot(path, view, ImageResolution=SIZE)
+    return read_png(path)
+
+
+def check_view_sky(view, display, pixels, output_dir, failures):
+    """A Nimbus Sky in the view: the balls over it, lit by its sun (Use the View's Sky)."""
+    sky = NimbusSky(SunElevationDegrees=45.0, SunAzimuthDegrees=135.0)  # noqa: F821
+    Show(sky, view)  # "Sky Background" by default
+    display.SunElevationDegrees = -60.0  # not used while the sky's sun is
+    with_sky = save(view, output_dir, "TestPluginCloudSplats-sky")
+    display.Visibility = 0
+    sky_only = save(view, output_dir, "TestPluginCloudSplats-sky-only")
+    display.Visibility = 1
+    over_sky = (abs(with_sky - sky_only).max(axis=2) > 8.0).mean()
+    print("with the sky: %.3f of the pixels are the balls'" % over_sky)
+    if over_sky < 0.05:
+        failures.append("the balls are not drawn over the sky (%.3f of the pixels)" % over_sky)
+    display.SunElevationDegrees = 10.0
+    own_sun = save(view, output_dir, "TestPluginCloudSplats-sky-own-sun")
+    own_change = abs(own_sun - with_sky).mean()
+    # The sky's own pixels change with its sun too: compare what the balls add to it.
+    sky.SunElevationDegrees = 10.0
+    sky_sun = save(view, output_dir, "TestPluginCloudSplats-sky-sun")
+    display.Visibility = 0
+    low_sky_only = save(view, output_dir, "TestPluginCloudSplats-sky-sun-only")
+    display.Visibility = 1
+    balls = abs(with_sky - sky_only).max(axis=2) > 8.0
+    sky_change = abs((sky_sun - low_sky_only) - (with_sky - sky_only)).max(axis=2)[balls].mean()
+    print("with the sky: mean change by the display's sun %.2f; by the sky's sun, "
+          "of what the balls add, %.2f" % (own_change, sky_change))
+    if own_change > 0.5:
+        failures.append("the display's own sun changes the image under the view's sky")
+    if sky_change < 5.0:
+        failures.append("the sky's sun does not reach the balls (%.2f)" % sky_change)
 
 
 def main():
@@ -82,6 +125,8 @@ def main():
     print("mean change with the sun below: %.2f" % change)
     if change < 1.0:
         failures.append("the sun's elevation does not change the image (%.2f)" % change)
+
+    check_view_sky(view, display, pixels, args.output_dir, failures)
 
     # The view goes before the interpreter exits: pvpython tearing it down during
     # sys.exit makes a destroyed GLX context current under Xvfb (an X error, exit 1).
