@@ -457,7 +457,7 @@ struct ReferenceSample
 /// The directions of a comparison: the dome, view elevations 2.5, 7.5, ..., 87.5 deg by
 /// azimuths 0, 10, ..., 180 deg from the sun (the sky is symmetric about the sun's
 /// vertical); rings 3, 5, 8, 12, 15 deg around the sun (12 directions each, those above
-/// 2 deg elevation); the zenith. scripts/hosek-wilkie-reference.py samples the same.
+/// 2 deg elevation); the zenith. measurements/hosek-wilkie-reference.py samples the same.
 std::vector<ReferenceSample> ComparisonDirections(double sunElevation)
 {
   std::vector<ReferenceSample> out;
@@ -647,7 +647,7 @@ double PublishedShapeRatio(
 }
 
 /// Hosek & Wilkie 2012 in ComparisonDirections, keyed by (turbidity, sun elevation):
-/// read from Data/hosek-wilkie-reference.csv (scripts/hosek-wilkie-reference.py).
+/// read from Data/hosek-wilkie-reference.csv (measurements/hosek-wilkie-reference.py).
 std::map<std::pair<int, int>, std::vector<ReferenceSample>> ReadHosekWilkieReference()
 {
   std::map<std::pair<int, int>, std::vector<ReferenceSample>> out;
@@ -737,7 +737,7 @@ TEST(Sky, ValidationAgainstPreetham)
 // Validation against Hosek & Wilkie 2012 ("An Analytic Model for Full Spectral Sky-Dome
 // Radiance", ACM TOG 31(4): fitted to path-traced spectral skies, with Preetham's
 // turbidity and a ground albedo), evaluated by Blender's Cycles (the authors' CIE XYZ
-// data set; scripts/hosek-wilkie-reference.py wrote the table), ground albedo 0.3 as
+// data set; measurements/hosek-wilkie-reference.py wrote the table), ground albedo 0.3 as
 // ours, over sun elevations 1..90 deg and turbidities 2..5. Goal: medians of the
 // normalised luminance ratio within 10 %, of the chromaticity differences within 0.02.
 // Compared twice: with the same physics as Hosek-Wilkie (no ozone: their sky does not

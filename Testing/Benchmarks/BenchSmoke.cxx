@@ -1,7 +1,7 @@
 // Benchmark (not a test) of the smoke solver (002 §4): time per frame against the grid
 // (N^3 cells over an 8 m cube, a hot sphere of radius 0.75 m at (0, 0, 0.75), vorticity
 // confinement 0.3, Smagorinsky 0.15, MacCormack, 24 frames per second), the same scene as
-// scripts/mantaflow-smoke-bench.py for Blender's Mantaflow.
+// measurements/mantaflow-smoke-bench.py for Blender's Mantaflow.
 //
 //   BenchSmoke [threads = 2] [frames = 24] [N ...]   (default N: 32 64)
 //

@@ -13,7 +13,7 @@ sun, whether it was interactive, its quality). Checks:
   sets the sun below the horizon before anything renders it: no daylight frame first);
 - Play through the flash's last time steps draws interactive frames (the reduced work of
   the Cloud's frame budget), and the next frame after it is a full-quality still one
-  (scripts/lightning-play-gui.py shows the GUI drawing it by itself);
+  (measurements/lightning-play-gui.py shows the GUI drawing it by itself);
 - the time steps re-run neither the cloud source nor the density's upload nor the sun's
   multiple-scattering solve (only the illumination filter's relight runs per step);
 - the representation's PlaybackInteractive is off again after Play.

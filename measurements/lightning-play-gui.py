@@ -1,6 +1,6 @@
 """Play of a lightning flash in the real ParaView GUI, timed and photographed.
 
-    /usr/bin/python3 scripts/lightning-play-gui.py \
+    /usr/bin/python3 measurements/lightning-play-gui.py \
         --plugin-dir build/lib/paraview-5.11/plugins/Nimbus --output-dir DIR \
         [--cache-dir DIR] [--play X Y] [--strokes]
 

@@ -3,7 +3,7 @@
 method of the SVS mapper, VTK's mapper and SVS with k_multi in one plot).
 
     PYTHONPATH=build/lib/python3.11/site-packages /usr/bin/python3 \
-        scripts/multiple-scattering-plots.py OUTPUT_DIR svs/trade.csv vtk/trade.csv ...
+        measurements/multiple-scattering-plots.py OUTPUT_DIR svs/trade.csv vtk/trade.csv ...
 
 Writes OUTPUT_DIR/<scene>-pareto.png and OUTPUT_DIR/trade.csv (the rows together).
 """

@@ -2,7 +2,7 @@
 """Smoke and fire: the Cloud representation against the path tracer (docs/smoke.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
-        scripts/smoke-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
+        measurements/smoke-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
 
 Two media from vtkNimbusSmokeSource (the default 8 x 8 x 12 m box of 32 x 32 x 48
 cells), written as .vti files beside their version-3 scene files:
@@ -104,7 +104,7 @@ def scene_for(name, vti):
                               "radiance_per_metre": EMISSION["radiance_per_metre"],
                               "temperature_kelvin": EMISSION["reference_kelvin"]}
     scene = {"nimbus_scene": 3, "name": "smoke_" + name,
-             "description": f"vtkNimbusSmokeSource's {name} (scripts/smoke-vs-path-tracer.py)",
+             "description": f"vtkNimbusSmokeSource's {name} (measurements/smoke-vs-path-tracer.py)",
              "camera": CAMERA, "medium": medium,
              "sun": {"azimuth_degrees": 200, "elevation_degrees": 30,
                      "illuminance": config["sun"], "temperature_kelvin": 5778},

@@ -5,7 +5,7 @@
 # type Hosek / Wilkie, the authors' CIE XYZ data set), rendered as an equirectangular
 # panorama of the upper hemisphere and read back at the test's directions.
 #
-#   blender -b --factory-startup --python scripts/hosek-wilkie-reference.py -- \
+#   blender -b --factory-startup --python measurements/hosek-wilkie-reference.py -- \
 #       Physics/Testing/Data/hosek-wilkie-reference.csv
 #
 # Blender 3.4 (Debian bookworm's `blender`); about 1 minute on 2 cores. Output: one row
@@ -137,7 +137,7 @@ def main():
                 raise SystemExit("panorama orientation: the sun is not at azimuth 0")
     with open(output, "w") as f:
         f.write("# Hosek & Wilkie 2012 clear sky, rendered by Blender %s Cycles; "
-                "scripts/hosek-wilkie-reference.py\n" % bpy.app.version_string)
+                "measurements/hosek-wilkie-reference.py\n" % bpy.app.version_string)
         f.write("turbidity,sun_elevation_deg,kind,view_elevation_deg,azimuth_from_sun_deg,X,Y,Z\n")
         f.write("\n".join(rows) + "\n")
     print("wrote %d rows to %s" % (len(rows), output))

@@ -2,7 +2,7 @@
 with the same renderer, optics, sun and camera (docs/smoke.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
-        scripts/smoke-side-by-side.py --nimbus A --mantaflow B --out C.png
+        measurements/smoke-side-by-side.py --nimbus A --mantaflow B --out C.png
 
 A, Nimbus's density, is either
   - a .vti with a point array "density" (what vtkNimbusSmokeSource writes; e.g.
@@ -11,7 +11,7 @@ A, Nimbus's density, is either
     (Testing/Benchmarks/BenchSmoke.cxx: RES^3 cells over the 8 m cube from (-4, -4, 0),
     the hot sphere of 0.75 m at (0, 0, 0.75), vorticity 0.3, Smagorinsky 0.15,
     MacCormack, 24 frames per second) to frame FRAMES (--threads, default 2).
-B, Mantaflow's, is the .vdb that scripts/mantaflow-smoke-bench.py printed (its last
+B, Mantaflow's, is the .vdb that measurements/mantaflow-smoke-bench.py printed (its last
 frame), or that bake's cache directory (its last data/fluid_data_NNNN.vdb is taken).
 
 Read with Nimbus's OpenVDB reader (the density grid only). Blender's cache grids carry a

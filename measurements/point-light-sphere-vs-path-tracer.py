@@ -2,7 +2,7 @@
 """A point light inside a uniform sphere: Nimbus's lightning illumination against the path tracer.
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
-        scripts/point-light-sphere-vs-path-tracer.py [--g 0.85] [--albedo 0.99] [--orders N]
+        measurements/point-light-sphere-vs-path-tracer.py [--g 0.85] [--albedo 0.99] [--orders N]
 
 The simplest case of light born inside a thick medium: an isotropic point light (1e6 W/sr)
 at the centre of a sphere of radius --radius [m] and extinction --sigma [1/m] (sampled on

@@ -1,10 +1,10 @@
 """What each rank holds: peak memory, time and bytes exchanged per rank for the OpenVDB reader
 and the cloud automaton under MPI (docs/parallel.md, "What each rank holds").
 
-    python3 scripts/parallel-pieces-bench.py --make-vdb FILE [--size 512]
+    python3 measurements/parallel-pieces-bench.py --make-vdb FILE [--size 512]
         writes the metaball cloud (vtkNimbusMetaballCloudSource, SIZE^3 points, defaults) with
         the OpenVDB writer (run once; plain python3)
-    python3 scripts/parallel-pieces-bench.py --table --vdb FILE [--ranks 1 2 4 8]
+    python3 measurements/parallel-pieces-bench.py --table --vdb FILE [--ranks 1 2 4 8]
         [--automaton 512 512 128]
         runs the cases below under `mpiexec --oversubscribe -n N pvbatch --symmetric` for each N
         and prints the table (markdown)

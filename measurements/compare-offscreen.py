@@ -3,7 +3,7 @@
 against the same file from the X run (build/Testing/Temporary), as a Markdown table of the
 largest and the RMS difference in 8-bit units over all channels.
 
-    python3 scripts/compare-offscreen.py [build/Testing/Temporary]
+    python3 measurements/compare-offscreen.py [build/Testing/Temporary]
 """
 import math
 import os

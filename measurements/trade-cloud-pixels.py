@@ -11,7 +11,7 @@ from nimbus import harness
 
 # Usage (after a harness run that cached the path-traced references and their sky-only
 # versions, e.g. --renderer vtk-gpu under --reference auto):
-#   Testing/with-display.sh /usr/bin/python3 scripts/trade-cloud-pixels.py CACHE_DIR SCENE.json...
+#   Testing/with-display.sh /usr/bin/python3 measurements/trade-cloud-pixels.py CACHE_DIR SCENE.json...
 cache = sys.argv[1]
 settings = {"vtk-gpu": [{"shading": "absorption", "sample_distance": 1.0},
                         {"shading": "volumetric", "sample_distance": 0.5, "reach": 0.0},

@@ -1,7 +1,7 @@
 """Frame times of the Cloud representation in ParaView (pvpython), beside ParaView's own
 Volume representation, in one run (interactive speed).
 
-    Testing/with-display.sh pvpython scripts/bench-paraview-frames.py \
+    Testing/with-display.sh pvpython measurements/bench-paraview-frames.py \
         --plugin build/lib/paraview-5.11/plugins/Nimbus/Nimbus.so [--size 1280 800] \
         [--dimensions 128] [--repeats 5] [--method {march,slices}] [--json out.json]
 

@@ -1,7 +1,7 @@
 """Writes Data/SatelliteClouds.png: a synthetic, satellite-like 8-bit grayscale picture of
 clouds over a dark sea (NOT a real satellite image). Deterministic (fixed seed).
 
-    /usr/bin/python3 scripts/make-sample-satellite-image.py Data/SatelliteClouds.png
+    /usr/bin/python3 measurements/make-sample-satellite-image.py Data/SatelliteClouds.png
 
 Sea and land (intensity ~20-60), a band of broken cumulus made of fractal value noise
 thresholded and brightened, and a few bright convective cells (discs with soft edges).

@@ -1,7 +1,7 @@
 """Writes the data files of the light scenes (Data/Scenes/lights/):
 
     PYTHONPATH=build/lib/python3.11/site-packages /usr/bin/python3 \
-        scripts/make-light-scenes.py [--output-dir Data/Scenes/lights]
+        measurements/make-light-scenes.py [--output-dir Data/Scenes/lights]
 
   window_gobo.png   a gobo for gobo_haze.json: a window of four panes behind a cross of
                     bars, 256 x 256 pixels, 8-bit grey (white = the light passes, black =
@@ -91,7 +91,7 @@ def write_post(path):
     vertices, triangles = post_triangles()
     with open(path, "w", newline="\n") as stream:
         stream.write("ply\nformat ascii 1.0\n")
-        stream.write("comment Nimbus streetlight_fog post: scripts/make-light-scenes.py\n")
+        stream.write("comment Nimbus streetlight_fog post: measurements/make-light-scenes.py\n")
         stream.write(f"element vertex {len(vertices)}\n")
         stream.write("property float x\nproperty float y\nproperty float z\n")
         stream.write(f"element face {len(triangles)}\n")

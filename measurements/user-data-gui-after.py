@@ -1,7 +1,7 @@
 """A user's steps with Data/UserData's files in the real ParaView GUI, photographed.
 
     Xvfb :57 -screen 0 1280x860x24 -noreset &
-    DISPLAY=:57 /usr/bin/python3 scripts/user-data-gui-after.py \
+    DISPLAY=:57 /usr/bin/python3 measurements/user-data-gui-after.py \
         --plugin-dir build/lib/paraview-5.11/plugins/Nimbus --data-dir Data/UserData \
         --output-dir DIR [--case vdb|netcdf|pvti]
 

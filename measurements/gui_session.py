@@ -1,4 +1,4 @@
-"""What scripts/gui-drag-check.py and scripts/gui-lights-check.py share to drive the real
+"""What measurements/gui-drag-check.py and measurements/gui-lights-check.py share to drive the real
 ParaView GUI under X: xdotool, a fresh `paraview` with a start-up script, its main window,
 and the render view found in a screenshot."""
 import os

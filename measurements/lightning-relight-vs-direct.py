@@ -2,7 +2,7 @@
 """Relight against the direct solve, in the picture (003; docs/lightning.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
-        scripts/lightning-relight-vs-direct.py [--spacing M ...] [--threshold XI ...]
+        measurements/lightning-relight-vs-direct.py [--spacing M ...] [--threshold XI ...]
 
 vtkNimbusLightningIllumination's two methods on the same cloud and flash (the seed-3
 metaball cumulus, a 3.5 km flash from 2 km high inside it, at the return stroke), drawn by

@@ -29,7 +29,7 @@ relative radiance units), each renderer against each reference. One CSV row per
 flock /tmp/nimbus-measure.lock.
 
     flock /tmp/nimbus-measure.lock Testing/with-display.sh /usr/bin/python3 \
-        scripts/splat-compare.py --counts 1000 10000 100000 1000000 --output build/splats
+        measurements/splat-compare.py --counts 1000 10000 100000 1000000 --output build/splats
 """
 import argparse
 import csv

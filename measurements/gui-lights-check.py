@@ -2,10 +2,10 @@
 display's Lights group, View > Light Inspector, a light added there and made a positional
 spotlight, its beam in the fog, and a light-map file that cannot be read.
 
-    DISPLAY=:63 /usr/bin/python3 scripts/gui-lights-check.py \
+    DISPLAY=:63 /usr/bin/python3 measurements/gui-lights-check.py \
         --plugin-dir build/lib/paraview-5.11/plugins/Nimbus --output-dir DIR
 
-Without a DISPLAY the script starts its own Xvfb (1600x1040, as scripts/gui-drag-check.py
+Without a DISPLAY the script starts its own Xvfb (1600x1040, as measurements/gui-drag-check.py
 uses) and stops it at the end. A fresh `paraview` (fresh settings folder, --dr) runs a
 start-up script that builds the scene of Examples/Python/lamp_in_fog_paraview.py without
 its light: a Wavelet grid, a Calculator that makes its "density" 0 everywhere shown as

@@ -1,8 +1,8 @@
 """Blender 3.4's Mantaflow smoke on the scene of build/bin/BenchSmoke (docs/smoke.md): time per
 frame and per Mantaflow step, and the last frame's density as OpenVDB for
-scripts/smoke-side-by-side.py.
+measurements/smoke-side-by-side.py.
 
-    blender -b --factory-startup -t 2 --python scripts/mantaflow-smoke-bench.py -- \
+    blender -b --factory-startup -t 2 --python measurements/mantaflow-smoke-bench.py -- \
         RES FRAMES CACHE_DIR [--steps N | --cfl C] [--no-step-timing]
 
 RES cells along each side of the 8 m cube, FRAMES frames of 1/24 s (BenchSmoke's
@@ -65,7 +65,7 @@ Checked at 32^3 against vtkNimbusSmokeSource with these parameters (frames 1, 6,
 amount 10 to 25 % lower (the clamp at 1 and the wall layer under the emitter).
 The .vdb's transform is a pure scale (voxel size 8/RES m, index (0, 0, 0) at the origin):
 world = domain corner (-4, -4, 0) + (index + 0.5) * voxel size for cell centres, which
-scripts/smoke-side-by-side.py applies.
+measurements/smoke-side-by-side.py applies.
 
 Why 64^3 bakes used to stop with "'NoneType' object has no attribute 'getDataPointer'"
 (and sometimes 32^3 ones too): the bake never started. Every bpy.ops call first updates

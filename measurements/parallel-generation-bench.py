@@ -1,7 +1,7 @@
 """Generation time and peak memory per rank of the Nimbus field sources in pieces (docs/parallel.md).
 
     PYTHONPATH=build/lib/python3.11/site-packages \
-        mpiexec -n N pvbatch --symmetric scripts/parallel-generation-bench.py \
+        mpiexec -n N pvbatch --symmetric measurements/parallel-generation-bench.py \
         --source metaball|automaton|smoke [--size 256] [--json out.json]
 
 (Open MPI as root: add --allow-run-as-root; more ranks than cores: --oversubscribe.) Every

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Frame time and memory per rank of the Cloud representation in pvbatch on 1, 2 and 4
-# ranks (docs/parallel.md). Usage: scripts/parallel-render-bench.sh [grid] [ranks...]
+# ranks (docs/parallel.md). Usage: measurements/parallel-render-bench.sh [grid] [ranks...]
 # Prints, per rank count, the first render (delivery, coarse all-gather, uploads and
 # solves), the mean of 3 still renders after small camera moves (passes and IceT
 # compositing), and every rank's peak resident memory (GNU time's %M).

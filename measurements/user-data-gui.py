@@ -3,7 +3,7 @@
     NIMBUS_USER_DATA_STEP=0|1|2|3 NIMBUS_USER_DATA_FILE=Data/UserData/cumulus_y_up.vdb \
     NIMBUS_USER_DATA_TIMING=/tmp/timing.txt \
     PV_PLUGIN_PATH=<build>/lib/paraview-5.11/plugins/Nimbus \
-        paraview --dr --script=scripts/user-data-gui.py
+        paraview --dr --script=measurements/user-data-gui.py
 
 Run inside the real GUI after the plugin has loaded (docs/user-data.md photographs the
 screen with ImageMagick's `import -window root` a few seconds later):

@@ -2,7 +2,7 @@
 """Lightning inside a cloud: Nimbus against the path tracer.
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
-        scripts/lightning-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
+        measurements/lightning-vs-path-tracer.py [--output-dir DIR] [--time-limit SECONDS]
 
 The scene: the metaball cumulus (seed 3, 3 km wide, base 1000 m) at night (no sun, no
 air, no ground, to isolate the cloud), lit by a Nimbus Lightning flash at its return
@@ -99,7 +99,7 @@ if len(lights) > 1024:
 scene = {
     "nimbus_scene": 3, "name": "lightning_in_cumulus",
     "description": "The seed-3 metaball cumulus lit from inside by a lightning flash at its "
-                   "return stroke (scripts/lightning-vs-path-tracer.py); no sun, air or ground.",
+                   "return stroke (measurements/lightning-vs-path-tracer.py); no sun, air or ground.",
     "camera": CAMERA,
     "medium": {"density": {"type": "metaball_cloud", "parameters": CLOUD},
                "extinction_per_density": 0.02, "single_scattering_albedo": 0.99,

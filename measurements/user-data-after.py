@@ -1,11 +1,11 @@
 """What a user must do now to get a believable cloud from Data/UserData's files.
 
     PYTHONPATH=build/lib/python3.11/site-packages \
-    /usr/bin/pvpython --force-offscreen-rendering scripts/user-data-after.py \
+    /usr/bin/pvpython --force-offscreen-rendering measurements/user-data-after.py \
         --plugin build/lib/paraview-5.11/plugins/Nimbus/Nimbus.so \
         --data-dir Data/UserData --output-dir DIR [--case vdb|netcdf|pvti] [--extinction]
 
-The "after" twin of scripts/user-data-before.py (same view, camera, checks and clock): for
+The "after" twin of measurements/user-data-before.py (same view, camera, checks and clock): for
 each file, the steps of docs/user-data.md's "after" column, one at a time, each rendered
 and judged by the checks of Testing/Python/TestUserData.py, with the seconds since the
 file was opened (the checks' own renders not counted). Images: DIR/<case>-<step>.png.

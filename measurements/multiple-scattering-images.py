@@ -9,7 +9,7 @@ tone-mapped like the harness's PNGs, with the RMSE and PSNR against the referenc
 (noise-corrected) under each panel.
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
-        scripts/multiple-scattering-images.py CACHE_DIR OUTPUT_DIR Data/Scenes/silver_lining.json ...
+        measurements/multiple-scattering-images.py CACHE_DIR OUTPUT_DIR Data/Scenes/silver_lining.json ...
 
 CACHE_DIR is a harness --cache-dir holding the scenes' path-traced references (run the
 harness once with --reference path to make them).

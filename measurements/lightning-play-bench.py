@@ -1,6 +1,6 @@
 """Play of a lightning flash in ParaView (pvpython): frames per second, and where a frame goes.
 
-    nice Testing/with-display.sh pvpython scripts/lightning-play-bench.py \
+    nice Testing/with-display.sh pvpython measurements/lightning-play-bench.py \
         --plugin build/lib/paraview-5.11/plugins/Nimbus/Nimbus.so [--size 1280 800] \
         [--cache-dir DIR] [--frames N] [--still] [--json out.json]
 

@@ -1,6 +1,6 @@
 """What a user must do today to get a believable cloud from Data/UserData's files.
 
-    /usr/bin/pvpython --force-offscreen-rendering scripts/user-data-before.py \
+    /usr/bin/pvpython --force-offscreen-rendering measurements/user-data-before.py \
         --plugin build/lib/paraview-5.11/plugins/Nimbus/Nimbus.so \
         --data-dir Data/UserData --output-dir DIR [--case vdb|netcdf|pvti] [--control]
 

@@ -13,7 +13,7 @@ colour through the air); vtkNimbusSkyPass draws the sky behind and adds the aeri
 over distance.
 
   PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \\
-      scripts/desert-scene.py [--output docs/images/desert.png] [--no-lod] [--frames N]
+      Examples/Python/desert_scene_vtk.py [--output docs/images/desert.png] [--no-lod] [--frames N]
 
 --no-lod uses the finest level everywhere (for the cost comparison); --frames N renders N
 more frames and prints the mean time per frame.
@@ -99,7 +99,7 @@ def ripple_texture(ripples, level):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--output", default=os.path.join(
-        os.path.dirname(__file__), "..", "docs", "images", "desert.png"))
+        os.path.dirname(__file__), "..", "..", "docs", "images", "desert.png"))
     parser.add_argument("--width", type=int, default=1280)
     parser.add_argument("--height", type=int, default=720)
     parser.add_argument("--tiles", type=int, default=11)

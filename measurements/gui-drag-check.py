@@ -3,7 +3,7 @@ Method, photographed: how the interactive frames look and how fast they come, an
 after the mouse is released the still frame is complete.
 
     Xvfb :63 -screen 0 1600x1040x24 -noreset &
-    DISPLAY=:63 /usr/bin/python3 scripts/gui-drag-check.py \
+    DISPLAY=:63 /usr/bin/python3 measurements/gui-drag-check.py \
         --plugin-dir build/lib/paraview-5.11/plugins/Nimbus --output-dir DIR \
         [--method march] [--method slices] [--window 1588 1035] [--drag-seconds 10]
 

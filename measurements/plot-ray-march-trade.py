@@ -3,7 +3,7 @@
 GPU ray caster, from the trade harness's CSVs of several runs (one run per renderer, since
 the harness's --settings applies to one renderer only).
 
-    python3 scripts/plot-ray-march-trade.py RUN1/trade.csv RUN2/trade.csv \
+    python3 measurements/plot-ray-march-trade.py RUN1/trade.csv RUN2/trade.csv \
         --output-dir docs/ray-march [--title-note "..."]
 
 Writes, in the output directory:
