@@ -1,4 +1,4 @@
-# The Cloud representation rendered by several pvbatch ranks (issue 18, label mpi):
+# The Cloud representation rendered by several pvbatch ranks (docs/parallel.md, label mpi):
 # the picture of 2 and 4 ranks against one rank's, within the bounds measured in
 # docs/parallel.md, and the air and the ground drawn once (an empty cloud, to 1 level).
 # Needs ParaView's pvbatch and an MPI launcher; without either the tests are left out.

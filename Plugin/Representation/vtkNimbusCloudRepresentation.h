@@ -351,7 +351,7 @@ protected:
   void UpdateMapperParameters() override;
 
   /// The superclass's data cache; under MPI (more than one process) also the
-  /// distributed cloud's shared view of itself (issue 18, docs/parallel.md): every
+  /// distributed cloud's shared view of itself (docs/parallel.md): every
   /// rank's piece bounds and a coarse copy of the whole density (CoarseDensityMaxSide
   /// points on its longest side at most), summed over the ranks (collective: every
   /// rank of the data server executes it).
