@@ -252,9 +252,9 @@ int vtkNimbusLightningIllumination::RequestData(
   {
     fieldData->ShallowCopy(cloud->GetFieldData());
   }
-  for (const char* name :
-    { "nimbus_lightning_in_scattering", "nimbus_lightning_grid", "nimbus_lightning_optics",
-      "nimbus_lightning_first_scattering", "nimbus_lightning_first_scattering_grid" })
+  for (const char* name : { "nimbus_lightning_in_scattering", "nimbus_lightning_grid",
+         "nimbus_lightning_optics", "nimbus_lightning_first_scattering",
+         "nimbus_lightning_first_scattering_reduced", "nimbus_lightning_first_scattering_grid" })
   {
     fieldData->RemoveArray(name);
   }
@@ -792,15 +792,53 @@ void vtkNimbusLightningIllumination::AddFirstScattering(
   {
     return;
   }
+  // The delta-M view's first scattering (the mapper's LightningDeltaMView): the beam
+  // through the reduced extinction (1 - f albedo) sigma_t alone, no peak given back,
+  // E' = I exp(-(1 - f albedo) tau) / r^2 (Wiscombe 1977, delta-M).
+  const nimbus::FirstScatteringForwardPeak peak = this->ForwardPeak();
+  nimbus::FirstScatteringField reduced;
+  if (peak.Fraction > 0.0)
+  {
+    const float scale = static_cast<float>(1.0 - peak.Fraction * peak.Albedo);
+    for (float& sigma : grid.Extinction)
+    {
+      sigma *= scale;
+    }
+    try
+    {
+      reduced = in.FirstScattering.Evaluate(grid, in.FirstScatteringGroups,
+        nimbus::FirstScatteringForwardPeak(), this->NumberOfThreads,
+        [this](double)
+        {
+          if (this->CheckAbort())
+          {
+            throw Aborted();
+          }
+        });
+    }
+    catch (const Aborted&)
+    {
+      return;
+    }
+  }
   in.FirstScatteringSeconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  vtkNew<vtkFloatArray> values;
-  values->SetName("nimbus_lightning_first_scattering");
-  values->SetNumberOfComponents(4);
-  values->SetNumberOfTuples(static_cast<vtkIdType>(field.Values.size() / 4));
   // E and F carry the lightning's colour: the grey sources' field times it, per channel
   // in the mapper (the colour is in nimbus_lightning_first_scattering_grid).
-  std::copy(field.Values.begin(), field.Values.end(), values->GetPointer(0));
+  auto addField = [fieldData](const nimbus::FirstScatteringField& f, const char* name)
+  {
+    vtkNew<vtkFloatArray> array;
+    array->SetName(name);
+    array->SetNumberOfComponents(4);
+    array->SetNumberOfTuples(static_cast<vtkIdType>(f.Values.size() / 4));
+    std::copy(f.Values.begin(), f.Values.end(), array->GetPointer(0));
+    fieldData->AddArray(array);
+  };
+  addField(field, "nimbus_lightning_first_scattering");
+  if (!reduced.Values.empty())
+  {
+    addField(reduced, "nimbus_lightning_first_scattering_reduced");
+  }
   vtkNew<vtkDoubleArray> gridArray;
   gridArray->SetName("nimbus_lightning_first_scattering_grid");
   gridArray->SetNumberOfTuples(10);
@@ -811,7 +849,6 @@ void vtkNimbusLightningIllumination::AddFirstScattering(
     gridArray->SetValue(7 + k, this->LightningColor[k]);
   }
   gridArray->SetValue(6, cellData ? 1 : 0);
-  fieldData->AddArray(values);
   fieldData->AddArray(gridArray);
 }
 

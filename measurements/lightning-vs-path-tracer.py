@@ -68,7 +68,9 @@ parser.add_argument("--variants", nargs="+",
                     default=["basis", "direct", "basis-fine1", "basis-coarse", "direct-coarse"],
                     help="Nimbus variants: basis or direct, with the first scattering on the "
                          "density's grid (automatic blocks; -fineN: N blocks) or on the "
-                         "illumination grid (-coarse, as before)")
+                         "illumination grid (-coarse, as before); -march: the mapper's ray "
+                         "march instead of its slices; -plain: the lightning's view without "
+                         "delta-M (LightningDeltaMView off); e.g. basis-march-plain")
 args = parser.parse_args()
 os.makedirs(args.output_dir, exist_ok=True)
 
@@ -182,15 +184,17 @@ cloud.SetSeed(CLOUD["Seed"])
 
 def render(variant):
     """One Nimbus variant (see --variants): the image, the filter's update seconds, the filter."""
-    method = 1 if variant.startswith("direct") else 0
+    tokens = variant.split("-")
+    method = 1 if tokens[0] == "direct" else 0
     illumination = nimbus.vtkNimbusLightningIllumination()
     illumination.SetInputConnection(0, cloud.GetOutputPort(0))
     illumination.SetInputConnection(1, lightning.GetOutputPort(0))  # the strokes
     illumination.SetMethod(method)
     illumination.SetDownsampling(args.downsampling)
-    illumination.SetFirstScatteringOnDensityGrid(not variant.endswith("-coarse"))
-    if "-fine" in variant:
-        illumination.SetFirstScatteringDownsampling(int(variant.split("-fine")[1]))
+    illumination.SetFirstScatteringOnDensityGrid("coarse" not in tokens)
+    for token in tokens:
+        if token.startswith("fine"):
+            illumination.SetFirstScatteringDownsampling(int(token[len("fine"):]))
     if args.cache_dir:
         illumination.SetCacheDirectory(args.cache_dir)
     if args.orders > 0:
@@ -213,6 +217,10 @@ def render(variant):
     mapper.SetAtmosphere(False)
     mapper.SetGround(False)
     mapper.SetNumberOfSlices(512)
+    if "march" in tokens:
+        mapper.SetRenderingMethodToRayMarching()
+    if "plain" in tokens:
+        mapper.SetLightningDeltaMView(False)
     mapper.SetExposure(harness.VTK_SCALE)
     image, _ = harness.render_mapper_radiance(mapper, CAMERA, args.size, (1.0, 1e6))
     return image, update, illumination

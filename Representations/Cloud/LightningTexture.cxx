@@ -134,9 +134,15 @@ bool LightningTexture::UpdateFirstScattering(vtkOpenGLRenderWindow* window, vtkI
   const std::array<int, 3>& textureFactors, std::string& error)
 {
   vtkFieldData* fields = image->GetFieldData();
-  vtkFloatArray* values = fields
+  vtkFloatArray* reduced = fields && this->PreferReduced
+    ? vtkFloatArray::SafeDownCast(
+        fields->GetAbstractArray("nimbus_lightning_first_scattering_reduced"))
+    : nullptr;
+  vtkFloatArray* values = reduced ? reduced
+    : fields
     ? vtkFloatArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_first_scattering"))
     : nullptr;
+  this->FirstScatteringReduced = reduced != nullptr;
   vtkDoubleArray* layout = fields ? vtkDoubleArray::SafeDownCast(fields->GetAbstractArray(
                                       "nimbus_lightning_first_scattering_grid"))
                                   : nullptr;

@@ -66,6 +66,13 @@ public:
     return this->FirstScatteringColour;
   }
 
+  /// Upload the delta-M view's first scattering ("nimbus_lightning_first_scattering_reduced":
+  /// the beam through the reduced extinction, vtkNimbusLightningIllumination) in place of
+  /// the plain one when the image has it.
+  void SetPreferReducedFirstScattering(bool prefer) { this->PreferReduced = prefer; }
+  /// Whether the uploaded first scattering is the reduced one.
+  bool IsFirstScatteringReduced() const { return this->FirstScatteringReduced; }
+
   void Release(vtkWindow* window);
 
 private:
@@ -76,6 +83,8 @@ private:
   vtkNew<vtkTextureObject> Textures[3];
   vtkNew<vtkTextureObject> FirstScattering;
   vtkDataArray* FirstScatteringArray = nullptr; // identity only, never dereferenced
+  bool PreferReduced = false;
+  bool FirstScatteringReduced = false;
   unsigned long FirstScatteringTime = 0;
   std::array<double, 3> FirstScatteringScale{ { 1, 1, 1 } };
   std::array<double, 3> FirstScatteringColour{ { 1, 1, 1 } };

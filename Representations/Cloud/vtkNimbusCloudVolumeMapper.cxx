@@ -346,6 +346,9 @@ struct vtkNimbusCloudVolumeMapper::FrameState
   // image's field data, uploaded; its first scattering on the density's grid, when there.
   bool LightningTexture = false;
   bool LightningFirstScattering = false;
+  // Drawn the delta-M way (LightningDeltaMView, with the reduced first scattering): the
+  // slices' third target, the march's second transmittance.
+  bool LightningDeltaM = false;
 
   // Temperature emission (EmissionTexture.h): uploaded and glowing.
   bool EmissionTexture = false;
@@ -404,6 +407,10 @@ struct vtkNimbusCloudVolumeMapper::Internals
   // Accumulation (S, alpha) at the viewport size, and copies of the scene's colour and depth.
   vtkNew<vtkTextureObject> Accumulation;
   vtkNew<vtkTextureObject> ClearAccumulation; // S without the cloud (over a sky)
+  // The lightning's delta-M view in the slices: its light through the reduced extinction
+  // (radiance, reduced transmittance), a third target; on when the last slices drew it.
+  vtkNew<vtkTextureObject> LightningAccumulation;
+  bool LightningAccumulationOn = false;
   vtkNew<vtkOpenGLFramebufferObject> AccumulationFramebuffer;
   vtkNew<vtkTextureObject> SceneColor;
   vtkNew<vtkTextureObject> SceneDepth;
@@ -511,7 +518,8 @@ struct vtkNimbusCloudVolumeMapper::Internals
         Shadow.GetPointer(), RayEnds.GetPointer(), ExternalShadowTexture.GetPointer(),
         SunDepthTexture.GetPointer(), BlockTexture.GetPointer(), FroxelScattering.GetPointer(),
         FroxelTransmittance.GetPointer(), LightMapTexture.GetPointer(), LightsImage.GetPointer(),
-        LightCloudVolume.GetPointer(), CloudSpanImage.GetPointer(), ShaftsImage.GetPointer() })
+        LightCloudVolume.GetPointer(), CloudSpanImage.GetPointer(), ShaftsImage.GetPointer(),
+        LightningAccumulation.GetPointer() })
     {
       t->ReleaseGraphicsResources(window);
     }
@@ -694,7 +702,7 @@ void vtkNimbusCloudVolumeMapper::AbandonFrame(FrameState& frame)
         in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
         in.ShadowMaps.GetTexture(), in.LightMapTexture.GetPointer(), in.LightsImage.GetPointer(),
         in.LightCloudVolume.GetPointer(), in.CloudSpanImage.GetPointer(),
-        in.ShaftsImage.GetPointer() })
+        in.ShaftsImage.GetPointer(), in.LightningAccumulation.GetPointer() })
     {
       if (t->GetContext())
       {
@@ -1645,7 +1653,7 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   }
   for (vtkTextureObject* t : { in.SunDepthTexture.GetPointer(), in.BlockTexture.GetPointer(),
          in.FroxelScattering.GetPointer(), in.FroxelTransmittance.GetPointer(),
-         in.ClearAccumulation.GetPointer() })
+         in.ClearAccumulation.GetPointer(), in.LightningAccumulation.GetPointer() })
   {
     if (t->GetContext())
     {
@@ -1941,10 +1949,12 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
   Internals& in = *this->Internal;
   frame.LightningTexture = false;
   frame.LightningFirstScattering = false;
+  frame.LightningDeltaM = false;
   if (this->Unlit)
   {
     return;
   }
+  in.Lightning.SetPreferReducedFirstScattering(this->LightningDeltaMView);
   int textureDims[3], textureFactors[3];
   in.Density.GetDimensions(textureDims);
   in.Density.GetFactors(textureFactors);
@@ -1963,6 +1973,8 @@ void vtkNimbusCloudVolumeMapper::UpdateLightning(FrameState& frame)
   }
   frame.LightningTexture = in.Lightning.HasTexture();
   frame.LightningFirstScattering = in.Lightning.HasFirstScattering();
+  frame.LightningDeltaM = this->LightningDeltaMView && frame.LightningFirstScattering &&
+    in.Lightning.IsFirstScatteringReduced();
   if (!frame.LightningTexture && !frame.LightningFirstScattering)
   {
     return;
@@ -2350,9 +2362,35 @@ void vtkNimbusCloudVolumeMapper::ClearAccumulation(const FrameState& frame)
     in.AccumulationFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
     in.AccumulationFramebuffer->ActivateDrawBuffers(2);
   }
+  // The lightning's delta-M view: a third target, cleared with the others, drawn by the
+  // slices only (UseLightningTarget).
+  in.AccumulationFramebuffer->RemoveColorAttachment(2);
+  in.LightningAccumulationOn = frame.LightningDeltaM;
+  if (frame.LightningDeltaM)
+  {
+    this->EnsureImageTarget(in.LightningAccumulation, frame);
+    in.AccumulationFramebuffer->AddColorAttachment(2, in.LightningAccumulation);
+  }
+  UseLightningTarget(frame, true);
   frame.State->vtkglViewport(0, 0, frame.Level.Width, frame.Level.Height);
   frame.State->vtkglClearColor(0.0f, 0.0f, 0.0f, 1.0f);
   frame.State->vtkglClear(GL_COLOR_BUFFER_BIT);
+  UseLightningTarget(frame, false);
+}
+
+//------------------------------------------------------------------------------
+// The accumulation framebuffer's draw buffers with the lightning's third target (on) or
+// as ClearAccumulation left them (off), set directly: this VTK's state cache can leave a
+// draw buffer at GL_NONE (RenderCloudMarch). Nothing without the delta-M view.
+void vtkNimbusCloudVolumeMapper::UseLightningTarget(const FrameState& frame, bool on)
+{
+  if (!frame.LightningDeltaM)
+  {
+    return;
+  }
+  const GLenum second = frame.Settings.OverSky ? GL_COLOR_ATTACHMENT1 : GL_NONE;
+  const GLenum buffers[3] = { GL_COLOR_ATTACHMENT0, second, GL_COLOR_ATTACHMENT2 };
+  glDrawBuffers(on ? 3 : (frame.Settings.OverSky ? 2 : 1), buffers);
 }
 
 //------------------------------------------------------------------------------
@@ -2466,8 +2504,19 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
   program->SetUniform3f("lightningColour", lightningColour);
   nimbus::CloudOptics lightningOptics;
   lightningOptics.G = this->CloudG;
+  const double k1 = nimbus::PhaseLegendreCoefficient(lightningOptics, 1);
+  program->SetUniformf("lightningFirstK1", static_cast<float>(k1));
+  // The delta-M view (LightningDeltaMView): f = k2, as the solver's truncation
+  // (MultipleScattering.cxx) and the filter's reduced first scattering take it, and the
+  // truncated phase function's g' = (k1 - k2) / (1 - k2).
+  const double k2 = nimbus::PhaseLegendreCoefficient(lightningOptics, 2);
+  const bool deltaM = frame.LightningDeltaM && k2 > 0.0 && k1 > k2 && k2 < 0.999;
+  const double truncatedG = deltaM ? (k1 - k2) / (1.0 - k2) : k1;
+  program->SetUniformi("lightningDeltaM", deltaM ? 1 : 0);
+  program->SetUniformf("lightningPeakFraction", static_cast<float>(deltaM ? k2 : 0.0));
+  program->SetUniformf("lightningTruncatedG", static_cast<float>(truncatedG));
   program->SetUniformf(
-    "lightningFirstK1", static_cast<float>(nimbus::PhaseLegendreCoefficient(lightningOptics, 1)));
+    "lightningDegreeOneScale", static_cast<float>(deltaM && k1 > 0.0 ? truncatedG / k1 : 1.0));
   // Temperature emission: the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
   // E [Y/(sr m)] scales them.
   program->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);
@@ -2729,6 +2778,7 @@ void vtkNimbusCloudVolumeMapper::RenderCloudMarch(const FrameState& frame)
   // sky only).
   this->EnsureImageTarget(in.Accumulation, frame);
   this->EnsureImageTarget(in.ClearAccumulation, frame);
+  in.LightningAccumulationOn = false; // the march attenuates the lightning itself
   DrawInto(in.MarchFramebuffer, in.Accumulation, frame.Window);
   in.MarchFramebuffer->RemoveColorAttachment(1);
   in.MarchFramebuffer->AddColorAttachment(1, in.ClearAccumulation);
@@ -2903,7 +2953,9 @@ void vtkNimbusCloudVolumeMapper::RenderSliceFromEye(
   UseSliceBlend(frame.State, frame.Axis.BackToFront);
   frame.Window->GetShaderCache()->ReadyShaderProgram(program);
   program->SetUniformf("sliceOffset", offset);
+  UseLightningTarget(frame, true);
   in.SlicePass->Render();
+  UseLightningTarget(frame, false);
   ++in.PassesLastRender;
   if (scissor)
   {
@@ -2968,6 +3020,23 @@ void vtkNimbusCloudVolumeMapper::CaptureRadianceImage(const FrameState& frame)
       }
     }
   }
+  if (!this->UsesRayMarching() && in.LightningAccumulationOn)
+  {
+    // The lightning's delta-M view (the slices' third target), which the composite adds.
+    std::vector<float> lightning(static_cast<std::size_t>(width) * height * 4);
+    in.AccumulationFramebuffer->Bind(GL_FRAMEBUFFER);
+    glReadBuffer(GL_COLOR_ATTACHMENT2);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, lightning.data());
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    float* radiance = values->GetPointer(0);
+    for (std::size_t i = 0; i < lightning.size(); i += 4)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        radiance[i + c] += lightning[i + c];
+      }
+    }
+  }
   in.Radiance->Initialize();
   in.Radiance->SetDimensions(width, height, 1);
   in.Radiance->GetPointData()->SetScalars(values);
@@ -3009,6 +3078,15 @@ void vtkNimbusCloudVolumeMapper::RenderComposite(const FrameState& frame)
     in.LightsImage->Activate();
   }
   program->SetUniformi("lightsImageOn", planes ? 1 : 0);
+  if (in.LightningAccumulationOn)
+  {
+    in.LightningAccumulation->Activate();
+  }
+  program->SetUniformi("lightningImageOn", in.LightningAccumulationOn ? 1 : 0);
+  program->SetUniformi("lightningAccumulation",
+    (in.LightningAccumulationOn ? in.LightningAccumulation.GetPointer()
+                                : in.Accumulation.GetPointer())
+      ->GetTextureUnit());
   program->SetUniformi("lightsImage",
     (planes ? in.LightsImage.GetPointer() : in.Accumulation.GetPointer())->GetTextureUnit());
   if (frame.Settings.OverSky)
@@ -3556,6 +3634,7 @@ void vtkNimbusCloudVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TemperatureEmission: " << (this->TemperatureEmission ? "on" : "off")
      << " (array \"" << this->EmissionTemperatureArray << "\", " << this->EmissionRadiancePerMetre
      << " Y/(sr m) per density at " << this->EmissionReferenceTemperatureKelvin << " K)\n";
+  os << indent << "LightningDeltaMView: " << (this->LightningDeltaMView ? "on" : "off") << "\n";
   os << indent << "CloudG: " << this->CloudG << "\n";
   os << indent << "MultipleScattering (k_multi): " << this->MultipleScattering << "\n";
   static const char* methods[4] = { "None", "Octaves", "ReferencePatterns", "DiscreteDirections" };

@@ -157,6 +157,20 @@ public:
   vtkGetMacro(EmissionReferenceTemperatureKelvin, double);
   ///@}
 
+  ///@{
+  /// The lightning's light drawn the delta-M way (on by default): the solver's orders >= 2
+  /// and the first scattering through the beam's reduced extinction (1 - f albedo) sigma,
+  /// with the truncated phase function's asymmetry g' = (k1 - k2) / (1 - k2) in their
+  /// degree-1 harmonics and (1 - f) of the scattering, f = k2 the forward peak the
+  /// solver folds into the beam (Wiscombe 1977). Off: J with the full phase function's
+  /// k1 through the full extinction. Needs vtkNimbusLightningIllumination's first
+  /// scattering on the density's grid (its "nimbus_lightning_first_scattering_reduced");
+  /// without it the lightning is drawn the plain way. The sun's terms do not change.
+  vtkSetMacro(LightningDeltaMView, bool);
+  vtkGetMacro(LightningDeltaMView, bool);
+  vtkBooleanMacro(LightningDeltaMView, bool);
+  ///@}
+
   /// How the light scattered more than once is computed (003, 004; see
   /// Physics/MultipleScattering.h and docs/multiple-scattering.md). The single
   /// scattering of the sun stays exact per sample (the slices); these add the rest:
@@ -722,6 +736,7 @@ protected:
   double ExtinctionPerDensity = 0.02;
   double Albedo = 0.99;
   bool TemperatureEmission = false;
+  bool LightningDeltaMView = true;
   std::string EmissionTemperatureArray = "temperature";
   double EmissionRadiancePerMetre = 1.0;
   double EmissionReferenceTemperatureKelvin = 1500.0;
@@ -825,6 +840,7 @@ private:
   bool UpdateAtmosphereTable(FrameState& frame);
   void UpdateMultipleScattering(FrameState& frame);
   void UpdateLightning(FrameState& frame);
+  void UseLightningTarget(const FrameState& frame, bool on);
   void UpdateEmission(FrameState& frame);
   const nimbus::SkyViewLut* CloudSkyView(const FrameState& frame, double cloudAltitude);
   const nimbus::SkyModel& FrameSkyModel(const FrameState& frame);

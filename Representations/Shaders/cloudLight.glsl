@@ -29,6 +29,15 @@ uniform sampler3D lightningFirst;
 uniform vec3 lightningFirstScale;     // density texture coordinates -> this texture's
 uniform vec3 lightningColour;
 uniform float lightningFirstK1;       // the cloud's phase function's mean cosine
+// The delta-M view (the mapper's LightningDeltaMView; then lightningFirst is the beam
+// through the reduced extinction alone, E' = I exp(-(1 - f albedo) tau) / r^2): the
+// lightning's light (1 - f) albedo sigma (J' + J1') attenuated by the reduced extinction
+// (1 - f albedo) sigma, J' the solver's J with its degree-1 part scaled by g'/k1, J1'
+// with the truncated phase function's g' (Wiscombe 1977; docs/lightning.md).
+uniform int lightningDeltaM;
+uniform float lightningPeakFraction;  // f = k2
+uniform float lightningTruncatedG;    // g' = (k1 - k2) / (1 - k2)
+uniform float lightningDegreeOneScale; // g' / k1
 // Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
 // [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
 uniform int emissionOn;
@@ -48,10 +57,12 @@ vec3 InScattering(vec3 p, vec3 w)
 }
 
 // J(p, w) of the lightning (the same form as InScattering, without the sun's scale).
-vec3 LightningInScattering(vec3 p, vec3 w)
+// degreeOne scales the degree-1 part (1, or g'/k1 for the delta-M view).
+vec3 LightningInScattering(vec3 p, vec3 w, float degreeOne)
 {
   vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * lightningTextureScale;
-  vec4 y = vec4(0.2820948, 0.4886025 * w.y, 0.4886025 * w.z, 0.4886025 * w.x);
+  float y1 = 0.4886025 * degreeOne;
+  vec4 y = vec4(0.2820948, y1 * w.y, y1 * w.z, y1 * w.x);
   return max(vec3(dot(texture(lightningRed, tc), y), dot(texture(lightningGreen, tc), y),
                dot(texture(lightningBlue, tc), y)), vec3(0.0));
 }
@@ -61,10 +72,33 @@ vec3 LightningInScattering(vec3 p, vec3 w)
 // p(w . F/|F|) around the net flux, exact for one point source, was measured darker than
 // the path tracer next to a channel: a line's light arrives in a fan of directions, which
 // the lobe folds into one: docs/lightning.md.)
-vec3 LightningFirstScattering(vec3 p, vec3 w)
+// k1: the mean cosine of the phase function (the truncated one's g' for the delta-M view).
+vec3 LightningFirstScattering(vec3 p, vec3 w, float k1)
 {
   vec4 v = texture(lightningFirst, (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale);
-  return lightningColour * max((v.a + 3.0 * lightningFirstK1 * dot(v.rgb, w)) / (4.0 * kPi), 0.0);
+  return lightningColour * max((v.a + 3.0 * k1 * dot(v.rgb, w)) / (4.0 * kPi), 0.0);
+}
+
+// The delta-M view's lightning at p toward the eye per metre, before the view's reduced
+// attenuation: (1 - f) albedo sigma (J'(p, -direction) + J1'(p, -direction)); 0 when off.
+vec3 CloudLightningDeltaM(vec3 p, vec3 direction, float sigma)
+{
+  if (lightningDeltaM == 0)
+  {
+    return vec3(0.0);
+  }
+  vec3 j = LightningFirstScattering(p, -direction, lightningTruncatedG);
+  if (lightningTextureOn != 0)
+  {
+    j += LightningInScattering(p, -direction, lightningDegreeOneScale);
+  }
+  return (1.0 - lightningPeakFraction) * cloudAlbedo * sigma * j;
+}
+
+// The reduced extinction's share (1 - f albedo) of the delta-M view.
+float LightningReducedExtinction()
+{
+  return 1.0 - lightningPeakFraction * cloudAlbedo;
 }
 
 // The sun's light scattered more than once that the mapper evaluates per sample,
@@ -105,13 +139,14 @@ vec3 CloudOtherSources(vec3 p, vec3 direction, float sigma)
   {
     source += cloudAlbedo * sigma * InScattering(p, -direction);
   }
-  if (lightningTextureOn != 0)
+  // (The delta-M view's lightning is CloudLightningDeltaM's, attenuated apart.)
+  if (lightningTextureOn != 0 && lightningDeltaM == 0)
   {
-    source += cloudAlbedo * sigma * LightningInScattering(p, -direction);
+    source += cloudAlbedo * sigma * LightningInScattering(p, -direction, 1.0);
   }
-  if (lightningFirstOn != 0)
+  if (lightningFirstOn != 0 && lightningDeltaM == 0)
   {
-    source += cloudAlbedo * sigma * LightningFirstScattering(p, -direction);
+    source += cloudAlbedo * sigma * LightningFirstScattering(p, -direction, lightningFirstK1);
   }
   if (emissionOn != 0)
   {

@@ -169,6 +169,10 @@ void MarchCloud(vec3 origin, vec3 direction, float first, float last, vec3 airIn
   // [first, last]: anchored to the eye, not to the box, so the samples do not move with
   // the box's extent (cell or point data, a piece's bounds).
   float t = (ceil(first / stepLength - jitter) + jitter) * stepLength;
+  // The delta-M view's lightning (CloudLightningDeltaM): its own transmittance through
+  // the reduced extinction, alpha^(1 - f albedo) a step.
+  float reducedShare = LightningReducedExtinction();
+  float reducedTransmittance = lightningDeltaM != 0 ? 1.0 : 0.0;
   for (int i = 0; i < maxSteps && t < last; ++i)
   {
     vec3 p = origin + t * direction;
@@ -188,8 +192,18 @@ void MarchCloud(vec3 origin, vec3 direction, float first, float last, vec3 airIn
         airIn * exp(airLogRatio * ((t - first) / span));
     }
     radiance += transmittance * source * stepIntegral;
+    if (reducedTransmittance > 0.0 && unlit == 0 && sigma > 0.0)
+    {
+      float reducedSigma = reducedShare * sigma;
+      float reducedAlpha = exp(-reducedSigma * stepMetres);
+      float reducedIntegral =
+        reducedSigma * stepMetres > 1e-4 ? (1.0 - reducedAlpha) / reducedSigma : stepMetres;
+      radiance += reducedTransmittance * CloudLightningDeltaM(p, direction, sigma) * reducedIntegral *
+        airIn * exp(airLogRatio * ((t - first) / span));
+      reducedTransmittance *= reducedAlpha;
+    }
     transmittance *= alpha;
-    if (transmittance < kOpaque)
+    if (transmittance < kOpaque && reducedTransmittance < kOpaque)
     {
       transmittance = 0.0;
       break;

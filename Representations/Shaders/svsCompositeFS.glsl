@@ -35,6 +35,10 @@ uniform int premultipliedPiece;
 // radiance toward the eye, added to the accumulation's.
 uniform int lightsImageOn;
 uniform sampler2D lightsImage;
+// The lightning's delta-M view (svsSliceFS.glsl's third target): its light, attenuated
+// by the reduced extinction, added to the accumulation's.
+uniform int lightningImageOn;
+uniform sampler2D lightningAccumulation;
 uniform int usePieceBackground;
 uniform vec3 pieceBackground;
 
@@ -46,6 +50,10 @@ void main()
   if (lightsImageOn != 0)
   {
     sum.rgb += texture(lightsImage, texCoord).rgb;
+  }
+  if (lightningImageOn != 0)
+  {
+    sum.rgb += texture(lightningAccumulation, texCoord).rgb;
   }
   vec4 background = texture(sceneColor, texCoord);
   float depth = texture(sceneDepth, texCoord).r;

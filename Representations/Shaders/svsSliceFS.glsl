@@ -51,6 +51,14 @@ void main()
   float slabLength = sigma * stepMetres > 1e-4 ? (1.0 - alpha) / sigma : stepMetres;
   vec3 source;
   vec3 clearColor = vec3(0.0); // the slab without the cloud
+  // Third output (bound for the lightning's delta-M view): the lightning's light
+  // (CloudLightningDeltaM) with the slab's transmittance through the reduced extinction
+  // as its own alpha, which the same blend accumulates; the composite adds it.
+  float reducedSigma = LightningReducedExtinction() * sigma;
+  float reducedAlpha = lightningDeltaM != 0 ? exp(-reducedSigma * stepMetres) : 1.0;
+  float reducedLength =
+    reducedSigma * stepMetres > 1e-4 ? (1.0 - reducedAlpha) / reducedSigma : stepMetres;
+  vec3 lightning = vec3(0.0);
   if (unlit != 0)
   {
     source = vec3(sigma);
@@ -68,6 +76,7 @@ void main()
       // other pieces' shade on p's sun line darkened the piece's face toward them;
       // left as it is, docs/parallel.md.)
       source = CloudSource(p, direction, sigma, sunDepth, intervalAndPhase.y, altitude);
+      lightning = CloudLightningDeltaM(p, direction, sigma);
     }
     vec3 viewTransmittance =
       BoxViewTransmittance(origin, direction, t, texture(rayEnds, texCoord).ba);
@@ -79,7 +88,9 @@ void main()
       clearColor = (air + multiple) * viewTransmittance * stepMetres;
     }
     source *= viewTransmittance;
+    lightning *= viewTransmittance;
   }
   gl_FragData[0] = vec4(source * slabLength, alpha);
   gl_FragData[1] = vec4(clearColor, 1.0);
+  gl_FragData[2] = vec4(lightning * reducedLength, reducedAlpha);
 }
