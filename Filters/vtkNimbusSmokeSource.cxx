@@ -70,6 +70,35 @@ float SampleCells(
   }
   return static_cast<float>(value);
 }
+
+// The simulation's temperature, density ("grid_density") and velocity at the points r times
+// finer per axis (trilinear), and the obstacles there (a fine point takes its cell's value).
+void SampleOnFinerPoints(const nimbus::SmokeSolver& solver, const nimbus::SmokeParameters& p, int r,
+  const std::array<int, 3>& dims, vtkFloatArray* temperature, vtkFloatArray* gridDensity,
+  vtkFloatArray* velocity, std::vector<std::uint8_t>& obstacles)
+{
+  const vtkIdType points = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  std::vector<std::uint8_t> fine(obstacles.empty() ? 0 : static_cast<std::size_t>(points));
+  for (int k = 0; k < dims[2]; ++k)
+    for (int j = 0; j < dims[1]; ++j)
+      for (int i = 0; i < dims[0]; ++i)
+      {
+        const vtkIdType id = (static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i;
+        // In the simulation's cell coordinates (cell c spans [c, c + 1]).
+        const double x = (i + 0.5) / r, y = (j + 0.5) / r, z = (k + 0.5) / r;
+        temperature->SetValue(id, SampleCells(solver.GetTemperature(), p.Dimensions, x, y, z));
+        gridDensity->SetValue(id, SampleCells(solver.GetDensity(), p.Dimensions, x, y, z));
+        const nimbus::Vector3 at{ { p.Origin[0] + x * p.CellSizeMetres,
+          p.Origin[1] + y * p.CellSizeMetres, p.Origin[2] + z * p.CellSizeMetres } };
+        const nimbus::Vector3 v = solver.VelocityAt(at);
+        velocity->SetTuple3(id, v[0], v[1], v[2]);
+        if (!fine.empty())
+        {
+          fine[static_cast<std::size_t>(id)] = obstacles[solver.CellIndex(i / r, j / r, k / r)];
+        }
+      }
+  obstacles.swap(fine);
+}
 } // namespace
 
 struct vtkNimbusSmokeSource::vtkInternals
@@ -89,6 +118,23 @@ struct vtkNimbusSmokeSource::vtkInternals
     this->Solver.reset();
     this->Puffs.reset();
     this->SolverFrame = -1;
+  }
+
+  // The solver's (and the puffs') state at SolverFrame, kept to go back to.
+  void SaveCheckpoint()
+  {
+    SmokeState& s = this->Checkpoints[this->SolverFrame];
+    s.Time = this->Solver->GetTime();
+    s.Density = this->Solver->GetDensity();
+    s.Temperature = this->Solver->GetTemperature();
+    s.U = this->Solver->GetU();
+    s.V = this->Solver->GetV();
+    s.W = this->Solver->GetW();
+    s.Pressure = this->Solver->GetPressureGuess();
+    if (this->Puffs)
+    {
+      s.Puffs = this->Puffs->GetState();
+    }
   }
 };
 
@@ -166,12 +212,90 @@ int vtkNimbusSmokeSource::RequestUpdateExtent(
   return 1;
 }
 
+// What one RequestData builds before it steps the solver: the solver's and the puffs'
+// parameters, and where the obstacles came from (for the key the states depend on).
+struct vtkNimbusSmokeSource::SmokeSetup
+{
+  nimbus::SmokeParameters Parameters;
+  nimbus::SmokeEmitter Emitter;
+  nimbus::PuffParameters PuffParameters;
+  double ObstacleKind = 0.0; // 0: none, 1: an image, 2: a surface
+  vtkMTimeType ObstacleTime = 0;
+};
+
 int vtkNimbusSmokeSource::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   vtkImageData* output = vtkImageData::GetData(outputVector, 0);
   output->Initialize();
   vtkInternals& in = *this->Internals;
+  this->WarnOnceAboutPieces(outputVector);
+
+  SmokeSetup setup;
+  this->FillSmokeParameters(setup);
+  if (!(this->FrameDurationSeconds > 0.0) || !std::isfinite(this->FrameDurationSeconds) ||
+    this->FrameDurationSeconds > 1e4)
+  {
+    vtkErrorMacro("Smoke: FrameDurationSeconds must be in (0, 1e4] seconds; no output.");
+    in.Reset();
+    return 1;
+  }
+  if (!this->ReadObstacles(inputVector[0], setup))
+  {
+    in.Reset();
+    return 1;
+  }
+  const std::string why = nimbus::CheckSmokeParameters(setup.Parameters);
+  if (!why.empty())
+  {
+    vtkErrorMacro("Smoke: " << why << "; no output.");
+    in.Reset();
+    return 1;
+  }
+  if (!this->FillPuffParameters(setup))
+  {
+    in.Reset();
+    return 1;
+  }
+  this->ForgetStatesIfChanged(setup);
+
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  double time = 0.0;
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+  }
+  const int frame =
+    std::clamp(static_cast<int>(std::floor(time / this->FrameDurationSeconds + 1e-9)), 0,
+      this->NumberOfFrames);
+  try
+  {
+    this->MoveSolverToCheckpoint(setup, frame);
+    if (!this->StepSolverTo(setup, frame))
+    {
+      output->Initialize(); // aborted
+      return 1;
+    }
+  }
+  catch (const std::exception& problem)
+  {
+    vtkErrorMacro("Smoke: " << problem.what() << "; no output.");
+    in.Reset();
+    return 1;
+  }
+  in.LastFrame = frame;
+
+  this->FillOutput(setup, output);
+  // Pieces: the pressure solve is global, so every piece runs the whole simulation
+  // (redundantly: memory and time are not divided between ranks) and outputs its extent.
+  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
+  output->GetInformation()->Set(
+    vtkDataObject::DATA_TIME_STEP(), frame * this->FrameDurationSeconds);
+  return 1;
+}
+
+void vtkNimbusSmokeSource::WarnOnceAboutPieces(vtkInformationVector* outputVector)
+{
   static bool warnedRanks = false; // once per process
   const int pieces = outputVector->GetInformationObject(0)->Get(
     vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
@@ -183,8 +307,11 @@ int vtkNimbusSmokeSource::RequestData(
                                    "domain (the pressure solve is global) and keeps its piece; "
                                    "more ranks make it neither faster nor smaller per rank.");
   }
+}
 
-  nimbus::SmokeParameters p;
+void vtkNimbusSmokeSource::FillSmokeParameters(SmokeSetup& setup) const
+{
+  nimbus::SmokeParameters& p = setup.Parameters;
   for (int k = 0; k < 3; ++k)
   {
     p.Dimensions[k] = this->Dimensions[k];
@@ -204,7 +331,7 @@ int vtkNimbusSmokeSource::RequestData(
     : this->SideBoundaries == 2                ? nimbus::SmokeSideBoundaries::Open
                                                : nimbus::SmokeSideBoundaries::Automatic;
   p.Threads = this->NumberOfThreads;
-  nimbus::SmokeEmitter emitter;
+  nimbus::SmokeEmitter& emitter = setup.Emitter;
   for (int k = 0; k < 3; ++k)
   {
     emitter.Centre[k] = this->EmitterCentre[k];
@@ -214,132 +341,145 @@ int vtkNimbusSmokeSource::RequestData(
   emitter.DensityPerSecond = this->EmitterDensityPerSecond;
   emitter.TemperatureKelvin = this->EmitterTemperatureKelvin;
   p.Emitters = { emitter };
-  if (!(this->FrameDurationSeconds > 0.0) || !std::isfinite(this->FrameDurationSeconds) ||
-    this->FrameDurationSeconds > 1e4)
-  {
-    vtkErrorMacro("Smoke: FrameDurationSeconds must be in (0, 1e4] seconds; no output.");
-    in.Reset();
-    return 1;
-  }
+}
 
+bool vtkNimbusSmokeSource::ReadObstacles(vtkInformationVector* inputVector, SmokeSetup& setup)
+{
   // The obstacles: one value per cell, as point data on the cells' grid or cell data on
   // the grid one larger; or a closed surface, voxelised (a cell is solid when its centre
   // is inside).
-  vtkImageData* obstacleImage = vtkImageData::GetData(inputVector[0], 0);
-  vtkPolyData* obstacleSurface = vtkPolyData::GetData(inputVector[0], 0);
-  vtkMTimeType obstacleTime = 0;
+  vtkImageData* obstacleImage = vtkImageData::GetData(inputVector, 0);
+  vtkPolyData* obstacleSurface = vtkPolyData::GetData(inputVector, 0);
+  setup.ObstacleKind = obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0);
   if (obstacleImage)
   {
-    vtkDataArray* mask = obstacleImage->GetPointData()->GetArray("obstacle");
-    bool cells = false;
-    if (!mask)
-    {
-      mask = obstacleImage->GetCellData()->GetArray("obstacle");
-      cells = true;
-    }
-    int dims[3];
-    obstacleImage->GetDimensions(dims);
-    bool fits = mask != nullptr;
-    for (int k = 0; fits && k < 3; ++k)
-    {
-      fits = (cells ? std::max(dims[k] - 1, 1) : dims[k]) == this->Dimensions[k];
-    }
-    if (!fits)
-    {
-      vtkErrorMacro("Smoke: the obstacle input needs a point array \"obstacle\" with one value "
-                    "per simulation cell ("
-        << this->Dimensions[0] << " x " << this->Dimensions[1] << " x " << this->Dimensions[2]
-        << " points, or cell data on one more point per axis); no output.");
-      in.Reset();
-      return 1;
-    }
-    p.Obstacles.resize(static_cast<std::size_t>(mask->GetNumberOfTuples()));
-    for (vtkIdType i = 0; i < mask->GetNumberOfTuples(); ++i)
-    {
-      const double v = mask->GetComponent(i, 0);
-      p.Obstacles[i] = (std::isfinite(v) && v != 0.0) ? 1 : 0;
-    }
-    obstacleTime = std::max(mask->GetMTime(), obstacleImage->GetMTime());
+    return this->ReadObstacleImage(obstacleImage, setup);
   }
-  else if (obstacleSurface)
+  if (obstacleSurface)
   {
-    // Coincident points merged (closedness is read from shared points), polygons and
-    // strips as triangles; lines and vertices bound no volume.
-    vtkNew<vtkCleanPolyData> merged;
-    merged->SetInputData(obstacleSurface);
-    merged->PointMergingOn();
-    merged->ConvertLinesToPointsOff();
-    merged->ConvertPolysToLinesOff();
-    merged->ConvertStripsToPolysOff();
-    vtkNew<vtkTriangleFilter> triangles;
-    triangles->SetInputConnection(merged->GetOutputPort());
-    triangles->PassVertsOff();
-    triangles->PassLinesOff();
-    triangles->Update();
-    vtkPolyData* surface = triangles->GetOutput();
-    std::vector<nimbus::Vector3> points(static_cast<std::size_t>(surface->GetNumberOfPoints()));
-    for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
-    {
-      surface->GetPoint(i, points[static_cast<std::size_t>(i)].data());
-    }
-    std::vector<std::array<std::int64_t, 3>> faces;
-    faces.reserve(static_cast<std::size_t>(surface->GetNumberOfPolys()));
-    vtkCellArray* polys = surface->GetPolys();
-    vtkIdType count = 0;
-    const vtkIdType* ids = nullptr;
-    for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
-    {
-      if (count == 3)
-      {
-        faces.push_back({ { ids[0], ids[1], ids[2] } });
-      }
-    }
-    std::string problem;
-    if (faces.empty() ||
-      !nimbus::VoxelizeClosedSurface(
-        points, faces, p.Dimensions, p.Origin, this->CellSizeMetres, p.Obstacles, problem))
-    {
-      vtkErrorMacro("Smoke: the obstacle surface can not be voxelised: "
-        << (faces.empty() ? std::string("it has no polygons") : problem)
-        << " (it must be a closed surface, in metres); no output.");
-      in.Reset();
-      return 1;
-    }
-    obstacleTime = obstacleSurface->GetMTime();
+    return this->VoxelizeObstacleSurface(obstacleSurface, setup);
   }
-  const std::string why = nimbus::CheckSmokeParameters(p);
-  if (!why.empty())
+  return true;
+}
+
+bool vtkNimbusSmokeSource::ReadObstacleImage(vtkImageData* obstacleImage, SmokeSetup& setup)
+{
+  vtkDataArray* mask = obstacleImage->GetPointData()->GetArray("obstacle");
+  bool cells = false;
+  if (!mask)
   {
-    vtkErrorMacro("Smoke: " << why << "; no output.");
-    in.Reset();
-    return 1;
+    mask = obstacleImage->GetCellData()->GetArray("obstacle");
+    cells = true;
   }
+  int dims[3];
+  obstacleImage->GetDimensions(dims);
+  bool fits = mask != nullptr;
+  for (int k = 0; fits && k < 3; ++k)
+  {
+    fits = (cells ? std::max(dims[k] - 1, 1) : dims[k]) == this->Dimensions[k];
+  }
+  if (!fits)
+  {
+    vtkErrorMacro("Smoke: the obstacle input needs a point array \"obstacle\" with one value "
+                  "per simulation cell ("
+      << this->Dimensions[0] << " x " << this->Dimensions[1] << " x " << this->Dimensions[2]
+      << " points, or cell data on one more point per axis); no output.");
+    return false;
+  }
+  std::vector<std::uint8_t>& obstacles = setup.Parameters.Obstacles;
+  obstacles.resize(static_cast<std::size_t>(mask->GetNumberOfTuples()));
+  for (vtkIdType i = 0; i < mask->GetNumberOfTuples(); ++i)
+  {
+    const double v = mask->GetComponent(i, 0);
+    obstacles[i] = (std::isfinite(v) && v != 0.0) ? 1 : 0;
+  }
+  setup.ObstacleTime = std::max(mask->GetMTime(), obstacleImage->GetMTime());
+  return true;
+}
+
+bool vtkNimbusSmokeSource::VoxelizeObstacleSurface(vtkPolyData* obstacleSurface, SmokeSetup& setup)
+{
+  // Coincident points merged (closedness is read from shared points), polygons and
+  // strips as triangles; lines and vertices bound no volume.
+  vtkNew<vtkCleanPolyData> merged;
+  merged->SetInputData(obstacleSurface);
+  merged->PointMergingOn();
+  merged->ConvertLinesToPointsOff();
+  merged->ConvertPolysToLinesOff();
+  merged->ConvertStripsToPolysOff();
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputConnection(merged->GetOutputPort());
+  triangles->PassVertsOff();
+  triangles->PassLinesOff();
+  triangles->Update();
+  vtkPolyData* surface = triangles->GetOutput();
+  std::vector<nimbus::Vector3> points(static_cast<std::size_t>(surface->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i)
+  {
+    surface->GetPoint(i, points[static_cast<std::size_t>(i)].data());
+  }
+  std::vector<std::array<std::int64_t, 3>> faces;
+  faces.reserve(static_cast<std::size_t>(surface->GetNumberOfPolys()));
+  vtkCellArray* polys = surface->GetPolys();
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);)
+  {
+    if (count == 3)
+    {
+      faces.push_back({ { ids[0], ids[1], ids[2] } });
+    }
+  }
+  nimbus::SmokeParameters& p = setup.Parameters;
+  std::string problem;
+  if (faces.empty() ||
+    !nimbus::VoxelizeClosedSurface(
+      points, faces, p.Dimensions, p.Origin, this->CellSizeMetres, p.Obstacles, problem))
+  {
+    vtkErrorMacro("Smoke: the obstacle surface can not be voxelised: "
+      << (faces.empty() ? std::string("it has no polygons") : problem)
+      << " (it must be a closed surface, in metres); no output.");
+    return false;
+  }
+  setup.ObstacleTime = obstacleSurface->GetMTime();
+  return true;
+}
+
+bool vtkNimbusSmokeSource::FillPuffParameters(SmokeSetup& setup)
+{
   // Puffs: each carries the smoke of 1 / PuffsPerSecond seconds of the emitter's,
   // DensityPerSecond V_emitter / PuffsPerSecond [density m^3], as a metaball of
   // WyvillFalloffIntegral(R0) per unit peak density.
-  nimbus::PuffParameters pp;
+  nimbus::PuffParameters& pp = setup.PuffParameters;
   pp.PuffsPerSecond = this->PuffsPerSecond;
   pp.RadiusMetres = this->PuffRadiusMetres;
   pp.GrowthPerSecond = this->PuffGrowthPerSecond;
   pp.LifetimeSeconds = this->PuffLifetimeSeconds;
   pp.Threads = this->NumberOfThreads;
-  if (this->Puffs)
+  if (!this->Puffs)
   {
-    const double emitterVolume = 4.0 / 3.0 * M_PI * std::pow(this->EmitterRadiusMetres, 3.0); // m^3
-    pp.DensityPerPuff = this->PuffsPerSecond > 0.0 && this->PuffRadiusMetres > 0.0
-      ? this->EmitterDensityPerSecond * emitterVolume /
-        (this->PuffsPerSecond * nimbus::WyvillFalloffIntegral(this->PuffRadiusMetres))
-      : 0.0;
-    const std::string puffWhy = nimbus::CheckPuffParameters(pp);
-    if (!puffWhy.empty() || !std::isfinite(pp.DensityPerPuff))
-    {
-      vtkErrorMacro("Smoke: puffs: "
-        << (puffWhy.empty() ? "the density per puff is not finite" : puffWhy) << "; no output.");
-      in.Reset();
-      return 1;
-    }
+    return true;
   }
+  const double emitterVolume = 4.0 / 3.0 * M_PI * std::pow(this->EmitterRadiusMetres, 3.0); // m^3
+  pp.DensityPerPuff = this->PuffsPerSecond > 0.0 && this->PuffRadiusMetres > 0.0
+    ? this->EmitterDensityPerSecond * emitterVolume /
+      (this->PuffsPerSecond * nimbus::WyvillFalloffIntegral(this->PuffRadiusMetres))
+    : 0.0;
+  const std::string puffWhy = nimbus::CheckPuffParameters(pp);
+  if (!puffWhy.empty() || !std::isfinite(pp.DensityPerPuff))
+  {
+    vtkErrorMacro("Smoke: puffs: "
+      << (puffWhy.empty() ? "the density per puff is not finite" : puffWhy) << "; no output.");
+    return false;
+  }
+  return true;
+}
 
+void vtkNimbusSmokeSource::ForgetStatesIfChanged(const SmokeSetup& setup)
+{
+  const nimbus::SmokeParameters& p = setup.Parameters;
+  const nimbus::SmokeEmitter& emitter = setup.Emitter;
+  const nimbus::PuffParameters& pp = setup.PuffParameters;
   // The states depend on everything above but the threads and the number of frames.
   std::vector<double> key = { static_cast<double>(p.Dimensions[0]),
     static_cast<double>(p.Dimensions[1]), static_cast<double>(p.Dimensions[2]), p.CellSizeMetres,
@@ -349,129 +489,113 @@ int vtkNimbusSmokeSource::RequestData(
     static_cast<double>(p.SideBoundaries), emitter.Centre[0], emitter.Centre[1], emitter.Centre[2],
     emitter.Velocity[0], emitter.Velocity[1], emitter.Velocity[2], emitter.RadiusMetres,
     emitter.DensityPerSecond, emitter.TemperatureKelvin, this->FrameDurationSeconds,
-    static_cast<double>(this->CheckpointInterval),
-    obstacleImage ? 1.0 : (obstacleSurface ? 2.0 : 0.0), static_cast<double>(obstacleTime),
-    this->Puffs ? 1.0 : 0.0, pp.PuffsPerSecond, pp.RadiusMetres, pp.GrowthPerSecond,
-    pp.LifetimeSeconds };
+    static_cast<double>(this->CheckpointInterval), setup.ObstacleKind,
+    static_cast<double>(setup.ObstacleTime), this->Puffs ? 1.0 : 0.0, pp.PuffsPerSecond,
+    pp.RadiusMetres, pp.GrowthPerSecond, pp.LifetimeSeconds };
+  vtkInternals& in = *this->Internals;
   if (key != in.Key)
   {
     in.Reset();
     in.Key = key;
     in.WarnedSubsteps = false;
   }
+}
 
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  double time = 0.0;
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+void vtkNimbusSmokeSource::MoveSolverToCheckpoint(const SmokeSetup& setup, int frame)
+{
+  vtkInternals& in = *this->Internals;
+  const auto restart = [&]()
   {
-    time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-  }
-  const int frame =
-    std::clamp(static_cast<int>(std::floor(time / this->FrameDurationSeconds + 1e-9)), 0,
-      this->NumberOfFrames);
-
-  try
+    in.Solver.reset(new nimbus::SmokeSolver(setup.Parameters));
+    in.Puffs.reset(this->Puffs ? new nimbus::SmokePuffs(setup.PuffParameters) : nullptr);
+    in.SolverFrame = 0;
+  };
+  const auto restore = [&](int checkpointFrame, const SmokeState& s)
   {
-    const auto restart = [&]()
+    in.Solver->SetState(s.Time, s.Density, s.Temperature, s.U, s.V, s.W);
+    in.Solver->SetPressureGuess(s.Pressure);
+    if (in.Puffs)
     {
-      in.Solver.reset(new nimbus::SmokeSolver(p));
-      in.Puffs.reset(this->Puffs ? new nimbus::SmokePuffs(pp) : nullptr);
-      in.SolverFrame = 0;
-    };
-    const auto restore = [&](int checkpointFrame, const SmokeState& s)
-    {
-      in.Solver->SetState(s.Time, s.Density, s.Temperature, s.U, s.V, s.W);
-      in.Solver->SetPressureGuess(s.Pressure);
-      if (in.Puffs)
-      {
-        in.Puffs->SetState(s.Puffs);
-      }
-      in.SolverFrame = checkpointFrame;
-    };
-    if (!in.Solver)
-    {
-      restart();
+      in.Puffs->SetState(s.Puffs);
     }
-    if (in.SolverFrame > frame)
+    in.SolverFrame = checkpointFrame;
+  };
+  if (!in.Solver)
+  {
+    restart();
+  }
+  if (in.SolverFrame > frame)
+  {
+    // Back to the last checkpoint at or before the frame (frame 0: the initial state).
+    auto checkpoint = in.Checkpoints.upper_bound(frame);
+    if (checkpoint != in.Checkpoints.begin())
     {
-      // Back to the last checkpoint at or before the frame (frame 0: the initial state).
-      auto checkpoint = in.Checkpoints.upper_bound(frame);
-      if (checkpoint != in.Checkpoints.begin())
-      {
-        --checkpoint;
-        restore(checkpoint->first, checkpoint->second);
-      }
-      else
-      {
-        restart();
-      }
+      --checkpoint;
+      restore(checkpoint->first, checkpoint->second);
     }
     else
     {
-      // Forward: from the solver, or from a later checkpoint if there is one.
-      auto checkpoint = in.Checkpoints.upper_bound(frame);
-      if (checkpoint != in.Checkpoints.begin())
-      {
-        --checkpoint;
-        if (checkpoint->first > in.SolverFrame)
-        {
-          restore(checkpoint->first, checkpoint->second);
-        }
-      }
-    }
-    const int first = in.SolverFrame;
-    in.LastSubsteps = 0;
-    while (in.SolverFrame < frame)
-    {
-      const nimbus::SmokeStepReport report = in.Solver->Step(this->FrameDurationSeconds);
-      in.LastSubsteps += report.Substeps;
-      if (report.Substeps > 1 && !in.WarnedSubsteps)
-      {
-        // Said once per set of parameters: the frames stay stable, but cost more.
-        in.WarnedSubsteps = true;
-        vtkWarningMacro("Smoke: frame " << in.SolverFrame + 1 << " took " << report.Substeps
-                                        << " sub-steps: the air moved more than " << p.MaxCfl
-                                        << " cells in one frame (up to " << report.MaxSpeed
-                                        << " m/s), so each frame is split "
-                                           "to stay stable and costs that many times more. "
-                                           "Shorter frames or larger cells avoid it.");
-      }
-      if (in.Puffs)
-      {
-        in.Puffs->Step(this->FrameDurationSeconds, *in.Solver);
-      }
-      ++in.SolverFrame;
-      if (in.SolverFrame % this->CheckpointInterval == 0)
-      {
-        SmokeState& s = in.Checkpoints[in.SolverFrame];
-        s.Time = in.Solver->GetTime();
-        s.Density = in.Solver->GetDensity();
-        s.Temperature = in.Solver->GetTemperature();
-        s.U = in.Solver->GetU();
-        s.V = in.Solver->GetV();
-        s.W = in.Solver->GetW();
-        s.Pressure = in.Solver->GetPressureGuess();
-        if (in.Puffs)
-        {
-          s.Puffs = in.Puffs->GetState();
-        }
-      }
-      this->UpdateProgress(static_cast<double>(in.SolverFrame - first) / (frame - first));
-      if (this->CheckAbort())
-      {
-        output->Initialize();
-        return 1;
-      }
+      restart();
     }
   }
-  catch (const std::exception& problem)
+  else
   {
-    vtkErrorMacro("Smoke: " << problem.what() << "; no output.");
-    in.Reset();
-    return 1;
+    // Forward: from the solver, or from a later checkpoint if there is one.
+    auto checkpoint = in.Checkpoints.upper_bound(frame);
+    if (checkpoint != in.Checkpoints.begin())
+    {
+      --checkpoint;
+      if (checkpoint->first > in.SolverFrame)
+      {
+        restore(checkpoint->first, checkpoint->second);
+      }
+    }
   }
-  in.LastFrame = frame;
+}
 
+bool vtkNimbusSmokeSource::StepSolverTo(const SmokeSetup& setup, int frame)
+{
+  vtkInternals& in = *this->Internals;
+  const int first = in.SolverFrame;
+  in.LastSubsteps = 0;
+  while (in.SolverFrame < frame)
+  {
+    const nimbus::SmokeStepReport report = in.Solver->Step(this->FrameDurationSeconds);
+    in.LastSubsteps += report.Substeps;
+    if (report.Substeps > 1 && !in.WarnedSubsteps)
+    {
+      // Said once per set of parameters: the frames stay stable, but cost more.
+      in.WarnedSubsteps = true;
+      vtkWarningMacro("Smoke: frame " << in.SolverFrame + 1 << " took " << report.Substeps
+                                      << " sub-steps: the air moved more than "
+                                      << setup.Parameters.MaxCfl << " cells in one frame (up to "
+                                      << report.MaxSpeed
+                                      << " m/s), so each frame is split "
+                                         "to stay stable and costs that many times more. "
+                                         "Shorter frames or larger cells avoid it.");
+    }
+    if (in.Puffs)
+    {
+      in.Puffs->Step(this->FrameDurationSeconds, *in.Solver);
+    }
+    ++in.SolverFrame;
+    if (in.SolverFrame % this->CheckpointInterval == 0)
+    {
+      in.SaveCheckpoint();
+    }
+    this->UpdateProgress(static_cast<double>(in.SolverFrame - first) / (frame - first));
+    if (this->CheckAbort())
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+void vtkNimbusSmokeSource::FillOutput(const SmokeSetup& setup, vtkImageData* output)
+{
+  vtkInternals& in = *this->Internals;
+  const nimbus::SmokeParameters& p = setup.Parameters;
   const nimbus::SmokeSolver& solver = *in.Solver;
   // Output points: the cells' centres, or with puffs PuffResolution per cell and axis.
   const int r = in.Puffs ? this->PuffResolution : 1;
@@ -508,27 +632,8 @@ int vtkNimbusSmokeSource::RequestData(
     vtkNew<vtkFloatArray> gridDensity;
     gridDensity->SetName("grid_density");
     gridDensity->SetNumberOfTuples(points);
-    std::vector<std::uint8_t> fine(obstacles.empty() ? 0 : static_cast<std::size_t>(points));
-    for (int k = 0; k < dims[2]; ++k)
-      for (int j = 0; j < dims[1]; ++j)
-        for (int i = 0; i < dims[0]; ++i)
-        {
-          const vtkIdType id = (static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i;
-          // In the simulation's cell coordinates (cell c spans [c, c + 1]).
-          const double x = (i + 0.5) / r, y = (j + 0.5) / r, z = (k + 0.5) / r;
-          temperature->SetValue(id, SampleCells(solver.GetTemperature(), p.Dimensions, x, y, z));
-          gridDensity->SetValue(id, SampleCells(solver.GetDensity(), p.Dimensions, x, y, z));
-          const nimbus::Vector3 at{ { p.Origin[0] + x * p.CellSizeMetres,
-            p.Origin[1] + y * p.CellSizeMetres, p.Origin[2] + z * p.CellSizeMetres } };
-          const nimbus::Vector3 v = solver.VelocityAt(at);
-          velocity->SetTuple3(id, v[0], v[1], v[2]);
-          if (!fine.empty())
-          {
-            fine[static_cast<std::size_t>(id)] = obstacles[solver.CellIndex(i / r, j / r, k / r)];
-          }
-        }
+    SampleOnFinerPoints(solver, p, r, dims, temperature, gridDensity, velocity, obstacles);
     output->GetPointData()->AddArray(gridDensity);
-    obstacles.swap(fine);
   }
   if (in.Puffs)
   {
@@ -547,12 +652,6 @@ int vtkNimbusSmokeSource::RequestData(
     std::copy(obstacles.begin(), obstacles.end(), obstacle->GetPointer(0));
     output->GetPointData()->AddArray(obstacle);
   }
-  // Pieces: the pressure solve is global, so every piece runs the whole simulation
-  // (redundantly: memory and time are not divided between ranks) and outputs its extent.
-  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
-  output->GetInformation()->Set(
-    vtkDataObject::DATA_TIME_STEP(), frame * this->FrameDurationSeconds);
-  return 1;
 }
 
 int vtkNimbusSmokeSource::GetLastFrame() const

@@ -53,6 +53,8 @@
 
 #include <memory> // for std::unique_ptr
 
+class vtkPolyData;
+
 class NIMBUSFILTERS_EXPORT vtkNimbusSmokeSource : public vtkImageAlgorithm
 {
 public:
@@ -201,6 +203,19 @@ private:
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
+
+  // RequestData's steps; false: an error was reported, no output.
+  struct SmokeSetup;
+  void WarnOnceAboutPieces(vtkInformationVector* outputVector);
+  void FillSmokeParameters(SmokeSetup& setup) const;
+  bool ReadObstacles(vtkInformationVector* inputVector, SmokeSetup& setup);
+  bool ReadObstacleImage(vtkImageData* obstacleImage, SmokeSetup& setup);
+  bool VoxelizeObstacleSurface(vtkPolyData* obstacleSurface, SmokeSetup& setup);
+  bool FillPuffParameters(SmokeSetup& setup);
+  void ForgetStatesIfChanged(const SmokeSetup& setup);
+  void MoveSolverToCheckpoint(const SmokeSetup& setup, int frame);
+  bool StepSolverTo(const SmokeSetup& setup, int frame); // false: aborted
+  void FillOutput(const SmokeSetup& setup, vtkImageData* output);
 };
 
 #endif
