@@ -279,6 +279,14 @@ int vtkNimbusImageCloudFilter::RequestData(
   return 1;
 }
 
+// The array the intensities are read from, and how.
+struct vtkNimbusImageCloudFilter::IntensityInput
+{
+  vtkDataArray* Array = nullptr;
+  std::string Name;       // "\"gray\"" or "(unnamed)", for the messages
+  bool CellArray = false; // pixels as cells: each point the mean of the cells around it
+};
+
 int vtkNimbusImageCloudFilter::Generate(
   vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -310,6 +318,62 @@ int vtkNimbusImageCloudFilter::Generate(
                   << dims[0] << " x " << dims[1] << " x " << dims[2] << ".");
     return 1;
   }
+  IntensityInput intensity;
+  if (!this->FindIntensityArray(inputVector, input, dims, intensity) ||
+    !this->CheckMappingParameters())
+  {
+    return 1;
+  }
+  const nimbus::ImageCloudParameters parameters = MakeParameters(this);
+  if (!this->CheckCloudSize(dims, parameters))
+  {
+    return 1;
+  }
+  std::vector<double> tau;
+  if (!this->ComputeOpticalDepths(intensity, dims, tau))
+  {
+    return aborted();
+  }
+
+  this->UpdateProgress(0.1);
+  if (this->CheckAbort())
+  {
+    return aborted();
+  }
+  const nimbus::ImageCloud cloud = nimbus::BuildImageCloud(tau, dims[0], dims[1], parameters,
+    [this](double fraction)
+    {
+      this->UpdateProgress(0.1 + 0.8 * std::clamp(fraction, 0.0, 1.0));
+      return !this->CheckAbort();
+    });
+  if (!cloud.Complete)
+  {
+    return aborted();
+  }
+  this->UpdateProgress(0.9);
+  const nimbus::ValueCensus densityCensus =
+    nimbus::TakeCensus(cloud.Density.data(), cloud.Density.size());
+  if (!densityCensus.AllFiniteNonNegative())
+  {
+    vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(densityCensus)
+                  << "; the output is withheld.");
+    return aborted();
+  }
+  this->FillOutputs(cloud, tau, output, map);
+  // Pieces: the fit rescales each column's balls by its optical depth, which its neighbours'
+  // balls change, for Iterations rounds; the dependency region of a point grows with every
+  // round and the normalisation uses the whole map's maximum. So the cloud is built from the
+  // whole image (requested whole in RequestUpdateExtent) and each output cropped to its
+  // requested extent: exact, but the work is not divided between ranks.
+  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
+  nimbus::CropToRequestedExtent(map, outputVector->GetInformationObject(1));
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+bool vtkNimbusImageCloudFilter::FindIntensityArray(
+  vtkInformationVector** inputVector, vtkImageData* input, const int dims[3], IntensityInput& found)
+{
   vtkDataArray* intensity = this->GetInputArrayToProcess(0, inputVector);
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* arrayName = arrayInfo->Has(vtkDataObject::FIELD_NAME())
@@ -354,7 +418,7 @@ int vtkNimbusImageCloudFilter::Generate(
                     << DescribeArrays(pointData) << " and its cell arrays "
                     << DescribeArrays(cellData) << ".");
     }
-    return 1;
+    return false;
   }
   const vtkIdType pixels = static_cast<vtkIdType>(dims[0]) * dims[1];
   const std::string intensityName = intensity->GetName() && *intensity->GetName()
@@ -376,28 +440,36 @@ int vtkNimbusImageCloudFilter::Generate(
     vtkErrorMacro(<< "The intensity array " << intensityName << " has "
                   << intensity->GetNumberOfTuples() << " values for " << dims[0] << " x " << dims[1]
                   << " = " << pixels << " points (or " << cellPixels << " cells).");
-    return 1;
+    return false;
   }
+  found.Array = intensity;
+  found.Name = intensityName;
+  found.CellArray = cellArray;
+  return true;
+}
+
+bool vtkNimbusImageCloudFilter::CheckMappingParameters()
+{
   if (!(this->IntensityRange[1] > this->IntensityRange[0]) ||
     !std::isfinite(this->IntensityRange[1] - this->IntensityRange[0]))
   {
     vtkErrorMacro(<< "IntensityRange must be finite with min < max, got ("
                   << this->IntensityRange[0] << ", " << this->IntensityRange[1] << ").");
-    return 1;
+    return false;
   }
   if (!std::isfinite(this->ClearIntensity) || !std::isfinite(this->WhiteIntensity))
   {
     vtkErrorMacro(<< "ClearIntensity and WhiteIntensity must be finite (normalised intensities, "
                      "usually in [0, 1]); got "
                   << this->ClearIntensity << " and " << this->WhiteIntensity << ".");
-    return 1;
+    return false;
   }
   if (!(this->WhiteIntensity > this->ClearIntensity) ||
     !std::isfinite(this->WhiteIntensity - this->ClearIntensity))
   {
     vtkErrorMacro(<< "WhiteIntensity (" << this->WhiteIntensity
                   << ") must be greater than ClearIntensity (" << this->ClearIntensity << ").");
-    return 1;
+    return false;
   }
   // The clamping setters keep NaN and infinities: name them here, not deep in the core.
   const struct
@@ -413,12 +485,17 @@ int vtkNimbusImageCloudFilter::Generate(
     {
       vtkErrorMacro(<< parameter.Name << " is " << parameter.Value
                     << "; it must be a finite number (finite values are clamped to its range).");
-      return 1;
+      return false;
     }
   }
+  return true;
+}
 
+bool vtkNimbusImageCloudFilter::CheckCloudSize(
+  const int dims[3], const nimbus::ImageCloudParameters& parameters)
+{
   // Size, memory and work, from the parameters alone, before anything is allocated.
-  const nimbus::ImageCloudParameters parameters = MakeParameters(this);
+  const vtkIdType pixels = static_cast<vtkIdType>(dims[0]) * dims[1];
   const nimbus::GridGeometry grid =
     nimbus::ImageCloudGrid(dims[0], dims[1], this->MaximumOpticalDepth, parameters);
   const double points = static_cast<double>(grid.NumberOfPoints());
@@ -437,7 +514,7 @@ int vtkNimbusImageCloudFilter::Generate(
     vtkErrorMacro(<< overBudget
                   << " (MemoryBudgetMiB); shrink the image, raise VerticalSpacing, or raise "
                      "MemoryBudgetMiB.");
-    return 1;
+    return false;
   }
   const double radius =
     this->BallRadiusFactor * this->BallSpacing * this->PixelSize * (1.0 + this->TopRoughness);
@@ -452,9 +529,14 @@ int vtkNimbusImageCloudFilter::Generate(
                   << Number(MaximumWork)
                   << " (minutes of work); shrink the image, lower Iterations or "
                      "BallRadiusFactor, or raise BallSpacing.");
-    return 1;
+    return false;
   }
+  return true;
+}
 
+bool vtkNimbusImageCloudFilter::ComputeOpticalDepths(
+  const IntensityInput& input, const int dims[3], std::vector<double>& tau)
+{
   // Intensity -> optical depth (OpticalDepthMapping).
   nimbus::OpticalDepthMapping mapping;
   mapping.Type = this->MappingType == TWO_STREAM ? nimbus::OpticalDepthMapping::Kind::TwoStream
@@ -465,8 +547,10 @@ int vtkNimbusImageCloudFilter::Generate(
   mapping.MaximumOpticalDepth = this->MaximumOpticalDepth;
   mapping.AsymmetryParameter = this->AsymmetryParameter;
   nimbus::IntensityToOpticalDepth(0.0, mapping); // throws now for a bad mapping
+  vtkDataArray* intensity = input.Array;
   const int components = intensity->GetNumberOfComponents();
-  std::vector<double> tau(static_cast<std::size_t>(pixels));
+  const vtkIdType pixels = static_cast<vtkIdType>(dims[0]) * dims[1];
+  tau.assign(static_cast<std::size_t>(pixels), 0.0);
   const double scale = 1.0 / (this->IntensityRange[1] - this->IntensityRange[0]);
   nimbus::ValueCensus census;
   auto luminance = [intensity, components](vtkIdType t)
@@ -484,7 +568,7 @@ int vtkNimbusImageCloudFilter::Generate(
   for (vtkIdType i = 0; i < pixels; ++i)
   {
     double value = 0.0;
-    if (cellArray)
+    if (input.CellArray)
     {
       const int x = static_cast<int>(i % dims[0]);
       const int y = static_cast<int>(i / dims[0]);
@@ -512,7 +596,7 @@ int vtkNimbusImageCloudFilter::Generate(
       this->UpdateProgress(0.1 * static_cast<double>(i) / static_cast<double>(pixels));
       if (this->CheckAbort())
       {
-        return aborted();
+        return false;
       }
     }
   }
@@ -522,37 +606,17 @@ int vtkNimbusImageCloudFilter::Generate(
   }
   if (!census.AllFiniteNonNegative())
   {
-    vtkWarningMacro(<< "The intensity array " << intensityName << " has "
+    vtkWarningMacro(<< "The intensity array " << input.Name << " has "
                     << nimbus::DescribeCensus(census)
                     << ": NaN pixels are read as clear sky, infinite and negative ones as the "
                        "ends of IntensityRange.");
   }
+  return true;
+}
 
-  this->UpdateProgress(0.1);
-  if (this->CheckAbort())
-  {
-    return aborted();
-  }
-  const nimbus::ImageCloud cloud = nimbus::BuildImageCloud(tau, dims[0], dims[1], parameters,
-    [this](double fraction)
-    {
-      this->UpdateProgress(0.1 + 0.8 * std::clamp(fraction, 0.0, 1.0));
-      return !this->CheckAbort();
-    });
-  if (!cloud.Complete)
-  {
-    return aborted();
-  }
-  this->UpdateProgress(0.9);
-  const nimbus::ValueCensus densityCensus =
-    nimbus::TakeCensus(cloud.Density.data(), cloud.Density.size());
-  if (!densityCensus.AllFiniteNonNegative())
-  {
-    vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(densityCensus)
-                  << "; the output is withheld.");
-    return aborted();
-  }
-
+void vtkNimbusImageCloudFilter::FillOutputs(const nimbus::ImageCloud& cloud,
+  const std::vector<double>& tau, vtkImageData* output, vtkImageData* map)
+{
   output->SetExtent(0, cloud.Grid.Dimensions[0] - 1, 0, cloud.Grid.Dimensions[1] - 1, 0,
     cloud.Grid.Dimensions[2] - 1);
   output->SetOrigin(cloud.Grid.Origin.data());
@@ -566,6 +630,7 @@ int vtkNimbusImageCloudFilter::Generate(
   map->SetExtent(0, cloud.Grid.Dimensions[0] - 1, 0, cloud.Grid.Dimensions[1] - 1, 0, 0);
   map->SetOrigin(cloud.Grid.Origin[0], cloud.Grid.Origin[1], this->BaseHeight);
   map->SetSpacing(cloud.Grid.Spacing.data());
+  const vtkIdType pixels = static_cast<vtkIdType>(tau.size());
   vtkNew<vtkFloatArray> target, achieved;
   target->SetName("optical_depth");
   achieved->SetName("column_optical_depth");
@@ -578,15 +643,6 @@ int vtkNimbusImageCloudFilter::Generate(
   }
   map->GetPointData()->SetScalars(target);
   map->GetPointData()->AddArray(achieved);
-  // Pieces: the fit rescales each column's balls by its optical depth, which its neighbours'
-  // balls change, for Iterations rounds; the dependency region of a point grows with every
-  // round and the normalisation uses the whole map's maximum. So the cloud is built from the
-  // whole image (requested whole in RequestUpdateExtent) and each output cropped to its
-  // requested extent: exact, but the work is not divided between ranks.
-  nimbus::CropToRequestedExtent(output, outputVector->GetInformationObject(0));
-  nimbus::CropToRequestedExtent(map, outputVector->GetInformationObject(1));
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 void vtkNimbusImageCloudFilter::PrintSelf(ostream& os, vtkIndent indent)

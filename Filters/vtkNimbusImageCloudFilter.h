@@ -48,7 +48,14 @@
 #include "NimbusFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
+#include <vector> // for std::vector
+
 class vtkImageData;
+namespace nimbus
+{
+struct ImageCloud;
+struct ImageCloudParameters;
+}
 
 class NIMBUSFILTERS_EXPORT vtkNimbusImageCloudFilter : public vtkImageAlgorithm
 {
@@ -197,6 +204,17 @@ protected:
 private:
   vtkNimbusImageCloudFilter(const vtkNimbusImageCloudFilter&) = delete;
   void operator=(const vtkNimbusImageCloudFilter&) = delete;
+
+  // Generate's steps; false: an error was reported (or, for ComputeOpticalDepths, aborted).
+  struct IntensityInput;
+  bool FindIntensityArray(vtkInformationVector** inputVector, vtkImageData* input,
+    const int dims[3], IntensityInput& found);
+  bool CheckMappingParameters();
+  bool CheckCloudSize(const int dims[3], const nimbus::ImageCloudParameters& parameters);
+  bool ComputeOpticalDepths(
+    const IntensityInput& input, const int dims[3], std::vector<double>& tau);
+  void FillOutputs(const nimbus::ImageCloud& cloud, const std::vector<double>& tau,
+    vtkImageData* output, vtkImageData* map);
 };
 
 #endif
