@@ -102,6 +102,56 @@ std::string Number(double value)
   text << value;
   return text.str();
 }
+
+// The isosurface's points (x, y, z each) and its triangles (three point ids each).
+void SurfaceTriangles(
+  vtkPolyData* surface, std::vector<double>& points, std::vector<std::int64_t>& triangles)
+{
+  points.resize(3 * static_cast<std::size_t>(surface->GetNumberOfPoints()));
+  for (vtkIdType p = 0; p < surface->GetNumberOfPoints(); ++p)
+  {
+    surface->GetPoint(p, &points[3 * p]);
+  }
+  triangles.reserve(3 * static_cast<std::size_t>(surface->GetNumberOfPolys()));
+  auto iterator = vtk::TakeSmartPointer(surface->GetPolys()->NewIterator());
+  for (iterator->GoToFirstCell(); !iterator->IsDoneWithTraversal(); iterator->GoToNextCell())
+  {
+    vtkIdType size;
+    const vtkIdType* ids;
+    iterator->GetCurrentCell(size, ids);
+    if (size == 3)
+    {
+      triangles.insert(triangles.end(), { ids[0], ids[1], ids[2] });
+    }
+  }
+}
+
+// Port 1: a vertex per ball at its centre, with its radius, density and growth level.
+void FillMetaballOutput(const std::vector<nimbus::Metaball>& balls, vtkPolyData* metaballs)
+{
+  vtkNew<vtkPoints> centres;
+  centres->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> radii;
+  radii->SetName("radius");
+  vtkNew<vtkDoubleArray> densities;
+  densities->SetName("density");
+  vtkNew<vtkIntArray> levels;
+  levels->SetName("level");
+  vtkNew<vtkCellArray> vertices;
+  for (const auto& ball : balls)
+  {
+    const vtkIdType id = centres->InsertNextPoint(ball.Center.data());
+    radii->InsertNextValue(ball.Radius);
+    densities->InsertNextValue(ball.Density);
+    levels->InsertNextValue(ball.Level);
+    vertices->InsertNextCell(1, &id);
+  }
+  metaballs->SetPoints(centres);
+  metaballs->SetVerts(vertices);
+  metaballs->GetPointData()->AddArray(radii);
+  metaballs->GetPointData()->AddArray(densities);
+  metaballs->GetPointData()->AddArray(levels);
+}
 }
 
 vtkNimbusMetaballCloudSource::vtkNimbusMetaballCloudSource()
@@ -179,6 +229,12 @@ int vtkNimbusMetaballCloudSource::FillOutputPortInformation(int port, vtkInforma
 
 bool vtkNimbusMetaballCloudSource::CheckParameters()
 {
+  return this->CheckGridParameters() && this->CheckBallParameters() &&
+    this->CheckShapeParameters() && this->CheckMemoryAndWork();
+}
+
+bool vtkNimbusMetaballCloudSource::CheckGridParameters()
+{
   if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
   {
     vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
@@ -213,6 +269,11 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
       return false;
     }
   }
+  return true;
+}
+
+bool vtkNimbusMetaballCloudSource::CheckBallParameters()
+{
   const double scalars[] = { this->FootprintRadius, this->TowerHeight, this->BallCountFactor,
     this->RadiusScalePerLevel, this->BallDensity, this->IsoValue, this->BaseHeight,
     this->BaseTransitionThickness, this->BaseBallRadiusRange[0], this->BaseBallRadiusRange[1] };
@@ -271,6 +332,11 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
       return false;
     }
   }
+  return true;
+}
+
+bool vtkNimbusMetaballCloudSource::CheckShapeParameters()
+{
   if (this->BallDensity < 0.0 || this->FootprintRadius < 0.0 || this->TowerHeight < 0.0 ||
     this->BaseTransitionThickness < 0.0)
   {
@@ -306,8 +372,14 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
                   << this->BallCountFactor << ".");
     return false;
   }
+  return true;
+}
 
+bool vtkNimbusMetaballCloudSource::CheckMemoryAndWork()
+{
   // --- memory and work, estimated before anything is allocated --------------------------------
+  const int* d = this->Dimensions;
+  const auto& userBalls = this->Internals->UserBalls;
   std::uint64_t points = 0;
   if (!nimbus::CheckedProduct({ static_cast<std::uint64_t>(d[0]), static_cast<std::uint64_t>(d[1]),
                                 static_cast<std::uint64_t>(d[2]) },
@@ -470,7 +542,7 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
   // Progress: growth levels and the final sampling share [0, 1]; each reports inside too.
   const int totalSteps = this->NumberOfLevels + 1;
   double stepStart = 0.0;
-  auto progress = [this, &stepStart, totalSteps](double fraction)
+  const nimbus::ProgressCallback progress = [this, &stepStart, totalSteps](double fraction)
   {
     this->UpdateProgress((stepStart + std::clamp(fraction, 0.0, 1.0)) / totalSteps);
     return !this->CheckAbort();
@@ -484,8 +556,48 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
 
   const nimbus::GridGeometry grid = MakeGrid(this->Dimensions, this->Bounds);
   nimbus::Random random(static_cast<std::uint64_t>(static_cast<std::uint32_t>(this->Seed)));
+  std::vector<nimbus::Metaball> balls = this->MakeBasicShape(random);
+  std::vector<float> density;
+  if (!this->GrowBalls(grid, random, stepStart, progress, balls, density))
+  {
+    return aborted();
+  }
 
-  // Basic shape.
+  // Final density on the requested extent only (the whole grid, or a piece with its ghost
+  // layers): SampleMetaballs gives every point the same sum as the whole grid's sampling.
+  stepStart = this->NumberOfLevels;
+  this->UpdateProgress(stepStart / totalSteps);
+  const nimbus::GridExtent& extent = this->Internals->Extent;
+  const bool anyPoint = extent[0] <= extent[1];
+  if (anyPoint && !nimbus::SampleMetaballs(balls, grid, extent, density, progress))
+  {
+    return aborted();
+  }
+  if (!anyPoint)
+  {
+    density.clear();
+  }
+  if (this->FlatBase && anyPoint)
+  {
+    nimbus::ApplyCloudBase(grid, extent, this->BaseHeight, this->BaseTransitionThickness, density);
+  }
+  if (!this->FillDensityOutput(grid, density, image))
+  {
+    return aborted();
+  }
+
+  // Port 1: the metaballs themselves (once: on piece 0 of a piece request).
+  if (this->Internals->WithMetaballs)
+  {
+    FillMetaballOutput(balls, metaballs);
+  }
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+std::vector<nimbus::Metaball> vtkNimbusMetaballCloudSource::MakeBasicShape(nimbus::Random& random)
+{
+  // Basic shape: the balls added with AddBall, else NumberOfBaseBalls placed at random.
   std::vector<nimbus::Metaball> balls = this->Internals->UserBalls;
   if (balls.empty())
   {
@@ -501,9 +613,15 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
     shape.TowerHeight = this->TowerHeight;
     balls = nimbus::MakeBasicShape(shape, random);
   }
+  return balls;
+}
 
+bool vtkNimbusMetaballCloudSource::GrowBalls(const nimbus::GridGeometry& grid,
+  nimbus::Random& random, double& stepStart, const std::function<bool(double)>& progress,
+  std::vector<nimbus::Metaball>& balls, std::vector<float>& density)
+{
   // Fractal growth (004 §4): isosurface -> balls on its triangles -> repeat.
-  std::vector<float> density;
+  const int totalSteps = this->NumberOfLevels + 1;
   vtkNew<vtkImageData> field;
   field->SetDimensions(grid.Dimensions.data());
   field->SetOrigin(grid.Origin.data());
@@ -531,14 +649,14 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
     this->UpdateProgress(stepStart / totalSteps);
     if (this->CheckAbort())
     {
-      return aborted();
+      return false;
     }
     // Sampling, flying edges and the growth share the level's part of the progress.
     auto part = [&progress](double from, double to)
     { return [&progress, from, to](double f) { return progress(from + (to - from) * f); }; };
     if (!nimbus::SampleMetaballs(balls, grid, density, part(0.0, 0.5)))
     {
-      return aborted();
+      return false;
     }
     fieldArray->SetArray(density.data(), static_cast<vtkIdType>(density.size()), 1);
     fieldArray->Modified();
@@ -552,28 +670,11 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
     contour->Update();
     if (!progress(0.7))
     {
-      return aborted();
+      return false;
     }
-    vtkPolyData* surface = contour->GetOutput();
-
-    std::vector<double> points(3 * static_cast<std::size_t>(surface->GetNumberOfPoints()));
-    for (vtkIdType p = 0; p < surface->GetNumberOfPoints(); ++p)
-    {
-      surface->GetPoint(p, &points[3 * p]);
-    }
+    std::vector<double> points;
     std::vector<std::int64_t> triangles;
-    triangles.reserve(3 * static_cast<std::size_t>(surface->GetNumberOfPolys()));
-    auto iterator = vtk::TakeSmartPointer(surface->GetPolys()->NewIterator());
-    for (iterator->GoToFirstCell(); !iterator->IsDoneWithTraversal(); iterator->GoToNextCell())
-    {
-      vtkIdType size;
-      const vtkIdType* ids;
-      iterator->GetCurrentCell(size, ids);
-      if (size == 3)
-      {
-        triangles.insert(triangles.end(), { ids[0], ids[1], ids[2] });
-      }
-    }
+    SurfaceTriangles(contour->GetOutput(), points, triangles);
 
     radiusScale *= this->RadiusScalePerLevel;
     nimbus::GrowthParameters growth;
@@ -593,7 +694,7 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
         });
     if (stopped)
     {
-      return aborted();
+      return false;
     }
     if (grown.empty())
     {
@@ -604,26 +705,13 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
     ballCount *= this->BallCountFactor;
   }
   fieldArray->SetArray(nullptr, 0, 1);
+  return true;
+}
 
-  // Final density on the requested extent only (the whole grid, or a piece with its ghost
-  // layers): SampleMetaballs gives every point the same sum as the whole grid's sampling.
-  stepStart = this->NumberOfLevels;
-  this->UpdateProgress(stepStart / totalSteps);
+bool vtkNimbusMetaballCloudSource::FillDensityOutput(
+  const nimbus::GridGeometry& grid, const std::vector<float>& density, vtkImageData* image)
+{
   const nimbus::GridExtent& extent = this->Internals->Extent;
-  const bool anyPoint = extent[0] <= extent[1];
-  if (anyPoint && !nimbus::SampleMetaballs(balls, grid, extent, density, progress))
-  {
-    return aborted();
-  }
-  if (!anyPoint)
-  {
-    density.clear();
-  }
-  if (this->FlatBase && anyPoint)
-  {
-    nimbus::ApplyCloudBase(grid, extent, this->BaseHeight, this->BaseTransitionThickness, density);
-  }
-
   int outputExtent[6];
   std::copy(extent.begin(), extent.end(), outputExtent);
   image->SetExtent(outputExtent);
@@ -640,40 +728,9 @@ int vtkNimbusMetaballCloudSource::Generate(vtkImageData* image, vtkPolyData* met
   {
     vtkErrorMacro(<< "The density has " << nimbus::DescribeCensus(census)
                   << "; the output is withheld. Lower BallDensity or the number of balls.");
-    return aborted();
+    return false;
   }
-
-  // Port 1: the metaballs themselves (once: on piece 0 of a piece request).
-  if (!this->Internals->WithMetaballs)
-  {
-    this->UpdateProgress(1.0);
-    return 1;
-  }
-  vtkNew<vtkPoints> centres;
-  centres->SetDataTypeToDouble();
-  vtkNew<vtkDoubleArray> radii;
-  radii->SetName("radius");
-  vtkNew<vtkDoubleArray> densities;
-  densities->SetName("density");
-  vtkNew<vtkIntArray> levels;
-  levels->SetName("level");
-  vtkNew<vtkCellArray> vertices;
-  for (const auto& ball : balls)
-  {
-    const vtkIdType id = centres->InsertNextPoint(ball.Center.data());
-    radii->InsertNextValue(ball.Radius);
-    densities->InsertNextValue(ball.Density);
-    levels->InsertNextValue(ball.Level);
-    vertices->InsertNextCell(1, &id);
-  }
-  metaballs->SetPoints(centres);
-  metaballs->SetVerts(vertices);
-  metaballs->GetPointData()->AddArray(radii);
-  metaballs->GetPointData()->AddArray(densities);
-  metaballs->GetPointData()->AddArray(levels);
-
-  this->UpdateProgress(1.0);
-  return 1;
+  return true;
 }
 
 void vtkNimbusMetaballCloudSource::PrintSelf(ostream& os, vtkIndent indent)

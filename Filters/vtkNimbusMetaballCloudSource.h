@@ -47,8 +47,17 @@
 
 #include <memory> // for std::unique_ptr
 
+#include <functional> // for std::function
+#include <vector>     // for std::vector
+
 class vtkImageData;
 class vtkPolyData;
+namespace nimbus
+{
+struct GridGeometry;
+struct Metaball;
+class Random;
+}
 
 class NIMBUSFILTERS_EXPORT vtkNimbusMetaballCloudSource : public vtkImageAlgorithm
 {
@@ -197,6 +206,20 @@ private:
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
+
+  // CheckParameters's steps, in order; false after vtkErrorMacro.
+  bool CheckGridParameters();  // MemoryBudgetMiB, Dimensions, Bounds
+  bool CheckBallParameters();  // finite values, levels, the basic shape's balls
+  bool CheckShapeParameters(); // densities, lengths, growth factors
+  bool CheckMemoryAndWork();   // the estimates against MemoryBudgetMiB and the work limit
+
+  // Generate's steps; false: aborted (or, for FillDensityOutput, an error was reported).
+  std::vector<nimbus::Metaball> MakeBasicShape(nimbus::Random& random);
+  bool GrowBalls(const nimbus::GridGeometry& grid, nimbus::Random& random, double& stepStart,
+    const std::function<bool(double)>& progress, std::vector<nimbus::Metaball>& balls,
+    std::vector<float>& density);
+  bool FillDensityOutput(
+    const nimbus::GridGeometry& grid, const std::vector<float>& density, vtkImageData* image);
 };
 
 #endif
