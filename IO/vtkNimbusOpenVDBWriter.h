@@ -35,7 +35,16 @@
 #include "NimbusIOOpenVDBModule.h" // export macro
 #include "vtkWriter.h"
 
+#include <vector> // for std::vector
+
 class vtkImageData;
+namespace nimbus
+{
+namespace vdb
+{
+struct FieldToWrite;
+}
+}
 
 class NIMBUSIOOPENVDB_EXPORT vtkNimbusOpenVDBWriter : public vtkWriter
 {
@@ -101,6 +110,9 @@ protected:
 private:
   vtkNimbusOpenVDBWriter(const vtkNimbusOpenVDBWriter&) = delete;
   void operator=(const vtkNimbusOpenVDBWriter&) = delete;
+
+  // WriteData's last step: the grids to FileName, errors to ErrorCode.
+  void WriteFields(const std::vector<nimbus::vdb::FieldToWrite>& fields);
 };
 
 #endif
