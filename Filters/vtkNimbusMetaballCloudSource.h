@@ -45,9 +45,8 @@
 #include "NimbusFiltersModule.h" // for export macro
 #include "vtkImageAlgorithm.h"
 
-#include <memory> // for std::unique_ptr
-
 #include <functional> // for std::function
+#include <memory>     // for std::unique_ptr
 #include <vector>     // for std::vector
 
 class vtkImageData;
