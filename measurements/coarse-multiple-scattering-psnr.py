@@ -8,8 +8,8 @@ gets the same coarse solve when the mapper's solver grid (MultipleScatteringDown
 blocks of texels per axis) leaves at most 64 points on a side. This script renders the
 metaball cloud (vtkNimbusMetaballCloudSource, default bounds 3000 x 3000 x 2000 m) sampled on
 N^3 points for each N given, with vtkNimbusCloudVolumeMapper alone (its defaults: discrete
-directions, atmosphere, ground; the sun 45 degrees up, sRGB, --exposure), once per solver grid side S given (blocks of
-ceil(N / S) texels), and compares each image with the finest solve's (the largest S,
+directions, atmosphere, ground; the sun 45 degrees up, sRGB, --exposure), once per solver
+grid side S given (blocks of ceil(N / S) texels), and compares each image with the finest solve's (the largest S,
 capped at N) by PSNR:
 
 - linear: the mapper's float radiance (CaptureRadiance), peak = the reference image's
@@ -19,9 +19,9 @@ each over the whole image and over the cloud's pixels only (where the reference 
 from the same view without the cloud by more than 1 % of the peak: the sky and the ground,
 the same in every image, do not dilute the error).
 
-It also prints the solve's grid, seconds and estimated bytes, and the cloud's mean free path
-(1 / (ExtinctionPerDensity x density) averaged over points with density > 1 % of the
-maximum) against the coarse cell size.
+It also prints the solve's grid, seconds and estimated bytes, its cell size in metres, and
+the cloud's mean free path: 1 / (ExtinctionPerDensity x the mean density over the points
+above 1 % of the largest).
 
     PYTHONPATH=build/lib/python3.11/site-packages Testing/with-display.sh /usr/bin/python3 \
         measurements/coarse-multiple-scattering-psnr.py --sizes 64 128 256 --sides 32 64 128 \
