@@ -456,6 +456,81 @@ void SunWindow(const std::vector<float>& centres, const std::vector<float>& radi
 }
 }
 
+namespace
+{
+// The GL state of a pass facing the sun, saved and restored around it: `target`
+// (size x size) the only colour attachment of `framebuffer`, cleared; no scissor, depth
+// test or culling; the blend summing the balls (Sum, cleared to 0) or multiplying their
+// attenuation in (Multiply, cleared to 1).
+class SunPassTarget
+{
+public:
+  enum Blend
+  {
+    Sum,
+    Multiply
+  };
+  SunPassTarget(vtkOpenGLRenderWindow* window, vtkOpenGLFramebufferObject* framebuffer,
+    vtkTextureObject* target, int size, Blend blend)
+    : State(window->GetState())
+    , ViewportSaver(State)
+    , ScissorSaver(State, GL_SCISSOR_TEST)
+    , DepthSaver(State, GL_DEPTH_TEST)
+    , BlendSaver(State, GL_BLEND)
+    , CullSaver(State, GL_CULL_FACE)
+    , BlendFuncSaver(State)
+    , ClearSaver(State)
+    , MaskSaver(State)
+    , Framebuffer(framebuffer)
+  {
+    this->State->PushFramebufferBindings();
+    framebuffer->SetContext(window);
+    framebuffer->Bind(GL_FRAMEBUFFER);
+    framebuffer->AddColorAttachment(0, target);
+    framebuffer->ActivateDrawBuffer(0);
+    framebuffer->ActivateReadBuffer(0);
+    vtkOpenGLState* state = this->State;
+    state->vtkglViewport(0, 0, size, size);
+    state->vtkglDisable(GL_SCISSOR_TEST);
+    state->vtkglDisable(GL_DEPTH_TEST);
+    state->vtkglDisable(GL_CULL_FACE);
+    state->vtkglEnable(GL_BLEND);
+    if (blend == Sum)
+    {
+      state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
+    }
+    else
+    {
+      state->vtkglBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_COLOR);
+    }
+    state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const float clear = blend == Sum ? 0.0f : 1.0f;
+    state->vtkglClearColor(clear, clear, clear, clear);
+    state->vtkglClear(GL_COLOR_BUFFER_BIT);
+  }
+  ~SunPassTarget()
+  {
+    this->Framebuffer->RemoveColorAttachment(0);
+    this->State->PopFramebufferBindings();
+  }
+  SunPassTarget(const SunPassTarget&) = delete;
+  SunPassTarget& operator=(const SunPassTarget&) = delete;
+
+private:
+  vtkOpenGLState* State;
+  vtkOpenGLState::ScopedglViewport ViewportSaver;
+  vtkOpenGLState::ScopedglEnableDisable ScissorSaver;
+  vtkOpenGLState::ScopedglEnableDisable DepthSaver;
+  vtkOpenGLState::ScopedglEnableDisable BlendSaver;
+  vtkOpenGLState::ScopedglEnableDisable CullSaver;
+  vtkOpenGLState::ScopedglBlendFuncSeparate BlendFuncSaver;
+  vtkOpenGLState::ScopedglClearColor ClearSaver;
+  vtkOpenGLState::ScopedglColorMask MaskSaver;
+  vtkOpenGLFramebufferObject* Framebuffer;
+};
+
+} // namespace
+
 // The GPU variant: the optical depth toward the sun accumulated in SunTextureLayers planes
 // of a 3-D float texture (002 §3.3's sun-facing billboards, summed instead of multiplied
 // and read back): a 2-D running sum gains each slab's columns (only the balls that cross
@@ -526,30 +601,7 @@ void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
   {
     throw std::runtime_error("the sun pass's shaders did not compile");
   }
-  vtkOpenGLState* state = window->GetState();
-  vtkOpenGLState::ScopedglViewport viewportSaver(state);
-  vtkOpenGLState::ScopedglEnableDisable scissorSaver(state, GL_SCISSOR_TEST);
-  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
-  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
-  vtkOpenGLState::ScopedglEnableDisable cullSaver(state, GL_CULL_FACE);
-  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
-  vtkOpenGLState::ScopedglClearColor clearSaver(state);
-  vtkOpenGLState::ScopedglColorMask maskSaver(state);
-  state->PushFramebufferBindings();
-  in.Framebuffer->SetContext(window);
-  in.Framebuffer->Bind(GL_FRAMEBUFFER);
-  in.Framebuffer->AddColorAttachment(0, running);
-  in.Framebuffer->ActivateDrawBuffer(0);
-  in.Framebuffer->ActivateReadBuffer(0);
-  state->vtkglViewport(0, 0, size, size);
-  state->vtkglDisable(GL_SCISSOR_TEST);
-  state->vtkglDisable(GL_DEPTH_TEST);
-  state->vtkglDisable(GL_CULL_FACE);
-  state->vtkglEnable(GL_BLEND);
-  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT);
+  SunPassTarget target(window, in.Framebuffer, running, size, SunPassTarget::Sum);
   Internals::BindLayout(in.SunLayout, in.SunLayoutProgram, program, in.SunInstances);
   in.SetSunFrameUniforms(program);
   in.Partial->Activate();
@@ -569,10 +621,8 @@ void vtkNimbusCloudSplatMapper::SunPassTexture(vtkOpenGLRenderWindow* window)
     glCopyTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, k, 0, 0, size, size);
   }
   texture->Deactivate();
-  in.Framebuffer->RemoveColorAttachment(0);
   in.Partial->Deactivate();
   in.SunLayout->Release();
-  state->PopFramebufferBindings();
 }
 
 // 002 §3.3's read-back: the framebuffer facing the sun starts at 1; the balls, nearest to
@@ -611,30 +661,7 @@ void vtkNimbusCloudSplatMapper::SunPassReadBack(vtkOpenGLRenderWindow* window)
   {
     throw std::runtime_error("the sun pass's shaders did not compile");
   }
-  vtkOpenGLState* state = window->GetState();
-  vtkOpenGLState::ScopedglViewport viewportSaver(state);
-  vtkOpenGLState::ScopedglEnableDisable scissorSaver(state, GL_SCISSOR_TEST);
-  vtkOpenGLState::ScopedglEnableDisable depthSaver(state, GL_DEPTH_TEST);
-  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
-  vtkOpenGLState::ScopedglEnableDisable cullSaver(state, GL_CULL_FACE);
-  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
-  vtkOpenGLState::ScopedglClearColor clearSaver(state);
-  vtkOpenGLState::ScopedglColorMask maskSaver(state);
-  state->PushFramebufferBindings();
-  in.Framebuffer->SetContext(window);
-  in.Framebuffer->Bind(GL_FRAMEBUFFER);
-  in.Framebuffer->AddColorAttachment(0, texture);
-  in.Framebuffer->ActivateDrawBuffer(0);
-  in.Framebuffer->ActivateReadBuffer(0);
-  state->vtkglViewport(0, 0, size, size);
-  state->vtkglDisable(GL_SCISSOR_TEST);
-  state->vtkglDisable(GL_DEPTH_TEST);
-  state->vtkglDisable(GL_CULL_FACE);
-  state->vtkglEnable(GL_BLEND);
-  state->vtkglBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_COLOR);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglClearColor(1.0f, 1.0f, 1.0f, 1.0f);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT);
+  SunPassTarget target(window, in.Framebuffer, texture, size, SunPassTarget::Multiply);
   Internals::BindLayout(in.SunLayout, in.SunLayoutProgram, program, in.SunInstances);
   in.SetSunFrameUniforms(program);
   in.Partial->Activate();
@@ -660,10 +687,8 @@ void vtkNimbusCloudSplatMapper::SunPassReadBack(vtkOpenGLRenderWindow* window)
     in.Transmittance[i] = static_cast<float>(value * std::exp(-in.Kappa[i] * halfColumn));
     glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, 4, 1, static_cast<GLuint>(n));
   }
-  in.Framebuffer->RemoveColorAttachment(0);
   in.Partial->Deactivate();
   in.SunLayout->Release();
-  state->PopFramebufferBindings();
 }
 
 // The billboards facing the viewer, back to front, into the frame.
