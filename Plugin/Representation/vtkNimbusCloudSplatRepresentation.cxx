@@ -179,6 +179,9 @@ void vtkNimbusCloudSplatRepresentation::ApplySun()
     }
   }
   this->LastRenderUsedSceneSky = sky != nullptr;
+  // Over the sky the mapper takes its sun, air and display too, as the Cloud
+  // representation's mapper does (the sky's light, the air, the frame's encoding).
+  this->Mapper->SetSky(sky);
   // Unchanged values leave the mapper (and its sun pass) untouched.
   this->Mapper->SetSunElevationDegrees(
     sky ? sky->GetSunElevationDegrees() : this->SunElevationDegrees);
@@ -332,6 +335,46 @@ void vtkNimbusCloudSplatRepresentation::SetSunLightMethod(int value)
 int vtkNimbusCloudSplatRepresentation::GetSunLightMethod()
 {
   return this->Mapper->GetSunLightMethod();
+}
+
+void vtkNimbusCloudSplatRepresentation::SetMultipleScattering(bool value)
+{
+  this->Mapper->SetMultipleScattering(value);
+}
+
+bool vtkNimbusCloudSplatRepresentation::GetMultipleScattering()
+{
+  return this->Mapper->GetMultipleScattering();
+}
+
+void vtkNimbusCloudSplatRepresentation::SetMultipleScatteringGridSize(int value)
+{
+  this->Mapper->SetMultipleScatteringGridSize(value);
+}
+
+int vtkNimbusCloudSplatRepresentation::GetMultipleScatteringGridSize()
+{
+  return this->Mapper->GetMultipleScatteringGridSize();
+}
+
+void vtkNimbusCloudSplatRepresentation::SetSkyLight(bool value)
+{
+  this->Mapper->SetSkyLight(value);
+}
+
+bool vtkNimbusCloudSplatRepresentation::GetSkyLight()
+{
+  return this->Mapper->GetSkyLight();
+}
+
+void vtkNimbusCloudSplatRepresentation::SetAerialPerspective(bool value)
+{
+  this->Mapper->SetAerialPerspective(value);
+}
+
+bool vtkNimbusCloudSplatRepresentation::GetAerialPerspective()
+{
+  return this->Mapper->GetAerialPerspective();
 }
 
 void vtkNimbusCloudSplatRepresentation::PrintSelf(ostream& os, vtkIndent indent)

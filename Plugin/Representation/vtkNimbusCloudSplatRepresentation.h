@@ -16,9 +16,12 @@
  * vtkNimbusCloudSplatMapper for their units); they do not re-execute the
  * representation. UseSceneSky (on by default): while a Nimbus Sky is shown in the same
  * view ("Sky Background", vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND), the balls are
- * lit by that sky's sun (its elevation, azimuth and temperature, illuminance 1, as the
- * Cloud representation takes it) instead of their own; the exposure and metres per unit
- * stay the representation's own (the mapper writes linear values, the sky sRGB ones).
+ * drawn over that sky as the Cloud representation's clouds are (the mapper's SetSky): its
+ * sun (elevation, azimuth and temperature, illuminance 1) reddened by the air down to
+ * each ball, the sky's and the ground's light on them, the air between the eye and them,
+ * its metres per unit and its display scale (exposure and white balance; the frame
+ * sRGB-encoded as the sky's); the representation's own sun, exposure and metres per unit
+ * apply without a sky.
  */
 #ifndef vtkNimbusCloudSplatRepresentation_h
 #define vtkNimbusCloudSplatRepresentation_h
@@ -102,6 +105,26 @@ public:
   double GetExposure();
   void SetSunLightMethod(int value);
   int GetSunLightMethod();
+  ///@}
+
+  ///@{
+  /// The light scattered more than once (off by default), solved on a grid over the
+  /// balls of MultipleScatteringGridSize points on its longest side (4 to 256, default
+  /// 32), forwarded to the mapper (vtkNimbusCloudSplatMapper::SetMultipleScattering).
+  void SetMultipleScattering(bool value);
+  bool GetMultipleScattering();
+  void SetMultipleScatteringGridSize(int value);
+  int GetMultipleScatteringGridSize();
+  ///@}
+
+  ///@{
+  /// Over the view's sky: its and the ground's light on the balls, and the air between
+  /// the camera and them (both on by default; vtkNimbusCloudSplatMapper::SetSkyLight,
+  /// SetAerialPerspective).
+  void SetSkyLight(bool value);
+  bool GetSkyLight();
+  void SetAerialPerspective(bool value);
+  bool GetAerialPerspective();
   ///@}
 
 protected:

@@ -15,6 +15,10 @@
 // exp(-kappa P) times J(x_j, toward the eye) (the solver's in-scattered radiance, SH
 // textures) plus the delta-M forward peak's part of the sun's light,
 // (1 - f) p(mu) E_sun (exp(-(1 - f albedo) tau_sun) - exp(-tau_sun)).
+// Over a sky: E_sun is the sun's colour above the air x the ball's tint (the air's
+// reddening at its centre), and the air between the eye and the ball dims the colour and
+// adds its own light where the ball covers: out = T_air C + (1 - a) L_air, coverage 1 - a
+// (the sky behind, which already holds L_air, is multiplied by a).
 //VTK::System::Dec
 // (the mapper defines SUN_SAMPLES, the number of points, on the next line)
 //SPLAT::SunSamples
@@ -27,6 +31,9 @@ in float kappa;
 in vec3 ballColor;
 in vec3 billboardPoint;
 flat in vec4 ballWorld;
+flat in vec3 sunTint;
+flat in vec3 airTransmittance;
+flat in vec3 airRadiance;
 uniform sampler2D billboard;
 #ifdef SUN_SAMPLES
 uniform sampler3D sunDepth;
@@ -46,7 +53,7 @@ uniform sampler3D scatteringGreen;
 uniform sampler3D scatteringBlue;
 uniform vec3 scatteringScale; // texture coordinate = x scatteringScale + scatteringOffset
 uniform vec3 scatteringOffset;
-uniform float scatteringExposure;
+uniform vec3 lightScale;
 uniform float forwardPeakFraction;
 
 // J(x, w) toward w (direction of travel), per unit scattering coefficient.
@@ -113,13 +120,13 @@ void main()
 #endif
     }
     // mu: the sunlight's direction (-toSun) against the way to the eye (-d).
-    color = albedo * CornetteShanks(dot(toSun, d), cloudG) * sunColor * sum;
+    color = albedo * CornetteShanks(dot(toSun, d), cloudG) * sunColor * sunTint * sum;
 #ifdef MULTIPLE_SCATTERING
-    color += albedo * (CornetteShanks(dot(toSun, d), cloudG) * sunColor *
+    color += albedo * (CornetteShanks(dot(toSun, d), cloudG) * sunColor * sunTint *
                         (1.0 - forwardPeakFraction) * peakSum +
-                      scatteringExposure * scatteredSum);
+                      lightScale * scatteredSum);
 #endif
   }
 #endif
-  gl_FragData[0] = vec4(color, opacity);
+  gl_FragData[0] = vec4(airTransmittance * color + opacity * airRadiance, opacity);
 }

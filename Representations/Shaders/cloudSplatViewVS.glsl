@@ -8,11 +8,19 @@
 // then hands it the billboard's point and the ball.
 // With MULTIPLE_SCATTERING (MultipleScattering on, the light at the centre) the ball's
 // colour adds the sun's light scattered more than once, read at its centre: the solver's
-// in-scattered radiance J(centre, toward the eye) and the delta-M forward peak's part.
+// in-scattered radiance J(centre, toward the eye) and the delta-M forward peak's part
+// (J holds the sky's light too over a sky with SkyLight, and only that without
+// MultipleScattering: then the forward peak's part is 0).
+// Over a sky (vtkNimbusCloudSplatMapper::SetSky) the ball brings the air's tint of the
+// sun at its centre (E_sun(z) / E_sun above the air) and the air between the eye and it
+// (transmittance, in-scattered radiance x display scale), handed to the fragment shader.
 //VTK::System::Dec
 //NIMBUS::Library
 in vec4 ball;       // xyz: the centre (world), w: the radius R (world units)
 in vec2 ballOptics; // x: kappa = k d R, y: the sun's transmittance read back (read-back variant)
+in vec3 ballTint;             // the sun's tint by the air at the centre (1 without air)
+in vec3 ballAirTransmittance; // the air's, eye to centre (1 without air)
+in vec3 ballAirRadiance;      // the air's in-scattered radiance x display scale (0 without)
 uniform mat4 MCVCMatrix;
 uniform mat4 VCDCMatrix;
 uniform vec3 eyeWorld;
@@ -37,7 +45,7 @@ uniform sampler3D scatteringGreen;
 uniform sampler3D scatteringBlue;
 uniform vec3 scatteringScale; // texture coordinate = x scatteringScale + scatteringOffset
 uniform vec3 scatteringOffset;
-uniform float scatteringExposure;
+uniform vec3 lightScale; // the display scale (exposure, or the sky's exposure x white balance)
 uniform float forwardPeakFraction; // f, the delta-M forward fraction of the solve
 
 // J(x, w): the radiance the cloud's particles scatter toward w (direction of travel) per
@@ -57,6 +65,9 @@ out float kappa;
 out vec3 ballColor;
 out vec3 billboardPoint; // world
 flat out vec4 ballWorld;
+flat out vec3 sunTint;
+flat out vec3 airTransmittance;
+flat out vec3 airRadiance;
 
 void main()
 {
@@ -67,6 +78,9 @@ void main()
   kappa = ballOptics.x;
   billboardPoint = ball.xyz + (viewRight * corner.x + viewUp * corner.y) * ball.w;
   ballWorld = ball;
+  sunTint = ballTint;
+  airTransmittance = ballAirTransmittance;
+  airRadiance = ballAirRadiance;
 
   float sunTransmittance = ballOptics.y;
 #ifdef SUN_TEXTURE
@@ -81,7 +95,7 @@ void main()
 #endif
   // The scattering angle: the sunlight's direction (-toSun) against the way to the eye.
   float mu = dot(-toSun, normalize(eyeWorld - ball.xyz));
-  ballColor = albedo * CornetteShanks(mu, cloudG) * sunColor * sunTransmittance;
+  ballColor = albedo * CornetteShanks(mu, cloudG) * sunColor * ballTint * sunTransmittance;
 #ifdef MULTIPLE_SCATTERING
   {
     // The forward peak the delta-M solve left on the sun's direction (as the cloud
@@ -89,8 +103,8 @@ void main()
     float tau = -log(max(sunTransmittance, 1e-30));
     float peak = (1.0 - forwardPeakFraction) *
       (exp(-(1.0 - forwardPeakFraction * albedo) * tau) - sunTransmittance);
-    ballColor += albedo * (CornetteShanks(mu, cloudG) * sunColor * peak +
-                   scatteringExposure * SplatInScattering(ball.xyz, normalize(eyeWorld - ball.xyz)));
+    ballColor += albedo * (CornetteShanks(mu, cloudG) * sunColor * ballTint * peak +
+                   lightScale * SplatInScattering(ball.xyz, normalize(eyeWorld - ball.xyz)));
   }
 #endif
 }

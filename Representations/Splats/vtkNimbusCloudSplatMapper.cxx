@@ -1,13 +1,17 @@
 #include "vtkNimbusCloudSplatMapper.h"
 
+#include "AtmosphereTable.h"
 #include "CloudSplats.h"
 #include "FiniteSetters.h"
 #include "MultipleScattering.h"
 #include "MultipleScatteringTexture.h"
 #include "ShaderLibrary.h"
+#include "Sky.h"
+#include "SkyViewTextures.h"
 #include "Sun.h"
 #include "SunAndAir.h"
 
+#include "cloudSplatCompositeFS.h"
 #include "cloudSplatSunFS.h"
 #include "cloudSplatSunVS.h"
 #include "cloudSplatViewFS.h"
@@ -19,10 +23,12 @@
 #include "vtkDataArray.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
+#include "vtkNimbusSky.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLBufferObject.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLFramebufferObject.h"
+#include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLRenderer.h"
 #include "vtkOpenGLShaderCache.h"
@@ -39,8 +45,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,8 +59,10 @@ constexpr int kBillboardSize = 64;
 constexpr int kBillboardSupersample = 4;
 constexpr int kTableU = 64;
 constexpr int kTableH = 128;
-// Six floats per ball instance: centre (3), radius, kappa, the sun's transmittance.
-constexpr int kInstanceFloats = 6;
+// Floats per ball instance: centre (3), radius, kappa, the sun's transmittance (read
+// back), the air's tint of the sun at the centre (3), the air's transmittance (3) and
+// in-scattered radiance (3) between the eye and the centre.
+constexpr int kInstanceFloats = 15;
 }
 
 struct vtkNimbusCloudSplatMapper::Internals
@@ -99,6 +109,36 @@ struct vtkNimbusCloudSplatMapper::Internals
   double ScatteringSeconds = 0.0;
   int ScatteringSolves = 0;
 
+  // The frame's sun, air and display: the mapper's own or the sky's (ComputeFrameSettings).
+  nimbus::SunParameters Sun;
+  nimbus::SceneAtmosphere Air; // Enabled only over a sky
+  double MetresPerUnit = 1.0;
+  std::array<double, 3> DisplayScale{ { 1.0, 1.0, 1.0 } };
+  bool OverSky = false;
+  double BallsMetres = 0.0; // the metres per unit of the balls' kappa
+  std::string LastSkyError;
+  // Over a sky: the atmosphere table over the balls' heights (E_sun(z), as the cloud
+  // mapper's row 0), the sun's tint at each ball (E_sun(z) / E_sun above the air; 3 per
+  // ball, the input's order), and the air between the eye and each ball (3 + 3 per ball;
+  // the radiance x the display scale).
+  nimbus::AtmosphereTable Table;
+  std::vector<double> TintKey;
+  std::vector<float> SunTint;
+  std::vector<float> AirTransmittance;
+  std::vector<float> AirRadiance;
+  double AirSeconds = 0.0;
+  // The sky seen from the balls' middle (the sky light's solve).
+  std::unique_ptr<nimbus::SkyViewLut> SkyView;
+  std::vector<double> SkyViewKey;
+
+  // The float target the balls are drawn into, the scene's depth and colour under them.
+  vtkNew<vtkTextureObject> FrameSum;
+  vtkNew<vtkTextureObject> FrameDepth;
+  vtkNew<vtkTextureObject> SceneColor;
+  vtkNew<vtkOpenGLFramebufferObject> FrameTarget;
+  std::unique_ptr<vtkOpenGLQuadHelper> Composite;
+  bool WarnedMultisampling = false;
+
   double SunSeconds = 0.0;
   double ViewSeconds = 0.0;
   vtkIdType Balls = 0;
@@ -114,6 +154,16 @@ struct vtkNimbusCloudSplatMapper::Internals
         texture->ReleaseGraphicsResources(window);
       }
       this->Framebuffer->ReleaseGraphicsResources(window);
+      for (vtkTextureObject* texture :
+        { this->FrameSum.Get(), this->FrameDepth.Get(), this->SceneColor.Get() })
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
+      this->FrameTarget->ReleaseGraphicsResources(window);
+      if (this->Composite)
+      {
+        this->Composite->ReleaseGraphicsResources(window);
+      }
       for (auto& texture : this->Scattering)
       {
         texture->ReleaseGraphicsResources(window);
@@ -128,7 +178,39 @@ struct vtkNimbusCloudSplatMapper::Internals
     this->SunLayoutProgram = nullptr;
     this->ViewLayoutProgram = nullptr;
     this->SunKey.clear();
+    this->Composite.reset();
     this->Window = nullptr;
+  }
+
+  // w x h texels, nearest filtered, reallocated only when the size changed: RGBA float,
+  // RGBA 8-bit or a float depth.
+  enum class TargetFormat
+  {
+    Float,
+    Byte,
+    Depth
+  };
+  static void EnsureTarget(
+    vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h, TargetFormat format)
+  {
+    texture->SetContext(window);
+    if (texture->GetHandle() && static_cast<int>(texture->GetWidth()) == w &&
+      static_cast<int>(texture->GetHeight()) == h)
+    {
+      return;
+    }
+    texture->ReleaseGraphicsResources(window);
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    const bool ok = format == TargetFormat::Depth
+      ? texture->AllocateDepth(w, h, vtkTextureObject::Float32)
+      : texture->Allocate2D(w, h, 4, format == TargetFormat::Float ? VTK_FLOAT : VTK_UNSIGNED_CHAR);
+    if (!ok)
+    {
+      throw std::runtime_error("the splats' frame target could not be allocated");
+    }
   }
 
   // A linear-filtered, edge-clamped single-channel float texture from values.
@@ -161,13 +243,19 @@ struct vtkNimbusCloudSplatMapper::Internals
       d[3] = this->Radii[i];
       d[4] = this->Kappa[i];
       d[5] = this->Transmittance.empty() ? 1.0f : this->Transmittance[i];
+      for (int c = 0; c < 3; ++c)
+      {
+        d[6 + c] = this->SunTint.empty() ? 1.0f : this->SunTint[3 * i + c];
+        d[9 + c] = this->AirTransmittance.empty() ? 1.0f : this->AirTransmittance[3 * i + c];
+        d[12 + c] = this->AirRadiance.empty() ? 0.0f : this->AirRadiance[3 * i + c];
+      }
     }
     buffer->Upload(data, vtkOpenGLBufferObject::ArrayBuffer);
   }
 
   // Binds `layout` for `program` over `buffer`'s instances.
   static void BindLayout(vtkOpenGLVertexArrayObject* layout, vtkShaderProgram*& layoutProgram,
-    vtkShaderProgram* program, vtkOpenGLBufferObject* buffer)
+    vtkShaderProgram* program, vtkOpenGLBufferObject* buffer, bool view = false)
   {
     if (layoutProgram != program)
     {
@@ -178,6 +266,15 @@ struct vtkNimbusCloudSplatMapper::Internals
         program, buffer, "ball", 0, stride, VTK_FLOAT, 4, false, 1, false);
       layout->AddAttributeArrayWithDivisor(
         program, buffer, "ballOptics", 4 * sizeof(float), stride, VTK_FLOAT, 2, false, 1, false);
+      if (view)
+      {
+        layout->AddAttributeArrayWithDivisor(
+          program, buffer, "ballTint", 6 * sizeof(float), stride, VTK_FLOAT, 3, false, 1, false);
+        layout->AddAttributeArrayWithDivisor(program, buffer, "ballAirTransmittance",
+          9 * sizeof(float), stride, VTK_FLOAT, 3, false, 1, false);
+        layout->AddAttributeArrayWithDivisor(program, buffer, "ballAirRadiance", 12 * sizeof(float),
+          stride, VTK_FLOAT, 3, false, 1, false);
+      }
       layoutProgram = program;
     }
     else
@@ -225,6 +322,14 @@ vtkNimbusCloudSplatMapper::~vtkNimbusCloudSplatMapper()
 {
   this->SetRadiusArrayName(nullptr);
   this->SetDensityArrayName(nullptr);
+  this->SetSky(nullptr);
+}
+
+vtkCxxSetObjectMacro(vtkNimbusCloudSplatMapper, Sky, vtkNimbusSky);
+
+double vtkNimbusCloudSplatMapper::GetLastAirSeconds() const
+{
+  return this->Internal->AirSeconds;
 }
 
 double vtkNimbusCloudSplatMapper::GetLastSunPassSeconds() const
@@ -265,11 +370,13 @@ bool vtkNimbusCloudSplatMapper::UpdateBalls(vtkPolyData* input, vtkActor* actor)
   Internals& in = *this->Internal;
   const vtkMTimeType time =
     std::max({ input->GetMTime(), this->GetMTime(), actor->GetMatrix()->GetMTime() });
-  if (time == in.BallsTime)
+  if (time == in.BallsTime && in.MetresPerUnit == in.BallsMetres)
   {
     return !in.Radii.empty();
   }
   in.BallsTime = time;
+  in.BallsMetres = in.MetresPerUnit;
+  in.TintKey.clear();
   in.SunKey.clear();
   in.Centres.clear();
   in.Radii.clear();
@@ -302,7 +409,7 @@ bool vtkNimbusCloudSplatMapper::UpdateBalls(vtkPolyData* input, vtkActor* actor)
     input->GetPoint(i, p);
     matrix->MultiplyPoint(p, p);
     // k d R (R in metres): tau through the column = kappa C(u) (CloudSplats.h).
-    const double kappa = this->ExtinctionPerDensity * density * radius * this->MetresPerUnit;
+    const double kappa = this->ExtinctionPerDensity * density * radius * in.MetresPerUnit;
     if (!(radius > 0.0) || !(density > 0.0) || !std::isfinite(radius) || !std::isfinite(kappa) ||
       !std::isfinite(p[0] + p[1] + p[2]))
     {
@@ -344,6 +451,7 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
   in.Window = window;
   try
   {
+    this->ComputeFrameSettings();
     if (!this->UpdateBalls(input, actor))
     {
       in.Balls = 0;
@@ -357,7 +465,7 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
 
     // The sun's pass, again only when the balls, the sun or its texture changed.
     const nimbus::Vector3 toSun =
-      nimbus::SunDirection(this->SunElevationDegrees, this->SunAzimuthDegrees);
+      nimbus::SunDirection(in.Sun.ElevationDegrees, in.Sun.AzimuthDegrees);
     const std::vector<double> sunKey = { toSun[0], toSun[1], toSun[2],
       static_cast<double>(this->SunLightMethod), static_cast<double>(this->SunTextureSize),
       static_cast<double>(this->SunTextureLayers) };
@@ -382,12 +490,13 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
     }
     timer->StopTimer();
     in.SunSeconds = timer->GetElapsedTime();
-    if (this->MultipleScattering)
+    this->UpdateSunTint();
+    if (this->MultipleScattering || (in.OverSky && this->SkyLight))
     {
       this->UpdateMultipleScattering(window, toSun.data());
     }
     timer->StartTimer();
-    this->ViewPass(renderer, window);
+    this->DrawIntoFloatTarget(renderer, window);
     if (this->TimePasses)
     {
       glFinish();
@@ -410,14 +519,8 @@ void vtkNimbusCloudSplatMapper::Render(vtkRenderer* renderer, vtkActor* actor)
 namespace
 {
 // The sun's irradiance above the air, linear sRGB of its blackbody spectrum (relative).
-std::array<double, 3> SunIrradianceRgb(
-  double azimuth, double elevation, double illuminance, double kelvin)
+std::array<double, 3> SunIrradianceRgb(const nimbus::SunParameters& sun)
 {
-  nimbus::SunParameters sun;
-  sun.AzimuthDegrees = azimuth;
-  sun.ElevationDegrees = elevation;
-  sun.Illuminance = illuminance;
-  sun.TemperatureKelvin = kelvin;
   nimbus::SceneAtmosphere air;
   air.Enabled = false;
   const nimbus::SunAndAir sunAndAir(sun, air, 16);
@@ -709,11 +812,13 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   {
     order = nimbus::SplatOrderBackToFront(in.Centres, { eye[0], eye[1], eye[2] });
   }
+  this->UpdateAir(renderer);
   in.UploadInstances(in.ViewInstances, order);
 
   const bool texture = this->SunLightMethod == AccumulationTexture;
   const int samples = texture ? this->SunLightSamples : 0;
-  const bool scattering = this->MultipleScattering && in.ScatteringOn;
+  const bool scattering =
+    (this->MultipleScattering || (in.OverSky && this->SkyLight)) && in.ScatteringOn;
   // Multiple scattering at the ball's centre (vertex shader) or along the fragment's ray.
   const bool centreScattering = scattering && samples == 0;
   std::string& source = in.ViewVertexSource[(texture ? 1 : 0) + (centreScattering ? 2 : 0)];
@@ -763,7 +868,7 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   state->vtkglEnable(GL_BLEND);
   state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
 
-  Internals::BindLayout(in.ViewLayout, in.ViewLayoutProgram, program, in.ViewInstances);
+  Internals::BindLayout(in.ViewLayout, in.ViewLayoutProgram, program, in.ViewInstances, true);
   vtkMatrix4x4* wcvc = nullptr;
   vtkMatrix4x4* vcdc = nullptr;
   vtkMatrix4x4* wcdc = nullptr;
@@ -800,11 +905,12 @@ void vtkNimbusCloudSplatMapper::ViewPass(vtkRenderer* renderer, vtkOpenGLRenderW
   program->SetUniform3f("viewRight", right);
   program->SetUniform3f("viewUp", up);
 
-  // The sun's colour above the air (linear sRGB of its blackbody spectrum) x exposure.
-  const std::array<double, 3> rgb = SunIrradianceRgb(this->SunAzimuthDegrees,
-    this->SunElevationDegrees, this->SunIlluminance, this->SunTemperatureKelvin);
-  const float color[3] = { static_cast<float>(rgb[0] * this->Exposure),
-    static_cast<float>(rgb[1] * this->Exposure), static_cast<float>(rgb[2] * this->Exposure) };
+  // The sun's colour above the air (linear sRGB of its blackbody spectrum) x the display
+  // scale (the exposure, or the sky's exposure and white balance); the air's tint per ball.
+  const std::array<double, 3> rgb = SunIrradianceRgb(in.Sun);
+  const float color[3] = { static_cast<float>(rgb[0] * in.DisplayScale[0]),
+    static_cast<float>(rgb[1] * in.DisplayScale[1]),
+    static_cast<float>(rgb[2] * in.DisplayScale[2]) };
   program->SetUniform3f("sunColor", color);
   program->SetUniformf("albedo", static_cast<float>(this->Albedo));
   program->SetUniformf("cloudG", static_cast<float>(this->CloudG));
@@ -840,8 +946,13 @@ void vtkNimbusCloudSplatMapper::UpdateMultipleScattering(
   vtkOpenGLRenderWindow* window, const double toSun[3])
 {
   Internals& in = *this->Internal;
+  const nimbus::SceneAtmosphere& air = in.Air;
   const std::vector<double> key = { static_cast<double>(in.BallsTime), toSun[0], toSun[1], toSun[2],
-    static_cast<double>(this->MultipleScatteringGridSize) };
+    static_cast<double>(this->MultipleScatteringGridSize), this->MultipleScattering ? 1.0 : 0.0,
+    in.OverSky && this->SkyLight ? 1.0 : 0.0, in.MetresPerUnit, in.Sun.Illuminance,
+    in.Sun.TemperatureKelvin, air.Enabled ? 1.0 : 0.0, air.RayleighScatteringPerMetre,
+    air.MieScatteringPerMetre, air.MieG, air.SceneAltitudeMetres,
+    this->Sky && in.OverSky ? this->Sky->GetGroundAlbedo() : 0.0 };
   if (key == in.ScatteringKey)
   {
     return;
@@ -853,7 +964,7 @@ void vtkNimbusCloudSplatMapper::UpdateMultipleScattering(
     in.Centres, in.Radii, in.Densities, this->MultipleScatteringGridSize);
   nimbus::ExtinctionGrid grid;
   grid.Dimensions = splat.Dimensions;
-  const double metres = this->MetresPerUnit;
+  const double metres = in.MetresPerUnit;
   for (int a = 0; a < 3; ++a)
   {
     grid.Origin[a] = splat.Origin[a] * metres;
@@ -874,12 +985,31 @@ void vtkNimbusCloudSplatMapper::UpdateMultipleScattering(
   nimbus::CloudLighting lighting;
   lighting.HasSun = true;
   lighting.Sun.ToLight = { { toSun[0], toSun[1], toSun[2] } };
-  const std::array<double, 3> rgb = SunIrradianceRgb(this->SunAzimuthDegrees,
-    this->SunElevationDegrees, this->SunIlluminance, this->SunTemperatureKelvin);
+  const std::array<double, 3> rgb = SunIrradianceRgb(in.Sun);
   lighting.Sun.ConstantIrradiance = { { rgb[0], rgb[1], rgb[2] } };
+  lighting.HasSun = this->MultipleScattering; // else the sky's light alone
+  if (in.OverSky && in.Table.HasAtmosphere)
+  {
+    const nimbus::AtmosphereTable& table = in.Table; // E_sun(z), z in scene metres
+    lighting.Sun.Irradiance = [&table](double z)
+    {
+      auto e = table.Lookup(0, z);
+      for (double& c : e)
+      {
+        c = std::max(c, 0.0);
+      }
+      return e;
+    };
+  }
   nimbus::MultipleScatteringOptions options;
   options.Method = nimbus::MultipleScatteringMethod::DiscreteDirections;
-  options.SkyLight = false; // no sky here: the sun's light only
+  options.SkyLight = in.OverSky && this->SkyLight;
+  if (options.SkyLight &&
+    !this->SkyLightOf((splat.Origin[2] + 0.5 * splat.Spacing * (splat.Dimensions[2] - 1)) * metres,
+      rgb.data(), lighting))
+  {
+    return;
+  }
   nimbus::MultipleScatteringField field;
   try
   {
@@ -897,7 +1027,8 @@ void vtkNimbusCloudSplatMapper::UpdateMultipleScattering(
     vtkErrorMacro("Multiple scattering not drawn: its textures could not be uploaded.");
     return;
   }
-  in.ForwardPeakFraction = static_cast<float>(field.ForwardPeakFraction);
+  // Without the sun in the solve (the sky alone) no forward peak is left on its direction.
+  in.ForwardPeakFraction = lighting.HasSun ? static_cast<float>(field.ForwardPeakFraction) : 0.0f;
   in.ScatteringOn = true;
   ++in.ScatteringSolves;
   in.ScatteringSeconds =
@@ -915,8 +1046,327 @@ void vtkNimbusCloudSplatMapper::SetMultipleScatteringUniforms(vtkShaderProgram* 
   }
   program->SetUniform3f("scatteringScale", in.ScatteringScale.data());
   program->SetUniform3f("scatteringOffset", in.ScatteringOffset.data());
-  program->SetUniformf("scatteringExposure", static_cast<float>(this->Exposure));
+  const float scale[3] = { static_cast<float>(in.DisplayScale[0]),
+    static_cast<float>(in.DisplayScale[1]), static_cast<float>(in.DisplayScale[2]) };
+  program->SetUniform3f("lightScale", scale);
   program->SetUniformf("forwardPeakFraction", in.ForwardPeakFraction);
+}
+
+// The frame's sun, air, metres per unit and display: the mapper's own, or over a sky the
+// sky's (as vtkNimbusCloudVolumeMapper::ComputeFrameSettings takes them).
+void vtkNimbusCloudSplatMapper::ComputeFrameSettings()
+{
+  Internals& in = *this->Internal;
+  in.Sun.AzimuthDegrees = this->SunAzimuthDegrees;
+  in.Sun.ElevationDegrees = this->SunElevationDegrees;
+  in.Sun.Illuminance = this->SunIlluminance;
+  in.Sun.TemperatureKelvin = this->SunTemperatureKelvin;
+  in.Air = nimbus::SceneAtmosphere();
+  in.Air.Enabled = false;
+  in.MetresPerUnit = this->MetresPerUnit;
+  in.DisplayScale = { { this->Exposure, this->Exposure, this->Exposure } };
+  in.OverSky = false;
+  if (!this->Sky)
+  {
+    return;
+  }
+  const nimbus::SkyParameters* parameters = nullptr;
+  try
+  {
+    parameters = &this->Sky->GetSkyModel().GetParameters();
+  }
+  catch (const std::exception& error)
+  {
+    const std::string message = std::string("The sky is invalid, the splats keep their own sun "
+                                            "and no air: ") +
+      error.what();
+    if (message != in.LastSkyError)
+    {
+      vtkErrorMacro(<< message);
+      in.LastSkyError = message;
+    }
+    return;
+  }
+  in.LastSkyError.clear();
+  in.Sun.AzimuthDegrees = this->Sky->GetSunAzimuthDegrees();
+  in.Sun.ElevationDegrees = this->Sky->GetSunElevationDegrees();
+  in.Sun.Illuminance = 1.0; // the sky's sun: luminance 1 above the air
+  in.Sun.TemperatureKelvin = parameters->SunTemperatureKelvin;
+  static_cast<nimbus::AtmosphereParameters&>(in.Air) = parameters->Atmosphere;
+  in.Air.SceneAltitudeMetres = this->Sky->GetSceneAltitudeMetres();
+  in.Air.Enabled = true;
+  in.MetresPerUnit = this->Sky->GetMetresPerUnit();
+  this->Sky->GetDisplayScale(in.DisplayScale.data());
+  in.OverSky = true;
+}
+
+// Over a sky: the sun at each ball as the cloud mapper's slices see it, E_sun(z) of the
+// atmosphere table (nimbus::BuildAtmosphereTable, its row 0) over the balls' heights,
+// kept as a tint E_sun(z) / E_sun above the air per ball. Again only when the balls, the
+// sun or the air change.
+void vtkNimbusCloudSplatMapper::UpdateSunTint()
+{
+  Internals& in = *this->Internal;
+  if (!in.OverSky)
+  {
+    in.SunTint.clear();
+    in.TintKey.clear();
+    in.Table = nimbus::AtmosphereTable();
+    return;
+  }
+  const nimbus::SceneAtmosphere& air = in.Air;
+  const std::vector<double> key = { static_cast<double>(in.BallsTime), in.MetresPerUnit,
+    in.Sun.AzimuthDegrees, in.Sun.ElevationDegrees, in.Sun.TemperatureKelvin,
+    air.RayleighScatteringPerMetre, air.MieScatteringPerMetre, air.MieG, air.MieAlbedo,
+    air.SceneAltitudeMetres, air.RayleighScaleHeightMetres, air.MieScaleHeightMetres };
+  if (key == in.TintKey)
+  {
+    return;
+  }
+  double zLow = std::numeric_limits<double>::max();
+  double zHigh = -zLow;
+  for (std::size_t i = 0; i < in.Radii.size(); ++i)
+  {
+    zLow = std::min(zLow, static_cast<double>(in.Centres[3 * i + 2] - in.Radii[i]));
+    zHigh = std::max(zHigh, static_cast<double>(in.Centres[3 * i + 2] + in.Radii[i]));
+  }
+  zLow *= in.MetresPerUnit;
+  zHigh = std::max(zHigh * in.MetresPerUnit, zLow + 1.0);
+  const nimbus::SunAndAir sunAndAir(in.Sun, air, 16); // 16 wavelengths, as the cloud mapper
+  in.Table = nimbus::BuildAtmosphereTable(sunAndAir, zLow, zHigh, 64);
+  const std::array<double, 3>& top = in.Table.SunIrradianceTop;
+  in.SunTint.resize(3 * in.Radii.size());
+  for (std::size_t i = 0; i < in.Radii.size(); ++i)
+  {
+    const std::array<double, 3> e = in.Table.Lookup(0, in.Centres[3 * i + 2] * in.MetresPerUnit);
+    for (int c = 0; c < 3; ++c)
+    {
+      in.SunTint[3 * i + c] =
+        top[c] > 0.0 ? static_cast<float>(std::max(e[c], 0.0) / top[c]) : 0.0f;
+    }
+  }
+  in.TintKey = key;
+}
+
+// Over a sky, with AerialPerspective: the air between the eye and each ball's centre, its
+// transmittance and in-scattered radiance (x the display scale) from the sky's
+// aerial-perspective table for the camera's altitude (what vtkNimbusSkyPass applies to
+// geometry; Physics/Sky.h AerialPerspectiveLut). Per frame: the eye moves.
+void vtkNimbusCloudSplatMapper::UpdateAir(vtkRenderer* renderer)
+{
+  Internals& in = *this->Internal;
+  in.AirSeconds = 0.0;
+  if (!in.OverSky || !this->AerialPerspective)
+  {
+    in.AirTransmittance.clear();
+    in.AirRadiance.clear();
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  double eye[3];
+  renderer->GetActiveCamera()->GetPosition(eye);
+  const double altitude = nimbus::SkyViewTextures::CameraAltitude(this->Sky, eye[2]);
+  const nimbus::AerialPerspectiveLut& table = this->Sky->GetAerialPerspectiveLut(altitude);
+  const std::size_t n = in.Radii.size();
+  in.AirTransmittance.resize(3 * n);
+  in.AirRadiance.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    nimbus::Vector3 w{ { in.Centres[3 * i] - eye[0], in.Centres[3 * i + 1] - eye[1],
+      in.Centres[3 * i + 2] - eye[2] } };
+    const double length = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    std::array<double, 3> t{ { 1.0, 1.0, 1.0 } };
+    std::array<double, 3> l{ { 0.0, 0.0, 0.0 } };
+    if (length > 0.0)
+    {
+      for (double& c : w)
+      {
+        c /= length;
+      }
+      table.Lookup(w, length * in.MetresPerUnit, in.Sun.AzimuthDegrees, t, l);
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      in.AirTransmittance[3 * i + c] = static_cast<float>(std::max(t[c], 0.0));
+      in.AirRadiance[3 * i + c] = static_cast<float>(std::max(l[c], 0.0) * in.DisplayScale[c]);
+    }
+  }
+  in.AirSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The sky's and the ground's light for the solve (004 §3.5): the sky seen from the balls'
+// middle (height zMiddle, scene metres) as a sky-view table of the sky's model (64 x
+// (32 + 16), as the cloud mapper's CloudSkyView), in the units of the mapper's sun
+// (sunTop: its linear-sRGB irradiance above the air). False (after an error) when the
+// sky's model is refused.
+bool vtkNimbusCloudSplatMapper::SkyLightOf(
+  double zMiddle, const double sunTop[3], nimbus::CloudLighting& lighting)
+{
+  Internals& in = *this->Internal;
+  try
+  {
+    const nimbus::SkyModel& model = this->Sky->GetSkyModel();
+    const double altitude = std::max(0.0, in.Air.SceneAltitudeMetres + zMiddle);
+    const std::vector<double> key = { in.Sun.ElevationDegrees, altitude,
+      static_cast<double>(this->Sky->GetModelBuilds()),
+      static_cast<double>(reinterpret_cast<std::uintptr_t>(&model)) };
+    if (!in.SkyView || key != in.SkyViewKey)
+    {
+      in.SkyView =
+        std::make_unique<nimbus::SkyViewLut>(model, in.Sun.ElevationDegrees, altitude, 64, 32, 16);
+      in.SkyViewKey = key;
+    }
+    // The sky's radiance is relative to its own sun.
+    const auto skySun = model.GetSpectrum().ToLinearSrgb(model.GetSunIrradiance());
+    nimbus::Rgb scale{ { 0, 0, 0 } };
+    for (int c = 0; c < 3; ++c)
+    {
+      scale[c] = skySun[c] > 0.0 ? sunTop[c] / skySun[c] : 0.0;
+    }
+    const nimbus::SkyViewLut* view = in.SkyView.get();
+    const double azimuth = in.Sun.AzimuthDegrees;
+    lighting.Sky = [view, scale, azimuth](const nimbus::Vector3& w)
+    {
+      auto radiance = view->Radiance(w, azimuth);
+      for (int c = 0; c < 3; ++c)
+      {
+        radiance[c] *= scale[c];
+      }
+      return radiance;
+    };
+  }
+  catch (const std::exception& error)
+  {
+    in.SkyView.reset();
+    vtkErrorMacro("The sky's light on the splats is off: " << error.what());
+    return false;
+  }
+  return true;
+}
+
+// The view pass into a float target of the renderer's size (the balls' premultiplied
+// colour and coverage, depth-tested against a copy of the scene's depth), then added to
+// the frame once (as vtkNimbusLightningGlowMapper): blended (1, 1 - coverage), or over a
+// sky's sRGB-encoded frame decoded, blended in linear light and encoded again.
+void vtkNimbusCloudSplatMapper::DrawIntoFloatTarget(
+  vtkRenderer* renderer, vtkOpenGLRenderWindow* window)
+{
+  Internals& in = *this->Internal;
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  if (width <= 0 || height <= 0)
+  {
+    return;
+  }
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglViewport viewportSaver(state);
+  vtkOpenGLState::ScopedglScissor scissorSaver(state);
+  vtkOpenGLState::ScopedglEnableDisable scissorTestSaver(state, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglEnableDisable depthTestSaver(state, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(state, GL_BLEND);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(state);
+  vtkOpenGLState::ScopedglClearColor clearColorSaver(state);
+  vtkOpenGLState::ScopedglColorMask colorMaskSaver(state);
+  vtkOpenGLState::ScopedglDepthMask depthMaskSaver(state);
+
+  // The scene's depth (and, over a sky, its colour) so far, from the frame's framebuffer.
+  GLint frame = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &frame);
+  state->PushFramebufferBindings();
+  try
+  {
+    state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, frame);
+    Internals::EnsureTarget(in.FrameSum, window, width, height, Internals::TargetFormat::Float);
+    Internals::EnsureTarget(in.FrameDepth, window, width, height, Internals::TargetFormat::Depth);
+    GLint samples = 0;
+    glGetIntegerv(GL_SAMPLES, &samples);
+    const bool sceneDepth = samples == 0;
+    if (sceneDepth)
+    {
+      in.FrameDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+      if (in.OverSky)
+      {
+        Internals::EnsureTarget(
+          in.SceneColor, window, width, height, Internals::TargetFormat::Byte);
+        in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
+      }
+    }
+    else if (!in.WarnedMultisampling)
+    {
+      vtkWarningMacro("The render window is multisampled (MultiSamples = "
+        << samples << "): opaque geometry will not hide the cloud splats. Set MultiSamples to 0.");
+      in.WarnedMultisampling = true;
+    }
+    in.FrameTarget->SetContext(window);
+    in.FrameTarget->Bind(GL_FRAMEBUFFER);
+    in.FrameTarget->RemoveColorAttachment(0);
+    in.FrameTarget->AddColorAttachment(0, in.FrameSum);
+    in.FrameTarget->AddDepthAttachment(in.FrameDepth);
+    in.FrameTarget->ActivateDrawBuffer(0);
+    state->vtkglViewport(0, 0, width, height);
+    state->vtkglDisable(GL_SCISSOR_TEST);
+    state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    if (sceneDepth)
+    {
+      state->vtkglClear(GL_COLOR_BUFFER_BIT);
+    }
+    else
+    {
+      state->vtkglDepthMask(GL_TRUE);
+      state->vtkglClearDepth(1.0);
+      state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
+    this->ViewPass(renderer, window);
+    in.FrameTarget->RemoveDepthAttachment();
+  }
+  catch (...)
+  {
+    state->PopFramebufferBindings();
+    throw;
+  }
+  state->PopFramebufferBindings();
+
+  // Added to the frame once.
+  state->vtkglViewport(x0, y0, width, height);
+  state->vtkglDisable(GL_DEPTH_TEST);
+  if (in.OverSky)
+  {
+    state->vtkglDisable(GL_BLEND);
+  }
+  else
+  {
+    state->vtkglEnable(GL_BLEND);
+    state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  }
+  if (!in.Composite)
+  {
+    const std::string source = nimbus::WithShaderLibrary(cloudSplatCompositeFS);
+    in.Composite = std::make_unique<vtkOpenGLQuadHelper>(window, nullptr, source.c_str(), "");
+  }
+  else
+  {
+    window->GetShaderCache()->ReadyShaderProgram(in.Composite->Program);
+  }
+  if (!in.Composite->Program)
+  {
+    throw std::runtime_error("the splats' composite shader did not compile");
+  }
+  vtkShaderProgram* program = in.Composite->Program;
+  in.FrameSum->Activate();
+  program->SetUniformi("splatSum", in.FrameSum->GetTextureUnit());
+  program->SetUniformi("encodeSrgb", in.OverSky ? 1 : 0);
+  if (in.OverSky)
+  {
+    in.SceneColor->Activate();
+    program->SetUniformi("sceneColor", in.SceneColor->GetTextureUnit());
+  }
+  in.Composite->Render();
+  if (in.OverSky)
+  {
+    in.SceneColor->Deactivate();
+  }
+  in.FrameSum->Deactivate();
 }
 
 void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
@@ -943,4 +1393,7 @@ void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TimePasses: " << this->TimePasses << "\n";
   os << indent << "MultipleScattering: " << this->MultipleScattering << "\n";
   os << indent << "MultipleScatteringGridSize: " << this->MultipleScatteringGridSize << "\n";
+  os << indent << "Sky: " << this->Sky << "\n";
+  os << indent << "SkyLight: " << this->SkyLight << "\n";
+  os << indent << "AerialPerspective: " << this->AerialPerspective << "\n";
 }

@@ -40,7 +40,30 @@
  * radiance J(x, w) read from three 3-D textures at the fragment's samples (or at the
  * ball's centre), with the delta-M forward peak's part of the sun's light as the cloud
  * mapper adds it. Solved again only when the balls or the sun change.
- * The sky's light and the air are not drawn.
+ *
+ * Over a Nimbus sky (SetSky: the vtkNimbusSky drawn behind the balls; in ParaView the
+ * Cloud Splats representation hands it the view's sky) the balls take that sky's sun
+ * (elevation, azimuth, temperature, illuminance 1), air, ground albedo, metres per unit
+ * and display scale (its exposure and white balance) instead of their own, as
+ * vtkNimbusCloudVolumeMapper does over its sky background, and they get what the
+ * Cloud representation's clouds get from it:
+ *  - the sun reddened by the air down to each ball (the atmosphere table's E_sun(z),
+ *    nimbus::BuildAtmosphereTable, the cloud mapper's row 0);
+ *  - SkyLight (default on): the sky's and the ground's light on the balls, all orders,
+ *    from the same solver and grid as MultipleScattering (Physics/MultipleScattering.h,
+ *    DiscreteDirections, the sky seen from the balls' middle as a nimbus::SkyViewLut of
+ *    the sky's model, 004 §3.5: the ground as upward sky light), as the cloud mapper's
+ *    SkyLight; with MultipleScattering off the solve carries the sky alone;
+ *  - AerialPerspective (default on): the air between the eye and each ball, its
+ *    transmittance and in-scattered light from the sky's aerial-perspective table
+ *    (nimbus::AerialPerspectiveLut, what vtkNimbusSkyPass applies to geometry):
+ *    colour T_air C + (1 - a) L_air;
+ *  - the frame's encoding: the balls composited over the sky's sRGB-encoded frame in
+ *    linear light (decoded, blended, encoded).
+ * The balls are drawn into a float target of the renderer's size (their colour and
+ * coverage, 002 §3.3's blending) and composited over the frame once, as the lightning
+ * glow (vtkNimbusLightningGlowMapper): one rounding to the frame's 8 bits instead of one
+ * per ball.
  *
  * Units: radii and points in world units, MetresPerUnit metres each; the sun
  * (SunAzimuthDegrees from +y toward +x, SunElevationDegrees above the x-y plane: z is
@@ -66,6 +89,11 @@
 
 #include <memory> // for std::unique_ptr
 
+namespace nimbus
+{
+struct CloudLighting;
+}
+class vtkNimbusSky;
 class vtkOpenGLRenderWindow;
 class vtkShaderProgram;
 
@@ -187,6 +215,23 @@ public:
   int GetNumberOfMultipleScatteringSolves() const;
   ///@}
 
+  ///@{
+  /// The sky the balls are drawn over (default none): its sun, air and display replace
+  /// the mapper's own (see the class comment). SkyLight: the sky's and the ground's light
+  /// on the balls (default on); AerialPerspective: the air between the eye and the balls
+  /// (default on). Both need a sky.
+  virtual void SetSky(vtkNimbusSky* sky);
+  vtkGetObjectMacro(Sky, vtkNimbusSky);
+  vtkSetMacro(SkyLight, bool);
+  vtkGetMacro(SkyLight, bool);
+  vtkBooleanMacro(SkyLight, bool);
+  vtkSetMacro(AerialPerspective, bool);
+  vtkGetMacro(AerialPerspective, bool);
+  vtkBooleanMacro(AerialPerspective, bool);
+  /// Seconds of the last frame's air look-ups (per ball, on the CPU; 0 without a sky).
+  double GetLastAirSeconds() const;
+  ///@}
+
   /// Seconds of the last frame's sun pass and view pass (each ended by glFinish only
   /// when TimePasses is on; default off).
   vtkSetMacro(TimePasses, bool);
@@ -223,6 +268,9 @@ protected:
   bool TimePasses = false;
   bool MultipleScattering = false;
   int MultipleScatteringGridSize = 32;
+  vtkNimbusSky* Sky = nullptr;
+  bool SkyLight = true;
+  bool AerialPerspective = true;
 
 private:
   vtkNimbusCloudSplatMapper(const vtkNimbusCloudSplatMapper&) = delete;
@@ -232,8 +280,13 @@ private:
   void SunPassTexture(vtkOpenGLRenderWindow* window);
   void SunPassReadBack(vtkOpenGLRenderWindow* window);
   void ViewPass(vtkRenderer* renderer, vtkOpenGLRenderWindow* window);
+  void DrawIntoFloatTarget(vtkRenderer* renderer, vtkOpenGLRenderWindow* window);
+  void ComputeFrameSettings();
+  void UpdateSunTint();
+  void UpdateAir(vtkRenderer* renderer);
   void UpdateMultipleScattering(vtkOpenGLRenderWindow* window, const double toSun[3]);
   void SetMultipleScatteringUniforms(vtkShaderProgram* program);
+  bool SkyLightOf(double zMiddle, const double sunTop[3], nimbus::CloudLighting& lighting);
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
