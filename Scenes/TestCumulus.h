@@ -1,6 +1,8 @@
-// Test support: the metaball cumulus the cloud mapper's tests and benchmark render
-// (3 km wide, base 1 km, top about 2.8 km; vtkNimbusMetaballCloudSource), on an
-// nx x ny x nz grid. A copy of the source's output (the source is gone on return).
+// The metaball cumulus that the cloud mapper's tests (Testing/Cxx) and benchmarks
+// (Benchmarks/) render (3 km wide, base 1 km, top about 2.8 km;
+// vtkNimbusMetaballCloudSource), on an nx x ny x nz grid. A copy of the source's output
+// (the source is gone on return). Header-only, in Scenes/ so that neither the tests nor
+// the benchmarks include the other's files; a user of it links Nimbus::Filters.
 #ifndef NimbusTestCumulus_h
 #define NimbusTestCumulus_h
 
