@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Check the links of README.md and docs/**/*.md.
+"""Check the links of README.md, each top-level folder's README.md and docs/**/*.md.
 
 Every relative link target must exist, and a #anchor into a markdown file must name one of
 its headings (GitHub's rule: lower case, punctuation dropped, spaces as hyphens, -1, -2 ...
@@ -43,7 +43,10 @@ def anchors(path):
 
 def main():
     root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
-    files = [root / "README.md"] + sorted((root / "docs").rglob("*.md"))
+    # The README of each top-level folder (Filters/, Benchmarks/, measurements/, ...) too;
+    # not the build tree's.
+    folders = sorted(p for p in root.glob("*/README.md") if p.parent.name not in ("docs", "build"))
+    files = [root / "README.md"] + folders + sorted((root / "docs").rglob("*.md"))
     bad = 0
     for md in files:
         for number, line in enumerate(outside_code(md.read_text()), 1):
