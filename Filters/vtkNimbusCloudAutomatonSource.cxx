@@ -1,6 +1,8 @@
 #include "vtkNimbusCloudAutomatonSource.h"
 
 #include "CloudAutomaton.h"
+#include "FiniteSetters.h"
+#include "GridParameters.h"
 #include "MemoryBudget.h"
 #include "PieceExtent.h"
 
@@ -86,22 +88,6 @@ struct vtkNimbusCloudAutomatonSource::vtkInternals
 
 namespace
 {
-// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
-// RequestData refuses them with a message instead of their being clamped silently.
-template <typename Object>
-void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
-{
-  if (std::isfinite(value))
-  {
-    value = std::clamp(value, low, high);
-  }
-  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
-  {
-    member = value;
-    object->Modified();
-  }
-}
-
 constexpr int MaximumCachedDensities = 4;
 // Valid ranges (see the class documentation).
 constexpr double MaximumLength = 1.0e8;        // m
@@ -125,17 +111,7 @@ bool ValidStepDuration(double seconds)
   return seconds >= MinimumStepDuration && seconds <= MaximumStepDuration;
 }
 
-bool AllFinite(const double* values, int count)
-{
-  for (int i = 0; i < count; ++i)
-  {
-    if (!std::isfinite(values[i]))
-    {
-      return false;
-    }
-  }
-  return true;
-}
+using nimbus::AllFinite;
 
 // Point spacing of the grid covering the bounds (one point: the whole length, or 1).
 double AxisSpacing(int points, double low, double high)
@@ -384,37 +360,19 @@ vtkNimbusCloudAutomatonSource::vtkNimbusCloudAutomatonSource()
 
 vtkNimbusCloudAutomatonSource::~vtkNimbusCloudAutomatonSource() = default;
 
-void vtkNimbusCloudAutomatonSource::SetExtinctionProbability(double value)
-{
-  SetClampedFiniteValue(this, this->ExtinctionProbability, value, 0.0, 1.0);
-}
+nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, ExtinctionProbability)
 
-void vtkNimbusCloudAutomatonSource::SetHumidityProbability(double value)
-{
-  SetClampedFiniteValue(this, this->HumidityProbability, value, 0.0, 1.0);
-}
+  nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, HumidityProbability)
 
-void vtkNimbusCloudAutomatonSource::SetActivationProbability(double value)
-{
-  SetClampedFiniteValue(this, this->ActivationProbability, value, 0.0, 1.0);
-}
+    nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, ActivationProbability)
 
-void vtkNimbusCloudAutomatonSource::SetInitialHumidity(double value)
-{
-  SetClampedFiniteValue(this, this->InitialHumidity, value, 0.0, 1.0);
-}
+      nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, InitialHumidity)
 
-void vtkNimbusCloudAutomatonSource::SetInitialActivation(double value)
-{
-  SetClampedFiniteValue(this, this->InitialActivation, value, 0.0, 1.0);
-}
+        nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, InitialActivation)
 
-void vtkNimbusCloudAutomatonSource::SetSmoothingRadius(double value)
-{
-  SetClampedFiniteValue(this, this->SmoothingRadius, value, 0.0, 16.0);
-}
+          nimbusDefineFiniteSetter(vtkNimbusCloudAutomatonSource, SmoothingRadius)
 
-int vtkNimbusCloudAutomatonSource::FillInputPortInformation(int, vtkInformation* info)
+            int vtkNimbusCloudAutomatonSource::FillInputPortInformation(int, vtkInformation* info)
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
   info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
@@ -480,40 +438,14 @@ int vtkNimbusCloudAutomatonSource::RequestUpdateExtent(
 
 bool vtkNimbusCloudAutomatonSource::CheckParameters()
 {
-  if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
+  const std::string gridProblem = nimbus::CheckGridParameters(
+    this->MemoryBudgetMiB, this->Dimensions, this->Bounds, MaximumLength);
+  if (!gridProblem.empty())
   {
-    vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
-                  << this->MemoryBudgetMiB << ".");
+    vtkErrorMacro(<< gridProblem);
     return false;
   }
   const int* d = this->Dimensions;
-  if (d[0] < 1 || d[1] < 1 || d[2] < 1)
-  {
-    vtkErrorMacro(<< "Dimensions must be >= 1 along every axis, got (" << d[0] << ", " << d[1]
-                  << ", " << d[2] << ").");
-    return false;
-  }
-  if (!AllFinite(this->Bounds, 6))
-  {
-    vtkErrorMacro(<< "Bounds must be finite numbers.");
-    return false;
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    if (!(this->Bounds[2 * a] < this->Bounds[2 * a + 1]))
-    {
-      vtkErrorMacro(<< "Bounds must satisfy min < max on every axis; axis " << a << " has ("
-                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
-      return false;
-    }
-    if (std::abs(this->Bounds[2 * a]) > MaximumLength ||
-      std::abs(this->Bounds[2 * a + 1]) > MaximumLength)
-    {
-      vtkErrorMacro(<< "Bounds must lie within +-" << MaximumLength << " m; axis " << a << " has ("
-                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
-      return false;
-    }
-  }
   if (!ValidStepDuration(this->StepDuration))
   {
     vtkErrorMacro(<< "StepDuration must be between " << MinimumStepDuration << " and "

@@ -56,15 +56,16 @@
  * (m/s) per metre of height; StepDuration in seconds; probabilities per cell per step.
  * The field data holds "AutomatonStep" (the fractional step shown).
  *
- * Bad input ends in an error message and an empty output, never in an exception or an
- * allocation VTK cannot make: NaN or infinite probabilities or smoothing radius (finite
- * values are clamped to their ranges), StepDuration outside [1e-6, 1e9] s, Bounds not finite, not
- * min < max or beyond +-1e8 m, a wind or shear that moves a layer more than 1e6 cells per step,
- * input arrays with values outside [0, 1] (counted in the message), a grid, cache and checkpoints
- * that would need more than MemoryBudgetMiB, or a requested time that would need more than about
- * 1e11 cell updates from the nearest cached state (the message gives the estimate). Stepping
- * reports progress and stops soon after AbortExecute is set (the output is then empty; the states
- * computed so far stay cached).
+ * NaN or infinite probabilities or smoothing radius are refused by their setters at once
+ * (an error naming the property and the value; the previous value is kept); finite values
+ * are clamped to their ranges. Other bad input ends in an error message and an empty
+ * output, never in an exception or an allocation VTK cannot make: StepDuration outside [1e-6, 1e9]
+ * s, Bounds not finite, not min < max or beyond +-1e8 m, a wind or shear that moves a layer more
+ * than 1e6 cells per step, input arrays with values outside [0, 1] (counted in the message), a
+ * grid, cache and checkpoints that would need more than MemoryBudgetMiB, or a requested time that
+ * would need more than about 1e11 cell updates from the nearest cached state (the message gives the
+ * estimate). Stepping reports progress and stops soon after AbortExecute is set (the output is then
+ * empty; the states computed so far stay cached).
  */
 #ifndef vtkNimbusCloudAutomatonSource_h
 #define vtkNimbusCloudAutomatonSource_h
@@ -105,17 +106,17 @@ public:
   /// vapour supply p_hum, activation supply p_act (002 §3); with formation regions, p_hum and
   /// p_act at a region's centre (scaled by the region's weight elsewhere). Defaults 0.06,
   /// 0.1, 0.005.
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetExtinctionProbability(double value);
   double GetExtinctionProbabilityMinValue() { return 0.0; }
   double GetExtinctionProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(ExtinctionProbability, double);
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetHumidityProbability(double value);
   double GetHumidityProbabilityMinValue() { return 0.0; }
   double GetHumidityProbabilityMaxValue() { return 1.0; }
   vtkGetMacro(HumidityProbability, double);
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetActivationProbability(double value);
   double GetActivationProbabilityMinValue() { return 0.0; }
   double GetActivationProbabilityMaxValue() { return 1.0; }
@@ -125,12 +126,12 @@ public:
   ///@{
   /// Probabilities of hum and act in each cell at step 0 (cld starts empty).
   /// Defaults 0 and 0 (the formation regions supply both).
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetInitialHumidity(double value);
   double GetInitialHumidityMinValue() { return 0.0; }
   double GetInitialHumidityMaxValue() { return 1.0; }
   vtkGetMacro(InitialHumidity, double);
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetInitialActivation(double value);
   double GetInitialActivationMinValue() { return 0.0; }
   double GetInitialActivationMaxValue() { return 1.0; }
@@ -185,7 +186,7 @@ public:
 
   ///@{
   /// Radius (cells) of the smoothing kernel; <= 1 gives the raw 0/1 cld field. Default 2.5.
-  /// Clamped to [0.0, 16.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 16.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetSmoothingRadius(double value);
   double GetSmoothingRadiusMinValue() { return 0.0; }
   double GetSmoothingRadiusMaxValue() { return 16.0; }

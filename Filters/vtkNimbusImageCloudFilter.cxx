@@ -1,5 +1,6 @@
 #include "vtkNimbusImageCloudFilter.h"
 
+#include "FiniteSetters.h"
 #include "ImageClouds.h"
 #include "MemoryBudget.h"
 #include "PieceExtent.h"
@@ -26,25 +27,6 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusImageCloudFilter);
-
-namespace
-{
-// Like vtkSetClampMacro, except that NaN and infinities are stored as given, so that
-// RequestData refuses them with a message instead of their being clamped silently.
-template <typename Object>
-void SetClampedFiniteValue(Object* object, double& member, double value, double low, double high)
-{
-  if (std::isfinite(value))
-  {
-    value = std::clamp(value, low, high);
-  }
-  if (!(member == value) && !(std::isnan(member) && std::isnan(value)))
-  {
-    member = value;
-    object->Modified();
-  }
-}
-}
 
 vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
 {
@@ -83,32 +65,17 @@ vtkNimbusImageCloudFilter::vtkNimbusImageCloudFilter()
 
 vtkNimbusImageCloudFilter::~vtkNimbusImageCloudFilter() = default;
 
-void vtkNimbusImageCloudFilter::SetGamma(double value)
-{
-  SetClampedFiniteValue(this, this->Gamma, value, 0.01, 100.0);
-}
+nimbusDefineFiniteSetter(vtkNimbusImageCloudFilter, Gamma)
 
-void vtkNimbusImageCloudFilter::SetMaximumOpticalDepth(double value)
-{
-  SetClampedFiniteValue(this, this->MaximumOpticalDepth, value, 0.0, 1000.0);
-}
+  nimbusDefineFiniteSetter(vtkNimbusImageCloudFilter, MaximumOpticalDepth)
 
-void vtkNimbusImageCloudFilter::SetAsymmetryParameter(double value)
-{
-  SetClampedFiniteValue(this, this->AsymmetryParameter, value, 0.0, 0.99);
-}
+    nimbusDefineFiniteSetter(vtkNimbusImageCloudFilter, AsymmetryParameter)
 
-void vtkNimbusImageCloudFilter::SetBallRadiusFactor(double value)
-{
-  SetClampedFiniteValue(this, this->BallRadiusFactor, value, 0.1, 20.0);
-}
+      nimbusDefineFiniteSetter(vtkNimbusImageCloudFilter, BallRadiusFactor)
 
-void vtkNimbusImageCloudFilter::SetTopRoughness(double value)
-{
-  SetClampedFiniteValue(this, this->TopRoughness, value, 0.0, 1.0);
-}
+        nimbusDefineFiniteSetter(vtkNimbusImageCloudFilter, TopRoughness)
 
-vtkImageData* vtkNimbusImageCloudFilter::GetOpticalDepthMap()
+          vtkImageData* vtkNimbusImageCloudFilter::GetOpticalDepthMap()
 {
   return vtkImageData::SafeDownCast(this->GetOutputDataObject(1));
 }

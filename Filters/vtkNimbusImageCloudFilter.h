@@ -32,7 +32,10 @@
  * neighbouring columns and normalises by the whole map, so every piece reads the whole input
  * image and builds the whole cloud, then crops: exact, but work and memory are not divided.
  *
- * Bad input ends in an error message and empty outputs, never in an exception or an
+ * NaN or infinite Gamma, MaximumOpticalDepth, AsymmetryParameter, BallRadiusFactor or
+ * TopRoughness are refused by their setters at once (an error naming the property and the
+ * value; the previous value is kept); finite values are clamped to their ranges. Other bad
+ * input ends in an error message and empty outputs, never in an exception or an
  * allocation VTK cannot make: NaN or infinite parameters, values outside the documented
  * ranges (PixelSize and VerticalSpacing in [1e-3, 1e6] m, ExtinctionCoefficient in
  * (0, 1e3] 1/m, NominalDensity in (0, 1e6], |BaseHeight| and BaseTransitionThickness at
@@ -88,17 +91,17 @@ public:
   vtkGetMacro(ClearIntensity, double);
   vtkSetMacro(WhiteIntensity, double);
   vtkGetMacro(WhiteIntensity, double);
-  /// Clamped to [0.01, 100.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.01, 100.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetGamma(double value);
   double GetGammaMinValue() { return 0.01; }
   double GetGammaMaxValue() { return 100.0; }
   vtkGetMacro(Gamma, double);
-  /// Clamped to [0.0, 1000.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1000.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetMaximumOpticalDepth(double value);
   double GetMaximumOpticalDepthMinValue() { return 0.0; }
   double GetMaximumOpticalDepthMaxValue() { return 1000.0; }
   vtkGetMacro(MaximumOpticalDepth, double);
-  /// Clamped to [0.0, 0.99]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 0.99]; NaN and infinities refused at once (error, value kept).
   virtual void SetAsymmetryParameter(double value);
   double GetAsymmetryParameterMinValue() { return 0.0; }
   double GetAsymmetryParameterMaxValue() { return 0.99; }
@@ -137,12 +140,12 @@ public:
   /// Seed of the jitter. Defaults 2, 3, 0.6, 10, 1.
   vtkSetClampMacro(BallSpacing, int, 1, 64);
   vtkGetMacro(BallSpacing, int);
-  /// Clamped to [0.1, 20.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.1, 20.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetBallRadiusFactor(double value);
   double GetBallRadiusFactorMinValue() { return 0.1; }
   double GetBallRadiusFactorMaxValue() { return 20.0; }
   vtkGetMacro(BallRadiusFactor, double);
-  /// Clamped to [0.0, 1.0]; NaN and infinities are kept, and refused by RequestData.
+  /// Clamped to [0.0, 1.0]; NaN and infinities refused at once (error, value kept).
   virtual void SetTopRoughness(double value);
   double GetTopRoughnessMinValue() { return 0.0; }
   double GetTopRoughnessMaxValue() { return 1.0; }

@@ -1,5 +1,7 @@
 #include "vtkNimbusMetaballCloudSource.h"
 
+#include "FiniteSetters.h"
+#include "GridParameters.h"
 #include "MemoryBudget.h"
 #include "Metaballs.h"
 #include "PieceExtent.h"
@@ -65,17 +67,7 @@ nimbus::GridGeometry MakeGrid(const int dims[3], const double bounds[6])
   return grid;
 }
 
-bool AllFinite(const double* values, int count)
-{
-  for (int i = 0; i < count; ++i)
-  {
-    if (!std::isfinite(values[i]))
-    {
-      return false;
-    }
-  }
-  return true;
-}
+using nimbus::AllFinite;
 
 // Valid ranges (see the class documentation).
 constexpr double MaximumLength = 1.0e8;      // m: coordinates, radii, heights
@@ -235,39 +227,12 @@ bool vtkNimbusMetaballCloudSource::CheckParameters()
 
 bool vtkNimbusMetaballCloudSource::CheckGridParameters()
 {
-  if (!std::isfinite(this->MemoryBudgetMiB) || !(this->MemoryBudgetMiB > 0.0))
+  const std::string problem = nimbus::CheckGridParameters(
+    this->MemoryBudgetMiB, this->Dimensions, this->Bounds, MaximumLength);
+  if (!problem.empty())
   {
-    vtkErrorMacro(<< "MemoryBudgetMiB must be a finite number of MiB > 0, got "
-                  << this->MemoryBudgetMiB << ".");
+    vtkErrorMacro(<< problem);
     return false;
-  }
-  const int* d = this->Dimensions;
-  if (d[0] < 1 || d[1] < 1 || d[2] < 1)
-  {
-    vtkErrorMacro(<< "Dimensions must be >= 1 along every axis, got (" << d[0] << ", " << d[1]
-                  << ", " << d[2] << ").");
-    return false;
-  }
-  if (!AllFinite(this->Bounds, 6))
-  {
-    vtkErrorMacro(<< "Bounds must be finite numbers.");
-    return false;
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    if (!(this->Bounds[2 * a] < this->Bounds[2 * a + 1]))
-    {
-      vtkErrorMacro(<< "Bounds must satisfy min < max on every axis; axis " << a << " has ("
-                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
-      return false;
-    }
-    if (std::abs(this->Bounds[2 * a]) > MaximumLength ||
-      std::abs(this->Bounds[2 * a + 1]) > MaximumLength)
-    {
-      vtkErrorMacro(<< "Bounds must lie within +-" << MaximumLength << " m; axis " << a << " has ("
-                    << this->Bounds[2 * a] << ", " << this->Bounds[2 * a + 1] << ").");
-      return false;
-    }
   }
   return true;
 }

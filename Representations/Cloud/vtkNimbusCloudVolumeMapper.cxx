@@ -83,7 +83,7 @@ vtkStandardNewMacro(vtkNimbusCloudVolumeMapper);
 vtkCxxSetObjectMacro(vtkNimbusCloudVolumeMapper, SkyBackground, vtkNimbusSkyBackground);
 
 // The physical numbers refuse NaN and infinity (an error; the value is kept) and
-// clamp finite values to their ranges (FiniteSetters.h).
+// clamp finite values to their ranges (Common/FiniteSetters.h).
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, ExtinctionPerDensity);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Albedo);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, CloudG);
@@ -143,10 +143,7 @@ double vtkNimbusCloudVolumeMapper::GetQualityMinValue()
 
 namespace
 {
-bool AllFinite(const double* values, int count)
-{
-  return std::all_of(values, values + count, [](double v) { return std::isfinite(v); });
-}
+using nimbus::AllFinite;
 
 // Column-major float copy of a VTK (row-major) matrix, for glUniformMatrix4fv.
 std::array<float, 16> ColumnMajor(const vtkMatrix4x4* m)

@@ -16,7 +16,7 @@
 vtkStandardNewMacro(vtkNimbusSky);
 
 // Non-finite values are refused (an error; the value is kept), finite ones clamped
-// (FiniteSetters.h).
+// (Common/FiniteSetters.h).
 nimbusDefineFiniteSetter(vtkNimbusSky, SunElevationDegrees);
 nimbusDefineFiniteSetter(vtkNimbusSky, SunAzimuthDegrees);
 nimbusDefineFiniteSetter(vtkNimbusSky, GroundAlbedo);

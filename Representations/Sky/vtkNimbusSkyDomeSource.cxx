@@ -30,7 +30,7 @@ vtkStandardNewMacro(vtkNimbusSkyDomeSource);
 vtkCxxSetObjectMacro(vtkNimbusSkyDomeSource, Sky, vtkNimbusSky);
 
 // Non-finite values are refused (an error; the value is kept), finite ones clamped
-// (FiniteSetters.h).
+// (Common/FiniteSetters.h).
 nimbusDefineFiniteSetter(vtkNimbusSkyDomeSource, Radius);
 
 void vtkNimbusSkyDomeSource::SetCenter(double x, double y, double z)

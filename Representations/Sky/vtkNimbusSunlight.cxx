@@ -16,7 +16,7 @@
 vtkStandardNewMacro(vtkNimbusSunlight);
 
 // Non-finite values are refused (an error; the value is kept), finite ones clamped
-// (FiniteSetters.h).
+// (Common/FiniteSetters.h).
 nimbusDefineFiniteSetter(vtkNimbusSunlight, SunElevationDegrees);
 nimbusDefineFiniteSetter(vtkNimbusSunlight, SunAzimuthDegrees);
 nimbusDefineFiniteSetter(vtkNimbusSunlight, SceneAltitudeMetres);

@@ -227,17 +227,20 @@ TEST(ImageCloudFilter, SizeAndBudgetMessagesNameTheRealCause)
   EXPECT_EQ(filter->GetOutput()->GetNumberOfPoints(), 0);
   EXPECT_EQ(filter->GetOpticalDepthMap()->GetNumberOfPoints(), 0);
 
-  // NaN in a clamped property, and an infinity that was clamped silently before.
+  // NaN in a clamped property, and an infinity that was clamped silently before: refused by
+  // the setter at once (an error naming the property and the value), the value kept.
   filter->SetMemoryBudgetMiB(1024.0);
-  filter->SetGamma(std::nan(""));
-  filter->Update();
-  ASSERT_EQ(catcher.Errors.size(), 2u);
-  EXPECT_NE(catcher.Errors[1].find("Gamma"), std::string::npos) << catcher.Errors[1];
   filter->SetGamma(1.0);
+  filter->SetGamma(std::nan(""));
+  ASSERT_EQ(catcher.Errors.size(), 2u);
+  EXPECT_NE(catcher.Errors[1].find("SetGamma(nan)"), std::string::npos) << catcher.Errors[1];
+  EXPECT_EQ(filter->GetGamma(), 1.0);
+  filter->SetMaximumOpticalDepth(30.0);
   filter->SetMaximumOpticalDepth(HUGE_VAL);
-  filter->Update();
   ASSERT_EQ(catcher.Errors.size(), 3u);
-  EXPECT_NE(catcher.Errors[2].find("MaximumOpticalDepth"), std::string::npos) << catcher.Errors[2];
+  EXPECT_NE(catcher.Errors[2].find("SetMaximumOpticalDepth(inf)"), std::string::npos)
+    << catcher.Errors[2];
+  EXPECT_EQ(filter->GetMaximumOpticalDepth(), 30.0);
   filter->SetMaximumOpticalDepth(1e308); // finite: clamped to 1000, as the setter documents
   EXPECT_EQ(filter->GetMaximumOpticalDepth(), 1000.0);
 }

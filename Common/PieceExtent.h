@@ -1,5 +1,6 @@
 // Pieces of an image source's output (data parallel, under MPI): the extent the pipeline asks
-// for, and the crop of a whole-grid result to it. Private to Nimbus::Filters.
+// for, and the crop of a whole-grid result to it (Nimbus::Common; used by the sources of
+// Nimbus::Filters).
 //
 // With CAN_PRODUCE_SUB_EXTENT set in RequestInformation, VTK's streaming executive turns a
 // piece request (UPDATE_PIECE_NUMBER, UPDATE_NUMBER_OF_PIECES, UPDATE_NUMBER_OF_GHOST_LEVELS)

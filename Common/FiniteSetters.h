@@ -1,5 +1,11 @@
-// Setters of the mapper's and the sky's physical numbers that refuse NaN and
-// infinity (private to Nimbus::Representations; included by .cxx files only).
+// Setters of the physical numbers of every Nimbus VTK class that refuse NaN and
+// infinity, and AllFinite (Nimbus::Common; included by .cxx files only).
+//
+// The one rule for a non-finite value given to a setter: it is refused at once, with a
+// vtkErrorMacro that names the property and the value, and the previous value is kept
+// (so the object stays valid and the next RequestData runs with what it had). Values
+// with no clamp range (bounds, vectors, lengths checked against each other) are still
+// checked by the class's RequestData with the rest of their range.
 //
 // vtkSetClampMacro lets NaN through (every comparison with NaN is false) and turns
 // +-infinity into the end of the range, a value nobody asked for; vtkSetMacro takes
@@ -33,5 +39,14 @@
       this->Modified();                                                                            \
     }                                                                                              \
   }
+
+namespace nimbus
+{
+/// Whether all `count` values are finite (no NaN, no infinity).
+inline bool AllFinite(const double* values, int count)
+{
+  return std::all_of(values, values + count, [](double v) { return std::isfinite(v); });
+}
+}
 
 #endif
