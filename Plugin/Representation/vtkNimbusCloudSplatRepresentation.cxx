@@ -48,6 +48,32 @@ void GrowByRadii(vtkPolyData* balls, vtkDataArray* radii, double bounds[6])
   }
 }
 
+// The sky background the view shows: the one its renderer names
+// (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND) when visible, else a visible one among
+// its props (a Nimbus Sky shown in a view has more than one background prop, one per
+// representation of the sky, and the renderer names the last added, which may be hidden).
+vtkNimbusSkyBackground* ViewSkyBackground(vtkRenderer* renderer)
+{
+  auto* named = vtkNimbusSkyBackground::SafeDownCast(
+    renderer->GetInformation()->Get(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
+  if (named && named->GetVisibility())
+  {
+    return named;
+  }
+  vtkPropCollection* props = renderer->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
+    if (background && background->GetVisibility())
+    {
+      return background;
+    }
+  }
+  return named;
+}
+
 // The splats are drawn in the opaque pass and write no depth; the sky background,
 // also drawn there, fills every pixel still at the far plane: drawn after the splats it
 // would cover them. Props draw in the renderer's order, so the splats' actor is moved
@@ -155,15 +181,17 @@ void vtkNimbusCloudSplatRepresentation::ApplySun()
   // The sky the view shows now (or none): the representations of a view are
   // separate, so the coupling goes through the renderer's information.
   vtkNimbusSky* sky = nullptr;
+  vtkNimbusSkyBackground* background = nullptr;
   auto* view = vtkPVRenderView::SafeDownCast(this->GetView());
   if (this->UseSceneSky && view && view->GetRenderer() && view->GetRenderer()->GetInformation())
   {
-    auto* background =
-      vtkNimbusSkyBackground::SafeDownCast(view->GetRenderer()->GetInformation()->Get(
-        vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
+    background = ViewSkyBackground(view->GetRenderer());
     sky = background && background->GetVisibility() ? background->GetSky() : nullptr;
     KeepAfterSky(view->GetRenderer(), this->Actor, background);
   }
+  // Over the sky the mapper takes its sun, air and display too while it is drawn, as the
+  // Cloud representation's mapper does (the sky's light, the air, the frame's encoding).
+  this->Mapper->SetSkyBackground(background);
   double temperature = this->SunTemperatureKelvin;
   if (sky)
   {
@@ -179,9 +207,6 @@ void vtkNimbusCloudSplatRepresentation::ApplySun()
     }
   }
   this->LastRenderUsedSceneSky = sky != nullptr;
-  // Over the sky the mapper takes its sun, air and display too, as the Cloud
-  // representation's mapper does (the sky's light, the air, the frame's encoding).
-  this->Mapper->SetSky(sky);
   // Unchanged values leave the mapper (and its sun pass) untouched.
   this->Mapper->SetSunElevationDegrees(
     sky ? sky->GetSunElevationDegrees() : this->SunElevationDegrees);

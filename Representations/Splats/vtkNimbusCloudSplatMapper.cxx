@@ -24,6 +24,7 @@
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackground.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLBufferObject.h"
 #include "vtkOpenGLCamera.h"
@@ -322,10 +323,10 @@ vtkNimbusCloudSplatMapper::~vtkNimbusCloudSplatMapper()
 {
   this->SetRadiusArrayName(nullptr);
   this->SetDensityArrayName(nullptr);
-  this->SetSky(nullptr);
+  this->SetSkyBackground(nullptr);
 }
 
-vtkCxxSetObjectMacro(vtkNimbusCloudSplatMapper, Sky, vtkNimbusSky);
+vtkCxxSetObjectMacro(vtkNimbusCloudSplatMapper, SkyBackground, vtkNimbusSkyBackground);
 
 double vtkNimbusCloudSplatMapper::GetLastAirSeconds() const
 {
@@ -1066,6 +1067,9 @@ void vtkNimbusCloudSplatMapper::ComputeFrameSettings()
   in.MetresPerUnit = this->MetresPerUnit;
   in.DisplayScale = { { this->Exposure, this->Exposure, this->Exposure } };
   in.OverSky = false;
+  this->Sky = this->SkyBackground && this->SkyBackground->GetVisibility()
+    ? this->SkyBackground->GetSky()
+    : nullptr;
   if (!this->Sky)
   {
     return;
@@ -1085,6 +1089,7 @@ void vtkNimbusCloudSplatMapper::ComputeFrameSettings()
       vtkErrorMacro(<< message);
       in.LastSkyError = message;
     }
+    this->Sky = nullptr;
     return;
   }
   in.LastSkyError.clear();
@@ -1393,7 +1398,7 @@ void vtkNimbusCloudSplatMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TimePasses: " << this->TimePasses << "\n";
   os << indent << "MultipleScattering: " << this->MultipleScattering << "\n";
   os << indent << "MultipleScatteringGridSize: " << this->MultipleScatteringGridSize << "\n";
-  os << indent << "Sky: " << this->Sky << "\n";
+  os << indent << "SkyBackground: " << this->SkyBackground << "\n";
   os << indent << "SkyLight: " << this->SkyLight << "\n";
   os << indent << "AerialPerspective: " << this->AerialPerspective << "\n";
 }

@@ -41,8 +41,9 @@
  * ball's centre), with the delta-M forward peak's part of the sun's light as the cloud
  * mapper adds it. Solved again only when the balls or the sun change.
  *
- * Over a Nimbus sky (SetSky: the vtkNimbusSky drawn behind the balls; in ParaView the
- * Cloud Splats representation hands it the view's sky) the balls take that sky's sun
+ * Over a Nimbus sky (SetSkyBackground: the vtkNimbusSkyBackground drawn behind the balls,
+ * followed while it is visible; in ParaView the Cloud Splats representation hands it the
+ * view's sky) the balls take that sky's sun
  * (elevation, azimuth, temperature, illuminance 1), air, ground albedo, metres per unit
  * and display scale (its exposure and white balance) instead of their own, as
  * vtkNimbusCloudVolumeMapper does over its sky background, and they get what the
@@ -94,6 +95,7 @@ namespace nimbus
 struct CloudLighting;
 }
 class vtkNimbusSky;
+class vtkNimbusSkyBackground;
 class vtkOpenGLRenderWindow;
 class vtkShaderProgram;
 
@@ -216,12 +218,14 @@ public:
   ///@}
 
   ///@{
-  /// The sky the balls are drawn over (default none): its sun, air and display replace
-  /// the mapper's own (see the class comment). SkyLight: the sky's and the ground's light
-  /// on the balls (default on); AerialPerspective: the air between the eye and the balls
-  /// (default on). Both need a sky.
-  virtual void SetSky(vtkNimbusSky* sky);
-  vtkGetObjectMacro(Sky, vtkNimbusSky);
+  /// The sky background the balls are drawn over (default none; add it to the renderer
+  /// before the balls' actor): while it is visible its sky's sun, air and display replace
+  /// the mapper's own (see the class comment), as vtkNimbusCloudVolumeMapper's
+  /// SetSkyBackground. SkyLight: the sky's and the ground's light on the balls (default
+  /// on); AerialPerspective: the air between the eye and the balls (default on). Both
+  /// need a sky.
+  virtual void SetSkyBackground(vtkNimbusSkyBackground* background);
+  vtkGetObjectMacro(SkyBackground, vtkNimbusSkyBackground);
   vtkSetMacro(SkyLight, bool);
   vtkGetMacro(SkyLight, bool);
   vtkBooleanMacro(SkyLight, bool);
@@ -268,7 +272,8 @@ protected:
   bool TimePasses = false;
   bool MultipleScattering = false;
   int MultipleScatteringGridSize = 32;
-  vtkNimbusSky* Sky = nullptr;
+  vtkNimbusSkyBackground* SkyBackground = nullptr;
+  vtkNimbusSky* Sky = nullptr; // the followed sky of this frame (not counted)
   bool SkyLight = true;
   bool AerialPerspective = true;
 

@@ -5,14 +5,20 @@
 // sun's light read back per ball (the paper's variant) must agree with the texture's
 // per-ball light (SunLightSamples 0) to an RMSE of 6 (8-bit), and a frame that moves
 // only the camera must not redo the sun pass's work; bad balls are skipped and a missing
-// array named.
+// array named. Over a Nimbus sky (SetSkyBackground) the same balls are compared with a
+// second baseline (<baseline>_sky.png): the sky's light must make them brighter,
+// the air between a far camera and them must bring them toward the sky behind, and the
+// mapper's own sun must not matter while it follows the sky.
 //
 //   TestCloudSplatMapper <baseline.png> <output dir>
 #include "vtkNimbusCloudSplatMapper.h"
 #include "vtkNimbusMetaballCloudSource.h"
 #include "vtkNimbusOffscreenRenderWindow.h"
+#include "vtkNimbusSky.h"
+#include "vtkNimbusSkyBackground.h"
 
 #include "vtkActor.h"
+#include "vtkAlgorithmOutput.h"
 #include "vtkCamera.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -29,6 +35,7 @@
 #include "ImageComparison.h"
 #include "MessageCatcher.h"
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -74,6 +81,138 @@ double MeanValue(vtkImageData* image)
   }
   return sum / std::max<vtkIdType>(3 * x->GetNumberOfTuples(), 1);
 }
+}
+
+// The mean colour (8-bit) of `image` where `reference` and `other` differ by more than 6
+// in some channel.
+std::array<double, 3> MeanWhereDifferent(
+  vtkImageData* image, vtkImageData* reference, vtkImageData* other)
+{
+  auto* x = vtkUnsignedCharArray::SafeDownCast(image->GetPointData()->GetScalars());
+  auto* r = vtkUnsignedCharArray::SafeDownCast(reference->GetPointData()->GetScalars());
+  auto* o = vtkUnsignedCharArray::SafeDownCast(other->GetPointData()->GetScalars());
+  std::array<double, 3> sum{ { 0.0, 0.0, 0.0 } };
+  vtkIdType count = 0;
+  for (vtkIdType i = 0; i < x->GetNumberOfTuples(); ++i)
+  {
+    double difference = 0.0;
+    for (int c = 0; c < 3; ++c)
+    {
+      difference = std::max(
+        difference, std::abs(r->GetTypedComponent(i, c) - 1.0 * o->GetTypedComponent(i, c)));
+    }
+    if (difference > 6.0)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        sum[c] += x->GetTypedComponent(i, c);
+      }
+      ++count;
+    }
+  }
+  for (double& c : sum)
+  {
+    c /= std::max<vtkIdType>(count, 1);
+  }
+  return sum;
+}
+
+double ColourDistance(const std::array<double, 3>& a, const std::array<double, 3>& b)
+{
+  return std::sqrt(
+    (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+// The balls over a Nimbus sky (the sun 30 degrees up behind the camera's left): the
+// picture against its baseline; the sky's light (brighter balls in every channel); the air
+// (a camera 30 km away sees the balls closer to the sky's colour behind them with it
+// than without); the mapper's own sun ignored while it follows the sky.
+bool CheckSky(vtkAlgorithmOutput* balls, const std::string& baseline, const std::string& outputDir)
+{
+  vtkNew<vtkNimbusSkyBackground> background;
+  background->GetSky()->SetSunElevationDegrees(30.0);
+  background->GetSky()->SetSunAzimuthDegrees(210.0);
+  vtkNew<vtkNimbusCloudSplatMapper> mapper;
+  mapper->SetInputConnection(balls);
+  mapper->SetExtinctionPerDensity(0.004);
+  mapper->SetMultipleScatteringGridSize(16); // the sky light's solve
+  mapper->SetSkyBackground(background);
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  vtkNew<vtkRenderer> renderer;
+  renderer->AddViewProp(background); // before the balls: they composite over the sky
+  renderer->AddActor(actor);
+  vtkCamera* camera = renderer->GetActiveCamera();
+  camera->SetPosition(0.0, -6000.0, 1500.0);
+  camera->SetFocalPoint(0.0, 0.0, 1600.0);
+  camera->SetViewUp(0.0, 0.0, 1.0);
+  camera->SetViewAngle(35.0);
+  camera->SetClippingRange(100.0, 50000.0);
+  vtkNew<vtkRenderWindow> window;
+  window->SetSize(320, 240);
+  window->SetMultiSamples(0);
+  window->AddRenderer(renderer);
+  window->Render();
+  vtkSmartPointer<vtkImageData> sky = Capture(window);
+  const std::string image = outputDir + "/TestCloudSplatMapper_sky.png";
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetFileName(image.c_str());
+  writer->SetInputData(sky);
+  writer->Write();
+  bool ok = nimbus::testing::CompareImageFiles(
+    image, baseline, outputDir, nimbus::testing::ImageComparisonLimits(), std::cout);
+
+  actor->VisibilityOff();
+  window->Render();
+  vtkSmartPointer<vtkImageData> clear = Capture(window);
+  actor->VisibilityOn();
+  mapper->SkyLightOff();
+  window->Render();
+  vtkSmartPointer<vtkImageData> unlit = Capture(window);
+  const auto lit = MeanWhereDifferent(sky, sky, clear);
+  const auto dark = MeanWhereDifferent(unlit, sky, clear);
+  std::cout << "sky light: balls " << dark[0] << " " << dark[1] << " " << dark[2] << " -> "
+            << lit[0] << " " << lit[1] << " " << lit[2] << " (8-bit, sRGB)\n";
+  if (!(lit[0] > dark[0] + 10.0 && lit[1] > dark[1] + 10.0 && lit[2] > dark[2] + 10.0))
+  {
+    std::cerr << "the sky's light does not brighten the balls\n";
+    ok = false;
+  }
+  mapper->SkyLightOn();
+
+  // 30 km away: the air between brings the balls toward the sky behind them.
+  camera->SetPosition(0.0, -30000.0, 1500.0);
+  window->Render();
+  vtkSmartPointer<vtkImageData> hazed = Capture(window);
+  actor->VisibilityOff();
+  window->Render();
+  vtkSmartPointer<vtkImageData> farClear = Capture(window);
+  actor->VisibilityOn();
+  mapper->AerialPerspectiveOff();
+  window->Render();
+  vtkSmartPointer<vtkImageData> clean = Capture(window);
+  mapper->AerialPerspectiveOn();
+  const auto behind = MeanWhereDifferent(farClear, clean, farClear);
+  const double withAir = ColourDistance(MeanWhereDifferent(hazed, clean, farClear), behind);
+  const double withoutAir = ColourDistance(MeanWhereDifferent(clean, clean, farClear), behind);
+  std::cout << "air at 30 km: the balls' colour " << withoutAir << " -> " << withAir
+            << " from the sky's behind them (8-bit)\n";
+  if (!(withAir < 0.8 * withoutAir))
+  {
+    std::cerr << "the air does not bring far balls toward the sky's colour\n";
+    ok = false;
+  }
+
+  // The mapper's own sun is not used while it follows the sky.
+  mapper->SetSunElevationDegrees(-60.0);
+  window->Render();
+  const double own = Rmse(hazed, Capture(window));
+  if (!(own < 0.5))
+  {
+    std::cerr << "the mapper's own sun changes the picture over the sky (RMSE " << own << ")\n";
+    ok = false;
+  }
+  return ok;
 }
 
 int main(int argc, char* argv[])
@@ -250,5 +389,7 @@ int main(int argc, char* argv[])
       ok = false;
     }
   }
+  const std::string skyBaseline = baseline.substr(0, baseline.size() - 4) + "_sky.png";
+  ok = CheckSky(cloud->GetOutputPort(1), skyBaseline, outputDir) && ok;
   return ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }
