@@ -13,7 +13,8 @@ Checks, through paraview.simple only:
      image;
   4. with a Nimbus Sky shown in the view ("Sky Background"), the balls are drawn over the
      sky, lit by the sky's sun: the sky's sun elevation changes the image, the display's
-     own does not.
+     own does not; the sky's light and the air between the camera and the balls (Sky
+     and Ground Light, Air Between Camera and Cloud) change the balls.
 """
 import argparse
 import os
@@ -67,6 +68,16 @@ def check_view_sky(view, display, pixels, output_dir, failures):
         failures.append("the display's own sun changes the image under the view's sky")
     if sky_change < 5.0:
         failures.append("the sky's sun does not reach the balls (%.2f)" % sky_change)
+    # The sky's light and the air reach the balls through the representation.
+    display.SplatSkyLight = 0
+    display.SplatAerialPerspective = 0
+    plain = save(view, output_dir, "TestPluginCloudSplats-sky-sun-plain")
+    display.SplatSkyLight = 1
+    display.SplatAerialPerspective = 1
+    terms = abs(sky_sun - plain).max(axis=2)[balls].mean()
+    print("with the sky: the sky's light and the air change the balls by %.2f" % terms)
+    if terms < 5.0:
+        failures.append("the sky's light and the air do not reach the balls (%.2f)" % terms)
 
 
 def main():
