@@ -2,6 +2,7 @@
 #include "VdbGrids.h"
 
 #include "VdbArchive.h"
+#include "VdbClippedRead.h"
 #include "VdbFileCheck.h"
 
 #include "MemoryBudget.h"
@@ -412,9 +413,10 @@ typename GridT::Ptr BuildGrid(const FieldToWrite& field)
 /// bytes through a FileRangeBuf (reads outside them fail), after ScanFile has checked the
 /// layout. OpenVDB's File reads from an ifstream whose failed reads it does not check, which
 /// is how a truncated file gave uninitialised values and a corrupt count unbounded
-/// allocations. With a clip box, OpenVDB reads the whole topology (the node masks) but only
-/// the voxel buffers of the leaves that touch the box, seeking over the others, and drops
-/// the rest of the tree as it goes: a piece's read holds and reads only the piece's voxels.
+/// allocations. With a clip box, the grid is a ClippedGrid (VdbClippedRead.h): it keeps only
+/// the topology that touches the box and reads only the voxel buffers of the leaves that touch
+/// it, seeking over the others; with `values` it writes the box's values there and keeps no
+/// tree. A piece's read holds and reads only the piece's voxels.
 class ArchiveReader : public openvdb::io::Archive
 {
 public:
@@ -437,10 +439,16 @@ public:
   }
 
   /// Grid `i` of the layout: metadata and transform only, or the whole grid, or (with
-  /// `clip`) the grid's voxels in that index box and nothing outside it.
-  openvdb::GridBase::Ptr Read(
-    size_t i, bool metadataOnly, int depth = 0, const openvdb::CoordBBox* clip = nullptr)
+  /// `clip`) the grid's voxels in that index box and nothing outside it; with `values` too,
+  /// those voxels' values written there (floats over `clip`, x fastest) and `*filled` true,
+  /// else (a file older than node-mask compression) the clipped tree and `*filled` false.
+  openvdb::GridBase::Ptr Read(size_t i, bool metadataOnly, int depth = 0,
+    const openvdb::CoordBBox* clip = nullptr, float* values = nullptr, bool* filled = nullptr)
   {
+    if (filled)
+    {
+      *filled = false;
+    }
     const GridLayout& g = this->Layout.Grids[i];
     FileRangeBuf buf(this->Path, g.DescriptorPos, metadataOnly ? g.BlockPos : g.EndPos,
       metadataOnly ? 64 << 10 : 1 << 20);
@@ -470,6 +478,19 @@ public:
     }
     if (clip)
     {
+      // Read only the topology that touches the box (VdbClippedRead.h) where the grid's type
+      // and the file's version allow; else OpenVDB's clipped read, which parses it all.
+      if (!gd.isInstance())
+      {
+        if (auto clipped = MakeClippedGrid(*grid, this->Layout.FormatVersion, *clip, values))
+        {
+          grid = clipped;
+          if (filled)
+          {
+            *filled = values != nullptr;
+          }
+        }
+      }
       Archive::readGrid(grid, gd, is, *clip);
     }
     else
@@ -491,7 +512,7 @@ public:
         throw Error("grid " + Quote(this->Layout.DistinctNames[i]) +
           " is an instance of a grid that is missing or itself an instance");
       }
-      grid->setTree(this->Read(parent, false, depth + 1, clip)->baseTreePtr());
+      grid->setTree(this->Read(parent, false, depth + 1, clip, values, filled)->baseTreePtr());
     }
     return grid;
   }
@@ -557,9 +578,15 @@ constexpr int64_t SlabBytes = int64_t(32) << 20;
 /// sampling reads the 8 voxels around each point). False (read the whole grid) for files older
 /// than grid instancing, whose metadata cannot be read apart, and for non-linear transforms,
 /// whose linearisation depends on the whole grid's active box.
+/// `copied` (when given) says whether the grid has the reference's transform.
 bool ClipBox(ArchiveReader& archive, const FileLayout& layout, size_t index,
-  const TransformInfo& reference, const IndexBox& box, openvdb::CoordBBox& clip)
+  const TransformInfo& reference, const IndexBox& box, openvdb::CoordBBox& clip,
+  bool* copied = nullptr)
 {
+  if (copied)
+  {
+    *copied = false;
+  }
   if (layout.FormatVersion < openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING || !reference.Linear ||
     box.Empty())
   {
@@ -574,6 +601,10 @@ bool ClipBox(ArchiveReader& archive, const FileLayout& layout, size_t index,
   if (AnalyseTransform(transform, openvdb::Vec3d(0.0)).SameAs(reference))
   {
     clip = ToCoordBox(box);
+    if (copied)
+    {
+      *copied = true;
+    }
     return true;
   }
   openvdb::Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
@@ -602,6 +633,90 @@ bool ClipBox(ArchiveReader& archive, const FileLayout& layout, size_t index,
     openvdb::Coord(
       int(std::ceil(hi[0])) + 2, int(std::ceil(hi[1])) + 2, int(std::ceil(hi[2])) + 2));
   return true;
+}
+
+/// Fills `target` (zeros first: every value is set even if a copy stops half-way) with the
+/// grid's values over `box` of the reference's index space, copied or resampled by its type.
+void ExtractAny(const openvdb::GridBase::Ptr& base, const TransformInfo& reference,
+  const IndexBox& box, float* target, bool& resampled, TransformInfo& own)
+{
+  const ValueKind kind = KindOf(*base);
+  std::fill(target, target + box.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
+  switch (kind)
+  {
+    case ValueKind::Float:
+      Extract<openvdb::FloatGrid, float>(base, reference, box, target, resampled, own);
+      break;
+    case ValueKind::Double:
+      Extract<openvdb::DoubleGrid, float>(base, reference, box, target, resampled, own);
+      break;
+    case ValueKind::Vec3Float:
+      Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(base, reference, box, target, resampled, own);
+      break;
+    case ValueKind::Vec3Double:
+      Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(base, reference, box, target, resampled, own);
+      break;
+    default:
+      throw Error("grid " + Quote(base->getName()) + " has unsupported value type " +
+        Quote(base->valueType()));
+  }
+}
+
+/// Grid `index`'s values over `box` into `target` (ReadDense). A grid with the reference's
+/// transform is read once, straight into the target (ClippedGrid with values: no tree held
+/// but one lower node's leaves). A resampled grid is read in slabs of whole leaves along z
+/// (multiples of 8 voxels, about SlabBytes of values each, at most 4 slabs: each read parses
+/// the grid's topology again), its clipped tree resampled slab by slab: the tree held at once
+/// is one slab's leaves, not the box's. One read of the whole grid where a clipped read is not
+/// possible (ClipBox).
+void ReadGrid(ArchiveReader& archive, const FileLayout& layout, size_t index,
+  const TransformInfo& reference, const IndexBox& box, float* target, bool& resampled,
+  TransformInfo& own)
+{
+  openvdb::CoordBBox clip;
+  bool copied = false;
+  const bool clipped = ClipBox(archive, layout, index, reference, box, clip, &copied);
+  if (clipped && copied)
+  {
+    const auto meta = archive.Read(index, /*metadataOnly=*/true);
+    const int components = ComponentsOf(KindOf(*meta));
+    if (components == 0)
+    {
+      throw Error("grid " + Quote(layout.DistinctNames[index]) + " has unsupported value type " +
+        Quote(meta->valueType()));
+    }
+    std::fill(target, target + box.VoxelCount() * uint64_t(components), 0.0f);
+    bool filled = false;
+    const auto base = archive.Read(index, false, 0, &clip, target, &filled);
+    if (filled)
+    {
+      own = AnalyseTransform(base->transform(), openvdb::Vec3d(0.0));
+      resampled = false;
+      return;
+    }
+    ExtractAny(base, reference, box, target, resampled, own);
+    return;
+  }
+  const int64_t nx = box.Max[0] - box.Min[0] + 1, ny = box.Max[1] - box.Min[1] + 1;
+  const int64_t nz = box.Max[2] - box.Min[2] + 1;
+  const int64_t thickness = std::max<int64_t>(
+    { 8, SlabBytes / std::max<int64_t>(1, 12 * nx * ny) / 8 * 8, (nz + 31) / 32 * 8 });
+  for (int64_t z0 = box.Min[2]; z0 <= box.Max[2];)
+  {
+    IndexBox slab = box;
+    if (clipped)
+    {
+      const int64_t end = z0 + thickness;
+      slab.Min[2] = z0;
+      slab.Max[2] = std::min(box.Max[2], end - (((end % 8) + 8) % 8) - 1);
+      ClipBox(archive, layout, index, reference, slab, clip);
+    }
+    const auto base = archive.Read(index, false, 0, clipped ? &clip : nullptr);
+    const uint64_t offset =
+      uint64_t(slab.Min[2] - box.Min[2]) * nx * ny * uint64_t(ComponentsOf(KindOf(*base)));
+    ExtractAny(base, reference, slab, target + offset, resampled, own);
+    z0 = slab.Max[2] + 1;
+  }
 }
 
 } // namespace
@@ -952,56 +1067,7 @@ void ReadDense(const std::string& path, const std::vector<std::string>& names,
       const size_t index = size_t(found - layout.DistinctNames.begin());
       bool wasResampled = false;
       TransformInfo own;
-      // Slabs of whole leaves along z (multiples of 8 voxels, about SlabBytes of values each,
-      // at most 4 slabs: each read parses the grid's whole topology again): the tree held at
-      // once is one slab's leaves, not the box's. One read of the whole grid where a clipped
-      // read is not possible (ClipBox).
-      openvdb::CoordBBox clip;
-      const bool clipped = ClipBox(archive, layout, index, reference, box, clip);
-      const int64_t nx = box.Max[0] - box.Min[0] + 1, ny = box.Max[1] - box.Min[1] + 1;
-      const int64_t nz = box.Max[2] - box.Min[2] + 1;
-      const int64_t thickness = std::max<int64_t>(
-        { 8, SlabBytes / std::max<int64_t>(1, 12 * nx * ny) / 8 * 8, (nz + 31) / 32 * 8 });
-      for (int64_t z0 = box.Min[2]; z0 <= box.Max[2];)
-      {
-        IndexBox slab = box;
-        if (clipped)
-        {
-          const int64_t end = z0 + thickness;
-          slab.Min[2] = z0;
-          slab.Max[2] = std::min(box.Max[2], end - (((end % 8) + 8) % 8) - 1);
-          ClipBox(archive, layout, index, reference, slab, clip);
-        }
-        const auto base = archive.Read(index, false, 0, clipped ? &clip : nullptr);
-        const ValueKind kind = KindOf(*base);
-        float* slabTarget =
-          target[g] + uint64_t(slab.Min[2] - box.Min[2]) * nx * ny * uint64_t(ComponentsOf(kind));
-        // Every value is set even if a copy stopped half-way: never uninitialised memory.
-        std::fill(slabTarget, slabTarget + slab.VoxelCount() * uint64_t(ComponentsOf(kind)), 0.0f);
-        switch (kind)
-        {
-          case ValueKind::Float:
-            Extract<openvdb::FloatGrid, float>(
-              base, reference, slab, slabTarget, wasResampled, own);
-            break;
-          case ValueKind::Double:
-            Extract<openvdb::DoubleGrid, float>(
-              base, reference, slab, slabTarget, wasResampled, own);
-            break;
-          case ValueKind::Vec3Float:
-            Extract<openvdb::Vec3SGrid, openvdb::Vec3s>(
-              base, reference, slab, slabTarget, wasResampled, own);
-            break;
-          case ValueKind::Vec3Double:
-            Extract<openvdb::Vec3DGrid, openvdb::Vec3s>(
-              base, reference, slab, slabTarget, wasResampled, own);
-            break;
-          default:
-            throw Error("grid " + Quote(names[g]) + " has unsupported value type " +
-              Quote(base->valueType()));
-        }
-        z0 = slab.Max[2] + 1;
-      }
+      ReadGrid(archive, layout, index, reference, box, target[g], wasResampled, own);
       if (wasResampled && resampled)
       {
         resampled->push_back(names[g]);
