@@ -30,6 +30,12 @@ flock /tmp/nimbus-measure.lock.
 
     flock /tmp/nimbus-measure.lock Testing/with-display.sh /usr/bin/python3 \
         measurements/splat-compare.py --counts 1000 10000 100000 1000000 --output build/splats
+
+With --sky-bench only the cost of the sky's terms is timed (sky_bench): the balls over a
+Nimbus sky, the mapper following it or not, camera moves and sun moves:
+
+    flock /tmp/nimbus-measure.lock Testing/with-display.sh /usr/bin/python3 \
+        measurements/splat-compare.py --sky-bench --counts 1000 10000 --repeats 5
 """
 import argparse
 import csv
@@ -216,6 +222,61 @@ def errors(image, reference, mask):
             "reference_mean": float(b.mean())}
 
 
+def sky_bench(counts, repeats, ms_grid_size):
+    """The cost of the sky's terms (--sky-bench): per count, the balls over a Nimbus sky
+    (vtkNimbusSkyBackground drawn first in both rows) with the mapper following it
+    (SetSkyBackground: the sky's light, the air, the sun's tint, the sRGB composite) and
+    without; the median of `repeats` frames that move the camera (2 degrees) and of
+    `repeats` frames that move the sky's sun (0.5 degrees: the sun pass, the tint and the
+    sky light's solve again). Prints one CSV row per (count, row)."""
+    from vtkmodules.vtkRenderingCore import vtkActor
+    print("balls,row,camera_move_s,view_pass_s,air_s,sun_move_s,solve_s")
+    for count in counts:
+        centres, radius = make_balls(count)
+        poly = balls_polydata(centres, radius)
+        for follow in (False, True):
+            background = nimbus.vtkNimbusSkyBackground()
+            background.GetSky().SetSunElevationDegrees(SUN["elevation_degrees"])
+            background.GetSky().SetSunAzimuthDegrees(SUN["azimuth_degrees"])
+            mapper = nimbus.vtkNimbusCloudSplatMapper()
+            mapper.SetInputData(poly)
+            mapper.SetSunElevationDegrees(SUN["elevation_degrees"])
+            mapper.SetSunAzimuthDegrees(SUN["azimuth_degrees"])
+            mapper.SetExtinctionPerDensity(EXTINCTION)
+            mapper.SetMultipleScatteringGridSize(ms_grid_size)
+            mapper.SetTimePasses(True)
+            if follow:
+                mapper.SetSkyBackground(background)
+            actor = vtkActor()
+            actor.SetMapper(mapper)
+            window, renderer = render_window((CAMERA["width"], CAMERA["height"]))
+            renderer.AddViewProp(background)
+            renderer.AddActor(actor)
+            window.Render()
+            camera_times, views, airs, sun_times, solves = [], [], [], [], []
+            for _ in range(repeats):
+                renderer.GetActiveCamera().Azimuth(2.0)
+                start = time.perf_counter()
+                window.Render()
+                camera_times.append(time.perf_counter() - start)
+                views.append(mapper.GetLastViewPassSeconds())
+                airs.append(mapper.GetLastAirSeconds())
+            sky = background.GetSky()
+            for k in range(repeats):
+                sky.SetSunElevationDegrees(SUN["elevation_degrees"] + 0.5 * (1 + k % 2))
+                mapper.SetSunElevationDegrees(sky.GetSunElevationDegrees())
+                start = time.perf_counter()
+                window.Render()
+                sun_times.append(time.perf_counter() - start)
+                solves.append(mapper.GetLastMultipleScatteringSeconds() if follow else 0.0)
+            window.Finalize()
+            print("%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f" % (
+                count, "sky" if follow else "no-sky", statistics.median(camera_times),
+                statistics.median(views), statistics.median(airs),
+                statistics.median(sun_times), statistics.median(solves)))
+            sys.stdout.flush()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--counts", type=int, nargs="+", default=[1000, 10000, 100000])
@@ -237,7 +298,12 @@ def main():
     parser.add_argument("--reuse-references", action="store_true",
                         help="load the references an earlier run saved in --output")
     parser.add_argument("--output", default="build/splats")
+    parser.add_argument("--sky-bench", action="store_true",
+                        help="only time the sky's terms (over a Nimbus sky, followed or not)")
     args = parser.parse_args()
+    if args.sky_bench:
+        sky_bench(args.counts, args.repeats, args.ms_grid_size)
+        return
     os.makedirs(args.output, exist_ok=True)
     rows = []
     for count in args.counts:
