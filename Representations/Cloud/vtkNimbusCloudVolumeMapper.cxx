@@ -39,6 +39,7 @@
 #include "svsSliceFS.h"
 
 #include "Sky.h"
+#include "SkyTableCache.h"
 #include "vtkNimbusSky.h"
 #include "vtkNimbusSkyBackground.h"
 
@@ -382,8 +383,6 @@ struct vtkNimbusCloudVolumeMapper::Internals
   std::string LastEmissionError;
   double LastPrecomputeSeconds = 0.0;
   double SolvedIlluminance = 0.0; // the sun's illuminance of the last solve
-  std::unique_ptr<nimbus::SkyViewLut> CloudSkyView;
-  std::vector<double> CloudSkyViewKey;
 
   // Atmosphere texture (000 §3), keyed by the parameters it depends on.
   vtkNew<vtkTextureObject> AtmosphereTexture;
@@ -391,10 +390,9 @@ struct vtkNimbusCloudVolumeMapper::Internals
   nimbus::AtmosphereTable Table;
   // The air's multiple scattering (AirMultipleScattering): a sky model of the air.
   // The sky model of the frame's air and ground (FrameSkyModel): the air's multiple
-  // scattering and the cloud's sky light share it; rebuilt (1.5 s) when they change.
-  std::unique_ptr<nimbus::SkyModel> FrameSky;
-  std::vector<double> FrameSkyKey;
-  int FrameSkyGeneration = 0;
+  // scattering and the cloud's sky light share it; rebuilt (1.5 s) when they change. And
+  // the sky seen from the cloud (CloudSkyView: its sky-view table, slot 0).
+  nimbus::SkyTableCache FrameSky;
 
   // Sampling-interval and Mie-phase texture (000 §4.4), keyed likewise.
   vtkNew<vtkTextureObject> IntervalPhase;
@@ -863,13 +861,13 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameReuseKey(const FrameState& 
       static_cast<double>(in.Lightning.GetNumberOfUploads()), frame.LightningTexture ? 1.0 : 0.0,
       static_cast<double>(in.Emission.GetNumberOfUploads()), frame.EmissionTexture ? 1.0 : 0.0,
       static_cast<double>(in.ExternalMapBuilds), frame.ExternalShadow ? 1.0 : 0.0,
-      static_cast<double>(in.AtmosphereBuilds), static_cast<double>(in.FrameSkyGeneration),
-      frame.Settings.Sun.ElevationDegrees, frame.Settings.Sun.AzimuthDegrees,
-      frame.Settings.OverSky ? 1.0 : 0.0, static_cast<double>(frame.Width),
-      static_cast<double>(frame.Height), static_cast<double>(frame.X0),
-      static_cast<double>(frame.Y0), static_cast<double>(frame.Level.Width),
-      static_cast<double>(frame.Level.Height), static_cast<double>(frame.Level.Slices),
-      static_cast<double>(frame.Level.ShadowSurfaceSize),
+      static_cast<double>(in.AtmosphereBuilds),
+      static_cast<double>(in.FrameSky.GetModelGeneration()), frame.Settings.Sun.ElevationDegrees,
+      frame.Settings.Sun.AzimuthDegrees, frame.Settings.OverSky ? 1.0 : 0.0,
+      static_cast<double>(frame.Width), static_cast<double>(frame.Height),
+      static_cast<double>(frame.X0), static_cast<double>(frame.Y0),
+      static_cast<double>(frame.Level.Width), static_cast<double>(frame.Level.Height),
+      static_cast<double>(frame.Level.Slices), static_cast<double>(frame.Level.ShadowSurfaceSize),
       static_cast<double>(frame.SceneDepthHash >> 32),
       static_cast<double>(frame.SceneDepthHash & 0xffffffffu) });
   key.insert(key.end(), frame.WorldToNdc->GetData(), frame.WorldToNdc->GetData() + 16);
@@ -1807,7 +1805,7 @@ void vtkNimbusCloudVolumeMapper::UpdateMultipleScattering(FrameState& frame)
       return;
     }
     // The sky's radiance is relative to its own sun; the mapper's sun may be brighter.
-    const nimbus::SkyModel& model = *in.FrameSky;
+    const nimbus::SkyModel& model = *in.FrameSky.CurrentModel();
     const auto skySun = model.GetSpectrum().ToLinearSrgb(model.GetSunIrradiance());
     nimbus::Rgb scale{ { 0, 0, 0 } };
     for (int c = 0; c < 3; ++c)
@@ -2050,23 +2048,20 @@ const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
   const nimbus::SceneAtmosphere& air = settings.Air;
   try
   {
-    const nimbus::SkyModel& model = this->FrameSkyModel(frame);
+    this->FrameSkyModel(frame);
     const double altitude = std::max(0.0, air.SceneAltitudeMetres + cloudAltitude);
-    const std::vector<double> viewKey = { settings.Sun.ElevationDegrees, altitude,
-      static_cast<double>(in.FrameSkyGeneration) };
-    if (!in.CloudSkyView || viewKey != in.CloudSkyViewKey)
-    {
-      // 64 x (32 + 16): the solver looks up a few dozen directions (the background's
-      // 128 x (64 + 32) takes 0.36 s on 2 cores).
-      in.CloudSkyView = std::make_unique<nimbus::SkyViewLut>(
-        model, settings.Sun.ElevationDegrees, altitude, 64, 32, 16);
-      in.CloudSkyViewKey = viewKey;
-    }
+    // 64 x (32 + 16): the solver looks up a few dozen directions (the background's
+    // 128 x (64 + 32) takes 0.36 s on 2 cores). Rebuilt when the model, the sun's
+    // elevation or the altitude changed.
+    nimbus::SkyTableCache::ViewSize size;
+    size.Width = 64;
+    size.AboveRows = 32;
+    size.BelowRows = 16;
+    return &in.FrameSky.SkyView(0, settings.Sun.ElevationDegrees, altitude, 0.0, size);
   }
   catch (const std::exception& error)
   {
-    in.FrameSky.reset();
-    in.CloudSkyView.reset();
+    in.FrameSky.Clear();
     const std::string message = std::string("The sky light on the cloud is off: ") + error.what();
     if (message != in.LastScatteringError)
     {
@@ -2075,7 +2070,6 @@ const nimbus::SkyViewLut* vtkNimbusCloudVolumeMapper::CloudSkyView(
     }
     return nullptr;
   }
-  return in.CloudSkyView.get();
 }
 
 std::vector<double> vtkNimbusCloudVolumeMapper::FrameSkyKey(const FrameState& frame)
@@ -2092,21 +2086,17 @@ std::vector<double> vtkNimbusCloudVolumeMapper::FrameSkyKey(const FrameState& fr
 // air the model refuses).
 const nimbus::SkyModel& vtkNimbusCloudVolumeMapper::FrameSkyModel(const FrameState& frame)
 {
-  Internals& in = *this->Internal;
   const std::vector<double> key = FrameSkyKey(frame);
-  if (!in.FrameSky || key != in.FrameSkyKey)
-  {
-    in.FrameSky.reset();
-    nimbus::SkyParameters parameters;
-    parameters.Atmosphere = frame.Settings.Air;
-    parameters.GroundAlbedo = key[8];
-    parameters.SunTemperatureKelvin = frame.Settings.Sun.TemperatureKelvin;
-    parameters.Wavelengths = 16; // as the atmosphere table's SunAndAir
-    in.FrameSky = std::make_unique<nimbus::SkyModel>(parameters);
-    in.FrameSkyKey = key;
-    ++in.FrameSkyGeneration;
-  }
-  return *in.FrameSky;
+  return this->Internal->FrameSky.Model(key,
+    [&frame, &key]()
+    {
+      nimbus::SkyParameters parameters;
+      parameters.Atmosphere = frame.Settings.Air;
+      parameters.GroundAlbedo = key[8];
+      parameters.SunTemperatureKelvin = frame.Settings.Sun.TemperatureKelvin;
+      parameters.Wavelengths = 16; // as the atmosphere table's SunAndAir
+      return parameters;
+    });
 }
 
 int vtkNimbusCloudVolumeMapper::GetNumberOfMultipleScatteringSolves() const

@@ -1,6 +1,7 @@
 #include "vtkNimbusSky.h"
 
 #include "Sky.h"
+#include "SkyTableCache.h"
 #include "Sun.h"
 #include "UpAxis.h"
 
@@ -42,24 +43,25 @@ nimbusDefineFiniteSetter(vtkNimbusSky, MaxAerialDistanceMetres);
 
 struct vtkNimbusSky::Internals
 {
-  std::unique_ptr<nimbus::SkyModel> Model;
-  double ModelMieScattering = -1.0, ModelAlbedo = -1.0;
-  int ModelOrders = -1;
-  int ModelGeneration = 0;
-
-  std::unique_ptr<nimbus::SkyViewLut> SkyView;
-  double SkyViewElevation = 0.0, SkyViewAltitude = 0.0;
-  int SkyViewGeneration = -1;
-  // A second sky-view table, for a camera (GetSkyViewLutAt), so that the
-  // observer's table of GetRadiance and the dome is not rebuilt as the camera moves.
-  std::unique_ptr<nimbus::SkyViewLut> CameraSkyView;
-  double CameraSkyViewElevation = 0.0, CameraSkyViewAltitude = 0.0;
-  int CameraSkyViewGeneration = -1;
-
-  std::unique_ptr<nimbus::AerialPerspectiveLut> Aerial;
-  double AerialElevation = 0.0, AerialAltitude = 0.0, AerialRange = 0.0;
-  int AerialGeneration = -1;
+  // The model (keyed by the aerosol, the ground albedo and the scattering orders), the
+  // observer's sky-view table (slot ObserverView), a camera's (slot CameraView, so that
+  // the observer's table of GetRadiance and the dome is not rebuilt as the camera moves)
+  // and the aerial perspective.
+  nimbus::SkyTableCache Tables;
+  static constexpr int ObserverView = 0;
+  static constexpr int CameraView = 1;
 };
+
+namespace
+{
+// The sky's build counters (vtkGetMacro members) follow its cache's.
+void CopyBuildCounts(const nimbus::SkyTableCache& tables, int& model, int& view, int& aerial)
+{
+  model = tables.GetModelBuilds();
+  view = tables.GetSkyViewBuilds();
+  aerial = tables.GetAerialBuilds();
+}
+}
 
 vtkNimbusSky::vtkNimbusSky()
   : Internal(new Internals)
@@ -155,44 +157,30 @@ void vtkNimbusSky::GetSunDirection(double direction[3])
 const nimbus::SkyModel& vtkNimbusSky::GetSkyModel()
 {
   Internals& in = *this->Internal;
-  if (!in.Model || in.ModelMieScattering != this->MieScatteringPerMetre ||
-    in.ModelAlbedo != this->GroundAlbedo || in.ModelOrders != this->ScatteringOrders)
-  {
-    nimbus::SkyParameters p;
-    // The clear sky (Ångström exponent, phase function, ozone) with this aerosol amount.
-    p.Atmosphere = nimbus::ClearSkyAtmosphere(nimbus::kDefaultTurbidity);
-    p.Atmosphere.MieScatteringPerMetre = this->MieScatteringPerMetre;
-    p.GroundAlbedo = this->GroundAlbedo;
-    p.ScatteringOrders = this->ScatteringOrders;
-    in.SkyView.reset();
-    in.CameraSkyView.reset();
-    in.Aerial.reset();
-    in.Model = std::make_unique<nimbus::SkyModel>(p);
-    in.ModelMieScattering = this->MieScatteringPerMetre;
-    in.ModelAlbedo = this->GroundAlbedo;
-    in.ModelOrders = this->ScatteringOrders;
-    ++in.ModelGeneration;
-    ++this->ModelBuilds;
-  }
-  return *in.Model;
+  const nimbus::SkyModel& model = in.Tables.Model({ this->MieScatteringPerMetre, this->GroundAlbedo,
+                                                    static_cast<double>(this->ScatteringOrders) },
+    [this]()
+    {
+      nimbus::SkyParameters p;
+      // The clear sky (Ångström exponent, phase function, ozone) with this aerosol amount.
+      p.Atmosphere = nimbus::ClearSkyAtmosphere(nimbus::kDefaultTurbidity);
+      p.Atmosphere.MieScatteringPerMetre = this->MieScatteringPerMetre;
+      p.GroundAlbedo = this->GroundAlbedo;
+      p.ScatteringOrders = this->ScatteringOrders;
+      return p;
+    });
+  CopyBuildCounts(in.Tables, this->ModelBuilds, this->SkyViewBuilds, this->AerialBuilds);
+  return model;
 }
 
 const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLut()
 {
-  const nimbus::SkyModel& model = this->GetSkyModel();
+  this->GetSkyModel();
   Internals& in = *this->Internal;
-  if (!in.SkyView || in.SkyViewGeneration != in.ModelGeneration ||
-    in.SkyViewElevation != this->SunElevationDegrees ||
-    in.SkyViewAltitude != this->SceneAltitudeMetres)
-  {
-    in.SkyView = std::make_unique<nimbus::SkyViewLut>(
-      model, this->SunElevationDegrees, this->SceneAltitudeMetres);
-    in.SkyViewGeneration = in.ModelGeneration;
-    in.SkyViewElevation = this->SunElevationDegrees;
-    in.SkyViewAltitude = this->SceneAltitudeMetres;
-    ++this->SkyViewBuilds;
-  }
-  return *in.SkyView;
+  const nimbus::SkyViewLut& view = in.Tables.SkyView(
+    Internals::ObserverView, this->SunElevationDegrees, this->SceneAltitudeMetres, 0.0);
+  CopyBuildCounts(in.Tables, this->ModelBuilds, this->SkyViewBuilds, this->AerialBuilds);
+  return view;
 }
 
 const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLutAt(double altitude)
@@ -205,40 +193,22 @@ const nimbus::SkyViewLut& vtkNimbusSky::GetSkyViewLutAt(double altitude)
   {
     return observer;
   }
-  if (!in.CameraSkyView || in.CameraSkyViewGeneration != in.ModelGeneration ||
-    in.CameraSkyViewElevation != this->SunElevationDegrees ||
-    std::abs(in.CameraSkyViewAltitude - altitude) > tolerance)
-  {
-    in.CameraSkyView = std::make_unique<nimbus::SkyViewLut>(
-      this->GetSkyModel(), this->SunElevationDegrees, altitude);
-    in.CameraSkyViewGeneration = in.ModelGeneration;
-    in.CameraSkyViewElevation = this->SunElevationDegrees;
-    in.CameraSkyViewAltitude = altitude;
-    ++this->SkyViewBuilds;
-  }
-  return *in.CameraSkyView;
+  const nimbus::SkyViewLut& view =
+    in.Tables.SkyView(Internals::CameraView, this->SunElevationDegrees, altitude, tolerance);
+  CopyBuildCounts(in.Tables, this->ModelBuilds, this->SkyViewBuilds, this->AerialBuilds);
+  return view;
 }
 
 const nimbus::AerialPerspectiveLut& vtkNimbusSky::GetAerialPerspectiveLut(double cameraAltitude)
 {
-  const nimbus::SkyModel& model = this->GetSkyModel();
+  this->GetSkyModel();
   Internals& in = *this->Internal;
   cameraAltitude = std::max(0.0, cameraAltitude);
   const double tolerance = std::max(10.0, 0.01 * cameraAltitude);
-  if (!in.Aerial || in.AerialGeneration != in.ModelGeneration ||
-    in.AerialElevation != this->SunElevationDegrees ||
-    in.AerialRange != this->MaxAerialDistanceMetres ||
-    std::abs(in.AerialAltitude - cameraAltitude) > tolerance)
-  {
-    in.Aerial = std::make_unique<nimbus::AerialPerspectiveLut>(
-      model, this->SunElevationDegrees, cameraAltitude, this->MaxAerialDistanceMetres);
-    in.AerialGeneration = in.ModelGeneration;
-    in.AerialElevation = this->SunElevationDegrees;
-    in.AerialAltitude = cameraAltitude;
-    in.AerialRange = this->MaxAerialDistanceMetres;
-    ++this->AerialBuilds;
-  }
-  return *in.Aerial;
+  const nimbus::AerialPerspectiveLut& aerial = in.Tables.Aerial(
+    this->SunElevationDegrees, cameraAltitude, tolerance, this->MaxAerialDistanceMetres);
+  CopyBuildCounts(in.Tables, this->ModelBuilds, this->SkyViewBuilds, this->AerialBuilds);
+  return aerial;
 }
 
 void vtkNimbusSky::GetRadiance(const double direction[3], double rgb[3])

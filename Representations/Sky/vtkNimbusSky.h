@@ -6,7 +6,8 @@
  * (vtkNimbusSkyPass), the sky dome (vtkNimbusSkyDomeSource) and a cloud mapper
  * share, so that sky, haze and clouds agree. It is thin glue around
  * Physics/Sky.h (plain C++): it holds the parameters, builds the tables lazily
- * and rebuilds each only when what it depends on changed (cache keys):
+ * and rebuilds each only when what it depends on changed (cache keys; SkyTableCache.h,
+ * the cache the cloud mapper keeps its own sky tables in too):
  *  - SkyModel (transmittance + multiple scattering): Turbidity (= MieScatteringPerMetre),
  *    GroundAlbedo, ScatteringOrders;
  *  - sky-view table: the model, SunElevationDegrees, SceneAltitudeMetres;
