@@ -22,11 +22,12 @@
 // 512 bytes per lower node of the grid (its leaf mask). Inside the box the tree's values are those
 // of OpenVDB's clipped read, tile for tile and voxel for voxel (the same decoding calls on the same
 // bytes); outside it both hold the background. Given the box's dense array, the grid writes the
-// values there instead (each leaf copied and freed as soon as its buffer is read, the tiles and the
-// background as they are read; the nodes' own copyToDense conversions): it holds the box's topology
-// and one leaf's values. A damaged stream throws from a node that is whole (ReadLower), so that
-// unwinding frees it safely. Format versions before node-mask compression (OpenVDB 3, file format
-// 222) are left to OpenVDB (MakeClippedGrid returns null).
+// values there instead (each leaf decoded into a buffer of 512 values and copied as soon as its
+// buffer is read, the tiles and the background as they are read; the nodes' copyToDense conversion,
+// DenseValueT(value)), and holds no leaves: only the upper nodes and the leaf masks of the lower
+// nodes. A damaged stream throws from a node that is whole (ReadLower), so that unwinding frees it
+// safely. Format versions before node-mask compression (OpenVDB 3, file format 222) are left to
+// OpenVDB (MakeClippedGrid returns null).
 #ifndef NimbusVdbClippedRead_h
 #define NimbusVdbClippedRead_h
 
@@ -130,7 +131,7 @@ public:
       Upper& upper = entry.second;
       for (const Lower& lower : upper.Children)
       {
-        this->ReadLowerBuffers(is, upper, lower, fromHalf);
+        this->ReadLowerBuffers(is, lower, fromHalf);
       }
       if (upper.Node && !this->Target)
       {
@@ -152,13 +153,15 @@ private:
   struct Lower
   {
     LowerT* Node = nullptr; // kept (owned by its upper node, at Offset) or null
+    bool Copied = false;    // with a target: it touches the box (no node is kept)
     openvdb::Index Offset = 0;
+    openvdb::Coord Origin;
     /// The file's leaves, in the order of their buffers; Node holds those that touch the box.
     typename LowerT::NodeMaskType Leaves;
   };
   struct Upper
   {
-    std::unique_ptr<UpperT> Node; // null when it does not touch the box
+    std::unique_ptr<UpperT> Node; // null when it does not touch the box, or with a target
     std::vector<Lower> Children;  // in the order of their buffers
   };
 
@@ -166,11 +169,15 @@ private:
   Upper ReadUpper(std::istream& is, const openvdb::Coord& origin, bool fromHalf)
   {
     const ValueT& background = this->tree().root().background();
-    Upper upper;
-    upper.Node.reset(new UpperT(origin, background, /*active=*/false));
     // The root finds children only at its keys (an origin off them is read and dropped).
-    const bool keep =
-      origin == upper.Node->origin() && this->Clip.hasOverlap(upper.Node->getNodeBoundingBox());
+    const openvdb::Coord snapped = origin & ~(UpperT::DIM - 1);
+    const bool keep = origin == snapped &&
+      this->Clip.hasOverlap(openvdb::CoordBBox::createCube(snapped, UpperT::DIM));
+    Upper upper;
+    if (keep && !this->Target) // with a target its tiles go there, its leaves too: no node
+    {
+      upper.Node.reset(new UpperT(snapped, background, /*active=*/false));
+    }
     typename UpperT::NodeMaskType childMask, valueMask;
     childMask.load(is);
     valueMask.load(is);
@@ -179,12 +186,14 @@ private:
       openvdb::io::readCompressedValues(is, values.get(), UpperT::NUM_VALUES, valueMask, fromHalf);
       for (openvdb::Index i = 0; keep && i < UpperT::NUM_VALUES; ++i)
       {
-        if (!childMask.isOn(i))
+        if (!childMask.isOn(i) && upper.Node)
         {
           upper.Node->addTile(i, values[i], valueMask.isOn(i));
+        }
+        else if (!childMask.isOn(i))
+        {
           this->Fill(
-            openvdb::CoordBBox::createCube(upper.Node->offsetToGlobalCoord(i), LowerT::DIM),
-            values[i]);
+            openvdb::CoordBBox::createCube(UpperChildOrigin(i, snapped), LowerT::DIM), values[i]);
         }
       }
     }
@@ -192,8 +201,8 @@ private:
     {
       Lower record;
       record.Offset = it.pos();
-      const openvdb::Coord at = upper.Node->offsetToGlobalCoord(it.pos());
-      std::unique_ptr<LowerT> lower = this->ReadLower(is, at, keep, fromHalf, record.Leaves);
+      record.Origin = UpperChildOrigin(it.pos(), snapped);
+      std::unique_ptr<LowerT> lower = this->ReadLower(is, record.Origin, keep, fromHalf, record);
       if (lower)
       {
         record.Node = lower.get();
@@ -201,11 +210,15 @@ private:
       }
       upper.Children.push_back(record);
     }
-    if (!keep)
-    {
-      upper.Node.reset();
-    }
     return upper;
+  }
+
+  /// The origin of child `n` of the upper node at `origin` (InternalNode::offsetToGlobalCoord).
+  static openvdb::Coord UpperChildOrigin(openvdb::Index n, const openvdb::Coord& origin)
+  {
+    openvdb::Coord local;
+    UpperT::offsetToLocalCoord(n, local);
+    return (local << LowerT::TOTAL) + origin;
   }
 
   /// InternalNode::readTopology of a lower node (format >= 222): the node, if `keep` and it
@@ -214,17 +227,33 @@ private:
   /// (OpenVDB's sets the child mask before the children, so a node it stops reading cannot be
   /// deleted): the masks and tile values first, then each leaf (PartialCreate: no buffer yet)
   /// put in the node before its mask is read.
-  std::unique_ptr<LowerT> ReadLower(std::istream& is, const openvdb::Coord& origin, bool keep,
-    bool fromHalf, typename LowerT::NodeMaskType& leaves)
+  std::unique_ptr<LowerT> ReadLower(
+    std::istream& is, const openvdb::Coord& origin, bool keep, bool fromHalf, Lower& record)
   {
     const ValueT& background = this->tree().root().background();
+    typename LowerT::NodeMaskType& leaves = record.Leaves;
     typename LowerT::NodeMaskType valueMask;
     leaves.load(is);
     valueMask.load(is);
     std::unique_ptr<ValueT[]> values(new ValueT[LowerT::NUM_VALUES]);
     openvdb::io::readCompressedValues(is, values.get(), LowerT::NUM_VALUES, valueMask, fromHalf);
     std::unique_ptr<LowerT> lower;
-    if (keep && this->Clip.hasOverlap(openvdb::CoordBBox::createCube(origin, LowerT::DIM)))
+    const bool touches =
+      keep && this->Clip.hasOverlap(openvdb::CoordBBox::createCube(origin, LowerT::DIM));
+    if (touches && this->Target)
+    {
+      // Its tiles go to the target now, its leaves when their buffers come (CopyLeafBuffer):
+      // no node, no leaf objects.
+      record.Copied = true;
+      for (openvdb::Index i = 0; i < LowerT::NUM_VALUES; ++i)
+      {
+        if (!leaves.isOn(i))
+        {
+          this->Fill(openvdb::CoordBBox::createCube(ChildOrigin(i, origin), LeafT::DIM), values[i]);
+        }
+      }
+    }
+    else if (touches)
     {
       lower.reset(new LowerT(origin, background, /*active=*/false));
       for (openvdb::Index i = 0; i < LowerT::NUM_VALUES; ++i)
@@ -238,9 +267,7 @@ private:
     typename LeafT::NodeMaskType skipped;
     for (auto it = leaves.beginOn(); it; ++it)
     {
-      openvdb::Coord at;
-      LowerT::offsetToLocalCoord(it.pos(), at); // InternalNode::offsetToGlobalCoord
-      at = (at << LeafT::TOTAL) + origin;
+      const openvdb::Coord at = ChildOrigin(it.pos(), origin);
       if (lower && this->Clip.hasOverlap(openvdb::CoordBBox::createCube(at, LeafT::DIM)))
       {
         auto* leaf = new LeafT(openvdb::PartialCreate(), at, background);
@@ -256,45 +283,71 @@ private:
   }
 
   /// InternalNode::readBuffers(is, box) of a lower node as read by ReadLower: the kept leaves'
-  /// buffers read (LeafNode::readBuffers), the others skipped; then the node clipped, or, with
-  /// a target, its tiles written there, each leaf copied (LeafNode::copyToDense) and freed as
-  /// soon as it is read, and the node freed.
-  void ReadLowerBuffers(std::istream& is, Upper& upper, const Lower& lower, bool fromHalf)
+  /// buffers read (LeafNode::readBuffers), the others skipped; then the node clipped. With a
+  /// target, the leaves that touch the box are read into it (CopyLeafBuffer).
+  void ReadLowerBuffers(std::istream& is, const Lower& lower, bool fromHalf)
   {
-    const ValueT background = this->tree().root().background();
     LowerT* node = lower.Node;
-    if (node && this->Target)
-    {
-      for (auto it = node->cbeginValueAll(); it; ++it)
-      {
-        this->Fill(openvdb::CoordBBox::createCube(it.getCoord(), LeafT::DIM), *it);
-      }
-    }
     for (auto it = lower.Leaves.beginOn(); it; ++it)
     {
-      LeafT* leaf = node ? node->probeLeaf(node->offsetToGlobalCoord(it.pos())) : nullptr;
-      if (!leaf)
+      const openvdb::Coord at = ChildOrigin(it.pos(), lower.Origin);
+      if (lower.Copied && this->Clip.hasOverlap(openvdb::CoordBBox::createCube(at, LeafT::DIM)))
+      {
+        this->CopyLeafBuffer(is, at, fromHalf);
+      }
+      else if (LeafT* leaf = node ? node->probeLeaf(at) : nullptr)
+      {
+        leaf->readBuffers(is, this->Clip, fromHalf);
+      }
+      else
       {
         SkipLeafBuffer(is, fromHalf);
-        continue;
       }
-      leaf->readBuffers(is, this->Clip, fromHalf);
-      if (this->Target)
+    }
+    if (node)
+    {
+      node->clip(this->Clip, this->tree().root().background());
+    }
+  }
+
+  /// LeafNode::readBuffers then LeafNode::copyToDense of a leaf at `origin` that touches the
+  /// box, without a leaf: its value mask (stored again before its values), its values decoded
+  /// (io::readCompressedValues) into a buffer, the box's part written to the target as
+  /// DenseValueT(value).
+  void CopyLeafBuffer(std::istream& is, const openvdb::Coord& origin, bool fromHalf)
+  {
+    typename LeafT::NodeMaskType mask;
+    mask.load(is);
+    ValueT values[LeafT::SIZE];
+    openvdb::io::readCompressedValues(is, values, LeafT::SIZE, mask, fromHalf);
+    if (const auto meta = openvdb::io::getStreamMetadataPtr(is))
+    {
+      meta->setLeaf(meta->leaf() + 1); // as LeafNode::readBuffers counts leaves
+    }
+    openvdb::CoordBBox part = openvdb::CoordBBox::createCube(origin, LeafT::DIM);
+    part.intersect(this->Clip);
+    const size_t n = size_t(part.max()[0] - part.min()[0] + 1);
+    for (openvdb::Int32 k = part.min()[2]; k <= part.max()[2]; ++k)
+    {
+      for (openvdb::Int32 j = part.min()[1]; j <= part.max()[1]; ++j)
       {
-        openvdb::CoordBBox part = leaf->getNodeBoundingBox();
-        part.intersect(this->Clip);
-        leaf->copyToDense(part, *this->Target);
-        node->addTile(it.pos(), background, false); // frees the leaf
+        DenseValueT* row =
+          this->Target->data() + this->Target->coordToOffset(openvdb::Coord(part.min()[0], j, k));
+        for (size_t i = 0; i < n; ++i)
+        {
+          const openvdb::Coord xyz(part.min()[0] + openvdb::Int32(i), j, k);
+          row[i] = DenseValueT(values[LeafT::coordToOffset(xyz)]);
+        }
       }
     }
-    if (node && this->Target)
-    {
-      upper.Node->addTile(lower.Offset, background, false); // frees the node
-    }
-    else if (node)
-    {
-      node->clip(this->Clip, background);
-    }
+  }
+
+  /// The origin of child `n` of the lower node at `origin` (InternalNode::offsetToGlobalCoord).
+  static openvdb::Coord ChildOrigin(openvdb::Index n, const openvdb::Coord& origin)
+  {
+    openvdb::Coord local;
+    LowerT::offsetToLocalCoord(n, local);
+    return (local << LeafT::TOTAL) + origin;
   }
 
   /// Skips a leaf's buffer (LeafNode::readBuffers of a leaf outside the box): its value mask,

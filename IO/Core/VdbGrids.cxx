@@ -451,7 +451,7 @@ public:
     }
     const GridLayout& g = this->Layout.Grids[i];
     FileRangeBuf buf(this->Path, g.DescriptorPos, metadataOnly ? g.BlockPos : g.EndPos,
-      metadataOnly ? 64 << 10 : 1 << 20);
+      metadataOnly ? 64 << 10 : 256 << 10);
     buf.pubseekpos(g.DescriptorPos, std::ios_base::in);
     std::istream is(&buf);
     is.exceptions(std::ios::failbit | std::ios::badbit);
@@ -678,12 +678,15 @@ void ReadGrid(ArchiveReader& archive, const FileLayout& layout, size_t index,
   const bool clipped = ClipBox(archive, layout, index, reference, box, clip, &copied);
   if (clipped && copied)
   {
-    const auto meta = archive.Read(index, /*metadataOnly=*/true);
-    const int components = ComponentsOf(KindOf(*meta));
-    if (components == 0)
+    int components = 0;
     {
-      throw Error("grid " + Quote(layout.DistinctNames[index]) + " has unsupported value type " +
-        Quote(meta->valueType()));
+      const auto meta = archive.Read(index, /*metadataOnly=*/true);
+      components = ComponentsOf(KindOf(*meta));
+      if (components == 0)
+      {
+        throw Error("grid " + Quote(layout.DistinctNames[index]) + " has unsupported value type " +
+          Quote(meta->valueType()));
+      }
     }
     std::fill(target, target + box.VoxelCount() * uint64_t(components), 0.0f);
     bool filled = false;
