@@ -15,13 +15,13 @@
  * The sun, optics and display settings are forwarded to the mapper as they are set (see
  * vtkNimbusCloudSplatMapper for their units); they do not re-execute the
  * representation. UseSceneSky (on by default): while a Nimbus Sky is shown in the same
- * view ("Sky Background", vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND), the balls are
- * drawn over that sky as the Cloud representation's clouds are (the mapper's SetSky): its
- * sun (elevation, azimuth and temperature, illuminance 1) reddened by the air down to
- * each ball, the sky's and the ground's light on them, the air between the eye and them,
- * its metres per unit and its display scale (exposure and white balance; the frame
- * sRGB-encoded as the sky's); the representation's own sun, exposure and metres per unit
- * apply without a sky.
+ * view ("Sky Background": the visible vtkNimbusSkyBackground among the renderer's props,
+ * which may not be the one RENDERER_SKY_BACKGROUND names), the balls are drawn over that
+ * sky as the Cloud representation's clouds are (the mapper's SetSkyBackground): its sun (elevation,
+ * azimuth and temperature, illuminance 1) reddened by the air down to each ball, the sky's and the
+ * ground's light on them, the air between the eye and them, its metres per unit and its display
+ * scale (exposure and white balance; the frame sRGB-encoded as the sky's); the representation's own
+ * sun, exposure and metres per unit apply without a sky.
  */
 #ifndef vtkNimbusCloudSplatRepresentation_h
 #define vtkNimbusCloudSplatRepresentation_h

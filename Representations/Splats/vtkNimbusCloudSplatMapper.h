@@ -36,7 +36,8 @@
  * With MultipleScattering on (default off) the light scattered more than once is added:
  * the balls' density splatted onto a grid of MultipleScatteringGridSize points on its
  * longest side (CloudSplats.h SplatBallsOntoGrid), the sun's light of all orders solved
- * there (Physics/MultipleScattering.h, DiscreteDirections, no sky) and the in-scattered
+ * there (Physics/MultipleScattering.h, DiscreteDirections; the sky's light too over a sky,
+ * below) and the in-scattered
  * radiance J(x, w) read from three 3-D textures at the fragment's samples (or at the
  * ball's centre), with the delta-M forward peak's part of the sun's light as the cloud
  * mapper adds it. Solved again only when the balls or the sun change.
