@@ -69,7 +69,7 @@ constexpr std::uint32_t kFormatVersion = 1;
 // The solver's revision, in the fingerprint so that a basis the solver would now compute
 // differently is not taken from the disk cache (2: point lights' first source averaged
 // over the cells next to them, MultipleScattering.cxx ArrivalAt).
-constexpr std::uint32_t kSolverRevision = 2;
+constexpr std::uint32_t kSolverRevision = 3;
 
 template <typename T>
 void Put(std::ostream& out, const T& value)

@@ -165,7 +165,11 @@ struct NIMBUSPHYSICS_EXPORT MultipleScatteringOptions
   /// Orders computed explicitly (>= 2). DiscreteDirections: the radiance scattered
   /// 1..Orders times (so J of orders 2..Orders + 1; the sky's and the ground's from
   /// order 1), stopping earlier when an order carries < 1e-5 of the total, the rest a
-  /// geometric series when ExtrapolateHigherOrders. ReferencePatterns: J of orders
+  /// geometric series when ExtrapolateHigherOrders; with it, orders go on past Orders
+  /// (up to 4 x Orders) while the ratio of successive orders' energies still moves by
+  /// more than 1e-4 of itself per order, since a tail from a ratio still moving counts
+  /// too much light (a source deep in a cloud of low asymmetry) or too little (the
+  /// sun). ReferencePatterns: J of orders
   /// 2..Orders (the paper: 3).
   int Orders = 32;
   bool ExtrapolateHigherOrders = true;

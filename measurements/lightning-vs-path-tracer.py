@@ -70,7 +70,19 @@ parser.add_argument("--variants", nargs="+",
                          "density's grid (automatic blocks; -fineN: N blocks) or on the "
                          "illumination grid (-coarse, as before); -march: the mapper's ray "
                          "march instead of its slices; -plain: the lightning's view without "
-                         "delta-M (LightningDeltaMView off); e.g. basis-march-plain")
+                         "delta-M (LightningDeltaMView off); -first: only the first scattering drawn "
+                         "(compare with --max-order 1); -higher: only the orders >= 2; "
+                         "e.g. basis-march-plain")
+parser.add_argument("--cloud-g", type=float, default=0.85,
+                    help="the cloud's Cornette-Shanks asymmetry, in the reference and in Nimbus "
+                         "(default 0.85)")
+parser.add_argument("--extinction-per-density", type=float, default=0.02,
+                    help="the cloud's extinction per unit density [1/m], in the reference and in "
+                         "Nimbus (default 0.02; 0.0002 makes it thin, to check the first "
+                         "scattering's normalisation where it dominates)")
+parser.add_argument("--max-order", type=int, default=0,
+                    help="the reference's highest scattering order (0: all; 1: the light "
+                         "scattered once, to compare with the variants' -first token)")
 args = parser.parse_args()
 os.makedirs(args.output_dir, exist_ok=True)
 
@@ -104,8 +116,8 @@ scene = {
                    "return stroke (measurements/lightning-vs-path-tracer.py); no sun, air or ground.",
     "camera": CAMERA,
     "medium": {"density": {"type": "metaball_cloud", "parameters": CLOUD},
-               "extinction_per_density": 0.02, "single_scattering_albedo": 0.99,
-               "phase": [{"type": "cornette_shanks", "g": 0.85, "weight": 1}]},
+               "extinction_per_density": args.extinction_per_density, "single_scattering_albedo": 0.99,
+               "phase": [{"type": "cornette_shanks", "g": args.cloud_g, "weight": 1}]},
     "sun": {"azimuth_degrees": 0, "elevation_degrees": 45, "illuminance": 0,
             "temperature_kelvin": 5778},
     "atmosphere": {"enabled": False}, "ground": {"enabled": False},
@@ -118,6 +130,8 @@ with open(scene_path, "w") as stream:
 
 settings = {"mode": args.reference_mode, "min_spp": 16, "max_spp": 1 << 20,
             "time_limit": args.time_limit, "seed": 1}
+if args.max_order > 0:
+    settings["max_order"] = args.max_order
 key = "reference-" + harness.scene_hash(scene_path, settings)
 
 
@@ -182,6 +196,26 @@ cloud.SetBounds(*CLOUD["Bounds"])
 cloud.SetSeed(CLOUD["Seed"])
 
 
+def keep_one_part(lit_cloud, first):
+    """A copy of the lit cloud whose lightning light is only the first scattering (first) or
+    only the orders >= 2 (the other arrays zeroed), to tell the two parts' errors apart."""
+    copy = lit_cloud.NewInstance()
+    copy.ShallowCopy(lit_cloud)
+    fields = copy.GetFieldData()
+    names = (["nimbus_lightning_in_scattering"] if first else
+             ["nimbus_lightning_first_scattering", "nimbus_lightning_first_scattering_reduced"])
+    for name in names:
+        array = fields.GetArray(name)
+        if array is None:
+            continue
+        zero = array.NewInstance()
+        zero.DeepCopy(array)
+        zero.Fill(0.0)
+        fields.RemoveArray(name)
+        fields.AddArray(zero)
+    return copy
+
+
 def render(variant):
     """One Nimbus variant (see --variants): the image, the filter's update seconds, the filter."""
     tokens = variant.split("-")
@@ -203,15 +237,22 @@ def render(variant):
         illumination.SetNumberOfDirections(args.directions)
     illumination.SetLightningColor(1, 1, 1)  # grey, as the reference's 6500 K
     illumination.SetAlbedo(0.99)
+    illumination.SetCloudG(args.cloud_g)
+    illumination.SetExtinctionPerDensity(args.extinction_per_density)
     # The basis of this grid (96 x 96 x 64 in blocks of 3) may need ~2.3 GiB: more than
     # the filter's default budget of 2 GiB (it then refuses and leaves the cloud dark).
     illumination.SetMemoryBudgetMiB(4096)
     start = time.perf_counter()
     illumination.Update()
     update = time.perf_counter() - start
+    lit_cloud = illumination.GetOutput()
+    if "first" in tokens or "higher" in tokens:
+        lit_cloud = keep_one_part(lit_cloud, "first" in tokens)
     mapper = nimbus.vtkNimbusCloudVolumeMapper()
-    mapper.SetInputData(illumination.GetOutput())
+    mapper.SetInputData(lit_cloud)
     mapper.SetAlbedo(0.99)
+    mapper.SetCloudG(args.cloud_g)
+    mapper.SetExtinctionPerDensity(args.extinction_per_density)
     mapper.SetMultipleScatteringMethodToNone()
     mapper.SetSunIlluminance(0.0)
     mapper.SetAtmosphere(False)
