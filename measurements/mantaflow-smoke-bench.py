@@ -21,7 +21,7 @@ Mantaflow's heat, relative). The step count and times come from timers wrapped a
 Mantaflow's own Python step and cache-saving functions (see StepTimer; a few
 microseconds per step); --no-step-timing leaves them out and reports the wall time only.
 
-The scene, BenchSmoke's (Testing/Benchmarks/BenchSmoke.cxx) in Blender's terms:
+The scene, BenchSmoke's (Benchmarks/BenchSmoke.cxx) in Blender's terms:
   domain      a cube of 8 m from (-4, -4, 0) to (4, 4, 8), resolution_max RES (cells of
               8/RES m); no adaptive domain, no noise (high-resolution) pass; walls on the
               four sides and the bottom, the top open (Nimbus: the same, but Mantaflow's

@@ -8,7 +8,7 @@ A, Nimbus's density, is either
   - a .vti with a point array "density" (what vtkNimbusSmokeSource writes; e.g.
     --save-nimbus of an earlier run), or
   - RES:FRAMES, e.g. 64:24: vtkNimbusSmokeSource runs BenchSmoke's scene
-    (Testing/Benchmarks/BenchSmoke.cxx: RES^3 cells over the 8 m cube from (-4, -4, 0),
+    (Benchmarks/BenchSmoke.cxx: RES^3 cells over the 8 m cube from (-4, -4, 0),
     the hot sphere of 0.75 m at (0, 0, 0.75), vorticity 0.3, Smagorinsky 0.15,
     MacCormack, 24 frames per second) to frame FRAMES (--threads, default 2).
 B, Mantaflow's, is the .vdb that measurements/mantaflow-smoke-bench.py printed (its last
