@@ -105,45 +105,51 @@ def main():
     LoadPlugin(args.plugin, ns=globals())
 
     cloud = NimbusMetaballCloud()  # noqa: F821 (from the plugin)
-    view = CreateRenderView()
-    view.ViewSize = SIZE
-    view.OrientationAxesVisibility = 0
     sky = NimbusSky(SunAzimuthDegrees=args.azimuth)  # noqa: F821
-    sky_display = Show(sky, view)
-    if hasattr(sky_display, "AutomaticExposure"):
-        sky_display.AutomaticExposure = 0
-    density = Show(OutputPort(cloud, 0), view)
-    density.SetRepresentationType("Cloud")
-    balls = Show(OutputPort(cloud, 1), view)
-    balls.SetRepresentationType("Cloud Splats")
-    Hide(OutputPort(cloud, 0), view)
-    Hide(OutputPort(cloud, 1), view)
-    Render(view)  # paraview.simple resets the camera at a view's first render
+    # Two views, one per representation: a view that also shows polygonal data (the
+    # Metaballs) holds a second, hidden sky background prop (the Sky Background
+    # sub-representation of that data's display), which the renderer then names, and the
+    # Cloud representation follows the named one (it would draw with its own sun and air).
+    views = []
+    for port, kind in ((0, "Cloud"), (1, "Cloud Splats")):
+        view = CreateRenderView()
+        view.ViewSize = SIZE
+        view.OrientationAxesVisibility = 0
+        sky_display = Show(sky, view)
+        if hasattr(sky_display, "AutomaticExposure"):
+            sky_display.AutomaticExposure = 0
+        display = Show(OutputPort(cloud, port), view)
+        display.SetRepresentationType(kind)
+        Hide(OutputPort(cloud, port), view)
+        Render(view)  # paraview.simple resets the camera at a view's first render
+        views.append((view, display, port))
+    (cloud_view, _, _), (splat_view, balls, _) = views
 
     print("camera,elevation,renderer,ratio_r,ratio_g,ratio_b,ratio_luminance,"
           "dark_ratio_luminance,mean_r_x1000,mean_g_x1000,mean_b_x1000,cloud_pixels")
     for camera in args.cameras:
         position, focal = CAMERAS[camera]
-        view.CameraPosition = position
-        view.CameraFocalPoint = focal
-        view.CameraViewUp = [0.0, 0.0, 1.0]
-        view.CameraViewAngle = 30.0
+        for view, _, _ in views:
+            view.CameraPosition = position
+            view.CameraFocalPoint = focal
+            view.CameraViewUp = [0.0, 0.0, 1.0]
+            view.CameraViewAngle = 30.0
         for elevation in args.elevations:
             sky.SunElevationDegrees = elevation
             stem = "%s-e%g" % (camera, elevation)
-            sky_only = save(view, args.output, stem + "-sky")
-            Show(OutputPort(cloud, 0), view)
-            reference = save(view, args.output, stem + "-cloud")
-            Hide(OutputPort(cloud, 0), view)
+            sky_only = save(splat_view, args.output, stem + "-sky")
+            Show(OutputPort(cloud, 0), cloud_view)
+            reference = save(cloud_view, args.output, stem + "-cloud")
+            Hide(OutputPort(cloud, 0), cloud_view)
             pictures = [reference]
             splats = {}
-            Show(OutputPort(cloud, 1), view)
+            Show(OutputPort(cloud, 1), splat_view)
             for name, settings in VARIANTS.items():
                 for key, value in settings.items():
                     setattr(balls, key, value)
-                splats[name] = save(view, args.output, stem + "-splats-" + name)
+                splats[name] = save(splat_view, args.output, stem + "-splats-" + name)
                 pictures.append(splats[name])
-            Hide(OutputPort(cloud, 1), view)
+            Hide(OutputPort(cloud, 1), splat_view)
             # The cloud's pixels: where any splat picture differs from the sky alone (the
             # Cloud representation also draws its own ground, so its picture differs
             # everywhere below the horizon).
@@ -166,8 +172,9 @@ def main():
                     1000 * linear.mean(axis=0)[0], 1000 * linear.mean(axis=0)[1],
                     1000 * linear.mean(axis=0)[2], int(mask.sum())))
             sys.stdout.flush()
-    Delete(view)
-    del view
+    for view, _, _ in views:
+        Delete(view)
+    del views, cloud_view, splat_view
     return 0
 
 
