@@ -618,7 +618,8 @@ std::string vtkNimbusCloudAutomatonSource::vtkInternals::OverBudget(
   const int* densityBox = this->DensityBox;
   // This rank's share: its held layers, and the cells of its densities.
   const double heldLayers = static_cast<double>(this->Held[1] - this->Held[0]);
-  const double heldCells = cellCount / d[2] * heldLayers;
+  // The formation regions' probabilities are kept for the owned layers only.
+  const double ownedCells = cellCount / d[2] * (this->Owned[1] - this->Owned[0]);
   double densityCells = 1.0;
   for (int a = 0; a < 3; ++a)
   {
@@ -635,7 +636,7 @@ std::string vtkNimbusCloudAutomatonSource::vtkInternals::OverBudget(
   const double bytes = stateBytes * (2.0 + checkpoints) +
     4.0 * densityCells * (MaximumCachedDensities + 2 + 2 + 1) +
     (withInput ? 24.0 * cellCount : 0.0) +
-    (self->NumberOfFormationRegions > 0 ? 12.0 * heldCells : 0.0);
+    (self->NumberOfFormationRegions > 0 ? 12.0 * ownedCells : 0.0);
   std::ostringstream what;
   what << "the cloud automaton (" << d[0] << " x " << d[1] << " x " << d[2] << " cells, "
        << checkpoints << " checkpoints)";
@@ -769,9 +770,13 @@ bool vtkNimbusCloudAutomatonSource::SetUpAutomaton(vtkImageData* input, const in
   p.NumberOfThreads = this->NumberOfThreads;
   p.Layers[0] = held[0];
   p.Layers[1] = held[1];
-  // Values per held layer (the whole grid unless distributed).
+  // The automaton steps the owned layers only (the others are the halo, replaced after every
+  // step): probabilities per owned layer (the whole grid unless distributed).
+  const int* owned = internals.Owned;
+  p.Owned[0] = owned[0];
+  p.Owned[1] = owned[1];
   const std::size_t plane = static_cast<std::size_t>(d[0]) * d[1];
-  const std::size_t first = plane * held[0], last = plane * held[1];
+  const std::size_t first = plane * owned[0], last = plane * owned[1];
   if (this->NumberOfFormationRegions > 0)
   {
     // Regions in cells: the radii (metres) over the horizontal spacing, vertical semi-axes
@@ -791,7 +796,7 @@ bool vtkNimbusCloudAutomatonSource::SetUpAutomaton(vtkImageData* input, const in
       region.Radius[2] = 0.5 * metres / dz;
     }
     const std::vector<float> weights = nimbus::FormationRegionWeights(
-      d, regions, p.Boundary == nimbus::CloudBoundary::Periodic, held[0], held[1]);
+      d, regions, p.Boundary == nimbus::CloudBoundary::Periodic, owned[0], owned[1]);
     std::vector<float> hum(weights.size()), act(weights.size());
     for (std::size_t i = 0; i < weights.size(); ++i)
     {

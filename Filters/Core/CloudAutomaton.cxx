@@ -232,6 +232,7 @@ struct EventSampler
   Word Key;
   int Nx, Ny;
   int ZOffset; // global layer of held layer 0: random numbers are keyed by the global cell
+  int Owned0;  // held layer of the first stepped layer, the first of a Volume field's values
 
   Word operator()(Word candidates, Word wordIndex, int w, int y, int z) const
   {
@@ -247,7 +248,7 @@ struct EventSampler
     const std::size_t planeIndex = static_cast<std::size_t>(y) * this->Nx;
     const std::size_t base = this->Field->Type == ProbabilityField::Kind::Plane
       ? planeIndex
-      : planeIndex + static_cast<std::size_t>(z) * this->Nx * this->Ny;
+      : planeIndex + static_cast<std::size_t>(z - this->Owned0) * this->Nx * this->Ny;
     const std::size_t cellBase =
       planeIndex + static_cast<std::size_t>(z + this->ZOffset) * this->Nx * this->Ny;
     Word events = 0;
@@ -351,10 +352,22 @@ void CloudAutomaton::ValidateAndPrepare()
   this->Z0 = p.Layers[0];
   this->NZ = layerEnd - p.Layers[0];
   const std::size_t held = static_cast<std::size_t>(this->NZ);
+  const int ownedBegin = p.Owned[0] < 0 ? p.Layers[0] : p.Owned[0];
+  const int ownedEnd = p.Owned[0] < 0 ? layerEnd : p.Owned[1];
+  if (ownedBegin < p.Layers[0] || ownedEnd > layerEnd || ownedBegin >= ownedEnd)
+  {
+    std::ostringstream message;
+    message << "Owned must be a non-empty range within the held layers [" << p.Layers[0] << ", "
+            << layerEnd << "), got [" << ownedBegin << ", " << ownedEnd << ").";
+    throw std::invalid_argument(message.str());
+  }
+  this->O0 = ownedBegin - this->Z0;
+  this->ON = ownedEnd - ownedBegin;
+  const std::size_t owned = static_cast<std::size_t>(this->ON);
   // The thresholds replace the values, each field's as soon as they are made (GetParameters).
   auto thresholds = [&](ProbabilityField& field, const char* name)
   {
-    std::vector<std::uint32_t> t = MakeThresholds(field, nx * ny, nx * ny * held, name);
+    std::vector<std::uint32_t> t = MakeThresholds(field, nx * ny, nx * ny * owned, name);
     field.Values = std::vector<float>();
     return t;
   };
@@ -432,11 +445,11 @@ void CloudAutomaton::Step()
   CloudAutomatonState& out = this->Scratch;
 
   const EventSampler humidity{ &p.HumiditySupply, &this->HumidityThresholds,
-    StreamKey(p.Seed, n, StreamHumidity), nx, ny, layer0 };
+    StreamKey(p.Seed, n, StreamHumidity), nx, ny, layer0, this->O0 };
   const EventSampler activation{ &p.ActivationSupply, &this->ActivationThresholds,
-    StreamKey(p.Seed, n, StreamActivation), nx, ny, layer0 };
+    StreamKey(p.Seed, n, StreamActivation), nx, ny, layer0, this->O0 };
   const EventSampler extinction{ &p.Extinction, &this->ExtinctionThresholds,
-    StreamKey(p.Seed, n, StreamExtinction), nx, ny, layer0 };
+    StreamKey(p.Seed, n, StreamExtinction), nx, ny, layer0, this->O0 };
 
   // Row (y, z) of a field, nullptr outside the grid (open) -- y wraps when periodic.
   auto row = [&](const std::vector<Word>& field, int y, int z) -> const Word*
@@ -472,6 +485,16 @@ void CloudAutomaton::Step()
     {
       for (int z = z0; z < z1; ++z)
       {
+        if (z < this->O0 || z >= this->O0 + this->ON)
+        {
+          // A halo layer: its owner steps it (Parameters.Owned); empty until it is replaced.
+          const std::size_t first = static_cast<std::size_t>(z) * ny * W,
+                            count = std::size_t(ny) * W;
+          std::fill_n(out.Hum.begin() + first, count, Word(0));
+          std::fill_n(out.Act.begin() + first, count, Word(0));
+          std::fill_n(out.Cld.begin() + first, count, Word(0));
+          continue;
+        }
         for (int y = 0; y < ny; ++y)
         {
           const Word* act = row(in.Act, y, z);
@@ -960,9 +983,9 @@ void SmoothCloudBox(const CloudAutomatonParameters& parameters,
         }
       }
     });
-  density.assign(static_cast<std::size_t>(bx) * by * bz, 0.0f);
   if (K == 0)
   {
+    density.assign(static_cast<std::size_t>(bx) * by * bz, 0.0f);
     for (int k = 0; k < bz; ++k)
     {
       for (int j = 0; j < by; ++j)
@@ -1000,7 +1023,9 @@ void SmoothCloudBox(const CloudAutomatonParameters& parameters,
         }
       }
     });
+  // X freed before the result is made: two boxes of floats at a time, as SmoothCloud holds.
   X = std::vector<float>();
+  density.assign(static_cast<std::size_t>(bx) * by * bz, 0.0f);
   ForEachSlab(bz, threads,
     [&](int k0, int k1)
     {

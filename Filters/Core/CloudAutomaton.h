@@ -94,6 +94,13 @@ struct CloudAutomatonParameters
   /// right: Step treats the layers beyond the slab as empty, and the caller replaces the
   /// outermost held layers (the halo) with their owners' after every step.
   int Layers[2] = { 0, -1 };
+  /// The held layers this automaton steps: z in [Owned[0], Owned[1]) (Owned[0] < 0: all the
+  /// held layers, the default). The others are a distributed run's halo, which the caller
+  /// replaces with their owners' after every step: Step leaves them empty, and the Plane and
+  /// Volume probability fields keep thresholds for the stepped layers only (a Volume field
+  /// gives nx*ny values per stepped layer), 8 bytes per cell of the halo saved with the
+  /// formation regions.
+  int Owned[2] = { -1, -1 };
 };
 
 /// A distributed run's split of nz layers between `ranks`: rank r owns
@@ -166,6 +173,10 @@ public:
   /// The held layers [FirstLayer, FirstLayer + HeldLayers) (Parameters.Layers resolved).
   int FirstLayer() const { return this->Z0; }
   int HeldLayers() const { return this->NZ; }
+  /// The stepped layers [FirstOwnedLayer, FirstOwnedLayer + OwnedLayers) (Parameters.Owned
+  /// resolved).
+  int FirstOwnedLayer() const { return this->Z0 + this->O0; }
+  int OwnedLayers() const { return this->ON; }
   /// Words of field `field` at global layer z (held), ny rows of WordsPerRow() words:
   /// where a distributed run reads and replaces halo layers.
   std::uint64_t* Layer(Field field, int z);
@@ -179,6 +190,7 @@ private:
   CloudAutomatonParameters Parameters;
   int RowWords = 1;
   int Z0 = 0, NZ = 1; // held layers
+  int O0 = 0, ON = 1; // stepped layers, O0 counted from Z0
   std::uint64_t TailMask = ~std::uint64_t(0);
   int Threads = 1;
   // Probability thresholds on a 24-bit uniform integer: event when r < threshold.
