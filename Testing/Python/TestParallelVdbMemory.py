@@ -8,17 +8,21 @@ voxel active (noise in [0.1, 1): the tree is dense and Blosc hardly compresses i
 vtkNimbusOpenVDBWriter. --read: every rank resets its peak resident memory (5 into
 /proc/self/clear_refs), reads its piece with 1 ghost level (UpdatePiece(rank, N, 1)) and takes
 the growth of VmHWM over the resident memory before the read. With W = 4 S^3 bytes (the whole
-grid as floats) and P the piece's bytes, a piece read costs its output array (P), the leaves of
-one slab of it at a time (at most 32 MiB) and the whole tree's node masks (about W / 20); a
+grid as floats) and P the piece's bytes, a piece read costs its output array (P), its ghost
+levels' vtkGhostType array (P / 4), the topology that touches the piece (no leaves: each leaf's
+values go into the output as they are read) and the first read's fixed cost (OpenVDB's and
+Blosc's code and tables; with the ghost array about 10 MiB beside P measured here: 26.4 MiB for
+a piece of 16.3 MiB of a 256^3 grid on 4 ranks);
+a read that held the piece's leaves as a tree (as the reader did before) costs P more, and a
 rank that read the whole file (as the reader did before clipped reads) held the whole tree (W)
 and the file's bytes (about W here) besides its piece. The test fails when a rank's growth
 exceeds
 
-    limit = P + W / 2 + 8 MiB
+    limit = 1.5 P + 12 MiB
 
 and, as a check of the measurement itself, when a whole read (piece 0 of 1, by the last rank
 after its piece) does not exceed the limit; that rank's piece must also equal the whole read's
-crop bit for bit (the reads go in slabs of whole leaves, different ones for the two boxes). Every rank prints its figures; every rank exits
+crop bit for bit. Every rank prints its figures; every rank exits
 non-zero when a check failed on any rank.
 """
 import argparse
@@ -88,7 +92,7 @@ def read(path, size):
 
     try:
         reader, peak, piece_bytes = growth(rank, ranks, 1)
-        limit = piece_bytes + whole / 2.0 + 8.0 * MiB
+        limit = 1.5 * piece_bytes + 12.0 * MiB
         print("rank %d of %d: piece %.1f MiB (whole %.1f MiB), peak growth %.1f MiB, limit %.1f MiB"
               % (rank, ranks, piece_bytes / MiB, whole / MiB, peak / MiB, limit / MiB),
               flush=True)
@@ -102,8 +106,8 @@ def read(path, size):
         if rank == ranks - 1:
             piece = reader.GetOutput()
             whole_reader, whole_peak, _ = growth(0, 1, 0)
-            # The piece (leaves read in slabs of the piece's box) equals the whole read's
-            # crop (other slabs) bit for bit.
+            # The piece (only the topology that touches it read) equals the whole read's crop
+            # bit for bit.
             import numpy as np
             from vtkmodules.util.numpy_support import vtk_to_numpy
             full = whole_reader.GetOutput()
