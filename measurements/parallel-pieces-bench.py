@@ -140,12 +140,12 @@ def table(args):
                 whole, whole_imported = above, above_imported
 
             def goal(w):
-                return "%.0f" % (1.3 * w / n) if w is not None else "-"
+                return "%.1f" % (1.3 * w / n) if w is not None else "-"
             halo = "; ".join(str(r.get("halo_bytes_per_step", 0)) for r in rows) \
                 if job == "automaton" else "-"
             gathered = "%.2f" % (max(r.get("gather_bytes", 0) for r in rows) / MiB) \
                 if job == "automaton" else "-"
-            print("| %s | %d | %d | %.0f | %.0f | %.0f (%s) | %.0f (%s) | %.0f (%s) | %.2f | %s | %s |"
+            print("| %s | %d | %d | %.0f | %.0f | %.0f (%s) | %.1f (%s) | %.1f (%s) | %.2f | %s | %s |"
                   % (name, n, max(r["points"] for r in rows), base, imported, max(peaks),
                      ", ".join("%.0f" % p for p in peaks), above, goal(whole), above_imported,
                      goal(whole_imported), max(r["seconds"] for r in rows), halo, gathered),

@@ -82,6 +82,13 @@ public:
     TreeT& tree = this->tree();
     tree.clear();
     const bool fromHalf = this->saveFloatAsHalf();
+    // The per-leaf table of OpenVDB's delayed loading (a mask byte and a compressed size per
+    // leaf, held for the whole read) only spares the skipped leaves two small reads; without it
+    // io::readCompressedValues reads them from the stream, to the same values.
+    if (const auto meta = openvdb::io::getStreamMetadataPtr(is))
+    {
+      meta->gridMetadata().removeMeta(openvdb::GridBase::META_FILE_DELAYED_LOAD);
+    }
     int32_t bufferCount = 0; // TreeBase::readTopology
     is.read(reinterpret_cast<char*>(&bufferCount), sizeof(int32_t));
     // RootNode::readTopology (the current format).

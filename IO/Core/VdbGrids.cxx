@@ -451,7 +451,7 @@ public:
     }
     const GridLayout& g = this->Layout.Grids[i];
     FileRangeBuf buf(this->Path, g.DescriptorPos, metadataOnly ? g.BlockPos : g.EndPos,
-      metadataOnly ? 64 << 10 : 256 << 10);
+      metadataOnly ? 64 << 10 : 128 << 10);
     buf.pubseekpos(g.DescriptorPos, std::ios_base::in);
     std::istream is(&buf);
     is.exceptions(std::ios::failbit | std::ios::badbit);
