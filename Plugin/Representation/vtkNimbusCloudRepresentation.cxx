@@ -148,14 +148,9 @@ int vtkNimbusCloudRepresentation::ProcessViewRequest(
   {
     // The sky the view shows now (or none): the representations of a view are
     // separate, so the coupling goes through the renderer's information.
-    vtkNimbusSkyBackground* sky = nullptr;
     auto* view = vtkPVRenderView::SafeDownCast(this->GetView());
-    if (view && view->GetRenderer() && view->GetRenderer()->GetInformation())
-    {
-      sky = vtkNimbusSkyBackground::SafeDownCast(view->GetRenderer()->GetInformation()->Get(
-        vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
-    }
-    this->CloudMapper->SetSkyBackground(sky);
+    this->CloudMapper->SetSkyBackground(
+      view ? vtkNimbusSkyBackground::ShownIn(view->GetRenderer()) : nullptr);
     this->ConfigurePiece(view);
   }
   return 1;

@@ -48,32 +48,6 @@ void GrowByRadii(vtkPolyData* balls, vtkDataArray* radii, double bounds[6])
   }
 }
 
-// The sky background the view shows: the one its renderer names
-// (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND) when visible, else a visible one among
-// its props (a Nimbus Sky shown in a view has more than one background prop, one per
-// representation of the sky, and the renderer names the last added, which may be hidden).
-vtkNimbusSkyBackground* ViewSkyBackground(vtkRenderer* renderer)
-{
-  auto* named = vtkNimbusSkyBackground::SafeDownCast(
-    renderer->GetInformation()->Get(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
-  if (named && named->GetVisibility())
-  {
-    return named;
-  }
-  vtkPropCollection* props = renderer->GetViewProps();
-  vtkCollectionSimpleIterator it;
-  props->InitTraversal(it);
-  while (vtkProp* prop = props->GetNextProp(it))
-  {
-    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
-    if (background && background->GetVisibility())
-    {
-      return background;
-    }
-  }
-  return named;
-}
-
 // The splats are drawn in the opaque pass and write no depth; the sky background,
 // also drawn there, fills every pixel still at the far plane: drawn after the splats it
 // would cover them. Props draw in the renderer's order, so the splats' actor is moved
@@ -185,7 +159,7 @@ void vtkNimbusCloudSplatRepresentation::ApplySun()
   auto* view = vtkPVRenderView::SafeDownCast(this->GetView());
   if (this->UseSceneSky && view && view->GetRenderer() && view->GetRenderer()->GetInformation())
   {
-    background = ViewSkyBackground(view->GetRenderer());
+    background = vtkNimbusSkyBackground::ShownIn(view->GetRenderer());
     sky = background && background->GetVisibility() ? background->GetSky() : nullptr;
     KeepAfterSky(view->GetRenderer(), this->Actor, background);
   }

@@ -211,6 +211,27 @@ void vtkNimbusSkyBackgroundRepresentation::SetVisibility(bool visible)
 {
   this->Superclass::SetVisibility(visible);
   this->Background->SetVisibility(visible);
+  auto* renderView = vtkPVRenderView::SafeDownCast(this->GetView());
+  if (renderView && renderView->GetRenderer())
+  {
+    this->NameInRenderer(renderView->GetRenderer());
+  }
+}
+
+// The renderer names the visible sky for the view's Cloud representations
+// (vtkNimbusSkyBackground::ShownIn): every display of a data set carries a hidden Sky
+// Background representation, which must not take the name from the one shown.
+void vtkNimbusSkyBackgroundRepresentation::NameInRenderer(vtkRenderer* renderer)
+{
+  vtkInformation* information = renderer->GetInformation();
+  if (this->GetVisibility())
+  {
+    information->Set(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND(), this->Background);
+  }
+  else if (information->Get(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()) == this->Background)
+  {
+    information->Remove(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND());
+  }
 }
 
 bool vtkNimbusSkyBackgroundRepresentation::AddToView(vtkView* view)
@@ -222,9 +243,7 @@ bool vtkNimbusSkyBackgroundRepresentation::AddToView(vtkView* view)
   }
   vtkRenderer* renderer = renderView->GetRenderer();
   renderer->AddViewProp(this->Background);
-  // Named for the view's Cloud representations (vtkNimbusCloudRepresentation).
-  renderer->GetInformation()->Set(
-    vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND(), this->Background);
+  this->NameInRenderer(renderer);
   return this->Superclass::AddToView(view);
 }
 

@@ -41,6 +41,7 @@
 #include "vtkSmartPointer.h" // for vtkSmartPointer
 
 class vtkNimbusSkyBackground;
+class vtkRenderer;
 class vtkPolyData;
 
 class NIMBUSCLOUDREPRESENTATION_EXPORT vtkNimbusSkyBackgroundRepresentation
@@ -87,6 +88,10 @@ public:
   vtkGetMacro(LastExposureFactor, double);
 
 protected:
+  /// Name this representation's background in the renderer's information
+  /// (vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND) while it is visible; take the name
+  /// back when it is hidden.
+  void NameInRenderer(vtkRenderer* renderer);
   vtkNimbusSkyBackgroundRepresentation();
   ~vtkNimbusSkyBackgroundRepresentation() override;
 

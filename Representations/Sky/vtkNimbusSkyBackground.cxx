@@ -2,6 +2,7 @@
 
 #include "SkyViewTextures.h"
 #include "vtkCamera.h"
+#include "vtkInformation.h"
 #include "vtkInformationObjectBaseKey.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNimbusSky.h"
@@ -11,6 +12,7 @@
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLState.h"
+#include "vtkPropCollection.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 
@@ -21,6 +23,32 @@
 vtkStandardNewMacro(vtkNimbusSkyBackground);
 vtkInformationKeyRestrictedMacro(
   vtkNimbusSkyBackground, RENDERER_SKY_BACKGROUND, ObjectBase, "vtkNimbusSkyBackground");
+
+vtkNimbusSkyBackground* vtkNimbusSkyBackground::ShownIn(vtkRenderer* renderer)
+{
+  if (!renderer)
+  {
+    return nullptr;
+  }
+  auto* named = vtkNimbusSkyBackground::SafeDownCast(
+    renderer->GetInformation()->Get(vtkNimbusSkyBackground::RENDERER_SKY_BACKGROUND()));
+  if (named && named->GetVisibility())
+  {
+    return named;
+  }
+  vtkPropCollection* props = renderer->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* prop = props->GetNextProp(it))
+  {
+    auto* background = vtkNimbusSkyBackground::SafeDownCast(prop);
+    if (background && background->GetVisibility())
+    {
+      return background;
+    }
+  }
+  return named;
+}
 
 struct vtkNimbusSkyBackground::Internals
 {

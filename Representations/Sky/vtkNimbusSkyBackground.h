@@ -35,6 +35,7 @@
 
 class vtkInformationObjectBaseKey;
 class vtkNimbusSky;
+class vtkRenderer;
 
 class NIMBUSREPRESENTATIONS_EXPORT vtkNimbusSkyBackground : public vtkProp
 {
@@ -72,6 +73,13 @@ public:
   /// removed with it; read by whoever sets up a cloud mapper in that renderer
   /// (vtkNimbusCloudVolumeMapper::SetSkyBackground).
   static vtkInformationObjectBaseKey* RENDERER_SKY_BACKGROUND();
+
+  /// The sky background a renderer shows: the one its information names
+  /// (RENDERER_SKY_BACKGROUND) when that one is visible, else the first visible one among
+  /// its props, else the named one (nullptr when none). In ParaView every display of a
+  /// data set carries a hidden Sky Background representation of its own, so a renderer
+  /// may hold several backgrounds of which one is shown.
+  static vtkNimbusSkyBackground* ShownIn(vtkRenderer* renderer);
 
   int RenderOpaqueGeometry(vtkViewport* viewport) override;
   vtkTypeBool HasTranslucentPolygonalGeometry() override { return 0; }

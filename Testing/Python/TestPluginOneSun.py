@@ -14,7 +14,9 @@ Checks, through paraview.simple:
      in their tooltips and carry the NimbusViewSkyDecorator; every source's and
      filter's property keeps its pvpython name (a label spelling its XML name);
   4. the cloud follows the view's sky: with a Nimbus Sky shown, the mapper renders with
-     the sky's sun (not the cloud's own, different one); hidden, with its own again;
+     the sky's sun (not the cloud's own, different one), also with the cloud's balls
+     shown beside it (each display carries a hidden sky representation); hidden, with
+     its own again;
   5. automatic exposure (Sky Background): looking toward a sun 20 degrees high it keeps
      most of the frame below white (off: a large part is blown out); looking away
      from the sun it changes nothing (same pixels on and off); the tiles of a
@@ -27,8 +29,8 @@ import re
 import sys
 
 from paraview import servermanager
-from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, Render,
-                             SaveScreenshot, Show)
+from paraview.simple import (ColorBy, CreateRenderView, Delete, Hide, LoadPlugin, OutputPort,
+                             Render, SaveScreenshot, Show)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from image_compare import read_png  # noqa: E402
@@ -193,6 +195,15 @@ def main():
               % (mapper.GetLastSunElevationDegrees(), mapper.GetLastRenderUsedSceneSky()))
         if mapper.GetLastSunElevationDegrees() != 25.0 or not mapper.GetLastRenderUsedSceneSky():
             failures.append("with the sky shown the cloud did not take the sky's sun")
+        # Every display of a data set carries a hidden Sky Background representation of
+        # its own: the cloud's balls (port 1) shown beside it must not hide the sky.
+        Show(OutputPort(cloud, 1), view)
+        Render(view)
+        print("balls shown too: the mapper's sun %.1f deg, over the sky %d"
+              % (mapper.GetLastSunElevationDegrees(), mapper.GetLastRenderUsedSceneSky()))
+        if mapper.GetLastSunElevationDegrees() != 25.0 or not mapper.GetLastRenderUsedSceneSky():
+            failures.append("with the cloud's balls shown too the cloud lost the sky's sun")
+        Hide(OutputPort(cloud, 1), view)
         Hide(sky, view)
         Render(view)
         print("sky hidden: the mapper's sun %.1f deg" % mapper.GetLastSunElevationDegrees())
