@@ -39,6 +39,12 @@ p.add_argument("--offset", type=float, default=0.0)  # light x offset
 p.add_argument("--coarse-first", action="store_true")
 p.add_argument("--directions", type=int, default=0)
 p.add_argument("--out", default="point-light-sphere")
+p.add_argument("--reference-scaled", action="store_true",
+               help="the reference traces the delta-M-scaled medium the solver solves "
+                    "(extinction (1 - f a) sigma, albedo a (1 - f) / (1 - f a), Henyey-Greenstein "
+                    "g' = (k1 - f) / (1 - f), f = k2 of the Cornette-Shanks phase): Nimbus against "
+                    "its own approximation, to tell the delta-M scaling's error from the solver's "
+                    "and the view's")
 a = p.parse_args()
 os.makedirs(a.out, exist_ok=True)
 half = a.radius * 1.2
@@ -58,11 +64,27 @@ I = 1e6
 light = [a.offset, 0, 0]
 CAMERA = {"position": [0, -3 * a.radius * 2, 0], "focal_point": [0, 0, 0], "view_up": [0, 0, 1],
           "view_angle": 25, "width": 120, "height": 120}
+def cornette_shanks_moments(g):
+    """k1, k2: the Cornette-Shanks phase function's first two Legendre coefficients."""
+    mu = np.linspace(-1.0, 1.0, 400001)
+    p = 3 / (8 * np.pi) * (1 - g * g) / (2 + g * g) * (1 + mu ** 2) / (1 + g * g - 2 * g * mu) ** 1.5
+    return (2 * np.pi * np.trapz(p * mu, mu), 2 * np.pi * np.trapz(p * (1.5 * mu ** 2 - 0.5), mu))
+
+
+reference_sigma, reference_albedo = a.sigma, a.albedo
+reference_phase = [{"type": "cornette_shanks", "g": a.g, "weight": 1}]
+if a.reference_scaled:
+    k1, f = cornette_shanks_moments(a.g)
+    if k1 > f:
+        reference_sigma = (1 - f * a.albedo) * a.sigma
+        reference_albedo = a.albedo * (1 - f) / (1 - f * a.albedo)
+        reference_phase = [{"type": "henyey_greenstein", "g": (k1 - f) / (1 - f), "weight": 1}]
+        tag += "-scaled"
 scene = {"nimbus_scene": 3, "name": "sphere", "description": "diag",
   "camera": CAMERA,
   "medium": {"density": {"type": "file", "path": vti, "array": "density"},
-             "extinction_per_density": a.sigma, "single_scattering_albedo": a.albedo,
-             "phase": [{"type": "cornette_shanks", "g": a.g, "weight": 1}]},
+             "extinction_per_density": reference_sigma, "single_scattering_albedo": reference_albedo,
+             "phase": reference_phase},
   "sun": {"azimuth_degrees": 0, "elevation_degrees": 45, "illuminance": 0, "temperature_kelvin": 5778},
   "atmosphere": {"enabled": False}, "ground": {"enabled": False},
   "background": {"type": "constant", "radiance": 0},
