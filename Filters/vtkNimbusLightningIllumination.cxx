@@ -1,5 +1,7 @@
 #include "vtkNimbusLightningIllumination.h"
 
+#include "FiniteSetters.h"
+
 #include "LightningBasis.h"
 #include "LightningFirstScattering.h"
 
@@ -29,6 +31,17 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkNimbusLightningIllumination);
+
+// Setters with a range refuse NaN and infinity at once (the value is kept) and clamp
+// finite values (Common/FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, ExtinctionPerDensity);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, Albedo);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, CloudG);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, MetresPerUnit);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, LightSpacingMetres);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, Threshold);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, MemoryBudgetMiB);
+nimbusDefineFiniteSetter(vtkNimbusLightningIllumination, PointSourceSpacing);
 
 namespace
 {

@@ -106,13 +106,21 @@ public:
   ///@{
   /// Cloud optics, as on vtkNimbusCloudVolumeMapper (same defaults: 0.02 /m per density
   /// unit, 0.99, 0.85) and metres per world unit (1).
-  vtkSetClampMacro(ExtinctionPerDensity, double, 0.0, 1e6);
+  virtual void SetExtinctionPerDensity(double value);
+  virtual double GetExtinctionPerDensityMinValue() { return 0.0; }
+  virtual double GetExtinctionPerDensityMaxValue() { return 1e6; }
   vtkGetMacro(ExtinctionPerDensity, double);
-  vtkSetClampMacro(Albedo, double, 0.0, 1.0);
+  virtual void SetAlbedo(double value);
+  virtual double GetAlbedoMinValue() { return 0.0; }
+  virtual double GetAlbedoMaxValue() { return 1.0; }
   vtkGetMacro(Albedo, double);
-  vtkSetClampMacro(CloudG, double, -0.99, 0.99);
+  virtual void SetCloudG(double value);
+  virtual double GetCloudGMinValue() { return -0.99; }
+  virtual double GetCloudGMaxValue() { return 0.99; }
   vtkGetMacro(CloudG, double);
-  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  virtual void SetMetresPerUnit(double value);
+  virtual double GetMetresPerUnitMinValue() { return 1e-9; }
+  virtual double GetMetresPerUnitMaxValue() { return 1e9; }
   vtkGetMacro(MetresPerUnit, double);
   ///@}
 
@@ -125,7 +133,9 @@ public:
   ///@{
   /// The virtual lights: h_usr of 003 Eq. 4 in metres (0: automatic) and the lowest
   /// height they reach (metres; the ground, 0, by default).
-  vtkSetClampMacro(LightSpacingMetres, double, 0.0, 1e9);
+  virtual void SetLightSpacingMetres(double value);
+  virtual double GetLightSpacingMetresMinValue() { return 0.0; }
+  virtual double GetLightSpacingMetresMaxValue() { return 1e9; }
   vtkGetMacro(LightSpacingMetres, double);
   vtkSetMacro(SimulationBottomMetres, double);
   vtkGetMacro(SimulationBottomMetres, double);
@@ -138,7 +148,9 @@ public:
   vtkGetMacro(NumberOfDirections, int);
   vtkSetClampMacro(Orders, int, 1, 1000);
   vtkGetMacro(Orders, int);
-  vtkSetClampMacro(Threshold, double, 0.0, 1.0);
+  virtual void SetThreshold(double value);
+  virtual double GetThresholdMinValue() { return 0.0; }
+  virtual double GetThresholdMaxValue() { return 1.0; }
   vtkGetMacro(Threshold, double);
   vtkSetClampMacro(NumberOfThreads, int, 0, 1024);
   vtkGetMacro(NumberOfThreads, int);
@@ -146,7 +158,9 @@ public:
 
   ///@{
   /// The most memory the precompute may take (MiB; default 2048; 0: no limit).
-  vtkSetClampMacro(MemoryBudgetMiB, double, 0.0, 1e9);
+  virtual void SetMemoryBudgetMiB(double value);
+  virtual double GetMemoryBudgetMiBMinValue() { return 0.0; }
+  virtual double GetMemoryBudgetMiBMaxValue() { return 1e9; }
   vtkGetMacro(MemoryBudgetMiB, double);
   ///@}
 
@@ -165,7 +179,9 @@ public:
   /// made from strokes (metres, 10).
   vtkSetVector3Macro(LightningColor, double);
   vtkGetVector3Macro(LightningColor, double);
-  vtkSetClampMacro(PointSourceSpacing, double, 1e-3, 1e9);
+  virtual void SetPointSourceSpacing(double value);
+  virtual double GetPointSourceSpacingMinValue() { return 1e-3; }
+  virtual double GetPointSourceSpacingMaxValue() { return 1e9; }
   vtkGetMacro(PointSourceSpacing, double);
 
   /// The sources' first scattering computed on the density's own grid (exact

@@ -1,5 +1,7 @@
 #include "vtkNimbusOpenVDBWriter.h"
 
+#include "FiniteSetters.h"
+
 #include "VdbGrids.h"
 
 #include "vtkAbstractArray.h"
@@ -24,6 +26,10 @@
 namespace vdb = nimbus::vdb;
 
 vtkStandardNewMacro(vtkNimbusOpenVDBWriter);
+
+// Setters with a range refuse NaN and infinity at once (the value is kept) and clamp
+// finite values (Common/FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusOpenVDBWriter, Tolerance);
 
 vtkNimbusOpenVDBWriter::vtkNimbusOpenVDBWriter() = default;
 

@@ -62,7 +62,9 @@ public:
   ///@{
   /// Voxels within this distance of Background (per component, in the array's units) are
   /// inactive and not stored. Default 0 (only exact background values are dropped).
-  vtkSetClampMacro(Tolerance, double, 0.0, VTK_FLOAT_MAX);
+  virtual void SetTolerance(double value);
+  virtual double GetToleranceMinValue() { return 0.0; }
+  virtual double GetToleranceMaxValue() { return VTK_FLOAT_MAX; }
   vtkGetMacro(Tolerance, double);
   ///@}
 

@@ -1,5 +1,7 @@
 #include "vtkNimbusReferenceRenderer.h"
 
+#include "FiniteSetters.h"
+
 #include "DensityGrid.h"
 #include "DensityGridFromImage.h"
 #include "MemoryBudget.h"
@@ -34,6 +36,11 @@
 #include <thread>
 
 vtkStandardNewMacro(vtkNimbusReferenceRenderer);
+
+// Setters with a range refuse NaN and infinity at once (the value is kept) and clamp
+// finite values (Common/FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusReferenceRenderer, TimeLimitSeconds);
+nimbusDefineFiniteSetter(vtkNimbusReferenceRenderer, TargetImageRelativeError);
 
 struct vtkNimbusReferenceRenderer::vtkInternals
 {

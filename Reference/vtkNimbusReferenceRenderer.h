@@ -128,9 +128,13 @@ public:
   /// over RMS radiance) is at or below TargetImageRelativeError; 0 = no such stop.
   /// Field data "StoppedAtTimeLimit" and "ReachedImageTarget" say which ended it.
   /// Defaults 0, 0.
-  vtkSetClampMacro(TimeLimitSeconds, double, 0.0, 1.0e9);
+  virtual void SetTimeLimitSeconds(double value);
+  virtual double GetTimeLimitSecondsMinValue() { return 0.0; }
+  virtual double GetTimeLimitSecondsMaxValue() { return 1.0e9; }
   vtkGetMacro(TimeLimitSeconds, double);
-  vtkSetClampMacro(TargetImageRelativeError, double, 0.0, 1.0);
+  virtual void SetTargetImageRelativeError(double value);
+  virtual double GetTargetImageRelativeErrorMinValue() { return 0.0; }
+  virtual double GetTargetImageRelativeErrorMaxValue() { return 1.0; }
   vtkGetMacro(TargetImageRelativeError, double);
   ///@}
 

@@ -131,6 +131,11 @@ nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, TextureMemoryBudgetMiB);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, FrameBudgetMilliseconds);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, Quality);
 nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, InteractiveUpdateRate);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, OctaveExtinctionScale);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, OctaveScatteringScale);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, OctaveAsymmetryScale);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, PatternContribution);
+nimbusDefineFiniteSetter(vtkNimbusCloudVolumeMapper, PatternSelection);
 
 void vtkNimbusCloudVolumeMapper::SetScalarMode(int mode)
 {

@@ -220,11 +220,17 @@ public:
   /// per-octave scales of extinction a, scattering b and asymmetry c (0..1, 0.5).
   vtkSetClampMacro(Octaves, int, 1, 16);
   vtkGetMacro(Octaves, int);
-  vtkSetClampMacro(OctaveExtinctionScale, double, 0.01, 1.0);
+  virtual void SetOctaveExtinctionScale(double value);
+  virtual double GetOctaveExtinctionScaleMinValue() { return 0.01; }
+  virtual double GetOctaveExtinctionScaleMaxValue() { return 1.0; }
   vtkGetMacro(OctaveExtinctionScale, double);
-  vtkSetClampMacro(OctaveScatteringScale, double, 0.01, 1.0);
+  virtual void SetOctaveScatteringScale(double value);
+  virtual double GetOctaveScatteringScaleMinValue() { return 0.01; }
+  virtual double GetOctaveScatteringScaleMaxValue() { return 1.0; }
   vtkGetMacro(OctaveScatteringScale, double);
-  vtkSetClampMacro(OctaveAsymmetryScale, double, 0.01, 1.0);
+  virtual void SetOctaveAsymmetryScale(double value);
+  virtual double GetOctaveAsymmetryScaleMinValue() { return 0.01; }
+  virtual double GetOctaveAsymmetryScaleMaxValue() { return 1.0; }
   vtkGetMacro(OctaveAsymmetryScale, double);
   /// Reference patterns: the highest order (2..8, default 3 as in 004; each order's
   /// small bias compounds: with all orders the sum comes out 1.6-1.9x a Monte Carlo
@@ -236,9 +242,13 @@ public:
   /// and the fraction of them evaluated per point (0.25).
   vtkSetClampMacro(PatternRadius, int, 1, 64);
   vtkGetMacro(PatternRadius, int);
-  vtkSetClampMacro(PatternContribution, double, 0.01, 1.0);
+  virtual void SetPatternContribution(double value);
+  virtual double GetPatternContributionMinValue() { return 0.01; }
+  virtual double GetPatternContributionMaxValue() { return 1.0; }
   vtkGetMacro(PatternContribution, double);
-  vtkSetClampMacro(PatternSelection, double, 0.01, 1.0);
+  virtual void SetPatternSelection(double value);
+  virtual double GetPatternSelectionMinValue() { return 0.01; }
+  virtual double GetPatternSelectionMaxValue() { return 1.0; }
   vtkGetMacro(PatternSelection, double);
   /// Memory the solver may take, MiB (0, the default: half of the physical memory).
   /// Estimated before allocating; above it the term is off, with an error.

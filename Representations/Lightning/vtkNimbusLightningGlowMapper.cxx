@@ -1,5 +1,7 @@
 #include "vtkNimbusLightningGlowMapper.h"
 
+#include "FiniteSetters.h"
+
 #include "Lightning.h"
 
 #include "lightningGlowCompositeFS.h"
@@ -101,6 +103,14 @@ struct vtkNimbusLightningGlowMapper::Internals
 };
 
 vtkStandardNewMacro(vtkNimbusLightningGlowMapper);
+
+// Setters with a range refuse NaN and infinity at once (the value is kept) and clamp
+// finite values (Common/FiniteSetters.h).
+nimbusDefineFiniteSetter(vtkNimbusLightningGlowMapper, AirScatteringPerMetre);
+nimbusDefineFiniteSetter(vtkNimbusLightningGlowMapper, GlowRadiusMetres);
+nimbusDefineFiniteSetter(vtkNimbusLightningGlowMapper, ChannelRadiusMetres);
+nimbusDefineFiniteSetter(vtkNimbusLightningGlowMapper, Exposure);
+nimbusDefineFiniteSetter(vtkNimbusLightningGlowMapper, MetresPerUnit);
 
 vtkNimbusLightningGlowMapper::vtkNimbusLightningGlowMapper()
   : Internal(new Internals)

@@ -49,27 +49,37 @@ public:
 
   ///@{
   /// sigma_s of the air (1/m; default 1e-3: rain and haze).
-  vtkSetClampMacro(AirScatteringPerMetre, double, 0.0, 1.0);
+  virtual void SetAirScatteringPerMetre(double value);
+  virtual double GetAirScatteringPerMetreMinValue() { return 0.0; }
+  virtual double GetAirScatteringPerMetreMaxValue() { return 1.0; }
   vtkGetMacro(AirScatteringPerMetre, double);
   ///@}
 
   ///@{
   /// The radius of each source's glow (metres, default 300) and the channel's radius,
   /// inside which the profile stays at its value there (metres, default 2).
-  vtkSetClampMacro(GlowRadiusMetres, double, 1e-3, 1e6);
+  virtual void SetGlowRadiusMetres(double value);
+  virtual double GetGlowRadiusMetresMinValue() { return 1e-3; }
+  virtual double GetGlowRadiusMetresMaxValue() { return 1e6; }
   vtkGetMacro(GlowRadiusMetres, double);
-  vtkSetClampMacro(ChannelRadiusMetres, double, 1e-3, 1e3);
+  virtual void SetChannelRadiusMetres(double value);
+  virtual double GetChannelRadiusMetresMinValue() { return 1e-3; }
+  virtual double GetChannelRadiusMetresMaxValue() { return 1e3; }
   vtkGetMacro(ChannelRadiusMetres, double);
   ///@}
 
   ///@{
   /// Exposure (as the cloud mapper's: multiplies the radiance; default 1), the light's
   /// colour (default 0.85, 0.9, 1) and metres per world unit (default 1).
-  vtkSetClampMacro(Exposure, double, 0.0, 1e6);
+  virtual void SetExposure(double value);
+  virtual double GetExposureMinValue() { return 0.0; }
+  virtual double GetExposureMaxValue() { return 1e6; }
   vtkGetMacro(Exposure, double);
   vtkSetVector3Macro(Color, double);
   vtkGetVector3Macro(Color, double);
-  vtkSetClampMacro(MetresPerUnit, double, 1e-9, 1e9);
+  virtual void SetMetresPerUnit(double value);
+  virtual double GetMetresPerUnitMinValue() { return 1e-9; }
+  virtual double GetMetresPerUnitMaxValue() { return 1e9; }
   vtkGetMacro(MetresPerUnit, double);
   ///@}
 
