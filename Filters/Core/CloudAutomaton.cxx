@@ -561,6 +561,18 @@ void CloudAutomaton::Step()
     });
 
   // 3. wind: out -> in (shifted), or just swap when no layer moves this step.
+  this->MoveWithTheWind(n);
+  this->Current.Step = n + 1;
+}
+
+// Step's third part: the wind moves each held layer of Scratch (the step's result) by its
+// whole-cell shift of step n into Current, or Scratch and Current swap when no layer moves.
+void CloudAutomaton::MoveWithTheWind(std::int64_t n)
+{
+  const auto& p = this->Parameters;
+  const int nx = p.Dimensions[0], ny = p.Dimensions[1], nz = this->NZ, layer0 = this->Z0;
+  const int W = this->RowWords;
+  const bool periodic = p.Boundary == CloudBoundary::Periodic;
   if (!AnyLayerMoves(p, layer0, nz, n))
   {
     std::swap(this->Current.Hum, this->Scratch.Hum);
@@ -639,7 +651,6 @@ void CloudAutomaton::Step()
         }
       });
   }
-  this->Current.Step = n + 1;
 }
 
 bool CloudAutomaton::StepTo(std::int64_t step, const std::function<bool(double)>& progress)

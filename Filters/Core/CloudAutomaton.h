@@ -182,6 +182,8 @@ public:
   std::uint64_t* Layer(Field field, int z);
 
 private:
+  /// Step's wind: Scratch moved into Current by step n's shifts (or swapped).
+  void MoveWithTheWind(std::int64_t n);
   void ValidateAndPrepare();
   void InitialState();
   std::vector<std::uint64_t>& Data(Field field);

@@ -75,7 +75,7 @@
  * (linear, no sRGB encoding).
  *
  * The numeric setters refuse NaN and infinity (an error; the value is kept) and clamp
- * finite values to their ranges (Cloud/FiniteSetters.h).
+ * finite values to their ranges (Common/FiniteSetters.h).
  *
  * Drawn in the opaque pass after the props before it, as an emissive prop: depth-tested
  * against the scene's depth, writing none; opaque props drawn later are not hidden by
