@@ -4,6 +4,7 @@
 
 #include "Lightning.h"
 
+#include "FrameTexture.h"
 #include "lightningGlowCompositeFS.h"
 #include "lightningGlowSplatFS.h"
 #include "lightningGlowSplatVS.h"
@@ -74,31 +75,6 @@ struct vtkNimbusLightningGlowMapper::Internals
     this->VertexCount = 0;
     this->VerticesTime = 0;
     this->Window = nullptr;
-  }
-
-  // w x h texels, nearest filtered, reallocated only when the size changed.
-  static void Ensure(
-    vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h, bool depth)
-  {
-    texture->SetContext(window);
-    if (texture->GetHandle() && static_cast<int>(texture->GetWidth()) == w &&
-      static_cast<int>(texture->GetHeight()) == h)
-    {
-      return;
-    }
-    texture->ReleaseGraphicsResources(window);
-    texture->SetWrapS(vtkTextureObject::ClampToEdge);
-    texture->SetWrapT(vtkTextureObject::ClampToEdge);
-    texture->SetMinificationFilter(vtkTextureObject::Nearest);
-    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    if (depth)
-    {
-      texture->AllocateDepth(w, h, vtkTextureObject::Float32);
-    }
-    else
-    {
-      texture->Allocate2D(w, h, 4, VTK_FLOAT);
-    }
   }
 };
 
@@ -189,8 +165,8 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &frame);
   state->PushFramebufferBindings();
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, frame);
-  Internals::Ensure(in.Sum, window, width, height, false);
-  Internals::Ensure(in.Depth, window, width, height, true);
+  nimbus::EnsureFrameTexture(in.Sum, window, width, height, nimbus::FrameTextureFormat::Float);
+  nimbus::EnsureFrameTexture(in.Depth, window, width, height, nimbus::FrameTextureFormat::Depth);
   GLint samples = 0;
   glGetIntegerv(GL_SAMPLES, &samples);
   const bool sceneDepth = samples == 0;

@@ -3,6 +3,7 @@
 #include "AtmosphereTable.h"
 #include "CloudSplats.h"
 #include "FiniteSetters.h"
+#include "FrameTexture.h"
 #include "MultipleScattering.h"
 #include "MultipleScatteringTexture.h"
 #include "ShaderLibrary.h"
@@ -183,32 +184,11 @@ struct vtkNimbusCloudSplatMapper::Internals
     this->Window = nullptr;
   }
 
-  // w x h texels, nearest filtered, reallocated only when the size changed: RGBA float,
-  // RGBA 8-bit or a float depth.
-  enum class TargetFormat
+  // The splats' frame targets (FrameTexture.h); an allocation that fails stops the frame.
+  static void EnsureTarget(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h,
+    nimbus::FrameTextureFormat format)
   {
-    Float,
-    Byte,
-    Depth
-  };
-  static void EnsureTarget(
-    vtkTextureObject* texture, vtkOpenGLRenderWindow* window, int w, int h, TargetFormat format)
-  {
-    texture->SetContext(window);
-    if (texture->GetHandle() && static_cast<int>(texture->GetWidth()) == w &&
-      static_cast<int>(texture->GetHeight()) == h)
-    {
-      return;
-    }
-    texture->ReleaseGraphicsResources(window);
-    texture->SetWrapS(vtkTextureObject::ClampToEdge);
-    texture->SetWrapT(vtkTextureObject::ClampToEdge);
-    texture->SetMinificationFilter(vtkTextureObject::Nearest);
-    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    const bool ok = format == TargetFormat::Depth
-      ? texture->AllocateDepth(w, h, vtkTextureObject::Float32)
-      : texture->Allocate2D(w, h, 4, format == TargetFormat::Float ? VTK_FLOAT : VTK_UNSIGNED_CHAR);
-    if (!ok)
+    if (!nimbus::EnsureFrameTexture(texture, window, w, h, format))
     {
       throw std::runtime_error("the splats' frame target could not be allocated");
     }
@@ -1281,8 +1261,9 @@ void vtkNimbusCloudSplatMapper::DrawIntoFloatTarget(
   try
   {
     state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, frame);
-    Internals::EnsureTarget(in.FrameSum, window, width, height, Internals::TargetFormat::Float);
-    Internals::EnsureTarget(in.FrameDepth, window, width, height, Internals::TargetFormat::Depth);
+    Internals::EnsureTarget(in.FrameSum, window, width, height, nimbus::FrameTextureFormat::Float);
+    Internals::EnsureTarget(
+      in.FrameDepth, window, width, height, nimbus::FrameTextureFormat::Depth);
     GLint samples = 0;
     glGetIntegerv(GL_SAMPLES, &samples);
     const bool sceneDepth = samples == 0;
@@ -1292,7 +1273,7 @@ void vtkNimbusCloudSplatMapper::DrawIntoFloatTarget(
       if (in.OverSky)
       {
         Internals::EnsureTarget(
-          in.SceneColor, window, width, height, Internals::TargetFormat::Byte);
+          in.SceneColor, window, width, height, nimbus::FrameTextureFormat::Byte);
         in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
       }
     }
