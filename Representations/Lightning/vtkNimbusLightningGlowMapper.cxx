@@ -167,14 +167,8 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
   state->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, frame);
   nimbus::EnsureFrameTexture(in.Sum, window, width, height, nimbus::FrameTextureFormat::Float);
   nimbus::EnsureFrameTexture(in.Depth, window, width, height, nimbus::FrameTextureFormat::Depth);
-  GLint samples = 0;
-  glGetIntegerv(GL_SAMPLES, &samples);
-  const bool sceneDepth = samples == 0;
-  if (sceneDepth)
-  {
-    in.Depth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
-  }
-  else if (!in.WarnedMultisampling)
+  const int samples = nimbus::CopySceneDepth(in.Depth, x0, y0, width, height);
+  if (samples != 0 && !in.WarnedMultisampling)
   {
     vtkWarningMacro("The render window is multisampled (MultiSamples = "
       << samples << "): opaque geometry will not hide the lightning glow. Set MultiSamples to 0.");
@@ -182,26 +176,7 @@ void vtkNimbusLightningGlowMapper::Render(vtkRenderer* renderer, vtkActor* actor
   }
 
   // The splats, summed in float.
-  in.Framebuffer->SetContext(window);
-  in.Framebuffer->Bind(GL_FRAMEBUFFER);
-  in.Framebuffer->RemoveColorAttachment(0);
-  in.Framebuffer->AddColorAttachment(0, in.Sum);
-  in.Framebuffer->AddDepthAttachment(in.Depth);
-  in.Framebuffer->ActivateDrawBuffer(0);
-  state->vtkglViewport(0, 0, width, height);
-  state->vtkglDisable(GL_SCISSOR_TEST);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  if (sceneDepth)
-  {
-    state->vtkglClear(GL_COLOR_BUFFER_BIT);
-  }
-  else
-  {
-    state->vtkglDepthMask(GL_TRUE);
-    state->vtkglClearDepth(1.0);
-    state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  }
+  nimbus::BeginFrameTarget(in.Framebuffer, in.Sum, in.Depth, window, width, height, samples == 0);
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthFunc(GL_LEQUAL);
   state->vtkglDepthMask(GL_FALSE);

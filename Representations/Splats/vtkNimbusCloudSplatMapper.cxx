@@ -1264,45 +1264,22 @@ void vtkNimbusCloudSplatMapper::DrawIntoFloatTarget(
     Internals::EnsureTarget(in.FrameSum, window, width, height, nimbus::FrameTextureFormat::Float);
     Internals::EnsureTarget(
       in.FrameDepth, window, width, height, nimbus::FrameTextureFormat::Depth);
-    GLint samples = 0;
-    glGetIntegerv(GL_SAMPLES, &samples);
+    const int samples = nimbus::CopySceneDepth(in.FrameDepth, x0, y0, width, height);
     const bool sceneDepth = samples == 0;
-    if (sceneDepth)
+    if (sceneDepth && in.OverSky)
     {
-      in.FrameDepth->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
-      if (in.OverSky)
-      {
-        Internals::EnsureTarget(
-          in.SceneColor, window, width, height, nimbus::FrameTextureFormat::Byte);
-        in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
-      }
+      Internals::EnsureTarget(
+        in.SceneColor, window, width, height, nimbus::FrameTextureFormat::Byte);
+      in.SceneColor->CopyFromFrameBuffer(x0, y0, 0, 0, width, height);
     }
-    else if (!in.WarnedMultisampling)
+    else if (!sceneDepth && !in.WarnedMultisampling)
     {
       vtkWarningMacro("The render window is multisampled (MultiSamples = "
         << samples << "): opaque geometry will not hide the cloud splats. Set MultiSamples to 0.");
       in.WarnedMultisampling = true;
     }
-    in.FrameTarget->SetContext(window);
-    in.FrameTarget->Bind(GL_FRAMEBUFFER);
-    in.FrameTarget->RemoveColorAttachment(0);
-    in.FrameTarget->AddColorAttachment(0, in.FrameSum);
-    in.FrameTarget->AddDepthAttachment(in.FrameDepth);
-    in.FrameTarget->ActivateDrawBuffer(0);
-    state->vtkglViewport(0, 0, width, height);
-    state->vtkglDisable(GL_SCISSOR_TEST);
-    state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    state->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-    if (sceneDepth)
-    {
-      state->vtkglClear(GL_COLOR_BUFFER_BIT);
-    }
-    else
-    {
-      state->vtkglDepthMask(GL_TRUE);
-      state->vtkglClearDepth(1.0);
-      state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    }
+    nimbus::BeginFrameTarget(
+      in.FrameTarget, in.FrameSum, in.FrameDepth, window, width, height, sceneDepth);
     this->ViewPass(renderer, window);
     in.FrameTarget->RemoveDepthAttachment();
   }
