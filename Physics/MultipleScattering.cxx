@@ -1250,6 +1250,27 @@ double PhaseLegendreCoefficient(const CloudOptics& optics, int l)
   return 2.0 * kPi * sum;
 }
 
+double DeltaMPeakLobeG(const CloudOptics& optics)
+{
+  const double k1 = PhaseLegendreCoefficient(optics, 1);
+  const double k2 = PhaseLegendreCoefficient(optics, 2);
+  if (!(k2 > 0.0 && k1 > k2 && k2 < 0.999))
+  {
+    return 0.0;
+  }
+  const double truncatedG = (k1 - k2) / (1.0 - k2);
+  const double peakForward = (EvaluatePhaseFunction(optics.Phase, 1.0, optics.G) -
+                               (1.0 - k2) * HenyeyGreenstein(1.0, truncatedG)) /
+    k2;
+  if (!(peakForward > 1.0 / (4.0 * kPi)))
+  {
+    return 0.0; // no lobe brighter forward than an isotropic one
+  }
+  // c (1 - g)^2 = 1 + g, c = 4 pi HG(1; g): the root below 1.
+  const double c = 4.0 * kPi * peakForward;
+  return ClampAsymmetry(((2.0 * c + 1.0) - std::sqrt(8.0 * c + 1.0)) / (2.0 * c));
+}
+
 Rgb EvaluateInScattering(const float* coefficients, const Vector3& w)
 {
   const auto y = ShBasis(w);

@@ -272,6 +272,15 @@ NIMBUSPHYSICS_EXPORT Rgb EvaluateInScattering(const float* coefficients, const V
 /// p(mu) P_l(mu) dmu (k_0 = 1, k_1 = mean cosine). For l <= 2.
 NIMBUSPHYSICS_EXPORT double PhaseLegendreCoefficient(const CloudOptics& optics, int l);
 
+/// The forward peak that the delta-M truncation f = k_2 takes out of the phase function
+/// (Wiscombe 1977; the solver's and the lightning view's truncation), as a Henyey-Greenstein
+/// lobe of its own: the g whose HG(1; g) is the peak's forward value
+/// [p(1) - (1 - f) HG(1; g')] / f, g' = (k_1 - k_2) / (1 - k_2), solved in closed form from
+/// (1 + g) / (1 - g)^2 = 4 pi HG(1; g). For Cornette-Shanks g 0.85: 0.872 (half width 6 deg).
+/// 0 when the phase function has no peak to truncate (k_2 <= 0, k_1 <= k_2 or k_2 >= 0.999,
+/// as the mapper's delta-M view takes it).
+NIMBUSPHYSICS_EXPORT double DeltaMPeakLobeG(const CloudOptics& optics);
+
 /// A spherical Fibonacci set of n unit directions (equal solid angles 4 pi / n).
 NIMBUSPHYSICS_EXPORT std::vector<Vector3> FibonacciDirections(int n);
 

@@ -88,6 +88,39 @@ TEST(MultipleScattering, PhaseLegendreCoefficients)
   EXPECT_NEAR(nimbus::PhaseLegendreCoefficient(rayleigh, 2), 0.1, 1e-9); // 3/4 (1 + mu^2): 1/10
 }
 
+TEST(MultipleScattering, DeltaMPeakLobeHasThePeaksForwardValue)
+{
+  for (double g : { 0.5, 0.7, 0.85, 0.95 })
+  {
+    CloudOptics cs{ 1.0, PhaseFunctionKind::CornetteShanks, g };
+    const double k1 = nimbus::PhaseLegendreCoefficient(cs, 1);
+    const double k2 = nimbus::PhaseLegendreCoefficient(cs, 2);
+    const double truncatedG = (k1 - k2) / (1.0 - k2);
+    const double lobeG = nimbus::DeltaMPeakLobeG(cs);
+    // f HG(1; lobe) + (1 - f) HG(1; g') is the phase function's own forward value.
+    EXPECT_NEAR(k2 * nimbus::HenyeyGreenstein(1.0, lobeG) +
+        (1.0 - k2) * nimbus::HenyeyGreenstein(1.0, truncatedG),
+      nimbus::CornetteShanks(1.0, g), 1e-9 * nimbus::CornetteShanks(1.0, g))
+      << g;
+    // The peak is narrower than the truncated phase function and than the whole one.
+    EXPECT_GT(lobeG, truncatedG) << g;
+    EXPECT_GT(lobeG, g) << g;
+    EXPECT_LT(lobeG, 1.0) << g;
+  }
+  EXPECT_NEAR(nimbus::DeltaMPeakLobeG(CloudOptics{ 1.0, PhaseFunctionKind::CornetteShanks, 0.85 }),
+    0.8723, 1e-4);
+  // No peak to truncate: isotropic, Rayleigh (k1 = 0 < k2), backward.
+  EXPECT_EQ(
+    nimbus::DeltaMPeakLobeG(CloudOptics{ 1.0, PhaseFunctionKind::HenyeyGreenstein, 0.0 }), 0.0);
+  EXPECT_EQ(nimbus::DeltaMPeakLobeG(CloudOptics{ 1.0, PhaseFunctionKind::Rayleigh, 0.0 }), 0.0);
+  EXPECT_EQ(
+    nimbus::DeltaMPeakLobeG(CloudOptics{ 1.0, PhaseFunctionKind::CornetteShanks, -0.5 }), 0.0);
+  // g -> 1 stays finite.
+  const double nearOne =
+    nimbus::DeltaMPeakLobeG(CloudOptics{ 1.0, PhaseFunctionKind::CornetteShanks, 0.999999 });
+  EXPECT_TRUE(std::isfinite(nearOne));
+}
+
 TEST(MultipleScattering, OpticalDepthOfAUniformCube)
 {
   const ExtinctionGrid grid = UniformCube(9, 800.0, 0.01); // 100 m cells

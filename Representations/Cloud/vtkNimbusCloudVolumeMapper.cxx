@@ -2509,6 +2509,8 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
   program->SetUniformf("lightningTruncatedG", static_cast<float>(truncatedG));
   program->SetUniformf(
     "lightningDegreeOneScale", static_cast<float>(deltaM && k1 > 0.0 ? truncatedG / k1 : 1.0));
+  program->SetUniformf("lightningPeakLobeG",
+    static_cast<float>(deltaM ? nimbus::DeltaMPeakLobeG(lightningOptics) : 0.0));
   // Temperature emission: the texels hold rho B(T) / Y[B(T_ref)] (linear sRGB);
   // E [Y/(sr m)] scales them.
   program->SetUniformi("emissionOn", frame.EmissionTexture ? 1 : 0);

@@ -38,6 +38,7 @@ uniform int lightningDeltaM;
 uniform float lightningPeakFraction;  // f = k2
 uniform float lightningTruncatedG;    // g' = (k1 - k2) / (1 - k2)
 uniform float lightningDegreeOneScale; // g' / k1
+uniform float lightningPeakLobeG;     // the truncated peak's own HG lobe (DeltaMPeakLobeG)
 // Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
 // [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
 uniform int emissionOn;
@@ -95,6 +96,29 @@ vec3 CloudLightningDeltaM(vec3 p, vec3 direction, float sigma)
   return (1.0 - lightningPeakFraction) * cloudAlbedo * sigma * j;
 }
 
+// The light the delta-M view keeps on the sources' beams, seen by the eye: the beam E'
+// (through the reduced extinction) loses f albedo sigma E' a metre to the truncated
+// forward peak, and its last scattering toward the eye goes through the peak's own lobe
+// and then the full extinction (CloudOtherSources). Along a pencil from a point source
+// this sums to I (exp(-(1 - f albedo) tau) - exp(-tau)) / D^2, the light that scattered
+// only inside the peak: the source's aureole through the cloud, which the reduced view
+// alone draws nowhere (docs/lightning.md). The beam's directions at p are taken as an HG
+// lobe about F'/|F'| with mean cosine |F'|/E' (1 for one point source, less in a
+// channel's fan), so the peak's lobe folded with them is HG(g_peak |F'|/E') (HG lobes
+// fold by multiplying their g). Per unit scattering coefficient, like J.
+vec3 LightningForwardPeak(vec3 p, vec3 w)
+{
+  vec4 v = texture(lightningFirst, (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale);
+  float flux = length(v.rgb);
+  if (v.a <= 0.0 || flux <= 0.0)
+  {
+    return vec3(0.0);
+  }
+  float meanCosine = min(flux / v.a, 1.0);
+  float mu = clamp(dot(v.rgb, w) / flux, -1.0, 1.0);
+  return lightningColour * v.a * HenyeyGreenstein(mu, lightningPeakLobeG * meanCosine);
+}
+
 // The reduced extinction's share (1 - f albedo) of the delta-M view.
 float LightningReducedExtinction()
 {
@@ -147,6 +171,10 @@ vec3 CloudOtherSources(vec3 p, vec3 direction, float sigma)
   if (lightningFirstOn != 0 && lightningDeltaM == 0)
   {
     source += cloudAlbedo * sigma * LightningFirstScattering(p, -direction, lightningFirstK1);
+  }
+  if (lightningFirstOn != 0 && lightningDeltaM != 0)
+  {
+    source += lightningPeakFraction * cloudAlbedo * sigma * LightningForwardPeak(p, -direction);
   }
   if (emissionOn != 0)
   {
