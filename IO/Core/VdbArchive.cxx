@@ -363,7 +363,7 @@ FileRangeBuf::pos_type FileRangeBuf::seekpos(pos_type pos, std::ios_base::openmo
 
 FileLayout ScanFile(const std::string& path)
 {
-  openvdb::initialize();
+  RegisterOpenVdbTypes();
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
   {
@@ -447,6 +447,10 @@ FileLayout ScanFile(const std::string& path)
     {
       g.HalfFloat = true;
       g.TypeName.resize(g.TypeName.size() - half.size());
+    }
+    if (!openvdb::GridBase::isRegistered(g.TypeName))
+    {
+      RegisterOpenVdbTypes(/*everyGridType=*/true); // to list it with its value type
     }
     if (v >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING)
     {

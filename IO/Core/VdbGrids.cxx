@@ -15,6 +15,7 @@
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include <blosc.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <dlfcn.h>
 #include <fstream>
 #include <limits>
 #include <mutex>
@@ -37,10 +39,102 @@ namespace vdb
 namespace
 {
 
+/// OpenVDB's registries as far as Nimbus's grids need them (RegisterOpenVdbTypes).
 void Initialize()
 {
+  RegisterOpenVdbTypes();
+}
+
+template <typename MetadataT>
+void RegisterMetadata()
+{
+  if (!MetadataT::isRegisteredType())
+  {
+    MetadataT::registerType();
+  }
+}
+
+template <typename MapT>
+void RegisterMap()
+{
+  if (!MapT::isRegistered())
+  {
+    MapT::registerMap();
+  }
+}
+
+template <typename GridT>
+void RegisterGrid()
+{
+  if (!GridT::isRegistered())
+  {
+    GridT::registerGrid();
+  }
+}
+
+/// What openvdb::initialize() registers, in its order, less what RegisterOpenVdbTypes leaves
+/// out. Only the grid types this file instantiates anyway: another one would add its whole
+/// tree's code to this library.
+void RegisterCommonTypes()
+{
+  // Once (openvdb::uninitialize() leaves them): OpenVDB's logging as openvdb::initialize() sets
+  // it up (warnings to the console) where the library was built with it (the headers do not
+  // say; the function is then exported); Blosc with LZ4 (blosc_init does nothing when Blosc is
+  // initialised).
   static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
+  std::call_once(once,
+    []
+    {
+      const std::string space = OPENVDB_PREPROC_STRINGIFY(OPENVDB_VERSION_NAME);
+      const std::string logging =
+        "_ZN7openvdb" + std::to_string(space.size()) + space + "7logging10initializeEb";
+      using LoggingInit = void (*)(bool);
+      if (const auto init = reinterpret_cast<LoggingInit>(dlsym(RTLD_DEFAULT, logging.c_str())))
+      {
+        init(true);
+      }
+      blosc_init();
+      blosc_set_compressor("lz4");
+    });
+  RegisterMetadata<openvdb::BoolMetadata>();
+  RegisterMetadata<openvdb::DoubleMetadata>();
+  RegisterMetadata<openvdb::FloatMetadata>();
+  RegisterMetadata<openvdb::Int32Metadata>();
+  RegisterMetadata<openvdb::Int64Metadata>();
+  RegisterMetadata<openvdb::StringMetadata>();
+  RegisterMetadata<openvdb::Vec2IMetadata>();
+  RegisterMetadata<openvdb::Vec2SMetadata>();
+  RegisterMetadata<openvdb::Vec2DMetadata>();
+  RegisterMetadata<openvdb::Vec3IMetadata>();
+  RegisterMetadata<openvdb::Vec3SMetadata>();
+  RegisterMetadata<openvdb::Vec3DMetadata>();
+  RegisterMetadata<openvdb::Vec4IMetadata>();
+  RegisterMetadata<openvdb::Vec4SMetadata>();
+  RegisterMetadata<openvdb::Vec4DMetadata>();
+  RegisterMetadata<openvdb::Mat4SMetadata>();
+  RegisterMetadata<openvdb::Mat4DMetadata>();
+  RegisterMap<openvdb::math::AffineMap>();
+  RegisterMap<openvdb::math::UnitaryMap>();
+  RegisterMap<openvdb::math::ScaleMap>();
+  RegisterMap<openvdb::math::UniformScaleMap>();
+  RegisterMap<openvdb::math::TranslationMap>();
+  RegisterMap<openvdb::math::ScaleTranslateMap>();
+  RegisterMap<openvdb::math::UniformScaleTranslateMap>();
+  RegisterMap<openvdb::math::NonlinearFrustumMap>();
+  RegisterGrid<openvdb::FloatGrid>();
+  RegisterGrid<openvdb::DoubleGrid>();
+  RegisterGrid<openvdb::Vec3SGrid>();
+  RegisterGrid<openvdb::Vec3DGrid>();
+  const std::string index32 = openvdb::typeNameAsString<openvdb::PointIndex32>();
+  if (!openvdb::Metadata::isRegisteredType(index32))
+  {
+    openvdb::Metadata::registerType(index32, openvdb::Int32Metadata::createMetadata);
+  }
+  const std::string index64 = openvdb::typeNameAsString<openvdb::PointIndex64>();
+  if (!openvdb::Metadata::isRegisteredType(index64))
+  {
+    openvdb::Metadata::registerType(index64, openvdb::Int64Metadata::createMetadata);
+  }
 }
 
 std::string Quote(const std::string& s)
@@ -723,6 +817,18 @@ void ReadGrid(ArchiveReader& archive, const FileLayout& layout, size_t index,
 }
 
 } // namespace
+
+void RegisterOpenVdbTypes(bool everyGridType)
+{
+  // The look-ups each time: openvdb::uninitialize() may have cleared the registries since.
+  static std::mutex mutex;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (everyGridType)
+  {
+    openvdb::initialize(); // does nothing after its first time
+  }
+  RegisterCommonTypes();
+}
 
 uint64_t IndexBox::VoxelCount() const
 {

@@ -112,6 +112,20 @@ struct GridInfo
   bool Supported() const { return Kind != ValueKind::Unsupported; }
 };
 
+/// Registers with OpenVDB what Nimbus's reader and writer need, as openvdb::initialize() does
+/// but without what they do not use, whose registration faults in about 2 MiB of OpenVDB's
+/// code and tables in every process that reads a file: the point-data registries (attribute
+/// arrays and their codecs) and the grid types other than float, double, Vec3s and Vec3d.
+/// Registered: OpenVDB's logging, every metadata type and transform map openvdb::initialize()
+/// registers except the per-leaf table of OpenVDB's delayed loading ("__delayedload":
+/// unregistered, OpenVDB's metadata reader reads its bytes and drops them instead of decoding
+/// 9 bytes per leaf of the grid, up to three times per read; nothing here loads lazily), the
+/// four grid types, Blosc with its LZ4 compressor. Registers only what is not registered yet
+/// and clears nothing, so it agrees with openvdb::initialize() run before it. With
+/// `everyGridType` (ScanFile, for a file that holds a grid of another type: it is listed with
+/// its value type), openvdb::initialize() itself, which registers everything anew. Thread-safe.
+void RegisterOpenVdbTypes(bool everyGridType = false);
+
 /// Reads every grid's descriptor, metadata and transform (no voxel data unless a grid
 /// lacks bounding-box statistics), after ScanFile (VdbArchive.h) has checked the file's
 /// layout. Throws Error for a missing/unreadable file, a file that is not a VDB, a

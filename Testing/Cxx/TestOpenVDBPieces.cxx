@@ -6,7 +6,10 @@
 // at every level (a leaf-sized tile, a 128^3 tile, an inactive root tile) and a background
 // that is not zero; float, double and Vec3s grids; written without compression, with zip,
 // Blosc and active-mask compression, and as half floats. Then a y-up file through
-// vtkNimbusOpenVDBReader: the pieces of the turned image equal the whole image.
+// vtkNimbusOpenVDBReader: the pieces of the turned image equal the whole image. The same with
+// only the reader's own OpenVDB registrations (RegisterOpenVdbTypes: no point-data registries,
+// no delayed-load table), and a file's grids of other types listed with their value types.
+#include "VdbArchive.h"
 #include "VdbGrids.h"
 #include "vtkNimbusOpenVDBReader.h"
 
@@ -21,6 +24,7 @@
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
 
 #include <gtest/gtest.h>
 
@@ -175,13 +179,10 @@ std::vector<float> WholeGridCropped(const openvdb::GridBase::Ptr& base, const In
   return values;
 }
 
-void ExpectPiecesEqualTheWholeGrid(const std::string& path, const std::string& what)
+/// The boxes read as pieces by ExpectPiecesEqualTheWholeGrid.
+std::vector<IndexBox> PieceBoxes()
 {
-  const auto infos = nimbus::vdb::ReadFileInfo(path);
-  ASSERT_EQ(infos.size(), 3u);
-  openvdb::io::File file(path);
-  file.open(/*delayLoad=*/false);
-  const std::vector<IndexBox> boxes{
+  return {
     Box(-40, -10, 100, 170, 140, 150),       // all the voxels
     Box(100, -5, 120, 140, 30, 135),         // across lower nodes
     Box(-9, -9, 126, 9, 9, 130),             // across upper nodes
@@ -191,6 +192,46 @@ void ExpectPiecesEqualTheWholeGrid(const std::string& path, const std::string& w
     Box(1000, 1000, 1000, 1010, 1010, 1010), // nothing but background
     Box(57, 33, 111, 57, 33, 111),           // one voxel
   };
+}
+
+/// Reads every box of every grid of `path` as a piece (ReadDense), then compares each with
+/// OpenVDB's whole read. With `readersRegistry`, the pieces are read after
+/// openvdb::uninitialize(): with only what the reader registers itself, checked (no point-data
+/// registries, no delayed-load table); then openvdb::initialize() for OpenVDB's own read.
+void ExpectPiecesEqualTheWholeGrid(
+  const std::string& path, const std::string& what, bool readersRegistry = false)
+{
+  if (readersRegistry)
+  {
+    openvdb::uninitialize();
+  }
+  const auto infos = nimbus::vdb::ReadFileInfo(path);
+  ASSERT_EQ(infos.size(), 3u);
+  const std::vector<IndexBox> boxes = PieceBoxes();
+  std::vector<std::vector<float>> pieces;
+  for (const auto& info : infos)
+  {
+    for (const IndexBox& box : boxes)
+    {
+      std::vector<float> piece(box.VoxelCount() * info.Components, -999.0f);
+      std::vector<std::string> resampled;
+      nimbus::vdb::ReadDense(
+        path, { info.Name }, infos[0].Transform, box, { piece.data() }, &resampled);
+      EXPECT_TRUE(resampled.empty());
+      pieces.push_back(std::move(piece));
+    }
+  }
+  if (readersRegistry)
+  {
+    EXPECT_TRUE(openvdb::FloatGrid::isRegistered() && openvdb::Vec3SGrid::isRegistered());
+    EXPECT_FALSE(openvdb::points::PointDataGrid::isRegistered());
+    EXPECT_FALSE(openvdb::Int32Grid::isRegistered());
+    EXPECT_FALSE(openvdb::Metadata::isRegisteredType("__delayedload"));
+    openvdb::initialize();
+  }
+  openvdb::io::File file(path);
+  file.open(/*delayLoad=*/false);
+  size_t n = 0;
   for (const auto& info : infos)
   {
     const auto whole = file.readGrid(info.StoredName);
@@ -209,11 +250,8 @@ void ExpectPiecesEqualTheWholeGrid(const std::string& path, const std::string& w
       {
         expected = WholeGridCropped<openvdb::Vec3SGrid>(whole, box);
       }
-      std::vector<float> piece(expected.size(), -999.0f);
-      std::vector<std::string> resampled;
-      nimbus::vdb::ReadDense(
-        path, { info.Name }, infos[0].Transform, box, { piece.data() }, &resampled);
-      EXPECT_TRUE(resampled.empty());
+      const std::vector<float>& piece = pieces[n++];
+      ASSERT_EQ(piece.size(), expected.size());
       ASSERT_EQ(std::memcmp(piece.data(), expected.data(), expected.size() * sizeof(float)), 0)
         << what << ": grid " << info.Name << ", box " << box.Min[0] << " " << box.Min[1] << " "
         << box.Min[2] << " .. " << box.Max[0] << " " << box.Max[1] << " " << box.Max[2];
@@ -251,6 +289,62 @@ TEST(Pieces, EqualTheWholeGridForEveryCompression)
     ExpectPiecesEqualTheWholeGrid(path, c.Name);
     std::remove(path.c_str());
   }
+}
+
+// The reader registers with OpenVDB only what it reads (RegisterOpenVdbTypes): the pieces are
+// the same without the point-data registries and without decoding the delayed-load table.
+TEST(Pieces, EqualTheWholeGridWithTheReadersOwnRegistry)
+{
+  using namespace openvdb::io;
+  const struct
+  {
+    const char* Name;
+    uint32_t Compression;
+    bool Half;
+  } cases[] = {
+    { "own-zip-mask", COMPRESS_ZIP | COMPRESS_ACTIVE_MASK, false },
+    { "own-blosc-mask", COMPRESS_BLOSC | COMPRESS_ACTIVE_MASK, false },
+    { "own-half-blosc", COMPRESS_BLOSC, true },
+  };
+  for (const auto& c : cases)
+  {
+    if ((c.Compression & COMPRESS_BLOSC) && !Archive::hasBloscCompression())
+    {
+      continue;
+    }
+    const std::string path =
+      WriteGrids(std::string(c.Name) + ".vdb", c.Compression, c.Half, true, true);
+    ExpectPiecesEqualTheWholeGrid(path, c.Name, /*readersRegistry=*/true);
+    std::remove(path.c_str());
+  }
+}
+
+// A grid of a type the reader does not register up front is still listed with its value type
+// (the file's scan registers the rest of OpenVDB's grid types).
+TEST(Pieces, OtherGridTypesListedWithTheReadersOwnRegistry)
+{
+  openvdb::initialize();
+  auto density = openvdb::FloatGrid::create(0.0f);
+  density->setName("density");
+  density->tree().setValue(openvdb::Coord(1, 2, 3), 0.5f);
+  auto ids = openvdb::Int32Grid::create(0);
+  ids->setName("ids");
+  ids->tree().setValue(openvdb::Coord(1, 2, 3), 7);
+  const std::string path = TempPath("other-types.vdb");
+  openvdb::io::File file(path);
+  file.write({ density, ids });
+  file.close();
+  openvdb::uninitialize();
+  const auto infos = nimbus::vdb::ReadFileInfo(path);
+  ASSERT_EQ(infos.size(), 2u);
+  EXPECT_EQ(infos[0].ValueType, "float");
+  EXPECT_TRUE(infos[0].Supported());
+  EXPECT_EQ(infos[1].ValueType, "int32");
+  EXPECT_FALSE(infos[1].Supported());
+  EXPECT_TRUE(openvdb::Int32Grid::isRegistered());
+  EXPECT_TRUE(openvdb::points::PointDataGrid::isRegistered());
+  openvdb::initialize();
+  std::remove(path.c_str());
 }
 
 TEST(Pieces, YUpFilePiecesEqualTheWholeImage)
