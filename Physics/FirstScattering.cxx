@@ -449,4 +449,15 @@ double EvaluateFirstScattering(const float* values, const Vector3& w, double k1)
   return std::max(0.0, (e + 3.0 * k1 * f) / (4.0 * kPi));
 }
 
+double DeltaMBeamMeanCosine(double plainE, double reducedE, double fraction, double peakLobeG)
+{
+  if (!(reducedE > 0.0) || !(fraction > 0.0) || !(peakLobeG > 0.0) || !std::isfinite(plainE))
+  {
+    return 1.0;
+  }
+  const double unscattered = std::max(plainE - (1.0 - fraction) * reducedE, 0.0) / fraction;
+  const double ratio = std::min(unscattered / reducedE, 1.0);
+  return std::pow(ratio, 1.0 - std::min(peakLobeG, 1.0));
+}
+
 } // namespace nimbus

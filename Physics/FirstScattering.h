@@ -113,6 +113,20 @@ NIMBUSPHYSICS_EXPORT FirstScatteringField ComputeFirstScattering(const Extinctio
 NIMBUSPHYSICS_EXPORT FirstScatteringField CombineFirstScattering(
   const std::vector<const FirstScatteringField*>& fields, const std::vector<double>& weights);
 
+/// The mean cosine, about the sources' directions, of the delta-M beam at a point:
+/// E' = I exp(-(1 - f albedo) tau) / r^2 (the field through the reduced extinction) holds
+/// the unscattered light E = I exp(-tau) / r^2 and the light that scattered only inside
+/// the truncated forward peak, n times with probability Poisson(f albedo tau). Each peak
+/// scattering through an HG lobe of `peakLobeG` (DeltaMPeakLobeG) multiplies the mean
+/// cosine by it (HG lobes fold by multiplying g), so the beam's is
+///     sum_n P(n) g^n = exp(-f albedo tau (1 - g)) = (E / E')^(1 - g).
+/// E from the two fields at the point: `plainE` with T' = f exp(-tau) + (1 - f) E'/I r^2
+/// (FirstScatteringForwardPeak), E = (plainE - (1 - f) reducedE) / f. With several
+/// sources it is the ratio of the sums. 1 where reducedE <= 0, f <= 0 or peakLobeG <= 0;
+/// in [0, 1].
+NIMBUSPHYSICS_EXPORT double DeltaMBeamMeanCosine(
+  double plainE, double reducedE, double fraction, double peakLobeG);
+
 /// J1(w) for one point's 4 values in degree-1 spherical harmonics (the file comment), w a
 /// direction of propagation, k1 the phase function's mean cosine; clamped at 0.
 NIMBUSPHYSICS_EXPORT double EvaluateFirstScattering(

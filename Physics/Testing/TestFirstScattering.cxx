@@ -256,6 +256,37 @@ TEST(FirstScattering, DegreeOneHarmonicsAndTheForwardPeak)
     std::invalid_argument);
 }
 
+TEST(FirstScattering, DeltaMBeamSpreadsWithItsPeakScatterings)
+{
+  // The plain field (T') and the reduced one (through (1 - f a) sigma) of one source in a
+  // homogeneous medium, as vtkNimbusLightningIllumination computes them: their ratio gives
+  // the beam's mean cosine exp(-f a tau (1 - g_peak)) along an axis.
+  const double sigma = 0.02, f = 0.78, a = 0.99, lobeG = 0.87;
+  const ExtinctionGrid grid = Cube(31, 10.0, sigma);
+  nimbus::FirstScatteringForwardPeak peak;
+  peak.Fraction = f;
+  peak.Albedo = a;
+  const FirstScatteringField plain =
+    nimbus::ComputeFirstScattering(grid, { { { { 0, 0, 0 } }, 1.0 } }, 2, nullptr, peak);
+  const FirstScatteringField reduced = nimbus::ComputeFirstScattering(
+    Cube(31, 10.0, (1 - f * a) * sigma), { { { { 0, 0, 0 } }, 1.0 } }, 2, nullptr);
+  for (int i = 17; i < 31; i += 3)
+  {
+    const double tau = sigma * (i - 15) * 10.0;
+    const double cosine = nimbus::DeltaMBeamMeanCosine(
+      E(grid, plain, i, 15, 15), E(grid, reduced, i, 15, 15), f, lobeG);
+    // Measured to 2e-8 (the fields are floats).
+    EXPECT_NEAR(cosine, std::exp(-f * a * tau * (1 - lobeG)), 1e-7) << "tau " << tau;
+  }
+  // Where nothing says how the beam spread: 1. Never above 1 nor below 0.
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(1.0, 0.0, f, lobeG), 1.0);
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(1.0, 1.0, 0.0, lobeG), 1.0);
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(1.0, 1.0, f, 0.0), 1.0);
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(std::nan(""), 1.0, f, lobeG), 1.0);
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(5.0, 1.0, f, lobeG), 1.0); // E > E': rounding
+  EXPECT_EQ(nimbus::DeltaMBeamMeanCosine(0.0, 1.0, f, lobeG), 0.0); // all scattered
+}
+
 TEST(FirstScattering, RefusesBadInputAndHandlesExtremes)
 {
   const ExtinctionGrid grid = Cube(4, 10.0, 0.01);

@@ -1,5 +1,7 @@
 #include "LightningTexture.h"
 
+#include "FirstScattering.h"
+#include "MultipleScattering.h"
 #include "MultipleScatteringTexture.h"
 
 #include "vtkDataArray.h"
@@ -11,6 +13,7 @@
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkTextureObject.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -18,6 +21,37 @@
 
 namespace nimbus
 {
+namespace
+{
+// The delta-M beam's mean cosine at each point (DeltaMBeamMeanCosine) from the plain and
+// the reduced fields; 1 everywhere when the plain field or the optics are missing.
+std::vector<float> BeamMeanCosine(vtkFieldData* fields, vtkFloatArray* reduced, std::size_t points)
+{
+  std::vector<float> out(points, 1.0f);
+  vtkFloatArray* plain =
+    vtkFloatArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_first_scattering"));
+  vtkDoubleArray* optics =
+    vtkDoubleArray::SafeDownCast(fields->GetAbstractArray("nimbus_lightning_optics"));
+  if (!plain || !optics || optics->GetNumberOfValues() != 4 ||
+    static_cast<std::size_t>(plain->GetNumberOfTuples()) != points ||
+    plain->GetNumberOfComponents() != 4)
+  {
+    return out;
+  }
+  nimbus::CloudOptics phase; // the filter's: Cornette-Shanks of its CloudG
+  phase.G = optics->GetValue(2);
+  const double f = nimbus::PhaseLegendreCoefficient(phase, 2);
+  const double lobeG = nimbus::DeltaMPeakLobeG(phase);
+  const float* e = plain->GetPointer(0);
+  const float* r = reduced->GetPointer(0);
+  for (std::size_t i = 0; i < points; ++i)
+  {
+    out[i] = static_cast<float>(nimbus::DeltaMBeamMeanCosine(e[4 * i], r[4 * i], f, lobeG));
+  }
+  return out;
+}
+} // namespace
+
 LightningTexture::LightningTexture() = default;
 LightningTexture::~LightningTexture() = default;
 
@@ -212,6 +246,18 @@ bool LightningTexture::UpdateFirstScattering(vtkOpenGLRenderWindow* window, vtkI
     error = message.str();
     return false;
   }
+  // The delta-M view's beam: how far its light has spread from the sources' directions.
+  std::vector<float> beamCosine(points, 1.0f);
+  if (reduced)
+  {
+    beamCosine = BeamMeanCosine(fields, reduced, points);
+  }
+  if (!UploadFloatTexture3D(window, this->BeamCosine, grid, 1, beamCosine.data()))
+  {
+    error = "Could not upload the lightning beam's spread (GL out of memory?); the cloud is "
+            "drawn without lightning.";
+    return false;
+  }
   this->FirstScatteringTextured = true;
   ++this->Uploads;
   return true;
@@ -224,6 +270,7 @@ void LightningTexture::Release(vtkWindow* window)
     t->ReleaseGraphicsResources(window);
   }
   this->FirstScattering->ReleaseGraphicsResources(window);
+  this->BeamCosine->ReleaseGraphicsResources(window);
   this->Textured = false;
   this->UploadedArray = nullptr;
   this->FirstScatteringTextured = false;

@@ -72,6 +72,10 @@ public:
   void SetPreferReducedFirstScattering(bool prefer) { this->PreferReduced = prefer; }
   /// Whether the uploaded first scattering is the reduced one.
   bool IsFirstScatteringReduced() const { return this->FirstScatteringReduced; }
+  /// The delta-M view's beam's mean cosine about the sources' directions, one float per
+  /// point of the first scattering's grid (1 when the first scattering is not the reduced
+  /// one): (E / E')^(1 - g_peak), the spread its peak-only scatterings gave it.
+  vtkTextureObject* GetBeamCosineTexture() const { return this->BeamCosine; }
 
   void Release(vtkWindow* window);
 
@@ -82,6 +86,7 @@ private:
 
   vtkNew<vtkTextureObject> Textures[3];
   vtkNew<vtkTextureObject> FirstScattering;
+  vtkNew<vtkTextureObject> BeamCosine;
   vtkDataArray* FirstScatteringArray = nullptr; // identity only, never dereferenced
   bool PreferReduced = false;
   bool FirstScatteringReduced = false;

@@ -1586,6 +1586,7 @@ void vtkNimbusCloudVolumeMapper::BeginPasses(const FrameState& frame)
   if (frame.LightningFirstScattering)
   {
     in.Lightning.GetFirstScatteringTexture()->Activate();
+    in.Lightning.GetBeamCosineTexture()->Activate();
   }
   if (frame.EmissionTexture)
   {
@@ -1646,6 +1647,7 @@ void vtkNimbusCloudVolumeMapper::EndPasses(const FrameState& frame)
   if (frame.LightningFirstScattering)
   {
     in.Lightning.GetFirstScatteringTexture()->Deactivate();
+    in.Lightning.GetBeamCosineTexture()->Deactivate();
   }
   if (frame.EmissionTexture)
   {
@@ -2485,6 +2487,9 @@ void vtkNimbusCloudVolumeMapper::SetCloudLightUniforms(
   program->SetUniformi("lightningFirst",
     (frame.LightningFirstScattering ? in.Lightning.GetFirstScatteringTexture()
                                     : in.Density.GetTexture())
+      ->GetTextureUnit());
+  program->SetUniformi("lightningBeamCosine",
+    (frame.LightningFirstScattering ? in.Lightning.GetBeamCosineTexture() : in.Density.GetTexture())
       ->GetTextureUnit());
   const auto& firstScale = in.Lightning.GetFirstScatteringScale();
   const auto& colour = in.Lightning.GetFirstScatteringColour();

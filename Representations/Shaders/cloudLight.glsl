@@ -39,6 +39,7 @@ uniform float lightningPeakFraction;  // f = k2
 uniform float lightningTruncatedG;    // g' = (k1 - k2) / (1 - k2)
 uniform float lightningDegreeOneScale; // g' / k1
 uniform float lightningPeakLobeG;     // the truncated peak's own HG lobe (DeltaMPeakLobeG)
+uniform sampler3D lightningBeamCosine; // the delta-M beam's mean cosine (E / E')^(1 - g_peak)
 // Temperature emission (Physics/BlackbodyEmission.h): eta = E rho B(T) / Y[B(T_ref)]
 // [Y/(sr m)]; the texture holds rho B(T) / Y[B(T_ref)] in linear sRGB, on the density's texels.
 uniform int emissionOn;
@@ -103,18 +104,21 @@ vec3 CloudLightningDeltaM(vec3 p, vec3 direction, float sigma)
 // this sums to I (exp(-(1 - f albedo) tau) - exp(-tau)) / D^2, the light that scattered
 // only inside the peak: the source's aureole through the cloud, which the reduced view
 // alone draws nowhere (docs/lightning.md). The beam's directions at p are taken as an HG
-// lobe about F'/|F'| with mean cosine |F'|/E' (1 for one point source, less in a
-// channel's fan), so the peak's lobe folded with them is HG(g_peak |F'|/E') (HG lobes
-// fold by multiplying their g). Per unit scattering coefficient, like J.
+// lobe about F'/|F'| with mean cosine |F'|/E' (the sources' geometry: 1 for one point
+// source, less in a channel's fan) times the spread its own peak scatterings gave it
+// (lightningBeamCosine, DeltaMBeamMeanCosine), so the peak's lobe folded with them is
+// HG(g_peak times both) (HG lobes fold by multiplying their g). Per unit scattering
+// coefficient, like J.
 vec3 LightningForwardPeak(vec3 p, vec3 w)
 {
-  vec4 v = texture(lightningFirst, (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale);
+  vec3 tc = (worldToTexture * vec4(p, 1.0)).xyz * lightningFirstScale;
+  vec4 v = texture(lightningFirst, tc);
   float flux = length(v.rgb);
   if (v.a <= 0.0 || flux <= 0.0)
   {
     return vec3(0.0);
   }
-  float meanCosine = min(flux / v.a, 1.0);
+  float meanCosine = min(flux / v.a, 1.0) * clamp(texture(lightningBeamCosine, tc).r, 0.0, 1.0);
   float mu = clamp(dot(v.rgb, w) / flux, -1.0, 1.0);
   return lightningColour * v.a * HenyeyGreenstein(mu, lightningPeakLobeG * meanCosine);
 }
