@@ -9,6 +9,12 @@ and the cloud automaton under MPI (docs/parallel.md, "What each rank holds").
         runs the cases below under `mpiexec --oversubscribe -n N pvbatch --symmetric` for each N
         and prints the table (markdown)
 
+    python3 measurements/parallel-pieces-bench.py --breakdown --vdb FILE [--piece 0 8]
+        one process (no MPI): where the reader's memory goes, per mapping of /proc/self/smaps
+        (the image's anonymous block, each library's code and tables faulted in, the heap),
+        in KiB of resident memory above `import nimbus`, after UpdateInformation and after
+        UpdatePiece(P, N, 0), and malloc's heap (in use and freed but resident)
+
 One rank's part (run by --table through mpiexec):
     pvbatch --symmetric parallel-pieces-bench.py --rank-job baseline|vdb|automaton ...
       baseline: nothing loaded (no nimbus import): ParaView's, Python's and MPI's own memory;
@@ -41,6 +47,58 @@ def vm_hwm():
             if line.startswith("VmHWM:"):
                 return int(line.split()[1]) * 1024
     return 0
+
+
+def smaps_rss():
+    """Resident KiB per mapping (path and permissions) of this process."""
+    import collections
+    rss = collections.Counter()
+    name = None
+    with open("/proc/self/smaps") as smaps:
+        for line in smaps:
+            parts = line.split()
+            if len(parts) >= 5 and "-" in parts[0] and not parts[0].endswith(":"):
+                name = (parts[5] if len(parts) > 5 else "[anonymous]") + " " + parts[1]
+            elif parts[0] == "Rss:":
+                rss[name] += int(parts[1])
+    return rss
+
+
+def malloc_heap():
+    """glibc's heap (mallinfo2): KiB in use and KiB freed but kept."""
+    import ctypes
+
+    class MallInfo2(ctypes.Structure):
+        _fields_ = [(n, ctypes.c_size_t) for n in (
+            "arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks", "fsmblks", "uordblks",
+            "fordblks", "keepcost")]
+    libc = ctypes.CDLL("libc.so.6")
+    libc.mallinfo2.restype = MallInfo2
+    info = libc.mallinfo2()
+    return info.uordblks // 1024, info.fordblks // 1024
+
+
+def breakdown(args):
+    import nimbus
+    malloc_heap()
+    smaps_rss()  # the measuring's own code loaded and run once before the first snapshot
+    steps = [("imported", smaps_rss(), malloc_heap(), vm_hwm())]
+    reader = nimbus.vtkNimbusOpenVDBReader()
+    reader.SetFileName(args.vdb)
+    reader.UpdateInformation()
+    steps.append(("information", smaps_rss(), malloc_heap(), vm_hwm()))
+    reader.UpdatePiece(args.piece[0], args.piece[1], 0)
+    steps.append(("piece", smaps_rss(), malloc_heap(), vm_hwm()))
+    print("piece %d of %d of %s: %d points" % (args.piece[0], args.piece[1], args.vdb,
+                                                 reader.GetOutput().GetNumberOfPoints()))
+    print("VmHWM above imported: %.1f MiB" % ((steps[-1][3] - steps[0][3]) / MiB))
+    for (name, heap) in [(s[0], s[2]) for s in steps]:
+        print("malloc heap after %s: %d KiB in use, %d KiB freed and kept" % (name, heap[0], heap[1]))
+    first, info, last = steps[0][1], steps[1][1], steps[2][1]
+    print("KiB resident above imported: after UpdateInformation, then UpdatePiece, mapping")
+    for key in sorted(set(first) | set(last), key=lambda k: first[k] - last[k]):
+        if last[key] != first[key] or info[key] != first[key]:
+            print("%8d %8d  %s" % (info[key] - first[key], last[key] - info[key], key))
 
 
 def make_vdb(path, size):
@@ -160,11 +218,15 @@ def main():
     parser.add_argument("--vdb")
     parser.add_argument("--automaton", type=int, nargs=3, metavar=("NX", "NY", "NZ"))
     parser.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4, 8])
+    parser.add_argument("--breakdown", action="store_true")
+    parser.add_argument("--piece", type=int, nargs=2, default=[0, 8], metavar=("P", "N"))
     parser.add_argument("--result-dir")
     parser.add_argument("--rank-job", choices=["baseline", "imported", "vdb", "automaton"])
     args = parser.parse_args()
     if args.make_vdb:
         make_vdb(args.make_vdb, args.size)
+    elif args.breakdown:
+        breakdown(args)
     elif args.rank_job:
         rank_job(args)
     elif args.table:
