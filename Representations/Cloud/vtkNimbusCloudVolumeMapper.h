@@ -162,10 +162,15 @@ public:
   /// and the first scattering through the beam's reduced extinction (1 - f albedo) sigma,
   /// with the truncated phase function's asymmetry g' = (k1 - k2) / (1 - k2) in their
   /// degree-1 harmonics and (1 - f) of the scattering, f = k2 the forward peak the
-  /// solver folds into the beam (Wiscombe 1977). Off: J with the full phase function's
-  /// k1 through the full extinction. Needs vtkNimbusLightningIllumination's first
-  /// scattering on the density's grid (its "nimbus_lightning_first_scattering_reduced");
-  /// without it the lightning is drawn the plain way. The sun's terms do not change.
+  /// solver folds into the beam (Wiscombe 1977), plus the light the peak keeps on the
+  /// beam: f albedo sigma E' through the peak's own lobe (widened by the beam's spread)
+  /// and the full extinction, the sources' glow through the cloud. Off: J with the full
+  /// phase function's k1 through the full extinction (in a thin cloud its clamped
+  /// degree-1 lobe over-counts by up to a quarter at Cornette-Shanks 0.85; the delta-M
+  /// view is the one measured against the path tracer, docs/lightning.md). Needs
+  /// vtkNimbusLightningIllumination's first scattering on the density's grid (its
+  /// "nimbus_lightning_first_scattering_reduced"); without it the lightning is drawn the
+  /// plain way. The sun's terms do not change.
   vtkSetMacro(LightningDeltaMView, bool);
   vtkGetMacro(LightningDeltaMView, bool);
   vtkBooleanMacro(LightningDeltaMView, bool);
