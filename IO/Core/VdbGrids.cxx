@@ -825,7 +825,10 @@ void RegisterOpenVdbTypes(bool everyGridType)
   std::lock_guard<std::mutex> lock(mutex);
   if (everyGridType)
   {
-    openvdb::initialize(); // does nothing after its first time
+    // Does nothing after its first time. That first time it empties and refills OpenVDB's
+    // registries: a read running in another thread just then could miss a type (the reader's
+    // reads run in the pipeline's thread).
+    openvdb::initialize();
   }
   RegisterCommonTypes();
 }
