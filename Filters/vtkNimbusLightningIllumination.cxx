@@ -909,6 +909,11 @@ int vtkNimbusLightningIllumination::GetFirstScatteringGroupsComputed() const
   return this->Internals->FirstScattering.GetMisses();
 }
 
+int vtkNimbusLightningIllumination::GetFirstScatteringGroupsExtended() const
+{
+  return this->Internals->FirstScattering.GetExtensions();
+}
+
 double vtkNimbusLightningIllumination::GetLastPrecomputeSeconds() const
 {
   return this->Internals->PrecomputeSeconds;

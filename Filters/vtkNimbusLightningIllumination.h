@@ -198,10 +198,13 @@ public:
   vtkSetClampMacro(FirstScatteringDownsampling, int, 0, 4096);
   vtkGetMacro(FirstScatteringDownsampling, int);
   /// Seconds the last update spent on the first scattering (about 0 when its groups of
-  /// sources were kept from an earlier time step), and the groups kept and computed.
+  /// sources were kept from an earlier time step), and the groups kept and computed; of
+  /// the computed, those that extended a kept group (the leader's reached set: only its
+  /// new sources computed).
   double GetLastFirstScatteringSeconds() const;
   int GetFirstScatteringGroupsKept() const;
   int GetFirstScatteringGroupsComputed() const;
+  int GetFirstScatteringGroupsExtended() const;
   ///@}
 
   ///@{

@@ -89,6 +89,53 @@ std::uint64_t GroupKey(std::uint64_t gridHash, const LightningSourceGroup& group
   }
   return h;
 }
+// The sources of `kept` found in `group` (same positions), all at one ratio of relative
+// intensity: that ratio and the group's other sources; ratio 0 when they do not fit.
+std::pair<double, std::vector<ScalarPointSource>> SplitByKept(
+  const std::vector<ScalarPointSource>& kept, const std::vector<ScalarPointSource>& group)
+{
+  std::pair<double, std::vector<ScalarPointSource>> none{ 0.0, {} };
+  if (kept.empty() || kept.size() >= group.size())
+  {
+    return none;
+  }
+  std::map<Vector3, std::vector<std::size_t>> where;
+  for (std::size_t k = 0; k < group.size(); ++k)
+  {
+    where[group[k].Position].push_back(k);
+  }
+  std::vector<bool> used(group.size(), false);
+  double ratio = 0.0;
+  for (const ScalarPointSource& source : kept)
+  {
+    auto found = where.find(source.Position);
+    if (found == where.end() || found->second.empty() || !(source.Intensity > 0.0))
+    {
+      return none;
+    }
+    const std::size_t k = found->second.back();
+    found->second.pop_back();
+    used[k] = true;
+    const double r = group[k].Intensity / source.Intensity;
+    if (ratio == 0.0)
+    {
+      ratio = r;
+    }
+    else if (std::abs(r - ratio) > 1e-6 * ratio)
+    {
+      return none;
+    }
+  }
+  std::vector<ScalarPointSource> rest;
+  for (std::size_t k = 0; k < group.size(); ++k)
+  {
+    if (!used[k])
+    {
+      rest.push_back(group[k]);
+    }
+  }
+  return { ratio, std::move(rest) };
+}
 } // namespace
 
 std::uint64_t HashExtinctionGrid(const ExtinctionGrid& grid)
@@ -147,6 +194,39 @@ std::vector<LightningSourceGroup> GroupPointSources(
   return GroupByBrightness(std::move(atPeak), brightness);
 }
 
+FirstScatteringField LightningFirstScatteringCache::Extend(const ExtinctionGrid& grid,
+  std::uint64_t gridKey, const LightningSourceGroup& group, const FirstScatteringForwardPeak& peak,
+  int threads, const std::function<void(double)>& progress)
+{
+  const Entry* base = nullptr;
+  std::pair<double, std::vector<ScalarPointSource>> split{ 0.0, {} };
+  for (const Entry& e : this->Entries)
+  {
+    if (e.GridKey != gridKey || (base && e.Sources.size() <= base->Sources.size()))
+    {
+      continue;
+    }
+    auto candidate = SplitByKept(e.Sources, group.Sources);
+    if (candidate.first > 0.0)
+    {
+      base = &e;
+      split = std::move(candidate);
+    }
+  }
+  if (!base)
+  {
+    return {};
+  }
+  // Linear in the intensities: the kept field times the ratio, plus the rest's.
+  const FirstScatteringField rest =
+    ComputeFirstScattering(grid, split.second, threads, progress, peak);
+  FirstScatteringField field =
+    CombineFirstScattering({ &base->Field, &rest }, { split.first, 1.0 });
+  field.Seconds = rest.Seconds;
+  ++this->Extensions;
+  return field;
+}
+
 FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGrid& grid,
   const std::vector<LightningSourceGroup>& groups, const FirstScatteringForwardPeak& peak,
   int threads, const std::function<void(double)>& progress)
@@ -180,16 +260,20 @@ FirstScatteringField LightningFirstScatteringCache::Evaluate(const ExtinctionGri
     ++this->Misses;
     Entry entry;
     entry.Key = keys[g];
-    entry.Field = ComputeFirstScattering(
-      grid, groups[g].Sources, threads,
-      [&](double fraction)
+    entry.GridKey = gridHash;
+    entry.Sources = groups[g].Sources;
+    const auto groupProgress = [&](double fraction)
+    {
+      if (progress)
       {
-        if (progress)
-        {
-          progress((done + fraction) / groups.size());
-        }
-      },
-      peak);
+        progress((done + fraction) / groups.size());
+      }
+    };
+    entry.Field = this->Extend(grid, gridHash, groups[g], peak, threads, groupProgress);
+    if (entry.Field.Values.empty())
+    {
+      entry.Field = ComputeFirstScattering(grid, groups[g].Sources, threads, groupProgress, peak);
+    }
     this->LastComputeSeconds += entry.Field.Seconds;
     this->Entries.push_front(std::move(entry));
     ++done;

@@ -9,8 +9,10 @@
 // by one. So the sources are grouped by their brightness relative to their peak; a
 // group's field at unit scale is computed once and kept (the last few, keyed by the
 // grid and the group's positions and relative intensities), and a frame is the sum of its
-// groups' fields times their scales: a frame of a decaying stroke costs a weighted sum, a
-// frame of the leader (whose reached set grows) a new computation.
+// groups' fields times their scales: a frame of a decaying stroke costs a weighted sum. A
+// group that holds a kept group's sources, all at one ratio of intensity (the leader's
+// reached set, which grows step by step), is that group's field times the ratio plus the
+// field of its other sources alone: a leader's step costs its new segments.
 #ifndef nimbus_LightningFirstScattering_h
 #define nimbus_LightningFirstScattering_h
 
@@ -56,9 +58,11 @@ public:
     const std::vector<LightningSourceGroup>& groups, const FirstScatteringForwardPeak& peak,
     int threads, const std::function<void(double)>& progress = nullptr);
 
-  /// Groups found in the cache and computed, since construction.
+  /// Groups found in the cache and computed, since construction; of those computed, the
+  /// ones computed by extending a kept group (only their other sources computed).
   int GetHits() const { return this->Hits; }
   int GetMisses() const { return this->Misses; }
+  int GetExtensions() const { return this->Extensions; }
   /// Seconds spent computing in the last Evaluate (0 when every group was kept).
   double GetLastComputeSeconds() const { return this->LastComputeSeconds; }
   void Clear() { this->Entries.clear(); }
@@ -70,11 +74,21 @@ private:
   struct Entry
   {
     std::uint64_t Key = 0;
+    std::uint64_t GridKey = 0;              // the grid and the forward peak
+    std::vector<ScalarPointSource> Sources; // the group's, at relative intensity
     FirstScatteringField Field;
   };
+  /// The field of `group` from the kept group with the most of its sources (all of them
+  /// in `group` at one ratio of intensity) and the rest computed, or an empty field when
+  /// no kept group fits.
+  FirstScatteringField Extend(const ExtinctionGrid& grid, std::uint64_t gridKey,
+    const LightningSourceGroup& group, const FirstScatteringForwardPeak& peak, int threads,
+    const std::function<void(double)>& progress);
+
   std::deque<Entry> Entries; // most recently used first
   int Hits = 0;
   int Misses = 0;
+  int Extensions = 0;
   double LastComputeSeconds = 0.0;
 };
 
