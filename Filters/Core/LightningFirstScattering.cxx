@@ -89,6 +89,7 @@ std::uint64_t GroupKey(std::uint64_t gridHash, const LightningSourceGroup& group
   }
   return h;
 }
+
 // The sources of `kept` found in `group` (same positions), all at one ratio of relative
 // intensity: that ratio and the group's other sources; ratio 0 when they do not fit.
 std::pair<double, std::vector<ScalarPointSource>> SplitByKept(
